@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs the Debian packages ddemap needs to build and test. Idempotent: installs only
+# what is missing, and runs apt-get update only then.
+set -euo pipefail
+packages=(g++ make cmake python3 pkg-config
+          libeigen3-dev libspectra-dev libsuitesparse-dev doctest-dev
+          libcli11-dev nlohmann-json3-dev)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "installing: ${missing[*]}"
+    sudo_cmd=""
+    if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
+    $sudo_cmd apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

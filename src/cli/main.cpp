@@ -1,0 +1,423 @@
+// ddemap: a thin command-line front. It parses, calls the library, formats.
+// Exit codes: 0 success, 2 bad input (one line on stderr), 3 internal error.
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "ddemap/model.hpp"
+#include "ddemap/ring.hpp"
+#include "ddemap/string_stability.hpp"
+#include "ddemap/vehicles.hpp"
+#include "format.hpp"
+
+using json = nlohmann::ordered_json;
+using namespace ddemap;
+using ddemap::cli::exact;
+using ddemap::cli::rounded;
+
+namespace {
+
+struct BadInput : std::invalid_argument {
+    using std::invalid_argument::invalid_argument;
+};
+
+double parse_number(const std::string& flag, const std::string& text) {
+    const char* s = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s, &end);
+    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+        throw BadInput(flag + " = '" + text + "': expected a finite number");
+    }
+    return v;
+}
+
+long parse_integer(const std::string& flag, const std::string& text, long lo, long hi, const std::string& what) {
+    const char* s = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long v = std::strtol(s, &end, 10);
+    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
+        throw BadInput(flag + " = '" + text + "': expected " + what);
+    }
+    return v;
+}
+
+/// --ring N|inf -> N (0 for infinity)
+int parse_ring(const std::string& text) {
+    if (text == "inf" || text == "infinity") return 0;
+    return static_cast<int>(parse_integer("--ring", text, 2, 10000000, "an integer N >= 2 (at most 10000000) or 'inf'"));
+}
+
+/// The model options shared by the analysis commands.
+struct ModelArgs {
+    std::string model = "ovrv";
+    std::map<std::string, std::string> raw;  // flag name -> text, only those given
+
+    void add_to(CLI::App* app) {
+        app->add_option("--model", model, "car-following model: ovrv (paper eq. 3) or idm (intelligent driver model)")
+            ->capture_default_str();
+        struct P {
+            const char* name;
+            const char* help;
+        };
+        static const P params[] = {
+            {"k1", "OVRV gain on the gap error [1/s^2]"},
+            {"k2", "OVRV gain on the speed difference [1/s]"},
+            {"th", "time headway [s]"},
+            {"tau", "sensing delay [s] (0 gives the ODE)"},
+            {"eta", "jam gap [m] (ovrv default 10, idm default 2; does not enter the linearisation of ovrv)"},
+            {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20)"},
+            {"a", "IDM maximum acceleration [m/s^2] (default 1)"},
+            {"b", "IDM comfortable deceleration [m/s^2] (default 1.5)"},
+            {"v0", "IDM desired speed [m/s] (default 33.3)"},
+            {"delta", "IDM acceleration exponent [1] (default 4)"},
+        };
+        for (const auto& p : params) {
+            const std::string name = p.name;
+            app->add_option_function<std::string>(
+                "--" + name, [this, name](const std::string& v) { raw[name] = v; }, p.help);
+        }
+    }
+
+    std::unique_ptr<CarModel> build() const {
+        ParameterMap values;
+        for (const auto& [name, text] : raw) values[name] = parse_number("--" + name, text);
+        const auto names = model_names();
+        if (std::find(names.begin(), names.end(), model) == names.end()) {
+            throw BadInput("--model = '" + model + "': expected one of ovrv, idm");
+        }
+        return make_model(model, values);
+    }
+};
+
+enum class Format { Table, Json, Csv };
+
+Format parse_format(const std::string& text) {
+    if (text == "table") return Format::Table;
+    if (text == "json") return Format::Json;
+    if (text == "csv") return Format::Csv;
+    throw BadInput("--format = '" + text + "': expected table, json or csv");
+}
+
+/// A finite double for JSON, or null (never NaN or inf in the output).
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json parameters_json(const CarModel& m) {
+    json p = json::object();
+    for (const auto& [k, v] : m.parameters()) p[k] = v;
+    return p;
+}
+
+std::string describe(const CarModel& m) {
+    std::ostringstream os;
+    os << m.name();
+    for (const auto& [k, v] : m.parameters()) os << " " << k << "=" << rounded(v, 6);
+    return os.str();
+}
+
+std::string ring_name(int cars) { return cars == 0 ? "inf" : std::to_string(cars); }
+
+// ------------------------------------------------------------------ roots
+
+struct RootsArgs {
+    ModelArgs model;
+    std::string ring = "22";
+    std::string count = "6";
+    std::string format = "table";
+};
+
+void run_roots(const RootsArgs& args) {
+    const auto model = args.model.build();
+    const int cars = parse_ring(args.ring);
+    const int count = static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000"));
+    const Format format = parse_format(args.format);
+    RingOptions opt;
+    opt.roots.count = count;
+    const RingResult r = analyse_ring(model->linearise(), cars, opt);
+
+    std::ostringstream out;
+    if (format == Format::Json) {
+        json j;
+        j["command"] = "roots";
+        j["version"] = DDEMAP_VERSION;
+        j["model"] = model->name();
+        j["parameters"] = parameters_json(*model);
+        j["ring"] = cars == 0 ? json("inf") : json(cars);
+        json roots = json::array();
+        for (const auto& x : r.roots) {
+            json o;
+            o["re"] = num(x.root.value.real());
+            o["im"] = num(x.root.value.imag());
+            o["mode"] = x.mode < 0 ? json(nullptr) : json(x.mode);
+            o["theta"] = num(x.theta);
+            o["residual"] = num(x.root.residual);
+            o["newton_step"] = num(x.root.newton_step);
+            roots.push_back(o);
+        }
+        j["roots"] = roots;
+        j["spectral_abscissa"] = num(r.spectral_abscissa);
+        j["abscissa_mode"] = r.abscissa_mode < 0 ? json(nullptr) : json(r.abscissa_mode);
+        j["abscissa_theta"] = num(r.abscissa_theta);
+        j["abscissa_is_limit"] = r.abscissa_is_limit;
+        j["ring_stable"] = r.stable;
+        j["ring_margin"] = num(-r.spectral_abscissa);
+        j["unstable_roots"] = r.unstable_roots < 0 ? json(nullptr) : json(r.unstable_roots);
+        j["marginal_roots"] = r.marginal_roots;
+        j["trivial_root"] = {{"re", 0.0}, {"im", 0.0}, {"mode", 0}, {"excluded", true},
+                             {"meaning", "ring-length invariance (family of equilibria)"}};
+        j["degree"] = r.degree;
+        j["degree_reason"] = r.reason;
+        j["status"] = to_string(r.status);
+        j["modes_solved"] = r.modes_solved;
+        out << j.dump(2) << "\n";
+    } else if (format == Format::Csv) {
+        out << "mode,theta,re,im,residual,newton_step\n";
+        for (const auto& x : r.roots) {
+            out << (x.mode < 0 ? std::string() : std::to_string(x.mode)) << "," << exact(x.theta) << ","
+                << exact(x.root.value.real()) << "," << exact(x.root.value.imag()) << "," << exact(x.root.residual)
+                << "," << exact(x.root.newton_step) << "\n";
+        }
+    } else {
+        out << "model      " << describe(*model) << "\n";
+        out << "ring       N = " << ring_name(cars) << "\n";
+        out << "degree     M = " << r.degree << " (" << to_string(r.status) << ")\n";
+        out << "trivial    lambda = 0 in mode 0 (ring-length invariance), excluded from the verdict\n";
+        out << "abscissa   " << rounded(r.spectral_abscissa, 10);
+        if (cars == 0) {
+            out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
+        } else {
+            out << " (mode " << r.abscissa_mode << ")";
+        }
+        out << "\n";
+        out << "verdict    ring " << (r.stable ? "STABLE" : "UNSTABLE");
+        if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
+        out << "\n\n";
+        out << "  #   mode        theta                re                 im    residual\n";
+        int i = 0;
+        for (const auto& x : r.roots) {
+            char line[200];
+            std::snprintf(line, sizeof line, "%3d %6s %12.6f %17.12f %18.12f %11.2e\n", ++i,
+                          x.mode < 0 ? "-" : std::to_string(x.mode).c_str(), x.theta, x.root.value.real(),
+                          x.root.value.imag(), x.root.residual);
+            out << line;
+        }
+    }
+    std::cout << out.str();
+}
+
+// ------------------------------------------------------------------ string
+
+struct StringArgs {
+    ModelArgs model;
+    std::string ring;
+    std::string format = "table";
+};
+
+void run_string(const StringArgs& args) {
+    const auto model = args.model.build();
+    const Format format = parse_format(args.format);
+    std::optional<int> cars;
+    if (!args.ring.empty()) cars = parse_ring(args.ring);
+    const Linearisation lin = model->linearise();
+    const StringResult s = analyse_string(lin);
+    std::optional<RingResult> ring;
+    if (cars) ring = analyse_ring(lin, *cars);
+
+    std::ostringstream out;
+    if (format == Format::Json) {
+        json j;
+        j["command"] = "string";
+        j["version"] = DDEMAP_VERSION;
+        j["model"] = model->name();
+        j["parameters"] = parameters_json(*model);
+        j["plant_stable"] = s.plant_stable;
+        j["plant_abscissa"] = num(s.plant_abscissa);
+        j["plant_margin"] = num(-s.plant_abscissa);
+        j["sup_gamma"] = num(s.sup_gamma);
+        j["omega_peak"] = num(s.omega_peak);
+        j["peak_margin"] = num(s.peak_margin);
+        j["lowfreq_margin"] = num(s.lowfreq_margin);
+        j["lowfreq"] = {{"c2", num(s.lowfreq.c2)}, {"c4", num(s.lowfreq.c4)}, {"c6", num(s.lowfreq.c6)},
+                        {"c8", num(s.lowfreq.c8)}, {"decisive_order", s.lowfreq.decisive_order},
+                        {"attenuates", s.lowfreq.attenuates}};
+        j["string_stable"] = s.string_stable;
+        json peaks = json::array();
+        for (const auto& p : s.peaks) peaks.push_back({{"omega", num(p.omega)}, {"gain", num(p.gain)}});
+        j["peaks"] = peaks;
+        j["omega_search_max"] = num(s.omega_search_max);
+        j["plant_degree"] = s.plant_roots.degree;
+        if (ring) {
+            j["ring"] = *cars == 0 ? json("inf") : json(*cars);
+            j["ring_stable"] = ring->stable;
+            j["spectral_abscissa"] = num(ring->spectral_abscissa);
+            j["ring_margin"] = num(-ring->spectral_abscissa);
+        }
+        out << j.dump(2) << "\n";
+    } else if (format == Format::Csv) {
+        out << "plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable";
+        if (ring) out << ",ring,ring_stable,spectral_abscissa";
+        out << "\n";
+        out << (s.plant_stable ? "true" : "false") << "," << exact(s.plant_abscissa) << "," << exact(s.sup_gamma)
+            << "," << exact(s.omega_peak) << "," << exact(s.peak_margin) << "," << exact(s.lowfreq_margin) << ","
+            << (s.string_stable ? "true" : "false");
+        if (ring) out << "," << ring_name(*cars) << "," << (ring->stable ? "true" : "false") << "," << exact(ring->spectral_abscissa);
+        out << "\n";
+    } else {
+        out << "model            " << describe(*model) << "\n";
+        out << "plant            " << (s.plant_stable ? "stable" : "UNSTABLE") << "   (rightmost root of D: Re = "
+            << rounded(s.plant_abscissa, 6) << ")\n";
+        out << "sup |Gamma(iw)|  " << rounded(s.sup_gamma, 10);
+        if (s.omega_peak > 0.0) out << " at w = " << rounded(s.omega_peak, 8) << " rad/s";
+        else out << " (only approached as w -> 0)";
+        out << "\n";
+        out << "low frequency    c" << s.lowfreq.decisive_order << " = " << rounded(s.lowfreq_margin, 6)
+            << (s.lowfreq.attenuates ? "  (attenuates as w -> 0)" : "  (AMPLIFIES as w -> 0)") << "\n";
+        if (ring) {
+            out << "ring N=" << ring_name(*cars) << "        " << (ring->stable ? "stable" : "UNSTABLE")
+                << "   (spectral abscissa " << rounded(ring->spectral_abscissa, 6) << ")\n";
+        }
+        out << "verdict          string " << (s.string_stable ? "STABLE" : "UNSTABLE") << "\n";
+    }
+    std::cout << out.str();
+}
+
+// ------------------------------------------------------------------ classify
+
+struct ClassifyArgs {
+    std::string ring = "22";
+    std::string format = "table";
+};
+
+void run_classify(const ClassifyArgs& args) {
+    const int cars = parse_ring(args.ring);
+    const Format format = parse_format(args.format);
+    const auto& table = paper_calibration_table();
+    struct Row {
+        const CalibratedVehicle* v;
+        StringResult s;
+        RingResult r;
+    };
+    std::vector<Row> rows;
+    for (const auto& v : table) {
+        const Linearisation lin = make_model("ovrv", v.parameters)->linearise();
+        rows.push_back({&v, analyse_string(lin), analyse_ring(lin, cars)});
+    }
+    static const char* keys[] = {"k1", "k2", "th", "tau", "eta"};
+    std::ostringstream out;
+    if (format == Format::Json) {
+        json j;
+        j["command"] = "classify";
+        j["version"] = DDEMAP_VERSION;
+        j["source"] = "Gunter et al., calibration table (built in)";
+        j["ring"] = cars == 0 ? json("inf") : json(cars);
+        json arr = json::array();
+        for (const auto& row : rows) {
+            json o;
+            o["name"] = row.v->name;
+            for (const char* k : keys) o[k] = row.v->parameters.at(k);
+            o["plant_stable"] = row.s.plant_stable;
+            o["ring_stable"] = row.r.stable;
+            o["string_stable"] = row.s.string_stable;
+            o["sup_gamma"] = num(row.s.sup_gamma);
+            o["omega_peak"] = num(row.s.omega_peak);
+            o["lowfreq_margin"] = num(row.s.lowfreq_margin);
+            o["spectral_abscissa"] = num(row.r.spectral_abscissa);
+            o["plant_abscissa"] = num(row.s.plant_abscissa);
+            arr.push_back(o);
+        }
+        j["vehicles"] = arr;
+        out << j.dump(2) << "\n";
+    } else if (format == Format::Csv) {
+        out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
+               "spectral_abscissa,plant_abscissa\n";
+        for (const auto& row : rows) {
+            out << row.v->name;
+            for (const char* k : keys) out << "," << exact(row.v->parameters.at(k));
+            out << "," << (row.s.plant_stable ? "true" : "false") << "," << (row.r.stable ? "true" : "false") << ","
+                << (row.s.string_stable ? "true" : "false") << "," << exact(row.s.sup_gamma) << ","
+                << exact(row.s.omega_peak) << "," << exact(row.s.lowfreq_margin) << "," << exact(row.r.spectral_abscissa)
+                << "," << exact(row.s.plant_abscissa) << "\n";
+        }
+    } else {
+        out << "vehicle settings of the paper's calibration table; ring N = " << ring_name(cars) << "\n\n";
+        out << "name      k1     k2     th     tau    eta     plant     ring      string    sup|Gamma|  w_peak   c2\n";
+        for (const auto& row : rows) {
+            char line[256];
+            const auto& p = row.v->parameters;
+            std::snprintf(line, sizeof line, "%-7s %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %9.6f %7.4f %9.2e\n",
+                          row.v->name.c_str(), p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
+                          row.s.plant_stable ? "stable" : "UNSTABLE", row.r.stable ? "stable" : "UNSTABLE",
+                          row.s.string_stable ? "stable" : "UNSTABLE", row.s.sup_gamma, row.s.omega_peak,
+                          row.s.lowfreq_margin);
+            out << line;
+        }
+    }
+    std::cout << out.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"ddemap: stability of delay differential car-following models.\n"
+                 "Rightmost characteristic roots of rings of cars, string stability verdicts."};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", std::string(DDEMAP_VERSION));
+
+    RootsArgs roots_args;
+    auto* roots = app.add_subcommand("roots", "rightmost characteristic roots of a ring of N identical cars");
+    roots_args.model.add_to(roots);
+    roots->add_option("--ring", roots_args.ring, "number of cars N >= 2, or inf for all wave numbers")->capture_default_str();
+    roots->add_option("--count", roots_args.count, "how many rightmost roots to list")->capture_default_str();
+    roots->add_option("--format", roots_args.format, "table, json or csv")->capture_default_str();
+
+    StringArgs string_args;
+    auto* str = app.add_subcommand("string", "plant and string stability from the head-to-tail transfer function");
+    string_args.model.add_to(str);
+    str->add_option("--ring", string_args.ring, "also decide ring stability for N cars (N >= 2 or inf)");
+    str->add_option("--format", string_args.format, "table, json or csv")->capture_default_str();
+
+    ClassifyArgs classify_args;
+    auto* cls = app.add_subcommand("classify", "verdicts for the built-in calibration table (14 vehicle settings)");
+    cls->add_option("--ring", classify_args.ring, "ring size N >= 2 or inf for the ring verdict")->capture_default_str();
+    cls->add_option("--format", classify_args.format, "table, json or csv")->capture_default_str();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::string msg = e.what();
+        for (auto& c : msg)
+            if (c == '\n') c = ' ';
+        std::cerr << "ddemap: error: " << msg << " (see ddemap --help)\n";
+        return 2;
+    }
+    try {
+        if (roots->parsed()) run_roots(roots_args);
+        else if (str->parsed()) run_string(string_args);
+        else if (cls->parsed()) run_classify(classify_args);
+        return 0;
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "ddemap: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "ddemap: internal error: " << e.what() << "\n";
+        return 3;
+    }
+}

@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# Command-line tests: JSON keys, exit codes, one-line errors, no NaN in output.
+set -u
+bin="${DDEMAP:?set DDEMAP to the ddemap binary}"
+fail=0
+pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*"; fail=$((fail + 1)); }
+
+json_has() {  # json_has FILE key1 key2 ...
+    python3 - "$@" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+missing = [k for k in sys.argv[2:] if k not in d]
+if missing:
+    print("missing keys:", missing); sys.exit(1)
+PY
+}
+
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+# roots --format json
+if "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 22 --format json >"$tmp/r.json"; then
+    json_has "$tmp/r.json" roots spectral_abscissa ring_stable degree && ok || bad "roots json keys"
+    python3 - "$tmp/r.json" <<'PY' && ok || bad "roots json content"
+import json, sys
+d = json.load(open(sys.argv[1]))
+r = d["roots"]
+assert len(r) >= 6, r
+for x in r:
+    for k in ("re", "im", "mode", "residual"):
+        assert k in x, k
+    assert x["residual"] < 1e-12
+assert d["ring_stable"] is False          # the paper's example is ring unstable at N = 22
+assert abs(d["spectral_abscissa"] - r[0]["re"]) == 0
+assert isinstance(d["degree"], int) and d["degree"] > 0
+PY
+else
+    bad "roots json exit status"
+fi
+
+# string --format json
+if "$bin" string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --format json >"$tmp/s.json"; then
+    json_has "$tmp/s.json" plant_stable sup_gamma omega_peak lowfreq_margin string_stable && ok || bad "string json keys"
+    python3 - "$tmp/s.json" <<'PY' && ok || bad "string json content"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["plant_stable"] is True and d["string_stable"] is False
+assert d["sup_gamma"] > 1 and d["omega_peak"] > 0 and d["lowfreq_margin"] < 0
+PY
+else
+    bad "string json exit status"
+fi
+
+# table and csv formats, ring inf, tau = 0, k1 = 0, idm
+for args in "roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1" \
+            "roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring inf --format csv" \
+            "roots --k1 0 --k2 0.2 --th 1.5 --tau 0.1 --ring 5" \
+            "roots --k1 0.3 --k2 0.2 --th 1.5 --tau 0 --ring 1000 --count 3" \
+            "string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 50 --format csv" \
+            "string --model idm --th 1.5 --tau 0.3 --speed 15" \
+            "roots --model idm --th 1.5 --tau 0.3 --format json"; do
+    if "$bin" $args >"$tmp/o.txt" 2>"$tmp/e.txt"; then
+        if grep -qi -E 'nan|-inf|inf,|: inf' "$tmp/o.txt"; then bad "NaN/inf in output of: $args"; else ok; fi
+    else
+        bad "exit status of: $args"; cat "$tmp/e.txt"
+    fi
+done
+
+# bad input: exit 2, one line on stderr naming the value, nothing on stdout
+expect_error() {  # expect_error PATTERN args...
+    local pattern="$1"; shift
+    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
+    local rc=$?
+    if [ $rc -ne 2 ]; then bad "exit $rc (expected 2) for: $*"; return; fi
+    if [ -s "$tmp/o.txt" ]; then bad "stdout not empty for: $*"; return; fi
+    if [ "$(wc -l <"$tmp/e.txt")" -ne 1 ]; then bad "stderr not one line for: $*"; cat "$tmp/e.txt"; return; fi
+    if ! grep -q -- "$pattern" "$tmp/e.txt"; then bad "stderr lacks '$pattern' for: $*: $(cat "$tmp/e.txt")"; return; fi
+    ok
+}
+expect_error "k1 = -0.5" roots --k1 -0.5 --k2 0.2 --th 1.5 --tau 0.1
+expect_error "tau = -1" roots --k1 0.5 --k2 0.2 --th 1.5 --tau -1
+expect_error "'abc'" roots --k1 abc --k2 0.2 --th 1.5 --tau 0.1
+expect_error "'nan'" string --k1 nan --k2 0.2 --th 1.5 --tau 0.1
+expect_error "'inf'" string --k1 0.1 --k2 inf --th 1.5 --tau 0.1
+expect_error "'1e999'" string --k1 0.1 --k2 1e999 --th 1.5 --tau 0.1
+expect_error "--ring = '1'" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 1
+expect_error "--ring = 'x'" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring x
+expect_error "--count = '0'" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --count 0
+expect_error "--model = 'bando'" roots --model bando --th 1 --tau 0.1
+expect_error "needs tau" roots --k1 0.2 --k2 0.2 --th 1.5
+expect_error "--format = 'xml'" string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --format xml
+expect_error "does not belong" roots --model idm --k1 0.2 --th 1.5 --tau 0.1
+expect_error "--bogus" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --bogus 3
+expect_error "speed = 40" string --model idm --th 1.5 --tau 0.2 --speed 40
+
+# help on every command, with units
+for c in roots string; do
+    if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi
+done
+"$bin" --help >/dev/null && ok || bad "--help"
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,44 @@
+// Spectral convergence of the collocation in the degree M, against Lambert W.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "ddemap/collocation.hpp"
+#include "ddemap/roots.hpp"
+#include "lambert_w.hpp"
+
+using namespace ddemap;
+
+TEST_CASE("the rightmost collocation eigenvalue converges as M grows") {
+    // x'(t) = -x(t - 1): rightmost root W_0(-1)
+    MatrixXc a0 = MatrixXc::Zero(1, 1), a1(1, 1);
+    a1(0, 0) = -1.0;
+    const LinearDDE dde(a0, {{a1, 1.0}});
+    const cplx exact = ddemap::test::lambert_w(cplx(-1.0, 0.0), 0);
+    double previous = 1e300;
+    for (int m : {2, 4, 6, 8, 12}) {
+        const MatrixXc a = collocation_matrix(dde, m);
+        Eigen::ComplexEigenSolver<MatrixXc> es(a, false);
+        double err = 1e300;
+        for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) err = std::min(err, std::abs(es.eigenvalues()(i) - exact));
+        CAPTURE(m);
+        CAPTURE(err);
+        CHECK(err < previous * 0.5);
+        previous = err;
+    }
+    CHECK(previous < 1e-8);
+}
+
+TEST_CASE("the adaptive degree reports why it is trusted") {
+    MatrixXc a0 = MatrixXc::Zero(1, 1), a1(1, 1);
+    a1(0, 0) = -2.0;
+    const RootResult r = rightmost_roots(LinearDDE(a0, {{a1, 1.5}}));
+    CHECK(r.status == RootStatus::Converged);
+    CHECK(r.degree > r.previous_degree);
+    CHECK(r.previous_degree > 0);
+    CHECK(r.degree_change <= 1e-11);
+    CHECK(r.reason.find("agree between") != std::string::npos);
+}

@@ -1,0 +1,22 @@
+#pragma once
+// The one table of test tolerances. Each entry says what it bounds and why that size.
+namespace ddemap::test::tol {
+
+/// Refined characteristic roots against an analytic value (Lambert W, closed forms): Newton
+/// converges to rounding, |lambda| <= ~20 in these tests, so 1e-12 absolute leaves a 100x margin.
+constexpr double root_abs = 1e-12;
+/// Rightmost roots against the 40-digit reference data (issue requirement: 1e-10).
+constexpr double reference_root = 1e-10;
+/// sup |Gamma(iw)| against the reference data, relative (issue requirement: 1e-8).
+constexpr double reference_sup_rel = 1e-8;
+/// omega of the peak against the reference, relative: the maximum is quadratic, so omega is
+/// determined only to about sqrt of the value accuracy; 1e-6 is what the refinement achieves.
+constexpr double reference_omega_rel = 1e-6;
+/// Same root from two algorithms in double precision (dense full ring vs Fourier modes).
+constexpr double same_root = 1e-10;
+/// Coefficients computed two ways in double precision (series vs closed form).
+constexpr double coefficient_rel = 1e-13;
+/// Linearisation against central finite differences with step 1e-5 (error O(h^2) ~ 1e-10).
+constexpr double finite_difference = 1e-7;
+
+}  // namespace ddemap::test::tol
