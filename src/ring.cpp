@@ -1,6 +1,7 @@
 #include "ddemap/ring.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -111,13 +112,50 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
     std::vector<RingRoot> all;
 
     if (cars > 0) {
-        for (int m = 0; 2 * m <= cars; ++m) {
+        // Each mode first gives its two rightmost roots (more while they are unstable); then
+        // any mode whose last root is still right of the count-th root overall is asked for
+        // more, until the global `count` rightmost roots are certain.
+        const int modes = cars / 2 + 1;
+        std::vector<RootResult> per_mode(modes);
+        std::vector<int> asked(modes, std::min(count, 2));
+        auto solve = [&](int m) {
             const double theta = 2.0 * M_PI * m / cars;
             const LinearDDE dde = m == 0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, std::polar(1.0, -theta));
-            const RootResult rr = solve_mode(dde, options.roots, true);
-            absorb_status(r, rr);
+            RootOptions o = options.roots;
+            o.count = asked[m];
+            per_mode[m] = solve_mode(dde, o, true);
+            asked[m] = std::max(asked[m], static_cast<int>(per_mode[m].roots.size()));
+        };
+        for (int m = 0; m < modes; ++m) solve(m);
+        auto weight = [&](int m) { return (m > 0 && 2 * m != cars) ? 2 : 1; };
+        for (int round = 0; round < 16; ++round) {
+            std::vector<double> re;
+            for (int m = 0; m < modes; ++m)
+                for (const auto& root : per_mode[m].roots)
+                    for (int w = 0; w < weight(m); ++w) re.push_back(root.value.real());
+            if (re.size() < std::size_t(count)) {
+                re.clear();
+            } else {
+                std::nth_element(re.begin(), re.begin() + (count - 1), re.end(), std::greater<double>());
+            }
+            const double threshold = re.empty() ? -std::numeric_limits<double>::infinity() : re[count - 1];
+            bool more = false;
+            for (int m = 0; m < modes; ++m) {
+                const auto& rr = per_mode[m];
+                const bool exhausted = static_cast<int>(rr.roots.size()) < asked[m];  // fewer exist in the strip
+                if (!exhausted && asked[m] < count && !rr.roots.empty() && rr.roots.back().value.real() >= threshold) {
+                    asked[m] = std::min(count, 2 * asked[m]);
+                    solve(m);
+                    more = true;
+                }
+            }
+            if (!more) break;
+        }
+        for (int m = 0; m < modes; ++m) {
+            absorb_status(r, per_mode[m]);
+            const double theta = 2.0 * M_PI * m / cars;
             const bool paired = m > 0 && 2 * m != cars;
-            for (const auto& root : rr.roots) {
+            for (const auto& root : per_mode[m].roots) {
                 all.push_back({root, m, theta});
                 if (paired) {
                     Root c = root;
@@ -140,7 +178,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
     } else {
         // N = infinity: maximise the rightmost real part over wave numbers theta in (0, pi]
         RootOptions per = options.roots;
-        per.count = 2;  // the abscissa needs the rightmost root (and its conjugate twin if real)
+        per.count = 1;  // the abscissa needs only the rightmost root
         auto alpha = [&](double theta, RootResult* keep) {
             const RootResult rr = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -theta)), per);
             absorb_status(r, rr);

@@ -58,6 +58,7 @@ void RootOptions::validate() const {
     positive(residual_tolerance, "residual_tolerance");
     positive(agreement_tolerance, "agreement_tolerance");
     positive(collocation_tolerance, "collocation_tolerance");
+    positive(spectral_tolerance, "spectral_tolerance");
     if (!(std::isfinite(depth) && depth >= 0.0)) {
         std::ostringstream os;
         os << "depth = " << depth << ": expected a finite value >= 0 (0 = automatic)";
@@ -223,14 +224,15 @@ RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options, con
         ev.resize(k);
         int dropped = 0;
         std::vector<Root> current = cut_rightmost(refine_all(dde, ev, options, dropped), options.count);
-        // the strip Re >= floor is where completeness is certified (and compared between degrees)
+        // Completeness is certified right of sigma: the last of the `count` roots, or, when fewer
+        // were found, the floor of the strip Re >= alpha - depth (all roots there are listed).
         const double depth = options.depth > 0.0 ? options.depth : 2.0 / tau;
+        const bool full = current.size() >= std::size_t(options.count);
         const double floor = current.empty() ? -depth : current.front().value.real() - depth;
+        const double sigma = full ? current.back().value.real() : floor;
         std::size_t in_strip = 0;
-        while (in_strip < current.size() && current[in_strip].value.real() >= floor) ++in_strip;
-        const bool full = in_strip >= std::size_t(options.count);
-        // every root right of sigma is within the bound; none may lie beyond the resolved radius
-        const double sigma = full ? current[in_strip - 1].value.real() : floor;
+        while (in_strip < current.size() && current[in_strip].value.real() >= sigma) ++in_strip;
+        // every root right of sigma is within the bound; M must resolve that disc
         const double needed = dde.root_bound(sigma);
         double change = std::numeric_limits<double>::infinity();
         bool collocated = true;
@@ -240,15 +242,26 @@ RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options, con
                 change = std::max(change, std::abs(current[i].value - previous[i].value) / scale_of(current[i].value));
             }
         }
-        for (std::size_t i = 0; i < in_strip; ++i)
-            if (const auto& r = current[i]; r.collocation_error > options.collocation_tolerance * scale_of(r.value)) collocated = false;
-
-        const bool settled = change <= options.agreement_tolerance && collocated && covered >= needed;
+        double worst_collocation = 0.0;
+        for (std::size_t i = 0; i < in_strip; ++i) {
+            const double e = current[i].collocation_error / scale_of(current[i].value);
+            worst_collocation = std::max(worst_collocation, e);
+            if (e > options.collocation_tolerance) collocated = false;
+        }
+        // Two certificates: the eigenvalues themselves already equal the Newton-refined roots
+        // (spectral accuracy reached at this M), or the refined roots agree between two degrees.
+        const bool covers = covered >= needed;
+        // (With fewer than `count` roots found only the second certificate applies: a larger M
+        // may reveal more roots, so the same set must come out of two degrees.)
+        const bool spectral = full && worst_collocation <= options.spectral_tolerance && covers;
+        const bool agreed = change <= options.agreement_tolerance && collocated && covers;
+        const bool settled = spectral || agreed;
         if (settled || m >= options.max_degree) {
             result.roots = current;
             result.degree = m;
             result.previous_degree = previous_degree;
             result.degree_change = change;
+            result.collocation_error = worst_collocation;
             result.covered_radius = covered;
             result.strip_floor = sigma;
             result.dropped = dropped;
@@ -256,10 +269,16 @@ RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options, con
             os.precision(3);
             if (settled) {
                 result.status = RootStatus::Converged;
-                os << "the " << in_strip << " rightmost roots" << (full ? "" : " (all with Re >= " + std::to_string(floor) + ")") << " agree between M=" << previous_degree << " and M=" << m
-                   << " (max relative change " << change << "), every root is within "
-                   << options.collocation_tolerance << " of a collocation eigenvalue, and M resolves |lambda| <= "
-                   << covered << ", beyond the bound " << needed << " on any root with Re >= " << sigma;
+                os << "the " << in_strip << " rightmost roots" << (full ? "" : " (all with Re >= " + std::to_string(floor) + ")");
+                if (spectral) {
+                    os << " equal collocation eigenvalues at M=" << m << " to " << worst_collocation
+                       << " (relative; spectral accuracy reached)";
+                } else {
+                    os << " agree between M=" << previous_degree << " and M=" << m << " (max relative change " << change
+                       << "; eigenvalues within " << worst_collocation << ")";
+                }
+                os << ", and M resolves |lambda| <= " << covered << ", beyond the bound " << needed
+                   << " on any root with Re >= " << sigma;
             } else {
                 result.status = RootStatus::MaxDegreeReached;
                 os << "max degree M=" << m << " reached before the roots settled (change " << change

@@ -103,6 +103,7 @@ LowFrequency low_frequency_expansion(const Linearisation& lin) {
 
 void StringOptions::validate() const {
     roots.validate();
+    if (plant_roots < 1) throw std::invalid_argument("plant_roots = " + std::to_string(plant_roots) + ": expected >= 1");
     if (grid_points < 16) throw std::invalid_argument("grid_points = " + std::to_string(grid_points) + ": expected >= 16");
 }
 
@@ -167,8 +168,10 @@ StringResult analyse_string(const Linearisation& lin, const StringOptions& optio
     options.validate();
     StringResult r;
     // plant
+    // The rightmost plant roots decide plant stability; the last one found also bounds the width
+    // of every resonance peak of roots further left (see the grid step below).
     RootOptions ro = options.roots;
-    ro.count = std::max(ro.count, 8);
+    ro.count = options.plant_roots;
     r.plant_roots = rightmost_roots(plant_dde(lin), ro);
     r.plant_abscissa = r.plant_roots.spectral_abscissa();
     r.plant_stable = r.plant_roots.status == RootStatus::Converged && r.plant_abscissa < 0.0;

@@ -23,9 +23,11 @@ struct RootOptions {
     double residual_tolerance = 1e-9;  ///< accept a root when its relative residual is below
     double agreement_tolerance = 1e-11;  ///< roots equal between degrees (relative to max(1,|lambda|))
     double collocation_tolerance = 1e-5; ///< |eigenvalue - refined root| <= tol * max(1,|lambda|)
-    /// Roots are sought in the strip Re(lambda) >= alpha - depth (alpha the rightmost root); fewer
-    /// than `count` are returned when the strip holds fewer. 0 = automatic: 2 / tau_max, the
-    /// depth at which a mode decays by e^{-2} more per delay interval than the rightmost one.
+    /// One degree suffices when every eigenvalue is already this close (relative) to its refined
+    /// root: the discretisation error at that M is below it for these roots.
+    double spectral_tolerance = 1e-10;
+    /// When fewer than `count` roots are found, the result is certified complete in the strip
+    /// Re(lambda) >= alpha - depth (alpha the rightmost root). 0 = automatic: 2 / tau_max.
     double depth = 0.0;
     void validate() const;
 };
@@ -39,7 +41,7 @@ struct Root {
 };
 
 enum class RootStatus {
-    Converged,         ///< rightmost roots unchanged between two degrees, disc covered
+    Converged,         ///< rightmost roots certified (spectral accuracy or two degrees), disc covered
     MaxDegreeReached,  ///< the degree cap was hit before the roots settled
     EigenFailure       ///< the eigen-solver backend failed
 };
@@ -49,8 +51,9 @@ std::string to_string(RootStatus s);
 struct RootResult {
     std::vector<Root> roots;  ///< rightmost first (ties: larger imaginary part first)
     int degree = 0;           ///< the collocation degree M used (0 for an ODE)
-    int previous_degree = 0;  ///< the degree it was checked against
-    double degree_change = 0.0;  ///< max relative change of the roots between the two degrees
+    int previous_degree = 0;  ///< the degree it was checked against (0 when one degree sufficed)
+    double degree_change = 0.0;  ///< max relative change of the roots between the two degrees (inf if one degree)
+    double collocation_error = 0.0;  ///< max |eigenvalue - refined root| / max(1, |lambda|) over the roots
     double covered_radius = 0.0; ///< |lambda| up to which the collocation resolves e^{lambda theta}
     double strip_floor = 0.0;    ///< every root with Re >= strip_floor is in `roots` or right of them
     int dropped = 0;          ///< candidates dropped (Newton failed, spurious or duplicate)

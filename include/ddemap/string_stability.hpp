@@ -52,7 +52,8 @@ struct LowFrequency {
 LowFrequency low_frequency_expansion(const Linearisation& lin);
 
 struct StringOptions {
-    RootOptions roots;            ///< for the plant roots
+    RootOptions roots;            ///< for the plant roots (its count is replaced by plant_roots)
+    int plant_roots = 2;          ///< rightmost roots of D computed (>= 1)
     int grid_points = 400;        ///< base samples of |Gamma(i w)| before refinement (>= 16)
     void validate() const;
 };

@@ -285,7 +285,9 @@ void run_string(const StringArgs& args) {
         out << "low frequency    c" << s.lowfreq.decisive_order << " = " << rounded(s.lowfreq_margin, 6)
             << (s.lowfreq.attenuates ? "  (attenuates as w -> 0)" : "  (AMPLIFIES as w -> 0)") << "\n";
         if (ring) {
-            out << "ring N=" << ring_name(*cars) << "        " << (ring->stable ? "stable" : "UNSTABLE")
+            char label[32];
+            std::snprintf(label, sizeof label, "%-17s", ("ring N=" + ring_name(*cars)).c_str());
+            out << label << (ring->stable ? "stable" : "UNSTABLE")
                 << "   (spectral abscissa " << rounded(ring->spectral_abscissa, 6) << ")\n";
         }
         out << "verdict          string " << (s.string_stable ? "STABLE" : "UNSTABLE") << "\n";
