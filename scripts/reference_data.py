@@ -58,9 +58,10 @@ Finding ALL roots in a right region
    halves changes arg F by less than pi/8 and |F| by less than a factor 2
    (this rules out aliasing and detects roots close to the contour; if a root
    is within ~1e-9 of the left side, sigma is shifted slightly).  The total
-   phase change divided by 2*pi must be an integer to 1e-6.  As an extra
-   consistency check the count is also obtained for a few problems by
-   integrating F'/F along the contour with mpmath.quad.
+   phase change divided by 2*pi must be an integer to 1e-6.  As a second,
+   independent evaluation the final count of every problem is also obtained
+   by integrating F'/F along the contour with mpmath.quad (25 digits); both
+   must agree.
 3. Finding.  Newton's method (double precision, analytic derivative) is
    started from a grid of points covering the rectangle; the converged points
    inside the rectangle are polished with mpmath.findroot (Newton, analytic
@@ -70,8 +71,8 @@ Finding ALL roots in a right region
    repeated.  Any remaining disagreement aborts the script.
 4. sigma starts at -3.  If fewer roots than required (3 for a ring mode, 1
    for the plant) have Re > sigma, sigma is lowered over the integers
-   -4, -5, ..., -15 and the largest sigma with enough roots is used (the
-   count is monotone in sigma, so this is done by bisection over that list).
+   -4, -5, ..., -15 and the first sigma with enough roots is used (the
+   counts are checked to be monotone in sigma).
    If even Re > -15 contains fewer roots, just those are reported: a ring
    mode with fewer than three rows in the CSV has NO further root with
    Re(lam) > -15 (for small tau the delay-induced root chains lie far to the
@@ -121,7 +122,7 @@ formula; the 14 calibration settings should have c2 < 0 and sup_gamma > 1
 whose rightmost roots must equal W_0(a tau)/tau and W_{-1}(a tau)/tau to 1e-30
 and whose root count must match the number of Lambert-W branches.
 
-Usage:  scripts/reference_data.py        (run from anywhere; ~ a few minutes on 2 cores)
+Usage:  scripts/reference_data.py     (run from anywhere; about 10 minutes on 2 cores)
 """
 
 import cmath
@@ -444,45 +445,39 @@ def sort_roots(roots):
 
 
 def rightmost_roots(qp, need):
-    """All roots with Re > sigma, sigma in SIGMA_LIST chosen as described above."""
+    """All roots with Re > sigma, sigma = first of SIGMA_LIST with >= need roots."""
     info = {"label": qp.label}
     cache = {}
-
-    def cnt(k):
-        if k not in cache:
-            R = qp.bound(SIGMA_LIST[k])
-            if R > R_CAP:
-                cache[k] = None
-            else:
-                cache[k] = count_with_shift(qp, SIGMA_LIST[k])
-        return cache[k]
-
     k = 0
-    if cnt(0)[4] < need:
-        last = len(SIGMA_LIST) - 1
-        while cnt(last) is None:        # rectangle too large: lower bound of search
-            last -= 1
+    for k, sig in enumerate(SIGMA_LIST):
+        if k > 0 and qp.bound(sig) > R_CAP:     # rectangle would be absurdly large
+            k -= 1
             info["capped"] = True
-        if cnt(last)[4] < need:
-            k = last
-        else:                            # largest sigma index with enough roots
-            lo, hi = 0, last             # cnt(lo) < need <= cnt(hi)
-            while hi - lo > 1:
-                mid = (lo + hi) // 2
-                if cnt(mid)[4] >= need:
-                    hi = mid
-                else:
-                    lo = mid
-            k = hi
+            break
+        cache[k] = count_with_shift(qp, sig)
+        if cache[k][4] >= need:
+            break
     # monotonicity of the counts (sanity check of the argument principle)
-    ks = sorted(i for i in cache if cache[i] is not None)
+    ks = sorted(cache)
     for i, j in zip(ks, ks[1:]):
         assert cache[i][4] <= cache[j][4], (qp.label, cache)
-    sigma, X, H, R, n = cnt(k)
+    sigma, X, H, R, n = cache[k]
     roots = find_all(qp, sigma, X, H, n, info) if n > 0 else []
+    if qp.real:
+        # real coefficients: make conjugate pairs exactly symmetric
+        upper = [z for z in roots if z.imag > 0]
+        lower = [z for z in roots if z.imag < 0]
+        assert len(upper) == len(lower), (qp.label, roots)
+        for z in upper:
+            assert min(abs(mpmath.conj(z) - w) for w in lower) < mpf("1e-25"), (qp.label, z)
+        roots = ([z for z in roots if z.imag == 0] + upper +
+                 [mpmath.conj(z) for z in upper])
     for z in roots:
         assert abs(z) <= R * (1 + mpf("1e-30")), (qp.label, z, R)
-    info.update(sigma=sigma, R=R, count=n, counts_evaluated=len(cache))
+    # second, independent evaluation of the final count: contour integral of F'/F
+    nq = quad_count(qp, sigma, X, H)
+    assert nq == n == len(roots), (qp.label, n, nq, len(roots))
+    info.update(sigma=sigma, R=R, count=n, quad_count=nq, counts_evaluated=len(cache))
     if qp.tau == 0:
         # polynomial: cross-check against mpmath.polyroots
         pr = mpmath.polyroots(qp.poly_coeffs(), maxsteps=200, extraprec=200)
@@ -569,6 +564,12 @@ def string_quantities(fs, fv, fl, tau, plant_roots):
     tay = mpmath.taylor(lambda x: abs(D(mpc(0, x))) ** 2 - abs(Nn(mpc(0, x))) ** 2, 0, 2)
     assert abs(tay[0]) < mpf("1e-25") and abs(tay[1]) < mpf("1e-15")
     assert abs(tay[2] - c2) < mpf("1e-12") * (1 + abs(c2)), (tay, c2)
+    # c2 also equals 2 k1 (k1 th^2/2 + k2 th - 1 - tau (k1 th + k2)) (algebra:
+    # expand f_v^2 with f_s = k1, f_v = -(k1 th + k2), f_l = k2); consistency check only
+    k1, k2 = fs, fl
+    th = (-fv - k2) / k1
+    alt = 2 * k1 * (k1 * th * th / 2 + k2 * th - 1 - tau * (k1 * th + k2))
+    assert abs(alt - c2) < mpf("1e-30"), (alt, c2)
 
     # upper frequency W: bound B(w) < 1/2 and decreasing on [W, inf)
     a, b = abs(fs), abs(fl)

@@ -61,11 +61,19 @@ RootResult solve_mode(const LinearDDE& dde, RootOptions opts, bool all_unstable)
 
 }  // namespace
 
-double marginal_band(cplx lambda) { return 1e-13 * std::max(1.0, std::abs(lambda)); }
 
 void RingOptions::validate() const {
     roots.validate();
     if (theta_grid < 4) throw std::invalid_argument("theta_grid = " + std::to_string(theta_grid) + ": expected >= 4");
+}
+
+cplx ring_zeta(int m, int cars) {
+    const long k = ((static_cast<long>(m) % cars) + cars) % cars;
+    if (k == 0) return 1.0;
+    if (4 * k == cars) return cplx(0.0, -1.0);
+    if (2 * k == cars) return -1.0;
+    if (4 * k == 3L * cars) return cplx(0.0, 1.0);
+    return std::polar(1.0, -2.0 * M_PI * static_cast<double>(k) / cars);
 }
 
 LinearDDE ring_mode_dde(const Linearisation& lin, cplx zeta) {
@@ -119,8 +127,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
         std::vector<RootResult> per_mode(modes);
         std::vector<int> asked(modes, std::min(count, 2));
         auto solve = [&](int m) {
-            const double theta = 2.0 * M_PI * m / cars;
-            const LinearDDE dde = m == 0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, std::polar(1.0, -theta));
+            const LinearDDE dde = m == 0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, ring_zeta(m, cars));
             RootOptions o = options.roots;
             o.count = asked[m];
             per_mode[m] = solve_mode(dde, o, true);

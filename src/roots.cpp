@@ -66,6 +66,8 @@ void RootOptions::validate() const {
     }
 }
 
+double marginal_band(cplx lambda) { return 1e-13 * std::max(1.0, std::abs(lambda)); }
+
 double RootResult::spectral_abscissa() const {
     double a = -std::numeric_limits<double>::infinity();
     for (const auto& r : roots) a = std::max(a, r.value.real());

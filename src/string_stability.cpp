@@ -166,15 +166,20 @@ double refine_peak(const TransferFunction& tf, double lo, double hi, int& evals)
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options) {
     options.validate();
-    StringResult r;
-    // plant
     // The rightmost plant roots decide plant stability; the last one found also bounds the width
     // of every resonance peak of roots further left (see the grid step below).
     RootOptions ro = options.roots;
     ro.count = options.plant_roots;
-    r.plant_roots = rightmost_roots(plant_dde(lin), ro);
+    return analyse_string(lin, rightmost_roots(plant_dde(lin), ro), options);
+}
+
+StringResult analyse_string(const Linearisation& lin, RootResult plant, const StringOptions& options) {
+    options.validate();
+    StringResult r;
+    r.plant_roots = std::move(plant);
     r.plant_abscissa = r.plant_roots.spectral_abscissa();
-    r.plant_stable = r.plant_roots.status == RootStatus::Converged && r.plant_abscissa < 0.0;
+    r.plant_stable = r.plant_roots.status == RootStatus::Converged && !r.plant_roots.roots.empty() &&
+                     r.plant_abscissa < -marginal_band(r.plant_roots.roots.front().value);
 
     r.lowfreq = low_frequency_expansion(lin);
     switch (r.lowfreq.decisive_order) {

@@ -19,6 +19,10 @@
 
 namespace ddemap {
 
+/// zeta_m = exp(-2 pi i m / N), exact at the quarter turns (1, -i, -1, i) so that the real modes
+/// m = 0 and m = N/2 have real coefficients.
+cplx ring_zeta(int m, int cars);
+
 /// Mode DDE for a given zeta (|zeta| = 1).
 LinearDDE ring_mode_dde(const Linearisation& lin, cplx zeta);
 /// Mode 0 with the trivial factor lambda removed: v' = (own + lead) * v.
@@ -26,9 +30,6 @@ LinearDDE ring_mode0_dde(const Linearisation& lin);
 /// The whole 2N-dimensional ring, state (s_1, v_1, ..., s_N, v_N), assembled directly.
 LinearDDE full_ring_dde(const Linearisation& lin, int cars);
 
-/// A root that is within this distance of the imaginary axis is marginal, neither stable nor
-/// unstable: 1e-13 max(1, |lambda|) (roots are refined to about 1e-15).
-double marginal_band(cplx lambda);
 
 struct RingOptions {
     RootOptions roots;      ///< per-mode options; roots.count is the number of roots reported

@@ -70,6 +70,10 @@ RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options = {}
 /// Newton refinement of one root estimate. Returns false when it did not converge.
 bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, Root& out);
 
+/// A root within this distance of the imaginary axis is marginal, neither stable nor
+/// unstable: 1e-13 max(1, |lambda|) (roots are refined to about 1e-15).
+double marginal_band(cplx lambda);
+
 /// Relative residual sigma_min(Delta(lambda)) / scale(lambda) (see Root::residual).
 double relative_residual(const LinearDDE& dde, cplx lambda);
 

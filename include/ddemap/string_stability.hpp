@@ -82,5 +82,7 @@ struct StringResult {
 };
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options = {});
+/// The same with the rightmost plant roots given (rightmost first; e.g. tracked in a sweep).
+StringResult analyse_string(const Linearisation& lin, RootResult plant_roots, const StringOptions& options);
 
 }  // namespace ddemap

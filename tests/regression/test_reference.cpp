@@ -81,7 +81,7 @@ TEST_CASE("ring roots agree with the 40-digit reference to 1e-10 (N = 2 .. 50)")
         for (const auto& [m, refs] : ref_by_mode) {
             RootOptions o;
             o.count = static_cast<int>(refs.size()) + 2;
-            const LinearDDE dde = m == 0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, std::polar(1.0, -2.0 * M_PI * m / n));
+            const LinearDDE dde = m == 0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, ring_zeta(m, n));
             const RootResult rr = rightmost_roots(dde, o);
             for (std::size_t i = 0; i < refs.size(); ++i) {
                 CAPTURE(key.first);
@@ -91,7 +91,12 @@ TEST_CASE("ring roots agree with the 40-digit reference to 1e-10 (N = 2 .. 50)")
                 REQUIRE(i < rr.roots.size());
                 CAPTURE(rr.roots[i].value);
                 CAPTURE(refs[i]);
-                CHECK(std::abs(rr.roots[i].value - refs[i]) < tol::reference_root);
+                // same rank by real part; the root itself matched among ours (conjugate twins
+                // of the real modes tie in the real part, so their order is not fixed)
+                CHECK(std::abs(rr.roots[i].value.real() - refs[i].real()) < tol::reference_root);
+                double nearest = 1e300;
+                for (const auto& x : rr.roots) nearest = std::min(nearest, std::abs(x.value - refs[i]));
+                CHECK(nearest < tol::reference_root);
                 ++compared;
             }
         }

@@ -1,0 +1,183 @@
+#include "ddemap/quasi.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace ddemap {
+
+using cplx = std::complex<double>;
+
+namespace {
+
+void add_term(std::vector<QuasiPolynomial::Term>& terms, double delay, int power, cplx coef) {
+    if (coef == cplx(0.0)) return;
+    auto it = std::find_if(terms.begin(), terms.end(), [&](const QuasiPolynomial::Term& t) { return t.delay == delay; });
+    if (it == terms.end()) {
+        terms.push_back({{}, delay});
+        it = terms.end() - 1;
+    }
+    if (static_cast<int>(it->poly.size()) <= power) it->poly.resize(power + 1, cplx(0.0));
+    it->poly[power] += coef;
+}
+
+}  // namespace
+
+QuasiPolynomial::QuasiPolynomial(int degree, std::vector<Term> terms) : m_degree(degree), m_terms(std::move(terms)) {
+    if (degree != 1 && degree != 2) throw std::invalid_argument("quasi-polynomial degree must be 1 or 2");
+    for (const auto& t : m_terms) {
+        if (static_cast<int>(t.poly.size()) > degree) throw std::invalid_argument("quasi-polynomial term of degree >= n: not of retarded type");
+        if (!(t.delay >= 0.0) || !std::isfinite(t.delay)) throw std::invalid_argument("quasi-polynomial delay must be finite and >= 0");
+        m_max_delay = std::max(m_max_delay, t.delay);
+    }
+}
+
+QuasiPolynomial QuasiPolynomial::ring_mode(const Linearisation& lin, cplx zeta) {
+    std::vector<Term> terms;
+    for (const auto& t : lin.own.terms()) add_term(terms, t.delay, 1, -t.coef);
+    for (const auto& t : lin.gap.terms()) add_term(terms, t.delay, 0, t.coef * (1.0 - zeta));
+    for (const auto& t : lin.lead.terms()) add_term(terms, t.delay, 1, -zeta * t.coef);
+    return QuasiPolynomial(2, std::move(terms));
+}
+
+QuasiPolynomial QuasiPolynomial::ring_mode0(const Linearisation& lin) {
+    std::vector<Term> terms;
+    for (const auto& t : lin.own.terms()) add_term(terms, t.delay, 0, -t.coef);
+    for (const auto& t : lin.lead.terms()) add_term(terms, t.delay, 0, -t.coef);
+    return QuasiPolynomial(1, std::move(terms));
+}
+
+QuasiPolynomial QuasiPolynomial::plant(const Linearisation& lin) { return ring_mode(lin, cplx(0.0)); }
+
+void QuasiPolynomial::evaluate(cplx lambda, cplx& f, cplx& fp) const {
+    if (m_degree == 2) {
+        f = lambda * lambda;
+        fp = 2.0 * lambda;
+    } else {
+        f = lambda;
+        fp = 1.0;
+    }
+    for (const auto& t : m_terms) {
+        cplx p = 0.0, dp = 0.0;
+        for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) {
+            dp = dp * lambda + p;
+            p = p * lambda + t.poly[k];
+        }
+        if (t.delay == 0.0) {
+            f += p;
+            fp += dp;
+        } else {
+            const cplx e = std::exp(-lambda * t.delay);
+            f += p * e;
+            fp += (dp - t.delay * p) * e;
+        }
+    }
+}
+
+bool QuasiPolynomial::is_real() const {
+    for (const auto& t : m_terms)
+        for (cplx c : t.poly)
+            if (c.imag() != 0.0) return false;
+    return true;
+}
+
+cplx QuasiPolynomial::operator()(cplx lambda) const {
+    cplx f = m_degree == 2 ? lambda * lambda : lambda;
+    for (const auto& t : m_terms) {
+        cplx p = 0.0;
+        for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) p = p * lambda + t.poly[k];
+        f += t.delay == 0.0 ? p : p * std::exp(-lambda * t.delay);
+    }
+    return f;
+}
+
+bool QuasiPolynomial::newton(cplx& lambda, int max_iterations) const {
+    for (int it = 0; it < max_iterations; ++it) {
+        cplx f, fp;
+        evaluate(lambda, f, fp);
+        if (f == cplx(0.0)) return true;
+        if (fp == cplx(0.0)) return false;
+        const cplx step = f / fp;
+        lambda -= step;
+        if (!std::isfinite(lambda.real()) || !std::isfinite(lambda.imag())) return false;
+        if (std::abs(step) <= 4.0 * 2.220446049250313e-16 * std::max(1.0, std::abs(lambda))) return true;
+    }
+    return false;
+}
+
+namespace {
+
+/// arg(b / a) without a complex division
+double arg_ratio(cplx b, cplx a) { return std::arg(b * std::conj(a)); }
+
+struct Tracker {
+    const QuasiPolynomial& f;
+    double sigma;
+    int budget = 20000;
+    bool failed = false;
+    /// Continuous change of arg f(sigma + i w) from wa to wb; d = principal arg(fb / fa).
+    double change(double wa, cplx fa, double wb, cplx fb, double d, int depth) {
+        const double wm = 0.5 * (wa + wb);
+        const cplx fm = f(cplx(sigma, wm));
+        if (--budget < 0 || fm == cplx(0.0) || depth > 64) {
+            failed = true;
+            return 0.0;
+        }
+        const double d1 = arg_ratio(fm, fa), d2 = arg_ratio(fb, fm);
+        if (std::abs(d1) < M_PI / 4 && std::abs(d2) < M_PI / 4 && std::abs(d1 + d2 - d) < 1e-6) return d;
+        return change(wa, fa, wm, fm, d1, depth + 1) + change(wm, fm, wb, fb, d2, depth + 1);
+    }
+};
+
+}  // namespace
+
+int QuasiPolynomial::zeros_right_of(double sigma) const {
+    // radius r of the half circle |lambda - sigma| = r, Re >= sigma, on which
+    // |f - (lambda - sigma)^n| <= r^n / 2, so that arg f follows arg (lambda - sigma)^n there
+    const double s = std::abs(sigma);
+    auto bound = [&](double r) {
+        const double lam = r + s;
+        double b = m_degree == 2 ? 2.0 * s * lam + s * s : s;
+        for (const auto& t : m_terms) {
+            const double e = t.delay == 0.0 ? 1.0 : std::exp(-sigma * t.delay);
+            double p = 0.0;
+            for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) p = p * lam + std::abs(t.poly[k]);
+            b += e * p;
+        }
+        return b;
+    };
+    double r = 1.0;
+    for (int i = 0; i < 200 && bound(r) >= 0.5 * std::pow(r, m_degree); ++i) r *= 2.0;
+    if (bound(r) >= 0.5 * std::pow(r, m_degree)) return -1;
+
+    // the line from sigma - i r to sigma + i r, sampled at least every pi / (4 tau_max)
+    int pieces = 16;
+    if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
+    pieces = std::min(pieces, 4096);
+    Tracker tr{*this, sigma};
+    double total = 0.0;
+    double wa = -r;
+    cplx fa = (*this)(cplx(sigma, wa));
+    if (fa == cplx(0.0)) return -1;
+    const cplx first = fa;
+    for (int i = 1; i <= pieces; ++i) {
+        const double wb = -r + 2.0 * r * i / pieces;
+        const cplx fb = (*this)(cplx(sigma, wb));
+        if (fb == cplx(0.0)) return -1;
+        total += tr.change(wa, fa, wb, fb, arg_ratio(fb, fa), 0);
+        if (tr.failed) return -1;
+        wa = wb;
+        fa = fb;
+    }
+    const cplx last = fa;
+    // along the half circle (counter-clockwise, bottom to top) arg f changes by
+    // n pi + arg h(top) - arg h(bottom), h = f / (lambda - sigma)^n (principal args: |h - 1| < 1/2)
+    const cplx top = cplx(0.0, r), bottom = cplx(0.0, -r);
+    const double arc = m_degree * M_PI + arg_ratio(last, std::pow(top, m_degree)) - arg_ratio(first, std::pow(bottom, m_degree));
+    const double z = (arc - total) / (2.0 * M_PI);
+    const double zr = std::round(z);
+    if (std::abs(z - zr) > 0.05 || zr < 0) return -1;
+    return static_cast<int>(zr);
+}
+
+}  // namespace ddemap
