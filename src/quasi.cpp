@@ -110,22 +110,48 @@ namespace {
 /// arg(b / a) without a complex division
 double arg_ratio(cplx b, cplx a) { return std::arg(b * std::conj(a)); }
 
+/// |arg(b / a)| < pi/4, without atan2: Re(b conj a) > |Im(b conj a)|
+bool within_quarter(cplx b, cplx a) {
+    const cplx w = b * std::conj(a);
+    return w.real() > std::abs(w.imag());
+}
+
+/// A sample of f on the line: value and phase speed d/dw arg f(sigma + i w) = Re(f'/f).
+struct Sample {
+    double w;
+    cplx f;
+    double speed;
+};
+
 struct Tracker {
     const QuasiPolynomial& f;
     double sigma;
     int budget = 20000;
     bool failed = false;
-    /// Continuous change of arg f(sigma + i w) from wa to wb; d = principal arg(fb / fa).
-    double change(double wa, cplx fa, double wb, cplx fb, double d, int depth) {
-        const double wm = 0.5 * (wa + wb);
-        const cplx fm = f(cplx(sigma, wm));
-        if (--budget < 0 || fm == cplx(0.0) || depth > 64) {
+    Sample at(double w) {
+        cplx v, d;
+        f.evaluate(cplx(sigma, w), v, d);
+        if (v == cplx(0.0)) {
+            failed = true;
+            return {w, cplx(1.0), 0.0};
+        }
+        return {w, v, (d / v).real()};
+    }
+    /// Continuous change of arg f from a to b. A piece is accepted when, on each of its halves,
+    /// the phase turns by less than pi/4 between the samples and the phase speed at the samples
+    /// times the half length is below pi/8 (a zero near the piece makes |f'/f| large at some
+    /// sample, or turns the phase by about pi between two of them).
+    double change(const Sample& a, const Sample& b, int depth) {
+        if (--budget < 0 || depth > 80) {
             failed = true;
             return 0.0;
         }
-        const double d1 = arg_ratio(fm, fa), d2 = arg_ratio(fb, fm);
-        if (std::abs(d1) < M_PI / 4 && std::abs(d2) < M_PI / 4 && std::abs(d1 + d2 - d) < 1e-6) return d;
-        return change(wa, fa, wm, fm, d1, depth + 1) + change(wm, fm, wb, fb, d2, depth + 1);
+        const Sample m = at(0.5 * (a.w + b.w));
+        if (failed) return 0.0;
+        const double h = 0.5 * (b.w - a.w);
+        const bool slow = std::abs(a.speed) * h < M_PI / 8 && std::abs(m.speed) * h < M_PI / 8 && std::abs(b.speed) * h < M_PI / 8;
+        if (slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f)) return arg_ratio(b.f, a.f);
+        return change(a, m, depth + 1) + change(m, b, depth + 1);
     }
 };
 
@@ -156,19 +182,17 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     pieces = std::min(pieces, 4096);
     Tracker tr{*this, sigma};
     double total = 0.0;
-    double wa = -r;
-    cplx fa = (*this)(cplx(sigma, wa));
-    if (fa == cplx(0.0)) return -1;
-    const cplx first = fa;
+    Sample a = tr.at(-r);
+    if (tr.failed) return -1;
+    const cplx first = a.f;
     for (int i = 1; i <= pieces; ++i) {
-        const double wb = -r + 2.0 * r * i / pieces;
-        const cplx fb = (*this)(cplx(sigma, wb));
-        if (fb == cplx(0.0)) return -1;
-        total += tr.change(wa, fa, wb, fb, arg_ratio(fb, fa), 0);
+        const Sample b = tr.at(-r + 2.0 * r * i / pieces);
         if (tr.failed) return -1;
-        wa = wb;
-        fa = fb;
+        total += tr.change(a, b, 0);
+        if (tr.failed) return -1;
+        a = b;
     }
+    const cplx fa = a.f;
     const cplx last = fa;
     // along the half circle (counter-clockwise, bottom to top) arg f changes by
     // n pi + arg h(top) - arg h(bottom), h = f / (lambda - sigma)^n (principal args: |h - 1| < 1/2)

@@ -13,6 +13,7 @@
 #include <omp.h>
 #endif
 
+#include "ddemap/eigensolver.hpp"
 #include "ddemap/ring.hpp"
 #include "ddemap/string_stability.hpp"
 
@@ -92,9 +93,31 @@ CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<
         }
     }
     out.fell_back = true;
+    // a cheap low-degree collocation gives the guesses; the certificate decides
+    const LinearDDE problem = dde();
+    {
+        DenseEigenSolver dense;
+        const EigenResult eig = dense.eigenvalues(problem, 8, 1);
+        std::vector<cplx> ev = eig.values;
+        std::sort(ev.begin(), ev.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
+        bool have = false;
+        cplx best;
+        for (std::size_t i = 0; i < std::min<std::size_t>(ev.size(), 4); ++i) {
+            cplx z = ev[i];
+            if (f.newton(z) && (!have || z.real() > best.real())) {
+                best = z;
+                have = true;
+            }
+        }
+        if (have && is_rightmost(f, best)) {
+            out.value = best;
+            out.certified = true;
+            return out;
+        }
+    }
     RootOptions o;
     o.count = 1;
-    const RootResult rr = rightmost_roots(dde(), o);
+    const RootResult rr = rightmost_roots(problem, o);
     if (rr.roots.empty()) return out;
     cplx z = rr.roots.front().value;
     f.newton(z);
@@ -267,13 +290,29 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
     const auto t0 = std::chrono::steady_clock::now();
     std::atomic<int> rows_done{0};
     int fallbacks = 0, uncertified = 0;
+    // The first column is continued sequentially (one collocation solve at its first point);
+    // each row then starts from the roots of its first point. The path of every point is thus
+    // fixed, whatever the number of threads.
+    std::vector<RingTracker> ring_seed;
+    std::vector<PlantTracker> plant_seed;
+    {
+        RingTracker ring(spec.cars);
+        PlantTracker plant;
+        for (int iy = 0; iy < ny; ++iy) {
+            const Linearisation lin = model_at(spec, spec.x.value(0), spec.y.value(iy))->linearise();
+            fallbacks += ring.evaluate(lin).fallbacks;
+            plant.evaluate(lin, fallbacks);
+            ring_seed.push_back(ring);
+            plant_seed.push_back(plant);
+        }
+    }
 #ifdef DDEMAP_WITH_OPENMP
     result.threads = omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : fallbacks, uncertified)
 #endif
     for (int iy = 0; iy < ny; ++iy) {
-        RingTracker ring(spec.cars);
-        PlantTracker plant;
+        RingTracker ring = ring_seed[iy];
+        PlantTracker plant = plant_seed[iy];
         StringOptions so;
         so.grid_points = 120;
         for (int ix = 0; ix < nx; ++ix) {
