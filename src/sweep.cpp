@@ -287,6 +287,8 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
     result.spec = spec;
     const int nx = spec.x.count, ny = spec.y.count;
     result.points.resize(static_cast<std::size_t>(nx) * ny);
+    result.modes = spec.cars > 0 ? spec.cars / 2 + 1 : 0;
+    result.mode_roots.resize(result.points.size() * result.modes);
     const auto t0 = std::chrono::steady_clock::now();
     std::atomic<int> rows_done{0};
     int fallbacks = 0, uncertified = 0;
@@ -331,6 +333,16 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
             p.sup_gamma = sr.sup_gamma;
             p.omega_peak = sr.omega_peak;
             p.lowfreq_margin = sr.lowfreq_margin;
+            for (const auto& pk : sr.peaks) {
+                if (pk.gain > p.peak_gain) {
+                    p.peak_gain = pk.gain;
+                    p.peak_omega = pk.omega;
+                }
+            }
+            if (!sr.plant_roots.roots.empty()) p.plant_root = sr.plant_roots.roots.front().value;
+            for (int m = 0; m < result.modes; ++m) {
+                result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
+            }
             p.plant_abscissa = sr.plant_abscissa;
             p.plant_stable = sr.plant_stable;
             p.string_stable = sr.string_stable;

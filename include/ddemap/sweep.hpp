@@ -56,6 +56,9 @@ public:
     explicit RingTracker(int cars);  ///< cars >= 2, or 0 for infinity
     RingSummary evaluate(const Linearisation& lin);
     void reset();
+    /// The rightmost root of every mode (wave number) at the last point evaluated.
+    const std::vector<std::optional<cplx>>& roots() const { return m_guess; }
+    const std::vector<double>& thetas() const { return m_thetas; }
 
 private:
     int m_cars;
@@ -88,7 +91,10 @@ struct SweepPoint {
     int abscissa_mode = 0;
     double sup_gamma = 1.0, omega_peak = 0.0;
     double lowfreq_margin = 0.0;
+    double peak_gain = 0.0;   ///< highest local maximum of |Gamma(iw)| at w > 0 (0 if none)
+    double peak_omega = 0.0;  ///< its frequency
     double plant_abscissa = 0.0;
+    cplx plant_root;          ///< rightmost root of the plant (Im >= 0)
     bool plant_stable = false, ring_stable = false, string_stable = false;
     bool certified = true;
 };
@@ -96,6 +102,8 @@ struct SweepPoint {
 struct SweepResult {
     SweepSpec spec;
     std::vector<SweepPoint> points;  ///< row-major: y outer, x inner
+    int modes = 0;                   ///< finite N: N/2 + 1 modes per point
+    std::vector<cplx> mode_roots;    ///< finite N: rightmost root of each mode, point-major
     int fallbacks = 0;               ///< points x modes that needed collocation
     int uncertified = 0;             ///< points whose certificate failed even after collocation
     double seconds = 0.0;
