@@ -93,6 +93,7 @@ CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<
         }
     }
     out.fell_back = true;
+    out.degree = 8;
     // a cheap low-degree collocation gives the guesses; the certificate decides
     const LinearDDE problem = dde();
     {
@@ -118,6 +119,7 @@ CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<
     RootOptions o;
     o.count = 1;
     const RootResult rr = rightmost_roots(problem, o);
+    out.degree = std::max(out.degree, rr.degree);
     if (rr.roots.empty()) return out;
     cplx z = rr.roots.front().value;
     f.newton(z);
@@ -155,6 +157,7 @@ RingSummary RingTracker::evaluate(const Linearisation& lin) {
             fs.back(), [&] { return mode0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, zeta); }, m_guess[i]);
         m_guess[i] = roots[i].value;
         s.fallbacks += roots[i].fell_back;
+        s.degree = std::max(s.degree, roots[i].degree);
         s.certified = s.certified && roots[i].certified;
     }
     std::size_t best = 0;
@@ -196,6 +199,7 @@ RingSummary RingTracker::evaluate(const Linearisation& lin) {
         const QuasiPolynomial f = QuasiPolynomial::ring_mode(lin, zeta);
         const CertifiedRoot c = certified_rightmost(f, [&] { return ring_mode_dde(lin, zeta); }, seed);
         s.fallbacks += c.fell_back;
+        s.degree = std::max(s.degree, c.degree);
         s.certified = s.certified && c.certified;
         return c.value.real();
     };
@@ -291,7 +295,7 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
     result.mode_roots.resize(result.points.size() * result.modes);
     const auto t0 = std::chrono::steady_clock::now();
     std::atomic<int> rows_done{0};
-    int fallbacks = 0, uncertified = 0;
+    int fallbacks = 0, uncertified = 0, degree = 0;
     // The first column is continued sequentially (one collocation solve at its first point);
     // each row then starts from the roots of its first point. The path of every point is thus
     // fixed, whatever the number of threads.
@@ -302,7 +306,9 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
         PlantTracker plant;
         for (int iy = 0; iy < ny; ++iy) {
             const Linearisation lin = model_at(spec, spec.x.value(0), spec.y.value(iy))->linearise();
-            fallbacks += ring.evaluate(lin).fallbacks;
+            const RingSummary rs = ring.evaluate(lin);
+            fallbacks += rs.fallbacks;
+            degree = std::max(degree, rs.degree);
             plant.evaluate(lin, fallbacks);
             ring_seed.push_back(ring);
             plant_seed.push_back(plant);
@@ -310,7 +316,7 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
     }
 #ifdef DDEMAP_WITH_OPENMP
     result.threads = omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : fallbacks, uncertified)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : fallbacks, uncertified) reduction(max : degree)
 #endif
     for (int iy = 0; iy < ny; ++iy) {
         RingTracker ring = ring_seed[iy];
@@ -347,6 +353,7 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
             p.plant_stable = sr.plant_stable;
             p.string_stable = sr.string_stable;
             fallbacks += fb;
+            degree = std::max(degree, rs.degree);
             uncertified += !rs.certified;
         }
         const int done = ++rows_done;
@@ -359,6 +366,7 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
     }
     result.fallbacks = fallbacks;
     result.uncertified = uncertified;
+    result.degree_max = degree;
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return result;
 }

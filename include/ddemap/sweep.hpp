@@ -35,6 +35,7 @@ struct CertifiedRoot {
     cplx value;
     bool certified = false;  ///< no zero right of Re(value) + 1e-10 max(1, |value|)
     bool fell_back = false;  ///< collocation was needed
+    int degree = 0;          ///< collocation degree used (0 if none)
 };
 /// `dde` builds the same problem as a LinearDDE for the collocation fallback.
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
@@ -49,6 +50,7 @@ struct RingSummary {
     bool stable = false;
     bool certified = true;           ///< every mode's rightmost root certified
     int fallbacks = 0;
+    int degree = 0;                  ///< largest collocation degree used
 };
 
 class RingTracker {
@@ -106,6 +108,7 @@ struct SweepResult {
     std::vector<cplx> mode_roots;    ///< finite N: rightmost root of each mode, point-major
     int fallbacks = 0;               ///< points x modes that needed collocation
     int uncertified = 0;             ///< points whose certificate failed even after collocation
+    int degree_max = 0;              ///< largest collocation degree any fallback used
     double seconds = 0.0;
     int threads = 1;
     const SweepPoint& at(int ix, int iy) const { return points[static_cast<std::size_t>(iy) * spec.x.count + ix]; }

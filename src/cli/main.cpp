@@ -19,116 +19,16 @@
 #include "ddemap/ring.hpp"
 #include "ddemap/string_stability.hpp"
 #include "ddemap/vehicles.hpp"
+#include "charts.hpp"
+#include "common.hpp"
 #include "format.hpp"
 
-using json = nlohmann::ordered_json;
 using namespace ddemap;
+using namespace ddemap::cli;
 using ddemap::cli::exact;
 using ddemap::cli::rounded;
 
 namespace {
-
-struct BadInput : std::invalid_argument {
-    using std::invalid_argument::invalid_argument;
-};
-
-double parse_number(const std::string& flag, const std::string& text) {
-    const char* s = text.c_str();
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(s, &end);
-    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-        throw BadInput(flag + " = '" + text + "': expected a finite number");
-    }
-    return v;
-}
-
-long parse_integer(const std::string& flag, const std::string& text, long lo, long hi, const std::string& what) {
-    const char* s = text.c_str();
-    char* end = nullptr;
-    errno = 0;
-    const long v = std::strtol(s, &end, 10);
-    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
-        throw BadInput(flag + " = '" + text + "': expected " + what);
-    }
-    return v;
-}
-
-/// --ring N|inf -> N (0 for infinity)
-int parse_ring(const std::string& text) {
-    if (text == "inf" || text == "infinity") return 0;
-    return static_cast<int>(parse_integer("--ring", text, 2, 10000000, "an integer N >= 2 (at most 10000000) or 'inf'"));
-}
-
-/// The model options shared by the analysis commands.
-struct ModelArgs {
-    std::string model = "ovrv";
-    std::map<std::string, std::string> raw;  // flag name -> text, only those given
-
-    void add_to(CLI::App* app) {
-        app->add_option("--model", model, "car-following model: ovrv (paper eq. 3) or idm (intelligent driver model)")
-            ->capture_default_str();
-        struct P {
-            const char* name;
-            const char* help;
-        };
-        static const P params[] = {
-            {"k1", "OVRV gain on the gap error [1/s^2]"},
-            {"k2", "OVRV gain on the speed difference [1/s]"},
-            {"th", "time headway [s]"},
-            {"tau", "sensing delay [s] (0 gives the ODE)"},
-            {"eta", "jam gap [m] (ovrv default 10, idm default 2; does not enter the linearisation of ovrv)"},
-            {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20)"},
-            {"a", "IDM maximum acceleration [m/s^2] (default 1)"},
-            {"b", "IDM comfortable deceleration [m/s^2] (default 1.5)"},
-            {"v0", "IDM desired speed [m/s] (default 33.3)"},
-            {"delta", "IDM acceleration exponent [1] (default 4)"},
-        };
-        for (const auto& p : params) {
-            const std::string name = p.name;
-            app->add_option_function<std::string>(
-                "--" + name, [this, name](const std::string& v) { raw[name] = v; }, p.help);
-        }
-    }
-
-    std::unique_ptr<CarModel> build() const {
-        ParameterMap values;
-        for (const auto& [name, text] : raw) values[name] = parse_number("--" + name, text);
-        const auto names = model_names();
-        if (std::find(names.begin(), names.end(), model) == names.end()) {
-            throw BadInput("--model = '" + model + "': expected one of ovrv, idm");
-        }
-        return make_model(model, values);
-    }
-};
-
-enum class Format { Table, Json, Csv };
-
-Format parse_format(const std::string& text) {
-    if (text == "table") return Format::Table;
-    if (text == "json") return Format::Json;
-    if (text == "csv") return Format::Csv;
-    throw BadInput("--format = '" + text + "': expected table, json or csv");
-}
-
-/// A finite double for JSON, or null (never NaN or inf in the output).
-json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json parameters_json(const CarModel& m) {
-    json p = json::object();
-    for (const auto& [k, v] : m.parameters()) p[k] = v;
-    return p;
-}
-
-std::string describe(const CarModel& m) {
-    std::ostringstream os;
-    os << m.name();
-    for (const auto& [k, v] : m.parameters()) os << " " << k << "=" << rounded(v, 6);
-    return os.str();
-}
-
-std::string ring_name(int cars) { return cars == 0 ? "inf" : std::to_string(cars); }
-
 // ------------------------------------------------------------------ roots
 
 struct RootsArgs {
@@ -395,6 +295,9 @@ int main(int argc, char** argv) {
     cls->add_option("--ring", classify_args.ring, "ring size N >= 2 or inf for the ring verdict")->capture_default_str();
     cls->add_option("--format", classify_args.format, "table, json or csv")->capture_default_str();
 
+    ChartCommands charts;
+    charts.add_to(app);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -414,10 +317,14 @@ int main(int argc, char** argv) {
         if (roots->parsed()) run_roots(roots_args);
         else if (str->parsed()) run_string(string_args);
         else if (cls->parsed()) run_classify(classify_args);
+        else charts.run();
         return 0;
     } catch (const std::invalid_argument& e) {
         std::cerr << "ddemap: error: " << e.what() << "\n";
         return 2;
+    } catch (const std::runtime_error& e) {
+        std::cerr << "ddemap: error: " << e.what() << "\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "ddemap: internal error: " << e.what() << "\n";
         return 3;
