@@ -4,7 +4,8 @@
 set -euo pipefail
 packages=(g++ make cmake python3 pkg-config
           libeigen3-dev libspectra-dev libsuitesparse-dev doctest-dev
-          libcli11-dev nlohmann-json3-dev)
+          libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
+          libxml2-utils librsvg2-bin)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

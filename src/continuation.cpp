@@ -317,6 +317,10 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
         all.insert(all.end(), fwd.begin(), fwd.end());
         for (const auto& v : all) {
             BoundaryPoint bp{p.x(v(0)), p.y(v(1)), v.size() == 3 ? v(2) : 0.0};
+            if (!curve.points.empty()) {
+                const auto& q = curve.points.back();
+                if (std::abs(q.x - bp.x) + std::abs(q.y - bp.y) + std::abs(q.omega - bp.omega) < 1e-13) continue;
+            }
             curve.points.push_back(bp);
         }
         // a ring crossing at negative frequency is the conjugate mode's at positive frequency

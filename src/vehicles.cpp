@@ -1,5 +1,12 @@
 #include "ddemap/vehicles.hpp"
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
 namespace ddemap {
 
 const std::vector<CalibratedVehicle>& paper_calibration_table() {
@@ -33,6 +40,120 @@ const std::vector<CalibratedVehicle>& paper_calibration_table() {
         return t;
     }();
     return table;
+}
+
+namespace {
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+    std::vector<std::string> out;
+    std::string field;
+    bool quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (quoted) {
+            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                field += '"';
+                ++i;
+            } else if (c == '"') {
+                quoted = false;
+            } else {
+                field += c;
+            }
+        } else if (c == '"') {
+            quoted = true;
+        } else if (c == ',') {
+            out.push_back(field);
+            field.clear();
+        } else if (c != '\r') {
+            field += c;
+        }
+    }
+    out.push_back(field);
+    for (auto& f : out) {
+        const auto b = f.find_first_not_of(" \t");
+        const auto e = f.find_last_not_of(" \t");
+        f = b == std::string::npos ? std::string() : f.substr(b, e - b + 1);
+    }
+    return out;
+}
+
+}  // namespace
+
+std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
+    std::istringstream in(text);
+    std::string line;
+    int lineno = 0;
+    std::vector<std::string> header;
+    while (std::getline(in, line)) {
+        ++lineno;
+        if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+        header = split_csv_line(line);
+        break;
+    }
+    if (header.empty()) throw std::invalid_argument(source + ": empty file: expected a header name,k1,k2,th,tau[,eta]");
+    const int header_line = lineno;
+    auto column = [&](const std::string& name, bool required) {
+        const auto it = std::find(header.begin(), header.end(), name);
+        if (it == header.end()) {
+            if (required) {
+                throw std::invalid_argument(source + ":" + std::to_string(header_line) + ": missing column '" + name +
+                                            "' (expected name,k1,k2,th,tau[,eta])");
+            }
+            return -1;
+        }
+        return static_cast<int>(it - header.begin());
+    };
+    const int c_name = column("name", true);
+    const char* params[] = {"k1", "k2", "th", "tau", "eta"};
+    int c_param[5];
+    for (int i = 0; i < 5; ++i) c_param[i] = column(params[i], i < 4);
+    std::vector<CalibratedVehicle> out;
+    while (std::getline(in, line)) {
+        ++lineno;
+        if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+        const auto f = split_csv_line(line);
+        const std::string at = source + ":" + std::to_string(lineno);
+        if (f.size() != header.size()) {
+            throw std::invalid_argument(at + ": " + std::to_string(f.size()) + " fields, expected " + std::to_string(header.size()) +
+                                        " as in the header");
+        }
+        CalibratedVehicle v;
+        v.name = f[c_name];
+        if (v.name.empty()) throw std::invalid_argument(at + ": column 'name' is empty: expected a vehicle name");
+        v.vehicle = v.name;
+        v.parameters["eta"] = 10.0;
+        for (int i = 0; i < 5; ++i) {
+            if (c_param[i] < 0) continue;
+            const std::string& t = f[c_param[i]];
+            char* end = nullptr;
+            errno = 0;
+            const double x = std::strtod(t.c_str(), &end);
+            if (t.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(x)) {
+                throw std::invalid_argument(at + ": column '" + params[i] + "' = '" + t + "': expected a finite number");
+            }
+            v.parameters[params[i]] = x;
+        }
+        try {
+            (void)make_model("ovrv", v.parameters);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(at + ": " + e.what());
+        }
+        out.push_back(v);
+    }
+    if (out.empty()) throw std::invalid_argument(source + ": no vehicles after the header");
+    return out;
+}
+
+std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars) {
+    std::vector<Classification> out(vehicles.size());
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+    for (std::size_t i = 0; i < vehicles.size(); ++i) {
+        const Linearisation lin = make_model("ovrv", vehicles[i].parameters)->linearise();
+        out[i] = {vehicles[i], analyse_string(lin), analyse_ring(lin, cars)};
+    }
+    return out;
 }
 
 }  // namespace ddemap

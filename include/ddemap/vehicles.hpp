@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "ddemap/model.hpp"
+#include "ddemap/ring.hpp"
+#include "ddemap/string_stability.hpp"
 
 namespace ddemap {
 
@@ -22,5 +24,20 @@ struct CalibratedVehicle {
 
 /// The 14 settings of the paper's calibration table, in the paper's order.
 const std::vector<CalibratedVehicle>& paper_calibration_table();
+
+/// Reads vehicles from CSV text: a header with at least name, k1, k2, th, tau (eta optional,
+/// default 10; other columns are ignored), one vehicle per line. Errors name `source`, the line
+/// and the column (std::invalid_argument).
+std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source);
+
+/// Verdicts of one vehicle setting.
+struct Classification {
+    CalibratedVehicle vehicle;
+    StringResult string;
+    RingResult ring;
+};
+
+/// Plant, ring (N cars, 0 = infinity) and string verdicts of every vehicle (OVRV).
+std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars);
 
 }  // namespace ddemap

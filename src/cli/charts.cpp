@@ -3,13 +3,17 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "common.hpp"
 #include "ddemap/chart.hpp"
 #include "ddemap/continuation.hpp"
+#include "ddemap/chart_spec.hpp"
 #include "ddemap/sweep.hpp"
+#include "ddemap/vehicles.hpp"
+#include "builtin_maps.hpp"
 #include "ddemap/writers.hpp"
 
 namespace ddemap::cli {
@@ -81,9 +85,155 @@ std::string fixed_title(const SweepSpec& spec) {
     return t.str();
 }
 
+std::string read_text_file(const std::string& flag, const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+const char* keys[] = {"k1", "k2", "th", "tau", "eta"};
+
+std::string classification_table(const std::vector<Classification>& rows, int cars, const std::string& source) {
+    std::ostringstream out;
+    out << "vehicle settings of " << source << "; ring N = " << (cars == 0 ? std::string("inf") : std::to_string(cars)) << "\n\n";
+    out << "name      k1     k2     th     tau    eta     plant     ring      string    sup|Gamma|  w_peak   c2\n";
+    for (const auto& row : rows) {
+        char line[256];
+        const auto& p = row.vehicle.parameters;
+        std::snprintf(line, sizeof line, "%-7s %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %9.6f %7.4f %9.2e\n",
+                      row.vehicle.name.c_str(), p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
+                      row.string.plant_stable ? "stable" : "UNSTABLE", row.ring.stable ? "stable" : "UNSTABLE",
+                      row.string.string_stable ? "stable" : "UNSTABLE", row.string.sup_gamma, row.string.omega_peak,
+                      row.string.lowfreq_margin);
+        out << line;
+    }
+    return out.str();
+}
+
+std::string classification_csv(const std::vector<Classification>& rows) {
+    std::ostringstream out;
+    out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
+           "spectral_abscissa,plant_abscissa\n";
+    for (const auto& row : rows) {
+        out << csv_field(row.vehicle.name);
+        for (const char* k : keys) out << "," << exact(row.vehicle.parameters.at(k));
+        out << "," << (row.string.plant_stable ? "true" : "false") << "," << (row.ring.stable ? "true" : "false") << ","
+            << (row.string.string_stable ? "true" : "false") << "," << exact(row.string.sup_gamma) << ","
+            << exact(row.string.omega_peak) << "," << exact(row.string.lowfreq_margin) << "," << exact(row.ring.spectral_abscissa)
+            << "," << exact(row.string.plant_abscissa) << "\n";
+    }
+    return out.str();
+}
+
+json classification_json(const std::vector<Classification>& rows, int cars, const std::string& source) {
+    json j;
+    j["command"] = "classify";
+    j["version"] = DDEMAP_VERSION;
+    j["source"] = source;
+    j["ring"] = cars == 0 ? json("inf") : json(cars);
+    json arr = json::array();
+    for (const auto& row : rows) {
+        json o;
+        o["name"] = row.vehicle.name;
+        for (const char* k : keys) o[k] = row.vehicle.parameters.at(k);
+        o["plant_stable"] = row.string.plant_stable;
+        o["ring_stable"] = row.ring.stable;
+        o["string_stable"] = row.string.string_stable;
+        o["sup_gamma"] = num(row.string.sup_gamma);
+        o["omega_peak"] = num(row.string.omega_peak);
+        o["lowfreq_margin"] = num(row.string.lowfreq_margin);
+        o["spectral_abscissa"] = num(row.ring.spectral_abscissa);
+        o["plant_abscissa"] = num(row.string.plant_abscissa);
+        arr.push_back(o);
+    }
+    j["vehicles"] = arr;
+    return j;
+}
+
+/// The classification figure's spec for a set of vehicles: the built-in spec's window and
+/// layout with one panel per vehicle.
+ChartSpec classification_chart(const std::vector<CalibratedVehicle>& vehicles, int cars) {
+    ChartSpec spec = parse_chart_spec(builtin_classification_toml, "maps/classification.toml");
+    spec.panels = vehicle_panels(vehicles);
+    spec.cars = cars;
+    if (cars != 22) spec.title = "Calibrated vehicles on their own stability charts, N = " + (cars == 0 ? std::string("inf") : std::to_string(cars));
+    return spec;
+}
+
 }  // namespace
 
 struct ChartCommands::Impl {
+    CLI::App* classify_cmd = nullptr;
+    std::string classify_file, classify_ring = "22", classify_format = "table", classify_svg;
+    CLI::App* chart = nullptr;
+    std::string chart_spec, chart_out;
+    CLI::App* paper = nullptr;
+    std::string paper_out;
+
+    void run_classify() const {
+        const int cars = parse_ring(classify_ring);
+        const Format format = parse_format(classify_format);
+        if (!classify_svg.empty()) check_output("--svg", classify_svg);
+        std::vector<CalibratedVehicle> vehicles;
+        std::string source = "the paper's calibration table (built in)";
+        if (classify_file.empty()) {
+            vehicles = paper_calibration_table();
+        } else {
+            vehicles = read_vehicles_csv(read_text_file("VEHICLES.csv", classify_file), classify_file);
+            source = classify_file;
+        }
+        const auto rows = ddemap::classify(vehicles, cars);
+        std::string text;
+        if (format == Format::Json) text = classification_json(rows, cars, source).dump(2) + "\n";
+        else if (format == Format::Csv) text = classification_csv(rows);
+        else text = classification_table(rows, cars, source);
+        if (!classify_svg.empty()) write_all({{classify_svg, render_chart(classification_chart(vehicles, cars)).svg}});
+        std::cout << text;
+    }
+
+    void run_chart() const {
+        check_output("--out", chart_out);
+        const ChartSpec spec = parse_chart_spec(read_text_file("SPEC", chart_spec), chart_spec);
+        const RenderedChart r = render_chart(spec);
+        write_all({{chart_out, r.svg}});
+        std::cout << "chart      " << spec.panels.size() << " panels in " << rounded(r.seconds, 3) << " s\nwrote      " << chart_out << "\n";
+    }
+
+    void run_paper() const {
+        if (paper_out.empty()) throw BadInput("--out DIR is required");
+        if (access(paper_out.c_str(), W_OK) != 0) throw BadInput("--out = '" + paper_out + "': the folder does not exist or is not writable");
+        const std::string dir = paper_out + "/";
+        // the classification of the built-in table, and its figure
+        const auto rows = ddemap::classify(paper_calibration_table(), 22);
+        const std::string source = "the paper's calibration table (built in)";
+        std::vector<std::pair<std::string, std::string>> files;
+        files.emplace_back(dir + "classification.csv", classification_csv(rows));
+        files.emplace_back(dir + "classification.json", classification_json(rows, 22, source).dump(2) + "\n");
+        const RenderedChart cls = render_chart(classification_chart(paper_calibration_table(), 22));
+        files.emplace_back(dir + "classification.svg", cls.svg);
+        // the paper's stability diagrams
+        const ChartSpec spec = parse_chart_spec(builtin_paper_toml, "maps/paper.toml");
+        const RenderedChart fig = render_chart(spec);
+        files.emplace_back(dir + "paper.svg", fig.svg);
+        json summary = json::array();
+        for (std::size_t i = 0; i < fig.sweeps.size(); ++i) {
+            const std::string base = dir + "paper-panel" + std::to_string(i + 1);
+            files.emplace_back(base + ".csv", sweep_csv(fig.sweeps[i]));
+            files.emplace_back(base + "-boundaries.csv", boundary_csv(fig.specs[i], fig.boundaries[i]));
+            summary.push_back(sweep_json(fig.sweeps[i], &fig.boundaries[i]));
+        }
+        files.emplace_back(dir + "paper.json", json{{"command", "paper"}, {"version", DDEMAP_VERSION}, {"panels", summary},
+                                                    {"seconds", fig.seconds + cls.seconds}}.dump(2) + "\n");
+        write_all(files);
+        std::ostringstream out;
+        out << classification_table(rows, 22, source);
+        out << "\nfigures and data in " << paper_out << ": paper.svg (" << spec.panels.size()
+            << " panels), classification.svg, classification.csv/.json, paper-panel*.csv, paper-panel*-boundaries.csv, paper.json\n";
+        std::cout << out.str();
+    }
+
     CLI::App* sweep = nullptr;
     CLI::App* boundary = nullptr;
     ModelArgs sweep_model, boundary_model;
@@ -120,7 +270,7 @@ struct ChartCommands::Impl {
 
     void run_sweep_command() const {
         const SweepSpec spec = spec_from(sweep_model, sweep_ring, sweep_x, true, "");
-        if (sweep_out.empty()) throw BadInput("--out PREFIX is required");
+        check_output("--out", sweep_out);
         const bool tty = isatty(2);
         const SweepResult sw = run_sweep(spec, tty ? progress_line : nullptr);
         BoundarySet b;
@@ -157,7 +307,7 @@ struct ChartCommands::Impl {
     void run_boundary_command() const {
         const int grid = static_cast<int>(parse_integer("--seed-grid", boundary_grid, 5, 2001, "an integer between 5 and 2001"));
         const SweepSpec spec = spec_from(boundary_model, boundary_ring, "", false, std::to_string(grid));
-        if (boundary_out.empty()) throw BadInput("--out FILE.csv is required");
+        check_output("--out", boundary_out);
         const SweepResult sw = run_sweep(spec);
         const BoundarySet b = trace_boundaries(sw);
         write_all({{boundary_out, boundary_csv(spec, b)}});
@@ -176,6 +326,20 @@ struct ChartCommands::Impl {
 
 void ChartCommands::add_to(CLI::App& app) {
     m = std::make_shared<Impl>();
+    m->classify_cmd = app.add_subcommand("classify",
+                                     "plant, ring and string verdicts of calibrated vehicles (default: the paper's 14 settings)");
+    m->classify_cmd->add_option("VEHICLES.csv", m->classify_file, "CSV with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m)");
+    m->classify_cmd->add_option("--ring", m->classify_ring, "ring size N >= 2 or inf for the ring verdict")->capture_default_str();
+    m->classify_cmd->add_option("--format", m->classify_format, "table, json or csv")->capture_default_str();
+    m->classify_cmd->add_option("--svg", m->classify_svg, "also write the figure: one (k1, k2) chart per vehicle, vehicle marked");
+
+    m->chart = app.add_subcommand("chart", "render a chart spec (TOML, see maps/) to SVG");
+    m->chart->add_option("SPEC", m->chart_spec, "chart specification (TOML)")->required();
+    m->chart->add_option("--out", m->chart_out, "output SVG file")->required();
+
+    m->paper = app.add_subcommand("paper", "the seed paper's main job: classification table on stdout, figures and data in DIR");
+    m->paper->add_option("--out", m->paper_out, "output folder (must exist)")->required();
+
     m->sweep = app.add_subcommand("sweep",
                                   "grid sweep over two model parameters (each given as LO:HI:COUNT): spectral abscissa, "
                                   "unstable roots, sup|Gamma| and verdicts per point; writes PREFIX.csv, .json, .svg");
@@ -195,6 +359,18 @@ void ChartCommands::add_to(CLI::App& app) {
 }
 
 bool ChartCommands::run() const {
+    if (m->classify_cmd->parsed()) {
+        m->run_classify();
+        return true;
+    }
+    if (m->chart->parsed()) {
+        m->run_chart();
+        return true;
+    }
+    if (m->paper->parsed()) {
+        m->run_paper();
+        return true;
+    }
     if (m->sweep->parsed()) {
         m->run_sweep_command();
         return true;

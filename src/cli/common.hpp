@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -115,6 +117,16 @@ struct ModelArgs {
         return make_model(model, values);
     }
 };
+
+/// The folder of an output path must exist and be writable (checked before any work).
+inline void check_output(const std::string& flag, const std::string& path) {
+    if (path.empty()) throw BadInput(flag + " is required");
+    const auto slash = path.find_last_of('/');
+    const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+    if (access(dir.c_str(), W_OK) != 0) {
+        throw BadInput(flag + " = '" + path + "': the folder '" + dir + "' does not exist or is not writable");
+    }
+}
 
 enum class Format { Table, Json, Csv };
 

@@ -195,80 +195,6 @@ void run_string(const StringArgs& args) {
     std::cout << out.str();
 }
 
-// ------------------------------------------------------------------ classify
-
-struct ClassifyArgs {
-    std::string ring = "22";
-    std::string format = "table";
-};
-
-void run_classify(const ClassifyArgs& args) {
-    const int cars = parse_ring(args.ring);
-    const Format format = parse_format(args.format);
-    const auto& table = paper_calibration_table();
-    struct Row {
-        const CalibratedVehicle* v;
-        StringResult s;
-        RingResult r;
-    };
-    std::vector<Row> rows;
-    for (const auto& v : table) {
-        const Linearisation lin = make_model("ovrv", v.parameters)->linearise();
-        rows.push_back({&v, analyse_string(lin), analyse_ring(lin, cars)});
-    }
-    static const char* keys[] = {"k1", "k2", "th", "tau", "eta"};
-    std::ostringstream out;
-    if (format == Format::Json) {
-        json j;
-        j["command"] = "classify";
-        j["version"] = DDEMAP_VERSION;
-        j["source"] = "Gunter et al., calibration table (built in)";
-        j["ring"] = cars == 0 ? json("inf") : json(cars);
-        json arr = json::array();
-        for (const auto& row : rows) {
-            json o;
-            o["name"] = row.v->name;
-            for (const char* k : keys) o[k] = row.v->parameters.at(k);
-            o["plant_stable"] = row.s.plant_stable;
-            o["ring_stable"] = row.r.stable;
-            o["string_stable"] = row.s.string_stable;
-            o["sup_gamma"] = num(row.s.sup_gamma);
-            o["omega_peak"] = num(row.s.omega_peak);
-            o["lowfreq_margin"] = num(row.s.lowfreq_margin);
-            o["spectral_abscissa"] = num(row.r.spectral_abscissa);
-            o["plant_abscissa"] = num(row.s.plant_abscissa);
-            arr.push_back(o);
-        }
-        j["vehicles"] = arr;
-        out << j.dump(2) << "\n";
-    } else if (format == Format::Csv) {
-        out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
-               "spectral_abscissa,plant_abscissa\n";
-        for (const auto& row : rows) {
-            out << row.v->name;
-            for (const char* k : keys) out << "," << exact(row.v->parameters.at(k));
-            out << "," << (row.s.plant_stable ? "true" : "false") << "," << (row.r.stable ? "true" : "false") << ","
-                << (row.s.string_stable ? "true" : "false") << "," << exact(row.s.sup_gamma) << ","
-                << exact(row.s.omega_peak) << "," << exact(row.s.lowfreq_margin) << "," << exact(row.r.spectral_abscissa)
-                << "," << exact(row.s.plant_abscissa) << "\n";
-        }
-    } else {
-        out << "vehicle settings of the paper's calibration table; ring N = " << ring_name(cars) << "\n\n";
-        out << "name      k1     k2     th     tau    eta     plant     ring      string    sup|Gamma|  w_peak   c2\n";
-        for (const auto& row : rows) {
-            char line[256];
-            const auto& p = row.v->parameters;
-            std::snprintf(line, sizeof line, "%-7s %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %9.6f %7.4f %9.2e\n",
-                          row.v->name.c_str(), p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
-                          row.s.plant_stable ? "stable" : "UNSTABLE", row.r.stable ? "stable" : "UNSTABLE",
-                          row.s.string_stable ? "stable" : "UNSTABLE", row.s.sup_gamma, row.s.omega_peak,
-                          row.s.lowfreq_margin);
-            out << line;
-        }
-    }
-    std::cout << out.str();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -289,11 +215,6 @@ int main(int argc, char** argv) {
     string_args.model.add_to(str);
     str->add_option("--ring", string_args.ring, "also decide ring stability for N cars (N >= 2 or inf)");
     str->add_option("--format", string_args.format, "table, json or csv")->capture_default_str();
-
-    ClassifyArgs classify_args;
-    auto* cls = app.add_subcommand("classify", "verdicts for the built-in calibration table (14 vehicle settings)");
-    cls->add_option("--ring", classify_args.ring, "ring size N >= 2 or inf for the ring verdict")->capture_default_str();
-    cls->add_option("--format", classify_args.format, "table, json or csv")->capture_default_str();
 
     ChartCommands charts;
     charts.add_to(app);
@@ -316,7 +237,6 @@ int main(int argc, char** argv) {
     try {
         if (roots->parsed()) run_roots(roots_args);
         else if (str->parsed()) run_string(string_args);
-        else if (cls->parsed()) run_classify(classify_args);
         else charts.run();
         return 0;
     } catch (const std::invalid_argument& e) {
