@@ -116,7 +116,8 @@ bool within_quarter(cplx b, cplx a) {
     return w.real() > std::abs(w.imag());
 }
 
-/// A sample of f on the line: value and phase speed d/dw arg f(sigma + i w) = Re(f'/f).
+/// A sample of f on the line: value and |f'/f|, which bounds the phase speed
+/// |d/dw arg f(sigma + i w)| = |Re(f'/f)| and is at least 1/distance to a nearby zero.
 struct Sample {
     double w;
     cplx f;
@@ -135,12 +136,13 @@ struct Tracker {
             failed = true;
             return {w, cplx(1.0), 0.0};
         }
-        return {w, v, (d / v).real()};
+        return {w, v, std::abs(d / v)};
     }
     /// Continuous change of arg f from a to b. A piece is accepted when, on each of its halves,
-    /// the phase turns by less than pi/4 between the samples and the phase speed at the samples
-    /// times the half length is below pi/8 (a zero near the piece makes |f'/f| large at some
-    /// sample, or turns the phase by about pi between two of them).
+    /// the phase turns by less than pi/4 between the samples and |f'/f| at the three samples
+    /// times the half length is below pi/8. A zero within the piece's reach lies within about
+    /// half its length of some sample, where |f'/f| >= 1/distance, so it forces subdivision
+    /// until the pieces near it are shorter than its distance to the line.
     double change(const Sample& a, const Sample& b, int depth) {
         if (--budget < 0 || depth > 80) {
             failed = true;
@@ -177,7 +179,7 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     if (bound(r) >= 0.5 * std::pow(r, m_degree)) return -1;
 
     // the line from sigma - i r to sigma + i r, sampled at least every pi / (4 tau_max)
-    int pieces = 16;
+    int pieces = 8;
     if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
     pieces = std::min(pieces, 4096);
     Tracker tr{*this, sigma};

@@ -8,6 +8,42 @@
 
 namespace ddemap {
 
+TransferFunction::TransferFunction(Linearisation lin) : m_lin(std::move(lin)) {
+    auto group = [&](double delay) -> DelayGroup& {
+        for (auto& g : m_groups)
+            if (g.delay == delay) return g;
+        m_groups.push_back({delay, 0.0, 0.0, 0.0});
+        return m_groups.back();
+    };
+    for (const auto& t : m_lin.gap.terms()) group(t.delay).gap += t.coef;
+    for (const auto& t : m_lin.own.terms()) group(t.delay).own += t.coef;
+    for (const auto& t : m_lin.lead.terms()) group(t.delay).lead += t.coef;
+}
+
+void TransferFunction::evaluate(cplx s, cplx& n, cplx& d) const {
+    cplx gap = 0.0, own = 0.0, lead = 0.0;
+    for (const auto& g : m_groups) {
+        const cplx e = g.delay == 0.0 ? cplx(1.0) : std::exp(-s * g.delay);
+        gap += g.gap * e;
+        own += g.own * e;
+        lead += g.lead * e;
+    }
+    n = gap + s * lead;
+    d = s * s - s * own + gap;
+}
+
+cplx TransferFunction::numerator(cplx s) const {
+    cplx n, d;
+    evaluate(s, n, d);
+    return n;
+}
+
+cplx TransferFunction::denominator(cplx s) const {
+    cplx n, d;
+    evaluate(s, n, d);
+    return d;
+}
+
 cplx TransferFunction::derivative(cplx s) const {
     const cplx n = numerator(s);
     const cplx d = denominator(s);

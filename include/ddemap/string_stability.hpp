@@ -18,10 +18,16 @@ namespace ddemap {
 /// Gamma(s) and its derivative from a Linearisation.
 class TransferFunction {
 public:
-    explicit TransferFunction(Linearisation lin) : m_lin(std::move(lin)) {}
-    cplx numerator(cplx s) const { return m_lin.gap(s) + s * m_lin.lead(s); }
-    cplx denominator(cplx s) const { return s * s - s * m_lin.own(s) + m_lin.gap(s); }
-    cplx operator()(cplx s) const { return numerator(s) / denominator(s); }
+    explicit TransferFunction(Linearisation lin);
+    cplx numerator(cplx s) const;
+    cplx denominator(cplx s) const;
+    /// N and D together (one exponential per distinct delay).
+    void evaluate(cplx s, cplx& n, cplx& d) const;
+    cplx operator()(cplx s) const {
+        cplx n, d;
+        evaluate(s, n, d);
+        return n / d;
+    }
     /// Gamma'(s) = (N' D - N D') / D^2
     cplx derivative(cplx s) const;
     /// |Gamma(i w)|^2
@@ -32,6 +38,11 @@ public:
 
 private:
     Linearisation m_lin;
+    struct DelayGroup {
+        double delay;
+        double gap, own, lead;  // coefficients of e^{-s delay}
+    };
+    std::vector<DelayGroup> m_groups;
 };
 
 /// The plant: one car behind a lead car held at its equilibrium speed,

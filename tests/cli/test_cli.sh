@@ -95,8 +95,74 @@ expect_error "does not belong" roots --model idm --k1 0.2 --th 1.5 --tau 0.1
 expect_error "--bogus" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --bogus 3
 expect_error "speed = 40" string --model idm --th 1.5 --tau 0.2 --speed 40
 
+# sweep: files, columns, valid SVG, bitwise identical for 1 and 2 threads
+if OMP_NUM_THREADS=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --k2 0.01:1:25 --out "$tmp/s1" >/dev/null &&
+   OMP_NUM_THREADS=2 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --k2 0.01:1:25 --out "$tmp/s2" >/dev/null; then
+    cmp -s "$tmp/s1.csv" "$tmp/s2.csv" && ok || bad "sweep CSV differs between 1 and 2 threads"
+    [ "$(wc -l <"$tmp/s1.csv")" -eq 751 ] && ok || bad "sweep CSV rows"
+    head -1 "$tmp/s1.csv" | grep -q '^k1,k2,spectral_abscissa,unstable_roots,sup_gamma,omega_peak,plant_stable,ring_stable,string_stable' && ok || bad "sweep CSV header"
+    xmllint --noout "$tmp/s1.svg" && ok || bad "sweep SVG is not valid XML"
+    grep -q '<text' "$tmp/s1.svg" && grep -q 'id="panel1-boundaries"' "$tmp/s1.svg" && ok || bad "sweep SVG layers"
+    json_has "$tmp/s1.json" model fixed x y ring degree seconds version && ok || bad "sweep JSON keys"
+    head -1 "$tmp/s1-boundaries.csv" | grep -q '^branch,kind,subkind,mode,k1,k2,omega' && ok || bad "boundaries CSV header"
+else
+    bad "sweep exit status"
+fi
+expect_error "exactly two swept" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --out "$tmp/x"
+expect_error "LO:HI:COUNT" sweep --th 1.5 --tau 0.5 --k1 0.01:1:1 --k2 0:1:4 --out "$tmp/x"
+expect_error "k1 = -1" sweep --th 1.5 --tau 0.5 --k1 -1:1:4 --k2 0:1:4 --out "$tmp/x"
+expect_error "does not exist" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out /nonexistent/x
+[ ! -e "$tmp/x.csv" ] && ok || bad "a failed sweep left output"
+
+# boundary
+if "$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --seed-grid 21 --out "$tmp/b.csv" >/dev/null; then
+    grep -q ',hopf,ring,' "$tmp/b.csv" && grep -q ',string,lowfreq,' "$tmp/b.csv" && ok || bad "boundary kinds"
+else
+    bad "boundary exit status"
+fi
+expect_error "LO:HI" boundary --th 1.5 --tau 0.5 --k1 0.01:1:5 --k2 0.01:1 --out "$tmp/b2.csv"
+
+# classify: built in, from a file, errors naming line and column
+"$bin" classify --format csv >"$tmp/c.csv" && [ "$(grep -c ',false,false,false,' "$tmp/c.csv")" -eq 0 ] && ok || bad "classify csv"
+[ "$(tail -n +2 "$tmp/c.csv" | wc -l)" -eq 14 ] && ok || bad "classify rows"
+[ "$(cut -d, -f9 "$tmp/c.csv" | grep -c false)" -eq 14 ] && ok || bad "all 14 string unstable"
+printf 'name,k1,k2,th,tau,eta
+mine,0.2,0.6,1.5,0.1,10
+' >"$tmp/v.csv"
+"$bin" classify "$tmp/v.csv" --format json >"$tmp/v.json" && python3 -c "
+import json,sys; d=json.load(open('$tmp/v.json')); v=d['vehicles'][0]
+assert v['name']=='mine' and v['string_stable'] is True, v" && ok || bad "classify file"
+printf 'name,k1,k2,th,tau
+A,0.1,0.2,1,0.3
+B,0.1,abc,1,0.3
+' >"$tmp/bad.csv"
+expect_error "bad.csv:3: column 'k2' = 'abc'" classify "$tmp/bad.csv"
+printf 'name,k1,k2,th
+A,0.1,0.2,1
+' >"$tmp/bad2.csv"
+expect_error "bad2.csv:1: missing column 'tau'" classify "$tmp/bad2.csv"
+printf 'name,k1,k2,th,tau
+A,0.1,0.2,1
+' >"$tmp/bad3.csv"
+expect_error "bad3.csv:2: 4 fields, expected 5" classify "$tmp/bad3.csv"
+printf 'name,k1,k2,th,tau
+A,-0.1,0.2,1,0.3
+' >"$tmp/bad4.csv"
+expect_error "bad4.csv:2: k1 = -0.1" classify "$tmp/bad4.csv"
+expect_error "cannot open" classify "$tmp/none.csv"
+
+# chart spec errors
+printf 'model = "ovrv"
+[x]
+name = "k1"
+lo = 0
+hi = 1
+count = 1
+' >"$tmp/bad.toml"
+expect_error "bad.toml:2: x: expected lo < hi" chart "$tmp/bad.toml" --out "$tmp/bad.svg"
+
 # help on every command, with units
-for c in roots string; do
+for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi
 done
 "$bin" --help >/dev/null && ok || bad "--help"
