@@ -121,7 +121,7 @@ bool within_quarter(cplx b, cplx a) {
 struct Sample {
     double w;
     cplx f;
-    double speed;
+    double speed2;  // |f'/f|^2
 };
 
 struct Tracker {
@@ -136,7 +136,7 @@ struct Tracker {
             failed = true;
             return {w, cplx(1.0), 0.0};
         }
-        return {w, v, std::abs(d / v)};
+        return {w, v, std::norm(d) / std::norm(v)};
     }
     /// Continuous change of arg f from a to b. A piece is accepted when, on each of its halves,
     /// the phase turns by less than pi/4 between the samples and |f'/f| at the three samples
@@ -151,7 +151,8 @@ struct Tracker {
         const Sample m = at(0.5 * (a.w + b.w));
         if (failed) return 0.0;
         const double h = 0.5 * (b.w - a.w);
-        const bool slow = std::abs(a.speed) * h < M_PI / 8 && std::abs(m.speed) * h < M_PI / 8 && std::abs(b.speed) * h < M_PI / 8;
+        const double limit = (M_PI / 8) * (M_PI / 8) / (h * h);
+        const bool slow = a.speed2 < limit && m.speed2 < limit && b.speed2 < limit;
         if (slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f)) return arg_ratio(b.f, a.f);
         return change(a, m, depth + 1) + change(m, b, depth + 1);
     }
@@ -163,20 +164,18 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     // radius r of the half circle |lambda - sigma| = r, Re >= sigma, on which
     // |f - (lambda - sigma)^n| <= r^n / 2, so that arg f follows arg (lambda - sigma)^n there
     const double s = std::abs(sigma);
-    auto bound = [&](double r) {
-        const double lam = r + s;
-        double b = m_degree == 2 ? 2.0 * s * lam + s * s : s;
-        for (const auto& t : m_terms) {
-            const double e = t.delay == 0.0 ? 1.0 : std::exp(-sigma * t.delay);
-            double p = 0.0;
-            for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) p = p * lam + std::abs(t.poly[k]);
-            b += e * p;
-        }
-        return b;
-    };
+    // |f - (lambda - sigma)^n| <= c0 + c1 |lambda| (+ 2 s |lambda| + s^2 for n = 2), |lambda| <= r + s
+    double c0 = m_degree == 2 ? s * s : s, c1 = m_degree == 2 ? 2.0 * s : 0.0;
+    for (const auto& t : m_terms) {
+        const double e = t.delay == 0.0 ? 1.0 : std::exp(-sigma * t.delay);
+        if (!t.poly.empty()) c0 += e * std::abs(t.poly[0]);
+        if (t.poly.size() > 1) c1 += e * std::abs(t.poly[1]);
+    }
+    auto bound = [&](double r) { return c0 + c1 * (r + s); };
+    auto enough = [&](double r) { return bound(r) < 0.5 * (m_degree == 2 ? r * r : r); };
     double r = 1.0;
-    for (int i = 0; i < 200 && bound(r) >= 0.5 * std::pow(r, m_degree); ++i) r *= 2.0;
-    if (bound(r) >= 0.5 * std::pow(r, m_degree)) return -1;
+    for (int i = 0; i < 400 && !enough(r); ++i) r *= 1.25;
+    if (!enough(r)) return -1;
 
     // the line from sigma - i r to sigma + i r, sampled at least every pi / (4 tau_max)
     int pieces = 8;
