@@ -217,6 +217,129 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     return s.str();
 }
 
+namespace {
+const char* palette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                         "#7f7f7f", "#bcbd22", "#17becf", "#393b79", "#637939", "#8c6d31", "#843c39"};
+}  // namespace
+
+std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& o) {
+    if (panels.empty()) throw std::invalid_argument("a plot needs at least one panel");
+    const int cols = std::max(1, std::min<int>(o.columns, static_cast<int>(panels.size())));
+    const int rows = (static_cast<int>(panels.size()) + cols - 1) / cols;
+    const double ml = 62, mr = 16, mt = 34, mb = 48;
+    const double cw = o.panel_width + ml + mr, ch = o.panel_height + mt + mb;
+    const double header = o.title.empty() ? 10 : 34;
+    const double width = cols * cw + 10;
+    // legend entries: the series names of the first panel
+    std::vector<std::pair<std::string, std::string>> entries;
+    std::vector<bool> dashed_entries;
+    if (o.legend) {
+        std::size_t i = 0;
+        for (const auto& sr : panels.front().series) {
+            entries.emplace_back(sr.name, sr.colour.empty() ? palette[i % 14] : sr.colour);
+            dashed_entries.push_back(sr.dashed);
+            ++i;
+        }
+    }
+    const int per_row = std::max(1, static_cast<int>((width - 20) / 150));
+    const double legend_h = entries.empty() ? 10 : 20.0 * ((entries.size() + per_row - 1) / per_row) + 12;
+    const double note_h = o.note.empty() ? 0 : 20;
+    const double height = header + rows * ch + legend_h + note_h;
+    std::ostringstream s;
+    s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" viewBox=\"0 0 "
+      << num(width) << " " << num(height) << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
+    s << "<rect id=\"background\" x=\"0\" y=\"0\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" fill=\"#ffffff\"/>\n";
+    if (!o.title.empty()) {
+        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
+          << esc(o.title) << "</text>\n";
+    }
+    for (std::size_t pi = 0; pi < panels.size(); ++pi) {
+        const PlotPanel& p = panels[pi];
+        double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+        for (const auto& sr : p.series)
+            for (std::size_t k = 0; k < sr.x.size() && k < sr.y.size(); ++k) {
+                if (!std::isfinite(sr.x[k]) || !std::isfinite(sr.y[k])) continue;
+                x0 = std::min(x0, sr.x[k]); x1 = std::max(x1, sr.x[k]);
+                y0 = std::min(y0, sr.y[k]); y1 = std::max(y1, sr.y[k]);
+            }
+        for (const auto& m : p.markers) {
+            x0 = std::min(x0, m.x); x1 = std::max(x1, m.x);
+            y0 = std::min(y0, m.y); y1 = std::max(y1, m.y);
+        }
+        if (!(x1 > x0)) { x0 -= 0.5; x1 += 0.5; }
+        if (!(y1 > y0)) { y0 -= 0.5; y1 += 0.5; }
+        const double pad = 0.04 * (y1 - y0);
+        y0 -= pad;
+        y1 += pad;
+        const double sx = nice_step(x1 - x0), sy = nice_step(y1 - y0);
+        x0 = std::floor(x0 / sx) * sx; x1 = std::ceil(x1 / sx) * sx;
+        y0 = std::floor(y0 / sy) * sy; y1 = std::ceil(y1 / sy) * sy;
+        const double ox = (pi % cols) * cw + ml + 5, oy = header + (pi / cols) * ch + mt;
+        const double pw = o.panel_width, ph = o.panel_height;
+        auto X = [&](double x) { return ox + (x - x0) / (x1 - x0) * pw; };
+        auto Y = [&](double y) { return oy + ph - (y - y0) / (y1 - y0) * ph; };
+        const std::string id = "plot" + std::to_string(pi + 1);
+        s << "<g id=\"" << id << "\">\n";
+        s << "<text id=\"" << id << "-title\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy - 10) << "\" text-anchor=\"middle\" font-size=\"12\">"
+          << esc(p.title) << "</text>\n";
+        s << "<g id=\"" << id << "-axes\" font-size=\"10\">\n";
+        s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
+          << "\" fill=\"none\" stroke=\"#000\"/>\n";
+        for (double t = x0; t <= x1 + 1e-9 * sx; t += sx) {
+            s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph)
+              << "\" stroke=\"#e5e5e5\"/>\n";
+            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 15) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
+        }
+        for (double t = y0; t <= y1 + 1e-9 * sy; t += sy) {
+            s << "<line x1=\"" << num(ox) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox + pw) << "\" y2=\"" << num(Y(t))
+              << "\" stroke=\"#e5e5e5\"/>\n";
+            s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 3.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
+        }
+        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 34) << "\" text-anchor=\"middle\" font-size=\"12\">" << esc(p.x_label)
+          << "</text>\n";
+        s << "<text transform=\"translate(" << num(ox - 44) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"12\">"
+          << esc(p.y_label) << "</text>\n";
+        s << "</g>\n";
+        s << "<g id=\"" << id << "-series\" fill=\"none\" stroke-width=\"1.4\" stroke-linejoin=\"round\">\n";
+        std::size_t si = 0;
+        for (const auto& sr : p.series) {
+            const std::string colour = sr.colour.empty() ? palette[si % 14] : sr.colour;
+            ++si;
+            s << "<polyline stroke=\"" << colour << "\"" << (sr.dashed ? " stroke-dasharray=\"5,3\"" : "") << " points=\"";
+            for (std::size_t k = 0; k < sr.x.size() && k < sr.y.size(); ++k)
+                if (std::isfinite(sr.x[k]) && std::isfinite(sr.y[k])) s << num(X(sr.x[k])) << "," << num(Y(sr.y[k])) << " ";
+            s << "\"><title>" << esc(sr.name) << "</title></polyline>\n";
+        }
+        s << "</g>\n";
+        s << "<g id=\"" << id << "-markers\" stroke-width=\"2\" font-size=\"9\">\n";
+        for (const auto& m : p.markers) {
+            const double cx = X(m.x), cy = Y(m.y);
+            s << "<path d=\"M" << num(cx - 4) << "," << num(cy - 4) << " L" << num(cx + 4) << "," << num(cy + 4) << " M" << num(cx - 4) << ","
+              << num(cy + 4) << " L" << num(cx + 4) << "," << num(cy - 4) << "\" stroke=\"" << m.colour << "\"/>\n";
+            if (!m.label.empty())
+                s << "<text x=\"" << num(cx + 6) << "\" y=\"" << num(cy - 5) << "\" stroke=\"none\" fill=\"" << m.colour << "\">" << esc(m.label) << "</text>\n";
+        }
+        s << "</g>\n</g>\n";
+    }
+    if (!entries.empty()) {
+        const double ly = header + rows * ch + 4;
+        s << "<g id=\"legend\" font-size=\"11\">\n";
+        for (std::size_t i = 0; i < entries.size(); ++i) {
+            const double x = 10 + (i % per_row) * 150, y = ly + (i / per_row) * 20;
+            s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7) << "\" x2=\"" << num(x + 24) << "\" y2=\"" << num(y + 7)
+              << "\" stroke=\"" << entries[i].second << "\" stroke-width=\"2\"" << (dashed_entries[i] ? " stroke-dasharray=\"5,3\"" : "")
+              << "/>\n<text x=\"" << num(x + 29) << "\" y=\"" << num(y + 11) << "\">" << esc(entries[i].first) << "</text>\n";
+        }
+        s << "</g>\n";
+    }
+    if (!o.note.empty()) {
+        s << "<text id=\"note\" x=\"10\" y=\"" << num(height - 6) << "\" font-size=\"11\">" << esc(o.note) << "</text>\n";
+    }
+    s << "</svg>\n";
+    return s.str();
+}
+
 void write_file_atomic(const std::string& path, const std::string& text) {
     const std::string tmp = path + ".tmp";
     {

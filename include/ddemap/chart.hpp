@@ -41,6 +41,36 @@ std::string axis_label(const std::string& model, const std::string& parameter);
 
 std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartOptions& options);
 
+/// Line plots (simulation traces, disturbance growth, calibration fits).
+struct PlotSeries {
+    std::string name;
+    std::vector<double> x, y;
+    std::string colour;  ///< empty: from the palette
+    bool dashed = false;
+};
+
+struct PlotMarker {
+    double x = 0.0, y = 0.0;
+    std::string colour = "#000000";
+    std::string label;  ///< optional text next to the cross
+};
+
+struct PlotPanel {
+    std::string title, x_label, y_label;
+    std::vector<PlotSeries> series;
+    std::vector<PlotMarker> markers;  ///< drawn as crosses
+};
+
+struct PlotOptions {
+    std::string title;
+    int columns = 2;
+    double panel_width = 420.0, panel_height = 280.0;
+    bool legend = true;
+    std::string note;  ///< one line under the legend (e.g. what the markers mean)
+};
+
+std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& options);
+
 /// Writes `text` to `path` atomically (a temporary file renamed into place); throws
 /// std::runtime_error naming the path on failure.
 void write_file_atomic(const std::string& path, const std::string& text);

@@ -63,6 +63,7 @@ struct SimEvent {
     double time = 0.0;
     double speed = 0.0;
     double gap = 0.0;
+    double lowest_speed = 0.0;  ///< the car's lowest speed up to the event
 };
 
 struct CarSummary {
@@ -91,5 +92,21 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
 
 /// Followers of one calibrated vehicle setting (OVRV), with the paper's minimum ACC speed.
 std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers);
+
+/// Disturbance growth along a platoon of identical followers (the paper's growth figure):
+/// per position the speed drop, the amplification (drop / the lead's drop) and the minimum gap,
+/// up to the first position whose car disengages or collides (where the platoon fails).
+struct GrowthResult {
+    std::string name;
+    std::vector<double> speed_drop, amplification, min_gap;  ///< positions 1 .. (failed_at - 1) or all
+    int failed_at = 0;            ///< first failing position (0: none)
+    std::string failure;          ///< "disengage" or "collision"
+    double failure_time = 0.0;
+    double failure_amplification = 0.0;  ///< (v0 - lowest speed up to the event) / lead drop
+    double failure_gap = 0.0;
+};
+
+std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle>& vehicles, const LeadProfile& lead,
+                                             int followers, const SimOptions& options = {});
 
 }  // namespace ddemap

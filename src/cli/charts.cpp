@@ -14,6 +14,7 @@
 #include "ddemap/sweep.hpp"
 #include "ddemap/vehicles.hpp"
 #include "builtin_maps.hpp"
+#include "sim_commands.hpp"
 #include "ddemap/writers.hpp"
 
 namespace ddemap::cli {
@@ -224,13 +225,19 @@ struct ChartCommands::Impl {
             files.emplace_back(base + "-boundaries.csv", boundary_csv(fig.specs[i], fig.boundaries[i]));
             summary.push_back(sweep_json(fig.sweeps[i], &fig.boundaries[i]));
         }
+        // the disturbance growth study behind the platoon-test dip
+        const auto growth = disturbance_growth(paper_calibration_table(), LeadProfile::builtin("dip"), 15);
+        files.emplace_back(dir + "growth.csv", growth_csv(growth));
+        files.emplace_back(dir + "growth.svg", growth_svg(growth, "dip"));
         files.emplace_back(dir + "paper.json", json{{"command", "paper"}, {"version", DDEMAP_VERSION}, {"panels", summary},
                                                     {"seconds", fig.seconds + cls.seconds}}.dump(2) + "\n");
         write_all(files);
         std::ostringstream out;
         out << classification_table(rows, 22, source);
+        out << "\ndisturbance growth behind the dip (22.4 -> 19.7 -> 22.4 m/s), platoons of up to 15 followers\n";
+        out << growth_table(growth);
         out << "\nfigures and data in " << paper_out << ": paper.svg (" << spec.panels.size()
-            << " panels), classification.svg, classification.csv/.json, paper-panel*.csv, paper-panel*-boundaries.csv, paper.json\n";
+            << " panels), classification.svg, classification.csv/.json, paper-panel*.csv, paper-panel*-boundaries.csv, growth.csv/.svg, paper.json\n";
         std::cout << out.str();
     }
 

@@ -20,6 +20,7 @@
 #include "ddemap/string_stability.hpp"
 #include "ddemap/vehicles.hpp"
 #include "charts.hpp"
+#include "sim_commands.hpp"
 #include "common.hpp"
 #include "format.hpp"
 
@@ -218,6 +219,8 @@ int main(int argc, char** argv) {
 
     ChartCommands charts;
     charts.add_to(app);
+    SimCommands sims;
+    sims.add_to(app);
 
     try {
         app.parse(argc, argv);
@@ -237,7 +240,7 @@ int main(int argc, char** argv) {
     try {
         if (roots->parsed()) run_roots(roots_args);
         else if (str->parsed()) run_string(string_args);
-        else charts.run();
+        else if (!charts.run()) sims.run();
         return 0;
     } catch (const std::invalid_argument& e) {
         std::cerr << "ddemap: error: " << e.what() << "\n";

@@ -1,0 +1,275 @@
+#include "sim_commands.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "common.hpp"
+#include "ddemap/chart.hpp"
+#include "ddemap/vehicles.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+
+std::string read_file(const std::string& flag, const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// --lead-profile NAME (built in) or --lead FILE.csv
+LeadProfile lead_from(const std::string& profile, const std::string& file, std::string& label) {
+    if (!profile.empty() && !file.empty()) throw BadInput("give either --lead FILE.csv or --lead-profile NAME, not both");
+    if (!file.empty()) {
+        label = file;
+        return LeadProfile::from_csv(read_file("--lead", file), file);
+    }
+    const std::string name = profile.empty() ? "dip" : profile;
+    const auto names = LeadProfile::builtin_names();
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+        throw BadInput("--lead-profile = '" + name + "': expected one of dip, oscillatory, step-low, step-high");
+    }
+    label = name;
+    return LeadProfile::builtin(name);
+}
+
+const CalibratedVehicle& builtin_vehicle(const std::string& name) {
+    for (const auto& v : paper_calibration_table())
+        if (v.name == name) return v;
+    throw BadInput("vehicle '" + name + "': expected a name of the calibration table (A_min .. G_max) or a fleet CSV file");
+}
+
+/// --fleet "A_min*3,C_max" (built-in names, *K repeats) or a CSV file (name,k1,k2,th,tau[,eta][,min_speed])
+std::vector<SimCar> fleet_from(const std::string& text) {
+    std::vector<SimCar> cars;
+    if (text.size() > 4 && text.substr(text.size() - 4) == ".csv") {
+        const std::string body = read_file("--fleet", text);
+        const auto vehicles = read_vehicles_csv(body, text);
+        for (const auto& v : vehicles) {
+            std::shared_ptr<const CarModel> m = make_model("ovrv", v.parameters);
+            cars.push_back({m, 0.0, v.name});
+        }
+        return cars;
+    }
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        int repeat = 1;
+        const auto star = item.find('*');
+        std::string name = item.substr(0, star);
+        if (star != std::string::npos) {
+            repeat = static_cast<int>(parse_integer("--fleet", item.substr(star + 1), 1, 10000, "NAME*COUNT with COUNT from 1 to 10000"));
+        }
+        const auto& v = builtin_vehicle(name);
+        for (auto& c : platoon_of(v, repeat)) cars.push_back(c);
+    }
+    if (cars.empty()) throw BadInput("--fleet = '" + text + "': expected vehicle names such as A_min*7");
+    return cars;
+}
+
+}  // namespace
+
+std::string growth_table(const std::vector<GrowthResult>& g) {
+    std::ostringstream out;
+    out << "name     amplification by position (speed drop / lead drop)                       platoon fails at\n";
+    for (const auto& r : g) {
+        char head[32];
+        std::snprintf(head, sizeof head, "%-8s", r.name.c_str());
+        out << head;
+        for (std::size_t i = 0; i < r.amplification.size() && i < 8; ++i) out << " " << rounded(r.amplification[i], 3);
+        if (r.amplification.size() > 8) out << " ...";
+        out << "   ";
+        if (r.failed_at) out << "car " << r.failed_at << " (" << r.failure << " at t = " << rounded(r.failure_time, 4) << " s)";
+        else out << "none";
+        out << "\n";
+    }
+    return out.str();
+}
+
+std::string growth_csv(const std::vector<GrowthResult>& g) {
+    std::ostringstream out;
+    out << "name,position,speed_drop,amplification,min_gap,failure\n";
+    for (const auto& r : g) {
+        for (std::size_t i = 0; i < r.amplification.size(); ++i) {
+            out << r.name << "," << i + 1 << "," << exact(r.speed_drop[i]) << "," << exact(r.amplification[i]) << "," << exact(r.min_gap[i]) << ",\n";
+        }
+        if (r.failed_at) {
+            out << r.name << "," << r.failed_at << ",," << exact(r.failure_amplification) << "," << exact(r.failure_gap) << "," << r.failure << "\n";
+        }
+    }
+    return out.str();
+}
+
+std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& lead_name) {
+    PlotPanel gap{"Minimum gap", "position in the platoon", "minimum gap [m]", {}, {}};
+    PlotPanel amp{"Disturbance amplification", "position in the platoon", "speed drop / lead's drop [1]", {}, {}};
+    for (const auto& r : g) {
+        PlotSeries a{r.name, {}, {}, "", r.name.find("max") != std::string::npos};
+        PlotSeries b = a;
+        for (std::size_t i = 0; i < r.amplification.size(); ++i) {
+            a.x.push_back(i + 1.0);
+            a.y.push_back(r.min_gap[i]);
+            b.x.push_back(i + 1.0);
+            b.y.push_back(r.amplification[i]);
+        }
+        if (r.failed_at) {
+            const std::string colour = r.failure == "collision" ? "#d62728" : "#000000";
+            a.x.push_back(r.failed_at);
+            a.y.push_back(r.failure_gap);
+            b.x.push_back(r.failed_at);
+            b.y.push_back(r.failure_amplification);
+            gap.markers.push_back({double(r.failed_at), r.failure_gap, colour, ""});
+            amp.markers.push_back({double(r.failed_at), r.failure_amplification, colour, ""});
+        }
+        gap.series.push_back(a);
+        amp.series.push_back(b);
+    }
+    PlotOptions o;
+    o.title = "Disturbance growth behind the '" + lead_name + "' lead profile (calibrated OVRV platoons)";
+    o.note = "black x: ACC disengages (speed below the minimum ACC speed); red x: gap reaches zero (collision); dashed: max setting";
+    return render_line_plots_svg({gap, amp}, o);
+}
+
+struct SimCommands::Impl {
+    CLI::App* simulate = nullptr;
+    std::string fleet, lead_file, lead_profile, out, on_event = "continue", t_end = "0", step = "0.05", output_dt = "0.1";
+    CLI::App* growth = nullptr;
+    std::string g_followers = "15", g_lead_profile, g_lead_file, g_out, g_format = "table";
+
+    SimOptions options() const {
+        SimOptions o;
+        o.step = parse_number("--step", step);
+        o.t_end = parse_number("--t-end", t_end);
+        o.output_dt = parse_number("--output-dt", output_dt);
+        if (on_event == "stop") o.on_event = OnEvent::Stop;
+        else if (on_event != "continue") throw BadInput("--on-event = '" + on_event + "': expected stop or continue");
+        o.validate();
+        return o;
+    }
+
+    void run_simulate() const {
+        if (fleet.empty()) throw BadInput("--fleet is required (e.g. --fleet A_min*7 or --fleet cars.csv)");
+        check_output("--out", out);
+        const SimOptions o = options();
+        std::string label;
+        const LeadProfile lead = lead_from(lead_profile, lead_file, label);
+        const std::vector<SimCar> cars = fleet_from(fleet);
+        const SimResult r = simulate_platoon(lead, cars, o);
+        std::ostringstream csv;
+        csv << "time,car,position,speed,gap\n";
+        for (std::size_t k = 0; k < r.time.size(); ++k)
+            for (std::size_t c = 0; c < r.speed.size(); ++c) {
+                csv << exact(r.time[k]) << "," << c << "," << exact(r.position[c][k]) << "," << exact(r.speed[c][k]) << ",";
+                if (c > 0) csv << exact(r.gap[c][k]);
+                csv << "\n";
+            }
+        json j;
+        j["command"] = "simulate";
+        j["version"] = DDEMAP_VERSION;
+        j["lead"] = label;
+        j["initial_speed"] = r.initial_speed;
+        j["t_end"] = r.t_end;
+        j["stopped_at_event"] = r.stopped;
+        j["steps"] = r.steps;
+        json cs = json::array();
+        for (const auto& c : r.cars) {
+            json e = json::array();
+            for (const auto& ev : c.events) e.push_back({{"type", ev.type}, {"time", ev.time}, {"speed", ev.speed}, {"gap", ev.gap}});
+            cs.push_back({{"car", c.car}, {"name", c.name}, {"min_speed", c.min_speed}, {"speed_drop", c.speed_drop}, {"min_gap", c.min_gap}, {"events", e}});
+        }
+        j["cars"] = cs;
+        PlotPanel p{"Speeds", "time [s]", "speed [m/s]", {}, {}};
+        for (std::size_t c = 0; c < r.speed.size(); ++c) {
+            PlotSeries sr{c == 0 ? "lead" : "car " + std::to_string(c) + " (" + r.cars[c - 1].name + ")", r.time, r.speed[c], c == 0 ? "#000000" : "", c == 0};
+            p.series.push_back(sr);
+        }
+        for (const auto& ev : r.events)
+            p.markers.push_back({ev.time, ev.speed, ev.type == "collision" ? "#d62728" : "#000000", ev.type + " car " + std::to_string(ev.car)});
+        PlotOptions po;
+        po.title = "Platoon behind the '" + label + "' lead profile";
+        po.columns = 1;
+        po.panel_width = 760;
+        po.panel_height = 340;
+        write_file_atomic(out + ".csv.part", csv.str());
+        write_file_atomic(out + ".json.part", j.dump(2) + "\n");
+        write_file_atomic(out + ".svg.part", render_line_plots_svg({p}, po));
+        for (const char* ext : {".csv", ".json", ".svg"}) std::rename((out + ext + ".part").c_str(), (out + ext).c_str());
+        std::ostringstream s;
+        s << "simulated  " << cars.size() << " followers to t = " << rounded(r.t_end, 5) << " s (" << r.steps << " steps)\n";
+        s << "car  name      min speed  speed drop  min gap   events\n";
+        for (const auto& c : r.cars) {
+            char line[160];
+            std::snprintf(line, sizeof line, "%3d  %-8s %9.3f %11.3f %8.3f   ", c.car, c.name.c_str(), c.min_speed, c.speed_drop, c.min_gap);
+            s << line;
+            for (const auto& ev : c.events) s << ev.type << " at " << rounded(ev.time, 4) << " s  ";
+            s << "\n";
+        }
+        s << "wrote      " << out << ".csv " << out << ".json " << out << ".svg\n";
+        std::cout << s.str();
+    }
+
+    void run_growth() const {
+        const int followers = static_cast<int>(parse_integer("--followers", g_followers, 1, 200, "an integer from 1 to 200"));
+        const Format format = parse_format(g_format);
+        if (!g_out.empty()) check_output("--out", g_out);
+        std::string label;
+        const LeadProfile lead = lead_from(g_lead_profile, g_lead_file, label);
+        const auto g = disturbance_growth(paper_calibration_table(), lead, followers);
+        if (!g_out.empty()) {
+            write_file_atomic(g_out + ".csv.part", growth_csv(g));
+            write_file_atomic(g_out + ".svg.part", growth_svg(g, label));
+            std::rename((g_out + ".csv.part").c_str(), (g_out + ".csv").c_str());
+            std::rename((g_out + ".svg.part").c_str(), (g_out + ".svg").c_str());
+        }
+        if (format == Format::Csv) {
+            std::cout << growth_csv(g);
+        } else if (format == Format::Json) {
+            json arr = json::array();
+            for (const auto& r : g) {
+                arr.push_back({{"name", r.name}, {"speed_drop", r.speed_drop}, {"amplification", r.amplification}, {"min_gap", r.min_gap},
+                               {"failed_at", r.failed_at}, {"failure", r.failure}, {"failure_time", r.failure_time}});
+            }
+            std::cout << json{{"command", "growth"}, {"version", DDEMAP_VERSION}, {"lead", label}, {"vehicles", arr}}.dump(2) << "\n";
+        } else {
+            std::cout << growth_table(g);
+        }
+    }
+};
+
+void SimCommands::add_to(CLI::App& app) {
+    m = std::make_shared<Impl>();
+    m->simulate = app.add_subcommand("simulate", "nonlinear platoon simulation behind a lead speed profile; writes PREFIX.csv, .json, .svg");
+    m->simulate->add_option("--fleet", m->fleet, "followers in platoon order: built-in names with repeats (A_min*7,C_max) or a CSV name,k1,k2,th,tau[,eta]");
+    m->simulate->add_option("--lead", m->lead_file, "lead speed CSV with columns time_s, lead_speed_mps (piecewise linear)");
+    m->simulate->add_option("--lead-profile", m->lead_profile, "built-in lead profile: dip (22.4 -> 19.7 -> 22.4 m/s), oscillatory, step-low, step-high");
+    m->simulate->add_option("--out", m->out, "output prefix");
+    m->simulate->add_option("--on-event", m->on_event, "stop or continue at the first disengagement or collision")->capture_default_str();
+    m->simulate->add_option("--t-end", m->t_end, "end time [s] (0: the profile's last breakpoint + 30 s)")->capture_default_str();
+    m->simulate->add_option("--step", m->step, "largest integration step [s]")->capture_default_str();
+    m->simulate->add_option("--output-dt", m->output_dt, "output sampling [s]")->capture_default_str();
+
+    m->growth = app.add_subcommand("growth", "disturbance growth for every setting of the calibration table: platoons of 1 to 15 followers");
+    m->growth->add_option("--followers", m->g_followers, "longest platoon")->capture_default_str();
+    m->growth->add_option("--lead-profile", m->g_lead_profile, "built-in lead profile (default dip)");
+    m->growth->add_option("--lead", m->g_lead_file, "lead speed CSV (time_s, lead_speed_mps)");
+    m->growth->add_option("--out", m->g_out, "also write PREFIX.csv and PREFIX.svg");
+    m->growth->add_option("--format", m->g_format, "table, json or csv")->capture_default_str();
+}
+
+bool SimCommands::run() const {
+    if (m->simulate->parsed()) {
+        m->run_simulate();
+        return true;
+    }
+    if (m->growth->parsed()) {
+        m->run_growth();
+        return true;
+    }
+    return false;
+}
+
+}  // namespace ddemap::cli
