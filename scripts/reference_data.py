@@ -478,6 +478,25 @@ def rightmost_roots(qp, need):
         assert cache[i][4] <= cache[j][4], (qp.label, cache)
     sigma, X, H, R, n = cache[k]
     roots = find_all(qp, sigma, X, H, n, info) if n > 0 else []
+    for z in roots:
+        assert abs(z) <= R * (1 + mpf("1e-30")), (qp.label, z, R)
+    # second, independent evaluation of the final count: contour integral of F'/F
+    nq = quad_count(qp, sigma, X, H)
+    assert nq == n == len(roots), (qp.label, n, nq, len(roots))
+    info.update(sigma=sigma, R=R, count=n, quad_count=nq, counts_evaluated=len(cache))
+    if info.get("capped") and n >= need:
+        del info["capped"]               # the cap did not limit the result
+    if qp.tau == 0:
+        # polynomial: cross-check against mpmath.polyroots and report its values
+        pr = mpmath.polyroots(qp.poly_coeffs(), maxsteps=200, extraprec=200)
+        pr = [mpc(p) for p in (pr if isinstance(pr, list) else [pr])]
+        inside = [p for p in pr if p.real > sigma]
+        assert len(inside) == len(roots), (qp.label, pr, roots)
+        for p in inside:
+            assert min(abs(p - z) for z in roots) < mpf("1e-30"), (qp.label, p, roots)
+        info["polyroots_all"] = pr
+        roots = [mpc(z.real, 0) if qp.real and abs(z.imag) < mpf("1e-30") else z
+                 for z in inside]
     if qp.real:
         # real coefficients: make conjugate pairs exactly symmetric
         upper = [z for z in roots if z.imag > 0]
@@ -487,25 +506,6 @@ def rightmost_roots(qp, need):
             assert min(abs(mpmath.conj(z) - w) for w in lower) < mpf("1e-25"), (qp.label, z)
         roots = ([z for z in roots if z.imag == 0] + upper +
                  [mpmath.conj(z) for z in upper])
-    for z in roots:
-        assert abs(z) <= R * (1 + mpf("1e-30")), (qp.label, z, R)
-    # second, independent evaluation of the final count: contour integral of F'/F
-    nq = quad_count(qp, sigma, X, H)
-    assert nq == n == len(roots), (qp.label, n, nq, len(roots))
-    info.update(sigma=sigma, R=R, count=n, quad_count=nq, counts_evaluated=len(cache))
-    if qp.tau == 0:
-        # polynomial: cross-check against mpmath.polyroots
-        pr = mpmath.polyroots(qp.poly_coeffs(), maxsteps=200, extraprec=200)
-        pr = [mpc(p) for p in (pr if isinstance(pr, list) else [pr])]
-        inside = [p for p in pr if p.real > sigma]
-        assert len(inside) == len(roots), (qp.label, pr, roots)
-        for p in inside:
-            assert min(abs(p - z) for z in roots) < mpf("1e-30"), (qp.label, p, roots)
-        info["polyroots_all"] = pr
-        # report the polyroots values (the specification for tau = 0)
-        roots = [min(inside, key=lambda p: abs(p - z)) for z in roots]
-        roots = [mpc(z.real, 0) if qp.real and abs(z.imag) < mpf("1e-30") else z
-                 for z in roots]
     for z in roots:
         res = abs(qp.f(z))
         assert res < RESIDUAL_TOL, (qp.label, z, res)

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common.hpp"
+#include "ddemap/calibrate.hpp"
 #include "ddemap/chart.hpp"
 #include "ddemap/vehicles.hpp"
 
@@ -134,7 +135,146 @@ std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& le
     return render_line_plots_svg({gap, amp}, o);
 }
 
+namespace {
+
+std::string base_name(const std::string& path) {
+    std::string b = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+    if (b.size() > 4 && b.substr(b.size() - 4) == ".csv") b.resize(b.size() - 4);
+    return b;
+}
+
+json fit_json(const std::string& name, const CalibrationResult& r) {
+    json j;
+    j["name"] = name;
+    for (const char* k : {"k1", "k2", "th", "tau", "eta"}) j[k] = r.parameters.at(k);
+    j["rmse_speed"] = r.all.rmse_speed;
+    j["rmse_gap"] = r.all.rmse_gap;
+    j["train"] = {{"rmse_speed", r.train.rmse_speed}, {"rmse_gap", r.train.rmse_gap}, {"samples", r.train.samples}};
+    if (r.test.samples > 0) j["test"] = {{"rmse_speed", r.test.rmse_speed}, {"rmse_gap", r.test.rmse_gap}, {"samples", r.test.samples}};
+    j["naive_rmse_speed"] = r.naive.rmse_speed;
+    j["naive_delay"] = r.naive_delay;
+    j["status"] = r.status;
+    j["evaluations"] = r.evaluations;
+    j["seconds"] = r.seconds;
+    return j;
+}
+
+}  // namespace
+
 struct SimCommands::Impl {
+    CLI::App* calibrate_cmd = nullptr;
+    std::vector<std::string> c_files;
+    std::string c_train, c_model = "ovrv", c_bounds, c_gap_weight = "0.02", c_out, c_format = "table";
+
+    void run_calibrate() const {
+        if (c_model != "ovrv") throw BadInput("--model = '" + c_model + "': calibration supports ovrv");
+        const Format format = parse_format(c_format);
+        if (!c_out.empty()) check_output("--out", c_out);
+        CalibrationOptions o;
+        o.gap_weight = parse_number("--gap-weight", c_gap_weight);
+        if (!c_train.empty()) {
+            const auto colon = c_train.find(':');
+            if (colon == std::string::npos) throw BadInput("--train = '" + c_train + "': expected T0:T1 in seconds");
+            o.train_start = parse_number("--train", c_train.substr(0, colon));
+            o.train_end = parse_number("--train", c_train.substr(colon + 1));
+            if (!(o.train_start >= 0 && o.train_end > o.train_start)) throw BadInput("--train = '" + c_train + "': expected 0 <= T0 < T1");
+        }
+        if (!c_bounds.empty()) {
+            std::stringstream ss(c_bounds);
+            std::string item;
+            const char* names[5] = {"k1", "k2", "th", "tau", "eta"};
+            while (std::getline(ss, item, ',')) {
+                const auto eq = item.find('='), colon = item.find(':');
+                if (eq == std::string::npos || colon == std::string::npos || colon < eq) {
+                    throw BadInput("--bounds item '" + item + "': expected NAME=LO:HI, e.g. eta=0:15");
+                }
+                const std::string name = item.substr(0, eq);
+                const auto it = std::find_if(std::begin(names), std::end(names), [&](const char* n) { return name == n; });
+                if (it == std::end(names)) throw BadInput("--bounds item '" + item + "': expected one of k1, k2, th, tau, eta");
+                const int i = static_cast<int>(it - std::begin(names));
+                o.lower[i] = parse_number("--bounds " + name, item.substr(eq + 1, colon - eq - 1));
+                o.upper[i] = parse_number("--bounds " + name, item.substr(colon + 1));
+            }
+        }
+        o.validate();
+        std::vector<Trace> traces;
+        for (const auto& f : c_files) traces.push_back(read_trace_csv(read_file("DATA.csv", f), f));
+        std::vector<CalibrationResult> fits(traces.size());
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+        for (std::size_t i = 0; i < traces.size(); ++i) fits[i] = ddemap::calibrate(traces[i], o);
+
+        std::ostringstream csv;
+        csv << "name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,"
+               "naive_rmse_speed,status\n";
+        for (std::size_t i = 0; i < fits.size(); ++i) {
+            const auto& r = fits[i];
+            csv << csv_field(base_name(c_files[i]));
+            for (const char* k : {"k1", "k2", "th", "tau", "eta"}) csv << "," << exact(r.parameters.at(k));
+            csv << "," << exact(r.all.rmse_speed) << "," << exact(r.all.rmse_gap) << "," << exact(r.train.rmse_speed) << ","
+                << exact(r.train.rmse_gap) << ",";
+            if (r.test.samples > 0) csv << exact(r.test.rmse_speed) << "," << exact(r.test.rmse_gap);
+            else csv << ",";
+            csv << "," << exact(r.naive.rmse_speed) << "," << r.status << "\n";
+        }
+        json j;
+        if (fits.size() == 1) {
+            j = fit_json(base_name(c_files[0]), fits[0]);
+        } else {
+            json arr = json::array();
+            for (std::size_t i = 0; i < fits.size(); ++i) arr.push_back(fit_json(base_name(c_files[i]), fits[i]));
+            j["fits"] = arr;
+        }
+        j["command"] = "calibrate";
+        j["version"] = DDEMAP_VERSION;
+        j["gap_weight"] = o.gap_weight;
+        j["bounds"] = {{"k1", {o.lower[0], o.upper[0]}}, {"k2", {o.lower[1], o.upper[1]}}, {"th", {o.lower[2], o.upper[2]}},
+                       {"tau", {o.lower[3], o.upper[3]}}, {"eta", {o.lower[4], o.upper[4]}}};
+        if (!c_out.empty()) {
+            std::vector<PlotPanel> panels;
+            for (std::size_t i = 0; i < fits.size(); ++i) {
+                const Trace& t = traces[i];
+                const std::string name = base_name(c_files[i]);
+                PlotPanel sp{name + ": speed", "time [s]", "speed [m/s]", {}, {}};
+                sp.series.push_back({"lead (measured)", t.t, t.lead, "#7f7f7f", true});
+                sp.series.push_back({"follower (measured)", t.t, t.speed, "#000000", false});
+                sp.series.push_back({"follower (model)", t.t, fits[i].sim_speed, "#d62728", false});
+                PlotPanel gp{name + ": gap", "time [s]", "gap [m]", {}, {}};
+                gp.series.push_back({"lead (measured)", {}, {}, "#7f7f7f", true});
+                gp.series.push_back({"follower (measured)", t.t, t.gap, "#000000", false});
+                gp.series.push_back({"follower (model)", t.t, fits[i].sim_gap, "#d62728", false});
+                panels.push_back(sp);
+                panels.push_back(gp);
+            }
+            PlotOptions po;
+            po.title = "Calibrated OVRV: measured and simulated follower";
+            po.columns = 2;
+            write_file_atomic(c_out + ".csv.part", csv.str());
+            write_file_atomic(c_out + ".json.part", j.dump(2) + "\n");
+            write_file_atomic(c_out + ".svg.part", render_line_plots_svg(panels, po));
+            for (const char* ext : {".csv", ".json", ".svg"}) std::rename((c_out + ext + ".part").c_str(), (c_out + ext).c_str());
+        }
+        if (format == Format::Json) {
+            std::cout << j.dump(2) << "\n";
+        } else if (format == Format::Csv) {
+            std::cout << csv.str();
+        } else {
+            std::ostringstream out;
+            out << "file                                         k1      k2     th     tau    eta   rmse_v  rmse_gap  naive_v  status\n";
+            for (std::size_t i = 0; i < fits.size(); ++i) {
+                const auto& r = fits[i];
+                const auto& p = r.parameters;
+                char line[300];
+                std::snprintf(line, sizeof line, "%-42.42s %7.4f %7.4f %6.3f %6.3f %6.2f %7.3f %8.3f %8.3f  %s\n",
+                              base_name(c_files[i]).c_str(), p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
+                              r.all.rmse_speed, r.all.rmse_gap, r.naive.rmse_speed, r.status.c_str());
+                out << line;
+            }
+            std::cout << out.str();
+        }
+    }
+
     CLI::App* simulate = nullptr;
     std::string fleet, lead_file, lead_profile, out, on_event = "continue", t_end = "0", step = "0.05", output_dt = "0.1";
     CLI::App* growth = nullptr;
@@ -242,6 +382,14 @@ struct SimCommands::Impl {
 
 void SimCommands::add_to(CLI::App& app) {
     m = std::make_shared<Impl>();
+    m->calibrate_cmd = app.add_subcommand("calibrate", "fit OVRV (k1, k2, th, tau, eta) to measured car-following traces (NLopt: DIRECT-L, then BOBYQA)");
+    m->calibrate_cmd->add_option("DATA.csv", m->c_files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m")->required();
+    m->calibrate_cmd->add_option("--train", m->c_train, "training window T0:T1 [s] (default: the whole file; the rest is the test part)");
+    m->calibrate_cmd->add_option("--model", m->c_model, "the model to fit (ovrv)")->capture_default_str();
+    m->calibrate_cmd->add_option("--bounds", m->c_bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
+    m->calibrate_cmd->add_option("--gap-weight", m->c_gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
+    m->calibrate_cmd->add_option("--out", m->c_out, "write PREFIX.csv (a table for classify), PREFIX.json, PREFIX.svg");
+    m->calibrate_cmd->add_option("--format", m->c_format, "table, json or csv")->capture_default_str();
     m->simulate = app.add_subcommand("simulate", "nonlinear platoon simulation behind a lead speed profile; writes PREFIX.csv, .json, .svg");
     m->simulate->add_option("--fleet", m->fleet, "followers in platoon order: built-in names with repeats (A_min*7,C_max) or a CSV name,k1,k2,th,tau[,eta]");
     m->simulate->add_option("--lead", m->lead_file, "lead speed CSV with columns time_s, lead_speed_mps (piecewise linear)");
@@ -261,6 +409,10 @@ void SimCommands::add_to(CLI::App& app) {
 }
 
 bool SimCommands::run() const {
+    if (m->calibrate_cmd->parsed()) {
+        m->run_calibrate();
+        return true;
+    }
     if (m->simulate->parsed()) {
         m->run_simulate();
         return true;

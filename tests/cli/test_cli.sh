@@ -161,6 +161,59 @@ count = 1
 ' >"$tmp/bad.toml"
 expect_error "bad.toml:2: x: expected lo < hi" chart "$tmp/bad.toml" --out "$tmp/bad.svg"
 
+# simulate: files, JSON keys, events
+if "$bin" simulate --fleet 'B_min*6' --lead-profile dip --out "$tmp/sim" >/dev/null; then
+    head -1 "$tmp/sim.csv" | grep -q '^time,car,position,speed,gap$' && ok || bad "simulate CSV header"
+    python3 - "$tmp/sim.json" <<'PY' && ok || bad "simulate JSON"
+import json, sys
+d = json.load(open(sys.argv[1]))
+cars = d["cars"]
+assert len(cars) == 6
+for c in cars:
+    for k in ("min_speed", "speed_drop", "min_gap", "events"):
+        assert k in c, k
+assert any(e["type"] == "collision" for c in cars for e in c["events"])  # B_min fails within 6 cars
+PY
+    xmllint --noout "$tmp/sim.svg" && ok || bad "simulate SVG"
+else
+    bad "simulate exit status"
+fi
+printf 'time_s,lead_speed_mps
+0,20
+10,20
+20,18
+40,20
+' >"$tmp/lead.csv"
+"$bin" simulate --fleet 'E_min*2,A_max' --lead "$tmp/lead.csv" --out "$tmp/sim2" >/dev/null && ok || bad "simulate with a lead file"
+expect_error "'Z_min'" simulate --fleet 'Z_min' --out "$tmp/sim3"
+expect_error "--on-event = 'maybe'" simulate --fleet A_min --on-event maybe --out "$tmp/sim3"
+expect_error "--lead-profile = 'wave'" simulate --fleet A_min --lead-profile wave --out "$tmp/sim3"
+printf 'time_s,lead_speed_mps
+0,20
+0,21
+' >"$tmp/badlead.csv"
+expect_error "badlead.csv:3: time_s = 0" simulate --fleet A_min --lead "$tmp/badlead.csv" --out "$tmp/sim3"
+
+# growth
+"$bin" growth --format csv >"$tmp/g.csv" && head -1 "$tmp/g.csv" | grep -q '^name,position,speed_drop,amplification,min_gap,failure$' && ok || bad "growth csv"
+
+# calibrate: an excerpt of real data (tests/data), JSON keys, the table goes into classify
+excerpt="$(dirname "$0")/../data/openacc_excerpt_rav4_to_etron.csv"
+if "$bin" calibrate "$excerpt" --format json --out "$tmp/cal" >"$tmp/cal.json"; then
+    json_has "$tmp/cal.json" k1 k2 th tau eta rmse_speed rmse_gap status && ok || bad "calibrate JSON keys"
+    "$bin" classify "$tmp/cal.csv" --format csv >/dev/null && ok || bad "calibrate table into classify"
+    xmllint --noout "$tmp/cal.svg" && ok || bad "calibrate SVG"
+else
+    bad "calibrate exit status"
+fi
+printf 'time_s,lead_speed_mps,follower_speed_mps,gap_m
+0,1,1,1
+0.1,1,x,1
+' >"$tmp/badtrace.csv"
+expect_error "badtrace.csv:3: column 'follower_speed_mps' = 'x'" calibrate "$tmp/badtrace.csv"
+expect_error "--bounds item 'eta=15'" calibrate "$excerpt" --bounds eta=15
+expect_error "--train = '5'" calibrate "$excerpt" --train 5
+
 # help on every command, with units
 for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi
