@@ -67,7 +67,7 @@ void QuasiPolynomial::evaluate(cplx lambda, cplx& f, cplx& fp) const {
             f += p;
             fp += dp;
         } else {
-            const cplx e = std::exp(-lambda * t.delay);
+            const cplx e = std::polar(std::exp(-lambda.real() * t.delay), -lambda.imag() * t.delay);
             f += p * e;
             fp += (dp - t.delay * p) * e;
         }
@@ -86,7 +86,7 @@ cplx QuasiPolynomial::operator()(cplx lambda) const {
     for (const auto& t : m_terms) {
         cplx p = 0.0;
         for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) p = p * lambda + t.poly[k];
-        f += t.delay == 0.0 ? p : p * std::exp(-lambda * t.delay);
+        f += t.delay == 0.0 ? p : p * std::polar(std::exp(-lambda.real() * t.delay), -lambda.imag() * t.delay);
     }
     return f;
 }
