@@ -301,7 +301,7 @@ struct ChartCommands::Impl {
         write_all(files);
         std::ostringstream out;
         out << "sweep      " << sw.points.size() << " points in " << rounded(sw.seconds, 3) << " s ("
-            << rounded(sw.points.size() / std::max(sw.seconds, 1e-9), 4) << " points/s, " << sw.threads << " threads)\n";
+ << static_cast<long>(std::lround(sw.points.size() / std::max(sw.seconds, 1e-9))) << " points/s, " << sw.threads << " threads)\n";
         out << "regions    plant unstable " << j["regions"]["plant_unstable"] << ", ring unstable " << j["regions"]["ring_unstable"]
             << ", string unstable " << j["regions"]["string_unstable"] << ", string stable " << j["regions"]["string_stable"] << "\n";
         if (!no_boundaries) out << "boundaries " << b.curves.size() << " curves\n";
