@@ -11,28 +11,11 @@
 #include <nlopt.hpp>
 
 #include "ddemap/dde_solver.hpp"
+#include "text.hpp"
 
 namespace ddemap {
 
 namespace {
-
-std::string fmt(double v) {
-    std::ostringstream os;
-    os.precision(10);
-    os << v;
-    return os.str();
-}
-
-std::vector<std::string> split(const std::string& l) {
-    std::vector<std::string> f;
-    std::stringstream ss(l);
-    std::string x;
-    while (std::getline(ss, x, ',')) {
-        while (!x.empty() && (x.back() == '\r' || x.back() == ' ')) x.pop_back();
-        f.push_back(x);
-    }
-    return f;
-}
 
 /// linear interpolation of samples (constant outside)
 double interp(const std::vector<double>& t, const std::vector<double>& y, double x) {
@@ -66,8 +49,8 @@ Trace read_trace_csv(const std::string& text, const std::string& source) {
     std::vector<std::string> header;
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        header = split(line);
+        if (detail::is_blank(line)) continue;
+        header = detail::split_csv_line(line);
         break;
     }
     const char* cols[4] = {"time_s", "lead_speed_mps", "follower_speed_mps", "gap_m"};
@@ -85,14 +68,12 @@ Trace read_trace_csv(const std::string& text, const std::string& source) {
     std::vector<double>* dest[4] = {&tr.t, &tr.lead, &tr.speed, &tr.gap};
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        const auto f = split(line);
+        if (detail::is_blank(line)) continue;
+        const auto f = detail::split_csv_line(line);
         for (int c = 0; c < 4; ++c) {
             const std::string x = idx[c] < f.size() ? f[idx[c]] : std::string();
-            char* end = nullptr;
-            errno = 0;
-            const double d = std::strtod(x.c_str(), &end);
-            if (x.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(d)) {
+            double d = 0.0;
+            if (!detail::parse_finite(x, d)) {
                 throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": column '" + cols[c] + "' = '" + x +
                                             "': expected a finite number");
             }
@@ -100,13 +81,13 @@ Trace read_trace_csv(const std::string& text, const std::string& source) {
         }
         const std::size_t n = tr.t.size();
         if (n > 1 && !(tr.t[n - 1] > tr.t[n - 2])) {
-            throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": time_s = " + fmt(tr.t[n - 1]) + " after " +
-                                        fmt(tr.t[n - 2]) + ": expected increasing times");
+            throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": time_s = " + detail::format_number(tr.t[n - 1]) + " after " +
+                                        detail::format_number(tr.t[n - 2]) + ": expected increasing times");
         }
     }
     if (tr.t.size() < 100 || tr.t.back() - tr.t.front() < 20.0) {
         throw std::invalid_argument(source + ": " + std::to_string(tr.t.size()) + " rows over " +
-                                    fmt(tr.t.empty() ? 0.0 : tr.t.back() - tr.t.front()) +
+                                    detail::format_number(tr.t.empty() ? 0.0 : tr.t.back() - tr.t.front()) +
                                     " s: expected at least 100 rows and 20 s");
     }
     return tr;
@@ -115,14 +96,14 @@ Trace read_trace_csv(const std::string& text, const std::string& source) {
 void CalibrationOptions::validate() const {
     for (int i = 0; i < 5; ++i) {
         if (!(std::isfinite(lower[i]) && std::isfinite(upper[i]) && lower[i] <= upper[i] && lower[i] >= 0.0)) {
-            throw std::invalid_argument(std::string("bounds for ") + names[i] + " = " + fmt(lower[i]) + ":" + fmt(upper[i]) +
+            throw std::invalid_argument(std::string("bounds for ") + names[i] + " = " + detail::format_number(lower[i]) + ":" + detail::format_number(upper[i]) +
                                         ": expected finite 0 <= LO <= HI");
         }
     }
-    if (upper[3] > 5.0) throw std::invalid_argument("upper bound for tau = " + fmt(upper[3]) + ": expected at most 5 s");
-    if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + fmt(gap_weight) + ": expected >= 0");
+    if (upper[3] > 5.0) throw std::invalid_argument("upper bound for tau = " + detail::format_number(upper[3]) + ": expected at most 5 s");
+    if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected >= 0");
     if (global_evaluations < 0 || local_evaluations < 1) throw std::invalid_argument("evaluation budgets: expected global >= 0, local >= 1");
-    if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + fmt(step) + ": expected 0 < step <= 0.5 s");
+    if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 0.5 s");
 }
 
 void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double step, std::vector<double>& speed,
@@ -201,8 +182,8 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     double a = o.train_start < 0.0 ? first : o.train_start;
     double b = o.train_end < 0.0 ? last : o.train_end;
     if (!(a >= first && b <= last && b - a >= 20.0)) {
-        throw std::invalid_argument("training window " + fmt(a) + ":" + fmt(b) + " s: expected at least 20 s within the file's " +
-                                    fmt(first) + ":" + fmt(last) + " s");
+        throw std::invalid_argument("training window " + detail::format_number(a) + ":" + detail::format_number(b) + " s: expected at least 20 s within the file's " +
+                                    detail::format_number(first) + ":" + detail::format_number(last) + " s");
     }
     // every candidate is scored on the same samples: those after the longest admissible delay
     const double t_from = a + o.upper[3];

@@ -1,5 +1,7 @@
 #include "ddemap/model.hpp"
 
+#include "text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -12,13 +14,6 @@ double Linearisation::max_delay() const {
 }
 
 namespace {
-
-std::string fmt(double v) {
-    std::ostringstream os;
-    os.precision(17);
-    os << v;
-    return os.str();
-}
 
 const std::vector<ParameterSpec>& ovrv_specs() {
     static const std::vector<ParameterSpec> specs = {
@@ -66,10 +61,10 @@ ParameterMap resolve(const std::string& model, const std::vector<ParameterSpec>&
             continue;
         }
         const double v = it->second;
-        if (!std::isfinite(v)) throw std::invalid_argument(s.name + " = " + fmt(v) + ": expected a finite number [" + s.unit + "]");
+        if (!std::isfinite(v)) throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected a finite number [" + s.unit + "]");
         if (s.lower_open ? !(v > s.lower) : !(v >= s.lower)) {
-            throw std::invalid_argument(s.name + " = " + fmt(v) + ": expected a value " + (s.lower_open ? "> " : ">= ") +
-                                        fmt(s.lower) + " [" + s.unit + "]");
+            throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected a value " + (s.lower_open ? "> " : ">= ") +
+                                        detail::format_number(s.lower) + " [" + s.unit + "]");
         }
         out[s.name] = v;
     }
@@ -123,7 +118,7 @@ IdmModel::IdmModel(const ParameterMap& values) {
     m_tau = p.at("tau");
     m_speed = p.at("speed");
     if (!(m_speed < m_v0)) {
-        throw std::invalid_argument("speed = " + fmt(m_speed) + ": expected an equilibrium speed below v0 = " + fmt(m_v0) + " m/s");
+        throw std::invalid_argument("speed = " + detail::format_number(m_speed) + ": expected an equilibrium speed below v0 = " + detail::format_number(m_v0) + " m/s");
     }
     if (m_eta + m_th * m_speed <= 0.0) {
         throw std::invalid_argument("eta + th * speed = 0: the IDM equilibrium gap vanishes; expected eta > 0 or th * speed > 0");

@@ -8,25 +8,17 @@
 #include <stdexcept>
 
 #include "ddemap/dde_solver.hpp"
+#include "text.hpp"
 
 namespace ddemap {
-
-namespace {
-std::string fmt(double v) {
-    std::ostringstream os;
-    os.precision(17);
-    os << v;
-    return os.str();
-}
-}  // namespace
 
 LeadProfile::LeadProfile(std::vector<double> times, std::vector<double> speeds) : m_t(std::move(times)), m_v(std::move(speeds)) {
     if (m_t.empty() || m_t.size() != m_v.size()) throw std::invalid_argument("lead profile: expected as many times as speeds, at least one");
     for (std::size_t i = 0; i < m_t.size(); ++i) {
         if (!std::isfinite(m_t[i]) || !std::isfinite(m_v[i])) throw std::invalid_argument("lead profile: non-finite value at sample " + std::to_string(i + 1));
-        if (m_v[i] < 0.0) throw std::invalid_argument("lead profile: speed " + fmt(m_v[i]) + " at t = " + fmt(m_t[i]) + ": expected >= 0");
+        if (m_v[i] < 0.0) throw std::invalid_argument("lead profile: speed " + detail::format_number(m_v[i]) + " at t = " + detail::format_number(m_t[i]) + ": expected >= 0");
         if (i > 0 && !(m_t[i] > m_t[i - 1])) {
-            throw std::invalid_argument("lead profile: time " + fmt(m_t[i]) + " after " + fmt(m_t[i - 1]) + ": expected increasing times");
+            throw std::invalid_argument("lead profile: time " + detail::format_number(m_t[i]) + " after " + detail::format_number(m_t[i - 1]) + ": expected increasing times");
         }
     }
     if (m_t.front() > 0.0) {
@@ -99,20 +91,10 @@ LeadProfile LeadProfile::from_csv(const std::string& text, const std::string& so
     std::string line;
     int lineno = 0;
     std::vector<std::string> header;
-    auto split = [](const std::string& l) {
-        std::vector<std::string> f;
-        std::stringstream ss(l);
-        std::string x;
-        while (std::getline(ss, x, ',')) {
-            while (!x.empty() && (x.back() == '\r' || x.back() == ' ')) x.pop_back();
-            f.push_back(x);
-        }
-        return f;
-    };
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        header = split(line);
+        if (detail::is_blank(line)) continue;
+        header = detail::split_csv_line(line);
         break;
     }
     const auto ct = std::find(header.begin(), header.end(), "time_s");
@@ -124,31 +106,29 @@ LeadProfile LeadProfile::from_csv(const std::string& text, const std::string& so
     std::vector<double> t, v;
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        const auto f = split(line);
+        if (detail::is_blank(line)) continue;
+        const auto f = detail::split_csv_line(line);
         for (auto [col, name] : {std::pair{it, "time_s"}, std::pair{iv, "lead_speed_mps"}}) {
             const std::string x = col < f.size() ? f[col] : std::string();
-            char* end = nullptr;
-            errno = 0;
-            const double d = std::strtod(x.c_str(), &end);
-            if (x.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(d)) {
+            double d = 0.0;
+            if (!detail::parse_finite(x, d)) {
                 throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": column '" + name + "' = '" + x + "': expected a finite number");
             }
             (col == it ? t : v).push_back(d);
         }
         if (t.size() > 1 && !(t.back() > t[t.size() - 2])) {
-            throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": time_s = " + fmt(t.back()) + ": expected increasing times");
+            throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": time_s = " + detail::format_number(t.back()) + ": expected increasing times");
         }
-        if (v.back() < 0.0) throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": lead_speed_mps = " + fmt(v.back()) + ": expected >= 0");
+        if (v.back() < 0.0) throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": lead_speed_mps = " + detail::format_number(v.back()) + ": expected >= 0");
     }
     if (t.size() < 2) throw std::invalid_argument(source + ": expected at least two samples");
     return LeadProfile(t, v);
 }
 
 void SimOptions::validate() const {
-    if (!(std::isfinite(step) && step > 0.0 && step <= 1.0)) throw std::invalid_argument("step = " + fmt(step) + ": expected 0 < step <= 1 s");
-    if (!(std::isfinite(t_end) && t_end >= 0.0)) throw std::invalid_argument("t_end = " + fmt(t_end) + ": expected >= 0");
-    if (!(std::isfinite(output_dt) && output_dt > 0.0)) throw std::invalid_argument("output_dt = " + fmt(output_dt) + ": expected > 0");
+    if (!(std::isfinite(step) && step > 0.0 && step <= 1.0)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 1 s");
+    if (!(std::isfinite(t_end) && t_end >= 0.0)) throw std::invalid_argument("t_end = " + detail::format_number(t_end) + ": expected >= 0");
+    if (!(std::isfinite(output_dt) && output_dt > 0.0)) throw std::invalid_argument("output_dt = " + detail::format_number(output_dt) + ": expected > 0");
 }
 
 std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers) {
@@ -171,7 +151,7 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
         tau[i] = cars[i].model->delay();
         if (tau[i] > 0.0) h = std::min(h, tau[i]);
         if (!(s_eq[i] > 0.0) || !std::isfinite(s_eq[i])) {
-            throw std::invalid_argument("follower " + std::to_string(i + 1) + ": no positive equilibrium gap at the lead's initial speed " + fmt(v0) + " m/s");
+            throw std::invalid_argument("follower " + std::to_string(i + 1) + ": no positive equilibrium gap at the lead's initial speed " + detail::format_number(v0) + " m/s");
         }
     }
     const double t_end = options.t_end > 0.0 ? options.t_end : lead.duration() + 30.0;

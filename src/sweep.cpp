@@ -16,17 +16,11 @@
 #include "ddemap/eigensolver.hpp"
 #include "ddemap/ring.hpp"
 #include "ddemap/string_stability.hpp"
+#include "text.hpp"
 
 namespace ddemap {
 
 namespace {
-
-std::string fmt(double v) {
-    std::ostringstream os;
-    os.precision(17);
-    os << v;
-    return os.str();
-}
 
 double certificate_gap(cplx z) { return 1e-10 * std::max(1.0, std::abs(z)); }
 
@@ -42,9 +36,8 @@ Axis parse_axis(const std::string& name, const std::string& text) {
         throw std::invalid_argument(what);
     }
     auto number = [&](const std::string& t) {
-        char* end = nullptr;
-        const double v = std::strtod(t.c_str(), &end);
-        if (t.empty() || *end != '\0' || !std::isfinite(v)) throw std::invalid_argument(what);
+        double v = 0.0;
+        if (!detail::parse_finite(t, v)) throw std::invalid_argument(what);
         return v;
     };
     a.lo = number(text.substr(0, c1));
@@ -271,7 +264,7 @@ void SweepSpec::validate() const {
     for (const auto& a : {x, y}) {
         if (fixed.count(a.name)) throw std::invalid_argument("parameter '" + a.name + "' is both swept and fixed");
         if (!(std::isfinite(a.lo) && std::isfinite(a.hi) && a.lo < a.hi)) {
-            throw std::invalid_argument("--" + a.name + " range " + fmt(a.lo) + ":" + fmt(a.hi) + ": expected finite LO < HI");
+            throw std::invalid_argument("--" + a.name + " range " + detail::format_number(a.lo) + ":" + detail::format_number(a.hi) + ": expected finite LO < HI");
         }
     }
     for (double xv : {x.lo, x.hi})

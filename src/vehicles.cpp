@@ -1,5 +1,7 @@
 #include "ddemap/vehicles.hpp"
 
+#include "text.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -42,43 +44,6 @@ const std::vector<CalibratedVehicle>& paper_calibration_table() {
     return table;
 }
 
-namespace {
-
-std::vector<std::string> split_csv_line(const std::string& line) {
-    std::vector<std::string> out;
-    std::string field;
-    bool quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char c = line[i];
-        if (quoted) {
-            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-                field += '"';
-                ++i;
-            } else if (c == '"') {
-                quoted = false;
-            } else {
-                field += c;
-            }
-        } else if (c == '"') {
-            quoted = true;
-        } else if (c == ',') {
-            out.push_back(field);
-            field.clear();
-        } else if (c != '\r') {
-            field += c;
-        }
-    }
-    out.push_back(field);
-    for (auto& f : out) {
-        const auto b = f.find_first_not_of(" \t");
-        const auto e = f.find_last_not_of(" \t");
-        f = b == std::string::npos ? std::string() : f.substr(b, e - b + 1);
-    }
-    return out;
-}
-
-}  // namespace
-
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
     std::istringstream in(text);
     std::string line;
@@ -86,8 +51,8 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
     std::vector<std::string> header;
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-        header = split_csv_line(line);
+        if (detail::is_blank(line) || line[0] == '#') continue;
+        header = detail::split_csv_line(line);
         break;
     }
     if (header.empty()) throw std::invalid_argument(source + ": empty file: expected a header name,k1,k2,th,tau[,eta]");
@@ -110,8 +75,8 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
     std::vector<CalibratedVehicle> out;
     while (std::getline(in, line)) {
         ++lineno;
-        if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-        const auto f = split_csv_line(line);
+        if (detail::is_blank(line) || line[0] == '#') continue;
+        const auto f = detail::split_csv_line(line);
         const std::string at = source + ":" + std::to_string(lineno);
         if (f.size() != header.size()) {
             throw std::invalid_argument(at + ": " + std::to_string(f.size()) + " fields, expected " + std::to_string(header.size()) +
@@ -125,10 +90,8 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
         for (int i = 0; i < 5; ++i) {
             if (c_param[i] < 0) continue;
             const std::string& t = f[c_param[i]];
-            char* end = nullptr;
-            errno = 0;
-            const double x = std::strtod(t.c_str(), &end);
-            if (t.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(x)) {
+            double x = 0.0;
+            if (!detail::parse_finite(t, x)) {
                 throw std::invalid_argument(at + ": column '" + params[i] + "' = '" + t + "': expected a finite number");
             }
             v.parameters[params[i]] = x;

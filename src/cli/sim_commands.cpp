@@ -241,7 +241,6 @@ struct SimCommands::Impl {
                 sp.series.push_back({"follower (measured)", t.t, t.speed, "#000000", false});
                 sp.series.push_back({"follower (model)", t.t, fits[i].sim_speed, "#d62728", false});
                 PlotPanel gp{name + ": gap", "time [s]", "gap [m]", {}, {}};
-                gp.series.push_back({"lead (measured)", {}, {}, "#7f7f7f", true});
                 gp.series.push_back({"follower (measured)", t.t, t.gap, "#000000", false});
                 gp.series.push_back({"follower (model)", t.t, fits[i].sim_gap, "#d62728", false});
                 panels.push_back(sp);

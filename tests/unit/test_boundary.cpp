@@ -6,18 +6,11 @@
 #include "ddemap/continuation.hpp"
 #include "ddemap/ring.hpp"
 #include "ddemap/string_stability.hpp"
+#include "chart_helpers.hpp"
 
 using namespace ddemap;
 
 namespace {
-SweepSpec chart(int n, int cars, double th, double tau) {
-    SweepSpec s;
-    s.fixed = {{"th", th}, {"tau", tau}};
-    s.x = parse_axis("k1", "0.01:1:" + std::to_string(n));
-    s.y = parse_axis("k2", "0.01:1:" + std::to_string(n));
-    s.cars = cars;
-    return s;
-}
 /// Closed form: k1 [i w th + e^{-i w tau}(1 - zeta)] + k2 [i w (1 - zeta e^{-i w tau})] = w^2.
 void closed_form(double w, cplx zeta, double th, double tau, double& k1, double& k2) {
     const cplx e = std::exp(cplx(0.0, -w * tau));
@@ -31,7 +24,7 @@ void closed_form(double w, cplx zeta, double th, double tau, double& k1, double&
 
 TEST_CASE("ring Hopf curves equal the closed-form D-subdivision curves to 1e-8") {
     for (const auto& [th, tau] : {std::pair{1.5, 0.5}, std::pair{1.0, 0.2}}) {
-        const SweepSpec spec = chart(31, 12, th, tau);
+        const SweepSpec spec = ddemap::test::ovrv_chart(31, 12, th, tau);
         const SweepResult sweep = run_sweep(spec);
         const BoundarySet set = trace_boundaries(sweep);
         int ring_points = 0, ring_curves = 0;
@@ -71,7 +64,7 @@ TEST_CASE("ring Hopf curves equal the closed-form D-subdivision curves to 1e-8")
 }
 
 TEST_CASE("the low-frequency string boundary is c2 = 0 and ends on the window edges") {
-    const SweepSpec spec = chart(31, 12, 1.5, 0.5);
+    const SweepSpec spec = ddemap::test::ovrv_chart(31, 12, 1.5, 0.5);
     const BoundarySet set = trace_boundaries(run_sweep(spec));
     int found = 0;
     for (const auto& c : set.curves) {

@@ -7,22 +7,13 @@
 #include "ddemap/ring.hpp"
 #include "ddemap/string_stability.hpp"
 #include "ddemap/sweep.hpp"
+#include "chart_helpers.hpp"
 
 using namespace ddemap;
 
-namespace {
-SweepSpec chart(int n, int cars, double th, double tau) {
-    SweepSpec s;
-    s.fixed = {{"th", th}, {"tau", tau}};
-    s.x = parse_axis("k1", "0.01:1:" + std::to_string(n));
-    s.y = parse_axis("k2", "0.01:1:" + std::to_string(n));
-    s.cars = cars;
-    return s;
-}
-}  // namespace
 
 TEST_CASE("sweep points equal the per-point computation (random points, boundaries, mode switches)") {
-    const SweepResult r = run_sweep(chart(41, 22, 1.5, 0.5));
+    const SweepResult r = run_sweep(ddemap::test::ovrv_chart(41, 22, 1.5, 0.5));
     CHECK(r.uncertified == 0);
     std::mt19937 rng(23);
     std::uniform_int_distribution<int> pick(0, 40);
@@ -65,7 +56,7 @@ TEST_CASE("sweep points equal the per-point computation (random points, boundari
 }
 
 TEST_CASE("N = infinity sweeps agree with the per-point verdicts") {
-    const SweepResult r = run_sweep(chart(7, 0, 1.2, 0.3));
+    const SweepResult r = run_sweep(ddemap::test::ovrv_chart(7, 0, 1.2, 0.3));
     for (const auto& p : r.points) {
         const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
         const RingResult ring = analyse_ring(lin, 0);
@@ -81,7 +72,7 @@ TEST_CASE("axes and sweep specs are validated") {
     CHECK_THROWS_AS(parse_axis("k1", "0:1"), std::invalid_argument);
     CHECK_THROWS_AS(parse_axis("k1", "0:1:1"), std::invalid_argument);
     CHECK_THROWS_AS(parse_axis("k1", "0:x:4"), std::invalid_argument);
-    SweepSpec s = chart(3, 22, 1.5, 0.5);
+    SweepSpec s = ddemap::test::ovrv_chart(3, 22, 1.5, 0.5);
     s.x = parse_axis("k1", "-1:1:3");
     CHECK_THROWS_WITH_AS(s.validate(), "k1 = -1: expected a value >= 0 [1/s^2]", std::invalid_argument);
 }
