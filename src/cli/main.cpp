@@ -1,6 +1,7 @@
 // ddemap: a thin command-line front. It parses, calls the library, formats.
 // Exit codes: 0 success, 2 bad input (one line on stderr), 3 internal error.
 #include <cerrno>
+#include <fstream>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -18,6 +19,7 @@
 #include "ddemap/model.hpp"
 #include "ddemap/ring.hpp"
 #include "ddemap/string_stability.hpp"
+#include "ddemap/system_io.hpp"
 #include "ddemap/vehicles.hpp"
 #include "charts.hpp"
 #include "sim_commands.hpp"
@@ -37,9 +39,74 @@ struct RootsArgs {
     std::string ring = "22";
     std::string count = "6";
     std::string format = "table";
+    std::string system;
+    bool ring_given = false;
 };
 
+/// roots --system FILE.json: any linear DDE with discrete delays
+void run_system_roots(const RootsArgs& args) {
+    if (!args.model.raw.empty() || args.ring_given || args.model.model != "ovrv") {
+        throw BadInput("--system takes the whole problem from the file: expected no model parameters, --model or --ring");
+    }
+    const int count = static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000"));
+    const Format format = parse_format(args.format);
+    std::ifstream in(args.system, std::ios::binary);
+    if (!in) throw BadInput("--system = '" + args.system + "': cannot open the file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    const LinearDDE dde = read_linear_dde_json(text.str(), args.system);
+    RootOptions opt;
+    opt.count = count;
+    const RootResult r = rightmost_roots(dde, opt);
+    const double a = r.spectral_abscissa();
+    const bool stable = r.status == RootStatus::Converged && !r.roots.empty() && a < -marginal_band(r.roots.front().value);
+    std::ostringstream out;
+    if (format == Format::Json) {
+        json j;
+        j["command"] = "roots";
+        j["version"] = DDEMAP_VERSION;
+        j["system"] = args.system;
+        j["dimension"] = dde.dimension();
+        json delays = json::array();
+        for (const auto& t : dde.delayed()) delays.push_back(t.delay);
+        j["delays"] = delays;
+        json roots = json::array();
+        for (const auto& x : r.roots) {
+            roots.push_back({{"re", num(x.value.real())}, {"im", num(x.value.imag())}, {"residual", num(x.residual)},
+                             {"newton_step", num(x.newton_step)}});
+        }
+        j["roots"] = roots;
+        j["spectral_abscissa"] = num(a);
+        j["stable"] = stable;
+        j["degree"] = r.degree;
+        j["degree_reason"] = r.reason;
+        j["status"] = to_string(r.status);
+        out << j.dump(2) << "\n";
+    } else if (format == Format::Csv) {
+        out << "re,im,residual,newton_step\n";
+        for (const auto& x : r.roots)
+            out << exact(x.value.real()) << "," << exact(x.value.imag()) << "," << exact(x.residual) << "," << exact(x.newton_step) << "\n";
+    } else {
+        out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
+        out << "degree     M = " << r.degree << " (" << to_string(r.status) << ")\n";
+        out << "abscissa   " << rounded(a, 10) << "\n";
+        out << "verdict    " << (stable ? "STABLE" : "NOT asymptotically stable") << "\n\n";
+        out << "  #                re                 im    residual\n";
+        int i = 0;
+        for (const auto& x : r.roots) {
+            char line[160];
+            std::snprintf(line, sizeof line, "%3d %17.12f %18.12f %11.2e\n", ++i, x.value.real(), x.value.imag(), x.residual);
+            out << line;
+        }
+    }
+    std::cout << out.str();
+}
+
 void run_roots(const RootsArgs& args) {
+    if (!args.system.empty()) {
+        run_system_roots(args);
+        return;
+    }
     const auto model = args.model.build();
     const int cars = parse_ring(args.ring);
     const int count = static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000"));
@@ -210,6 +277,7 @@ int main(int argc, char** argv) {
     roots->add_option("--ring", roots_args.ring, "number of cars N >= 2, or inf for all wave numbers")->capture_default_str();
     roots->add_option("--count", roots_args.count, "how many rightmost roots to list")->capture_default_str();
     roots->add_option("--format", roots_args.format, "table, json or csv")->capture_default_str();
+    roots->add_option("--system", roots_args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
 
     StringArgs string_args;
     auto* str = app.add_subcommand("string", "plant and string stability from the head-to-tail transfer function");
@@ -238,7 +306,10 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
-        if (roots->parsed()) run_roots(roots_args);
+        if (roots->parsed()) {
+            roots_args.ring_given = roots->count("--ring") > 0;
+            run_roots(roots_args);
+        }
         else if (str->parsed()) run_string(string_args);
         else if (!charts.run()) sims.run();
         return 0;

@@ -214,6 +214,16 @@ expect_error "badtrace.csv:3: column 'follower_speed_mps' = 'x'" calibrate "$tmp
 expect_error "--bounds item 'eta=15'" calibrate "$excerpt" --bounds eta=15
 expect_error "--train = '5'" calibrate "$excerpt" --train 5
 
+# roots --system: any linear DDE from JSON
+cat >"$tmp/sys.json" <<'JSON'
+{"dimension": 2, "delays": [1.0, 0.3], "A0": [[0, 0], [0, 0]],
+ "A": [{"triplets": [[0, 0, -1]]}, {"triplets": [[1, 1, [0, 0.5]]]}]}
+JSON
+"$bin" roots --system "$tmp/sys.json" --format json >"$tmp/sys.out" && json_has "$tmp/sys.out" roots spectral_abscissa stable degree status && ok || bad "roots --system"
+printf '{"dimension": 2, "A0": [[1, 2], [3]]}' >"$tmp/bad.json"
+expect_error "bad.json: A0\[1\]: expected 2 entries" roots --system "$tmp/bad.json"
+expect_error "expected no model parameters" roots --system "$tmp/sys.json" --k1 0.3
+
 # help on every command, with units
 for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi
