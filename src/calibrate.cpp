@@ -43,46 +43,19 @@ std::string nlopt_status(nlopt::result r) {
 }  // namespace
 
 Trace read_trace_csv(const std::string& text, const std::string& source) {
-    std::istringstream in(text);
-    std::string line;
-    int lineno = 0;
-    std::vector<std::string> header;
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (detail::is_blank(line)) continue;
-        header = detail::split_csv_line(line);
-        break;
-    }
+    detail::CsvReader csv(text, source, "time_s, lead_speed_mps, follower_speed_mps, gap_m");
     const char* cols[4] = {"time_s", "lead_speed_mps", "follower_speed_mps", "gap_m"};
-    std::size_t idx[4];
-    for (int c = 0; c < 4; ++c) {
-        const auto it = std::find(header.begin(), header.end(), cols[c]);
-        if (it == header.end()) {
-            throw std::invalid_argument(source + ":" + std::to_string(std::max(lineno, 1)) + ": missing column '" + cols[c] +
-                                        "' (expected time_s, lead_speed_mps, follower_speed_mps, gap_m)");
-        }
-        idx[c] = it - header.begin();
-    }
+    int idx[4];
+    for (int c = 0; c < 4; ++c) idx[c] = csv.column(cols[c]);
     Trace tr;
     tr.source = source;
     std::vector<double>* dest[4] = {&tr.t, &tr.lead, &tr.speed, &tr.gap};
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (detail::is_blank(line)) continue;
-        const auto f = detail::split_csv_line(line);
-        for (int c = 0; c < 4; ++c) {
-            const std::string x = idx[c] < f.size() ? f[idx[c]] : std::string();
-            double d = 0.0;
-            if (!detail::parse_finite(x, d)) {
-                throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": column '" + cols[c] + "' = '" + x +
-                                            "': expected a finite number");
-            }
-            dest[c]->push_back(d);
-        }
+    while (csv.next()) {
+        for (int c = 0; c < 4; ++c) dest[c]->push_back(csv.number(idx[c], cols[c]));
         const std::size_t n = tr.t.size();
         if (n > 1 && !(tr.t[n - 1] > tr.t[n - 2])) {
-            throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": time_s = " + detail::format_number(tr.t[n - 1]) + " after " +
-                                        detail::format_number(tr.t[n - 2]) + ": expected increasing times");
+            csv.fail("time_s = " + detail::format_number(tr.t[n - 1]) + " after " + detail::format_number(tr.t[n - 2]) +
+                     ": expected increasing times");
         }
     }
     if (tr.t.size() < 100 || tr.t.back() - tr.t.front() < 20.0) {

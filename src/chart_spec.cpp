@@ -52,6 +52,17 @@ Axis read_axis(const std::string& source, const toml::table& root, const char* k
 
 }  // namespace
 
+SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel) {
+    SweepSpec s;
+    s.model = spec.model;
+    s.fixed = spec.fixed;
+    for (const auto& [k, v] : spec.panels.at(panel).parameters) s.fixed[k] = v;
+    s.x = spec.x;
+    s.y = spec.y;
+    s.cars = spec.cars;
+    return s;
+}
+
 std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehicles) {
     std::vector<PanelSpec> panels;
     for (const auto& v : vehicles) {
@@ -146,15 +157,8 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     if (spec.panels.empty()) spec.panels.push_back(PanelSpec{});
     // validate every panel's model at the window corners now, with the source named
     for (std::size_t i = 0; i < spec.panels.size(); ++i) {
-        SweepSpec s;
-        s.model = spec.model;
-        s.fixed = spec.fixed;
-        for (const auto& [k, v] : spec.panels[i].parameters) s.fixed[k] = v;
-        s.x = spec.x;
-        s.y = spec.y;
-        s.cars = spec.cars;
         try {
-            s.validate();
+            panel_sweep(spec, i).validate();
         } catch (const std::invalid_argument& e) {
             throw std::invalid_argument(source + ": panel " + std::to_string(i + 1) + ": " + e.what());
         }
@@ -170,14 +174,8 @@ RenderedChart render_chart(const ChartSpec& spec) {
     out.sweeps.resize(n);
     out.boundaries.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-        SweepSpec& s = out.specs[i];
-        s.model = spec.model;
-        s.fixed = spec.fixed;
-        for (const auto& [k, v] : spec.panels[i].parameters) s.fixed[k] = v;
-        s.x = spec.x;
-        s.y = spec.y;
-        s.cars = spec.cars;
-        out.sweeps[i] = run_sweep(s);
+        out.specs[i] = panel_sweep(spec, i);
+        out.sweeps[i] = run_sweep(out.specs[i]);
         if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i]);
     }
     std::vector<ChartPanel> panels(n);

@@ -87,39 +87,16 @@ LeadProfile LeadProfile::builtin(const std::string& name) {
 }
 
 LeadProfile LeadProfile::from_csv(const std::string& text, const std::string& source) {
-    std::istringstream in(text);
-    std::string line;
-    int lineno = 0;
-    std::vector<std::string> header;
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (detail::is_blank(line)) continue;
-        header = detail::split_csv_line(line);
-        break;
-    }
-    const auto ct = std::find(header.begin(), header.end(), "time_s");
-    const auto cv = std::find(header.begin(), header.end(), "lead_speed_mps");
-    if (ct == header.end() || cv == header.end()) {
-        throw std::invalid_argument(source + ":" + std::to_string(std::max(lineno, 1)) + ": expected columns time_s and lead_speed_mps");
-    }
-    const std::size_t it = ct - header.begin(), iv = cv - header.begin();
+    detail::CsvReader csv(text, source, "time_s, lead_speed_mps");
+    const int it = csv.column("time_s"), iv = csv.column("lead_speed_mps");
     std::vector<double> t, v;
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (detail::is_blank(line)) continue;
-        const auto f = detail::split_csv_line(line);
-        for (auto [col, name] : {std::pair{it, "time_s"}, std::pair{iv, "lead_speed_mps"}}) {
-            const std::string x = col < f.size() ? f[col] : std::string();
-            double d = 0.0;
-            if (!detail::parse_finite(x, d)) {
-                throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": column '" + name + "' = '" + x + "': expected a finite number");
-            }
-            (col == it ? t : v).push_back(d);
-        }
+    while (csv.next()) {
+        t.push_back(csv.number(it, "time_s"));
+        v.push_back(csv.number(iv, "lead_speed_mps"));
         if (t.size() > 1 && !(t.back() > t[t.size() - 2])) {
-            throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": time_s = " + detail::format_number(t.back()) + ": expected increasing times");
+            csv.fail("time_s = " + detail::format_number(t.back()) + ": expected increasing times");
         }
-        if (v.back() < 0.0) throw std::invalid_argument(source + ":" + std::to_string(lineno) + ": lead_speed_mps = " + detail::format_number(v.back()) + ": expected >= 0");
+        if (v.back() < 0.0) csv.fail("lead_speed_mps = " + detail::format_number(v.back()) + ": expected >= 0");
     }
     if (t.size() < 2) throw std::invalid_argument(source + ": expected at least two samples");
     return LeadProfile(t, v);

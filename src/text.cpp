@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
+#include <stdexcept>
 
 namespace ddemap::detail {
 
@@ -58,5 +60,55 @@ bool parse_finite(const std::string& text, double& value) {
 }
 
 bool is_blank(const std::string& line) { return line.find_first_not_of(" \t\r") == std::string::npos; }
+
+CsvReader::CsvReader(const std::string& text, std::string source, std::string expected)
+    : m_source(std::move(source)), m_expected(std::move(expected)) {
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) m_lines.push_back(line);
+    while (m_pos < m_lines.size()) {
+        const std::string& l = m_lines[m_pos++];
+        if (is_blank(l) || l[0] == '#') continue;
+        m_header = split_csv_line(l);
+        m_header_line = static_cast<int>(m_pos);
+        break;
+    }
+    if (m_header.empty()) throw std::invalid_argument(m_source + ": empty file: expected a header " + m_expected);
+}
+
+int CsvReader::column(const std::string& name, bool required) const {
+    for (std::size_t i = 0; i < m_header.size(); ++i)
+        if (m_header[i] == name) return static_cast<int>(i);
+    if (required) {
+        throw std::invalid_argument(m_source + ":" + std::to_string(m_header_line) + ": missing column '" + name + "' (expected " +
+                                    m_expected + ")");
+    }
+    return -1;
+}
+
+bool CsvReader::next() {
+    while (m_pos < m_lines.size()) {
+        const std::string& l = m_lines[m_pos++];
+        if (is_blank(l) || l[0] == '#') continue;
+        m_fields = split_csv_line(l);
+        m_line = static_cast<int>(m_pos);
+        if (m_fields.size() != m_header.size()) {
+            fail(std::to_string(m_fields.size()) + " fields, expected " + std::to_string(m_header.size()) + " as in the header");
+        }
+        return true;
+    }
+    return false;
+}
+
+std::string CsvReader::where() const { return m_source + ":" + std::to_string(m_line); }
+
+double CsvReader::number(int column, const std::string& name) const {
+    const std::string& x = m_fields.at(static_cast<std::size_t>(column));
+    double v = 0.0;
+    if (!parse_finite(x, v)) fail("column '" + name + "' = '" + x + "': expected a finite number");
+    return v;
+}
+
+void CsvReader::fail(const std::string& what) const { throw std::invalid_argument(where() + ": " + what); }
 
 }  // namespace ddemap::detail

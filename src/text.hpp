@@ -18,4 +18,31 @@ bool parse_finite(const std::string& text, double& value);
 /// True for an empty or all-blank line.
 bool is_blank(const std::string& line);
 
+/// A CSV text with a header line; blank lines and lines starting with '#' are skipped. Errors
+/// are std::invalid_argument starting with "SOURCE:LINE: ".
+class CsvReader {
+public:
+    /// `expected` describes the columns for messages, e.g. "name,k1,k2,th,tau[,eta]".
+    CsvReader(const std::string& text, std::string source, std::string expected);
+    /// Index of a column; -1 if absent and not required; required and absent: an error.
+    int column(const std::string& name, bool required = true) const;
+    int columns() const { return static_cast<int>(m_header.size()); }
+    /// Advances to the next data row; false at the end.
+    bool next();
+    /// "SOURCE:LINE" of the current row.
+    std::string where() const;
+    const std::vector<std::string>& fields() const { return m_fields; }
+    /// The current row's field as a finite number ("column 'NAME' = 'X': expected a finite number").
+    double number(int column, const std::string& name) const;
+    /// Throws "SOURCE:LINE: what" for the current row.
+    [[noreturn]] void fail(const std::string& what) const;
+
+private:
+    std::vector<std::string> m_lines;
+    std::string m_source, m_expected;
+    std::vector<std::string> m_header, m_fields;
+    std::size_t m_pos = 0;
+    int m_header_line = 0, m_line = 0;
+};
+
 }  // namespace ddemap::detail

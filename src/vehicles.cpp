@@ -45,61 +45,24 @@ const std::vector<CalibratedVehicle>& paper_calibration_table() {
 }
 
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
-    std::istringstream in(text);
-    std::string line;
-    int lineno = 0;
-    std::vector<std::string> header;
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (detail::is_blank(line) || line[0] == '#') continue;
-        header = detail::split_csv_line(line);
-        break;
-    }
-    if (header.empty()) throw std::invalid_argument(source + ": empty file: expected a header name,k1,k2,th,tau[,eta]");
-    const int header_line = lineno;
-    auto column = [&](const std::string& name, bool required) {
-        const auto it = std::find(header.begin(), header.end(), name);
-        if (it == header.end()) {
-            if (required) {
-                throw std::invalid_argument(source + ":" + std::to_string(header_line) + ": missing column '" + name +
-                                            "' (expected name,k1,k2,th,tau[,eta])");
-            }
-            return -1;
-        }
-        return static_cast<int>(it - header.begin());
-    };
-    const int c_name = column("name", true);
+    detail::CsvReader csv(text, source, "name,k1,k2,th,tau[,eta]");
+    const int c_name = csv.column("name");
     const char* params[] = {"k1", "k2", "th", "tau", "eta"};
     int c_param[5];
-    for (int i = 0; i < 5; ++i) c_param[i] = column(params[i], i < 4);
+    for (int i = 0; i < 5; ++i) c_param[i] = csv.column(params[i], i < 4);
     std::vector<CalibratedVehicle> out;
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (detail::is_blank(line) || line[0] == '#') continue;
-        const auto f = detail::split_csv_line(line);
-        const std::string at = source + ":" + std::to_string(lineno);
-        if (f.size() != header.size()) {
-            throw std::invalid_argument(at + ": " + std::to_string(f.size()) + " fields, expected " + std::to_string(header.size()) +
-                                        " as in the header");
-        }
+    while (csv.next()) {
         CalibratedVehicle v;
-        v.name = f[c_name];
-        if (v.name.empty()) throw std::invalid_argument(at + ": column 'name' is empty: expected a vehicle name");
+        v.name = csv.fields()[c_name];
+        if (v.name.empty()) csv.fail("column 'name' is empty: expected a vehicle name");
         v.vehicle = v.name;
         v.parameters["eta"] = 10.0;
-        for (int i = 0; i < 5; ++i) {
-            if (c_param[i] < 0) continue;
-            const std::string& t = f[c_param[i]];
-            double x = 0.0;
-            if (!detail::parse_finite(t, x)) {
-                throw std::invalid_argument(at + ": column '" + params[i] + "' = '" + t + "': expected a finite number");
-            }
-            v.parameters[params[i]] = x;
-        }
+        for (int i = 0; i < 5; ++i)
+            if (c_param[i] >= 0) v.parameters[params[i]] = csv.number(c_param[i], params[i]);
         try {
             (void)make_model("ovrv", v.parameters);
         } catch (const std::invalid_argument& e) {
-            throw std::invalid_argument(at + ": " + e.what());
+            csv.fail(e.what());
         }
         out.push_back(v);
     }

@@ -37,6 +37,9 @@ struct ChartSpec {
 /// Parses a chart spec; std::invalid_argument naming `source`, the line and the key on error.
 ChartSpec parse_chart_spec(const std::string& text, const std::string& source);
 
+/// The sweep of one panel: the chart's model, window and ring with the panel's parameters.
+SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel);
+
 /// Panels for a list of vehicles: each at its own tau and th (and eta), marked at (k1, k2).
 std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehicles);
 

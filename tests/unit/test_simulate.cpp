@@ -132,7 +132,7 @@ TEST_CASE("lead profiles: exact position, validation, CSV errors") {
     CHECK_THROWS_AS(LeadProfile({0.0, 1.0}, {1.0, -1.0}), std::invalid_argument);
     CHECK_THROWS_WITH_AS(LeadProfile::from_csv("time_s,lead_speed_mps\n0,20\n1,x\n", "lead.csv"),
                          "lead.csv:3: column 'lead_speed_mps' = 'x': expected a finite number", std::invalid_argument);
-    CHECK_THROWS_WITH_AS(LeadProfile::from_csv("t,v\n0,20\n", "lead.csv"), "lead.csv:1: expected columns time_s and lead_speed_mps",
+    CHECK_THROWS_WITH_AS(LeadProfile::from_csv("t,v\n0,20\n", "lead.csv"), "lead.csv:1: missing column 'time_s' (expected time_s, lead_speed_mps)",
                          std::invalid_argument);
     CHECK_THROWS_AS(LeadProfile::builtin("wave"), std::invalid_argument);
     const LeadProfile dip = LeadProfile::builtin("dip");
