@@ -54,7 +54,7 @@ inline long parse_integer(const std::string& flag, const std::string& text, long
 /// --ring N|inf -> N (0 for infinity)
 inline int parse_ring(const std::string& text) {
     if (text == "inf" || text == "infinity") return 0;
-    return static_cast<int>(parse_integer("--ring", text, 2, 10000000, "an integer N >= 2 (at most 10000000) or 'inf'"));
+    return static_cast<int>(parse_integer("--ring", text, 2, 1000000, "an integer N >= 2 (at most 1000000) or 'inf'"));
 }
 
 /// The model options shared by the analysis commands.
