@@ -48,6 +48,18 @@ double nice_step(double range) {
     return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
 }
 
+/// XML declaration, the svg element (width x height px), a white background and the title.
+void svg_preamble(std::ostringstream& s, double width, double height, const std::string& title) {
+    s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\"" << num(height)
+      << "\" viewBox=\"0 0 " << num(width) << " " << num(height) << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
+    s << "<rect id=\"background\" x=\"0\" y=\"0\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" fill=\"#ffffff\"/>\n";
+    if (!title.empty()) {
+        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
+          << esc(title) << "</text>\n";
+    }
+}
+
 struct Style {
     const char* colour;
     const char* dash;
@@ -97,14 +109,7 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     const double height = header + rows * ch + legend_h;
 
     std::ostringstream s;
-    s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\"" << num(height)
-      << "\" viewBox=\"0 0 " << num(width) << " " << num(height) << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
-    s << "<rect id=\"background\" x=\"0\" y=\"0\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" fill=\"#ffffff\"/>\n";
-    if (!o.title.empty()) {
-        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
-          << esc(o.title) << "</text>\n";
-    }
+    svg_preamble(s, width, height, o.title);
     for (std::size_t pi = 0; pi < panels.size(); ++pi) {
         const ChartPanel& panel = panels[pi];
         const SweepResult& sw = *panel.sweep;
@@ -246,14 +251,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     const double note_h = o.note.empty() ? 0 : 20;
     const double height = header + rows * ch + legend_h + note_h;
     std::ostringstream s;
-    s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" viewBox=\"0 0 "
-      << num(width) << " " << num(height) << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
-    s << "<rect id=\"background\" x=\"0\" y=\"0\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" fill=\"#ffffff\"/>\n";
-    if (!o.title.empty()) {
-        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
-          << esc(o.title) << "</text>\n";
-    }
+    svg_preamble(s, width, height, o.title);
     for (std::size_t pi = 0; pi < panels.size(); ++pi) {
         const PlotPanel& p = panels[pi];
         double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
@@ -355,6 +353,22 @@ void write_file_atomic(const std::string& path, const std::string& text) {
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         std::remove(tmp.c_str());
         throw std::runtime_error("cannot write " + path);
+    }
+}
+
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
+    std::vector<std::string> written;
+    try {
+        for (const auto& [path, text] : files) {
+            write_file_atomic(path + ".part", text);
+            written.push_back(path + ".part");
+        }
+    } catch (...) {
+        for (const auto& w : written) std::remove(w.c_str());
+        throw;
+    }
+    for (const auto& [path, text] : files) {
+        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) throw std::runtime_error("cannot write " + path);
     }
 }
 

@@ -6,6 +6,7 @@
 /// panels (small multiples). The writer only formats what it is given.
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ddemap/continuation.hpp"
@@ -74,5 +75,9 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
 /// Writes `text` to `path` atomically (a temporary file renamed into place); throws
 /// std::runtime_error naming the path on failure.
 void write_file_atomic(const std::string& path, const std::string& text);
+
+/// Writes several files so that either all appear or none is left half-written: all are
+/// written to temporary files first, then renamed into place.
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace ddemap

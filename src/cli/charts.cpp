@@ -27,23 +27,6 @@ void progress_line(int done, int total) {
     std::fflush(stderr);
 }
 
-/// Writes several files so that either all appear or none is left half-written.
-void write_all(const std::vector<std::pair<std::string, std::string>>& files) {
-    std::vector<std::string> written;
-    try {
-        for (const auto& [path, text] : files) {
-            write_file_atomic(path + ".part", text);
-            written.push_back(path + ".part");
-        }
-    } catch (...) {
-        for (const auto& w : written) std::remove(w.c_str());
-        throw;
-    }
-    for (const auto& [path, text] : files) {
-        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) throw std::runtime_error("cannot write " + path);
-    }
-}
-
 json sweep_json(const SweepResult& sw, const BoundarySet* b) {
     json j;
     j["command"] = "sweep";
@@ -190,7 +173,7 @@ struct ChartCommands::Impl {
         if (format == Format::Json) text = classification_json(rows, cars, source).dump(2) + "\n";
         else if (format == Format::Csv) text = classification_csv(rows);
         else text = classification_table(rows, cars, source);
-        if (!classify_svg.empty()) write_all({{classify_svg, render_chart(classification_chart(vehicles, cars)).svg}});
+        if (!classify_svg.empty()) write_files_atomic({{classify_svg, render_chart(classification_chart(vehicles, cars)).svg}});
         std::cout << text;
     }
 
@@ -198,7 +181,7 @@ struct ChartCommands::Impl {
         check_output("--out", chart_out);
         const ChartSpec spec = parse_chart_spec(read_text_file("SPEC", chart_spec), chart_spec);
         const RenderedChart r = render_chart(spec);
-        write_all({{chart_out, r.svg}});
+        write_files_atomic({{chart_out, r.svg}});
         std::cout << "chart      " << spec.panels.size() << " panels in " << rounded(r.seconds, 3) << " s\nwrote      " << chart_out << "\n";
     }
 
@@ -231,7 +214,7 @@ struct ChartCommands::Impl {
         files.emplace_back(dir + "growth.svg", growth_svg(growth, "dip"));
         files.emplace_back(dir + "paper.json", json{{"command", "paper"}, {"version", DDEMAP_VERSION}, {"panels", summary},
                                                     {"seconds", fig.seconds + cls.seconds}}.dump(2) + "\n");
-        write_all(files);
+        write_files_atomic(files);
         std::ostringstream out;
         out << classification_table(rows, 22, source);
         out << "\ndisturbance growth behind the dip (22.4 -> 19.7 -> 22.4 m/s), platoons of up to 15 followers\n";
@@ -298,7 +281,7 @@ struct ChartCommands::Impl {
             {sweep_out + ".svg", render_chart_svg({panel}, co)},
         };
         if (!no_boundaries) files.emplace_back(sweep_out + "-boundaries.csv", boundary_csv(spec, b));
-        write_all(files);
+        write_files_atomic(files);
         std::ostringstream out;
         out << "sweep      " << sw.points.size() << " points in " << rounded(sw.seconds, 3) << " s ("
  << static_cast<long>(std::lround(sw.points.size() / std::max(sw.seconds, 1e-9))) << " points/s, " << sw.threads << " threads)\n";
@@ -317,7 +300,7 @@ struct ChartCommands::Impl {
         check_output("--out", boundary_out);
         const SweepResult sw = run_sweep(spec);
         const BoundarySet b = trace_boundaries(sw);
-        write_all({{boundary_out, boundary_csv(spec, b)}});
+        write_files_atomic({{boundary_out, boundary_csv(spec, b)}});
         std::ostringstream out;
         out << "boundaries " << b.curves.size() << " curves (" << b.seeds << " seeds on a " << grid << " x " << grid << " grid)\n";
         for (std::size_t i = 0; i < b.curves.size(); ++i) {

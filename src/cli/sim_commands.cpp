@@ -249,10 +249,8 @@ struct SimCommands::Impl {
             PlotOptions po;
             po.title = "Calibrated OVRV: measured and simulated follower";
             po.columns = 2;
-            write_file_atomic(c_out + ".csv.part", csv.str());
-            write_file_atomic(c_out + ".json.part", j.dump(2) + "\n");
-            write_file_atomic(c_out + ".svg.part", render_line_plots_svg(panels, po));
-            for (const char* ext : {".csv", ".json", ".svg"}) std::rename((c_out + ext + ".part").c_str(), (c_out + ext).c_str());
+            write_files_atomic({{c_out + ".csv", csv.str()}, {c_out + ".json", j.dump(2) + "\n"},
+                                {c_out + ".svg", render_line_plots_svg(panels, po)}});
         }
         if (format == Format::Json) {
             std::cout << j.dump(2) << "\n";
@@ -333,10 +331,7 @@ struct SimCommands::Impl {
         po.columns = 1;
         po.panel_width = 760;
         po.panel_height = 340;
-        write_file_atomic(out + ".csv.part", csv.str());
-        write_file_atomic(out + ".json.part", j.dump(2) + "\n");
-        write_file_atomic(out + ".svg.part", render_line_plots_svg({p}, po));
-        for (const char* ext : {".csv", ".json", ".svg"}) std::rename((out + ext + ".part").c_str(), (out + ext).c_str());
+        write_files_atomic({{out + ".csv", csv.str()}, {out + ".json", j.dump(2) + "\n"}, {out + ".svg", render_line_plots_svg({p}, po)}});
         std::ostringstream s;
         s << "simulated  " << cars.size() << " followers to t = " << rounded(r.t_end, 5) << " s (" << r.steps << " steps)\n";
         s << "car  name      min speed  speed drop  min gap   events\n";
@@ -359,10 +354,7 @@ struct SimCommands::Impl {
         const LeadProfile lead = lead_from(g_lead_profile, g_lead_file, label);
         const auto g = disturbance_growth(paper_calibration_table(), lead, followers);
         if (!g_out.empty()) {
-            write_file_atomic(g_out + ".csv.part", growth_csv(g));
-            write_file_atomic(g_out + ".svg.part", growth_svg(g, label));
-            std::rename((g_out + ".csv.part").c_str(), (g_out + ".csv").c_str());
-            std::rename((g_out + ".svg.part").c_str(), (g_out + ".svg").c_str());
+            write_files_atomic({{g_out + ".csv", growth_csv(g)}, {g_out + ".svg", growth_svg(g, label)}});
         }
         if (format == Format::Csv) {
             std::cout << growth_csv(g);
