@@ -124,7 +124,16 @@ TEST_CASE("a narrow resonance peak is found (plant roots close to the axis)") {
 
 TEST_CASE("idm goes through the same analysis") {
     const auto m = make_model("idm", {{"th", 1.5}, {"tau", 0.3}, {"speed", 15}});
-    const StringResult s = analyse_string(m->linearise());
+    const Linearisation lin = m->linearise();
+    const StringResult s = analyse_string(lin);
     CHECK(s.plant_stable);
-    CHECK(std::isfinite(s.sup_gamma));
+    // sup against brute-force sampling, c2 against |D|^2 - |N|^2 evaluated at a small w
+    const TransferFunction tf(lin);
+    double brute = 1.0;
+    for (int j = 1; j <= 200000; ++j) brute = std::max(brute, std::abs(tf(cplx(0.0, s.omega_search_max * j / 200000.0))));
+    CHECK(s.sup_gamma >= brute * (1.0 - 1e-14));
+    CHECK(s.sup_gamma - brute < 1e-5 * s.sup_gamma);
+    const double w = 1e-3;
+    const double p = std::norm(tf.denominator(cplx(0.0, w))) - std::norm(tf.numerator(cplx(0.0, w)));
+    CHECK(p / (w * w) == doctest::Approx(s.lowfreq.c2).epsilon(1e-4));
 }
