@@ -10,7 +10,15 @@
 namespace ddemap {
 
 double Linearisation::max_delay() const {
-    return std::max({gap.max_delay(), own.max_delay(), lead.max_delay()});
+    double d = std::max({gap.max_delay(), own.max_delay(), lead.max_delay()});
+    for (const auto& f : further) d = std::max(d, f.max_delay());
+    return d;
+}
+
+void require_single_leader(const Linearisation& lin, const std::string& analysis) {
+    if (lin.leaders() > 1)
+        throw std::invalid_argument(analysis + " needs a law that uses only the car ahead; this one uses " +
+                                    std::to_string(lin.leaders()) + " cars ahead (analyse it as a ring or a fleet)");
 }
 
 namespace {
@@ -21,6 +29,20 @@ const std::vector<ParameterSpec>& ovrv_specs() {
         {"k2", "1/s", "gain on the speed difference v_lead - v", true, 0.0, 0.0, false},
         {"th", "s", "time headway", true, 0.0, 0.0, false},
         {"tau", "s", "sensing delay", true, 0.0, 0.0, false},
+        {"eta", "m", "jam (standstill) gap", false, 10.0, 0.0, false},
+        {"speed", "m/s", "equilibrium speed (the linearisation does not depend on it)", false, 20.0, 0.0, false},
+    };
+    return specs;
+}
+
+const std::vector<ParameterSpec>& ccc_specs() {
+    static const std::vector<ParameterSpec> specs = {
+        {"k1", "1/s^2", "gain on the gap error s - eta - th v", true, 0.0, 0.0, false},
+        {"k2", "1/s", "gain on the speed difference to the car ahead", true, 0.0, 0.0, false},
+        {"k3", "1/s", "gain on the speed difference to the car two ahead (V2V)", true, 0.0, 0.0, false},
+        {"th", "s", "time headway", true, 0.0, 0.0, false},
+        {"tau", "s", "sensing delay (gap, car ahead)", true, 0.0, 0.0, false},
+        {"tau2", "s", "delay of the V2V signal from the car two ahead", true, 0.0, 0.0, false},
         {"eta", "m", "jam (standstill) gap", false, 10.0, 0.0, false},
         {"speed", "m/s", "equilibrium speed (the linearisation does not depend on it)", false, 20.0, 0.0, false},
     };
@@ -105,6 +127,55 @@ Linearisation OvrvModel::linearise() const {
     return l;
 }
 
+std::unique_ptr<CarModel> OvrvModel::at_speed(double speed) const {
+    ParameterMap p = parameters();
+    p["speed"] = speed;
+    return std::make_unique<OvrvModel>(p);
+}
+
+// ---------------------------------------------------------------- CCC
+
+CccModel::CccModel(const ParameterMap& values) {
+    const ParameterMap p = resolve("ccc", ccc_specs(), values);
+    m_k1 = p.at("k1");
+    m_k2 = p.at("k2");
+    m_k3 = p.at("k3");
+    m_th = p.at("th");
+    m_tau = p.at("tau");
+    m_tau2 = p.at("tau2");
+    m_eta = p.at("eta");
+    m_speed = p.at("speed");
+}
+
+std::string CccModel::law() const {
+    return "v'(t) = k1 [s(t-tau) - eta - th v(t)] + k2 [v_{i-1}(t-tau) - v(t)] + k3 [v_{i-2}(t-tau2) - v(t)]";
+}
+
+ParameterMap CccModel::parameters() const {
+    return {{"k1", m_k1}, {"k2", m_k2}, {"k3", m_k3}, {"th", m_th}, {"tau", m_tau}, {"tau2", m_tau2}, {"eta", m_eta}, {"speed", m_speed}};
+}
+
+double CccModel::acceleration(double gap, double speed, double lead_speed) const {
+    return m_k1 * (gap - m_eta - m_th * speed) + (m_k2 + m_k3) * (lead_speed - speed);
+}
+
+Linearisation CccModel::linearise() const {
+    Linearisation l;
+    l.gap.add(m_k1, m_tau);
+    l.own.add(-(m_k1 * m_th + m_k2 + m_k3), 0.0);
+    l.lead.add(m_k2, m_tau);
+    ExpPoly two;
+    two.add(m_k3, m_tau2);
+    l.further.push_back(two);
+    return l;
+}
+
+std::unique_ptr<CarModel> CccModel::at_speed(double speed) const {
+    ParameterMap p = parameters();
+    p["speed"] = speed;
+    return std::make_unique<CccModel>(p);
+}
+
 // ---------------------------------------------------------------- IDM
 
 IdmModel::IdmModel(const ParameterMap& values) {
@@ -160,20 +231,28 @@ Linearisation IdmModel::linearise() const {
     return l;
 }
 
+std::unique_ptr<CarModel> IdmModel::at_speed(double speed) const {
+    ParameterMap p = parameters();
+    p["speed"] = speed;
+    return std::make_unique<IdmModel>(p);
+}
+
 // ---------------------------------------------------------------- registry
 
-std::vector<std::string> model_names() { return {"ovrv", "idm"}; }
+std::vector<std::string> model_names() { return {"ovrv", "idm", "ccc"}; }
 
 std::vector<ParameterSpec> model_parameters(const std::string& model) {
     if (model == "ovrv") return ovrv_specs();
     if (model == "idm") return idm_specs();
-    throw std::invalid_argument("model '" + model + "': expected one of ovrv, idm");
+    if (model == "ccc") return ccc_specs();
+    throw std::invalid_argument("model '" + model + "': expected one of ovrv, idm, ccc");
 }
 
 std::unique_ptr<CarModel> make_model(const std::string& model, const ParameterMap& values) {
     if (model == "ovrv") return std::make_unique<OvrvModel>(values);
     if (model == "idm") return std::make_unique<IdmModel>(values);
-    throw std::invalid_argument("model '" + model + "': expected one of ovrv, idm");
+    if (model == "ccc") return std::make_unique<CccModel>(values);
+    throw std::invalid_argument("model '" + model + "': expected one of ovrv, idm, ccc");
 }
 
 }  // namespace ddemap

@@ -37,6 +37,11 @@ QuasiPolynomial QuasiPolynomial::ring_mode(const Linearisation& lin, cplx zeta) 
     for (const auto& t : lin.own.terms()) add_term(terms, t.delay, 1, -t.coef);
     for (const auto& t : lin.gap.terms()) add_term(terms, t.delay, 0, t.coef * (1.0 - zeta));
     for (const auto& t : lin.lead.terms()) add_term(terms, t.delay, 1, -zeta * t.coef);
+    cplx power = zeta;
+    for (const auto& f : lin.further) {
+        power *= zeta;  // zeta^{j+2} for the car j+2 ahead
+        for (const auto& t : f.terms()) add_term(terms, t.delay, 1, -power * t.coef);
+    }
     return QuasiPolynomial(2, std::move(terms));
 }
 
@@ -44,6 +49,8 @@ QuasiPolynomial QuasiPolynomial::ring_mode0(const Linearisation& lin) {
     std::vector<Term> terms;
     for (const auto& t : lin.own.terms()) add_term(terms, t.delay, 0, -t.coef);
     for (const auto& t : lin.lead.terms()) add_term(terms, t.delay, 0, -t.coef);
+    for (const auto& f : lin.further)
+        for (const auto& t : f.terms()) add_term(terms, t.delay, 0, -t.coef);
     return QuasiPolynomial(1, std::move(terms));
 }
 

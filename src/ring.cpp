@@ -83,6 +83,11 @@ LinearDDE ring_mode_dde(const Linearisation& lin, cplx zeta) {
     place(terms, a0, lin.gap, 1, 0, 1.0);
     place(terms, a0, lin.own, 1, 1, 1.0);
     place(terms, a0, lin.lead, 1, 1, zeta);
+    cplx power = zeta;
+    for (const auto& f : lin.further) {
+        power *= zeta;  // zeta^{j+2}: the car j+2 ahead
+        place(terms, a0, f, 1, 1, power);
+    }
     return LinearDDE(a0, terms);
 }
 
@@ -91,6 +96,7 @@ LinearDDE ring_mode0_dde(const Linearisation& lin) {
     std::vector<DelayTerm> terms;
     place(terms, a0, lin.own, 0, 0, 1.0);
     place(terms, a0, lin.lead, 0, 0, 1.0);
+    for (const auto& f : lin.further) place(terms, a0, f, 0, 0, 1.0);
     return LinearDDE(a0, terms);
 }
 
@@ -107,6 +113,10 @@ LinearDDE full_ring_dde(const Linearisation& lin, int cars) {
         place(terms, a0, lin.gap, v, s, 1.0);
         place(terms, a0, lin.own, v, v, 1.0);
         place(terms, a0, lin.lead, v, va, 1.0);
+        for (std::size_t j = 0; j < lin.further.size(); ++j) {
+            const int far = ((i - 2 - static_cast<int>(j)) % cars + cars) % cars;
+            place(terms, a0, lin.further[j], v, 2 * far + 1, 1.0);
+        }
     }
     return LinearDDE(a0, terms);
 }
@@ -184,6 +194,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
         r.trivial_branch_stable = r.stable;
     } else {
         // N = infinity: maximise the rightmost real part over wave numbers theta in (0, pi]
+        require_single_leader(lin, "the infinite ring (N = inf)");
         RootOptions per = options.roots;
         per.count = 1;  // the abscissa needs only the rightmost root
         auto alpha = [&](double theta, RootResult* keep) {

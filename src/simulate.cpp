@@ -124,6 +124,10 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
     double h = options.step;
     for (int i = 0; i < n; ++i) {
         if (!cars[i].model) throw std::invalid_argument("follower " + std::to_string(i + 1) + " has no model");
+        if (cars[i].model->leaders() > 1)
+            throw std::invalid_argument("follower " + std::to_string(i + 1) + ": model " + cars[i].model->name() +
+                                        " uses " + std::to_string(cars[i].model->leaders()) +
+                                        " cars ahead; the platoon simulation supports laws of the car ahead only");
         s_eq[i] = cars[i].model->equilibrium_gap(v0);
         tau[i] = cars[i].model->delay();
         if (tau[i] > 0.0) h = std::min(h, tau[i]);

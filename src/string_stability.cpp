@@ -9,6 +9,7 @@
 namespace ddemap {
 
 TransferFunction::TransferFunction(Linearisation lin) : m_lin(std::move(lin)) {
+    require_single_leader(m_lin, "the head-to-tail transfer function");
     auto group = [&](double delay) -> DelayGroup& {
         for (auto& g : m_groups)
             if (g.delay == delay) return g;
@@ -87,6 +88,7 @@ LinearDDE plant_dde(const Linearisation& lin) {
 }
 
 LowFrequency low_frequency_expansion(const Linearisation& lin) {
+    require_single_leader(lin, "the low-frequency string condition");
     constexpr int K = 8;
     double dn[K + 1], nn[K + 1];
     for (int n = 0; n <= K; ++n) {

@@ -20,12 +20,24 @@ namespace ddemap {
 /// where (E * x)(t) = sum_j c_j x(t - d_j) for E(s) = sum_j c_j e^{-s d_j}. For a law
 /// F(s(t - tau), v(t), v_lead(t - tau)) with partials f_s, f_v, f_l:
 /// gap = f_s e^{-s tau}, own = f_v, lead = f_l e^{-s tau}.
+///
+/// Connected cruise control adds the speeds of cars further ahead, each with its own delays:
+///     v_i'(t) = ... + sum_j (further[j] * v_{i-2-j})(t),
+/// so further[0] acts on the car two ahead. Analyses built on one leader (the head-to-tail
+/// transfer function, the plant, simulation) reject a Linearisation with `further` terms; the
+/// ring (Fourier modes and the full system) accepts it.
 struct Linearisation {
     ExpPoly gap;
     ExpPoly own;
     ExpPoly lead;
+    std::vector<ExpPoly> further;
     double max_delay() const;
+    /// Number of cars ahead whose speed is used (1 + further.size()).
+    int leaders() const { return 1 + static_cast<int>(further.size()); }
 };
+
+/// Throws std::invalid_argument naming `analysis` when `lin` uses more than one leader.
+void require_single_leader(const Linearisation& lin, const std::string& analysis);
 
 /// Description of one named model parameter.
 struct ParameterSpec {
@@ -59,6 +71,10 @@ public:
     virtual double operating_speed() const = 0;
     /// Partials of F at (s*(v*), v*, v*), as a Linearisation with the delays of the law.
     virtual Linearisation linearise() const = 0;
+    /// Cars ahead whose speed the law uses (1: the predecessor only).
+    virtual int leaders() const { return 1; }
+    /// A copy linearised at another equilibrium speed (same law and parameters otherwise).
+    virtual std::unique_ptr<CarModel> at_speed(double speed) const = 0;
 };
 
 /// OVRV with sensing delay (the seed paper's eq. 3):
@@ -75,9 +91,34 @@ public:
     double equilibrium_gap(double speed) const override { return m_eta + m_th * speed; }
     double operating_speed() const override { return m_speed; }
     Linearisation linearise() const override;
+    std::unique_ptr<CarModel> at_speed(double speed) const override;
 
 private:
     double m_k1, m_k2, m_th, m_tau, m_eta, m_speed;
+};
+
+/// Connected cruise control (after Orosz and co-workers): OVRV plus the speed of the car two
+/// ahead, received over V2V with its own delay tau2:
+///     F = k1 [ s(t - tau) - eta - th v(t) ] + k2 [ v_{i-1}(t - tau) - v(t) ] + k3 [ v_{i-2}(t - tau2) - v(t) ];
+///     gap = k1 e^{-s tau}, own = -(k1 th + k2 + k3), lead = k2 e^{-s tau}, further[0] = k3 e^{-s tau2}.
+/// acceleration() of the one-leader interface is not defined for it (leaders() = 2).
+class CccModel final : public CarModel {
+public:
+    explicit CccModel(const ParameterMap& p);
+    std::string name() const override { return "ccc"; }
+    std::string law() const override;
+    ParameterMap parameters() const override;
+    double delay() const override { return m_tau; }
+    /// With the car two ahead at lead_speed too (the one-leader view); simulation rejects CCC.
+    double acceleration(double gap, double speed, double lead_speed) const override;
+    double equilibrium_gap(double speed) const override { return m_eta + m_th * speed; }
+    double operating_speed() const override { return m_speed; }
+    Linearisation linearise() const override;
+    int leaders() const override { return 2; }
+    std::unique_ptr<CarModel> at_speed(double speed) const override;
+
+private:
+    double m_k1, m_k2, m_k3, m_th, m_tau, m_tau2, m_eta, m_speed;
 };
 
 /// Intelligent driver model (Treiber, Hennecke, Helbing 2000) with sensing delay:
@@ -96,6 +137,7 @@ public:
     double equilibrium_gap(double speed) const override;
     double operating_speed() const override { return m_speed; }
     Linearisation linearise() const override;
+    std::unique_ptr<CarModel> at_speed(double speed) const override;
 
 private:
     double m_a, m_b, m_v0, m_delta, m_th, m_eta, m_tau, m_speed;

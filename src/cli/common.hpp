@@ -63,7 +63,7 @@ struct ModelArgs {
     std::map<std::string, std::string> raw;  // flag name -> text, only those given
 
     void add_to(CLI::App* app) {
-        app->add_option("--model", model, "car-following model: ovrv (paper eq. 3) or idm (intelligent driver model)")
+        app->add_option("--model", model, "car-following model: ovrv (paper eq. 3), idm (intelligent driver model) or ccc (connected cruise control: ovrv + the car two ahead)")
             ->capture_default_str();
         struct P {
             const char* name;
@@ -75,11 +75,13 @@ struct ModelArgs {
             {"th", "time headway [s]"},
             {"tau", "sensing delay [s] (0 gives the ODE)"},
             {"eta", "jam gap [m] (ovrv default 10, idm default 2; does not enter the linearisation of ovrv)"},
-            {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20)"},
+            {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20; for a fleet: the common speed)"},
             {"a", "IDM maximum acceleration [m/s^2] (default 1)"},
             {"b", "IDM comfortable deceleration [m/s^2] (default 1.5)"},
             {"v0", "IDM desired speed [m/s] (default 33.3)"},
             {"delta", "IDM acceleration exponent [1] (default 4)"},
+            {"k3", "CCC gain on the speed difference to the car two ahead [1/s]"},
+            {"tau2", "CCC delay of the V2V signal from the car two ahead [s]"},
         };
         for (const auto& p : params) {
             const std::string name = p.name;
