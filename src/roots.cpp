@@ -19,9 +19,10 @@ bool rightmost_first(const Root& a, const Root& b) {
     return a.value.imag() > b.value.imag();
 }
 
-/// Degree needed so that Chebyshev interpolation of e^{lambda theta} on [-tau, 0] is accurate
-/// to rounding for |lambda| <= radius (interpolating e^{z x} on [-1, 1], |z| = radius tau / 2,
-/// converges once M exceeds about e|z|/2 + 15).
+}  // namespace
+
+namespace detail {
+
 int degree_for_radius(double radius, double tau) {
     const double m = 0.7 * radius * tau + 15.0;
     return m > 1e6 ? 1000000 : static_cast<int>(std::ceil(m));
@@ -29,7 +30,10 @@ int degree_for_radius(double radius, double tau) {
 
 double radius_for_degree(int degree, double tau) { return std::max(0.0, (degree - 15.0) / (0.7 * tau)); }
 
-}  // namespace
+}  // namespace detail
+
+using detail::degree_for_radius;
+using detail::radius_for_degree;
 
 std::string to_string(RootStatus s) {
     switch (s) {

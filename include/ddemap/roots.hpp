@@ -74,6 +74,15 @@ bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, R
 /// unstable: 1e-13 max(1, |lambda|) (roots are refined to about 1e-15).
 double marginal_band(cplx lambda);
 
+namespace detail {
+/// Degree needed so that Chebyshev interpolation of e^{lambda theta} on [-tau, 0] is accurate
+/// to rounding for |lambda| <= radius (interpolating e^{z x} on [-1, 1], |z| = radius tau / 2,
+/// converges once M exceeds about e|z|/2 + 15): M = ceil(0.7 radius tau + 15).
+int degree_for_radius(double radius, double tau);
+/// The inverse: the radius resolved by degree M, (M - 15) / (0.7 tau).
+double radius_for_degree(int degree, double tau);
+}  // namespace detail
+
 /// Relative residual sigma_min(Delta(lambda)) / scale(lambda) (see Root::residual).
 double relative_residual(const LinearDDE& dde, cplx lambda);
 
