@@ -27,6 +27,7 @@ public:
     /// Index of a column; -1 if absent and not required; required and absent: an error.
     int column(const std::string& name, bool required = true) const;
     int columns() const { return static_cast<int>(m_header.size()); }
+    const std::vector<std::string>& header() const { return m_header; }
     /// Advances to the next data row; false at the end.
     bool next();
     /// "SOURCE:LINE" of the current row.

@@ -14,6 +14,15 @@ constexpr double reference_sup_rel = 1e-8;
 constexpr double reference_omega_rel = 1e-6;
 /// Same root from two algorithms in double precision (dense full ring vs Fourier modes).
 constexpr double same_root = 1e-10;
+/// Collocation eigenvalues from the sparse shift-invert against a dense eigen-decomposition of
+/// the same matrix (issue requirement: 1e-9; both are backward stable, |lambda| <= ~3 here).
+constexpr double sparse_vs_dense = 1e-9;
+/// A spectrum that must change when the cars are reordered (connected cruise control): the
+/// abscissas differ by far more than this in the cases tested (~1e-2).
+constexpr double order_matters = 1e-4;
+/// |prod Gamma_i(lambda) - 1| at a refined root of a ring of N <= 60 cars: the sum of N
+/// logarithms loses about N eps |d log Gamma / d lambda| ~ 1e-13.
+constexpr double product_residual = 1e-10;
 /// Coefficients computed two ways in double precision (series vs closed form).
 constexpr double coefficient_rel = 1e-13;
 /// Linearisation against central finite differences with step 1e-5 (error O(h^2) ~ 1e-10).

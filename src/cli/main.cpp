@@ -22,6 +22,7 @@
 #include "ddemap/system_io.hpp"
 #include "ddemap/vehicles.hpp"
 #include "charts.hpp"
+#include "fleet_commands.hpp"
 #include "sim_commands.hpp"
 #include "common.hpp"
 #include "format.hpp"
@@ -40,6 +41,7 @@ struct RootsArgs {
     std::string count = "6";
     std::string format = "table";
     std::string system;
+    FleetArgs fleet;
     bool ring_given = false;
 };
 
@@ -103,6 +105,15 @@ void run_system_roots(const RootsArgs& args) {
 }
 
 void run_roots(const RootsArgs& args) {
+    if (args.fleet.given()) {
+        auto raw = args.model.raw;
+        const std::string speed = raw.count("speed") ? raw.at("speed") : "";
+        raw.erase("speed");
+        if (!args.system.empty() || !raw.empty() || args.ring_given || args.model.model != "ovrv")
+            throw BadInput("--fleet/--fleet-pattern define the ring: expected no --system, --ring, --model or model parameters (--speed or --length set the equilibrium)");
+        run_fleet_roots(args.fleet, speed, args.count, args.format);
+        return;
+    }
     if (!args.system.empty()) {
         run_system_roots(args);
         return;
@@ -272,12 +283,13 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string(DDEMAP_VERSION));
 
     RootsArgs roots_args;
-    auto* roots = app.add_subcommand("roots", "rightmost characteristic roots of a ring of N identical cars");
+    auto* roots = app.add_subcommand("roots", "rightmost characteristic roots of a ring of N identical cars, a mixed fleet, or any linear DDE");
     roots_args.model.add_to(roots);
     roots->add_option("--ring", roots_args.ring, "number of cars N >= 2 (time grows linearly: about 0.3 ms per mode, N/2+1 modes), or inf for all wave numbers")->capture_default_str();
     roots->add_option("--count", roots_args.count, "how many rightmost roots to list")->capture_default_str();
     roots->add_option("--format", roots_args.format, "table, json or csv")->capture_default_str();
     roots->add_option("--system", roots_args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
+    roots_args.fleet.add_to(roots);
 
     StringArgs string_args;
     auto* str = app.add_subcommand("string", "plant and string stability from the head-to-tail transfer function");
@@ -289,6 +301,8 @@ int main(int argc, char** argv) {
     charts.add_to(app);
     SimCommands sims;
     sims.add_to(app);
+    MixCommand mix;
+    mix.add_to(app);
 
     try {
         app.parse(argc, argv);
@@ -311,7 +325,7 @@ int main(int argc, char** argv) {
             run_roots(roots_args);
         }
         else if (str->parsed()) run_string(string_args);
-        else if (!charts.run()) sims.run();
+        else if (!charts.run() && !sims.run()) mix.run();
         return 0;
     } catch (const std::invalid_argument& e) {
         std::cerr << "ddemap: error: " << e.what() << "\n";

@@ -224,6 +224,39 @@ printf '{"dimension": 2, "A0": [[1, 2], [3]]}' >"$tmp/bad.json"
 expect_error "bad.json: A0\[1\]: expected 2 entries" roots --system "$tmp/bad.json"
 expect_error "expected no model parameters" roots --system "$tmp/sys.json" --k1 0.3
 
+# mixed fleets: roots --fleet-pattern / --fleet, bad fleet files, mix
+"$bin" roots --fleet-pattern "A_min,E_min*2" --cars 12 --count 4 --format json >"$tmp/fleet.json" &&
+    json_has "$tmp/fleet.json" roots spectral_abscissa stable trivial_root_found product_residual strip_floor status reason && ok || bad "roots --fleet-pattern json"
+python3 - "$tmp/fleet.json" <<'PY' && ok || bad "roots --fleet-pattern content"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "converged" and d["cars"] == 12, d
+assert len(d["roots"]) >= 4 and all(r["residual"] < 1e-12 for r in d["roots"]), d["roots"]
+assert d["product_residual"] < 1e-10, d["product_residual"]
+PY
+printf 'vehicle,model,k1,k2,th,tau,k3,tau2,count
+A_min,,,,,,,,4
+,ccc,0.2,0.4,1.2,0.4,0.2,0.2,4
+' >"$tmp/fleet.csv"
+"$bin" roots --fleet "$tmp/fleet.csv" --length 300 --format json >"$tmp/fleet2.json" && json_has "$tmp/fleet2.json" roots speed length && ok || bad "roots --fleet"
+printf 'vehicle,k1
+A_min,0.1
+B_mx,0.2
+' >"$tmp/badfleet.csv"
+expect_error "badfleet.csv:3: column 'vehicle' = 'B_mx'" roots --fleet "$tmp/badfleet.csv"
+expect_error "fleet pattern entry 'Q'" roots --fleet-pattern "A_min,Q" --cars 4
+expect_error "expected at least" roots --fleet-pattern "A_min" --cars 4 --length 5
+if "$bin" mix --x E_min --y A_min --cars 10 --p 0:1:3 --out "$tmp/mix" >/dev/null && [ -s "$tmp/mix.csv" ] && xmllint --noout "$tmp/mix.svg"; then
+    python3 - "$tmp/mix.csv" <<'PY' && ok || bad "mix csv"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert [r["x_cars"] for r in rows] == ["0", "5", "10"], rows
+assert all(r["status"] == "converged" for r in rows), rows
+PY
+else bad "mix"; fi
+expect_error "p = 1.5" mix --x E_min --y A_min --cars 10 --p 0:1.5:3 --out "$tmp/mix2"
+[ ! -e "$tmp/mix2.csv" ] && ok || bad "mix wrote output after an error"
+
 # help on every command, with units
 for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi
