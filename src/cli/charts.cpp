@@ -69,14 +69,6 @@ std::string fixed_title(const SweepSpec& spec) {
     return t.str();
 }
 
-std::string read_text_file(const std::string& flag, const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 const char* keys[] = {"k1", "k2", "th", "tau", "eta"};
 
 std::string classification_table(const std::vector<Classification>& rows, int cars, const std::string& source) {
@@ -165,7 +157,7 @@ struct ChartCommands::Impl {
         if (classify_file.empty()) {
             vehicles = paper_calibration_table();
         } else {
-            vehicles = read_vehicles_csv(read_text_file("VEHICLES.csv", classify_file), classify_file);
+            vehicles = read_vehicles_csv(read_input_file("VEHICLES.csv", classify_file), classify_file);
             source = classify_file;
         }
         const auto rows = ddemap::classify(vehicles, cars);
@@ -179,7 +171,7 @@ struct ChartCommands::Impl {
 
     void run_chart() const {
         check_output("--out", chart_out);
-        const ChartSpec spec = parse_chart_spec(read_text_file("SPEC", chart_spec), chart_spec);
+        const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", chart_spec), chart_spec);
         const RenderedChart r = render_chart(spec);
         write_files_atomic({{chart_out, r.svg}});
         std::cout << "chart      " << spec.panels.size() << " panels in " << rounded(r.seconds, 3) << " s\nwrote      " << chart_out << "\n";

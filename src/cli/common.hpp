@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -28,6 +29,15 @@ using json = nlohmann::ordered_json;
 struct BadInput : std::invalid_argument {
     using std::invalid_argument::invalid_argument;
 };
+
+/// The whole file as text; a file that cannot be opened is bad input naming the flag and path.
+inline std::string read_input_file(const std::string& flag, const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
 
 inline double parse_number(const std::string& flag, const std::string& text) {
     const char* s = text.c_str();

@@ -16,14 +16,6 @@ namespace ddemap::cli {
 
 namespace {
 
-std::string read_text(const std::string& flag, const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
-
 /// speed / length flags -> ring options (default: speed 20 m/s)
 void set_equilibrium(MixedRingOptions& o, const std::string& speed, const std::string& length) {
     if (!speed.empty() && !length.empty()) throw BadInput("--speed and --length: expected only one of them");
@@ -57,7 +49,7 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
     Fleet fleet;
     if (!args.fleet.empty()) {
         if (!args.cars.empty()) throw BadInput("--cars goes with --fleet-pattern; a --fleet file lists every car (use its count column)");
-        fleet = read_fleet_csv(read_text("--fleet", args.fleet), args.fleet);
+        fleet = read_fleet_csv(read_input_file("--fleet", args.fleet), args.fleet);
     } else {
         const int cars = args.cars.empty() ? 0 : static_cast<int>(parse_integer("--cars", args.cars, 2, 1000000, "an integer 2..1000000"));
         fleet = fleet_from_pattern(args.pattern, cars);

@@ -52,11 +52,7 @@ void run_system_roots(const RootsArgs& args) {
     }
     const int count = static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000"));
     const Format format = parse_format(args.format);
-    std::ifstream in(args.system, std::ios::binary);
-    if (!in) throw BadInput("--system = '" + args.system + "': cannot open the file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    const LinearDDE dde = read_linear_dde_json(text.str(), args.system);
+    const LinearDDE dde = read_linear_dde_json(read_input_file("--system", args.system), args.system);
     RootOptions opt;
     opt.count = count;
     const RootResult r = rightmost_roots(dde, opt);

@@ -8,26 +8,19 @@
 #include "common.hpp"
 #include "ddemap/calibrate.hpp"
 #include "ddemap/chart.hpp"
+#include "ddemap/fleet.hpp"
 #include "ddemap/vehicles.hpp"
 
 namespace ddemap::cli {
 
 namespace {
 
-std::string read_file(const std::string& flag, const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// --lead-profile NAME (built in) or --lead FILE.csv
 LeadProfile lead_from(const std::string& profile, const std::string& file, std::string& label) {
     if (!profile.empty() && !file.empty()) throw BadInput("give either --lead FILE.csv or --lead-profile NAME, not both");
     if (!file.empty()) {
         label = file;
-        return LeadProfile::from_csv(read_file("--lead", file), file);
+        return LeadProfile::from_csv(read_input_file("--lead", file), file);
     }
     const std::string name = profile.empty() ? "dip" : profile;
     const auto names = LeadProfile::builtin_names();
@@ -48,7 +41,7 @@ const CalibratedVehicle& builtin_vehicle(const std::string& name) {
 std::vector<SimCar> fleet_from(const std::string& text) {
     std::vector<SimCar> cars;
     if (text.size() > 4 && text.substr(text.size() - 4) == ".csv") {
-        const std::string body = read_file("--fleet", text);
+        const std::string body = read_input_file("--fleet", text);
         const auto vehicles = read_vehicles_csv(body, text);
         for (const auto& v : vehicles) {
             std::shared_ptr<const CarModel> m = make_model("ovrv", v.parameters);
@@ -56,18 +49,8 @@ std::vector<SimCar> fleet_from(const std::string& text) {
         }
         return cars;
     }
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        int repeat = 1;
-        const auto star = item.find('*');
-        std::string name = item.substr(0, star);
-        if (star != std::string::npos) {
-            repeat = static_cast<int>(parse_integer("--fleet", item.substr(star + 1), 1, 10000, "NAME*COUNT with COUNT from 1 to 10000"));
-        }
-        const auto& v = builtin_vehicle(name);
-        for (auto& c : platoon_of(v, repeat)) cars.push_back(c);
-    }
+    for (const FleetCar& car : fleet_from_pattern(text, 0))
+        for (auto& c : platoon_of(builtin_vehicle(car.label), 1)) cars.push_back(c);
     if (cars.empty()) throw BadInput("--fleet = '" + text + "': expected vehicle names such as A_min*7");
     return cars;
 }
@@ -198,7 +181,7 @@ struct SimCommands::Impl {
         }
         o.validate();
         std::vector<Trace> traces;
-        for (const auto& f : c_files) traces.push_back(read_trace_csv(read_file("DATA.csv", f), f));
+        for (const auto& f : c_files) traces.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
         std::vector<CalibrationResult> fits(traces.size());
 #ifdef DDEMAP_WITH_OPENMP
 #pragma omp parallel for schedule(dynamic, 1)
