@@ -127,12 +127,6 @@ Linearisation OvrvModel::linearise() const {
     return l;
 }
 
-std::unique_ptr<CarModel> OvrvModel::at_speed(double speed) const {
-    ParameterMap p = parameters();
-    p["speed"] = speed;
-    return std::make_unique<OvrvModel>(p);
-}
-
 // ---------------------------------------------------------------- CCC
 
 CccModel::CccModel(const ParameterMap& values) {
@@ -168,12 +162,6 @@ Linearisation CccModel::linearise() const {
     two.add(m_k3, m_tau2);
     l.further.push_back(two);
     return l;
-}
-
-std::unique_ptr<CarModel> CccModel::at_speed(double speed) const {
-    ParameterMap p = parameters();
-    p["speed"] = speed;
-    return std::make_unique<CccModel>(p);
 }
 
 // ---------------------------------------------------------------- IDM
@@ -229,12 +217,6 @@ Linearisation IdmModel::linearise() const {
     l.own.add(f_v, 0.0);
     l.lead.add(f_l, m_tau);
     return l;
-}
-
-std::unique_ptr<CarModel> IdmModel::at_speed(double speed) const {
-    ParameterMap p = parameters();
-    p["speed"] = speed;
-    return std::make_unique<IdmModel>(p);
 }
 
 // ---------------------------------------------------------------- registry

@@ -73,8 +73,6 @@ public:
     virtual Linearisation linearise() const = 0;
     /// Cars ahead whose speed the law uses (1: the predecessor only).
     virtual int leaders() const { return 1; }
-    /// A copy linearised at another equilibrium speed (same law and parameters otherwise).
-    virtual std::unique_ptr<CarModel> at_speed(double speed) const = 0;
 };
 
 /// OVRV with sensing delay (the seed paper's eq. 3):
@@ -91,7 +89,6 @@ public:
     double equilibrium_gap(double speed) const override { return m_eta + m_th * speed; }
     double operating_speed() const override { return m_speed; }
     Linearisation linearise() const override;
-    std::unique_ptr<CarModel> at_speed(double speed) const override;
 
 private:
     double m_k1, m_k2, m_th, m_tau, m_eta, m_speed;
@@ -115,7 +112,6 @@ public:
     double operating_speed() const override { return m_speed; }
     Linearisation linearise() const override;
     int leaders() const override { return 2; }
-    std::unique_ptr<CarModel> at_speed(double speed) const override;
 
 private:
     double m_k1, m_k2, m_k3, m_th, m_tau, m_tau2, m_eta, m_speed;
@@ -137,7 +133,6 @@ public:
     double equilibrium_gap(double speed) const override;
     double operating_speed() const override { return m_speed; }
     Linearisation linearise() const override;
-    std::unique_ptr<CarModel> at_speed(double speed) const override;
 
 private:
     double m_a, m_b, m_v0, m_delta, m_th, m_eta, m_tau, m_speed;
