@@ -334,11 +334,8 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
             break;
         }
     }
-    std::size_t keep = std::min<std::size_t>(r.roots.size(), options.roots.count);
-    if (keep > 0 && keep < r.roots.size() && r.roots[keep - 1].value.imag() > 0.0 &&
-        r.roots[keep].value == std::conj(r.roots[keep - 1].value))
-        ++keep;
-    r.roots.resize(keep);
+    r.roots = detail::cut_rightmost(r.roots, options.roots.count);
+    const std::size_t keep = r.roots.size();
     if (r.eigenvalues.size() > keep) r.eigenvalues.resize(keep);
     out.spectral_abscissa = r.spectral_abscissa();
     for (const auto& x : r.roots) {

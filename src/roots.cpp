@@ -172,8 +172,9 @@ std::vector<Root> refine_all(const LinearDDE& dde, std::vector<cplx> candidates,
     return found;
 }
 
-/// First `count` roots, plus the conjugate partner of the last one when it would be cut off.
-std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count) {
+}  // namespace
+
+std::vector<Root> detail::cut_rightmost(const std::vector<Root>& all, int count) {
     std::vector<Root> out(all.begin(), all.begin() + std::min<std::size_t>(all.size(), count));
     if (!out.empty() && out.size() < all.size()) {
         const Root& last = out.back();
@@ -183,7 +184,7 @@ std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count) {
     return out;
 }
 
-}  // namespace
+using detail::cut_rightmost;
 
 RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options, const EigenSolverBackend* backend) {
     options.validate();

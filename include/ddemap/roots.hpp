@@ -81,6 +81,9 @@ namespace detail {
 int degree_for_radius(double radius, double tau);
 /// The inverse: the radius resolved by degree M, (M - 15) / (0.7 tau).
 double radius_for_degree(int degree, double tau);
+/// The first `count` roots (sorted rightmost first), plus the conjugate partner of the last one
+/// when the cut would separate a pair.
+std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count);
 }  // namespace detail
 
 /// Relative residual sigma_min(Delta(lambda)) / scale(lambda) (see Root::residual).
