@@ -50,6 +50,18 @@ namespace {
 using SpC = Eigen::SparseMatrix<cplx>;
 using SpD = Eigen::SparseMatrix<double>;
 
+/// The union of the patterns of A0, I and every A_k (compressed): the pattern of Delta(z) and
+/// of the shifted matrix S, analysed once for every sparse LU and Gershgorin test.
+SpD union_pattern(const SparseDDE& dde) {
+    SpD pattern = dde.a0;
+    SpD eye(dde.dimension(), dde.dimension());
+    eye.setIdentity();
+    pattern += eye;
+    for (const auto& t : dde.delayed) pattern += t.matrix;
+    pattern.makeCompressed();
+    return pattern;
+}
+
 /// Spectra operation: y = Re((A_M - sigma I)^{-1} x) for the collocation matrix A_M.
 class StructuredShiftInvert {
 public:
@@ -63,15 +75,10 @@ public:
             m_ak.push_back(t.matrix.cast<cplx>());
         }
         m_a0 = dde.a0.cast<cplx>();
-        // the pattern of S is the union of the patterns of A0, I and every A_k
-        SpD pattern = dde.a0;
-        SpD eye(m_n, m_n);
-        eye.setIdentity();
-        pattern += eye;
-        for (const auto& t : dde.delayed) pattern += t.matrix;
-        m_pattern = pattern.cast<cplx>();
+        m_pattern = union_pattern(dde).cast<cplx>();
         m_pattern.makeCompressed();
-        m_eye = eye.cast<cplx>();
+        m_eye.resize(m_n, m_n);
+        m_eye.setIdentity();
         m_lu.analyzePattern(m_pattern);
     }
 
@@ -337,14 +344,7 @@ bool inside(const Cell& c, const Disc& d) {
 /// diag^{-1} W (power iteration), the best scaling when one exists.
 class Gershgorin {
 public:
-    explicit Gershgorin(const SparseDDE& dde) : m_n(dde.dimension()) {
-        SpD pattern = dde.a0;
-        SpD eye(m_n, m_n);
-        eye.setIdentity();
-        pattern += eye;
-        for (const auto& t : dde.delayed) pattern += t.matrix;
-        pattern.makeCompressed();
-        m_p = pattern;
+    explicit Gershgorin(const SparseDDE& dde) : m_n(dde.dimension()), m_p(union_pattern(dde)) {
         auto aligned = [&](const SpD& m) {
             SpD a = m + 0.0 * m_p;
             a.makeCompressed();
@@ -571,12 +571,7 @@ private:
 class SparseNewton {
 public:
     SparseNewton(const SparseDDE& dde, const Bounds& bounds) : m_dde(dde), m_bounds(bounds) {
-        SpD pattern = dde.a0;
-        SpD eye(dde.dimension(), dde.dimension());
-        eye.setIdentity();
-        pattern += eye;
-        for (const auto& t : dde.delayed) pattern += t.matrix;
-        m_pattern = pattern.cast<cplx>();
+        m_pattern = union_pattern(dde).cast<cplx>();
         m_pattern.makeCompressed();
         m_lu.analyzePattern(m_pattern);
     }
