@@ -276,45 +276,52 @@ double log_norm_bound(const SpD& a) {
     return bound.size() ? bound.maxCoeff() : 0.0;
 }
 
-struct Bounds {
-    double n0 = 0.0;
-    std::vector<double> nk, tk;
-    double mu = 0.0;
-    /// R(a) = ||A0|| + sum ||A_k|| e^{-a tau_k}
-    double radius(double a) const {
-        double r = n0;
-        for (std::size_t k = 0; k < nk.size(); ++k) r += nk[k] * std::exp(-a * tk[k]);
-        return r;
-    }
-    /// the fixed point of x = mu + sum ||A_k|| e^{-x tau_k}
-    double right_bound() const {
-        auto f = [&](double x) {
-            double r = mu - x;
-            for (std::size_t k = 0; k < nk.size(); ++k) r += nk[k] * std::exp(-x * tk[k]);
-            return r;
-        };
-        double lo = mu, hi = mu + 1.0;
-        for (std::size_t k = 0; k < nk.size(); ++k) hi += nk[k];
-        while (f(lo) < 0.0) lo -= std::max(1.0, std::abs(lo));
-        for (int i = 0; i < 200; ++i) {
-            const double mid = 0.5 * (lo + hi);
-            (f(mid) > 0.0 ? lo : hi) = mid;
-        }
-        return hi;
-    }
-    double scale(cplx lambda) const { return std::abs(lambda) + radius(lambda.real()); }
-};
+using Bounds = detail::RootBounds;
 
-Bounds bounds_of(const SparseDDE& dde) {
-    Bounds b;
+}  // namespace
+
+namespace detail {
+
+double RootBounds::delayed_norm(double a) const {
+    if (entries.empty()) return 0.0;
+    std::vector<double> rows(static_cast<std::size_t>(n), 0.0), cols(static_cast<std::size_t>(n), 0.0);
+    for (const auto& e : entries) {
+        const double v = e.value * std::exp(-a * e.delay);
+        rows[static_cast<std::size_t>(e.row)] += v;
+        cols[static_cast<std::size_t>(e.col)] += v;
+    }
+    return std::sqrt(*std::max_element(rows.begin(), rows.end()) * *std::max_element(cols.begin(), cols.end()));
+}
+
+double RootBounds::radius(double a) const { return n0 + delayed_norm(a); }
+
+double RootBounds::right_bound() const {
+    auto f = [&](double x) { return mu - x + delayed_norm(x); };
+    double lo = mu, hi = mu + 1.0 + delayed_norm(mu);
+    while (f(lo) < 0.0) lo -= std::max(1.0, std::abs(lo));
+    while (f(hi) > 0.0) hi += std::max(1.0, std::abs(hi));
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(hi)); ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (f(mid) > 0.0 ? lo : hi) = mid;
+    }
+    return hi;
+}
+
+RootBounds root_bounds(const SparseDDE& dde) {
+    RootBounds b;
+    b.n = dde.dimension();
     b.n0 = norm2_bound(dde.a0);
     b.mu = log_norm_bound(dde.a0);
-    for (const auto& t : dde.delayed) {
-        b.nk.push_back(norm2_bound(t.matrix));
-        b.tk.push_back(t.delay);
-    }
+    for (const auto& t : dde.delayed)
+        for (int k = 0; k < t.matrix.outerSize(); ++k)
+            for (SpD::InnerIterator it(t.matrix, k); it; ++it)
+                if (it.value() != 0.0) b.entries.push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), std::abs(it.value()), t.delay});
     return b;
 }
+
+}  // namespace detail
+
+namespace {
 
 struct Disc {
     cplx centre;
@@ -672,7 +679,7 @@ SparseRootResult sparse_rightmost_roots(const SparseDDE& input, const SparseRoot
     const SparseDDE dde = normalised(input);
     if (dde.delayed.empty()) throw std::invalid_argument("the sparse path needs at least one delay > 0 (an ODE: use the dense path)");
     const int n = dde.dimension();
-    const Bounds bounds = bounds_of(dde);
+    const Bounds bounds = detail::root_bounds(dde);
     const double tau = dde.max_delay();
     SparseRootResult result;
     result.right_bound = bounds.right_bound();
@@ -807,7 +814,8 @@ SolverMethod parse_solver_method(const std::string& name) {
     if (name == "auto") return SolverMethod::Automatic;
     if (name == "dense") return SolverMethod::Dense;
     if (name == "sparse") return SolverMethod::Sparse;
-    throw std::invalid_argument("solver '" + name + "': expected auto, dense or sparse");
+    if (name == "product") return SolverMethod::Product;
+    throw std::invalid_argument("solver '" + name + "': expected auto, dense, sparse or product");
 }
 
 std::string to_string(SolverMethod m) {
@@ -815,6 +823,7 @@ std::string to_string(SolverMethod m) {
         case SolverMethod::Automatic: return "auto";
         case SolverMethod::Dense: return "dense";
         case SolverMethod::Sparse: return "sparse";
+        case SolverMethod::Product: return "product";
     }
     return "auto";
 }
@@ -823,6 +832,8 @@ SparseRootResult system_rightmost_roots(const SparseDDE& dde, const SparseRootOp
                                         int dense_limit) {
     options.validate();
     dde.validate();
+    if (method == SolverMethod::Product)
+        throw std::invalid_argument("solver 'product' solves rings of cars that react only to the car ahead, not a general system: expected auto, dense or sparse");
     const bool dense = method == SolverMethod::Dense ||
                        (method == SolverMethod::Automatic && (dde.dimension() <= dense_limit || dde.delayed.empty()));
     if (!dense) return sparse_rightmost_roots(dde, options);

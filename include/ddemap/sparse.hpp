@@ -14,9 +14,9 @@
 /// (M+1) n matrix is never formed.
 ///
 /// Shift strategy (completeness). Every root with Re(lambda) >= alpha satisfies
-/// Re(lambda) <= beta and |Im(lambda)| <= R(alpha), with
-///     beta:  the fixed point of x = mu(A0) + sum_k ||A_k|| e^{-x tau_k}  (mu the log-norm),
-///     R(a) = ||A0|| + sum_k ||A_k|| e^{-a tau_k}.
+/// Re(lambda) <= beta and |Im(lambda)| <= R(alpha), with (detail::RootBounds)
+///     beta:  the fixed point of x = mu(A0) + || sum_k |A_k| e^{-x tau_k} ||  (mu the log-norm),
+///     R(a) = ||A0|| + || sum_k |A_k| e^{-a tau_k} ||.
 /// The rectangle [alpha, beta] x [0, R(alpha)] (real problems: the lower half is its mirror) is
 /// covered by discs: a shift sigma whose Arnoldi run returns the nev eigenvalues of largest
 /// |nu(lambda)|, nu = (1/(lambda - sigma) + 1/(lambda - conj sigma)) / 2 (Spectra's operator
@@ -109,13 +109,44 @@ struct SparseRootResult {
 SparseRootResult sparse_rightmost_roots(const SparseDDE& dde, const SparseRootOptions& options = {});
 
 /// Which eigen-solver path `system_rightmost_roots` takes.
-enum class SolverMethod { Automatic, Dense, Sparse };
-SolverMethod parse_solver_method(const std::string& name);  ///< "auto", "dense" or "sparse"
+/// Product: rings of one-leader cars only (ring_product.hpp); analyse_mixed_ring takes it
+/// automatically for such rings.
+enum class SolverMethod { Automatic, Dense, Sparse, Product };
+SolverMethod parse_solver_method(const std::string& name);  ///< "auto", "dense", "sparse" or "product"
 std::string to_string(SolverMethod m);
 
 /// One interface for both paths: dense collocation (all eigenvalues, the core solver) for
 /// dimension <= dense_limit, otherwise the sparse solver. The result has the sparse layout.
 SparseRootResult system_rightmost_roots(const SparseDDE& dde, const SparseRootOptions& options,
                                         SolverMethod method = SolverMethod::Automatic, int dense_limit = 16);
+
+namespace detail {
+/// Where the roots of a DDE can lie: every root with Re(lambda) >= a has Re(lambda) <= beta and
+/// |Im(lambda)| <= R(a) (see the file comment). For Re(lambda) >= a the delayed part is bounded
+/// entrywise, |sum_k A_k e^{-lambda tau_k}| <= sum_k |A_k| e^{-a tau_k}, so with ||.|| the 2-norm
+/// bound sqrt(||.||_1 ||.||_inf) and mu a bound of the log-norm mu_2(A0):
+///     R(a) = ||A0|| + || sum_k |A_k| e^{-a tau_k} ||,   beta: x = mu + || sum_k |A_k| e^{-x tau_k} ||
+/// (tighter than summing ||A_k|| over the delays when, as in a ring, each row has few delays).
+struct RootBounds {
+    struct Entry {
+        int row, col;
+        double value;  ///< |A_k(row, col)|
+        double delay;  ///< tau_k
+    };
+    int n = 0;
+    double n0 = 0.0;              ///< ||A0||
+    double mu = 0.0;              ///< >= mu_2(A0)
+    std::vector<Entry> entries;   ///< every nonzero of every delayed matrix
+    /// || sum_k |A_k| e^{-a tau_k} ||
+    double delayed_norm(double a) const;
+    /// R(a) = ||A0|| + delayed_norm(a)
+    double radius(double a) const;
+    /// beta: the fixed point of x = mu + delayed_norm(x)
+    double right_bound() const;
+    /// |lambda| + R(Re lambda): the scale of Delta(lambda) in relative residuals
+    double scale(cplx lambda) const { return std::abs(lambda) + radius(lambda.real()); }
+};
+RootBounds root_bounds(const SparseDDE& dde);
+}  // namespace detail
 
 }  // namespace ddemap
