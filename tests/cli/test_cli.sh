@@ -223,6 +223,26 @@ JSON
 printf '{"dimension": 2, "A0": [[1, 2], [3]]}' >"$tmp/bad.json"
 expect_error "bad.json: A0\[1\]: expected 2 entries" roots --system "$tmp/bad.json"
 expect_error "expected no model parameters" roots --system "$tmp/sys.json" --k1 0.3
+expect_error "the sparse path needs real coefficients" roots --system "$tmp/sys.json" --solver sparse
+expect_error "--solver product goes with --fleet" roots --system "$tmp/sys.json" --solver product
+# a real 20-dimensional cyclic system: auto takes the sparse path; the dense path agrees
+python3 - >"$tmp/cyc.json" <<'PY'
+import json
+n = 20
+print(json.dumps({"dimension": n, "delays": [1.0, 0.4], "A0": {"triplets": [[i, i, -1.0] for i in range(n)]},
+                  "A": [{"triplets": [[i, (i - 1) % n, 0.9] for i in range(n)]}, {"triplets": [[i, (i + 1) % n, 0.3] for i in range(n)]}]}))
+PY
+"$bin" roots --system "$tmp/cyc.json" --count 6 --format json >"$tmp/cyc_s.json" &&
+    "$bin" roots --system "$tmp/cyc.json" --count 6 --solver dense --format json >"$tmp/cyc_d.json" &&
+    python3 - "$tmp/cyc_s.json" "$tmp/cyc_d.json" <<'PY' && ok || bad "roots --system: sparse (auto) against dense"
+import json, sys
+s, d = (json.load(open(f)) for f in sys.argv[1:3])
+assert s["solver"] == "sparse" and d["solver"] == "dense", (s["solver"], d["solver"])
+assert s["status"] == d["status"] == "converged"
+zs = [complex(r["re"], r["im"]) for r in s["roots"]]
+zd = [complex(r["re"], r["im"]) for r in d["roots"]]
+assert len(zs) >= 6 and all(min(abs(z - w) for w in zd) < 1e-9 for z in zs), (zs, zd)
+PY
 
 # mixed fleets: roots --fleet-pattern / --fleet, bad fleet files, mix
 "$bin" roots --fleet-pattern "A_min,E_min*2" --cars 12 --count 4 --format json >"$tmp/fleet.json" &&
