@@ -96,60 +96,74 @@ TEST_CASE("homogeneous ring: the sparse path equals the Fourier-mode roots (N up
     }
 }
 
+namespace {
+
+/// One random fleet of n cars (every third one CCC): the sparse path's rightmost collocation
+/// eigenvalues against a dense eigen-decomposition of the same degree-M collocation matrix.
+void check_sparse_against_dense(std::mt19937& rng, int n, int degree) {
+    std::vector<Linearisation> lins;
+    for (int i = 0; i < n; ++i) {
+        const FleetCar c = random_car(rng, i % 3 == 2);
+        ParameterMap p = c.parameters;
+        p["speed"] = 20.0;
+        lins.push_back(make_model(c.model, p)->linearise());
+    }
+    const SparseDDE dde = mixed_ring_dde(lins);
+    SparseRootOptions o;
+    o.count = 6;
+    o.degree = degree;
+    o.refine = false;
+    o.arnoldi_tolerance = 1e-13;
+    const SparseRootResult sp = sparse_rightmost_roots(dde, o);
+    REQUIRE(sp.status == RootStatus::Converged);
+    const MatrixXc a = collocation_matrix(dde.to_dense(), sp.degree);
+    Eigen::EigenSolver<Eigen::MatrixXd> es(a.real(), false);
+    std::vector<cplx> dense(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+    std::sort(dense.begin(), dense.end(), [](cplx x, cplx y) { return x.real() > y.real(); });
+    CAPTURE(n);
+    // the certificate's rectangle: Re >= floor, |Im| <= height (outside it there are no roots,
+    // only collocation artefacts of large modulus, which the dense matrix also has), and the
+    // degree resolves |lambda| <= covered_radius (beyond it the collocation matrix has artefacts
+    // that are not roots, which the Gershgorin cells rightly skip)
+    dense.erase(std::remove_if(dense.begin(), dense.end(),
+                               [&](cplx z) { return std::abs(z.imag()) > sp.height || std::abs(z) > sp.covered_radius; }),
+                dense.end());
+    // every dense eigenvalue right of the certified floor is among the sparse ones
+    int in_strip = 0;
+    for (cplx z : dense) {
+        if (z.real() < sp.strip_floor - tol::sparse_vs_dense) break;  // the floor is the last listed one
+        ++in_strip;
+        CAPTURE(z);
+        CHECK(nearest(sp.eigenvalues, z) < tol::sparse_vs_dense);
+    }
+    // the same set: the sparse eigenvalues inside the resolved rectangle are exactly these
+    std::vector<cplx> listed;
+    for (cplx z : sp.eigenvalues)
+        if (std::abs(z.imag()) <= sp.height && std::abs(z) <= sp.covered_radius) listed.push_back(z);
+    CHECK(listed.size() >= 2);
+    CHECK(in_strip == static_cast<int>(listed.size()));
+    for (std::size_t i = 0; i < listed.size() && i < dense.size(); ++i)
+        CHECK(std::abs(listed[i].real() - dense[i].real()) < tol::sparse_vs_dense);
+}
+
+}  // namespace
+
 TEST_CASE("random mixed fleets: the sparse path finds the rightmost collocation eigenvalues of a dense decomposition, none missed") {
     std::mt19937 rng(20261121);
     int draws = 0;
     for (int n : {4, 5, 8, 12, 20, 20, 30}) {
         for (int rep = 0; rep < (n <= 12 ? 4 : 1); ++rep) {
-            std::vector<Linearisation> lins;
-            for (int i = 0; i < n; ++i) {
-                const FleetCar c = random_car(rng, i % 3 == 2);
-                ParameterMap p = c.parameters;
-                p["speed"] = 20.0;
-                lins.push_back(make_model(c.model, p)->linearise());
-            }
-            const SparseDDE dde = mixed_ring_dde(lins);
-            const int count = 6;
-            SparseRootOptions o;
-            o.count = count;
-            o.degree = 20;  // resolves |lambda| <= 5 / (0.7 tau_max) >= 7
-            o.refine = false;
-            o.arnoldi_tolerance = 1e-13;
-            const SparseRootResult sp = sparse_rightmost_roots(dde, o);
-            REQUIRE(sp.status == RootStatus::Converged);
-            const MatrixXc a = collocation_matrix(dde.to_dense(), sp.degree);
-            Eigen::EigenSolver<Eigen::MatrixXd> es(a.real(), false);
-            std::vector<cplx> dense(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
-            std::sort(dense.begin(), dense.end(), [](cplx x, cplx y) { return x.real() > y.real(); });
-            CAPTURE(n);
             CAPTURE(rep);
-            // the certificate's rectangle: Re >= floor, |Im| <= height (outside it there are no
-            // roots, only collocation artefacts of large modulus, which the dense matrix also has)
-            // and the degree resolves |lambda| <= covered_radius; beyond it the collocation matrix
-            // has artefacts that are not roots, which the Gershgorin cells rightly skip)
-            dense.erase(std::remove_if(dense.begin(), dense.end(),
-                                       [&](cplx z) { return std::abs(z.imag()) > sp.height || std::abs(z) > sp.covered_radius; }),
-                        dense.end());
-            // every dense eigenvalue right of the certified floor is among the sparse ones
-            int in_strip = 0;
-            for (cplx z : dense) {
-                if (z.real() < sp.strip_floor - tol::sparse_vs_dense) break;  // the floor is the last listed one
-                ++in_strip;
-                CAPTURE(z);
-                CHECK(nearest(sp.eigenvalues, z) < tol::sparse_vs_dense);
-            }
-            // the same set: the sparse eigenvalues inside the resolved rectangle are exactly these
-            std::vector<cplx> listed;
-            for (cplx z : sp.eigenvalues)
-                if (std::abs(z.imag()) <= sp.height && std::abs(z) <= sp.covered_radius) listed.push_back(z);
-            CHECK(listed.size() >= 2);
-            CHECK(in_strip == static_cast<int>(listed.size()));
-            for (std::size_t i = 0; i < listed.size() && i < dense.size(); ++i)
-                CHECK(std::abs(listed[i].real() - dense[i].real()) < tol::sparse_vs_dense);
+            check_sparse_against_dense(rng, n, 20);  // M = 20 resolves |lambda| <= 5 / (0.7 tau_max) >= 7
             ++draws;
         }
     }
     CHECK(draws == 19);
+}
+
+TEST_CASE("random mixed fleets of 45 and 60 cars: sparse against a dense decomposition (M = 16, 1920 and 2040 states)") {
+    std::mt19937 rng(60);
+    for (int n : {45, 60}) check_sparse_against_dense(rng, n, 16);  // M = 16 resolves |lambda| <= 1 / (0.7 tau_max)
 }
 
 TEST_CASE("predecessor-only mixed ring: permuting the cars leaves the spectrum unchanged and prod Gamma_i = 1 at every root") {
