@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "ddemap/ring_product.hpp"
 #include "ddemap/roots.hpp"
 #include "ddemap/vehicles.hpp"
 #include "text.hpp"
@@ -323,7 +324,19 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     const SparseDDE dde = mixed_ring_dde(lins);
     SparseRootOptions ro = options.roots;
     ro.count = options.roots.count + 1;  // room for the trivial root
-    SparseRootResult r = system_rightmost_roots(dde, ro, options.method);
+    bool one_leader = true;
+    for (const auto& c : lins) one_leader = one_leader && c.leaders() == 1;
+    if (options.method == SolverMethod::Product && !one_leader)
+        throw std::invalid_argument("solver 'product': every car must react only to the car ahead (this fleet has CCC cars); expected auto, dense or sparse");
+    SparseRootResult r;
+    if (options.method == SolverMethod::Product || (options.method == SolverMethod::Automatic && one_leader)) {
+        ProductRootOptions po;
+        po.count = ro.count;
+        po.residual_tolerance = ro.residual_tolerance;
+        r = product_ring_roots(lins, po);
+    } else {
+        r = system_rightmost_roots(dde, ro, options.method);
+    }
     // the trivial root: lambda = 0 to rounding
     for (std::size_t i = 0; i < r.roots.size(); ++i) {
         if (std::abs(r.roots[i].value) <= 1e-8) {

@@ -38,7 +38,7 @@ void FleetArgs::add_to(CLI::App* roots) {
     roots->add_option("--fleet-pattern", pattern, "a mixed ring from calibrated vehicles, e.g. \"A_min,C_max*3,E_min\", repeated to --cars");
     roots->add_option("--cars", cars, "number of cars for --fleet-pattern (default: the pattern once)");
     roots->add_option("--length", length, "fleet: ring length [m] (sum of the gaps); the speed follows");
-    roots->add_option("--solver", solver, "fleet: auto (dense up to 16 states, i.e. 8 cars), dense or sparse")->capture_default_str();
+    roots->add_option("--solver", solver, "fleet: auto (product for cars that react only to the car ahead, else dense up to 8 cars and sparse beyond), product, dense or sparse")->capture_default_str();
     roots->add_option("--degree", degree, "fleet: collocation degree M (0 = automatic)")->capture_default_str();
 }
 
@@ -134,7 +134,7 @@ void MixCommand::add_to(CLI::App& app) {
     c->add_option("--seed", m->seed, "seed of the random arrangements")->capture_default_str();
     c->add_option("--speed", m->speed, "common equilibrium speed [m/s] (default 20)");
     c->add_option("--length", m->length, "ring length [m]; the speed follows for each mix");
-    c->add_option("--solver", m->solver, "auto, dense or sparse")->capture_default_str();
+    c->add_option("--solver", m->solver, "auto, product, dense or sparse (as roots --fleet)")->capture_default_str();
     c->add_option("--out", m->out, "output prefix: writes PREFIX.csv and PREFIX.svg")->required();
     m->app = c;
 }

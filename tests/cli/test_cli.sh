@@ -265,6 +265,19 @@ B_mx,0.2
 ' >"$tmp/badfleet.csv"
 expect_error "badfleet.csv:3: column 'vehicle' = 'B_mx'" roots --fleet "$tmp/badfleet.csv"
 expect_error "fleet pattern entry 'Q'" roots --fleet-pattern "A_min,Q" --cars 4
+# the product path (automatic for cars of the car ahead) against the sparse path
+"$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --cars 40 --count 6 --format json >"$tmp/prod.json" &&
+    "$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --cars 40 --count 6 --solver sparse --format json >"$tmp/spar.json" &&
+    python3 - "$tmp/prod.json" "$tmp/spar.json" <<'PY' && ok || bad "roots --fleet-pattern: product against sparse"
+import json, sys
+p, s = (json.load(open(f)) for f in sys.argv[1:3])
+assert p["status"] == s["status"] == "converged"
+assert p["shifts"] == 0 and s["shifts"] > 0, (p["shifts"], s["shifts"])
+zp = [complex(r["re"], r["im"]) for r in p["roots"]]
+zs = [complex(r["re"], r["im"]) for r in s["roots"]]
+assert len(zp) == len(zs) >= 6 and all(abs(a - b) < 1e-10 for a, b in zip(zp, zs)), (zp, zs)
+PY
+expect_error "react only to the car ahead" roots --fleet "$tmp/fleet.csv" --solver product
 expect_error "expected at least" roots --fleet-pattern "A_min" --cars 4 --length 5
 if "$bin" mix --x E_min --y A_min --cars 10 --p 0:1:3 --out "$tmp/mix" >/dev/null && [ -s "$tmp/mix.csv" ] && xmllint --noout "$tmp/mix.svg"; then
     python3 - "$tmp/mix.csv" <<'PY' && ok || bad "mix csv"

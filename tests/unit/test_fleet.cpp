@@ -172,7 +172,7 @@ TEST_CASE("predecessor-only mixed ring: permuting the cars leaves the spectrum u
     for (int i = 0; i < 14; ++i) fleet.push_back(random_car(rng, false));
     Fleet shuffled = fleet;
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
-    for (SolverMethod method : {SolverMethod::Sparse, SolverMethod::Dense}) {
+    for (SolverMethod method : {SolverMethod::Sparse, SolverMethod::Dense, SolverMethod::Product}) {
         const MixedRingResult a = analyse_mixed_ring(fleet, at_speed(8, method));
         const MixedRingResult b = analyse_mixed_ring(shuffled, at_speed(8, method));
         REQUIRE(a.roots.status == RootStatus::Converged);

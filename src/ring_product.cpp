@@ -1,0 +1,484 @@
+#include "ddemap/ring_product.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "ddemap/fleet.hpp"
+#include "ddemap/roots.hpp"
+
+namespace ddemap {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+bool same(const ExpPoly& a, const ExpPoly& b) {
+    const auto &ta = a.terms(), &tb = b.terms();
+    if (ta.size() != tb.size()) return false;
+    for (std::size_t j = 0; j < ta.size(); ++j)
+        if (ta[j].coef != tb[j].coef || ta[j].delay != tb[j].delay) return false;
+    return true;
+}
+
+bool same(const Linearisation& a, const Linearisation& b) {
+    return same(a.gap, b.gap) && same(a.own, b.own) && same(a.lead, b.lead) && a.further.empty() && b.further.empty();
+}
+
+/// P = lambda^2 - lambda own + gap
+cplx p_of(const Linearisation& c, cplx z) { return z * z - z * c.own(z) + c.gap(z); }
+cplx dp_of(const Linearisation& c, cplx z) { return 2.0 * z - c.own(z) - z * c.own.derivative(z) + c.gap.derivative(z); }
+/// Q = gap + lambda lead
+cplx q_of(const Linearisation& c, cplx z) { return c.gap(z) + z * c.lead(z); }
+cplx dq_of(const Linearisation& c, cplx z) { return c.gap.derivative(z) + c.lead(z) + z * c.lead.derivative(z); }
+
+double scale_of(cplx z) { return std::max(1.0, std::abs(z)); }
+
+bool finite(cplx z) { return std::isfinite(z.real()) && std::isfinite(z.imag()); }
+
+}  // namespace
+
+RingDeterminant::RingDeterminant(const std::vector<Linearisation>& cars) {
+    if (cars.size() < 2) throw std::invalid_argument("a ring needs at least 2 cars, got " + std::to_string(cars.size()));
+    for (const auto& c : cars) {
+        require_single_leader(c, "the ring determinant prod P_i - prod Q_i");
+        auto it = std::find_if(m_types.begin(), m_types.end(), [&](const Type& t) { return same(t.lin, c); });
+        if (it == m_types.end())
+            m_types.push_back({c, 1.0});
+        else
+            it->n += 1.0;
+    }
+    m_cars = static_cast<int>(cars.size());
+}
+
+cplx RingDeterminant::phi(cplx z) const {
+    cplx s = 0.0;
+    for (const auto& t : m_types) s += t.n * std::log(q_of(t.lin, z) / p_of(t.lin, z));
+    return s;
+}
+
+cplx RingDeterminant::log_value(cplx z) const {
+    cplx sp = 0.0, sq = 0.0, ph = 0.0;
+    for (const auto& t : m_types) {
+        const cplx p = p_of(t.lin, z), q = q_of(t.lin, z);
+        sp += t.n * std::log(p);
+        sq += t.n * std::log(q);
+        ph += t.n * std::log(q / p);
+    }
+    if (ph.real() <= 0.0) return sp + std::log(1.0 - std::exp(ph));
+    return cplx(0.0, kTwoPi / 2.0) + sq + std::log(1.0 - std::exp(-ph));
+}
+
+cplx RingDeterminant::log_derivative(cplx z) const {
+    cplx dp = 0.0, dq = 0.0, ph = 0.0;
+    for (const auto& t : m_types) {
+        const cplx p = p_of(t.lin, z), q = q_of(t.lin, z);
+        dp += t.n * dp_of(t.lin, z) / p;
+        dq += t.n * dq_of(t.lin, z) / q;
+        ph += t.n * std::log(q / p);
+    }
+    const cplx dphi = dq - dp;
+    if (ph.real() <= 0.0) {
+        const cplx e = std::exp(ph);
+        return dp - dphi * e / (1.0 - e);
+    }
+    const cplx e = std::exp(-ph);
+    return dq + dphi * e / (1.0 - e);
+}
+
+struct RingDeterminant::Sample {
+    std::vector<cplx> p, r;  ///< P_t and Gamma_t = Q_t / P_t per type
+    cplx phi;                ///< sum n_t log Gamma_t (principal logs: e^phi exact, Im modulo 2 pi)
+    bool ok = false;
+};
+
+RingDeterminant::Sample RingDeterminant::sample(cplx z) const {
+    Sample s;
+    s.p.resize(m_types.size());
+    s.r.resize(m_types.size());
+    s.phi = 0.0;
+    s.ok = true;
+    for (std::size_t k = 0; k < m_types.size(); ++k) {
+        const cplx p = p_of(m_types[k].lin, z), q = q_of(m_types[k].lin, z);
+        s.p[k] = p;
+        s.r[k] = q / p;
+        if (p == 0.0 || q == 0.0 || !finite(s.r[k]) || !finite(p)) {
+            s.ok = false;
+            return s;
+        }
+        s.phi += m_types[k].n * std::log(s.r[k]);
+    }
+    if (!finite(s.phi) || std::abs(1.0 - std::exp(s.phi.real() <= 0.0 ? s.phi : -s.phi)) == 0.0) s.ok = false;
+    return s;
+}
+
+bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, int& evaluations) const {
+    const double length = std::abs(b - a);
+    if (length == 0.0) return true;
+    const double tiny = 1e-14 * (std::abs(a) + std::abs(b) + 1.0);
+    Sample cur = sample(a);
+    ++evaluations;
+    if (!cur.ok) return false;
+    double t = 0.0, h = length / 8.0;
+    while (t < length) {
+        h = std::min(h, length - t);
+        const double tn = (length - t - h <= tiny) ? length : t + h;
+        const cplx z = a + (b - a) * (tn / length);
+        const Sample nxt = sample(z);
+        ++evaluations;
+        bool accept = nxt.ok;
+        double darg = 0.0;
+        cplx dphi = 0.0;
+        if (accept) {
+            for (std::size_t k = 0; k < m_types.size() && accept; ++k) {
+                const double dp = std::arg(nxt.p[k] * std::conj(cur.p[k]));
+                const cplx dr = std::log(nxt.r[k] / cur.r[k]);
+                if (std::abs(dp) > theta || std::abs(dr.imag()) > theta) accept = false;
+                darg += m_types[k].n * dp;
+                dphi += m_types[k].n * dr;
+            }
+        }
+        double dg = 0.0;
+        if (accept) {
+            const double ro = cur.phi.real(), rn = nxt.phi.real();
+            const bool left_o = ro <= 0.0, left_n = rn <= 0.0;
+            const double near = std::min(std::abs(ro), std::abs(rn));
+            const double limit = left_o == left_n ? std::max(theta, 0.5 * near) : theta;
+            if (std::abs(dphi) > limit) accept = false;
+            if (accept) {
+                double wrapped;
+                if (left_o && left_n) {
+                    wrapped = std::arg((1.0 - std::exp(nxt.phi)) / (1.0 - std::exp(cur.phi)));
+                    dg = wrapped;
+                } else if (!left_o && !left_n) {
+                    wrapped = std::arg((1.0 - std::exp(-nxt.phi)) / (1.0 - std::exp(-cur.phi)));
+                    dg = dphi.imag() + wrapped;
+                } else {
+                    wrapped = std::arg((1.0 - std::exp(nxt.phi)) / (1.0 - std::exp(cur.phi)));
+                    dg = wrapped;
+                }
+                if (!(std::abs(wrapped) <= theta)) accept = false;
+            }
+        }
+        if (accept) {
+            total += darg + dg;
+            cur = nxt;
+            t = tn;
+            h *= 1.6;
+        } else {
+            h *= 0.35;
+            if (h < tiny) return false;
+        }
+    }
+    return true;
+}
+
+RingDeterminant::Count RingDeterminant::count(double x0, double x1, double y0, double y1, double theta) const {
+    Count c;
+    double total = 0.0;
+    const cplx z00(x0, y0), z10(x1, y0), z11(x1, y1), z01(x0, y1);
+    c.ok = follow(z00, z10, theta, total, c.evaluations) && follow(z10, z11, theta, total, c.evaluations) &&
+           follow(z11, z01, theta, total, c.evaluations) && follow(z01, z00, theta, total, c.evaluations);
+    if (!c.ok) return c;
+    const double w = total / kTwoPi;
+    c.zeros = static_cast<int>(std::lround(w));
+    c.ok = std::abs(w - c.zeros) < 0.25 && c.zeros >= 0;
+    return c;
+}
+
+RingDeterminant::Count RingDeterminant::count_symmetric(double x0, double x1, double y, double theta) const {
+    Count c;
+    double total = 0.0;
+    const cplx a(x1, 0.0), b(x1, y), d(x0, y), e(x0, 0.0);
+    c.ok = follow(a, b, theta, total, c.evaluations) && follow(b, d, theta, total, c.evaluations) &&
+           follow(d, e, theta, total, c.evaluations);
+    if (!c.ok) return c;
+    const double w = 2.0 * total / kTwoPi;
+    c.zeros = static_cast<int>(std::lround(w));
+    c.ok = std::abs(w - c.zeros) < 0.25 && c.zeros >= 0;
+    return c;
+}
+
+void ProductRootOptions::validate() const {
+    auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
+    if (count < 1) fail("count = " + std::to_string(count) + ": expected an integer >= 1");
+    if (!(max_arg_step > 0.0 && max_arg_step <= 1.0)) fail("max_arg_step: expected a value in (0, 1] radians");
+    if (max_cells < 1) fail("max_cells: expected >= 1");
+    if (newton_max_iterations < 1) fail("newton_max_iterations: expected >= 1");
+    if (!(std::isfinite(newton_tolerance) && newton_tolerance > 0.0)) fail("newton_tolerance: expected a finite value > 0");
+    if (!(std::isfinite(residual_tolerance) && residual_tolerance > 0.0)) fail("residual_tolerance: expected a finite value > 0");
+}
+
+namespace {
+
+/// A cell of the search: [x0, x1] x [y0, y1], or for an axis cell [x0, x1] x [-y1, y1].
+struct Cell {
+    double x0, x1, y0, y1;
+    bool axis;
+    int zeros;
+};
+
+class Locator {
+public:
+    Locator(const RingDeterminant& det, const ProductRootOptions& o) : m_det(det), m_o(o) {}
+
+    /// Count of a cell (false when a zero lies on its boundary or the budget ran out).
+    bool count(Cell& c) {
+        if (++m_counts > m_o.max_cells) return false;
+        const auto r = c.axis ? m_det.count_symmetric(c.x0, c.x1, c.y1, m_o.max_arg_step)
+                              : m_det.count(c.x0, c.x1, c.y0, c.y1, m_o.max_arg_step);
+        m_evaluations += r.evaluations;
+        c.zeros = r.zeros;
+        return r.ok;
+    }
+
+    /// Count of the child cell made by `make(f)`, f the fraction of the split; when a zero lies
+    /// on the split line the line is moved (the parent's outer boundary never moves).
+    template <class Make>
+    bool count_split(Make make, Cell& child) {
+        for (double f : {0.5, 0.5123, 0.4871, 0.5377, 0.4619, 0.5931}) {
+            child = make(f);
+            if (count(child)) return true;
+            if (m_counts > m_o.max_cells) return false;
+        }
+        return false;
+    }
+
+    /// Newton on D from z; true when converged.
+    bool newton(cplx z, bool real, cplx& out, double& step_out) const {
+        double step = std::numeric_limits<double>::infinity();
+        for (int it = 0; it < m_o.newton_max_iterations; ++it) {
+            const cplx d = m_det.log_derivative(z);
+            if (!finite(d) || d == 0.0) {
+                // at a root to working precision (D = 0 makes D'/D infinite)
+                step = 0.0;
+                break;
+            }
+            cplx s = 1.0 / d;
+            if (real) s.imag(0.0);
+            z -= s;
+            step = std::abs(s);
+            if (!finite(z)) return false;
+            if (step <= m_o.newton_tolerance * scale_of(z)) break;
+        }
+        out = z;
+        step_out = step;
+        return step <= 1e-8 * scale_of(z);
+    }
+
+    /// Splits `top` until every root inside is isolated and found. False when the budget ran out
+    /// or the counts were inconsistent.
+    bool locate(const Cell& top) {
+        std::vector<Cell> stack{top};
+        while (!stack.empty()) {
+            Cell c = stack.back();
+            stack.pop_back();
+            if (c.zeros == 0) continue;
+            if (c.zeros < 0) return false;
+            const double w = c.x1 - c.x0, h = c.axis ? 2.0 * c.y1 : c.y1 - c.y0;
+            const cplx centre(0.5 * (c.x0 + c.x1), c.axis ? 0.0 : 0.5 * (c.y0 + c.y1));
+            const double size = std::max(w, h);
+            const bool smallest = size <= 1e-11 * scale_of(centre);
+            if (c.zeros == 1 || smallest) {
+                cplx z;
+                double step = 0.0;
+                const bool real = c.axis && c.zeros == 1;
+                if (newton(centre, real, z, step) || smallest) {
+                    const double m = 1e-12 * scale_of(z);
+                    const bool in = z.real() >= c.x0 - m && z.real() <= c.x1 + m &&
+                                    (c.axis ? std::abs(z.imag()) <= c.y1 + m : (z.imag() >= c.y0 - m && z.imag() <= c.y1 + m));
+                    if (in || smallest) {
+                        if (smallest && !in) z = centre;
+                        record(z, real ? 1 : c.zeros, step, smallest && c.zeros > 1);
+                        continue;
+                    }
+                }
+            }
+            if (smallest) return false;
+            // split; the second child's count follows from the first's
+            if (c.axis && w >= c.y1) {
+                Cell a{}, b = c;
+                if (!count_split([&](double f) { Cell x = c; x.x1 = c.x0 + f * w; return x; }, a)) return false;
+                b.x0 = a.x1;
+                b.zeros = c.zeros - a.zeros;
+                stack.push_back(a);
+                stack.push_back(b);
+            } else if (c.axis) {
+                Cell low{}, up = c;
+                if (!count_split([&](double f) { Cell x = c; x.y1 = f * c.y1; return x; }, low)) return false;
+                up.axis = false;
+                up.y0 = low.y1;
+                const int rest = c.zeros - low.zeros;
+                if (rest < 0 || rest % 2 != 0) return false;
+                up.zeros = rest / 2;
+                stack.push_back(low);
+                stack.push_back(up);
+            } else {
+                Cell a{}, b = c;
+                if (w >= h) {
+                    if (!count_split([&](double f) { Cell x = c; x.x1 = c.x0 + f * w; return x; }, a)) return false;
+                    b.x0 = a.x1;
+                } else {
+                    if (!count_split([&](double f) { Cell x = c; x.y1 = c.y0 + f * h; return x; }, a)) return false;
+                    b.y0 = a.y1;
+                }
+                b.zeros = c.zeros - a.zeros;
+                stack.push_back(a);
+                stack.push_back(b);
+            }
+        }
+        return true;
+    }
+
+    struct Found {
+        cplx value;
+        int multiplicity;
+        double step;
+        bool cluster;
+    };
+    const std::vector<Found>& found() const { return m_found; }
+    int counts() const { return m_counts; }
+    long evaluations() const { return m_evaluations; }
+
+private:
+    void record(cplx z, int multiplicity, double step, bool cluster) {
+        if (std::abs(z.imag()) <= 1e-14 * scale_of(z) && multiplicity == 1) z.imag(0.0);
+        m_found.push_back({z, multiplicity, step, cluster});
+    }
+
+    const RingDeterminant& m_det;
+    const ProductRootOptions& m_o;
+    std::vector<Found> m_found;
+    int m_counts = 0;
+    long m_evaluations = 0;
+};
+
+/// ||Delta(lambda) x|| / (||x|| scale) for the ring eigenvector x_v,i = Gamma_i x_v,i-1.
+double ring_residual(const std::vector<Linearisation>& cars, const SparseDDE& dde, const detail::RootBounds& bounds, cplx z) {
+    const int n = static_cast<int>(cars.size());
+    std::vector<cplx> logv(n);
+    logv[0] = 0.0;
+    for (int i = 1; i < n; ++i) logv[i] = logv[i - 1] + std::log(q_of(cars[i], z) / p_of(cars[i], z));
+    double top = -std::numeric_limits<double>::infinity();
+    for (const auto& l : logv) top = std::max(top, l.real());
+    Eigen::VectorXcd x(2 * n);
+    for (int i = 0; i < n; ++i) x(2 * i + 1) = std::exp(logv[i] - top);
+    for (int i = 0; i < n; ++i) {
+        const cplx v = x(2 * i + 1), va = x(2 * ((i + n - 1) % n) + 1);
+        const cplx g = cars[i].gap(z);
+        // from the speed row when the gap term is not small, otherwise from the gap row
+        if (std::abs(g) >= std::abs(z))
+            x(2 * i) = (z * v - cars[i].own(z) * v - cars[i].lead(z) * va) / g;
+        else
+            x(2 * i) = (va - v) / z;
+    }
+    const double norm = x.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) return std::numeric_limits<double>::infinity();
+    return (dde.characteristic_matrix(z) * x).norm() / (norm * bounds.scale(z));
+}
+
+bool rightmost_first(const Root& a, const Root& b) {
+    if (a.value.real() != b.value.real()) return a.value.real() > b.value.real();
+    return a.value.imag() > b.value.imag();
+}
+
+}  // namespace
+
+SparseRootResult product_ring_roots(const std::vector<Linearisation>& cars, const ProductRootOptions& options) {
+    options.validate();
+    const RingDeterminant det(cars);
+    const SparseDDE dde = mixed_ring_dde(cars);
+    const detail::RootBounds bounds = detail::root_bounds(normalised(dde));
+    double tau = 0.0;
+    for (const auto& c : cars) tau = std::max(tau, c.max_delay());
+    const double beta = bounds.right_bound();
+    SparseRootResult result;
+    result.right_bound = beta;
+    Locator loc(det, options);
+    // the strip [a, beta] x [-R(a), R(a)]; a is moved by a hair when a root lies on its edge
+    auto count_from = [&](double a, Cell& cell) {
+        for (int attempt = 0; attempt < 6; ++attempt) {
+            const double x = a - 1e-9 * attempt * std::max(1.0, std::abs(a));
+            cell = {x, beta, 0.0, bounds.radius(x), true, 0};
+            if (loc.count(cell)) return true;
+        }
+        return false;
+    };
+    auto fail = [&](const std::string& why) {
+        result.status = RootStatus::EigenFailure;
+        result.reason = why;
+        return result;
+    };
+    // a floor with at least `count` roots right of it
+    double a_hi = beta, a_lo = std::min(0.0, beta) - 1.0 / std::max(tau, 1e-300);
+    Cell lo{}, mid{};
+    if (!count_from(a_lo, lo)) return fail("the argument principle failed on the first strip");
+    for (int i = 0; lo.zeros < options.count; ++i) {
+        if (i == 60) return fail("fewer than " + std::to_string(options.count) + " roots in any strip");
+        a_hi = a_lo;
+        a_lo -= std::max(beta - a_lo, 1.0 / std::max(tau, 1e-300));
+        if (!count_from(a_lo, lo)) return fail("the argument principle failed on a strip");
+    }
+    // bisection: as few roots as possible beyond `count` (a conjugate pair may add one)
+    while (lo.zeros > options.count + 1 && a_hi - a_lo > 1e-12 * std::max(1.0, std::abs(a_lo))) {
+        const double a = 0.5 * (a_lo + a_hi);
+        if (!count_from(a, mid)) return fail("the argument principle failed while bisecting the strip floor");
+        if (mid.zeros >= options.count) {
+            lo = mid;
+            a_lo = lo.x0;
+        } else {
+            a_hi = a;
+        }
+    }
+    const bool located = loc.locate(lo);
+    result.strip_floor = lo.x0;
+    result.height = lo.y1;
+    result.eigenvalues_found = lo.zeros;
+    int listed = 0, clusters = 0;
+    for (const auto& f : loc.found()) {
+        listed += f.multiplicity;
+        clusters += f.cluster ? 1 : 0;
+        Root r;
+        r.value = f.value;
+        r.newton_step = f.step;
+        r.residual = ring_residual(cars, dde, bounds, f.value);
+        result.roots.push_back(r);
+        if (f.value.imag() > 0.0) {
+            r.value = std::conj(f.value);
+            result.roots.push_back(r);
+            listed += f.multiplicity;
+        }
+    }
+    std::stable_sort(result.roots.begin(), result.roots.end(), rightmost_first);
+    std::vector<Root> all = result.roots;
+    result.roots = detail::cut_rightmost(all, options.count);
+    if (result.roots.size() < all.size() && !result.roots.empty())
+        result.strip_floor = std::max(result.strip_floor, result.roots.back().value.real());
+    for (const auto& r : result.roots) {
+        result.eigenvalues.push_back(r.value);
+        result.max_residual = std::max(result.max_residual, r.residual);
+    }
+    int bad = 0;
+    for (const auto& r : result.roots) bad += r.residual <= options.residual_tolerance ? 0 : 1;
+    std::ostringstream os;
+    os.precision(3);
+    if (!located || listed != lo.zeros) {
+        result.status = RootStatus::EigenFailure;
+        os << "the argument principle counts " << lo.zeros << " roots with Re >= " << lo.x0 << " but " << listed
+           << " were located (" << loc.counts() << " contour counts)";
+    } else if (bad > 0 || clusters > 0) {
+        result.status = RootStatus::MaxDegreeReached;
+        os << bad << " roots above the residual tolerance, " << clusters << " clusters of coincident roots";
+    } else {
+        os << "all " << lo.zeros << " roots of det Delta = prod P_i - prod Q_i with Re >= " << lo.x0
+           << " located (argument principle on [" << lo.x0 << ", " << beta << "] x [-" << lo.y1 << ", " << lo.y1
+           << "], no root lies outside it; " << loc.counts() << " contour counts, " << loc.evaluations() << " evaluations over "
+           << det.types() << (det.types() == 1 ? " car type" : " car types") << "); each refined by Newton on D (max residual " << result.max_residual << ")";
+    }
+    result.reason = os.str();
+    return result;
+}
+
+}  // namespace ddemap
