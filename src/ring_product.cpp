@@ -27,12 +27,10 @@ bool same(const Linearisation& a, const Linearisation& b) {
     return same(a.gap, b.gap) && same(a.own, b.own) && same(a.lead, b.lead) && a.further.empty() && b.further.empty();
 }
 
-/// P = lambda^2 - lambda own + gap
+/// P = lambda^2 - lambda own + gap (for single cars; the grouped types use Compiled below)
 cplx p_of(const Linearisation& c, cplx z) { return z * z - z * c.own(z) + c.gap(z); }
-cplx dp_of(const Linearisation& c, cplx z) { return 2.0 * z - c.own(z) - z * c.own.derivative(z) + c.gap.derivative(z); }
 /// Q = gap + lambda lead
 cplx q_of(const Linearisation& c, cplx z) { return c.gap(z) + z * c.lead(z); }
-cplx dq_of(const Linearisation& c, cplx z) { return c.gap.derivative(z) + c.lead(z) + z * c.lead.derivative(z); }
 
 double scale_of(cplx z) { return std::max(1.0, std::abs(z)); }
 
@@ -46,23 +44,63 @@ RingDeterminant::RingDeterminant(const std::vector<Linearisation>& cars) {
         require_single_leader(c, "the ring determinant prod P_i - prod Q_i");
         auto it = std::find_if(m_types.begin(), m_types.end(), [&](const Type& t) { return same(t.lin, c); });
         if (it == m_types.end())
-            m_types.push_back({c, 1.0});
+            m_types.push_back({c, 1.0, {}, {}, {}, {}});
         else
             it->n += 1.0;
+    }
+    // gap, own and lead over their common delays: one exponential per delay and point
+    for (auto& t : m_types) {
+        auto slot = [&](double d) {
+            auto it = std::find(t.delays.begin(), t.delays.end(), d);
+            if (it != t.delays.end()) return static_cast<std::size_t>(it - t.delays.begin());
+            t.delays.push_back(d);
+            t.gap.push_back(0.0);
+            t.own.push_back(0.0);
+            t.lead.push_back(0.0);
+            return t.delays.size() - 1;
+        };
+        for (const auto& x : t.lin.gap.terms()) t.gap[slot(x.delay)] += x.coef;
+        for (const auto& x : t.lin.own.terms()) t.own[slot(x.delay)] += x.coef;
+        for (const auto& x : t.lin.lead.terms()) t.lead[slot(x.delay)] += x.coef;
     }
     m_cars = static_cast<int>(cars.size());
 }
 
+void RingDeterminant::factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const {
+    cplx g = 0.0, o = 0.0, l = 0.0, dg = 0.0, d_o = 0.0, dl = 0.0;
+    for (std::size_t j = 0; j < t.delays.size(); ++j) {
+        const double d = t.delays[j];
+        const cplx e = d == 0.0 ? cplx(1.0) : std::exp(-z * d);
+        g += t.gap[j] * e;
+        o += t.own[j] * e;
+        l += t.lead[j] * e;
+        if (dp) {
+            dg -= d * t.gap[j] * e;
+            d_o -= d * t.own[j] * e;
+            dl -= d * t.lead[j] * e;
+        }
+    }
+    p = z * z - z * o + g;  // P = lambda^2 - lambda own + gap
+    q = g + z * l;          // Q = gap + lambda lead
+    if (dp) {
+        *dp = 2.0 * z - o - z * d_o + dg;
+        *dq = dg + l + z * dl;
+    }
+}
+
 cplx RingDeterminant::phi(cplx z) const {
-    cplx s = 0.0;
-    for (const auto& t : m_types) s += t.n * std::log(q_of(t.lin, z) / p_of(t.lin, z));
+    cplx s = 0.0, p, q;
+    for (const auto& t : m_types) {
+        factors(t, z, p, q, nullptr, nullptr);
+        s += t.n * std::log(q / p);
+    }
     return s;
 }
 
 cplx RingDeterminant::log_value(cplx z) const {
-    cplx sp = 0.0, sq = 0.0, ph = 0.0;
+    cplx sp = 0.0, sq = 0.0, ph = 0.0, p, q;
     for (const auto& t : m_types) {
-        const cplx p = p_of(t.lin, z), q = q_of(t.lin, z);
+        factors(t, z, p, q, nullptr, nullptr);
         sp += t.n * std::log(p);
         sq += t.n * std::log(q);
         ph += t.n * std::log(q / p);
@@ -72,11 +110,11 @@ cplx RingDeterminant::log_value(cplx z) const {
 }
 
 cplx RingDeterminant::log_derivative(cplx z) const {
-    cplx dp = 0.0, dq = 0.0, ph = 0.0;
+    cplx dp = 0.0, dq = 0.0, ph = 0.0, p, q, pd, qd;
     for (const auto& t : m_types) {
-        const cplx p = p_of(t.lin, z), q = q_of(t.lin, z);
-        dp += t.n * dp_of(t.lin, z) / p;
-        dq += t.n * dq_of(t.lin, z) / q;
+        factors(t, z, p, q, &pd, &qd);
+        dp += t.n * pd / p;
+        dq += t.n * qd / q;
         ph += t.n * std::log(q / p);
     }
     const cplx dphi = dq - dp;
@@ -88,83 +126,75 @@ cplx RingDeterminant::log_derivative(cplx z) const {
     return dq + dphi * e / (1.0 - e);
 }
 
-struct RingDeterminant::Sample {
-    std::vector<cplx> p, r;  ///< P_t and Gamma_t = Q_t / P_t per type
-    cplx phi;                ///< sum n_t log Gamma_t (principal logs: e^phi exact, Im modulo 2 pi)
-    bool ok = false;
-};
-
-RingDeterminant::Sample RingDeterminant::sample(cplx z) const {
-    Sample s;
-    s.p.resize(m_types.size());
-    s.r.resize(m_types.size());
-    s.phi = 0.0;
-    s.ok = true;
-    for (std::size_t k = 0; k < m_types.size(); ++k) {
-        const cplx p = p_of(m_types[k].lin, z), q = q_of(m_types[k].lin, z);
-        s.p[k] = p;
-        s.r[k] = q / p;
-        if (p == 0.0 || q == 0.0 || !finite(s.r[k]) || !finite(p)) {
-            s.ok = false;
-            return s;
-        }
-        s.phi += m_types[k].n * std::log(s.r[k]);
-    }
-    if (!finite(s.phi) || std::abs(1.0 - std::exp(s.phi.real() <= 0.0 ? s.phi : -s.phi)) == 0.0) s.ok = false;
-    return s;
-}
-
 bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, int& evaluations) const {
     const double length = std::abs(b - a);
     if (length == 0.0) return true;
     const double tiny = 1e-14 * (std::abs(a) + std::abs(b) + 1.0);
-    Sample cur = sample(a);
+    const std::size_t nt = m_types.size();
+    // the current point: P_t and Gamma_t per type, and Phi (principal logs at the start of the
+    // segment, then continued by the increments: e^Phi is exact either way)
+    std::vector<cplx> cp(nt), cr(nt), np(nt), nr(nt);
+    cplx cphi = 0.0, p, q;
+    for (std::size_t k = 0; k < nt; ++k) {
+        factors(m_types[k], a, p, q, nullptr, nullptr);
+        if (p == 0.0 || q == 0.0 || !finite(p) || !finite(q)) return false;
+        cp[k] = p;
+        cr[k] = q / p;
+        cphi += m_types[k].n * std::log(cr[k]);
+    }
     ++evaluations;
-    if (!cur.ok) return false;
     double t = 0.0, h = length / 8.0;
     while (t < length) {
         h = std::min(h, length - t);
         const double tn = (length - t - h <= tiny) ? length : t + h;
         const cplx z = a + (b - a) * (tn / length);
-        const Sample nxt = sample(z);
         ++evaluations;
-        bool accept = nxt.ok;
+        // every factor's argument moves by at most theta (checked type by type, stopping early)
+        bool accept = true;
         double darg = 0.0;
         cplx dphi = 0.0;
-        if (accept) {
-            for (std::size_t k = 0; k < m_types.size() && accept; ++k) {
-                const double dp = std::arg(nxt.p[k] * std::conj(cur.p[k]));
-                const cplx dr = std::log(nxt.r[k] / cur.r[k]);
-                if (std::abs(dp) > theta || std::abs(dr.imag()) > theta) accept = false;
-                darg += m_types[k].n * dp;
-                dphi += m_types[k].n * dr;
+        for (std::size_t k = 0; k < nt && accept; ++k) {
+            factors(m_types[k], z, p, q, nullptr, nullptr);
+            if (p == 0.0 || q == 0.0 || !finite(p) || !finite(q)) {
+                accept = false;
+                break;
             }
+            const cplx r = q / p;
+            const double dp = std::arg(p * std::conj(cp[k]));
+            const cplx dr = std::log(r / cr[k]);
+            if (std::abs(dp) > theta || std::abs(dr.imag()) > theta) accept = false;
+            np[k] = p;
+            nr[k] = r;
+            darg += m_types[k].n * dp;
+            dphi += m_types[k].n * dr;
         }
+        const cplx nphi = cphi + dphi;
         double dg = 0.0;
         if (accept) {
-            const double ro = cur.phi.real(), rn = nxt.phi.real();
+            const double ro = cphi.real(), rn = nphi.real();
             const bool left_o = ro <= 0.0, left_n = rn <= 0.0;
             const double near = std::min(std::abs(ro), std::abs(rn));
             const double limit = left_o == left_n ? std::max(theta, 0.5 * near) : theta;
-            if (std::abs(dphi) > limit) accept = false;
+            if (!(std::abs(dphi) <= limit)) accept = false;
             if (accept) {
-                double wrapped;
-                if (left_o && left_n) {
-                    wrapped = std::arg((1.0 - std::exp(nxt.phi)) / (1.0 - std::exp(cur.phi)));
-                    dg = wrapped;
-                } else if (!left_o && !left_n) {
-                    wrapped = std::arg((1.0 - std::exp(-nxt.phi)) / (1.0 - std::exp(-cur.phi)));
-                    dg = dphi.imag() + wrapped;
+                // arg(1 - e^Phi): directly where |e^Phi| <= 1, through Im Phi + arg(1 - e^-Phi) beyond
+                cplx ratio;
+                if (!left_o && !left_n) {
+                    ratio = (1.0 - std::exp(-nphi)) / (1.0 - std::exp(-cphi));
+                    dg = dphi.imag();
                 } else {
-                    wrapped = std::arg((1.0 - std::exp(nxt.phi)) / (1.0 - std::exp(cur.phi)));
-                    dg = wrapped;
+                    ratio = (1.0 - std::exp(nphi)) / (1.0 - std::exp(cphi));
                 }
-                if (!(std::abs(wrapped) <= theta)) accept = false;
+                const double wrapped = std::arg(ratio);
+                if (!finite(ratio) || ratio == 0.0 || !(std::abs(wrapped) <= theta)) accept = false;
+                dg += wrapped;
             }
         }
         if (accept) {
             total += darg + dg;
-            cur = nxt;
+            std::swap(cp, np);
+            std::swap(cr, nr);
+            cphi = nphi;
             t = tn;
             h *= 1.6;
         } else {

@@ -58,9 +58,11 @@ private:
     struct Type {
         Linearisation lin;
         double n = 0.0;  ///< how many cars
+        std::vector<double> delays;          ///< the distinct delays of gap, own and lead
+        std::vector<double> gap, own, lead;  ///< their coefficients per delay
     };
-    struct Sample;
-    Sample sample(cplx z) const;
+    /// P, Q (and P', Q' when dp is given) of one type at z.
+    void factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const;
     /// Adds the change of arg D along the segment a -> b to `total`; false if the step underflowed.
     bool follow(cplx a, cplx b, double max_arg_step, double& total, int& evaluations) const;
     std::vector<Type> m_types;
