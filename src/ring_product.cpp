@@ -8,12 +8,15 @@
 
 #include "ddemap/fleet.hpp"
 #include "ddemap/roots.hpp"
+#include "text.hpp"
 
 namespace ddemap {
 
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925286766559;
+/// From this many car types on, a contour step evaluates the types on all threads.
+constexpr std::size_t kParallelTypes = 256;
 
 bool same(const ExpPoly& a, const ExpPoly& b) {
     const auto &ta = a.terms(), &tb = b.terms();
@@ -126,45 +129,89 @@ cplx RingDeterminant::log_derivative(cplx z) const {
     return dq + dphi * e / (1.0 - e);
 }
 
-bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, int& evaluations) const {
+bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, long& evaluations) const {
     const double length = std::abs(b - a);
+    if (!std::isfinite(length)) return false;
     if (length == 0.0) return true;
     const double tiny = 1e-14 * (std::abs(a) + std::abs(b) + 1.0);
     const std::size_t nt = m_types.size();
-    // the current point: P_t and Gamma_t per type, and Phi (principal logs at the start of the
-    // segment, then continued by the increments: e^Phi is exact either way)
+    // At each point: P_t and Gamma_t per type, Phi (principal logs at the start of the segment,
+    // then continued by the increments: e^Phi is exact either way) and the local turning rates
+    // max_t(|P_t'/P_t|, |Gamma_t'/Gamma_t|) and Phi', which cap the next step (the end-point
+    // checks alone could alias a step over a whole turn).
     std::vector<cplx> cp(nt), cr(nt), np(nt), nr(nt);
-    cplx cphi = 0.0, p, q;
+    struct Rates {
+        double factor = 0.0;  ///< max over the types of |P'/P| and |Gamma'/Gamma|
+        cplx phi = 0.0;       ///< Phi'
+    };
+    auto one = [&](std::size_t k, cplx z, cplx& pk, cplx& rk, Rates& rates) {
+        cplx qk, dpk, dqk;
+        factors(m_types[k], z, pk, qk, &dpk, &dqk);
+        if (pk == 0.0 || qk == 0.0 || !finite(pk) || !finite(qk)) return false;
+        rk = qk / pk;
+        const cplx lp = dpk / pk, lg = dqk / qk - lp;
+        rates.factor = std::max({rates.factor, std::abs(lp), std::abs(lg)});
+        rates.phi += m_types[k].n * lg;
+        return finite(lp) && finite(lg);
+    };
+    cplx cphi = 0.0;
+    Rates cur;
     for (std::size_t k = 0; k < nt; ++k) {
-        factors(m_types[k], a, p, q, nullptr, nullptr);
-        if (p == 0.0 || q == 0.0 || !finite(p) || !finite(q)) return false;
-        cp[k] = p;
-        cr[k] = q / p;
+        if (!one(k, a, cp[k], cr[k], cur)) return false;
         cphi += m_types[k].n * std::log(cr[k]);
     }
     ++evaluations;
-    double t = 0.0, h = length / 8.0;
+    // the largest step the rates at the current point allow
+    auto cap = [&](const Rates& r, cplx phi) {
+        double h = length / 8.0;
+        if (r.factor > 0.0) h = std::min(h, theta / r.factor);
+        const double re = std::abs(phi.real());
+        const double dphi = std::abs(r.phi);
+        if (dphi > 0.0) {
+            h = std::min(h, std::max(theta, 0.5 * re) / dphi);
+            // arg(1 - e^{+-Phi}) turns at |Phi'| |e^{-|Re Phi|}| / |1 - e^{+-Phi}|
+            const cplx e = std::exp(phi.real() <= 0.0 ? phi : -phi);
+            const double g = dphi * std::abs(e) / std::abs(1.0 - e);
+            if (g > 0.0 && std::isfinite(g)) h = std::min(h, theta / g);
+        }
+        return h;
+    };
+    double t = 0.0, h = cap(cur, cphi);
     while (t < length) {
         h = std::min(h, length - t);
         const double tn = (length - t - h <= tiny) ? length : t + h;
         const cplx z = a + (b - a) * (tn / length);
         ++evaluations;
-        // every factor's argument moves by at most theta (checked type by type, stopping early)
-        bool accept = true;
+        // every factor's argument moves by at most theta (types spread over the threads when many)
+        bool ok = true;
+        Rates next;
+#ifdef DDEMAP_WITH_OPENMP
+        if (nt >= kParallelTypes) {
+            int bad = 0;
+            double fmax = 0.0, pre = 0.0, pim = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : fmax) reduction(+ : pre, pim) reduction(| : bad)
+            for (long k = 0; k < static_cast<long>(nt); ++k) {
+                Rates r;
+                if (!one(static_cast<std::size_t>(k), z, np[k], nr[k], r)) bad |= 1;
+                fmax = std::max(fmax, r.factor);
+                pre += r.phi.real();
+                pim += r.phi.imag();
+            }
+            ok = bad == 0;
+            next.factor = fmax;
+            next.phi = cplx(pre, pim);
+        } else
+#endif
+        {
+            for (std::size_t k = 0; k < nt && ok; ++k) ok = one(k, z, np[k], nr[k], next);
+        }
+        bool accept = ok;
         double darg = 0.0;
         cplx dphi = 0.0;
         for (std::size_t k = 0; k < nt && accept; ++k) {
-            factors(m_types[k], z, p, q, nullptr, nullptr);
-            if (p == 0.0 || q == 0.0 || !finite(p) || !finite(q)) {
-                accept = false;
-                break;
-            }
-            const cplx r = q / p;
-            const double dp = std::arg(p * std::conj(cp[k]));
-            const cplx dr = std::log(r / cr[k]);
-            if (std::abs(dp) > theta || std::abs(dr.imag()) > theta) accept = false;
-            np[k] = p;
-            nr[k] = r;
+            const double dp = std::arg(np[k] * std::conj(cp[k]));
+            const cplx dr = std::log(nr[k] / cr[k]);
+            if (!(std::abs(dp) <= theta && std::abs(dr.imag()) <= theta)) accept = false;
             darg += m_types[k].n * dp;
             dphi += m_types[k].n * dr;
         }
@@ -195,8 +242,9 @@ bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, int& e
             std::swap(cp, np);
             std::swap(cr, nr);
             cphi = nphi;
+            cur = next;
             t = tn;
-            h *= 1.6;
+            h = std::min(1.6 * h, cap(cur, cphi));
         } else {
             h *= 0.35;
             if (h < tiny) return false;
@@ -236,6 +284,7 @@ void ProductRootOptions::validate() const {
     if (count < 1) fail("count = " + std::to_string(count) + ": expected an integer >= 1");
     if (!(max_arg_step > 0.0 && max_arg_step <= 1.0)) fail("max_arg_step: expected a value in (0, 1] radians");
     if (max_cells < 1) fail("max_cells: expected >= 1");
+    if (!(max_type_evaluations >= 1.0)) fail("max_type_evaluations: expected >= 1");
     if (newton_max_iterations < 1) fail("newton_max_iterations: expected >= 1");
     if (!(std::isfinite(newton_tolerance) && newton_tolerance > 0.0)) fail("newton_tolerance: expected a finite value > 0");
     if (!(std::isfinite(residual_tolerance) && residual_tolerance > 0.0)) fail("residual_tolerance: expected a finite value > 0");
@@ -254,14 +303,20 @@ class Locator {
 public:
     Locator(const RingDeterminant& det, const ProductRootOptions& o) : m_det(det), m_o(o) {}
 
-    /// Count of a cell (false when a zero lies on its boundary or the budget ran out).
+    /// Count of a cell (false when a zero lies on its boundary or a budget ran out).
     bool count(Cell& c) {
-        if (++m_counts > m_o.max_cells) return false;
+        if (exhausted()) return false;
+        ++m_counts;
         const auto r = c.axis ? m_det.count_symmetric(c.x0, c.x1, c.y1, m_o.max_arg_step)
                               : m_det.count(c.x0, c.x1, c.y0, c.y1, m_o.max_arg_step);
         m_evaluations += r.evaluations;
         c.zeros = r.zeros;
         return r.ok;
+    }
+
+    /// The cell-count or evaluation budget is used up.
+    bool exhausted() const {
+        return m_counts >= m_o.max_cells || static_cast<double>(m_evaluations) * m_det.types() > m_o.max_type_evaluations;
     }
 
     /// Count of the child cell made by `make(f)`, f the fraction of the split; when a zero lies
@@ -271,7 +326,7 @@ public:
         for (double f : {0.5, 0.5123, 0.4871, 0.5377, 0.4619, 0.5931}) {
             child = make(f);
             if (count(child)) return true;
-            if (m_counts > m_o.max_cells) return false;
+            if (exhausted()) return false;
         }
         return false;
     }
@@ -279,11 +334,13 @@ public:
     /// Newton on D from z; true when converged.
     bool newton(cplx z, bool real, cplx& out, double& step_out) const {
         double step = std::numeric_limits<double>::infinity();
+        out = z;
+        step_out = step;
         for (int it = 0; it < m_o.newton_max_iterations; ++it) {
             const cplx d = m_det.log_derivative(z);
-            if (!finite(d) || d == 0.0) {
-                // at a root to working precision (D = 0 makes D'/D infinite)
-                step = 0.0;
+            if (d == 0.0) return false;  // D' = 0: a critical point, not a root
+            if (!finite(d)) {
+                step = 0.0;  // D = 0 to working precision makes D'/D infinite: at a root
                 break;
             }
             cplx s = 1.0 / d;
@@ -298,8 +355,9 @@ public:
         return step <= 1e-8 * scale_of(z);
     }
 
-    /// Splits `top` until every root inside is isolated and found. False when the budget ran out
-    /// or the counts were inconsistent.
+    /// Splits `top` until every root inside is isolated and found. A cell that cannot be split
+    /// further (too small, or every split line meets a root: coincident roots) is recorded as a
+    /// cluster of its count. False when a budget ran out or the counts were inconsistent.
     bool locate(const Cell& top) {
         std::vector<Cell> stack{top};
         while (!stack.empty()) {
@@ -309,54 +367,61 @@ public:
             if (c.zeros < 0) return false;
             const double w = c.x1 - c.x0, h = c.axis ? 2.0 * c.y1 : c.y1 - c.y0;
             const cplx centre(0.5 * (c.x0 + c.x1), c.axis ? 0.0 : 0.5 * (c.y0 + c.y1));
-            const double size = std::max(w, h);
-            const bool smallest = size <= 1e-11 * scale_of(centre);
+            const bool smallest = std::max(w, h) <= 1e-11 * scale_of(centre);
             if (c.zeros == 1 || smallest) {
                 cplx z;
                 double step = 0.0;
                 const bool real = c.axis && c.zeros == 1;
-                if (newton(centre, real, z, step) || smallest) {
-                    const double m = 1e-12 * scale_of(z);
-                    const bool in = z.real() >= c.x0 - m && z.real() <= c.x1 + m &&
-                                    (c.axis ? std::abs(z.imag()) <= c.y1 + m : (z.imag() >= c.y0 - m && z.imag() <= c.y1 + m));
-                    if (in || smallest) {
-                        if (smallest && !in) z = centre;
-                        record(z, real ? 1 : c.zeros, step, smallest && c.zeros > 1);
-                        continue;
-                    }
+                if (newton(centre, real, z, step) && inside(c, z) && !known(z)) {
+                    record(c, z, c.zeros, step, c.zeros > 1);
+                    continue;
                 }
             }
-            if (smallest) return false;
+            if (smallest) {
+                cluster(c, centre);
+                continue;
+            }
             // split; the second child's count follows from the first's
+            bool split = true;
             if (c.axis && w >= c.y1) {
                 Cell a{}, b = c;
-                if (!count_split([&](double f) { Cell x = c; x.x1 = c.x0 + f * w; return x; }, a)) return false;
-                b.x0 = a.x1;
-                b.zeros = c.zeros - a.zeros;
-                stack.push_back(a);
-                stack.push_back(b);
+                split = count_split([&](double f) { Cell x = c; x.x1 = c.x0 + f * w; return x; }, a);
+                if (split) {
+                    b.x0 = a.x1;
+                    b.zeros = c.zeros - a.zeros;
+                    stack.push_back(a);
+                    stack.push_back(b);
+                }
             } else if (c.axis) {
                 Cell low{}, up = c;
-                if (!count_split([&](double f) { Cell x = c; x.y1 = f * c.y1; return x; }, low)) return false;
-                up.axis = false;
-                up.y0 = low.y1;
-                const int rest = c.zeros - low.zeros;
-                if (rest < 0 || rest % 2 != 0) return false;
-                up.zeros = rest / 2;
-                stack.push_back(low);
-                stack.push_back(up);
+                split = count_split([&](double f) { Cell x = c; x.y1 = f * c.y1; return x; }, low);
+                if (split) {
+                    up.axis = false;
+                    up.y0 = low.y1;
+                    const int rest = c.zeros - low.zeros;
+                    if (rest < 0 || rest % 2 != 0) return false;
+                    up.zeros = rest / 2;
+                    stack.push_back(low);
+                    stack.push_back(up);
+                }
             } else {
                 Cell a{}, b = c;
                 if (w >= h) {
-                    if (!count_split([&](double f) { Cell x = c; x.x1 = c.x0 + f * w; return x; }, a)) return false;
+                    split = count_split([&](double f) { Cell x = c; x.x1 = c.x0 + f * w; return x; }, a);
                     b.x0 = a.x1;
                 } else {
-                    if (!count_split([&](double f) { Cell x = c; x.y1 = c.y0 + f * h; return x; }, a)) return false;
+                    split = count_split([&](double f) { Cell x = c; x.y1 = c.y0 + f * h; return x; }, a);
                     b.y0 = a.y1;
                 }
-                b.zeros = c.zeros - a.zeros;
-                stack.push_back(a);
-                stack.push_back(b);
+                if (split) {
+                    b.zeros = c.zeros - a.zeros;
+                    stack.push_back(a);
+                    stack.push_back(b);
+                }
+            }
+            if (!split) {
+                if (exhausted()) return false;
+                cluster(c, centre);  // coincident roots: no split line avoids them
             }
         }
         return true;
@@ -373,8 +438,28 @@ public:
     long evaluations() const { return m_evaluations; }
 
 private:
-    void record(cplx z, int multiplicity, double step, bool cluster) {
-        if (std::abs(z.imag()) <= 1e-14 * scale_of(z) && multiplicity == 1) z.imag(0.0);
+    static bool inside(const Cell& c, cplx z) {
+        return z.real() >= c.x0 && z.real() <= c.x1 && (c.axis ? std::abs(z.imag()) <= c.y1 : (z.imag() >= c.y0 && z.imag() <= c.y1));
+    }
+    bool known(cplx z) const {
+        for (const auto& f : m_found)
+            if (std::abs(f.value - z) <= 1e-12 * scale_of(z) || std::abs(std::conj(f.value) - z) <= 1e-12 * scale_of(z)) return true;
+        return false;
+    }
+    /// `count` coincident roots in a cell that cannot be split: Newton from its centre if that
+    /// stays inside, else the centre (newton_step infinite).
+    void cluster(const Cell& c, cplx centre) {
+        cplx z;
+        double step = 0.0;
+        if (!(newton(centre, c.axis, z, step) && inside(c, z))) {
+            z = centre;
+            step = std::numeric_limits<double>::infinity();
+        }
+        record(c, z, c.zeros, step, true);
+    }
+    void record(const Cell& c, cplx z, int multiplicity, double step, bool cluster) {
+        // an axis cell's single root or cluster is real (a pair would have been split off)
+        if (c.axis && (multiplicity == 1 || cluster)) z.imag(0.0);
         m_found.push_back({z, multiplicity, step, cluster});
     }
 
@@ -432,6 +517,7 @@ SparseRootResult product_ring_roots(const std::vector<Linearisation>& cars, cons
         for (int attempt = 0; attempt < 6; ++attempt) {
             const double x = a - 1e-9 * attempt * std::max(1.0, std::abs(a));
             cell = {x, beta, 0.0, bounds.radius(x), true, 0};
+            if (!std::isfinite(cell.y1)) return false;
             if (loc.count(cell)) return true;
         }
         return false;
@@ -441,15 +527,19 @@ SparseRootResult product_ring_roots(const std::vector<Linearisation>& cars, cons
         result.reason = why;
         return result;
     };
-    // a floor with at least `count` roots right of it
-    double a_hi = beta, a_lo = std::min(0.0, beta) - 1.0 / std::max(tau, 1e-300);
+    // a floor with at least `count` roots right of it (or left of every root: a delay-free ring
+    // has only 2N roots, all with |lambda| <= R, and then the whole spectrum is listed)
+    const double unit = tau > 0.0 ? 1.0 / tau : 1.0;
+    double a_hi = beta, a_lo = std::min(0.0, beta) - unit;
     Cell lo{}, mid{};
+    // (with delays R(x) grows like e^{-x tau} and roots reach Re -> -infinity, so never then)
+    auto everything = [&](double a) { return tau == 0.0 && a < -bounds.radius(a); };
     if (!count_from(a_lo, lo)) return fail("the argument principle failed on the first strip");
-    for (int i = 0; lo.zeros < options.count; ++i) {
+    for (int i = 0; lo.zeros < options.count && !everything(a_lo); ++i) {
         if (i == 60) return fail("fewer than " + std::to_string(options.count) + " roots in any strip");
         a_hi = a_lo;
-        a_lo -= std::max(beta - a_lo, 1.0 / std::max(tau, 1e-300));
-        if (!count_from(a_lo, lo)) return fail("the argument principle failed on a strip");
+        a_lo -= std::max(beta - a_lo, unit);
+        if (!count_from(a_lo, lo)) return fail("the argument principle failed on a strip (Re >= " + detail::format_number(a_lo) + ")");
     }
     // bisection: as few roots as possible beyond `count` (a conjugate pair may add one)
     while (lo.zeros > options.count + 1 && a_hi - a_lo > 1e-12 * std::max(1.0, std::abs(a_lo))) {

@@ -46,7 +46,7 @@ public:
     /// Zeros of D inside a rectangle by the argument principle.
     struct Count {
         int zeros = 0;         ///< with multiplicity
-        int evaluations = 0;   ///< of the factors (each O(types))
+        long evaluations = 0;  ///< contour points (each O(types))
         bool ok = false;       ///< false: a zero on (or within rounding of) the boundary
     };
     /// [x0, x1] x [y0, y1], counter-clockwise boundary.
@@ -64,7 +64,7 @@ private:
     /// P, Q (and P', Q' when dp is given) of one type at z.
     void factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const;
     /// Adds the change of arg D along the segment a -> b to `total`; false if the step underflowed.
-    bool follow(cplx a, cplx b, double max_arg_step, double& total, int& evaluations) const;
+    bool follow(cplx a, cplx b, double max_arg_step, double& total, long& evaluations) const;
     std::vector<Type> m_types;
     int m_cars = 0;
 };
@@ -73,6 +73,7 @@ struct ProductRootOptions {
     int count = 10;                     ///< rightmost roots wanted (a conjugate partner may be added)
     double max_arg_step = 0.5;          ///< radians per step along a contour
     int max_cells = 200000;             ///< give up (EigenFailure) after this many cell counts
+    double max_type_evaluations = 2e9;  ///< or after this many evaluations of one car type's factors
     int newton_max_iterations = 60;
     double newton_tolerance = 1e-14;    ///< stop when |step| <= tol max(1, |lambda|)
     double residual_tolerance = 1e-9;   ///< accept a root below this relative residual

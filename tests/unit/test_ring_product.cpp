@@ -203,3 +203,92 @@ TEST_CASE("product path: long mixed rings stay certified, and a multi-leader car
     CHECK_THROWS_WITH_AS(analyse_mixed_ring(ccc, o), doctest::Contains("react only to the car ahead"), std::invalid_argument);
     CHECK_THROWS_AS(RingDeterminant(linearise_fleet(ccc, 20.0)), std::invalid_argument);
 }
+
+namespace {
+
+Linearisation ovrv_lin(double k1, double k2, double th, double tau) {
+    Linearisation l;
+    l.gap.add(k1, tau);
+    l.own.add(-(k1 * th + k2), 0.0);
+    l.lead.add(k2, tau);
+    return l;
+}
+
+/// Change of arg D along a -> b by n uniform steps of the principal log (a reference that
+/// shares nothing with the adaptive tracking but the evaluation of D).
+double brute_arg(const RingDeterminant& d, cplx a, cplx b, int n) {
+    double total = 0.0;
+    cplx prev = d.log_value(a);
+    for (int i = 1; i <= n; ++i) {
+        const cplx v = d.log_value(a + (b - a) * (static_cast<double>(i) / n));
+        total += std::remainder(v.imag() - prev.imag(), 2.0 * M_PI);
+        prev = v;
+    }
+    return total;
+}
+
+}  // namespace
+
+TEST_CASE("argument principle: counts far into the left half-plane equal a uniform fine sampling of arg D") {
+    // a 2-car ring with tau = 1: arg Gamma turns about once per 2 pi along vertical edges, so a
+    // first step of an eighth of a long edge can skip a whole turn unless the step is capped
+    // by the local rates (the first cell is such a case: it has no roots)
+    const RingDeterminant det({ovrv_lin(0.4, 0.5, 1.0, 1.0), ovrv_lin(0.5, 0.3, 1.2, 1.0)});
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int nonzero = 0;
+    for (int k = 0; k < 16; ++k) {
+        double x0 = -8.44701, w = 1.93213, y0 = 21.2957, h = 47.9416;
+        if (k > 0) {
+            x0 = -12.0 + 8.0 * u(rng);
+            w = 0.2 + 3.0 * u(rng);
+            y0 = 60.0 * u(rng);
+            h = 1.0 + 60.0 * u(rng);
+        }
+        const cplx a(x0, y0), b(x0 + w, y0), c(x0 + w, y0 + h), d(x0, y0 + h);
+        const int nw = 2000 + static_cast<int>(2000 * w), nh = 2000 + static_cast<int>(2000 * h);
+        const double total = brute_arg(det, a, b, nw) + brute_arg(det, b, c, nh) + brute_arg(det, c, d, nw) + brute_arg(det, d, a, nh);
+        const long reference = std::lround(total / (2.0 * M_PI));
+        CAPTURE(k);
+        CAPTURE(x0);
+        CAPTURE(y0);
+        const auto count = det.count(x0, x0 + w, y0, y0 + h);
+        REQUIRE(count.ok);
+        CHECK(count.zeros == reference);
+        nonzero += reference > 0 ? 1 : 0;
+    }
+    CHECK(nonzero >= 4);
+}
+
+TEST_CASE("product path: a delay-free ring (2N roots in all) and a double root at 0 (th = 0)") {
+    // tau = 0: D is a polynomial of degree 2N; the product path lists the whole spectrum,
+    // which must equal the eigenvalues of the ODE matrix
+    std::vector<Linearisation> cars{ovrv_lin(0.2, 0.5, 1.2, 0.0), ovrv_lin(0.2, 0.5, 1.2, 0.0), ovrv_lin(0.3, 0.4, 1.0, 0.0)};
+    ProductRootOptions po;
+    po.count = 20;  // more than the 6 roots there are
+    const SparseRootResult p = product_ring_roots(cars, po);
+    REQUIRE(p.status == RootStatus::Converged);
+    const SparseDDE dde = normalised(mixed_ring_dde(cars));
+    REQUIRE(dde.delayed.empty());
+    Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(dde.a0), false);
+    REQUIRE(p.roots.size() == 6);
+    for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) CHECK(nearest(p.roots, es.eigenvalues()(i)) < 1e-9);
+
+    // th = 0 for every car: lambda = 0 is a double root (the ring's and the equilibrium's);
+    // the cluster is reported as such and the other roots are still found
+    std::vector<Linearisation> flat(4, ovrv_lin(0.2, 0.5, 0.0, 0.5));
+    po.count = 8;
+    const SparseRootResult f = product_ring_roots(flat, po);
+    CHECK(f.status == RootStatus::MaxDegreeReached);
+    CHECK(f.reason.find("cluster") != std::string::npos);
+    RootOptions ro;
+    ro.count = 8;
+    const RootResult d = rightmost_roots(mixed_ring_dde(flat).to_dense(), ro);
+    int matched = 0;
+    for (const auto& r : d.roots) {
+        if (std::abs(r.value) < 1e-6 || r.value.real() < f.strip_floor) continue;
+        CHECK(nearest(f.roots, r.value) < tol::same_root);
+        ++matched;
+    }
+    CHECK(matched >= 4);
+}
