@@ -203,7 +203,10 @@ bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, long& 
         } else
 #endif
         {
-            for (std::size_t k = 0; k < nt && ok; ++k) ok = one(k, z, np[k], nr[k], next);
+            // serially, a type that turns too far rejects the step at once
+            for (std::size_t k = 0; k < nt && ok; ++k)
+                ok = one(k, z, np[k], nr[k], next) && std::abs(std::arg(np[k] * std::conj(cp[k]))) <= theta &&
+                     std::abs(std::arg(nr[k] / cr[k])) <= theta;
         }
         bool accept = ok;
         double darg = 0.0;
