@@ -194,8 +194,16 @@ RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options, con
 
     if (dde.is_ode()) {
         const MatrixXc a = dde.a0();
-        Eigen::ComplexEigenSolver<MatrixXc> es(a, false);
-        std::vector<cplx> ev(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        std::vector<cplx> ev;
+        if (dde.is_real()) {
+            // real arithmetic: exact conjugate pairs and real eigenvalues with zero imaginary part
+            // (refine_all skips Im < 0, so a real eigenvalue computed as x - 1e-18 i would be lost)
+            Eigen::EigenSolver<Eigen::MatrixXd> es(a.real(), false);
+            ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        } else {
+            Eigen::ComplexEigenSolver<MatrixXc> es(a, false);
+            ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        }
         result.roots = cut_rightmost(refine_all(dde, ev, options, result.dropped), options.count);
         result.degree = 0;
         result.status = RootStatus::Converged;

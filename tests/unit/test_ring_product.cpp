@@ -273,6 +273,13 @@ TEST_CASE("product path: a delay-free ring (2N roots in all) and a double root a
     Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(dde.a0), false);
     REQUIRE(p.roots.size() == 6);
     for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) CHECK(nearest(p.roots, es.eigenvalues()(i)) < 1e-9);
+    // the dense path's ODE branch lists the same six, lambda = 0 included (a real eigenvalue
+    // from a complex eigen-solver came with Im = -1e-18 and was skipped as a conjugate)
+    RootOptions dro;
+    dro.count = 6;
+    const RootResult dd = rightmost_roots(dde.to_dense(), dro);
+    REQUIRE(dd.roots.size() == 6);
+    for (const auto& r : dd.roots) CHECK(nearest(p.roots, r.value) < 1e-9);
 
     // th = 0 for every car: lambda = 0 is a double root (the ring's and the equilibrium's);
     // the cluster is reported as such and the other roots are still found
