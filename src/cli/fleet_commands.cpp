@@ -38,8 +38,8 @@ void FleetArgs::add_to(CLI::App* roots) {
     roots->add_option("--fleet-pattern", pattern, "a mixed ring from calibrated vehicles, e.g. \"A_min,C_max*3,E_min\", repeated to --cars");
     roots->add_option("--cars", cars, "number of cars for --fleet-pattern (default: the pattern once)");
     roots->add_option("--length", length, "fleet: ring length [m] (sum of the gaps); the speed follows");
-    roots->add_option("--solver", solver, "fleet: auto (product for cars that react only to the car ahead, else dense up to 8 cars and sparse beyond), product, dense or sparse")->capture_default_str();
-    roots->add_option("--degree", degree, "fleet: collocation degree M (0 = automatic)")->capture_default_str();
+    roots->add_option("--solver", solver, "--fleet: auto (product for cars that react only to the car ahead, else dense up to 8 cars and sparse beyond), product, dense or sparse; --system: auto (dense up to 16 states), dense or sparse")->capture_default_str();
+    roots->add_option("--degree", degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")->capture_default_str();
 }
 
 void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std::string& count_text, const std::string& format_text) {
