@@ -328,8 +328,12 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     for (const auto& c : lins) one_leader = one_leader && c.leaders() == 1;
     if (options.method == SolverMethod::Product && !one_leader)
         throw std::invalid_argument("solver 'product': every car must react only to the car ahead (this fleet has CCC cars); expected auto, dense or sparse");
+    if (options.method == SolverMethod::Product && options.roots.degree > 0)
+        throw std::invalid_argument("degree = " + std::to_string(options.roots.degree) +
+                                    ": the product path has no collocation degree; expected 0 (or the dense or sparse solver)");
     SparseRootResult r;
-    if (options.method == SolverMethod::Product || (options.method == SolverMethod::Automatic && one_leader)) {
+    // automatic: the product path, unless a collocation degree was asked for
+    if (options.method == SolverMethod::Product || (options.method == SolverMethod::Automatic && one_leader && options.roots.degree == 0)) {
         ProductRootOptions po;
         po.count = ro.count;
         po.residual_tolerance = ro.residual_tolerance;

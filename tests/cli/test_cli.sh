@@ -278,6 +278,8 @@ zs = [complex(r["re"], r["im"]) for r in s["roots"]]
 assert len(zp) == len(zs) >= 6 and all(abs(a - b) < 1e-10 for a, b in zip(zp, zs)), (zp, zs)
 PY
 expect_error "react only to the car ahead" roots --fleet "$tmp/fleet.csv" --solver product
+expect_error "the product path has no collocation degree" roots --fleet-pattern "A_min,E_min" --cars 6 --solver product --degree 20
+"$bin" roots --fleet-pattern "A_min,E_min" --cars 6 --degree 20 --format json | grep -q '"degree": 20' && ok || bad "--degree selects a collocation path"
 expect_error "expected at least" roots --fleet-pattern "A_min" --cars 4 --length 5
 if "$bin" mix --x E_min --y A_min --cars 10 --p 0:1:3 --out "$tmp/mix" >/dev/null && [ -s "$tmp/mix.csv" ] && xmllint --noout "$tmp/mix.svg"; then
     python3 - "$tmp/mix.csv" <<'PY' && ok || bad "mix csv"
