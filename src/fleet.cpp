@@ -9,6 +9,7 @@
 
 #include "ddemap/ring_product.hpp"
 #include "ddemap/roots.hpp"
+#include "ddemap/string_stability.hpp"
 #include "ddemap/vehicles.hpp"
 #include "text.hpp"
 
@@ -301,9 +302,8 @@ SparseDDE mixed_ring_dde(const std::vector<Linearisation>& cars) {
 double ring_product_residual(const std::vector<Linearisation>& cars, cplx lambda) {
     cplx sum = 0.0;
     for (const auto& c : cars) {
-        require_single_leader(c, "the product of transfer functions");
-        const cplx num = c.gap(lambda) + lambda * c.lead(lambda);
-        const cplx den = lambda * lambda - lambda * c.own(lambda) + c.gap(lambda);
+        cplx num, den;
+        TransferFunction(c).evaluate(lambda, num, den);  // (refuses a car with more than one leader)
         sum += std::log(num) - std::log(den);
     }
     return std::abs(std::exp(sum) - 1.0);

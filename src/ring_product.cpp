@@ -30,10 +30,6 @@ bool same(const Linearisation& a, const Linearisation& b) {
     return same(a.gap, b.gap) && same(a.own, b.own) && same(a.lead, b.lead) && a.further.empty() && b.further.empty();
 }
 
-/// P = lambda^2 - lambda own + gap (for single cars; the grouped types use Compiled below)
-cplx p_of(const Linearisation& c, cplx z) { return z * z - z * c.own(z) + c.gap(z); }
-/// Q = gap + lambda lead
-cplx q_of(const Linearisation& c, cplx z) { return c.gap(z) + z * c.lead(z); }
 
 double scale_of(cplx z) { return std::max(1.0, std::abs(z)); }
 
@@ -45,50 +41,21 @@ RingDeterminant::RingDeterminant(const std::vector<Linearisation>& cars) {
     if (cars.size() < 2) throw std::invalid_argument("a ring needs at least 2 cars, got " + std::to_string(cars.size()));
     for (const auto& c : cars) {
         require_single_leader(c, "the ring determinant prod P_i - prod Q_i");
-        auto it = std::find_if(m_types.begin(), m_types.end(), [&](const Type& t) { return same(t.lin, c); });
+        auto it = std::find_if(m_types.begin(), m_types.end(), [&](const Type& t) { return same(t.gamma.linearisation(), c); });
         if (it == m_types.end())
-            m_types.push_back({c, 1.0, {}, {}, {}, {}});
+            m_types.push_back({TransferFunction(c), 1.0});
         else
             it->n += 1.0;
-    }
-    // gap, own and lead over their common delays: one exponential per delay and point
-    for (auto& t : m_types) {
-        auto slot = [&](double d) {
-            auto it = std::find(t.delays.begin(), t.delays.end(), d);
-            if (it != t.delays.end()) return static_cast<std::size_t>(it - t.delays.begin());
-            t.delays.push_back(d);
-            t.gap.push_back(0.0);
-            t.own.push_back(0.0);
-            t.lead.push_back(0.0);
-            return t.delays.size() - 1;
-        };
-        for (const auto& x : t.lin.gap.terms()) t.gap[slot(x.delay)] += x.coef;
-        for (const auto& x : t.lin.own.terms()) t.own[slot(x.delay)] += x.coef;
-        for (const auto& x : t.lin.lead.terms()) t.lead[slot(x.delay)] += x.coef;
     }
     m_cars = static_cast<int>(cars.size());
 }
 
 void RingDeterminant::factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const {
-    cplx g = 0.0, o = 0.0, l = 0.0, dg = 0.0, d_o = 0.0, dl = 0.0;
-    for (std::size_t j = 0; j < t.delays.size(); ++j) {
-        const double d = t.delays[j];
-        const cplx e = d == 0.0 ? cplx(1.0) : std::exp(-z * d);
-        g += t.gap[j] * e;
-        o += t.own[j] * e;
-        l += t.lead[j] * e;
-        if (dp) {
-            dg -= d * t.gap[j] * e;
-            d_o -= d * t.own[j] * e;
-            dl -= d * t.lead[j] * e;
-        }
-    }
-    p = z * z - z * o + g;  // P = lambda^2 - lambda own + gap
-    q = g + z * l;          // Q = gap + lambda lead
-    if (dp) {
-        *dp = 2.0 * z - o - z * d_o + dg;
-        *dq = dg + l + z * dl;
-    }
+    // Gamma = Q / P: the transfer function's numerator and denominator (one exponential per delay)
+    if (dp)
+        t.gamma.evaluate(z, q, p, *dq, *dp);
+    else
+        t.gamma.evaluate(z, q, p);
 }
 
 cplx RingDeterminant::phi(cplx z) const {
@@ -474,11 +441,12 @@ private:
 };
 
 /// ||Delta(lambda) x|| / (||x|| scale) for the ring eigenvector x_v,i = Gamma_i x_v,i-1.
-double ring_residual(const std::vector<Linearisation>& cars, const SparseDDE& dde, const detail::RootBounds& bounds, cplx z) {
+double ring_residual(const std::vector<Linearisation>& cars, const std::vector<TransferFunction>& gamma, const SparseDDE& dde,
+                     const detail::RootBounds& bounds, cplx z) {
     const int n = static_cast<int>(cars.size());
     std::vector<cplx> logv(n);
     logv[0] = 0.0;
-    for (int i = 1; i < n; ++i) logv[i] = logv[i - 1] + std::log(q_of(cars[i], z) / p_of(cars[i], z));
+    for (int i = 1; i < n; ++i) logv[i] = logv[i - 1] + std::log(gamma[i](z));
     double top = -std::numeric_limits<double>::infinity();
     for (const auto& l : logv) top = std::max(top, l.real());
     Eigen::VectorXcd x(2 * n);
@@ -515,6 +483,7 @@ SparseRootResult product_ring_roots(const std::vector<Linearisation>& cars, cons
     SparseRootResult result;
     result.right_bound = beta;
     Locator loc(det, options);
+    const std::vector<TransferFunction> gamma(cars.begin(), cars.end());
     // the strip [a, beta] x [-R(a), R(a)]; a is moved by a hair when a root lies on its edge
     auto count_from = [&](double a, Cell& cell) {
         for (int attempt = 0; attempt < 6; ++attempt) {
@@ -566,7 +535,7 @@ SparseRootResult product_ring_roots(const std::vector<Linearisation>& cars, cons
         Root r;
         r.value = f.value;
         r.newton_step = f.step;
-        r.residual = ring_residual(cars, dde, bounds, f.value);
+        r.residual = ring_residual(cars, gamma, dde, bounds, f.value);
         result.roots.push_back(r);
         if (f.value.imag() > 0.0) {
             r.value = std::conj(f.value);

@@ -33,6 +33,23 @@ void TransferFunction::evaluate(cplx s, cplx& n, cplx& d) const {
     d = s * s - s * own + gap;
 }
 
+void TransferFunction::evaluate(cplx s, cplx& n, cplx& d, cplx& dn, cplx& dd) const {
+    cplx gap = 0.0, own = 0.0, lead = 0.0, dgap = 0.0, down = 0.0, dlead = 0.0;
+    for (const auto& g : m_groups) {
+        const cplx e = g.delay == 0.0 ? cplx(1.0) : std::exp(-s * g.delay);
+        gap += g.gap * e;
+        own += g.own * e;
+        lead += g.lead * e;
+        dgap -= g.delay * g.gap * e;
+        down -= g.delay * g.own * e;
+        dlead -= g.delay * g.lead * e;
+    }
+    n = gap + s * lead;
+    d = s * s - s * own + gap;
+    dn = dgap + lead + s * dlead;
+    dd = 2.0 * s - own - s * down + dgap;
+}
+
 cplx TransferFunction::numerator(cplx s) const {
     cplx n, d;
     evaluate(s, n, d);
@@ -46,10 +63,8 @@ cplx TransferFunction::denominator(cplx s) const {
 }
 
 cplx TransferFunction::derivative(cplx s) const {
-    const cplx n = numerator(s);
-    const cplx d = denominator(s);
-    const cplx np = m_lin.gap.derivative(s) + m_lin.lead(s) + s * m_lin.lead.derivative(s);
-    const cplx dp = 2.0 * s - m_lin.own(s) - s * m_lin.own.derivative(s) + m_lin.gap.derivative(s);
+    cplx n, d, np, dp;
+    evaluate(s, n, d, np, dp);
     return (np * d - n * dp) / (d * d);
 }
 

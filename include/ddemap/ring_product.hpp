@@ -25,6 +25,7 @@
 
 #include "ddemap/model.hpp"
 #include "ddemap/sparse.hpp"
+#include "ddemap/string_stability.hpp"
 
 namespace ddemap {
 
@@ -56,10 +57,8 @@ public:
 
 private:
     struct Type {
-        Linearisation lin;
-        double n = 0.0;  ///< how many cars
-        std::vector<double> delays;          ///< the distinct delays of gap, own and lead
-        std::vector<double> gap, own, lead;  ///< their coefficients per delay
+        TransferFunction gamma;  ///< Gamma = Q / P of one car of this type
+        double n = 0.0;          ///< how many cars
     };
     /// P, Q (and P', Q' when dp is given) of one type at z.
     void factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const;

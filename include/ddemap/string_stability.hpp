@@ -23,6 +23,9 @@ public:
     cplx denominator(cplx s) const;
     /// N and D together (one exponential per distinct delay).
     void evaluate(cplx s, cplx& n, cplx& d) const;
+    /// N, D and their derivatives N' = gap' + lead + s lead', D' = 2 s - own - s own' + gap'
+    /// (the same exponentials).
+    void evaluate(cplx s, cplx& n, cplx& d, cplx& dn, cplx& dd) const;
     cplx operator()(cplx s) const {
         cplx n, d;
         evaluate(s, n, d);
