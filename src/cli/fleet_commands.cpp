@@ -92,9 +92,7 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
         j["reason"] = rr.reason;
         out << j.dump(2) << "\n";
     } else if (format == Format::Csv) {
-        out << "re,im,residual,newton_step\n";
-        for (const auto& x : rr.roots)
-            out << exact(x.value.real()) << "," << exact(x.value.imag()) << "," << exact(x.residual) << "," << exact(x.newton_step) << "\n";
+        out << roots_csv(rr.roots);
     } else {
         out << "fleet      " << (args.fleet.empty() ? args.pattern : args.fleet) << ": " << fleet.size() << " cars, speed "
             << rounded(r.equilibrium.speed, 6) << " m/s, ring length " << rounded(r.equilibrium.length, 8) << " m\n";
@@ -107,13 +105,7 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
         out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
         out << "verdict    " << (r.stable ? "STABLE" : "UNSTABLE") << " (" << r.unstable_roots
             << (r.unstable_count_complete ? "" : " or more") << " unstable roots)\n\n";
-        out << "  #                re                 im    residual\n";
-        int i = 0;
-        for (const auto& x : rr.roots) {
-            char line[160];
-            std::snprintf(line, sizeof line, "%3d %17.12f %18.12f %11.2e\n", ++i, x.value.real(), x.value.imag(), x.residual);
-            out << line;
-        }
+        out << roots_table(rr.roots);
     }
     std::cout << out.str();
 }

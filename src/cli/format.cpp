@@ -26,4 +26,22 @@ std::string csv_field(const std::string& s) {
     return out + "\"";
 }
 
+std::string roots_csv(const std::vector<Root>& roots) {
+    std::string out = "re,im,residual,newton_step\n";
+    for (const auto& x : roots)
+        out += exact(x.value.real()) + "," + exact(x.value.imag()) + "," + exact(x.residual) + "," + exact(x.newton_step) + "\n";
+    return out;
+}
+
+std::string roots_table(const std::vector<Root>& roots) {
+    std::string out = "  #                re                 im    residual\n";
+    int i = 0;
+    for (const auto& x : roots) {
+        char line[160];
+        std::snprintf(line, sizeof line, "%3d %17.12f %18.12f %11.2e\n", ++i, x.value.real(), x.value.imag(), x.residual);
+        out += line;
+    }
+    return out;
+}
+
 }  // namespace ddemap::cli

@@ -2,6 +2,9 @@
 // Formatting helpers of the command-line front: round-trip numbers for machine output,
 // rounded numbers for tables. Formatting only; no numerics here.
 #include <string>
+#include <vector>
+
+#include "ddemap/roots.hpp"
 
 namespace ddemap::cli {
 
@@ -11,5 +14,9 @@ std::string exact(double v);
 std::string rounded(double v, int digits = 6);
 /// Quotes a CSV field if needed.
 std::string csv_field(const std::string& s);
+/// Roots as CSV: re,im,residual,newton_step (round-trip exact).
+std::string roots_csv(const std::vector<Root>& roots);
+/// Roots as a numbered human table (rounded).
+std::string roots_table(const std::vector<Root>& roots);
 
 }  // namespace ddemap::cli

@@ -109,22 +109,14 @@ void run_system_roots(const RootsArgs& args) {
         j["status"] = to_string(r.status);
         out << j.dump(2) << "\n";
     } else if (format == Format::Csv) {
-        out << "re,im,residual,newton_step\n";
-        for (const auto& x : r.roots)
-            out << exact(x.value.real()) << "," << exact(x.value.imag()) << "," << exact(x.residual) << "," << exact(x.newton_step) << "\n";
+        out << roots_csv(r.roots);
     } else {
         out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
         out << "solver     " << path << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
         out << "trusted    " << r.reason << "\n";
         out << "abscissa   " << rounded(a, 10) << "\n";
         out << "verdict    " << (stable ? "STABLE" : "NOT asymptotically stable") << "\n\n";
-        out << "  #                re                 im    residual\n";
-        int i = 0;
-        for (const auto& x : r.roots) {
-            char line[160];
-            std::snprintf(line, sizeof line, "%3d %17.12f %18.12f %11.2e\n", ++i, x.value.real(), x.value.imag(), x.residual);
-            out << line;
-        }
+        out << roots_table(r.roots);
     }
     std::cout << out.str();
 }
