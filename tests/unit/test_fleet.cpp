@@ -11,10 +11,13 @@
 #include "ddemap/collocation.hpp"
 #include "ddemap/fleet.hpp"
 #include "ddemap/ring.hpp"
+#include "fleet_helpers.hpp"
 #include "tolerances.hpp"
 
 using namespace ddemap;
 namespace tol = ddemap::test::tol;
+using ddemap::test::linearised;
+using ddemap::test::random_car;
 
 namespace {
 
@@ -28,17 +31,6 @@ std::vector<cplx> values(const std::vector<Root>& roots) {
     std::vector<cplx> v;
     for (const auto& r : roots) v.push_back(r.value);
     return v;
-}
-
-/// A random car: OVRV or (ccc = true) connected cruise control, parameters from a fixed generator.
-FleetCar random_car(std::mt19937& rng, bool ccc) {
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    ParameterMap p{{"k1", 0.02 + 0.4 * u(rng)}, {"k2", 0.05 + 0.6 * u(rng)}, {"th", 0.6 + 1.8 * u(rng)}, {"tau", 0.1 + 0.9 * u(rng)}};
-    if (ccc) {
-        p["k3"] = 0.05 + 0.4 * u(rng);
-        p["tau2"] = 0.05 + 0.5 * u(rng);
-    }
-    return {ccc ? "ccc" : "ovrv", ccc ? "ccc" : "ovrv", p};
 }
 
 MixedRingOptions at_speed(int count, SolverMethod method) {
@@ -103,10 +95,7 @@ namespace {
 void check_sparse_against_dense(std::mt19937& rng, int n, int degree) {
     std::vector<Linearisation> lins;
     for (int i = 0; i < n; ++i) {
-        const FleetCar c = random_car(rng, i % 3 == 2);
-        ParameterMap p = c.parameters;
-        p["speed"] = 20.0;
-        lins.push_back(make_model(c.model, p)->linearise());
+        lins.push_back(linearised(random_car(rng, i % 3 == 2)));
     }
     const SparseDDE dde = mixed_ring_dde(lins);
     SparseRootOptions o;

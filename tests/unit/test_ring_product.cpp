@@ -12,10 +12,14 @@
 #include "ddemap/fleet.hpp"
 #include "ddemap/ring.hpp"
 #include "ddemap/ring_product.hpp"
+#include "fleet_helpers.hpp"
 #include "tolerances.hpp"
 
 using namespace ddemap;
 namespace tol = ddemap::test::tol;
+using ddemap::test::linearised;
+using ddemap::test::ovrv;
+using ddemap::test::random_car;
 
 namespace {
 
@@ -34,9 +38,7 @@ std::vector<Linearisation> random_ring(std::mt19937& rng, int n) {
             out.push_back(out[static_cast<std::size_t>(u(rng) * i)]);
             continue;
         }
-        ParameterMap p{{"k1", 0.02 + 0.4 * u(rng)}, {"k2", 0.05 + 0.6 * u(rng)}, {"th", 0.6 + 1.8 * u(rng)},
-                       {"tau", 0.1 + 0.9 * u(rng)}, {"speed", 20.0}};
-        out.push_back(make_model("ovrv", p)->linearise());
+        out.push_back(linearised(random_car(rng, false)));
     }
     return out;
 }
@@ -206,14 +208,6 @@ TEST_CASE("product path: long mixed rings stay certified, and a multi-leader car
 
 namespace {
 
-Linearisation ovrv_lin(double k1, double k2, double th, double tau) {
-    Linearisation l;
-    l.gap.add(k1, tau);
-    l.own.add(-(k1 * th + k2), 0.0);
-    l.lead.add(k2, tau);
-    return l;
-}
-
 /// Change of arg D along a -> b by n uniform steps of the principal log (a reference that
 /// shares nothing with the adaptive tracking but the evaluation of D).
 double brute_arg(const RingDeterminant& d, cplx a, cplx b, int n) {
@@ -233,7 +227,7 @@ TEST_CASE("argument principle: counts far into the left half-plane equal a unifo
     // a 2-car ring with tau = 1: arg Gamma turns about once per 2 pi along vertical edges, so a
     // first step of an eighth of a long edge can skip a whole turn unless the step is capped
     // by the local rates (the first cell is such a case: it has no roots)
-    const RingDeterminant det({ovrv_lin(0.4, 0.5, 1.0, 1.0), ovrv_lin(0.5, 0.3, 1.2, 1.0)});
+    const RingDeterminant det({ovrv(0.4, 0.5, 1.0, 1.0), ovrv(0.5, 0.3, 1.2, 1.0)});
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     int nonzero = 0;
@@ -263,7 +257,7 @@ TEST_CASE("argument principle: counts far into the left half-plane equal a unifo
 TEST_CASE("product path: a delay-free ring (2N roots in all) and a double root at 0 (th = 0)") {
     // tau = 0: D is a polynomial of degree 2N; the product path lists the whole spectrum,
     // which must equal the eigenvalues of the ODE matrix
-    std::vector<Linearisation> cars{ovrv_lin(0.2, 0.5, 1.2, 0.0), ovrv_lin(0.2, 0.5, 1.2, 0.0), ovrv_lin(0.3, 0.4, 1.0, 0.0)};
+    std::vector<Linearisation> cars{ovrv(0.2, 0.5, 1.2, 0.0), ovrv(0.2, 0.5, 1.2, 0.0), ovrv(0.3, 0.4, 1.0, 0.0)};
     ProductRootOptions po;
     po.count = 20;  // more than the 6 roots there are
     const SparseRootResult p = product_ring_roots(cars, po);
@@ -283,7 +277,7 @@ TEST_CASE("product path: a delay-free ring (2N roots in all) and a double root a
 
     // th = 0 for every car: lambda = 0 is a double root (the ring's and the equilibrium's);
     // the cluster is reported as such and the other roots are still found
-    std::vector<Linearisation> flat(4, ovrv_lin(0.2, 0.5, 0.0, 0.5));
+    std::vector<Linearisation> flat(4, ovrv(0.2, 0.5, 0.0, 0.5));
     po.count = 8;
     const SparseRootResult f = product_ring_roots(flat, po);
     CHECK(f.status == RootStatus::MaxDegreeReached);
