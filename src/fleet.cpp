@@ -321,11 +321,9 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     out.equilibrium = std::isnan(options.length) ? ring_equilibrium_at_speed(fleet, options.speed)
                                                  : ring_equilibrium_at_length(fleet, options.length);
     const std::vector<Linearisation> lins = linearise_fleet(fleet, out.equilibrium.speed);
-    const SparseDDE dde = mixed_ring_dde(lins);
     SparseRootOptions ro = options.roots;
     ro.count = options.roots.count + 1;  // room for the trivial root
-    bool one_leader = true;
-    for (const auto& c : lins) one_leader = one_leader && c.leaders() == 1;
+    const bool one_leader = std::all_of(lins.begin(), lins.end(), [](const Linearisation& l) { return l.leaders() == 1; });
     if (options.method == SolverMethod::Product && !one_leader)
         throw std::invalid_argument("solver 'product': every car must react only to the car ahead (this fleet has CCC cars); expected auto, dense or sparse");
     if (options.method == SolverMethod::Product && options.roots.degree > 0)
@@ -339,7 +337,7 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
         po.residual_tolerance = ro.residual_tolerance;
         r = product_ring_roots(lins, po);
     } else {
-        r = system_rightmost_roots(dde, ro, options.method);
+        r = system_rightmost_roots(mixed_ring_dde(lins), ro, options.method);
     }
     // the trivial root: lambda = 0 to rounding
     for (std::size_t i = 0; i < r.roots.size(); ++i) {
@@ -361,8 +359,7 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     }
     out.stable = r.status == RootStatus::Converged && !r.roots.empty() && out.unstable_roots == 0 &&
                  r.roots.front().value.real() < -marginal_band(r.roots.front().value);
-    const bool predecessor = std::all_of(lins.begin(), lins.end(), [](const Linearisation& l) { return l.leaders() == 1; });
-    if (predecessor) {
+    if (one_leader) {
         out.product_residual = 0.0;
         for (const auto& x : r.roots) out.product_residual = std::max(out.product_residual, ring_product_residual(lins, x.value));
     }

@@ -47,7 +47,6 @@ RingDeterminant::RingDeterminant(const std::vector<Linearisation>& cars) {
         else
             it->n += 1.0;
     }
-    m_cars = static_cast<int>(cars.size());
 }
 
 void RingDeterminant::factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const {

@@ -35,7 +35,6 @@ public:
     /// Groups identical linearisations; throws std::invalid_argument for fewer than 2 cars or
     /// a car with more than one leader.
     explicit RingDeterminant(const std::vector<Linearisation>& cars);
-    int cars() const { return m_cars; }
     int types() const { return static_cast<int>(m_types.size()); }
     /// log D(lambda) (imaginary part modulo 2 pi); -inf real part at an exact root.
     cplx log_value(cplx lambda) const;
@@ -65,7 +64,6 @@ private:
     /// Adds the change of arg D along the segment a -> b to `total`; false if the step underflowed.
     bool follow(cplx a, cplx b, double max_arg_step, double& total, long& evaluations) const;
     std::vector<Type> m_types;
-    int m_cars = 0;
 };
 
 struct ProductRootOptions {
