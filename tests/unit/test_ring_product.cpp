@@ -143,8 +143,9 @@ TEST_CASE("product path: the same rightmost roots as the sparse path for random 
             CHECK(nearest(s.roots, p.roots[i].value) < tol::same_root);
             CHECK(p.roots[i].residual < 1e-12);
         }
-        // every root right of the product path's certified floor was also found by the sparse path
-        CHECK(p.strip_floor <= p.roots.back().value.real());
+        // and the other way: every sparse root right of the product path's certified floor is listed
+        for (const auto& r : s.roots)
+            if (r.value.real() >= p.strip_floor) CHECK(nearest(p.roots, r.value) < tol::same_root);
     }
 }
 
@@ -189,7 +190,6 @@ TEST_CASE("product path: long mixed rings stay certified, and a multi-leader car
     CHECK(r.roots.roots.size() >= 10);
     CHECK(r.roots.max_residual < 1e-11);
     CHECK(r.product_residual < 1e-8);  // sum of 20000 logarithms: ~N eps |Phi'| lost
-    CHECK(r.roots.strip_floor <= r.roots.roots.back().value.real());
     // the same fleet as four groups of 5000 identical cars: the order does not matter
     Fleet grouped;
     for (const char* name : {"A_min", "C_max", "E_min", "G_max"})
