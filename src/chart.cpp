@@ -246,7 +246,11 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             ++i;
         }
     }
-    const int per_row = std::max(1, static_cast<int>((width - 20) / 150));
+    // one slot per entry, wide enough for the longest name (11 px text: about 6.5 px a character)
+    std::size_t longest = 0;
+    for (const auto& e : entries) longest = std::max(longest, e.first.size());
+    const double slot = std::max(150.0, 29.0 + 6.5 * static_cast<double>(longest) + 14.0);
+    const int per_row = std::max(1, static_cast<int>((width - 20) / slot));
     const double legend_h = entries.empty() ? 10 : 20.0 * ((entries.size() + per_row - 1) / per_row) + 12;
     const double note_h = o.note.empty() ? 0 : 20;
     const double height = header + rows * ch + legend_h + note_h;
@@ -324,7 +328,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         const double ly = header + rows * ch + 4;
         s << "<g id=\"legend\" font-size=\"11\">\n";
         for (std::size_t i = 0; i < entries.size(); ++i) {
-            const double x = 10 + (i % per_row) * 150, y = ly + (i / per_row) * 20;
+            const double x = 10 + (i % per_row) * slot, y = ly + (i / per_row) * 20;
             s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7) << "\" x2=\"" << num(x + 24) << "\" y2=\"" << num(y + 7)
               << "\" stroke=\"" << entries[i].second << "\" stroke-width=\"2\"" << (dashed_entries[i] ? " stroke-dasharray=\"5,3\"" : "")
               << "/>\n<text x=\"" << num(x + 29) << "\" y=\"" << num(y + 11) << "\">" << esc(entries[i].first) << "</text>\n";
