@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/fleet.hpp"
+#include "ddemap/study/penetration.hpp"
 
 using namespace ddemap;
 

@@ -18,9 +18,9 @@
 #include <omp.h>
 #endif
 
-#include "ddemap/ring.hpp"
-#include "ddemap/string_stability.hpp"
-#include "ddemap/sweep.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/study/sweep.hpp"
 
 using namespace ddemap;
 using clock_type = std::chrono::steady_clock;

@@ -2,7 +2,7 @@
 // Shared test fixture: an OVRV (k1, k2) chart over [0.01, 1]^2.
 #include <string>
 
-#include "ddemap/sweep.hpp"
+#include "ddemap/study/sweep.hpp"
 
 namespace ddemap::test {
 

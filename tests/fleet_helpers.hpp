@@ -3,7 +3,7 @@
 // linearisation from its four parameters.
 #include <random>
 
-#include "ddemap/fleet.hpp"
+#include "ddemap/study/penetration.hpp"
 
 namespace ddemap::test {
 

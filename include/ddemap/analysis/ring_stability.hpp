@@ -1,0 +1,47 @@
+#pragma once
+/// \file ring_stability.hpp
+/// Rightmost roots and the stability verdict of a ring of N identical cars, mode by mode
+/// (traffic/ring.hpp); N = infinity over every wave number theta.
+
+#include <string>
+#include <vector>
+
+#include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/ring.hpp"
+
+namespace ddemap {
+
+struct RingOptions {
+    RootOptions roots;      ///< per-mode options; roots.count is the number of roots reported
+    int theta_grid = 64;    ///< N = infinity: uniform wave numbers in (0, pi] before refinement
+    void validate() const;
+};
+
+struct RingRoot {
+    Root root;
+    int mode = 0;         ///< m of zeta = exp(-2 pi i m / N); -1 for N = infinity
+    double theta = 0.0;   ///< wave number 2 pi m / N (N = infinity: the theta of this root)
+};
+
+struct RingResult {
+    int cars = 0;                    ///< N; 0 stands for infinity
+    std::vector<RingRoot> roots;     ///< the rightmost roots over all modes, rightmost first
+    double spectral_abscissa = 0.0;  ///< max Re over all roots, trivial zero excluded
+    int abscissa_mode = 0;           ///< mode where it is reached (-1 for N = infinity)
+    double abscissa_theta = 0.0;     ///< its wave number
+    bool abscissa_is_limit = false;  ///< N = infinity: the sup 0 is only approached as theta -> 0
+    int unstable_roots = 0;          ///< roots with Re > marginal band, all modes (-1 for N = infinity)
+    int marginal_roots = 0;          ///< roots within the marginal band of the axis
+    bool stable = false;             ///< every root (trivial one excluded) has Re < -marginal band
+    bool trivial_branch_stable = false;  ///< N = infinity: the branch through the trivial root bends left
+    int degree = 0;                  ///< the largest collocation degree used over the modes
+    int modes_solved = 0;            ///< mode (or wave-number) problems solved
+    RootStatus status = RootStatus::Converged;  ///< worst status over the modes
+    std::string reason;              ///< how the degree was chosen and trusted
+};
+
+/// Rightmost roots and the stability verdict of the ring (cars >= 2, or 0 for infinity).
+RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& options = {});
+
+}  // namespace ddemap

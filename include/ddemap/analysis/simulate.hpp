@@ -1,0 +1,96 @@
+#pragma once
+/// \file simulate.hpp
+/// Nonlinear platoon simulation: a lead car with a prescribed speed profile and followers, each
+/// with its own car-following law and delay,
+///     s_i' = v_{i-1} - v_i,   v_i' = F_i(s_i(t - tau_i), v_i(t), v_{i-1}(t - tau_i)),
+/// starting from equilibrium at the lead's initial speed (s_i = s*_i(v0), v_i = v0 for t <= 0),
+/// integrated by detail::DdeSolver (RK4 with a Hermite continuous extension, steps aligned
+/// with the lead profile's breakpoints and their first delayed echoes). Events: a follower
+/// below its minimum ACC speed disengages; a gap reaching zero is a collision.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/vehicles.hpp"
+
+namespace ddemap {
+
+/// v_0(t): piecewise linear through (t_k, v_k), constant before the first and after the last.
+class LeadProfile {
+public:
+    LeadProfile(std::vector<double> times, std::vector<double> speeds);
+    /// Built-in profiles of the paper's tests: "dip" (22.4 -> 19.7 -> 22.4 m/s, the platoon
+    /// test), "oscillatory" (24.5 <-> 21.9 m/s, each held 30 s), "step-low" (11.2 -> 15.6 m/s),
+    /// "step-high" (22.4 -> 26.8 m/s); transitions at 0.5 m/s^2 (see describe_builtin()).
+    static LeadProfile builtin(const std::string& name);
+    static std::vector<std::string> builtin_names();
+    static std::string describe_builtin(const std::string& name);
+    /// CSV with columns time_s, lead_speed_mps (other columns ignored); errors name line and column.
+    static LeadProfile from_csv(const std::string& text, const std::string& source);
+
+    double speed(double t) const;
+    /// integral of v_0 from 0 to t (exact)
+    double position(double t) const;
+    const std::vector<double>& times() const { return m_t; }
+    const std::vector<double>& speeds() const { return m_v; }
+    double duration() const { return m_t.back(); }
+
+private:
+    std::vector<double> m_t, m_v, m_x;  // m_x: position at m_t
+};
+
+struct SimCar {
+    std::shared_ptr<const CarModel> model;
+    double min_speed = 0.0;  ///< ACC disengages below this speed [m/s] (0: never)
+    std::string name;
+};
+
+enum class OnEvent { Continue, Stop };
+
+struct SimOptions {
+    double step = 0.05;        ///< largest step [s] (also limited by the smallest delay)
+    double t_end = 0.0;        ///< 0: the lead profile's last breakpoint plus 30 s
+    double output_dt = 0.1;    ///< output sampling [s]
+    OnEvent on_event = OnEvent::Continue;
+    void validate() const;
+};
+
+struct SimEvent {
+    std::string type;  ///< "disengage" or "collision"
+    int car = 0;       ///< follower index, 1 = first follower
+    double time = 0.0;
+    double speed = 0.0;
+    double gap = 0.0;
+    double lowest_speed = 0.0;  ///< the car's lowest speed up to the event
+};
+
+struct CarSummary {
+    int car = 0;
+    std::string name;
+    double min_speed = 0.0;     ///< lowest speed reached [m/s]
+    double speed_drop = 0.0;    ///< initial speed minus the lowest speed [m/s]
+    double min_gap = 0.0;       ///< smallest gap [m]
+    std::vector<SimEvent> events;
+};
+
+struct SimResult {
+    std::vector<double> time;                     ///< output times
+    std::vector<std::vector<double>> position;    ///< [car][k], car 0 = lead
+    std::vector<std::vector<double>> speed;       ///< [car][k]
+    std::vector<std::vector<double>> gap;         ///< [car][k] (car 0: none, empty)
+    std::vector<CarSummary> cars;                 ///< followers, platoon order
+    std::vector<SimEvent> events;                 ///< in time order
+    double initial_speed = 0.0;
+    double t_end = 0.0;
+    bool stopped = false;                         ///< ended early at an event (OnEvent::Stop)
+    std::size_t steps = 0;
+};
+
+SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options = {});
+
+/// Followers of one calibrated vehicle setting (OVRV), with the paper's minimum ACC speed.
+std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers);
+
+}  // namespace ddemap

@@ -1,0 +1,57 @@
+#pragma once
+/// \file chart_spec.hpp
+/// Chart specifications: a small TOML format (see maps/*.toml) naming the model, the ring, the
+/// two swept parameters, fixed parameters common to all panels, and one [[panel]] per panel
+/// with its own fixed parameters and optional [[panel.marker]] entries; or
+/// `vehicles = "paper"` for one panel per vehicle setting of the built-in calibration table,
+/// each at the vehicle's own tau and th with the vehicle marked.
+
+#include <string>
+#include <vector>
+
+#include "ddemap/io/svg.hpp"
+#include "ddemap/traffic/model.hpp"
+#include "ddemap/study/sweep.hpp"
+#include "ddemap/analysis/classify.hpp"
+
+namespace ddemap {
+
+struct PanelSpec {
+    std::string title;        ///< empty: made from the panel's fixed parameters
+    ParameterMap parameters;  ///< panel-specific fixed parameters
+    std::vector<ChartMarker> markers;
+};
+
+struct ChartSpec {
+    std::string title;
+    std::string model = "ovrv";
+    int cars = 22;            ///< 0 = infinity
+    ParameterMap fixed;
+    Axis x, y;
+    int columns = 3;
+    double panel_width = 260, panel_height = 220;
+    bool boundaries = true;
+    std::vector<PanelSpec> panels;
+};
+
+/// Parses a chart spec; std::invalid_argument naming `source`, the line and the key on error.
+ChartSpec parse_chart_spec(const std::string& text, const std::string& source);
+
+/// The sweep of one panel: the chart's model, window and ring with the panel's parameters.
+SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel);
+
+/// Panels for a list of vehicles: each at its own tau and th (and eta), marked at (k1, k2).
+std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehicles);
+
+/// The sweeps and boundaries of every panel, and the SVG.
+struct RenderedChart {
+    std::vector<SweepSpec> specs;
+    std::vector<SweepResult> sweeps;
+    std::vector<BoundarySet> boundaries;
+    std::string svg;
+    double seconds = 0.0;
+};
+
+RenderedChart render_chart(const ChartSpec& spec);
+
+}  // namespace ddemap

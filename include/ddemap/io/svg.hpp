@@ -1,0 +1,83 @@
+#pragma once
+/// \file chart.hpp
+/// Stability charts as SVG: shaded regions from a sweep (plant unstable, ring unstable, string
+/// unstable, string stable), boundary curves from the continuation drawn over them, axes with
+/// ticks and labels in units, a legend, titles and optional labelled markers; one or more
+/// panels (small multiples). The writer only formats what it is given.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ddemap/study/boundary.hpp"
+#include "ddemap/study/sweep.hpp"
+
+namespace ddemap {
+
+struct ChartMarker {
+    double x = 0.0, y = 0.0;
+    std::string label;
+};
+
+struct ChartPanel {
+    std::string title;                  ///< e.g. "tau = 0.5 s, th = 1.5 s"
+    const SweepResult* sweep = nullptr;  ///< regions (required)
+    const BoundarySet* boundaries = nullptr;  ///< curves (optional)
+    std::vector<ChartMarker> markers;
+};
+
+struct ChartOptions {
+    std::string title;
+    int columns = 3;
+    double panel_width = 300.0;   ///< plot area, px
+    double panel_height = 250.0;
+};
+
+/// Region class of a sweep point: 0 plant unstable, 1 ring unstable, 2 string unstable,
+/// 3 string stable.
+int region_class(const SweepPoint& p);
+
+/// "k1 [1/s^2]" for a model parameter (with the unit from the model's parameter table).
+std::string axis_label(const std::string& model, const std::string& parameter);
+
+std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartOptions& options);
+
+/// Line plots (simulation traces, disturbance growth, calibration fits).
+struct PlotSeries {
+    std::string name;
+    std::vector<double> x, y;
+    std::string colour;  ///< empty: from the palette
+    bool dashed = false;
+};
+
+struct PlotMarker {
+    double x = 0.0, y = 0.0;
+    std::string colour = "#000000";
+    std::string label;  ///< optional text next to the cross
+};
+
+struct PlotPanel {
+    std::string title, x_label, y_label;
+    std::vector<PlotSeries> series;
+    std::vector<PlotMarker> markers;  ///< drawn as crosses
+};
+
+struct PlotOptions {
+    std::string title;
+    int columns = 2;
+    double panel_width = 420.0, panel_height = 280.0;
+    bool legend = true;
+    std::string note;  ///< one line under the legend (e.g. what the markers mean)
+};
+
+std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& options);
+
+/// Writes `text` to `path` atomically (a temporary file renamed into place); throws
+/// std::runtime_error naming the path on failure.
+void write_file_atomic(const std::string& path, const std::string& text);
+
+/// Writes several files so that either all appear or none is left half-written: all are
+/// written to temporary files first, then renamed into place.
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
+
+}  // namespace ddemap

@@ -1,0 +1,29 @@
+#pragma once
+/// \file growth.hpp
+/// Disturbance growth along platoons of identical followers (the seed paper's growth figure).
+
+#include <string>
+#include <vector>
+
+#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/traffic/vehicles.hpp"
+
+namespace ddemap {
+
+/// Disturbance growth along a platoon of identical followers (the paper's growth figure):
+/// per position the speed drop, the amplification (drop / the lead's drop) and the minimum gap,
+/// up to the first position whose car disengages or collides (where the platoon fails).
+struct GrowthResult {
+    std::string name;
+    std::vector<double> speed_drop, amplification, min_gap;  ///< positions 1 .. (failed_at - 1) or all
+    int failed_at = 0;            ///< first failing position (0: none)
+    std::string failure;          ///< "disengage" or "collision"
+    double failure_time = 0.0;
+    double failure_amplification = 0.0;  ///< (v0 - lowest speed up to the event) / lead drop
+    double failure_gap = 0.0;
+};
+
+std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle>& vehicles, const LeadProfile& lead,
+                                             int followers, const SimOptions& options = {});
+
+}  // namespace ddemap

@@ -1,0 +1,41 @@
+#pragma once
+/// \file penetration.hpp
+/// Penetration-rate studies of two car types on a ring.
+
+#include <vector>
+
+#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/traffic/fleet.hpp"
+
+namespace ddemap {
+
+/// Penetration-rate study: the spectral abscissa of the mixed ring as a function of the fraction
+/// p of X cars (k = round(p N)). With draws > 0 every p is solved for `draws` random
+/// arrangements (and the spread one), reporting the range; for laws of the car ahead only the
+/// order does not matter, so draws add nothing there.
+struct MixOptions {
+    int cars = 40;
+    std::vector<double> fractions;  ///< p values in [0, 1]
+    int draws = 0;
+    unsigned seed = 1;
+    MixedRingOptions ring;          ///< speed or length, solver, roots.count
+    void validate() const;
+};
+
+struct MixPoint {
+    double fraction = 0.0;       ///< requested p
+    int x_cars = 0;              ///< k = round(p N)
+    double abscissa = 0.0;       ///< spread arrangement
+    double abscissa_min = 0.0;   ///< over the arrangements solved
+    double abscissa_max = 0.0;
+    double speed = 0.0;          ///< equilibrium speed of the spread arrangement
+    int arrangements = 0;
+    bool stable = false;         ///< every arrangement stable
+    int unstable_roots = 0;      ///< spread arrangement, among the listed roots
+    double max_residual = 0.0;
+    RootStatus status = RootStatus::Converged;  ///< worst over the arrangements
+};
+
+std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, const MixOptions& options);
+
+}  // namespace ddemap

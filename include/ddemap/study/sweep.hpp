@@ -1,0 +1,125 @@
+#pragma once
+/// \file sweep.hpp
+/// Grid sweeps over two model parameters. Along each grid row the rightmost root of every ring
+/// mode (and of the plant) is continued by Newton on its quasi-polynomial from the previous
+/// point, and certified at every point by the argument principle: no zero lies right of
+/// Re(lambda) + 1e-10 max(1, |lambda|). A failed certificate falls back to collocation. Rows are
+/// independent (each starts with collocation), so the output does not depend on the number of
+/// threads.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ddemap/traffic/model.hpp"
+#include "ddemap/problem/quasi_polynomial.hpp"
+#include "ddemap/solve/roots.hpp"
+
+namespace ddemap {
+
+/// One axis: `count` values from `lo` to `hi` inclusive (count >= 2, lo < hi), or a single value.
+struct Axis {
+    std::string name;
+    double lo = 0.0, hi = 0.0;
+    int count = 1;
+    double value(int i) const { return count == 1 ? lo : lo + (hi - lo) * i / (count - 1); }
+};
+
+/// Parses "LO:HI:COUNT" (std::invalid_argument naming the flag on error).
+Axis parse_axis(const std::string& name, const std::string& text);
+
+/// Certified rightmost root of a quasi-polynomial: Newton from `guess`, certificate, fallback.
+struct CertifiedRoot {
+    cplx value;
+    bool certified = false;  ///< no zero right of Re(value) + 1e-10 max(1, |value|)
+    bool fell_back = false;  ///< collocation was needed
+    int degree = 0;          ///< collocation degree used (0 if none)
+};
+/// `dde` builds the same problem as a LinearDDE for the collocation fallback.
+CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
+                                  const std::optional<cplx>& guess);
+
+/// Ring (N >= 2) or N = infinity summary at one point, continuing from the previous point.
+struct RingSummary {
+    double spectral_abscissa = 0.0;  ///< trivial zero excluded
+    int abscissa_mode = 0;           ///< -1 for N = infinity
+    double abscissa_theta = 0.0;
+    int unstable_roots = 0;          ///< over all modes (-1 for N = infinity)
+    bool stable = false;
+    bool certified = true;           ///< every mode's rightmost root certified
+    int fallbacks = 0;
+    int degree = 0;                  ///< largest collocation degree used
+};
+
+class RingTracker {
+public:
+    explicit RingTracker(int cars);  ///< cars >= 2, or 0 for infinity
+    RingSummary evaluate(const Linearisation& lin);
+    void reset();
+    /// The rightmost root of every mode (wave number) at the last point evaluated.
+    const std::vector<std::optional<cplx>>& roots() const { return m_guess; }
+    const std::vector<double>& thetas() const { return m_thetas; }
+
+private:
+    int m_cars;
+    std::vector<double> m_thetas;            // wave numbers of the modes (or samples for N = inf)
+    std::vector<std::optional<cplx>> m_guess;
+};
+
+/// The plant's rightmost root, continued the same way.
+class PlantTracker {
+public:
+    RootResult evaluate(const Linearisation& lin, int& fallbacks);
+    void reset() { m_guess.reset(); }
+
+private:
+    std::optional<cplx> m_guess;
+};
+
+struct SweepSpec {
+    std::string model = "ovrv";
+    ParameterMap fixed;  ///< the other parameters
+    Axis x, y;           ///< the two swept parameters (count >= 2 each)
+    int cars = 22;       ///< ring size, 0 = infinity
+    void validate() const;  ///< builds the model at the four corners
+};
+
+struct SweepPoint {
+    double x = 0.0, y = 0.0;
+    double spectral_abscissa = 0.0;
+    int unstable_roots = 0;
+    int abscissa_mode = 0;
+    double sup_gamma = 1.0, omega_peak = 0.0;
+    double lowfreq_margin = 0.0;
+    double peak_gain = 0.0;   ///< highest local maximum of |Gamma(iw)| at w > 0 (0 if none)
+    double peak_omega = 0.0;  ///< its frequency
+    double plant_abscissa = 0.0;
+    cplx plant_root;          ///< rightmost root of the plant (Im >= 0)
+    bool plant_stable = false, ring_stable = false, string_stable = false;
+    bool certified = true;
+};
+
+struct SweepResult {
+    SweepSpec spec;
+    std::vector<SweepPoint> points;  ///< row-major: y outer, x inner
+    int modes = 0;                   ///< finite N: N/2 + 1 modes per point
+    std::vector<cplx> mode_roots;    ///< finite N: rightmost root of each mode, point-major
+    int fallbacks = 0;               ///< points x modes that needed collocation
+    int uncertified = 0;             ///< points whose certificate failed even after collocation
+    int degree_max = 0;              ///< largest collocation degree any fallback used
+    double seconds = 0.0;
+    int threads = 1;
+    const SweepPoint& at(int ix, int iy) const { return points[static_cast<std::size_t>(iy) * spec.x.count + ix]; }
+};
+
+/// Progress callback (rows done, rows total); called from one thread at a time.
+using Progress = void (*)(int, int);
+
+SweepResult run_sweep(const SweepSpec& spec, Progress progress = nullptr);
+
+/// The model at one grid point.
+std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y);
+
+}  // namespace ddemap

@@ -1,0 +1,53 @@
+#pragma once
+/// \file transfer_function.hpp
+/// Head-to-tail transfer function of a linearised car-following law:
+///     Gamma(s) = N(s) / D(s),  N(s) = gap(s) + s lead(s),  D(s) = s^2 - s own(s) + gap(s)
+/// (for OVRV: Gamma = (k1 + k2 s) e^{-s tau} / (s^2 + (k1 th + k2) s + k1 e^{-s tau})), and the plant
+/// (one car behind a lead at constant speed), whose characteristic function is D.
+
+#include <complex>
+#include <vector>
+
+#include "ddemap/problem/linear_dde.hpp"
+#include "ddemap/traffic/model.hpp"
+
+namespace ddemap {
+
+/// Gamma(s) and its derivative from a Linearisation.
+class TransferFunction {
+public:
+    explicit TransferFunction(Linearisation lin);
+    cplx numerator(cplx s) const;
+    cplx denominator(cplx s) const;
+    /// N and D together (one exponential per distinct delay).
+    void evaluate(cplx s, cplx& n, cplx& d) const;
+    /// N, D and their derivatives N' = gap' + lead + s lead', D' = 2 s - own - s own' + gap'
+    /// (the same exponentials).
+    void evaluate(cplx s, cplx& n, cplx& d, cplx& dn, cplx& dd) const;
+    cplx operator()(cplx s) const {
+        cplx n, d;
+        evaluate(s, n, d);
+        return n / d;
+    }
+    /// Gamma'(s) = (N' D - N D') / D^2
+    cplx derivative(cplx s) const;
+    /// |Gamma(i w)|^2
+    double gain2(double w) const { return std::norm((*this)(cplx(0.0, w))); }
+    /// d/dw |Gamma(i w)|^2 = 2 Re( conj(Gamma(i w)) i Gamma'(i w) )
+    double gain2_derivative(double w) const;
+    const Linearisation& linearisation() const { return m_lin; }
+
+private:
+    Linearisation m_lin;
+    struct DelayGroup {
+        double delay;
+        double gap, own, lead;  // coefficients of e^{-s delay}
+    };
+    std::vector<DelayGroup> m_groups;
+};
+
+/// The plant: one car behind a lead car held at its equilibrium speed,
+/// x = (s, v): s' = -v, v' = gap*s + own*v. Its characteristic function is D(lambda).
+LinearDDE plant_dde(const Linearisation& lin);
+
+}  // namespace ddemap

@@ -1,0 +1,31 @@
+#pragma once
+/// \file vehicles.hpp
+/// The built-in vehicle set: the seed paper's calibration table (Gunter et al., "Are
+/// commercially implemented adaptive cruise control systems string stable?", table of
+/// calibrated OVRV parameters; seven 2018 vehicles A-G, minimum and maximum following setting).
+
+#include <string>
+#include <vector>
+
+#include "ddemap/traffic/model.hpp"
+
+namespace ddemap {
+
+struct CalibratedVehicle {
+    std::string name;       ///< e.g. "A_min"
+    std::string vehicle;    ///< "A".."G"
+    std::string setting;    ///< "min" or "max" following distance
+    int make = 1;           ///< 1 (vehicles A-D) or 2 (E-G)
+    double min_acc_speed = 0.0;  ///< m/s below which ACC disengages (make 1: 25 mph = 11.2 m/s; make 2: 0)
+    ParameterMap parameters;     ///< OVRV: k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]
+};
+
+/// The 14 settings of the paper's calibration table, in the paper's order.
+const std::vector<CalibratedVehicle>& paper_calibration_table();
+
+/// Reads vehicles from CSV text: a header with at least name, k1, k2, th, tau (eta optional,
+/// default 10; other columns are ignored), one vehicle per line. Errors name `source`, the line
+/// and the column (std::invalid_argument).
+std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source);
+
+}  // namespace ddemap

@@ -1,0 +1,224 @@
+#include "ddemap/analysis/string_stability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace ddemap {
+
+LowFrequency low_frequency_expansion(const Linearisation& lin) {
+    require_single_leader(lin, "the low-frequency string condition");
+    constexpr int K = 8;
+    double dn[K + 1], nn[K + 1];
+    for (int n = 0; n <= K; ++n) {
+        dn[n] = (n == 2 ? 1.0 : 0.0) + lin.gap.taylor(n) - (n >= 1 ? lin.own.taylor(n - 1) : 0.0);
+        nn[n] = lin.gap.taylor(n) + (n >= 1 ? lin.lead.taylor(n - 1) : 0.0);
+    }
+    // F(i w) = sum F_n i^n w^n = R(w) + i I(w); |F|^2 coefficients by convolution
+    auto split = [](const double* f, double* r, double* i) {
+        for (int n = 0; n <= K; ++n) {
+            const int q = n % 4;
+            const double sign = (q == 0 || q == 1) ? 1.0 : -1.0;  // i^n = 1, i, -1, -i
+            r[n] = (n % 2 == 0) ? sign * f[n] : 0.0;
+            i[n] = (n % 2 == 1) ? sign * f[n] : 0.0;
+        }
+    };
+    double dr[K + 1], di[K + 1], nr[K + 1], ni[K + 1];
+    split(dn, dr, di);
+    split(nn, nr, ni);
+    double p[K + 1] = {0}, scale[K + 1] = {0};
+    for (int k = 0; k <= K; ++k) {
+        for (int a = 0; a <= k; ++a) {
+            const int b = k - a;
+            const double d2 = dr[a] * dr[b] + di[a] * di[b];
+            const double n2 = nr[a] * nr[b] + ni[a] * ni[b];
+            p[k] += d2 - n2;
+            scale[k] += std::abs(dr[a] * dr[b]) + std::abs(di[a] * di[b]) + std::abs(nr[a] * nr[b]) +
+                        std::abs(ni[a] * ni[b]);
+        }
+    }
+    LowFrequency lf;
+    lf.c2 = p[2];
+    lf.c4 = p[4];
+    lf.c6 = p[6];
+    lf.c8 = p[8];
+    for (int k = 2; k <= K; k += 2) {
+        if (std::abs(p[k]) > 64.0 * std::numeric_limits<double>::epsilon() * scale[k]) {
+            lf.decisive_order = k;
+            lf.attenuates = p[k] > 0.0;
+            break;
+        }
+        if (k == 2) lf.c2 = 0.0;  // zero to rounding
+        if (k == 4) lf.c4 = 0.0;
+        if (k == 6) lf.c6 = 0.0;
+        if (k == 8) lf.c8 = 0.0;
+    }
+    lf.d0 = dn[0];
+    if (dn[0] != 0.0) lf.gamma_prime0 = (nn[1] * dn[0] - nn[0] * dn[1]) / (dn[0] * dn[0]);
+    return lf;
+}
+
+void StringOptions::validate() const {
+    roots.validate();
+    if (plant_roots < 1) throw std::invalid_argument("plant_roots = " + std::to_string(plant_roots) + ": expected >= 1");
+    if (grid_points < 16) throw std::invalid_argument("grid_points = " + std::to_string(grid_points) + ": expected >= 16");
+}
+
+namespace {
+
+/// Smallest w such that for all larger w the bound (a + l w) / (w^2 - h w - a) < target.
+double omega_beyond(double a, double h, double l, double target) {
+    const double b = h + l / target;
+    const double c = a * (1.0 + 1.0 / target);
+    return 0.5 * (b + std::sqrt(b * b + 4.0 * c));
+}
+
+/// Maximiser of |Gamma(i w)|^2 in [lo, hi] bracketing a local maximum.
+double refine_peak(const TransferFunction& tf, double lo, double hi, int& evals) {
+    double dlo = tf.gain2_derivative(lo), dhi = tf.gain2_derivative(hi);
+    evals += 2;
+    if (dlo > 0.0 && dhi < 0.0) {
+        // Illinois false position on the derivative, safeguarded by bisection
+        for (int it = 0; it < 200 && hi - lo > 4.0 * std::numeric_limits<double>::epsilon() * hi; ++it) {
+            double x = (it % 3 == 2) ? 0.5 * (lo + hi) : lo - dlo * (hi - lo) / (dhi - dlo);
+            if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+            const double dx = tf.gain2_derivative(x);
+            ++evals;
+            if (dx == 0.0) return x;
+            if (dx > 0.0) {
+                lo = x;
+                dlo = dx;
+            } else {
+                hi = x;
+                dhi = dx;
+            }
+        }
+        return tf.gain2(lo) >= tf.gain2(hi) ? lo : hi;
+    }
+    // golden section on the gain itself
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double f1 = tf.gain2(x1), f2 = tf.gain2(x2);
+    evals += 2;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; ++it) {
+        if (f1 < f2) {
+            lo = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = lo + g * (hi - lo);
+            f2 = tf.gain2(x2);
+        } else {
+            hi = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = hi - g * (hi - lo);
+            f1 = tf.gain2(x1);
+        }
+        ++evals;
+    }
+    return f1 > f2 ? x1 : x2;
+}
+
+}  // namespace
+
+StringResult analyse_string(const Linearisation& lin, const StringOptions& options) {
+    options.validate();
+    // The rightmost plant roots decide plant stability; the last one found also bounds the width
+    // of every resonance peak of roots further left (see the grid step below).
+    RootOptions ro = options.roots;
+    ro.count = options.plant_roots;
+    return analyse_string(lin, rightmost_roots(plant_dde(lin), ro), options);
+}
+
+StringResult analyse_string(const Linearisation& lin, RootResult plant, const StringOptions& options) {
+    options.validate();
+    StringResult r;
+    r.plant_roots = std::move(plant);
+    r.plant_abscissa = r.plant_roots.spectral_abscissa();
+    r.plant_stable = r.plant_roots.status == RootStatus::Converged && !r.plant_roots.roots.empty() &&
+                     r.plant_abscissa < -marginal_band(r.plant_roots.roots.front().value);
+
+    r.lowfreq = low_frequency_expansion(lin);
+    switch (r.lowfreq.decisive_order) {
+        case 2: r.lowfreq_margin = r.lowfreq.c2; break;
+        case 4: r.lowfreq_margin = r.lowfreq.c4; break;
+        case 6: r.lowfreq_margin = r.lowfreq.c6; break;
+        case 8: r.lowfreq_margin = r.lowfreq.c8; break;
+        default: r.lowfreq_margin = 0.0;
+    }
+
+    const TransferFunction tf(lin);
+    const double a = lin.gap.abs_sum(), h = lin.own.abs_sum(), l = lin.lead.abs_sum();
+    double w_hi = omega_beyond(a, h, l, 1.0) * 1.01;
+    if (!(w_hi > 0.0)) w_hi = 1.0;
+    r.omega_search_max = w_hi;
+    const double tau = lin.max_delay();
+
+    std::vector<double> grid;
+    const int np = options.grid_points;
+    const double w_lo = w_hi * 1e-6;
+    for (int i = 0; i < np; ++i) grid.push_back(w_lo * std::pow(w_hi / w_lo, double(i) / (np - 1)));
+    double step = w_hi / np;
+    if (tau > 0.0) step = std::min(step, M_PI / (8.0 * tau));
+    // roots of D left of those computed have Re <= the last computed one: their peaks are at
+    // least that wide, so a step below half of it resolves them
+    if (!r.plant_roots.roots.empty()) {
+        const double last = std::abs(r.plant_roots.roots.back().value.real());
+        if (last > 0.0) step = std::min(step, 0.5 * last);
+    }
+    step = std::max(step, w_hi / 50000.0);
+    for (double w = step; w < w_hi; w += step) grid.push_back(w);
+    for (const auto& root : r.plant_roots.roots) {
+        const double wp = root.value.imag();
+        if (wp <= 0.0 || wp >= w_hi) continue;
+        const double width = std::max(std::abs(root.value.real()), 1e-12 * wp);
+        for (int j = -6; j <= 6; ++j) {
+            const double w = wp + j * 0.5 * width;
+            if (w > 0.0 && w < w_hi) grid.push_back(w);
+        }
+    }
+    if (!r.lowfreq.attenuates && r.lowfreq.decisive_order == 2 && r.lowfreq.c4 > 0.0) {
+        const double wc = std::sqrt(-r.lowfreq.c2 / (2.0 * r.lowfreq.c4));
+        for (int i = 0; i <= 60; ++i) {
+            const double w = wc * std::pow(10.0, -2.0 + 3.0 * i / 60.0);
+            if (w < w_hi) grid.push_back(w);
+        }
+    }
+    std::sort(grid.begin(), grid.end());
+    grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+    std::vector<double> g(grid.size());
+    for (std::size_t i = 0; i < grid.size(); ++i) g[i] = tf.gain2(grid[i]);
+    r.evaluations += static_cast<int>(grid.size());
+
+    // a maximum at the first sample when low frequencies amplify: move the bracket towards 0
+    std::vector<std::pair<double, double>> brackets;
+    if (grid.size() >= 2 && g[0] > g[1] && g[0] > 1.0) brackets.emplace_back(0.0, grid[1]);
+    for (std::size_t i = 1; i + 1 < grid.size(); ++i) {
+        if (g[i] >= g[i - 1] && g[i] > g[i + 1]) brackets.emplace_back(grid[i - 1], grid[i + 1]);
+    }
+    double best = 1.0;  // the limit w -> 0
+    double best_w = 0.0;
+    double highest_peak = -1.0;
+    for (const auto& [lo, hi] : brackets) {
+        const double w = refine_peak(tf, lo > 0.0 ? lo : hi * 1e-9, hi, r.evaluations);
+        const double gw = tf.gain2(w);
+        ++r.evaluations;
+        if (!std::isfinite(gw)) continue;
+        r.peaks.push_back({w, std::sqrt(gw)});
+        highest_peak = std::max(highest_peak, gw);
+        if (gw > best) {
+            best = gw;
+            best_w = w;
+        }
+    }
+    std::sort(r.peaks.begin(), r.peaks.end(), [](const GainPeak& x, const GainPeak& y) { return x.omega < y.omega; });
+    r.sup_gamma = std::sqrt(best);
+    r.omega_peak = best_w;
+    r.peak_margin = highest_peak < 0.0 ? 1.0 : 1.0 - std::sqrt(highest_peak);
+    r.string_stable = r.plant_stable && r.lowfreq.attenuates && highest_peak <= 1.0;
+    return r;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,114 @@
+#include "ddemap/core/text.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace ddemap::detail {
+
+std::string format_number(double v) {
+    char buf[40];
+    for (int p = 15; p <= 17; ++p) {
+        std::snprintf(buf, sizeof buf, "%.*g", p, v);
+        if (std::strtod(buf, nullptr) == v) break;
+    }
+    return buf;
+}
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+    std::vector<std::string> out;
+    std::string field;
+    bool quoted = false;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (quoted) {
+            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                field += '"';
+                ++i;
+            } else if (c == '"') {
+                quoted = false;
+            } else {
+                field += c;
+            }
+        } else if (c == '"') {
+            quoted = true;
+        } else if (c == ',') {
+            out.push_back(field);
+            field.clear();
+        } else if (c != '\r') {
+            field += c;
+        }
+    }
+    out.push_back(field);
+    for (auto& f : out) {
+        const auto b = f.find_first_not_of(" \t");
+        const auto e = f.find_last_not_of(" \t");
+        f = b == std::string::npos ? std::string() : f.substr(b, e - b + 1);
+    }
+    return out;
+}
+
+bool parse_finite(const std::string& text, double& value) {
+    if (text.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    value = std::strtod(text.c_str(), &end);
+    return *end == '\0' && errno != ERANGE && std::isfinite(value);
+}
+
+bool is_blank(const std::string& line) { return line.find_first_not_of(" \t\r") == std::string::npos; }
+
+CsvReader::CsvReader(const std::string& text, std::string source, std::string expected)
+    : m_source(std::move(source)), m_expected(std::move(expected)) {
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) m_lines.push_back(line);
+    while (m_pos < m_lines.size()) {
+        const std::string& l = m_lines[m_pos++];
+        if (is_blank(l) || l[0] == '#') continue;
+        m_header = split_csv_line(l);
+        m_header_line = static_cast<int>(m_pos);
+        break;
+    }
+    if (m_header.empty()) throw std::invalid_argument(m_source + ": empty file: expected a header " + m_expected);
+}
+
+int CsvReader::column(const std::string& name, bool required) const {
+    for (std::size_t i = 0; i < m_header.size(); ++i)
+        if (m_header[i] == name) return static_cast<int>(i);
+    if (required) {
+        throw std::invalid_argument(m_source + ":" + std::to_string(m_header_line) + ": missing column '" + name + "' (expected " +
+                                    m_expected + ")");
+    }
+    return -1;
+}
+
+bool CsvReader::next() {
+    while (m_pos < m_lines.size()) {
+        const std::string& l = m_lines[m_pos++];
+        if (is_blank(l) || l[0] == '#') continue;
+        m_fields = split_csv_line(l);
+        m_line = static_cast<int>(m_pos);
+        if (m_fields.size() != m_header.size()) {
+            fail(std::to_string(m_fields.size()) + " fields, expected " + std::to_string(m_header.size()) + " as in the header");
+        }
+        return true;
+    }
+    return false;
+}
+
+std::string CsvReader::where() const { return m_source + ":" + std::to_string(m_line); }
+
+double CsvReader::number(int column, const std::string& name) const {
+    const std::string& x = m_fields.at(static_cast<std::size_t>(column));
+    double v = 0.0;
+    if (!parse_finite(x, v)) fail("column '" + name + "' = '" + x + "': expected a finite number");
+    return v;
+}
+
+void CsvReader::fail(const std::string& what) const { throw std::invalid_argument(where() + ": " + what); }
+
+}  // namespace ddemap::detail

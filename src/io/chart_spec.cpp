@@ -1,0 +1,207 @@
+#include "ddemap/io/chart_spec.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <toml++/toml.h>
+
+namespace ddemap {
+
+namespace {
+
+std::string where(const std::string& source, const toml::node& n) {
+    const auto& src = n.source();
+    return source + ":" + std::to_string(src.begin.line);
+}
+
+double number(const std::string& source, const toml::node& n, const std::string& key) {
+    if (auto v = n.value<double>()) {
+        if (!std::isfinite(*v)) throw std::invalid_argument(where(source, n) + ": " + key + ": expected a finite number");
+        return *v;
+    }
+    throw std::invalid_argument(where(source, n) + ": " + key + ": expected a number");
+}
+
+std::string short_number(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
+
+Axis read_axis(const std::string& source, const toml::table& root, const char* key) {
+    const toml::node* n = root.get(key);
+    if (!n || !n->is_table()) throw std::invalid_argument(source + ": [" + std::string(key) + "] table missing: expected name, lo, hi, count");
+    const toml::table& t = *n->as_table();
+    Axis a;
+    const toml::node* name = t.get("name");
+    if (!name || !name->is_string()) throw std::invalid_argument(where(source, *n) + ": " + key + ".name: expected a parameter name");
+    a.name = *name->value<std::string>();
+    for (const char* k : {"lo", "hi", "count"})
+        if (!t.get(k)) throw std::invalid_argument(where(source, *n) + ": " + key + "." + k + " missing");
+    a.lo = number(source, *t.get("lo"), std::string(key) + ".lo");
+    a.hi = number(source, *t.get("hi"), std::string(key) + ".hi");
+    const auto c = t.get("count")->value<int64_t>();
+    if (!c || *c < 2 || *c > 100000 || !(a.lo < a.hi)) {
+        throw std::invalid_argument(where(source, *n) + ": " + key + ": expected lo < hi and an integer count >= 2");
+    }
+    a.count = static_cast<int>(*c);
+    return a;
+}
+
+}  // namespace
+
+SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel) {
+    SweepSpec s;
+    s.model = spec.model;
+    s.fixed = spec.fixed;
+    for (const auto& [k, v] : spec.panels.at(panel).parameters) s.fixed[k] = v;
+    s.x = spec.x;
+    s.y = spec.y;
+    s.cars = spec.cars;
+    return s;
+}
+
+std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehicles) {
+    std::vector<PanelSpec> panels;
+    for (const auto& v : vehicles) {
+        PanelSpec p;
+        const auto& q = v.parameters;
+        p.title = v.name + ": tau = " + short_number(q.at("tau")) + " s, th = " + short_number(q.at("th")) + " s";
+        for (const char* k : {"tau", "th", "eta"})
+            if (q.count(k)) p.parameters[k] = q.at(k);
+        p.markers.push_back({q.at("k1"), q.at("k2"), v.name});
+        panels.push_back(p);
+    }
+    return panels;
+}
+
+ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
+    toml::table root;
+    try {
+        root = toml::parse(text, source);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream os;
+        os << source << ":" << e.source().begin.line << ": " << e.description();
+        throw std::invalid_argument(os.str());
+    }
+    ChartSpec spec;
+    static const char* known[] = {"title", "model", "ring", "fixed", "x", "y", "columns", "panel_width",
+                                  "panel_height", "boundaries", "panel", "vehicles"};
+    for (const auto& [k, v] : root) {
+        const std::string key(k.str());
+        if (std::find_if(std::begin(known), std::end(known), [&](const char* s) { return key == s; }) == std::end(known)) {
+            throw std::invalid_argument(where(source, v) + ": unknown key '" + key + "'");
+        }
+    }
+    if (auto t = root["title"].value<std::string>()) spec.title = *t;
+    if (auto m = root["model"].value<std::string>()) spec.model = *m;
+    if (const toml::node* r = root.get("ring")) {
+        if (auto s = r->value<std::string>(); s && *s == "inf") {
+            spec.cars = 0;
+        } else if (auto n = r->value<int64_t>(); n && *n >= 2) {
+            spec.cars = static_cast<int>(*n);
+        } else {
+            throw std::invalid_argument(where(source, *r) + ": ring: expected an integer N >= 2 or \"inf\"");
+        }
+    }
+    if (const toml::node* f = root.get("fixed")) {
+        if (!f->is_table()) throw std::invalid_argument(where(source, *f) + ": fixed: expected a table of parameters");
+        for (const auto& [k, v] : *f->as_table()) spec.fixed[std::string(k.str())] = number(source, v, "fixed." + std::string(k.str()));
+    }
+    spec.x = read_axis(source, root, "x");
+    spec.y = read_axis(source, root, "y");
+    if (auto c = root["columns"].value<int64_t>()) spec.columns = static_cast<int>(std::max<int64_t>(1, *c));
+    if (const toml::node* w = root.get("panel_width")) spec.panel_width = number(source, *w, "panel_width");
+    if (const toml::node* h = root.get("panel_height")) spec.panel_height = number(source, *h, "panel_height");
+    if (auto b = root["boundaries"].value<bool>()) spec.boundaries = *b;
+    if (const toml::node* v = root.get("vehicles")) {
+        if (v->value<std::string>() != std::optional<std::string>("paper")) {
+            throw std::invalid_argument(where(source, *v) + ": vehicles: expected \"paper\" (the built-in calibration table)");
+        }
+        spec.panels = vehicle_panels(paper_calibration_table());
+    }
+    if (const toml::node* ps = root.get("panel")) {
+        const toml::array* arr = ps->as_array();
+        if (!arr) throw std::invalid_argument(where(source, *ps) + ": panel: expected [[panel]] tables");
+        for (const auto& pn : *arr) {
+            const toml::table* pt = pn.as_table();
+            if (!pt) throw std::invalid_argument(where(source, pn) + ": panel: expected a table");
+            PanelSpec p;
+            for (const auto& [k, v] : *pt) {
+                const std::string key(k.str());
+                if (key == "title") {
+                    p.title = v.value<std::string>().value_or("");
+                } else if (key == "marker") {
+                    const toml::array* ms = v.as_array();
+                    if (!ms) throw std::invalid_argument(where(source, v) + ": marker: expected [[panel.marker]] tables");
+                    for (const auto& mn : *ms) {
+                        const toml::table* mt = mn.as_table();
+                        if (!mt || !mt->get(spec.x.name) || !mt->get(spec.y.name)) {
+                            throw std::invalid_argument(where(source, mn) + ": marker: expected " + spec.x.name + " and " + spec.y.name);
+                        }
+                        ChartMarker m;
+                        m.x = number(source, *mt->get(spec.x.name), "marker." + spec.x.name);
+                        m.y = number(source, *mt->get(spec.y.name), "marker." + spec.y.name);
+                        m.label = (*mt)["label"].value<std::string>().value_or("");
+                        p.markers.push_back(m);
+                    }
+                } else {
+                    p.parameters[key] = number(source, v, "panel." + key);
+                }
+            }
+            spec.panels.push_back(p);
+        }
+    }
+    if (spec.panels.empty()) spec.panels.push_back(PanelSpec{});
+    // validate every panel's model at the window corners now, with the source named
+    for (std::size_t i = 0; i < spec.panels.size(); ++i) {
+        try {
+            panel_sweep(spec, i).validate();
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(source + ": panel " + std::to_string(i + 1) + ": " + e.what());
+        }
+    }
+    return spec;
+}
+
+RenderedChart render_chart(const ChartSpec& spec) {
+    const auto t0 = std::chrono::steady_clock::now();
+    RenderedChart out;
+    const std::size_t n = spec.panels.size();
+    out.specs.resize(n);
+    out.sweeps.resize(n);
+    out.boundaries.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        out.specs[i] = panel_sweep(spec, i);
+        out.sweeps[i] = run_sweep(out.specs[i]);
+        if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i]);
+    }
+    std::vector<ChartPanel> panels(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        panels[i].sweep = &out.sweeps[i];
+        panels[i].boundaries = spec.boundaries ? &out.boundaries[i] : nullptr;
+        panels[i].markers = spec.panels[i].markers;
+        std::string title = spec.panels[i].title;
+        if (title.empty()) {
+            for (const auto& [k, v] : spec.panels[i].parameters) {
+                std::string unit;
+                for (const auto& ps : model_parameters(spec.model))
+                    if (ps.name == k && ps.unit != "1") unit = " " + ps.unit;
+                title += (title.empty() ? "" : ", ") + k + " = " + short_number(v) + unit;
+            }
+        }
+        panels[i].title = title;
+    }
+    ChartOptions co;
+    co.title = spec.title;
+    co.columns = spec.columns;
+    co.panel_width = spec.panel_width;
+    co.panel_height = spec.panel_height;
+    out.svg = render_chart_svg(panels, co);
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,105 @@
+#include "ddemap/io/system_json.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "ddemap/core/text.hpp"
+
+namespace ddemap {
+
+namespace {
+
+using json = nlohmann::json;
+
+[[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& what) {
+    throw std::invalid_argument(source + ": " + field + ": " + what);
+}
+
+cplx value_of(const json& v, const std::string& source, const std::string& field) {
+    if (v.is_number()) {
+        const double x = v.get<double>();
+        if (!std::isfinite(x)) fail(source, field, "expected a finite number");
+        return x;
+    }
+    if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number()) {
+        const double re = v[0].get<double>(), im = v[1].get<double>();
+        if (!std::isfinite(re) || !std::isfinite(im)) fail(source, field, "expected finite [re, im]");
+        return {re, im};
+    }
+    fail(source, field, "expected a number or [re, im]");
+}
+
+MatrixXc matrix_of(const json& m, int n, const std::string& source, const std::string& field) {
+    MatrixXc a = MatrixXc::Zero(n, n);
+    if (m.is_object()) {
+        if (!m.contains("triplets") || !m["triplets"].is_array()) fail(source, field, "expected {\"triplets\": [[row, col, value], ...]}");
+        const json& t = m["triplets"];
+        for (std::size_t i = 0; i < t.size(); ++i) {
+            const std::string f = field + ".triplets[" + std::to_string(i) + "]";
+            if (!t[i].is_array() || t[i].size() != 3 || !t[i][0].is_number_integer() || !t[i][1].is_number_integer()) {
+                fail(source, f, "expected [row, col, value] with integer row and col");
+            }
+            const long r = t[i][0].get<long>(), c = t[i][1].get<long>();
+            if (r < 0 || r >= n || c < 0 || c >= n) {
+                fail(source, f, "index (" + std::to_string(r) + ", " + std::to_string(c) + ") outside 0.." + std::to_string(n - 1));
+            }
+            a(r, c) += value_of(t[i][2], source, f);
+        }
+        return a;
+    }
+    if (!m.is_array() || static_cast<int>(m.size()) != n) fail(source, field, "expected " + std::to_string(n) + " rows or {\"triplets\": ...}");
+    for (int r = 0; r < n; ++r) {
+        const std::string fr = field + "[" + std::to_string(r) + "]";
+        if (!m[r].is_array() || static_cast<int>(m[r].size()) != n) fail(source, fr, "expected " + std::to_string(n) + " entries");
+        for (int c = 0; c < n; ++c) a(r, c) = value_of(m[r][c], source, fr + "[" + std::to_string(c) + "]");
+    }
+    return a;
+}
+
+}  // namespace
+
+LinearDDE read_linear_dde_json(const std::string& text, const std::string& source) {
+    json j;
+    try {
+        j = json::parse(text);
+    } catch (const json::parse_error& e) {
+        throw std::invalid_argument(source + ": not valid JSON (" + std::string(e.what()) + ")");
+    }
+    if (!j.is_object()) fail(source, "top level", "expected an object with dimension, delays, A0, A");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        if (it.key() != "dimension" && it.key() != "delays" && it.key() != "A0" && it.key() != "A" && it.key() != "comment") {
+            fail(source, it.key(), "unknown field (expected dimension, delays, A0, A, comment)");
+        }
+    }
+    if (!j.contains("dimension") || !j["dimension"].is_number_integer() || j["dimension"].get<long>() < 1 ||
+        j["dimension"].get<long>() > 20000) {
+        fail(source, "dimension", "expected an integer from 1 to 20000");
+    }
+    const int n = j["dimension"].get<int>();
+    std::vector<double> delays;
+    if (j.contains("delays")) {
+        if (!j["delays"].is_array()) fail(source, "delays", "expected an array of delays [s]");
+        for (std::size_t k = 0; k < j["delays"].size(); ++k) {
+            const json& d = j["delays"][k];
+            const std::string f = "delays[" + std::to_string(k) + "]";
+            if (!d.is_number()) fail(source, f, "expected a number");
+            const double x = d.get<double>();
+            if (!std::isfinite(x) || x < 0.0) fail(source, f, detail::format_number(x) + ": expected a finite delay >= 0");
+            delays.push_back(x);
+        }
+    }
+    const MatrixXc a0 = j.contains("A0") ? matrix_of(j["A0"], n, source, "A0") : MatrixXc::Zero(n, n);
+    std::vector<DelayTerm> terms;
+    const std::size_t given = j.contains("A") ? (j["A"].is_array() ? j["A"].size() : std::size_t(-1)) : 0;
+    if (given != delays.size()) {
+        fail(source, "A", "expected an array of " + std::to_string(delays.size()) + " matrices, one per delay");
+    }
+    for (std::size_t k = 0; k < delays.size(); ++k) {
+        terms.push_back({matrix_of(j["A"][k], n, source, "A[" + std::to_string(k) + "]"), delays[k]});
+    }
+    return LinearDDE(a0, terms);
+}
+
+}  // namespace ddemap

@@ -1,0 +1,177 @@
+#include "ddemap/problem/quasi_polynomial.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace ddemap {
+
+using cplx = std::complex<double>;
+
+
+QuasiPolynomial::QuasiPolynomial(int degree, std::vector<Term> terms) : m_degree(degree), m_terms(std::move(terms)) {
+    if (degree != 1 && degree != 2) throw std::invalid_argument("quasi-polynomial degree must be 1 or 2");
+    for (const auto& t : m_terms) {
+        if (static_cast<int>(t.poly.size()) > degree) throw std::invalid_argument("quasi-polynomial term of degree >= n: not of retarded type");
+        if (!(t.delay >= 0.0) || !std::isfinite(t.delay)) throw std::invalid_argument("quasi-polynomial delay must be finite and >= 0");
+        m_max_delay = std::max(m_max_delay, t.delay);
+    }
+}
+
+void QuasiPolynomial::evaluate(cplx lambda, cplx& f, cplx& fp) const {
+    if (m_degree == 2) {
+        f = lambda * lambda;
+        fp = 2.0 * lambda;
+    } else {
+        f = lambda;
+        fp = 1.0;
+    }
+    for (const auto& t : m_terms) {
+        cplx p = 0.0, dp = 0.0;
+        for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) {
+            dp = dp * lambda + p;
+            p = p * lambda + t.poly[k];
+        }
+        if (t.delay == 0.0) {
+            f += p;
+            fp += dp;
+        } else {
+            const cplx e = std::polar(std::exp(-lambda.real() * t.delay), -lambda.imag() * t.delay);
+            f += p * e;
+            fp += (dp - t.delay * p) * e;
+        }
+    }
+}
+
+bool QuasiPolynomial::is_real() const {
+    for (const auto& t : m_terms)
+        for (cplx c : t.poly)
+            if (c.imag() != 0.0) return false;
+    return true;
+}
+
+cplx QuasiPolynomial::operator()(cplx lambda) const {
+    cplx f = m_degree == 2 ? lambda * lambda : lambda;
+    for (const auto& t : m_terms) {
+        cplx p = 0.0;
+        for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) p = p * lambda + t.poly[k];
+        f += t.delay == 0.0 ? p : p * std::polar(std::exp(-lambda.real() * t.delay), -lambda.imag() * t.delay);
+    }
+    return f;
+}
+
+bool QuasiPolynomial::newton(cplx& lambda, int max_iterations) const {
+    for (int it = 0; it < max_iterations; ++it) {
+        cplx f, fp;
+        evaluate(lambda, f, fp);
+        if (f == cplx(0.0)) return true;
+        if (fp == cplx(0.0)) return false;
+        const cplx step = f / fp;
+        lambda -= step;
+        if (!std::isfinite(lambda.real()) || !std::isfinite(lambda.imag())) return false;
+        if (std::abs(step) <= 4.0 * 2.220446049250313e-16 * std::max(1.0, std::abs(lambda))) return true;
+    }
+    return false;
+}
+
+namespace {
+
+/// arg(b / a) without a complex division
+double arg_ratio(cplx b, cplx a) { return std::arg(b * std::conj(a)); }
+
+/// |arg(b / a)| < pi/4, without atan2: Re(b conj a) > |Im(b conj a)|
+bool within_quarter(cplx b, cplx a) {
+    const cplx w = b * std::conj(a);
+    return w.real() > std::abs(w.imag());
+}
+
+/// A sample of f on the line: value and |f'/f|, which bounds the phase speed
+/// |d/dw arg f(sigma + i w)| = |Re(f'/f)| and is at least 1/distance to a nearby zero.
+struct Sample {
+    double w;
+    cplx f;
+    double speed2;  // |f'/f|^2
+};
+
+struct Tracker {
+    const QuasiPolynomial& f;
+    double sigma;
+    int budget = 20000;
+    bool failed = false;
+    Sample at(double w) {
+        cplx v, d;
+        f.evaluate(cplx(sigma, w), v, d);
+        if (v == cplx(0.0)) {
+            failed = true;
+            return {w, cplx(1.0), 0.0};
+        }
+        return {w, v, std::norm(d) / std::norm(v)};
+    }
+    /// Continuous change of arg f from a to b. A piece is accepted when, on each of its halves,
+    /// the phase turns by less than pi/4 between the samples and |f'/f| at the three samples
+    /// times the half length is below pi/8. A zero within the piece's reach lies within about
+    /// half its length of some sample, where |f'/f| >= 1/distance, so it forces subdivision
+    /// until the pieces near it are shorter than its distance to the line.
+    double change(const Sample& a, const Sample& b, int depth) {
+        if (--budget < 0 || depth > 80) {
+            failed = true;
+            return 0.0;
+        }
+        const Sample m = at(0.5 * (a.w + b.w));
+        if (failed) return 0.0;
+        const double h = 0.5 * (b.w - a.w);
+        const double limit = (M_PI / 8) * (M_PI / 8) / (h * h);
+        const bool slow = a.speed2 < limit && m.speed2 < limit && b.speed2 < limit;
+        if (slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f)) return arg_ratio(b.f, a.f);
+        return change(a, m, depth + 1) + change(m, b, depth + 1);
+    }
+};
+
+}  // namespace
+
+int QuasiPolynomial::zeros_right_of(double sigma) const {
+    // radius r of the half circle |lambda - sigma| = r, Re >= sigma, on which
+    // |f - (lambda - sigma)^n| <= r^n / 2, so that arg f follows arg (lambda - sigma)^n there
+    const double s = std::abs(sigma);
+    // |f - (lambda - sigma)^n| <= c0 + c1 |lambda| (+ 2 s |lambda| + s^2 for n = 2), |lambda| <= r + s
+    double c0 = m_degree == 2 ? s * s : s, c1 = m_degree == 2 ? 2.0 * s : 0.0;
+    for (const auto& t : m_terms) {
+        const double e = t.delay == 0.0 ? 1.0 : std::exp(-sigma * t.delay);
+        if (!t.poly.empty()) c0 += e * std::abs(t.poly[0]);
+        if (t.poly.size() > 1) c1 += e * std::abs(t.poly[1]);
+    }
+    auto bound = [&](double r) { return c0 + c1 * (r + s); };
+    auto enough = [&](double r) { return bound(r) < 0.5 * (m_degree == 2 ? r * r : r); };
+    double r = 1.0;
+    for (int i = 0; i < 400 && !enough(r); ++i) r *= 1.25;
+    if (!enough(r)) return -1;
+
+    // the line from sigma - i r to sigma + i r, sampled at least every pi / (4 tau_max)
+    int pieces = 8;
+    if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
+    pieces = std::min(pieces, 4096);
+    Tracker tr{*this, sigma};
+    double total = 0.0;
+    Sample a = tr.at(-r);
+    if (tr.failed) return -1;
+    const cplx first = a.f;
+    for (int i = 1; i <= pieces; ++i) {
+        const Sample b = tr.at(-r + 2.0 * r * i / pieces);
+        if (tr.failed) return -1;
+        total += tr.change(a, b, 0);
+        if (tr.failed) return -1;
+        a = b;
+    }
+    const cplx fa = a.f;
+    const cplx last = fa;
+    // along the half circle (counter-clockwise, bottom to top) arg f changes by
+    // n pi + arg h(top) - arg h(bottom), h = f / (lambda - sigma)^n (principal args: |h - 1| < 1/2)
+    const cplx top = cplx(0.0, r), bottom = cplx(0.0, -r);
+    const double arc = m_degree * M_PI + arg_ratio(last, std::pow(top, m_degree)) - arg_ratio(first, std::pow(bottom, m_degree));
+    const double z = (arc - total) / (2.0 * M_PI);
+    const double zr = std::round(z);
+    if (std::abs(z - zr) > 0.05 || zr < 0) return -1;
+    return static_cast<int>(zr);
+}
+
+}  // namespace ddemap

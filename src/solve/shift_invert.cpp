@@ -1,0 +1,861 @@
+#include "ddemap/solve/shift_invert.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/UmfPackSupport>
+#include <Spectra/GenEigsComplexShiftSolver.h>
+
+#include "ddemap/discretize/chebyshev.hpp"
+
+namespace ddemap {
+
+double SparseDDE::max_delay() const {
+    double d = 0.0;
+    for (const auto& t : delayed) d = std::max(d, t.delay);
+    return d;
+}
+
+void SparseDDE::validate() const {
+    const auto n = a0.rows();
+    if (n < 1 || a0.cols() != n) throw std::invalid_argument("A0 must be square with dimension >= 1");
+    auto finite = [](const Eigen::SparseMatrix<double>& m) {
+        for (int k = 0; k < m.outerSize(); ++k)
+            for (Eigen::SparseMatrix<double>::InnerIterator it(m, k); it; ++it)
+                if (!std::isfinite(it.value())) return false;
+        return true;
+    };
+    if (!finite(a0)) throw std::invalid_argument("A0 has a non-finite entry");
+    for (std::size_t k = 0; k < delayed.size(); ++k) {
+        const auto& t = delayed[k];
+        if (t.matrix.rows() != n || t.matrix.cols() != n) throw std::invalid_argument("delayed matrix " + std::to_string(k + 1) + " has the wrong size");
+        if (!finite(t.matrix)) throw std::invalid_argument("delayed matrix " + std::to_string(k + 1) + " has a non-finite entry");
+        if (!(std::isfinite(t.delay) && t.delay > 0.0)) throw std::invalid_argument("delay " + std::to_string(k + 1) + ": expected a finite delay > 0");
+    }
+}
+
+LinearDDE SparseDDE::to_dense() const {
+    std::vector<DelayTerm> terms;
+    for (const auto& t : delayed) terms.push_back({MatrixXc(Eigen::MatrixXd(t.matrix).cast<cplx>()), t.delay});
+    return LinearDDE(MatrixXc(Eigen::MatrixXd(a0).cast<cplx>()), terms);
+}
+
+namespace {
+
+using SpC = Eigen::SparseMatrix<cplx>;
+using SpD = Eigen::SparseMatrix<double>;
+
+/// The union of the patterns of A0, I and every A_k (compressed): the pattern of Delta(z) and
+/// of the shifted matrix S, analysed once for every sparse LU and Gershgorin test.
+SpD union_pattern(const SparseDDE& dde) {
+    SpD pattern = dde.a0;
+    SpD eye(dde.dimension(), dde.dimension());
+    eye.setIdentity();
+    pattern += eye;
+    for (const auto& t : dde.delayed) pattern += t.matrix;
+    pattern.makeCompressed();
+    return pattern;
+}
+
+/// Spectra operation: y = Re((A_M - sigma I)^{-1} x) for the collocation matrix A_M.
+class StructuredShiftInvert {
+public:
+    using Scalar = double;
+
+    StructuredShiftInvert(const SparseDDE& dde, int degree) : m_dde(dde), m_m(degree), m_n(dde.dimension()) {
+        const double tau = dde.max_delay();
+        m_d = detail::chebyshev_differentiation(degree) * (2.0 / tau);
+        for (const auto& t : dde.delayed) {
+            m_l.push_back(detail::chebyshev_lagrange_row(degree, 1.0 - 2.0 * t.delay / tau));
+            m_ak.push_back(t.matrix.cast<cplx>());
+        }
+        m_a0 = dde.a0.cast<cplx>();
+        m_pattern = union_pattern(dde).cast<cplx>();
+        m_pattern.makeCompressed();
+        m_eye.resize(m_n, m_n);
+        m_eye.setIdentity();
+        m_lu.analyzePattern(m_pattern);
+    }
+
+    Eigen::Index rows() const { return static_cast<Eigen::Index>(m_m + 1) * m_n; }
+    Eigen::Index cols() const { return rows(); }
+
+    /// Factorises for the shift; false when S is singular to working precision.
+    bool factor(cplx sigma) {
+        if (m_ok && sigma == m_sigma) return true;
+        const int m = m_m;
+        Eigen::MatrixXcd b = m_d.block(1, 1, m, m).cast<cplx>();
+        b.diagonal().array() -= sigma;
+        m_blu.compute(b);
+        m_g = m_blu.solve(m_d.block(1, 0, m, 1).cast<cplx>());
+        m_c.clear();
+        for (const auto& l : m_l) m_c.push_back(l(0) - (l.tail(m).cast<cplx>().transpose() * m_g)(0));
+        // UMFPACK keeps using the matrix after factorising it (in solves): it is a member
+        m_s = m_a0 - sigma * m_eye;
+        for (std::size_t k = 0; k < m_ak.size(); ++k) m_s += m_c[k] * m_ak[k];
+        m_s += cplx(0.0) * m_pattern;  // the analysed pattern, explicit zeros included
+        m_s.makeCompressed();
+        m_lu.factorize(m_s);
+        ++m_factorizations;
+        m_sigma = sigma;
+        m_ok = m_lu.info() == Eigen::Success && m_g.allFinite();
+        return m_ok;
+    }
+
+    /// Spectra's contract; a singular shift leaves the operator returning NaN (Arnoldi then fails).
+    void set_shift(double sr, double si) { factor(cplx(sr, si)); }
+
+    /// u = (A_M - sigma I)^{-1} b for complex b, blocks u_j of n entries
+    Eigen::VectorXcd solve(const Eigen::VectorXcd& b) const {
+        const int m = m_m, n = m_n;
+        Eigen::Map<const Eigen::MatrixXcd> bb(b.data(), n, m + 1);  // column j = block j
+        const Eigen::MatrixXcd w = m_blu.solve(bb.rightCols(m).transpose());  // M x n: B^{-1} b[1:]
+        Eigen::VectorXcd r = bb.col(0);
+        for (std::size_t k = 0; k < m_ak.size(); ++k) {
+            const Eigen::VectorXcd h = (m_l[k].tail(m).cast<cplx>().transpose() * w).transpose();
+            r -= m_ak[k] * h;
+        }
+        Eigen::VectorXcd u0 = m_lu.solve(r);
+        Eigen::VectorXcd u(static_cast<Eigen::Index>(m + 1) * n);
+        u.head(n) = u0;
+        Eigen::Map<Eigen::MatrixXcd> ub(u.data() + n, n, m);  // column j-1 = block j
+        ub.noalias() = w.transpose();
+        ub.noalias() -= u0 * m_g.transpose();
+        return u;
+    }
+
+    void perform_op(const double* x_in, double* y_out) const {
+        const Eigen::Index len = rows();
+        if (!m_ok) {
+            Eigen::Map<Eigen::VectorXd>(y_out, len).setConstant(std::numeric_limits<double>::quiet_NaN());
+            return;
+        }
+        const Eigen::VectorXcd b = Eigen::Map<const Eigen::VectorXd>(x_in, len).cast<cplx>();
+        Eigen::Map<Eigen::VectorXd>(y_out, len) = solve(b).real();
+    }
+
+    int factorizations() const { return m_factorizations; }
+
+private:
+    const SparseDDE& m_dde;
+    int m_m, m_n;
+    Eigen::MatrixXd m_d;
+    std::vector<Eigen::VectorXd> m_l;
+    std::vector<SpC> m_ak;
+    SpC m_a0, m_eye;
+    SpC m_pattern;
+    SpC m_s;
+    Eigen::UmfPackLU<SpC> m_lu;
+    Eigen::PartialPivLU<Eigen::MatrixXcd> m_blu;
+    Eigen::VectorXcd m_g;
+    std::vector<cplx> m_c;
+    cplx m_sigma{0.0, 0.0};
+    bool m_ok = false;
+    int m_factorizations = 0;
+};
+
+}  // namespace
+
+SparseEigenResult sparse_collocation_eigenvalues(const SparseDDE& dde, int degree, const std::vector<cplx>& shifts, int nev) {
+    dde.validate();
+    if (dde.delayed.empty()) throw std::invalid_argument("the sparse path needs at least one delay");
+    if (degree < 2) throw std::invalid_argument("collocation degree must be >= 2");
+    StructuredShiftInvert op(dde, degree);
+    const Eigen::Index size = op.rows();
+    if (nev < 1 || nev > size - 3) throw std::invalid_argument("nev: expected 1 <= nev <= size - 3");
+    SparseEigenResult out;
+    for (cplx sigma : shifts) {
+        const Eigen::Index ncv = std::min<Eigen::Index>(size, std::max<Eigen::Index>(2 * nev + 1, 20));
+        Spectra::GenEigsComplexShiftSolver<StructuredShiftInvert> solver(op, nev, ncv, sigma.real(), sigma.imag());
+        solver.init();
+        solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+        if (solver.info() != Spectra::CompInfo::Successful) out.status = RootStatus::EigenFailure;
+        const Eigen::VectorXcd ev = solver.eigenvalues();
+        for (Eigen::Index i = 0; i < ev.size(); ++i) {
+            const cplx z = ev(i);
+            const bool dup = std::any_of(out.values.begin(), out.values.end(),
+                                         [&](cplx w) { return std::abs(w - z) <= 1e-9 * std::max(1.0, std::abs(z)); });
+            if (!dup) out.values.push_back(z);
+        }
+    }
+    out.factorizations = op.factorizations();
+    return out;
+}
+
+
+Eigen::SparseMatrix<cplx> SparseDDE::characteristic_matrix(cplx lambda) const {
+    const int n = dimension();
+    Eigen::SparseMatrix<cplx> eye(n, n);
+    eye.setIdentity();
+    Eigen::SparseMatrix<cplx> d = lambda * eye - a0.cast<cplx>();
+    for (const auto& t : delayed) d -= std::exp(-lambda * t.delay) * t.matrix.cast<cplx>();
+    return d;
+}
+
+Eigen::SparseMatrix<cplx> SparseDDE::characteristic_derivative(cplx lambda) const {
+    const int n = dimension();
+    Eigen::SparseMatrix<cplx> d(n, n);
+    d.setIdentity();
+    for (const auto& t : delayed) d += (t.delay * std::exp(-lambda * t.delay)) * t.matrix.cast<cplx>();
+    return d;
+}
+
+SparseDDE normalised(const SparseDDE& dde) {
+    dde.validate();
+    SparseDDE out;
+    out.a0 = dde.a0;
+    std::vector<SparseDDE::Term> terms;
+    for (const auto& t : dde.delayed) {
+        auto same = std::find_if(terms.begin(), terms.end(), [&](const SparseDDE::Term& u) { return u.delay == t.delay; });
+        if (same != terms.end())
+            same->matrix += t.matrix;
+        else
+            terms.push_back(t);
+    }
+    std::sort(terms.begin(), terms.end(), [](const SparseDDE::Term& a, const SparseDDE::Term& b) { return a.delay < b.delay; });
+    for (auto& t : terms) {
+        t.matrix.prune(0.0);
+        if (t.matrix.nonZeros() > 0) out.delayed.push_back(std::move(t));
+    }
+    out.a0.prune(0.0);
+    return out;
+}
+
+void SparseRootOptions::validate() const {
+    auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
+    if (count < 1) fail("count = " + std::to_string(count) + ": expected an integer >= 1");
+    if (degree < 0 || degree == 1) fail("degree = " + std::to_string(degree) + ": expected 0 (automatic) or >= 2");
+    if (max_degree < 2) fail("max_degree = " + std::to_string(max_degree) + ": expected an integer >= 2");
+    if (degree > max_degree) fail("degree exceeds max_degree");
+    if (eigenvalues_per_shift < 2) fail("eigenvalues_per_shift = " + std::to_string(eigenvalues_per_shift) + ": expected >= 2");
+    if (max_shifts < 1) fail("max_shifts: expected >= 1");
+    if (arnoldi_max_restarts < 1) fail("arnoldi_max_restarts: expected >= 1");
+    if (newton_max_iterations < 1) fail("newton_max_iterations: expected >= 1");
+    auto positive = [&](double v, const char* name) {
+        if (!(std::isfinite(v) && v > 0.0)) fail(std::string(name) + ": expected a finite value > 0");
+    };
+    positive(arnoldi_tolerance, "arnoldi_tolerance");
+    positive(newton_tolerance, "newton_tolerance");
+    positive(residual_tolerance, "residual_tolerance");
+    positive(collocation_tolerance, "collocation_tolerance");
+}
+
+double SparseRootResult::spectral_abscissa() const {
+    double a = -std::numeric_limits<double>::infinity();
+    for (const auto& r : roots) a = std::max(a, r.value.real());
+    return a;
+}
+
+namespace {
+
+double scale_of(cplx z) { return std::max(1.0, std::abs(z)); }
+
+/// ||A||_2 <= sqrt(||A||_1 ||A||_inf)
+double norm2_bound(const SpD& a) {
+    Eigen::VectorXd rows = Eigen::VectorXd::Zero(a.rows()), cols = Eigen::VectorXd::Zero(a.cols());
+    for (int k = 0; k < a.outerSize(); ++k)
+        for (SpD::InnerIterator it(a, k); it; ++it) {
+            rows(it.row()) += std::abs(it.value());
+            cols(it.col()) += std::abs(it.value());
+        }
+    const double r = rows.size() ? rows.maxCoeff() : 0.0, c = cols.size() ? cols.maxCoeff() : 0.0;
+    return std::sqrt(r * c);
+}
+
+/// mu_2(A) = lambda_max((A + A^T)/2) <= max_i (a_ii + sum_{j != i} |a_ij + a_ji| / 2) (Gershgorin)
+double log_norm_bound(const SpD& a) {
+    const SpD sym = 0.5 * (a + SpD(a.transpose()));
+    Eigen::VectorXd bound = Eigen::VectorXd::Zero(a.rows());
+    for (int k = 0; k < sym.outerSize(); ++k)
+        for (SpD::InnerIterator it(sym, k); it; ++it) bound(it.row()) += it.row() == it.col() ? it.value() : std::abs(it.value());
+    return bound.size() ? bound.maxCoeff() : 0.0;
+}
+
+using Bounds = detail::RootBounds;
+
+}  // namespace
+
+namespace detail {
+
+double RootBounds::delayed_norm(double a) const {
+    if (entries.empty()) return 0.0;
+    std::vector<double> rows(static_cast<std::size_t>(n), 0.0), cols(static_cast<std::size_t>(n), 0.0);
+    for (const auto& e : entries) {
+        const double v = e.value * std::exp(-a * e.delay);
+        rows[static_cast<std::size_t>(e.row)] += v;
+        cols[static_cast<std::size_t>(e.col)] += v;
+    }
+    return std::sqrt(*std::max_element(rows.begin(), rows.end()) * *std::max_element(cols.begin(), cols.end()));
+}
+
+double RootBounds::radius(double a) const { return n0 + delayed_norm(a); }
+
+double RootBounds::right_bound() const {
+    auto f = [&](double x) { return mu - x + delayed_norm(x); };
+    double lo = mu, hi = mu + 1.0 + delayed_norm(mu);
+    while (f(lo) < 0.0) lo -= std::max(1.0, std::abs(lo));
+    while (f(hi) > 0.0) hi += std::max(1.0, std::abs(hi));
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(hi)); ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (f(mid) > 0.0 ? lo : hi) = mid;
+    }
+    return hi;
+}
+
+RootBounds root_bounds(const SparseDDE& dde) {
+    RootBounds b;
+    b.n = dde.dimension();
+    b.n0 = norm2_bound(dde.a0);
+    b.mu = log_norm_bound(dde.a0);
+    for (const auto& t : dde.delayed)
+        for (int k = 0; k < t.matrix.outerSize(); ++k)
+            for (SpD::InnerIterator it(t.matrix, k); it; ++it)
+                if (it.value() != 0.0) b.entries.push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), std::abs(it.value()), t.delay});
+    return b;
+}
+
+}  // namespace detail
+
+namespace {
+
+struct Disc {
+    cplx centre;
+    double radius = 0.0;
+};
+
+struct Cell {
+    double x0, x1, y0, y1;
+    bool shifted = false;
+};
+
+bool inside(const Cell& c, const Disc& d) {
+    const double r2 = d.radius * d.radius;
+    for (double x : {c.x0, c.x1})
+        for (double y : {c.y0, c.y1})
+            if (std::norm(cplx(x, y) - d.centre) >= r2) return false;
+    return true;
+}
+
+/// Root-free cells by the Gershgorin theorem for Delta(z) (nonlinear in z): Delta(z) is
+/// nonsingular when D^{-1} Delta(z) D is strictly diagonally dominant by rows for a positive
+/// diagonal D. Over a cell (centre z_c, half-diagonal h, left edge x0) with
+///     diag_i = |Delta_ii(z_c)| - h (1 + q_ii),
+///     W_ij = min(|Delta_ij(z_c)| + h q_ij, |A0_ij| + sum_k |A_k,ij| e^{-x0 tau_k})   (j != i),
+///     q_ij = sum_k |A_k,ij| tau_k e^{-x0 tau_k}  (a Lipschitz bound of Delta_ij over the cell),
+/// no root lies in the cell if (W d)_i < diag_i d_i for every row; d is the Perron vector of
+/// diag^{-1} W (power iteration), the best scaling when one exists.
+class Gershgorin {
+public:
+    explicit Gershgorin(const SparseDDE& dde) : m_n(dde.dimension()), m_p(union_pattern(dde)) {
+        auto aligned = [&](const SpD& m) {
+            SpD a = m + 0.0 * m_p;
+            a.makeCompressed();
+            return std::vector<double>(a.valuePtr(), a.valuePtr() + a.nonZeros());
+        };
+        m_a0 = aligned(dde.a0);
+        for (const auto& t : dde.delayed) {
+            m_ak.push_back(aligned(t.matrix));
+            m_tau.push_back(t.delay);
+        }
+    }
+
+    /// True when no root of Delta lies in [x0, x1] x [y0, y1] (h = 0: the single point).
+    bool excludes(double x0, double x1, double y0, double y1) const {
+        const cplx zc(0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        const double h = 0.5 * std::hypot(x1 - x0, y1 - y0);
+        const std::size_t nk = m_tau.size();
+        std::vector<cplx> e(nk);
+        std::vector<double> elo(nk);
+        for (std::size_t k = 0; k < nk; ++k) {
+            e[k] = std::exp(-zc * m_tau[k]);
+            elo[k] = std::exp(-x0 * m_tau[k]);
+        }
+        const Eigen::Index nnz = m_p.nonZeros();
+        std::vector<double> w(nnz, 0.0);
+        Eigen::VectorXd diag(m_n);
+        const int* outer = m_p.outerIndexPtr();
+        const int* inner = m_p.innerIndexPtr();
+        for (int j = 0; j < m_n; ++j) {
+            for (int p = outer[j]; p < outer[j + 1]; ++p) {
+                const int i = inner[p];
+                cplx v = -m_a0[p];
+                double q = 0.0, global = std::abs(m_a0[p]);
+                for (std::size_t k = 0; k < nk; ++k) {
+                    const double a = m_ak[k][p];
+                    if (a == 0.0) continue;
+                    v -= a * e[k];
+                    q += std::abs(a) * m_tau[k] * elo[k];
+                    global += std::abs(a) * elo[k];
+                }
+                if (i == j) {
+                    diag(i) = std::abs(v + zc) - h * (1.0 + q);
+                } else {
+                    w[p] = std::min(std::abs(v) + h * q, global);
+                }
+            }
+        }
+        if (diag.minCoeff() <= 0.0) return false;
+        auto times_w = [&](const Eigen::VectorXd& d) {
+            Eigen::VectorXd t = Eigen::VectorXd::Zero(m_n);
+            for (int j = 0; j < m_n; ++j)
+                for (int p = outer[j]; p < outer[j + 1]; ++p) t(inner[p]) += w[p] * d(j);
+            return t;
+        };
+        Eigen::VectorXd d = Eigen::VectorXd::Ones(m_n);
+        for (int it = 0; it < 60; ++it) {
+            const Eigen::VectorXd t = times_w(d);
+            if ((t.array() < (1.0 - 1e-12) * diag.array() * d.array()).all()) return true;
+            d = (t.array() / diag.array()).matrix() + d;  // Perron vector of diag^{-1} W (shifted by I)
+            d /= d.maxCoeff();
+            if (d.minCoeff() <= 0.0 || !d.allFinite()) return false;
+        }
+        return false;
+    }
+
+private:
+    int m_n;
+    SpD m_p;
+    std::vector<double> m_a0;
+    std::vector<std::vector<double>> m_ak;
+    std::vector<double> m_tau;
+};
+
+/// The covering: discs of completeness around the shifts, root-free Gershgorin cells, and
+/// the distinct eigenvalues met.
+class Covering {
+public:
+    Covering(StructuredShiftInvert& op, const Gershgorin& gersh, const SparseRootOptions& o) : m_op(op), m_gersh(gersh), m_o(o) {}
+
+    /// Runs one shift (nudged off a singular point); false after max_shifts.
+    bool shift_at(cplx sigma) {
+        if (m_shifts >= m_o.max_shifts) return false;
+        ++m_shifts;
+        const double nudge = 1e-7 * scale_of(sigma);
+        for (int attempt = 0; attempt < 4 && !m_op.factor(sigma); ++attempt) sigma += cplx(nudge, sigma.imag() != 0.0 ? nudge : 0.0);
+        const Eigen::Index size = m_op.rows();
+        const int nev = static_cast<int>(std::min<Eigen::Index>(m_o.eigenvalues_per_shift, size - 3));
+        const Eigen::Index ncv = std::min<Eigen::Index>(size, 5 * nev / 2 + 20);
+        Spectra::GenEigsComplexShiftSolver<StructuredShiftInvert> solver(m_op, nev, ncv, sigma.real(), sigma.imag());
+        solver.init();
+        solver.compute(Spectra::SortRule::LargestMagn, m_o.arnoldi_max_restarts, m_o.arnoldi_tolerance);
+        const Eigen::VectorXcd ev = solver.eigenvalues();
+        double numin = std::numeric_limits<double>::infinity();
+        for (Eigen::Index i = 0; i < ev.size(); ++i) {
+            const cplx z = ev(i);
+            if (!std::isfinite(z.real()) || !std::isfinite(z.imag())) continue;
+            add(z);
+            const cplx nu = 0.5 * (1.0 / (z - sigma) + 1.0 / (z - std::conj(sigma)));
+            numin = std::min(numin, std::abs(nu));
+        }
+        if (solver.info() != Spectra::CompInfo::Successful || ev.size() < nev || !std::isfinite(numin)) {
+            ++m_failed;
+            return true;  // no disc: the cell is split and tried again
+        }
+        numin *= 1.0 + 1e-6;  // margin for the Ritz values' own error
+        const double b = std::abs(sigma.imag());
+        double rho;
+        if (b == 0.0) {
+            rho = 1.0 / numin;
+        } else {
+            // smaller root of c rho^2 - 2 (c b + 1) rho + 2 b = 0, c = 2 nu_min, in stable form
+            const double c = 2.0 * numin, p = c * b + 1.0;
+            rho = 2.0 * b / (p + std::sqrt(p * p - 2.0 * c * b));
+        }
+        m_discs.push_back({sigma, rho});
+        return true;
+    }
+
+    /// Covers [floor, beta] x [0, R(floor)], floor starting at alpha and raised, as eigenvalues
+    /// are found, to the count-th rightmost one met (cells left of it are no longer needed).
+    /// Cells are taken rightmost first. False when the shift budget ran out.
+    bool cover(double alpha, double beta, const Bounds& bounds, int count) {
+        m_floor = alpha;
+        const double height = bounds.radius(alpha);
+        auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
+        std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
+        // roughly square cells to start with
+        const double w = beta - alpha;
+        const int nx = std::max(1, static_cast<int>(std::ceil(w / std::max(height, 1e-300))));
+        const int ny = std::max(1, static_cast<int>(std::ceil(height / std::max(w, 1e-300))));
+        for (int i = 0; i < nx; ++i)
+            for (int j = 0; j < ny; ++j)
+                queue.push({alpha + w * i / nx, alpha + w * (i + 1) / nx, height * j / ny, height * (j + 1) / ny});
+        while (!queue.empty()) {
+            Cell c = queue.top();
+            queue.pop();
+            if (c.x1 < m_floor || c.y0 > m_height) continue;
+            c.x0 = std::max(c.x0, m_floor);
+            c.y1 = std::min(c.y1, m_height);
+            if (covered(c)) continue;
+            if (m_gersh.excludes(c.x0, c.x1, c.y0, c.y1)) {
+                ++m_excluded;
+                continue;
+            }
+            const double cw = c.x1 - c.x0, ch = c.y1 - c.y0;
+            if (std::max(cw, ch) <= 1e-13 * scale_of(cplx(c.x1, c.y1))) return false;
+            const double mx = 0.5 * (c.x0 + c.x1), my = 0.5 * (c.y0 + c.y1);
+            const cplx centre(mx, c.y0 == 0.0 ? 0.0 : my);
+            // where even the centre is root-free, smaller cells will be too: split instead of
+            // a (slow) shift far from the spectrum
+            const bool empty_centre = m_gersh.excludes(mx, mx, my, my) && std::max(cw, ch) > 1e-3 * scale_of(centre);
+            if (!c.shifted && !empty_centre) {
+                bool again = false;
+                for (const auto& d : m_discs) again = again || d.centre == centre;
+                if (!again) {
+                    if (!shift_at(centre)) return false;
+                    raise_floor(bounds, count);
+                }
+                c.shifted = true;
+                if (covered(c)) continue;
+            }
+            Cell a = c, b = c;
+            a.shifted = b.shifted = false;
+            if (cw >= ch) {
+                a.x1 = b.x0 = mx;
+            } else {
+                a.y1 = b.y0 = my;
+            }
+            queue.push(a);
+            queue.push(b);
+        }
+        return true;
+    }
+
+    /// The final floor: every eigenvalue with Re >= floor (and |Im| <= R(floor)) was found.
+    double floor() const { return m_floor; }
+
+    /// Distinct eigenvalues with Im >= 0 (real problem: conjugates implied).
+    const std::vector<cplx>& values() const { return m_values; }
+    int shifts() const { return m_shifts; }
+    int failed() const { return m_failed; }
+    int excluded() const { return m_excluded; }
+
+private:
+    bool covered(const Cell& c) const {
+        for (auto it = m_discs.rbegin(); it != m_discs.rend(); ++it)
+            if (inside(c, *it)) return true;
+        return false;
+    }
+    void add(cplx z) {
+        if (z.imag() < 0.0) z = std::conj(z);
+        if (z.imag() <= 1e-12 * scale_of(z)) z.imag(0.0);  // a real eigenvalue, not a pair
+        for (cplx w : m_values)
+            if (std::abs(w - z) <= 1e-10 * scale_of(z)) return;
+        m_values.push_back(z);
+    }
+
+    StructuredShiftInvert& m_op;
+    const Gershgorin& m_gersh;
+    const SparseRootOptions& m_o;
+    std::vector<Disc> m_discs;
+    std::vector<cplx> m_values;
+    int m_shifts = 0;
+    int m_failed = 0;
+    int m_excluded = 0;
+    double m_floor = 0.0;
+    double m_height = std::numeric_limits<double>::infinity();
+
+    void raise_floor(const Bounds& bounds, int count) {
+        std::vector<double> re;
+        for (cplx z : m_values) {
+            re.push_back(z.real());
+            if (z.imag() > 0.0) re.push_back(z.real());
+        }
+        if (re.size() < std::size_t(count)) return;
+        std::nth_element(re.begin(), re.begin() + (count - 1), re.end(), std::greater<double>());
+        m_floor = std::max(m_floor, re[count - 1]);
+        m_height = bounds.radius(m_floor);
+    }
+};
+
+/// Newton on [Delta(lambda) v = 0, c^H v = 1] (nonlinear inverse iteration):
+///     u = Delta(lambda)^{-1} Delta'(lambda) v,  lambda <- lambda - 1 / (c^H u),  v <- u / (c^H u).
+class SparseNewton {
+public:
+    SparseNewton(const SparseDDE& dde, const Bounds& bounds) : m_dde(dde), m_bounds(bounds) {
+        m_pattern = union_pattern(dde).cast<cplx>();
+        m_pattern.makeCompressed();
+        m_lu.analyzePattern(m_pattern);
+    }
+
+    bool refine(cplx guess, const SparseRootOptions& o, Root& out) {
+        const int n = m_dde.dimension();
+        const bool real = guess.imag() == 0.0;
+        std::mt19937 rng(12345);
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        Eigen::VectorXcd r(n);
+        for (int i = 0; i < n; ++i) r(i) = real ? cplx(u(rng), 0.0) : cplx(u(rng), u(rng));
+        cplx lambda = guess;
+        if (!factor(lambda)) return finish(guess, lambda, Eigen::VectorXcd(), 0.0, true, o, out);
+        Eigen::VectorXcd v = m_lu.solve(r);
+        if (!v.allFinite() || v.norm() == 0.0) return finish(guess, lambda, Eigen::VectorXcd(), 0.0, true, o, out);
+        v /= v.norm();
+        const Eigen::VectorXcd c = v;  // c^H v = 1
+        double step_size = std::numeric_limits<double>::infinity();
+        bool converged = false;
+        for (int it = 0; it < o.newton_max_iterations; ++it) {
+            if (it > 0 && !factor(lambda)) {
+                converged = true;  // Delta(lambda) singular: lambda is a root to working precision
+                break;
+            }
+            const Eigen::VectorXcd dv = m_dde.characteristic_derivative(lambda) * v;
+            const Eigen::VectorXcd w = m_lu.solve(dv);
+            const cplx chu = c.dot(w);
+            if (!w.allFinite() || chu == cplx(0.0)) {
+                converged = true;
+                break;
+            }
+            const cplx step = 1.0 / chu;
+            lambda -= step;
+            v = w / chu;
+            step_size = std::abs(step);
+            if (real) lambda.imag(0.0);
+            if (step_size <= o.newton_tolerance * scale_of(lambda)) {
+                converged = true;
+                break;
+            }
+        }
+        if (converged && step_size == std::numeric_limits<double>::infinity()) step_size = 0.0;
+        return finish(guess, lambda, v, step_size, converged, o, out);
+    }
+
+    int factorizations() const { return m_factorizations; }
+
+private:
+    bool factor(cplx lambda) {
+        m_d = m_dde.characteristic_matrix(lambda) + cplx(0.0) * m_pattern;
+        m_d.makeCompressed();
+        m_lu.factorize(m_d);
+        ++m_factorizations;
+        return m_lu.info() == Eigen::Success;
+    }
+    bool finish(cplx guess, cplx lambda, const Eigen::VectorXcd& v, double step, bool converged, const SparseRootOptions& o,
+                Root& out) {
+        out.value = lambda;
+        out.newton_step = step;
+        out.collocation_error = std::abs(lambda - guess);
+        if (v.size() > 0 && v.norm() > 0.0) {
+            out.residual = (m_dde.characteristic_matrix(lambda) * v).norm() / (v.norm() * m_bounds.scale(lambda));
+        } else {
+            out.residual = 0.0;  // Delta(lambda) singular to working precision
+        }
+        return (converged || step <= 1e-6 * scale_of(lambda)) && out.residual <= o.residual_tolerance &&
+               std::isfinite(lambda.real()) && std::isfinite(lambda.imag());
+    }
+
+    const SparseDDE& m_dde;
+    const Bounds& m_bounds;
+    SpC m_pattern, m_d;
+    Eigen::UmfPackLU<SpC> m_lu;
+    int m_factorizations = 0;
+};
+
+bool rightmost_first(cplx a, cplx b) {
+    if (a.real() != b.real()) return a.real() > b.real();
+    return a.imag() > b.imag();
+}
+
+/// The eigenvalues right of alpha in full (conjugates added), rightmost first.
+std::vector<cplx> with_conjugates(const std::vector<cplx>& upper, double alpha) {
+    std::vector<cplx> out;
+    for (cplx z : upper) {
+        if (z.real() < alpha) continue;
+        out.push_back(z);
+        if (z.imag() > 0.0) out.push_back(std::conj(z));
+    }
+    std::sort(out.begin(), out.end(), rightmost_first);
+    return out;
+}
+
+}  // namespace
+
+SparseRootResult sparse_rightmost_roots(const SparseDDE& input, const SparseRootOptions& options) {
+    options.validate();
+    const SparseDDE dde = normalised(input);
+    if (dde.delayed.empty()) throw std::invalid_argument("the sparse path needs at least one delay > 0 (an ODE: use the dense path)");
+    const int n = dde.dimension();
+    const Bounds bounds = detail::root_bounds(dde);
+    const double tau = dde.max_delay();
+    SparseRootResult result;
+    result.right_bound = bounds.right_bound();
+    const double beta = result.right_bound;
+    // the first strip is cheap (few eigenvalues); it is widened until `count` eigenvalues lie in it
+    // a deep first strip: the floor rises as soon as `count` eigenvalues are known
+    double alpha = std::min(0.0, beta) - 1.0 / tau;
+    int m = options.degree > 0 ? options.degree
+                               : std::clamp(detail::degree_for_radius(bounds.radius(std::min(0.0, beta) - 1.0 / tau), tau), 8,
+                                            options.max_degree);
+    const Gershgorin gersh(dde);
+    for (;;) {
+        StructuredShiftInvert op(dde, m);
+        if (op.rows() < 8)
+            throw std::invalid_argument("the sparse path needs (M+1) n >= 8; use the dense path for n = " + std::to_string(n));
+        Covering cover(op, gersh, options);
+        bool budget = true;
+        std::vector<cplx> right;
+        for (;;) {
+            budget = cover.cover(alpha, beta, bounds, options.count);
+            right = with_conjugates(cover.values(), cover.floor());
+            if (!budget || right.size() >= std::size_t(options.count)) break;
+            // fewer than `count` eigenvalues right of alpha: widen the strip
+            alpha -= std::max(beta - alpha, 1.0 / tau);
+        }
+        alpha = cover.floor();
+        result.shifts += cover.shifts();
+        result.factorizations += op.factorizations();
+        result.eigenvalues_found = static_cast<int>(cover.values().size());
+        const double height = bounds.radius(alpha);
+        const double resolved = detail::radius_for_degree(m, tau);
+        // M must resolve every eigenvalue of the rectangle; otherwise raise M and cover again
+        if (budget && options.degree == 0 && resolved < height && m < options.max_degree) {
+            m = std::min(options.max_degree, std::max(detail::degree_for_radius(height, tau), static_cast<int>(std::ceil(1.5 * m))));
+            continue;
+        }
+        // the `count` rightmost (plus a cut-off conjugate partner)
+        std::size_t keep = std::min<std::size_t>(right.size(), options.count);
+        if (keep > 0 && keep < right.size() && right[keep - 1].imag() > 0.0 && right[keep] == std::conj(right[keep - 1])) ++keep;
+        const bool cut = keep < right.size();
+        right.resize(keep);
+        result.degree = m;
+        // all eigenvalues right of alpha were found; the listed ones are those right of the last kept
+        result.strip_floor = cut && keep > 0 ? std::max(alpha, right.back().real()) : alpha;
+        result.height = height;
+        result.covered_radius = resolved;
+        result.roots.clear();
+        result.eigenvalues.clear();
+        result.collocation_error = 0.0;
+        result.max_residual = 0.0;
+        int failed_newton = 0;
+        if (options.refine) {
+            SparseNewton newton(dde, bounds);
+            for (cplx z : right) {
+                if (z.imag() < 0.0) continue;
+                Root r;
+                if (!newton.refine(z, options, r)) ++failed_newton;
+                result.roots.push_back(r);
+                result.eigenvalues.push_back(z);
+                if (z.imag() > 0.0) {
+                    Root c = r;
+                    c.value = std::conj(r.value);
+                    result.roots.push_back(c);
+                    result.eigenvalues.push_back(std::conj(z));
+                }
+            }
+            result.factorizations += newton.factorizations();
+        } else {
+            for (cplx z : right) {
+                Root r;
+                r.value = z;
+                r.newton_step = std::numeric_limits<double>::quiet_NaN();
+                result.roots.push_back(r);
+                result.eigenvalues.push_back(z);
+            }
+        }
+        for (const auto& r : result.roots) {
+            if (options.refine) result.collocation_error = std::max(result.collocation_error, r.collocation_error / scale_of(r.value));
+            result.max_residual = std::max(result.max_residual, r.residual);
+        }
+        // two refined roots on one root: a duplicate, the collocation did not separate them
+        int duplicates = 0;
+        for (std::size_t i = 0; i < result.roots.size(); ++i)
+            for (std::size_t j = i + 1; j < result.roots.size(); ++j)
+                if (std::abs(result.roots[i].value - result.roots[j].value) <= 1e-10 * scale_of(result.roots[i].value)) ++duplicates;
+        const bool accurate = result.collocation_error <= options.collocation_tolerance;
+        if (options.refine && options.degree == 0 && budget && (!accurate || duplicates > 0) && m < options.max_degree) {
+            m = std::min(options.max_degree, static_cast<int>(std::ceil(1.5 * m)));
+            continue;
+        }
+        // sort the refined roots
+        std::vector<std::size_t> order(result.roots.size());
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+            return rightmost_first(result.roots[a].value, result.roots[b].value);
+        });
+        std::vector<Root> roots;
+        std::vector<cplx> eigs;
+        for (std::size_t i : order) {
+            roots.push_back(result.roots[i]);
+            eigs.push_back(result.eigenvalues[i]);
+        }
+        result.roots = roots;
+        result.eigenvalues = eigs;
+        std::ostringstream os;
+        os.precision(3);
+        if (!budget) {
+            result.status = RootStatus::EigenFailure;
+            os << "the shift budget (" << options.max_shifts << ") ran out before the strip Re >= " << alpha << " was covered";
+        } else if (options.refine && (failed_newton > 0 || duplicates > 0)) {
+            result.status = RootStatus::MaxDegreeReached;
+            os << failed_newton << " Newton refinements failed and " << duplicates << " roots coincide at M=" << m;
+        } else if (options.refine && !accurate) {
+            result.status = RootStatus::MaxDegreeReached;
+            os << "max degree M=" << m << " reached with eigenvalues " << result.collocation_error << " from the roots";
+        } else {
+            result.status = RootStatus::Converged;
+            os << "every collocation eigenvalue (M=" << m << ") with Re >= " << alpha << " found by " << result.shifts
+               << " shifts covering [" << alpha << ", " << beta << "] x [0, " << height << "] (no root lies right of " << beta
+               << " or above " << height << " there)";
+            if (options.refine)
+                os << "; each refined by Newton (max residual " << result.max_residual << ", eigenvalues within "
+                   << result.collocation_error << ")";
+        }
+        if (cover.failed() > 0) os << "; " << cover.failed() << " Arnoldi runs did not converge and were replaced by smaller cells";
+        result.reason = os.str();
+        return result;
+    }
+}
+
+SolverMethod parse_solver_method(const std::string& name) {
+    if (name == "auto") return SolverMethod::Automatic;
+    if (name == "dense") return SolverMethod::Dense;
+    if (name == "sparse") return SolverMethod::Sparse;
+    if (name == "product") return SolverMethod::Product;
+    throw std::invalid_argument("solver '" + name + "': expected auto, dense, sparse or product");
+}
+
+std::string to_string(SolverMethod m) {
+    switch (m) {
+        case SolverMethod::Automatic: return "auto";
+        case SolverMethod::Dense: return "dense";
+        case SolverMethod::Sparse: return "sparse";
+        case SolverMethod::Product: return "product";
+    }
+    return "auto";
+}
+
+SparseRootResult system_rightmost_roots(const SparseDDE& dde, const SparseRootOptions& options, SolverMethod method,
+                                        int dense_limit) {
+    options.validate();
+    dde.validate();
+    if (method == SolverMethod::Product)
+        throw std::invalid_argument("solver 'product' solves rings of cars that react only to the car ahead, not a general system: expected auto, dense or sparse");
+    const bool dense = method == SolverMethod::Dense ||
+                       (method == SolverMethod::Automatic && (dde.dimension() <= dense_limit || dde.delayed.empty()));
+    if (!dense) return sparse_rightmost_roots(dde, options);
+    RootOptions ro;
+    ro.count = options.count;
+    ro.max_degree = options.max_degree;
+    if (options.degree > 0) ro.initial_degree = options.degree;
+    ro.residual_tolerance = options.residual_tolerance;
+    const RootResult r = rightmost_roots(dde.to_dense(), ro);
+    SparseRootResult out;
+    out.roots = r.roots;
+    for (const auto& root : r.roots) {
+        out.eigenvalues.push_back(root.value);  // (dense path: the refined root; its distance is collocation_error)
+        out.max_residual = std::max(out.max_residual, root.residual);
+    }
+    out.degree = r.degree;
+    out.strip_floor = r.strip_floor;
+    out.covered_radius = r.covered_radius;
+    out.collocation_error = r.collocation_error;
+    out.status = r.status;
+    out.reason = "dense collocation: " + r.reason;
+    return out;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,367 @@
+#include "ddemap/study/sweep.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#ifdef DDEMAP_WITH_OPENMP
+#include <omp.h>
+#endif
+
+#include "ddemap/solve/eigensolver.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/core/text.hpp"
+
+namespace ddemap {
+
+namespace {
+
+double certificate_gap(cplx z) { return 1e-10 * std::max(1.0, std::abs(z)); }
+
+}  // namespace
+
+Axis parse_axis(const std::string& name, const std::string& text) {
+    Axis a;
+    a.name = name;
+    const auto c1 = text.find(':');
+    const auto c2 = c1 == std::string::npos ? std::string::npos : text.find(':', c1 + 1);
+    const std::string what = "--" + name + " = '" + text + "': expected LO:HI:COUNT with finite LO < HI and an integer COUNT >= 2";
+    if (c1 == std::string::npos || c2 == std::string::npos || text.find(':', c2 + 1) != std::string::npos) {
+        throw std::invalid_argument(what);
+    }
+    auto number = [&](const std::string& t) {
+        double v = 0.0;
+        if (!detail::parse_finite(t, v)) throw std::invalid_argument(what);
+        return v;
+    };
+    a.lo = number(text.substr(0, c1));
+    a.hi = number(text.substr(c1 + 1, c2 - c1 - 1));
+    const std::string cs = text.substr(c2 + 1);
+    char* end = nullptr;
+    const long n = std::strtol(cs.c_str(), &end, 10);
+    if (cs.empty() || *end != '\0' || n < 2 || n > 100000 || !(a.lo < a.hi)) throw std::invalid_argument(what);
+    a.count = static_cast<int>(n);
+    return a;
+}
+
+namespace {
+
+/// True when z is the rightmost zero of f (up to its conjugate twin for real f). Counts the zeros
+/// right of a line a little left of z: exactly z (and its twin) means nothing else is further
+/// right. Lines at a distance keep the argument tracking cheap; closer lines only when another
+/// zero is near; the last resort is the line 1e-10 right of z.
+bool is_rightmost(const QuasiPolynomial& f, cplx z) {
+    const double scale = std::max(1.0, std::abs(z));
+    const bool twin = f.is_real() && std::abs(z.imag()) > 1e-12 * scale;
+    const int known = twin ? 2 : 1;
+    for (double delta : {1e-2, 1e-4, 1e-7}) {
+        const int left = f.zeros_right_of(z.real() - delta * scale);
+        if (left == known) return true;
+        if (left >= 0 && left < known) return false;  // z itself is not a zero: inconsistent
+        const int right = f.zeros_right_of(z.real() + delta * scale);
+        if (right != 0) return false;  // something lies further right (or undecided)
+    }
+    return f.zeros_right_of(z.real() + certificate_gap(z)) == 0;
+}
+
+}  // namespace
+
+CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
+                                  const std::optional<cplx>& guess) {
+    CertifiedRoot out;
+    if (guess) {
+        cplx z = *guess;
+        if (f.newton(z)) {
+            out.value = z;
+            if (is_rightmost(f, z)) {
+                out.certified = true;
+                return out;
+            }
+        }
+    }
+    out.fell_back = true;
+    out.degree = 8;
+    // a cheap low-degree collocation gives the guesses; the certificate decides
+    const LinearDDE problem = dde();
+    {
+        DenseEigenSolver dense;
+        const EigenResult eig = dense.eigenvalues(problem, 8, 1);
+        std::vector<cplx> ev = eig.values;
+        std::sort(ev.begin(), ev.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
+        bool have = false;
+        cplx best;
+        for (std::size_t i = 0; i < std::min<std::size_t>(ev.size(), 4); ++i) {
+            cplx z = ev[i];
+            if (f.newton(z) && (!have || z.real() > best.real())) {
+                best = z;
+                have = true;
+            }
+        }
+        if (have && is_rightmost(f, best)) {
+            out.value = best;
+            out.certified = true;
+            return out;
+        }
+    }
+    RootOptions o;
+    o.count = 1;
+    const RootResult rr = rightmost_roots(problem, o);
+    out.degree = std::max(out.degree, rr.degree);
+    if (rr.roots.empty()) return out;
+    cplx z = rr.roots.front().value;
+    f.newton(z);
+    out.value = z;
+    out.certified = is_rightmost(f, z);
+    return out;
+}
+
+RingTracker::RingTracker(int cars) : m_cars(cars) {
+    if (cars != 0 && cars < 2) throw std::invalid_argument("ring of " + std::to_string(cars) + " cars: expected N >= 2 or inf");
+    if (cars > 0) {
+        for (int m = 0; 2 * m <= cars; ++m) m_thetas.push_back(2.0 * M_PI * m / cars);
+    } else {
+        const int g = 64;
+        for (int k = 12; k >= 1; --k) m_thetas.push_back(M_PI * std::ldexp(1.0, -k) / g);
+        for (int j = 1; j <= g; ++j) m_thetas.push_back(M_PI * j / g);
+    }
+    m_guess.assign(m_thetas.size(), std::nullopt);
+}
+
+void RingTracker::reset() { std::fill(m_guess.begin(), m_guess.end(), std::nullopt); }
+
+RingSummary RingTracker::evaluate(const Linearisation& lin) {
+    RingSummary s;
+    const std::size_t n = m_thetas.size();
+    std::vector<CertifiedRoot> roots(n);
+    std::vector<QuasiPolynomial> fs;
+    fs.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double theta = m_thetas[i];
+        const bool mode0 = m_cars > 0 && i == 0;
+        const cplx zeta = m_cars > 0 ? ring_zeta(static_cast<int>(i), m_cars) : std::polar(1.0, -theta);
+        fs.push_back(mode0 ? ring_mode0_characteristic(lin) : ring_mode_characteristic(lin, zeta));
+        roots[i] = certified_rightmost(
+            fs.back(), [&] { return mode0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, zeta); }, m_guess[i]);
+        m_guess[i] = roots[i].value;
+        s.fallbacks += roots[i].fell_back;
+        s.degree = std::max(s.degree, roots[i].degree);
+        s.certified = s.certified && roots[i].certified;
+    }
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < n; ++i)
+        if (roots[i].value.real() > roots[best].value.real()) best = i;
+
+    if (m_cars > 0) {
+        s.spectral_abscissa = roots[best].value.real();
+        s.abscissa_mode = static_cast<int>(best);
+        s.abscissa_theta = m_thetas[best];
+        bool marginal = false;
+        for (std::size_t i = 0; i < n; ++i) {
+            const cplx z = roots[i].value;
+            const double band = marginal_band(z);
+            if (z.real() < -band) continue;
+            if (z.real() <= band) marginal = true;
+            const int weight = (i > 0 && 2 * static_cast<int>(i) != m_cars) ? 2 : 1;
+            const int above = fs[i].zeros_right_of(band);
+            if (above < 0) {
+                s.certified = false;
+                marginal = true;
+                continue;
+            }
+            // roots on the axis matter only when nothing is unstable in this mode
+            if (above == 0 && fs[i].zeros_right_of(-band) > 0) marginal = true;
+            s.unstable_roots += weight * above;
+        }
+        s.stable = s.certified && s.unstable_roots == 0 && !marginal;
+        return s;
+    }
+
+    // N = infinity: refine the best sample by golden section between its neighbours
+    double lo = best > 0 ? m_thetas[best - 1] : 0.5 * m_thetas[best];
+    double hi = best + 1 < n ? m_thetas[best + 1] : M_PI;
+    double best_theta = m_thetas[best], best_value = roots[best].value.real();
+    cplx seed = roots[best].value;
+    auto alpha = [&](double theta) {
+        const cplx zeta = std::polar(1.0, -theta);
+        const QuasiPolynomial f = ring_mode_characteristic(lin, zeta);
+        const CertifiedRoot c = certified_rightmost(f, [&] { return ring_mode_dde(lin, zeta); }, seed);
+        s.fallbacks += c.fell_back;
+        s.degree = std::max(s.degree, c.degree);
+        s.certified = s.certified && c.certified;
+        return c.value.real();
+    };
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double f1 = alpha(x1), f2 = alpha(x2);
+    for (int it = 0; it < 40 && hi - lo > 1e-9; ++it) {
+        if (f1 < f2) {
+            lo = x1; x1 = x2; f1 = f2; x2 = lo + g * (hi - lo); f2 = alpha(x2);
+        } else {
+            hi = x2; x2 = x1; f2 = f1; x1 = hi - g * (hi - lo); f1 = alpha(x1);
+        }
+    }
+    if (std::max(f1, f2) > best_value) {
+        best_value = std::max(f1, f2);
+        best_theta = f1 > f2 ? x1 : x2;
+    }
+    const LowFrequency lf = low_frequency_expansion(lin);
+    double margin = 0.0;
+    switch (lf.decisive_order) {
+        case 2: margin = lf.c2; break;
+        case 4: margin = lf.c4; break;
+        case 6: margin = lf.c6; break;
+        case 8: margin = lf.c8; break;
+        default: margin = 0.0;
+    }
+    const bool branch_stable = lf.decisive_order > 0 && lf.gamma_prime0 != 0.0 && lf.d0 != 0.0 && margin / lf.gamma_prime0 < 0.0;
+    const bool grid_stable = best_value < 0.0;
+    s.abscissa_mode = -1;
+    s.unstable_roots = -1;
+    s.spectral_abscissa = std::max(best_value, 0.0);
+    s.abscissa_theta = best_value > 0.0 ? best_theta : 0.0;
+    s.stable = s.certified && grid_stable && branch_stable;
+    return s;
+}
+
+RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
+    const QuasiPolynomial f = plant_characteristic(lin);
+    const CertifiedRoot c = certified_rightmost(f, [&] { return plant_dde(lin); }, m_guess);
+    fallbacks += c.fell_back;
+    m_guess = c.value;
+    RootResult rr;
+    if (!c.certified) {
+        RootOptions o;
+        o.count = 2;
+        return rightmost_roots(plant_dde(lin), o);
+    }
+    // real coefficients: the conjugate is a root too
+    cplx z = c.value;
+    if (std::abs(z.imag()) <= 1e-14 * std::max(1.0, std::abs(z))) z = cplx(z.real(), 0.0);
+    Root r;
+    r.value = z.imag() < 0.0 ? std::conj(z) : z;
+    r.residual = std::abs(f(r.value)) / (1.0 + std::norm(r.value));
+    rr.roots.push_back(r);
+    if (r.value.imag() > 0.0) {
+        Root c2 = r;
+        c2.value = std::conj(r.value);
+        rr.roots.push_back(c2);
+    }
+    rr.status = RootStatus::Converged;
+    rr.reason = "continued by Newton and certified by the argument principle";
+    return rr;
+}
+
+void SweepSpec::validate() const {
+    if (x.name == y.name) throw std::invalid_argument("the two swept parameters are both '" + x.name + "': expected two different parameters");
+    if (x.count < 2 || y.count < 2) throw std::invalid_argument("a swept axis needs COUNT >= 2");
+    if (cars != 0 && cars < 2) throw std::invalid_argument("ring of " + std::to_string(cars) + " cars: expected N >= 2 or inf");
+    for (const auto& a : {x, y}) {
+        if (fixed.count(a.name)) throw std::invalid_argument("parameter '" + a.name + "' is both swept and fixed");
+        if (!(std::isfinite(a.lo) && std::isfinite(a.hi) && a.lo < a.hi)) {
+            throw std::invalid_argument("--" + a.name + " range " + detail::format_number(a.lo) + ":" + detail::format_number(a.hi) + ": expected finite LO < HI");
+        }
+    }
+    for (double xv : {x.lo, x.hi})
+        for (double yv : {y.lo, y.hi}) (void)model_at(*this, xv, yv);
+}
+
+std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y) {
+    ParameterMap p = spec.fixed;
+    p[spec.x.name] = x;
+    p[spec.y.name] = y;
+    return make_model(spec.model, p);
+}
+
+SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
+    spec.validate();
+    SweepResult result;
+    result.spec = spec;
+    const int nx = spec.x.count, ny = spec.y.count;
+    result.points.resize(static_cast<std::size_t>(nx) * ny);
+    result.modes = spec.cars > 0 ? spec.cars / 2 + 1 : 0;
+    result.mode_roots.resize(result.points.size() * result.modes);
+    const auto t0 = std::chrono::steady_clock::now();
+    std::atomic<int> rows_done{0};
+    int fallbacks = 0, uncertified = 0, degree = 0;
+    // The first column is continued sequentially (one collocation solve at its first point);
+    // each row then starts from the roots of its first point. The path of every point is thus
+    // fixed, whatever the number of threads.
+    std::vector<RingTracker> ring_seed;
+    std::vector<PlantTracker> plant_seed;
+    {
+        RingTracker ring(spec.cars);
+        PlantTracker plant;
+        for (int iy = 0; iy < ny; ++iy) {
+            const Linearisation lin = model_at(spec, spec.x.value(0), spec.y.value(iy))->linearise();
+            const RingSummary rs = ring.evaluate(lin);
+            fallbacks += rs.fallbacks;
+            degree = std::max(degree, rs.degree);
+            plant.evaluate(lin, fallbacks);
+            ring_seed.push_back(ring);
+            plant_seed.push_back(plant);
+        }
+    }
+#ifdef DDEMAP_WITH_OPENMP
+    result.threads = omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : fallbacks, uncertified) reduction(max : degree)
+#endif
+    for (int iy = 0; iy < ny; ++iy) {
+        RingTracker ring = ring_seed[iy];
+        PlantTracker plant = plant_seed[iy];
+        StringOptions so;
+        so.grid_points = 120;
+        for (int ix = 0; ix < nx; ++ix) {
+            SweepPoint& p = result.points[static_cast<std::size_t>(iy) * nx + ix];
+            p.x = spec.x.value(ix);
+            p.y = spec.y.value(iy);
+            const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
+            const RingSummary rs = ring.evaluate(lin);
+            int fb = rs.fallbacks;
+            const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
+            p.spectral_abscissa = rs.spectral_abscissa;
+            p.unstable_roots = rs.unstable_roots;
+            p.abscissa_mode = rs.abscissa_mode;
+            p.ring_stable = rs.stable;
+            p.certified = rs.certified;
+            p.sup_gamma = sr.sup_gamma;
+            p.omega_peak = sr.omega_peak;
+            p.lowfreq_margin = sr.lowfreq_margin;
+            for (const auto& pk : sr.peaks) {
+                if (pk.gain > p.peak_gain) {
+                    p.peak_gain = pk.gain;
+                    p.peak_omega = pk.omega;
+                }
+            }
+            if (!sr.plant_roots.roots.empty()) p.plant_root = sr.plant_roots.roots.front().value;
+            for (int m = 0; m < result.modes; ++m) {
+                result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
+            }
+            p.plant_abscissa = sr.plant_abscissa;
+            p.plant_stable = sr.plant_stable;
+            p.string_stable = sr.string_stable;
+            fallbacks += fb;
+            degree = std::max(degree, rs.degree);
+            uncertified += !rs.certified;
+        }
+        const int done = ++rows_done;
+        if (progress) {
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp critical(ddemap_progress)
+#endif
+            progress(done, ny);
+        }
+    }
+    result.fallbacks = fallbacks;
+    result.uncertified = uncertified;
+    result.degree_max = degree;
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return result;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,73 @@
+#include "ddemap/traffic/vehicles.hpp"
+
+#include "ddemap/core/text.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace ddemap {
+
+const std::vector<CalibratedVehicle>& paper_calibration_table() {
+    struct Row {
+        const char* vehicle;
+        const char* setting;
+        double k1, k2, th, tau, eta;
+    };
+    // transcribed from the paper's calibration table
+    static const Row rows[] = {
+        {"A", "min", 0.052, 0.338, 0.819, 0.948, 8.030}, {"A", "max", 0.012, 0.167, 2.054, 0.992, 5.960},
+        {"B", "min", 0.052, 0.190, 0.725, 0.468, 6.849}, {"B", "max", 0.022, 0.116, 2.020, 0.153, 8.210},
+        {"C", "min", 0.029, 0.269, 0.907, 0.368, 10.070}, {"C", "max", 0.018, 0.152, 1.986, 0.324, 13.814},
+        {"D", "min", 0.051, 0.280, 0.544, 0.284, 13.400}, {"D", "max", 0.022, 0.221, 1.853, 0.935, 14.956},
+        {"E", "min", 0.051, 0.165, 1.127, 0.419, 5.170}, {"E", "max", 0.053, 0.142, 1.785, 0.839, 9.370},
+        {"F", "min", 0.071, 0.191, 0.696, 0.582, 10.090}, {"F", "max", 0.041, 0.164, 1.734, 0.922, 6.033},
+        {"G", "min", 0.070, 0.253, 0.549, 0.993, 14.500}, {"G", "max", 0.046, 0.129, 1.764, 0.994, 5.131},
+    };
+    static const std::vector<CalibratedVehicle> table = [] {
+        std::vector<CalibratedVehicle> t;
+        for (const auto& r : rows) {
+            CalibratedVehicle v;
+            v.vehicle = r.vehicle;
+            v.setting = r.setting;
+            v.name = v.vehicle + "_" + v.setting;
+            v.make = (v.vehicle < "E") ? 1 : 2;
+            v.min_acc_speed = v.make == 1 ? 11.176 : 0.0;  // 25 mph
+            v.parameters = {{"k1", r.k1}, {"k2", r.k2}, {"th", r.th}, {"tau", r.tau}, {"eta", r.eta}};
+            t.push_back(v);
+        }
+        return t;
+    }();
+    return table;
+}
+
+std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
+    detail::CsvReader csv(text, source, "name,k1,k2,th,tau[,eta]");
+    const int c_name = csv.column("name");
+    const char* params[] = {"k1", "k2", "th", "tau", "eta"};
+    int c_param[5];
+    for (int i = 0; i < 5; ++i) c_param[i] = csv.column(params[i], i < 4);
+    std::vector<CalibratedVehicle> out;
+    while (csv.next()) {
+        CalibratedVehicle v;
+        v.name = csv.fields()[c_name];
+        if (v.name.empty()) csv.fail("column 'name' is empty: expected a vehicle name");
+        v.vehicle = v.name;
+        v.parameters["eta"] = 10.0;
+        for (int i = 0; i < 5; ++i)
+            if (c_param[i] >= 0) v.parameters[params[i]] = csv.number(c_param[i], params[i]);
+        try {
+            (void)make_model("ovrv", v.parameters);
+        } catch (const std::invalid_argument& e) {
+            csv.fail(e.what());
+        }
+        out.push_back(v);
+    }
+    if (out.empty()) throw std::invalid_argument(source + ": no vehicles after the header");
+    return out;
+}
+
+}  // namespace ddemap

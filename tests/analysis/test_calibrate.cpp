@@ -1,0 +1,126 @@
+// Calibration: synthetic recovery (data from the platoon simulator, with noise) and real
+// measured traces (../shared/data/acc when present).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/study/growth.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+
+namespace {
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// 300 s at 10 Hz behind a lead with three frequencies, follower from simulate_platoon (its own
+/// equilibrium history, an independent code path from simulate_follower), noise added.
+Trace synthetic(const ParameterMap& p, unsigned seed) {
+    std::vector<double> t, v;
+    for (int k = 0; k <= 3000; ++k) {
+        const double x = 0.1 * k;
+        t.push_back(x);
+        v.push_back(20 + 2 * std::sin(0.1 * x) + 1.5 * std::sin(0.27 * x + 1) + 0.8 * std::sin(0.6 * x));
+    }
+    std::shared_ptr<const CarModel> m = make_model("ovrv", p);
+    SimOptions o;
+    o.t_end = 300;
+    o.step = 0.02;
+    const SimResult r = simulate_platoon(LeadProfile(t, v), {SimCar{m, 0.0, "x"}}, o);
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> nv(0, 0.05), ng(0, 0.2);
+    Trace tr;
+    tr.source = "synthetic";
+    for (std::size_t k = 0; k < r.time.size(); ++k) {
+        tr.t.push_back(r.time[k]);
+        tr.lead.push_back(r.speed[0][k]);
+        tr.speed.push_back(r.speed[1][k] + nv(rng));
+        tr.gap.push_back(r.gap[1][k] + ng(rng));
+    }
+    return tr;
+}
+}  // namespace
+
+TEST_CASE("calibration recovers known parameters from noisy synthetic data" * doctest::test_suite("slow")) {
+    // tolerances: 10% (+0.002) in k1, 5% in k2, 0.05 s in th, 0.03 s in tau, 0.5 m in eta, with
+    // noise of 0.05 m/s on speed and 0.2 m on gap
+    const double sets[][5] = {{0.05, 0.3, 1.2, 0.4, 8}, {0.1, 0.2, 1.8, 0.9, 6}, {0.03, 0.5, 0.8, 0.15, 12}};
+    unsigned seed = 1;
+    for (const auto& s : sets) {
+        const ParameterMap p{{"k1", s[0]}, {"k2", s[1]}, {"th", s[2]}, {"tau", s[3]}, {"eta", s[4]}};
+        const CalibrationResult r = calibrate(synthetic(p, seed++));
+        CAPTURE(s[3]);
+        CHECK(std::abs(r.parameters.at("k1") - s[0]) <= 0.1 * s[0] + 0.002);
+        CHECK(std::abs(r.parameters.at("k2") - s[1]) <= 0.05 * s[1]);
+        CHECK(std::abs(r.parameters.at("th") - s[2]) <= 0.05);
+        CHECK(std::abs(r.parameters.at("tau") - s[3]) <= 0.03);
+        CHECK(std::abs(r.parameters.at("eta") - s[4]) <= 0.5);
+        CHECK(r.all.rmse_speed < 0.06);  // the noise level: nothing left to explain
+        CHECK(r.status != "failure");
+    }
+}
+
+TEST_CASE("bad traces are rejected with the line and column") {
+    std::string ok = "time_s,lead_speed_mps,follower_speed_mps,gap_m\n";
+    for (int k = 0; k < 300; ++k) ok += std::to_string(0.1 * k) + ",20,20,30\n";
+    CHECK_NOTHROW(read_trace_csv(ok, "ok.csv"));
+    CHECK_THROWS_WITH_AS(read_trace_csv("time_s,lead_speed_mps,follower_speed_mps,gap_m\n0,1,1,nan\n", "a.csv"),
+                         "a.csv:2: column 'gap_m' = 'nan': expected a finite number", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_trace_csv("time_s,lead_speed_mps,follower_speed_mps,gap_m\n0,1,1,1\n0,1,1,1\n", "b.csv"),
+                         "b.csv:3: time_s = 0 after 0: expected increasing times", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_trace_csv("time_s,lead_speed_mps,gap_m\n0,1,1\n", "c.csv"),
+                         "c.csv:1: missing column 'follower_speed_mps' (expected time_s, lead_speed_mps, follower_speed_mps, gap_m)",
+                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_trace_csv("time_s,lead_speed_mps,follower_speed_mps,gap_m\n0,1,1,1\n0.1,1,1,1\n", "d.csv"),
+                         "d.csv: 2 rows over 0.1 s: expected at least 100 rows and 20 s", std::invalid_argument);
+    CalibrationOptions o;
+    o.lower[4] = 20;
+    CHECK_THROWS_AS(o.validate(), std::invalid_argument);
+}
+
+TEST_CASE("real OpenACC traces: every fit finishes, the model beats the naive predictor, th(L) > th(S)" * doctest::test_suite("reference")) {
+    const std::string dir = std::string(DDEMAP_TEST_DATA) + "/../../../shared/data/acc/openacc_zalazone";
+    if (!std::filesystem::exists(dir)) {
+        MESSAGE("shared data not found at " << dir << ": skipped");
+        return;
+    }
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        if (e.path().extension() == ".csv") files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    REQUIRE(files.size() == 12);
+    std::vector<CalibrationResult> fits(files.size());
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+    for (std::size_t i = 0; i < files.size(); ++i) fits[i] = calibrate(read_trace_csv(slurp(files[i]), files[i]));
+    int better = 0;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        CAPTURE(files[i]);
+        CHECK(fits[i].status != "failure");
+        CHECK(std::isfinite(fits[i].all.rmse_speed));
+        better += fits[i].all.rmse_speed < fits[i].naive.rmse_speed;
+    }
+    CHECK(better >= 10);
+    auto th = [&](const std::string& key) {
+        for (std::size_t i = 0; i < files.size(); ++i)
+            if (files[i].find(key) != std::string::npos) return fits[i].parameters.at("th");
+        FAIL("no file " << key);
+        return 0.0;
+    };
+    // the same follower (Tesla Model 3 behind a Tesla Model X), short and long setting, same track
+    CHECK(th("dynamic_p18_L_v08-v09") > th("dynamic_p04_S_v05-v06"));
+    CHECK(th("handling_p47_L_v02-v03") > th("handling_p02_S_v08-v09"));
+}
+
+TEST_SUITE_END();

@@ -1,0 +1,146 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "ddemap/solve/integrate.hpp"
+#include "ddemap/study/growth.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+
+namespace {
+/// Exact solution of y'(t) = -y(t - tau), y = 1 for t <= 0 (method of steps):
+/// y(t) = sum_{k=0}^{floor(t/tau)+1} (-1)^k (t - (k-1) tau)^k / k!
+double exact(double t, double tau) {
+    double y = 0.0, fact = 1.0;
+    const int m = static_cast<int>(std::floor(t / tau)) + 1;
+    for (int k = 0; k <= m; ++k) {
+        if (k > 0) fact *= k;
+        y += ((k % 2) ? -1.0 : 1.0) * std::pow(t - (k - 1) * tau, k) / fact;
+    }
+    return y;
+}
+
+double solve(double tau, double h, double t_end) {
+    detail::DdeSolver s(
+        1, 0.0, [](double, double* y) { y[0] = 1.0; },
+        [tau](double t, const double* y, const detail::DdeSolver& sol, double* dy) {
+            (void)y;
+            dy[0] = -sol.value(0, t - tau);
+        });
+    std::vector<double> marks;
+    for (int k = 1; k * tau < t_end; ++k) marks.push_back(k * tau);
+    s.integrate(t_end, h, marks);
+    return s.state()[0];
+}
+}  // namespace
+
+TEST_CASE("the DDE integrator converges with order 4 (y' = -y(t - tau), exact by the method of steps)") {
+    for (double tau : {1.0, 0.7}) {
+        const double t_end = 5.0;
+        std::vector<double> errors;
+        for (double h : {0.1, 0.05, 0.025, 0.0125}) errors.push_back(std::abs(solve(tau, h, t_end) - exact(t_end, tau)));
+        for (std::size_t i = 1; i < errors.size(); ++i) {
+            const double order = std::log2(errors[i - 1] / errors[i]);
+            CAPTURE(tau);
+            CAPTURE(i);
+            CAPTURE(errors[i]);
+            CHECK(order > 3.6);
+            CHECK(order < 4.4);
+        }
+        CHECK(errors.back() < 1e-8);
+    }
+}
+
+TEST_CASE("equilibrium stays equilibrium") {
+    const auto m = std::shared_ptr<const CarModel>(make_model("ovrv", {{"k1", 0.05}, {"k2", 0.3}, {"th", 1.2}, {"tau", 0.6}, {"eta", 8}}));
+    const LeadProfile lead({0.0, 100.0}, {20.0, 20.0});
+    std::vector<SimCar> cars(5, SimCar{m, 0.0, "x"});
+    const SimResult r = simulate_platoon(lead, cars);
+    for (int i = 1; i <= 5; ++i) {
+        for (std::size_t k = 0; k < r.time.size(); ++k) {
+            CHECK(std::abs(r.speed[i][k] - 20.0) < 1e-12);
+            CHECK(std::abs(r.gap[i][k] - (8 + 1.2 * 20)) < 1e-10);
+        }
+    }
+    CHECK(r.events.empty());
+}
+
+TEST_CASE("a small oscillation amplifies per car at the rate |Gamma(iw)| predicts") {
+    for (const char* model : {"ovrv", "idm"}) {
+        CAPTURE(model);
+        const ParameterMap p = std::string(model) == "ovrv"
+                                   ? ParameterMap{{"k1", 0.052}, {"k2", 0.19}, {"th", 0.725}, {"tau", 0.468}}
+                                   : ParameterMap{{"th", 1.2}, {"tau", 0.5}, {"speed", 20.0}, {"a", 0.8}};
+        const auto m = std::shared_ptr<const CarModel>(make_model(model, p));
+        const double v0 = m->operating_speed();
+        const StringResult s = analyse_string(m->linearise());
+        const double w = s.omega_peak > 0 ? s.omega_peak : 0.3;
+        const double gain = std::abs(TransferFunction(m->linearise())(cplx(0.0, w)));
+        const double eps = std::string(model) == "ovrv" ? 0.5 : 0.01;  // OVRV is affine: any amplitude
+        std::vector<double> t, v;
+        for (double x = 0.0; x <= 600.0; x += 0.02) {
+            t.push_back(x);
+            v.push_back(v0 + eps * std::sin(w * x) * (1.0 - std::exp(-x / 20.0)));
+        }
+        const LeadProfile lead(t, v);
+        SimOptions o;
+        o.t_end = 600.0;
+        o.step = 0.02;
+        const SimResult r = simulate_platoon(lead, std::vector<SimCar>(3, SimCar{m, 0.0, model}), o);
+        // amplitude of each car over the last 100 s
+        auto amplitude = [&](int car) {
+            double lo = 1e300, hi = -1e300;
+            for (std::size_t k = 0; k < r.time.size(); ++k)
+                if (r.time[k] > 500.0) {
+                    lo = std::min(lo, r.speed[car][k]);
+                    hi = std::max(hi, r.speed[car][k]);
+                }
+            return 0.5 * (hi - lo);
+        };
+        for (int car = 1; car <= 3; ++car) {
+            const double ratio = amplitude(car) / amplitude(car - 1);
+            CAPTURE(car);
+            CHECK(ratio == doctest::Approx(gain).epsilon(std::string(model) == "ovrv" ? 2e-3 : 2e-2));
+        }
+    }
+}
+
+TEST_CASE("the paper's dip grows through a platoon of A_min cars until the platoon fails") {
+    const auto& a_min = paper_calibration_table()[0];
+    SimOptions o;
+    o.on_event = OnEvent::Stop;
+    const SimResult r = simulate_platoon(LeadProfile::builtin("dip"), platoon_of(a_min, 15), o);
+    REQUIRE(r.stopped);
+    REQUIRE_FALSE(r.events.empty());
+    const SimEvent& first = r.events.front();
+    CHECK(first.car > 1);
+    // string unstable: the speed drop grows along the platoon ahead of the first failure
+    for (int i = 1; i < first.car - 1; ++i) CHECK(r.cars[i].speed_drop > r.cars[i - 1].speed_drop);
+    CHECK(r.cars[0].speed_drop > 2.7);
+    // the event is where the state says: a collision at zero gap or a disengagement at 11.176 m/s
+    if (first.type == "collision") CHECK(first.gap == 0.0);
+    else CHECK(first.speed == doctest::Approx(11.176));
+}
+
+TEST_CASE("lead profiles: exact position, validation, CSV errors") {
+    const LeadProfile p({0.0, 10.0, 20.0}, {10.0, 20.0, 20.0});
+    CHECK(p.position(10.0) == doctest::Approx(150.0));
+    CHECK(p.position(30.0) == doctest::Approx(150.0 + 400.0));
+    CHECK(p.speed(5.0) == doctest::Approx(15.0));
+    CHECK_THROWS_AS(LeadProfile({0.0, 0.0}, {1.0, 1.0}), std::invalid_argument);
+    CHECK_THROWS_AS(LeadProfile({0.0, 1.0}, {1.0, -1.0}), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(LeadProfile::from_csv("time_s,lead_speed_mps\n0,20\n1,x\n", "lead.csv"),
+                         "lead.csv:3: column 'lead_speed_mps' = 'x': expected a finite number", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(LeadProfile::from_csv("t,v\n0,20\n", "lead.csv"), "lead.csv:1: missing column 'time_s' (expected time_s, lead_speed_mps)",
+                         std::invalid_argument);
+    CHECK_THROWS_AS(LeadProfile::builtin("wave"), std::invalid_argument);
+    const LeadProfile dip = LeadProfile::builtin("dip");
+    CHECK(dip.speed(0.0) == doctest::Approx(22.4));
+    CHECK(dip.speed(30.0) == doctest::Approx(19.7));
+    CHECK(dip.speed(200.0) == doctest::Approx(22.4));
+}
+
+TEST_SUITE_END();

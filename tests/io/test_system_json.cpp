@@ -1,0 +1,62 @@
+// General linear DDEs from JSON: two delays and complex coefficients against Lambert W.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "ddemap/solve/roots.hpp"
+#include "ddemap/io/system_json.hpp"
+#include "lambert_w.hpp"
+#include "tolerances.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+TEST_CASE("a JSON system with two delays has the union of the blocks' Lambert W roots") {
+    // x1' = -x1(t - 1) and x2' = (0.5 i) x2(t - 0.3), decoupled: roots W_k(a tau) / tau of each
+    const std::string text = R"({"dimension": 2, "delays": [1.0, 0.3],
+        "A0": [[0, 0], [0, 0]],
+        "A": [{"triplets": [[0, 0, -1]]}, [[0, 0], [0, [0, 0.5]]]]})";
+    const LinearDDE dde = read_linear_dde_json(text, "sys.json");
+    CHECK(dde.dimension() == 2);
+    CHECK_FALSE(dde.is_real());
+    RootOptions o;
+    o.count = 6;
+    const RootResult r = rightmost_roots(dde, o);
+    REQUIRE(r.status == RootStatus::Converged);
+    std::vector<cplx> ref;
+    for (int k = -6; k <= 6; ++k) {
+        ref.push_back(ddemap::test::lambert_w(cplx(-1.0, 0.0), k) / 1.0);
+        ref.push_back(ddemap::test::lambert_w(cplx(0.0, 0.5 * 0.3), k) / 0.3);
+    }
+    for (const auto& root : r.roots) {
+        double nearest = 1e300;
+        for (cplx z : ref) nearest = std::min(nearest, std::abs(z - root.value));
+        CAPTURE(root.value);
+        CHECK(nearest < tol::root_abs * std::max(1.0, std::abs(root.value)));
+    }
+    // the rightmost is W_0(0.15 i) / 0.3 (right of W_0(-1))
+    CHECK(std::abs(r.roots.front().value - ddemap::test::lambert_w(cplx(0.0, 0.15), 0) / 0.3) < tol::root_abs);
+}
+
+TEST_CASE("bad system files name the field") {
+    CHECK_THROWS_WITH_AS(read_linear_dde_json("{", "s.json"), doctest::Contains("s.json: not valid JSON"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 0})", "s.json"), "s.json: dimension: expected an integer from 1 to 20000",
+                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 2, "delays": [-1], "A": [[[0,0],[0,0]]]})", "s.json"),
+                         "s.json: delays[0]: -1: expected a finite delay >= 0", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 2, "delays": [1], "A": []})", "s.json"),
+                         "s.json: A: expected an array of 1 matrices, one per delay", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 2, "A0": [[1, 2], [3]]})", "s.json"),
+                         "s.json: A0[1]: expected 2 entries", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 2, "delays": [1], "A": [{"triplets": [[2, 0, 1]]}]})", "s.json"),
+                         "s.json: A[0].triplets[0]: index (2, 0) outside 0..1", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 1, "A0": [["x"]]})", "s.json"),
+                         "s.json: A0[0][0]: expected a number or [re, im]", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 1, "B": 1})", "s.json"),
+                         "s.json: B: unknown field (expected dimension, delays, A0, A, comment)", std::invalid_argument);
+}
+
+TEST_SUITE_END();

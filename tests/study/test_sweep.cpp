@@ -1,0 +1,82 @@
+// Sweeps against the plain per-point computation (collocation for every mode, no continuation).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/study/sweep.hpp"
+#include "chart_helpers.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+
+
+TEST_CASE("sweep points equal the per-point computation (random points, boundaries, mode switches)" * doctest::test_suite("slow")) {
+    const SweepResult r = run_sweep(ddemap::test::ovrv_chart(41, 22, 1.5, 0.5));
+    CHECK(r.uncertified == 0);
+    std::mt19937 rng(23);
+    std::uniform_int_distribution<int> pick(0, 40);
+    std::vector<std::pair<int, int>> where;
+    for (int i = 0; i < 40; ++i) where.emplace_back(pick(rng), pick(rng));
+    // points next to a ring-stability boundary and where the abscissa mode changes along x
+    int near_boundary = 0, switches = 0;
+    for (int iy = 0; iy < 41; ++iy)
+        for (int ix = 0; ix + 1 < 41; ++ix) {
+            const auto& a = r.at(ix, iy);
+            const auto& b = r.at(ix + 1, iy);
+            if (a.ring_stable != b.ring_stable && near_boundary < 25) {
+                where.emplace_back(ix, iy);
+                where.emplace_back(ix + 1, iy);
+                ++near_boundary;
+            }
+            if (a.abscissa_mode != b.abscissa_mode && switches < 25) {
+                where.emplace_back(ix, iy);
+                where.emplace_back(ix + 1, iy);
+                ++switches;
+            }
+        }
+    CHECK(near_boundary >= 5);
+    CHECK(switches >= 5);
+    for (const auto& [ix, iy] : where) {
+        const SweepPoint& p = r.at(ix, iy);
+        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
+        const RingResult ring = analyse_ring(lin, 22);
+        const StringResult s = analyse_string(lin);
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(std::abs(p.spectral_abscissa - ring.spectral_abscissa) < 1e-8);
+        CHECK(p.unstable_roots == ring.unstable_roots);
+        CHECK(p.ring_stable == ring.stable);
+        CHECK(p.plant_stable == s.plant_stable);
+        CHECK(p.string_stable == s.string_stable);
+        CHECK(std::abs(p.sup_gamma - s.sup_gamma) < 1e-10 * s.sup_gamma);
+        CHECK(std::abs(p.plant_abscissa - s.plant_abscissa) < 1e-8);
+    }
+}
+
+TEST_CASE("N = infinity sweeps agree with the per-point verdicts" * doctest::test_suite("slow")) {
+    const SweepResult r = run_sweep(ddemap::test::ovrv_chart(7, 0, 1.2, 0.3));
+    for (const auto& p : r.points) {
+        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
+        const RingResult ring = analyse_ring(lin, 0);
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(p.ring_stable == ring.stable);
+        CHECK(std::abs(p.spectral_abscissa - ring.spectral_abscissa) < 1e-7);
+    }
+}
+
+TEST_CASE("axes and sweep specs are validated") {
+    CHECK_THROWS_WITH_AS(parse_axis("k1", "1:0:5"), "--k1 = '1:0:5': expected LO:HI:COUNT with finite LO < HI and an integer COUNT >= 2", std::invalid_argument);
+    CHECK_THROWS_AS(parse_axis("k1", "0:1"), std::invalid_argument);
+    CHECK_THROWS_AS(parse_axis("k1", "0:1:1"), std::invalid_argument);
+    CHECK_THROWS_AS(parse_axis("k1", "0:x:4"), std::invalid_argument);
+    SweepSpec s = ddemap::test::ovrv_chart(3, 22, 1.5, 0.5);
+    s.x = parse_axis("k1", "-1:1:3");
+    CHECK_THROWS_WITH_AS(s.validate(), "k1 = -1: expected a value >= 0 [1/s^2]", std::invalid_argument);
+}
+
+TEST_SUITE_END();

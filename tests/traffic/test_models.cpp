@@ -1,0 +1,75 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "ddemap/traffic/model.hpp"
+#include "tolerances.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+/// Partials of F by central differences at the equilibrium (s*(v), v, v).
+void finite_differences(const CarModel& m, double& fs, double& fv, double& fl) {
+    const double v = m.operating_speed();
+    const double s = m.equilibrium_gap(v);
+    const double h = 1e-5;
+    fs = (m.acceleration(s + h, v, v) - m.acceleration(s - h, v, v)) / (2 * h);
+    fv = (m.acceleration(s, v + h, v) - m.acceleration(s, v - h, v)) / (2 * h);
+    fl = (m.acceleration(s, v, v + h) - m.acceleration(s, v, v - h)) / (2 * h);
+}
+double single(const ExpPoly& e, double delay) {
+    REQUIRE(e.terms().size() == 1);
+    CHECK(e.terms()[0].delay == delay);
+    return e.terms()[0].coef;
+}
+}  // namespace
+
+TEST_CASE("linearisations match finite differences of the law at equilibrium") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int trial = 0; trial < 20; ++trial) {
+        const ParameterMap ovrv_p = {{"k1", u(rng)}, {"k2", u(rng)}, {"th", 3 * u(rng)}, {"tau", u(rng)},
+                                     {"eta", 5 + 10 * u(rng)}, {"speed", 30 * u(rng)}};
+        const ParameterMap idm_p = {{"a", 0.5 + u(rng)}, {"b", 1 + u(rng)}, {"v0", 30 + 5 * u(rng)},
+                                    {"th", 0.5 + u(rng)}, {"tau", u(rng)}, {"eta", 1 + 3 * u(rng)},
+                                    {"speed", 25 * u(rng)}};
+        for (const auto& m : {make_model("ovrv", ovrv_p), make_model("idm", idm_p)}) {
+            CAPTURE(m->name());
+            const double v = m->operating_speed();
+            CHECK(std::abs(m->acceleration(m->equilibrium_gap(v), v, v)) < 1e-12);
+            double fs, fv, fl;
+            finite_differences(*m, fs, fv, fl);
+            const Linearisation l = m->linearise();
+            CHECK(single(l.gap, m->delay()) == doctest::Approx(fs).epsilon(tol::finite_difference));
+            CHECK(single(l.own, 0.0) == doctest::Approx(fv).epsilon(tol::finite_difference));
+            if (std::abs(fl) > 1e-12) CHECK(single(l.lead, m->delay()) == doctest::Approx(fl).epsilon(tol::finite_difference));
+        }
+    }
+}
+
+TEST_CASE("OVRV partials are the paper's: f_s = k1, f_v = -(k1 th + k2), f_l = k2") {
+    const auto m = make_model("ovrv", {{"k1", 0.2}, {"k2", 0.3}, {"th", 1.5}, {"tau", 0.1}});
+    const Linearisation l = m->linearise();
+    CHECK(single(l.gap, 0.1) == 0.2);
+    CHECK(single(l.own, 0.0) == -(0.2 * 1.5 + 0.3));
+    CHECK(single(l.lead, 0.1) == 0.3);
+}
+
+TEST_CASE("model parameters are validated with a message naming the value") {
+    CHECK_THROWS_WITH_AS(make_model("ovrv", {{"k1", -0.5}, {"k2", 0.2}, {"th", 1}, {"tau", 0.1}}),
+                         "k1 = -0.5: expected a value >= 0 [1/s^2]", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(make_model("ovrv", {{"k1", 0.5}, {"k2", 0.2}, {"th", 1}}),
+                         "model ovrv needs tau [s] (sensing delay)", std::invalid_argument);
+    CHECK_THROWS_AS(make_model("ovrv", {{"k1", INFINITY}, {"k2", 0.2}, {"th", 1}, {"tau", 0.1}}), std::invalid_argument);
+    CHECK_THROWS_AS(make_model("ovrv", {{"k1", 0.1}, {"k2", 0.2}, {"th", 1}, {"tau", 0.1}, {"v0", 3}}), std::invalid_argument);
+    CHECK_THROWS_AS(make_model("idm", {{"th", 1}, {"tau", 0.1}, {"speed", 40}}), std::invalid_argument);
+    CHECK_THROWS_AS(make_model("bando", {}), std::invalid_argument);
+    // valid edge cases
+    CHECK_NOTHROW(make_model("ovrv", {{"k1", 0.0}, {"k2", 0.2}, {"th", 1}, {"tau", 0.0}}));
+}
+
+TEST_SUITE_END();
