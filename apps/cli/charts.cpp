@@ -254,7 +254,9 @@ struct ChartCommands::Impl {
         const SweepSpec spec = spec_from(sweep_model, sweep_ring, sweep_x, true, "");
         check_output("--out", sweep_out);
         const bool tty = isatty(2);
-        const SweepResult sw = run_sweep(spec, tty ? progress_line : nullptr);
+        ExecutionPolicy policy;
+        if (tty) policy.progress = progress_line;
+        const SweepResult sw = run_sweep(spec, policy);
         BoundarySet b;
         if (!no_boundaries) b = trace_boundaries(sw);
         ChartOptions co;

@@ -8,17 +8,15 @@
 namespace ddemap {
 
 std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle>& vehicles, const LeadProfile& lead,
-                                             int followers, const SimOptions& options) {
+                                             int followers, const SimOptions& options,
+                                             const ExecutionPolicy& policy) {
     if (followers < 1 || followers > 1000) throw std::invalid_argument("followers = " + std::to_string(followers) + ": expected 1 to 1000");
     double lead_min = lead.speed(0.0);
     for (double v : lead.speeds()) lead_min = std::min(lead_min, v);
     const double lead_drop = lead.speed(0.0) - lead_min;
     if (!(lead_drop > 0.0)) throw std::invalid_argument("the lead profile has no speed drop: expected a disturbance");
     std::vector<GrowthResult> out(vehicles.size());
-#ifdef DDEMAP_WITH_OPENMP
-#pragma omp parallel for schedule(dynamic, 1)
-#endif
-    for (std::size_t vi = 0; vi < vehicles.size(); ++vi) {
+    parallel_for(static_cast<long>(vehicles.size()), [&](long vi) {
         const SimResult r = simulate_platoon(lead, platoon_of(vehicles[vi], followers), options);
         GrowthResult g;
         g.name = vehicles[vi].name;
@@ -43,7 +41,7 @@ std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle
             g.failure_gap = ev->gap;
         }
         out[vi] = g;
-    }
+    }, policy);
     return out;
 }
 

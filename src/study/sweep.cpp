@@ -9,10 +9,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#ifdef DDEMAP_WITH_OPENMP
-#include <omp.h>
-#endif
-
 #include "ddemap/solve/eigensolver.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
@@ -278,7 +274,7 @@ std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y) {
     return make_model(spec.model, p);
 }
 
-SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
+SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
     spec.validate();
     SweepResult result;
     result.spec = spec;
@@ -287,7 +283,6 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
     result.modes = spec.cars > 0 ? spec.cars / 2 + 1 : 0;
     result.mode_roots.resize(result.points.size() * result.modes);
     const auto t0 = std::chrono::steady_clock::now();
-    std::atomic<int> rows_done{0};
     int fallbacks = 0, uncertified = 0, degree = 0;
     // The first column is continued sequentially (one collocation solve at its first point);
     // each row then starts from the roots of its first point. The path of every point is thus
@@ -307,11 +302,14 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
             plant_seed.push_back(plant);
         }
     }
-#ifdef DDEMAP_WITH_OPENMP
-    result.threads = omp_get_max_threads();
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : fallbacks, uncertified) reduction(max : degree)
-#endif
-    for (int iy = 0; iy < ny; ++iy) {
+    result.threads = thread_count(policy);
+    // per-row counters, summed in row order after the loop
+    std::vector<int> row_fallbacks(ny, 0), row_uncertified(ny, 0), row_degree(ny, 0);
+    parallel_for(ny, [&](long row) {
+        const int iy = static_cast<int>(row);
+        int& fallbacks = row_fallbacks[iy];
+        int& uncertified = row_uncertified[iy];
+        int& degree = row_degree[iy];
         RingTracker ring = ring_seed[iy];
         PlantTracker plant = plant_seed[iy];
         StringOptions so;
@@ -349,13 +347,11 @@ SweepResult run_sweep(const SweepSpec& spec, Progress progress) {
             degree = std::max(degree, rs.degree);
             uncertified += !rs.certified;
         }
-        const int done = ++rows_done;
-        if (progress) {
-#ifdef DDEMAP_WITH_OPENMP
-#pragma omp critical(ddemap_progress)
-#endif
-            progress(done, ny);
-        }
+    }, policy);
+    for (int iy = 0; iy < ny; ++iy) {
+        fallbacks += row_fallbacks[iy];
+        uncertified += row_uncertified[iy];
+        degree = std::max(degree, row_degree[iy]);
     }
     result.fallbacks = fallbacks;
     result.uncertified = uncertified;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/traffic/fleet.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/core/text.hpp"
@@ -17,6 +18,8 @@ namespace {
 constexpr double kTwoPi = 6.283185307179586476925286766559;
 /// From this many car types on, a contour step evaluates the types on all threads.
 constexpr std::size_t kParallelTypes = 256;
+/// types per block of the parallel reduction (fixed, so sums do not depend on the thread count)
+constexpr long kTypeBlock = 64;
 
 bool same(const ExpPoly& a, const ExpPoly& b) {
     const auto &ta = a.terms(), &tb = b.terms();
@@ -101,6 +104,7 @@ bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, long& 
     if (length == 0.0) return true;
     const double tiny = 1e-14 * (std::abs(a) + std::abs(b) + 1.0);
     const std::size_t nt = m_types.size();
+    const int threads = thread_count();
     // At each point: P_t and Gamma_t per type, Phi (principal logs at the start of the segment,
     // then continued by the increments: e^Phi is exact either way) and the local turning rates
     // max_t(|P_t'/P_t|, |Gamma_t'/Gamma_t|) and Phi', which cap the next step (the end-point
@@ -151,23 +155,29 @@ bool RingDeterminant::follow(cplx a, cplx b, double theta, double& total, long& 
         // every factor's argument moves by at most theta (types spread over the threads when many)
         bool ok = true;
         Rates next;
-#ifdef DDEMAP_WITH_OPENMP
-        if (nt >= kParallelTypes) {
-            int bad = 0;
-            double fmax = 0.0, pre = 0.0, pim = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : fmax) reduction(+ : pre, pim) reduction(| : bad)
-            for (long k = 0; k < static_cast<long>(nt); ++k) {
-                Rates r;
-                if (!one(static_cast<std::size_t>(k), z, np[k], nr[k], r)) bad |= 1;
-                fmax = std::max(fmax, r.factor);
-                pre += r.phi.real();
-                pim += r.phi.imag();
-            }
-            ok = bad == 0;
-            next.factor = fmax;
-            next.phi = cplx(pre, pim);
+        if (nt >= kParallelTypes && threads > 1) {
+            // fixed blocks of types, combined in block order: the same sums for any thread count
+            struct Part {
+                bool bad = false;
+                Rates rates;
+            };
+            const Part all = parallel_reduce(
+                static_cast<long>(nt), kTypeBlock, Part{},
+                [&](long begin, long end) {
+                    Part part;
+                    for (long k = begin; k < end; ++k)
+                        if (!one(static_cast<std::size_t>(k), z, np[k], nr[k], part.rates)) part.bad = true;
+                    return part;
+                },
+                [](Part acc, const Part& p) {
+                    acc.bad = acc.bad || p.bad;
+                    acc.rates.factor = std::max(acc.rates.factor, p.rates.factor);
+                    acc.rates.phi += p.rates.phi;
+                    return acc;
+                });
+            ok = !all.bad;
+            next = all.rates;
         } else
-#endif
         {
             // serially, a type that turns too far rejects the step at once
             for (std::size_t k = 0; k < nt && ok; ++k)

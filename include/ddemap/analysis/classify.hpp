@@ -4,6 +4,7 @@
 
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/traffic/vehicles.hpp"
@@ -18,6 +19,8 @@ struct Classification {
 };
 
 /// Plant, ring (N cars, 0 = infinity) and string verdicts of every vehicle (OVRV).
-std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars);
+/// Vehicles run in parallel under `policy`.
+std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars,
+                                     const ExecutionPolicy& policy = {});
 
 }  // namespace ddemap

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 
@@ -24,6 +25,7 @@ struct GrowthResult {
 };
 
 std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle>& vehicles, const LeadProfile& lead,
-                                             int followers, const SimOptions& options = {});
+                                             int followers, const SimOptions& options = {},
+                                             const ExecutionPolicy& policy = {});
 
 }  // namespace ddemap

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/problem/quasi_polynomial.hpp"
 #include "ddemap/solve/roots.hpp"
@@ -114,10 +115,9 @@ struct SweepResult {
     const SweepPoint& at(int ix, int iy) const { return points[static_cast<std::size_t>(iy) * spec.x.count + ix]; }
 };
 
-/// Progress callback (rows done, rows total); called from one thread at a time.
-using Progress = void (*)(int, int);
-
-SweepResult run_sweep(const SweepSpec& spec, Progress progress = nullptr);
+/// Rows run in parallel under `policy` (its progress: rows done, rows in all); the result is
+/// the same for any number of threads.
+SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy = {});
 
 /// The model at one grid point.
 std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y);

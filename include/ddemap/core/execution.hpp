@@ -1,0 +1,63 @@
+#pragma once
+/// \file execution.hpp
+/// The one execution policy. Every parallel loop of ddemap runs through parallel_for or
+/// parallel_reduce, so threads are chosen in one place, an exception thrown by a task is
+/// rethrown on the caller's thread (it never escapes a parallel region), and results do not
+/// depend on the number of threads:
+///   * parallel_for: each task i writes only its own outputs, so any schedule gives the same
+///     outputs;
+///   * parallel_reduce: [0, count) is cut into fixed blocks of `block` indices (a partition that
+///     does not depend on the thread count), each block reduced on its own, and the block
+///     results combined left to right in block order: bitwise the same for 1 or 64 threads.
+/// A later distributed (MPI) policy plugs in here.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace ddemap {
+
+/// Progress callback: (tasks done, tasks in all); called from one thread at a time.
+using Progress = std::function<void(long done, long total)>;
+
+struct ExecutionPolicy {
+    int threads = 0;    ///< 0: the default (OMP_NUM_THREADS, else every core); 1: serial
+    Progress progress;  ///< after each finished task of a parallel_for (may be empty)
+    /// True when usable; otherwise `why` (if given) names the field.
+    bool is_valid(std::string* why = nullptr) const;
+};
+
+/// The number of threads a loop under `policy` uses (1 without OpenMP).
+int thread_count(const ExecutionPolicy& policy = {});
+
+/// Runs task(i) for every i in [0, count), dynamically scheduled over the policy's threads.
+/// Tasks must be independent (each writes only its own outputs). If tasks throw, the exception
+/// of the lowest index is rethrown after every task has ended. Throws std::invalid_argument for
+/// an invalid policy or count < 0.
+void parallel_for(long count, const std::function<void(long)>& task, const ExecutionPolicy& policy = {});
+
+/// Deterministic reduction: partial(begin, end) -> T for every block [begin, end) of at most
+/// `block` indices, then init = combine(init, partial_b) for b = 0, 1, ... in order. Progress
+/// is not reported (blocks are internal).
+template <class T, class Partial, class Combine>
+T parallel_reduce(long count, long block, T init, Partial&& partial, Combine&& combine,
+                  const ExecutionPolicy& policy = {}) {
+    if (count <= 0) return init;
+    if (block < 1) block = 1;
+    const long blocks = (count + block - 1) / block;
+    std::vector<T> parts(static_cast<std::size_t>(blocks));
+    ExecutionPolicy quiet = policy;
+    quiet.progress = nullptr;
+    parallel_for(
+        blocks,
+        [&](long b) {
+            const long begin = b * block;
+            const long end = begin + block < count ? begin + block : count;
+            parts[static_cast<std::size_t>(b)] = partial(begin, end);
+        },
+        quiet);
+    for (auto& p : parts) init = combine(init, p);
+    return init;
+}
+
+}  // namespace ddemap
