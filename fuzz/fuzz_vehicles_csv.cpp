@@ -1,0 +1,8 @@
+// classify VEHICLES.csv: the vehicle reader.
+#include "fuzz_common.hpp"
+#include "ddemap/traffic/vehicles.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    return ddemap::fuzz::expect_value_or_bad_input(
+        [&] { (void)ddemap::read_vehicles_csv(ddemap::fuzz::text(data, size), "fuzz.csv"); });
+}

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang, AddressSanitizer and UndefinedBehaviorSanitizer in
+# build-fuzz/, then fuzzes each parser for SECONDS (default 60) from its corpus in fuzz/corpus/.
+# A crash, a sanitizer report, a non-one-line error or an input running over 10 s stops the
+# target and leaves the input in build-fuzz/findings/; add it to fuzz/corpus/<target>/ once
+# fixed, so the regression tests replay it. Usage: scripts/fuzz.sh [SECONDS] [TARGET...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+shift || true
+scripts/install-deps.sh
+packages=(clang libclang-rt-14-dev)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g -O1"
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDDEMAP_BUILD_FUZZERS=ON \
+    -DDDEMAP_BUILD_TESTS=OFF -DDDEMAP_BUILD_BENCH=OFF -DDDEMAP_WITH_OPENMP=OFF \
+    -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then
+    targets=(system_json fleet_csv fleet_pattern vehicles_csv trace_csv lead_csv chart_spec axis)
+fi
+cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}" >/dev/null
+mkdir -p build-fuzz/findings
+status=0
+for t in "${targets[@]}"; do
+    work=build-fuzz/corpus-$t
+    mkdir -p "$work"
+    echo "fuzz_$t: $seconds s"
+    if ! build-fuzz/fuzz/fuzz_$t "$work" "fuzz/corpus/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
+            -max_len=65536 -artifact_prefix=build-fuzz/findings/$t- -print_final_stats=1 > "build-fuzz/fuzz_$t.log" 2>&1; then
+        echo "fuzz_$t: FINDING (see build-fuzz/fuzz_$t.log and build-fuzz/findings/)"
+        tail -30 "build-fuzz/fuzz_$t.log"
+        status=1
+    else
+        grep -E "stat::number_of_executed_units" "build-fuzz/fuzz_$t.log" || true
+    fi
+done
+exit $status
