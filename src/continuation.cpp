@@ -223,6 +223,10 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
         p.keep_omega_sign(u);
         const ContinuationOptions eo = engine_options(options, p.unknowns());
         const ContinuationResult fwd = continue_branch(p, u, t, eo);
+        if (fwd.points.empty()) {  // no tangent at the seed after all
+            ++set.rejected;
+            continue;
+        }
         ContinuationResult bwd;
         if (fwd.stop != ContinuationStop::ClosedLoop) bwd = continue_branch(p, u, -t, eo);
         BoundaryCurve curve;

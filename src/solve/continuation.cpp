@@ -195,11 +195,8 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
     const Eigen::VectorXd start = u0.cwiseQuotient(c);
     Eigen::VectorXd u = start, t, f;
     if (!sp.residual(u, f)) return finish(ContinuationStop::TangentFailed, Status::NumericalIssue, "F cannot be evaluated at the start");
-    if (!tangent(sp, u, direction.cwiseQuotient(c), t)) {
-        r.points.push_back(u0);
-        r.max_residual = f.norm();
+    if (!tangent(sp, u, direction.cwiseQuotient(c), t))
         return finish(ContinuationStop::TangentFailed, Status::NumericalIssue, "no tangent at the start (J rank deficient)");
-    }
     add_point(u, t, f.norm());
     std::vector<double> g = test_values(u, t);
 
@@ -288,7 +285,9 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
             for (int i = 0; i < m && ok; ++i)
                 ok = i == face || (w(i) >= lo(i) - bound_slack && w(i) <= hi(i) + bound_slack);
             const std::string which = "the bound of unknown " + std::to_string(face);
-            if (!ok) return finish(ContinuationStop::Bound, Status::Converged, "crossed " + which + " where the crossing could not be located");
+            if (!ok)
+                return finish(ContinuationStop::Bound, converged(cb.status) ? Status::Converged : cb.status,
+                              "crossed " + which + " where the crossing could not be located");
             if (!tangent(sp, w, t, tw)) tw = t;
             ContinuationEvent e;
             e.kind = ContinuationEvent::Kind::Bound;

@@ -110,13 +110,15 @@ struct ContinuationEvent {
 };
 
 struct ContinuationResult {
-    std::vector<Eigen::VectorXd> points;    ///< points[0] is the start
+    /// points[0] is the start (points and tangents are empty when the start has no tangent)
+    std::vector<Eigen::VectorXd> points;
     std::vector<Eigen::VectorXd> tangents;  ///< unit tangent at every point
     std::vector<ContinuationEvent> events;  ///< in the order met
     ContinuationStop stop = ContinuationStop::MaxPoints;
     /// Converged when the branch ended at a bound, a terminal event, a closed loop or the
-    /// domain's edge; BudgetExhausted at max_points; otherwise the corrector's or tangent's
-    /// failure (MaxIterations, NumericalIssue).
+    /// domain's edge; BudgetExhausted at max_points; NumericalIssue when a tangent failed;
+    /// below min_step, the last rejection's: the corrector's status (MaxIterations,
+    /// NumericalIssue), or NumericalIssue for a jump or an angle.
     Status status = Status::Converged;
     std::string message;
     int newton_iterations = 0;  ///< over all corrector and event-location solves
