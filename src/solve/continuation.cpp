@@ -242,6 +242,8 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
         }
         e.u = sp.u(w_best);
         e.t = sp.u_tangent(t_best);
+        Eigen::VectorXd fe;
+        e.residual = sp.residual(w_best, fe) ? fe.norm() : inf;
         return e;
     };
 
@@ -296,6 +298,7 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
             add_point(w, tw, cb.residual);
             e.u = r.points.back();
             e.t = r.tangents.back();
+            e.residual = cb.residual;
             r.events.push_back(std::move(e));
             return finish(ContinuationStop::Bound, Status::Converged, "reached " + which);
         }
@@ -322,11 +325,9 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
             const bool terminal = tests[static_cast<std::size_t>(e.index)].terminal;
             r.events.push_back(e);
             if (!terminal) continue;
-            Eigen::VectorXd fe;
-            const double res = problem.residual(e.u, fe) ? fe.norm() : inf;
             r.points.push_back(e.u);
             r.tangents.push_back(e.t);
-            r.max_residual = std::max(r.max_residual, res);
+            r.max_residual = std::max(r.max_residual, e.residual);
             return finish(ContinuationStop::TerminalEvent, Status::Converged, "test function '" + tests[static_cast<std::size_t>(e.index)].name + "' vanished");
         }
 

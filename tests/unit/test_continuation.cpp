@@ -165,6 +165,7 @@ TEST_CASE("continuation: an event g(u) = u_0 - c is located on the curve at the 
     for (int k = 0; k < 2; ++k) {
         const ContinuationEvent& e = r.events[static_cast<std::size_t>(k)];
         CHECK(e.located);
+        CHECK(e.residual < 1e-13);
         CHECK(std::abs(e.u(0) - c) < 1e-10);
         CHECK(std::abs(e.u(1) - (k == 0 ? y : -y)) < 1e-10);
     }

@@ -105,6 +105,7 @@ struct ContinuationEvent {
     Kind kind = Kind::Test;
     int index = -1;           ///< the unknown whose bound was reached, or the test function's index
     Eigen::VectorXd u, t;     ///< the point on the curve and its unit tangent
+    double residual = std::numeric_limits<double>::infinity();  ///< |F(u)|
     int after = 0;            ///< index of the branch point before the event
     bool located = true;      ///< false when the location stopped early (u is then its best estimate)
 };
