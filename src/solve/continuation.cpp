@@ -27,10 +27,10 @@ bool ContinuationOptions::is_valid(std::string* why) const {
     else if (!(max_angle > 0.0 && max_angle <= half_pi)) w = "max_angle: expected a value in (0, pi/2]";
     else if (!positive(event_tolerance)) w = "event_tolerance: expected a finite value > 0";
     else if (!newton.is_valid(&message)) message = "newton." + message;
-    else if (lower.size() != 0 && upper.size() != 0 && lower.size() != upper.size()) w = "upper: expected as many entries as lower";
-    else if (lower.size() != 0 && upper.size() != 0 && !(lower.array() <= upper.array()).all()) w = "lower: expected lower <= upper";
     else if (lower.size() != 0 && lower.array().isNaN().any()) w = "lower: expected numbers (not NaN)";
     else if (upper.size() != 0 && upper.array().isNaN().any()) w = "upper: expected numbers (not NaN)";
+    else if (lower.size() != 0 && upper.size() != 0 && lower.size() != upper.size()) w = "upper: expected as many entries as lower";
+    else if (lower.size() != 0 && upper.size() != 0 && !(lower.array() <= upper.array()).all()) w = "lower: expected lower <= upper";
     else if (scale.size() != 0 && !(scale.array().isFinite().all() && (scale.array() > 0.0).all())) w = "scale: expected finite entries > 0";
     if (w) message = w;
     if (!message.empty() && why) *why = message;
