@@ -1,7 +1,6 @@
 #include "ddemap/study/boundary.hpp"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -9,9 +8,10 @@
 
 #include <Eigen/Dense>
 
-#include "ddemap/problem/quasi_polynomial.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/problem/quasi_polynomial.hpp"
+#include "ddemap/solve/continuation.hpp"
 
 namespace ddemap {
 
@@ -39,18 +39,17 @@ void BoundaryOptions::validate() const {
 namespace {
 
 /// The boundary equations in scaled unknowns u = (X, Y[, w]), X = (x - lo) / (hi - lo).
-class Problem {
+class Problem final : public ContinuationProblem {
 public:
     Problem(const SweepSpec& spec, BoundaryKind kind, int mode) : m_spec(spec), m_kind(kind), m_mode(mode) {}
-    int equations() const { return m_kind == BoundaryKind::LowFrequency ? 1 : 2; }
-    int unknowns() const { return equations() + 1; }
+    int equations() const override { return m_kind == BoundaryKind::LowFrequency ? 1 : 2; }
     double x(double X) const { return m_spec.x.lo + X * (m_spec.x.hi - m_spec.x.lo); }
     double y(double Y) const { return m_spec.y.lo + Y * (m_spec.y.hi - m_spec.y.lo); }
     double X(double x) const { return (x - m_spec.x.lo) / (m_spec.x.hi - m_spec.x.lo); }
     double Y(double y) const { return (y - m_spec.y.lo) / (m_spec.y.hi - m_spec.y.lo); }
 
     /// F(u); false when the model cannot be built there (outside its parameter domain).
-    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const {
+    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
         f.resize(equations());
         Linearisation lin;
         try {
@@ -87,117 +86,38 @@ public:
         return false;
     }
 
-    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const {
-        const int k = equations(), n = unknowns();
-        j.resize(k, n);
-        for (int c = 0; c < n; ++c) {
-            const double h = 1e-7 * std::max(1.0, std::abs(u(c)));
-            Eigen::VectorXd up = u, um = u, fp, fm;
-            up(c) += h;
-            um(c) -= h;
-            if (!residual(up, fp) || !residual(um, fm)) return false;
-            j.col(c) = (fp - fm) / (2.0 * h);
-        }
-        return true;
+    /// Central differences: any model works, linear in its parameters or not.
+    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override {
+        return central_difference_jacobian(*this, u, j);
     }
 
-    /// Unit tangent: the null vector of the k x (k+1) Jacobian.
-    bool tangent(const Eigen::VectorXd& u, Eigen::VectorXd& t) const {
-        Eigen::MatrixXd j;
-        if (!jacobian(u, j)) return false;
-        t.resize(unknowns());
-        if (equations() == 1) {
-            t << -j(0, 1), j(0, 0);
-        } else {
-            const Eigen::Vector3d a = j.row(0).transpose(), b = j.row(1).transpose();
-            t = a.cross(b);
-        }
-        const double n = t.norm();
-        if (!(n > 0.0) || !std::isfinite(n)) return false;
-        t /= n;
-        return true;
-    }
-
-    /// Newton on F(u) = 0 plus one linear constraint c . u = d. Returns iterations or -1.
-    int correct(Eigen::VectorXd& u, const Eigen::VectorXd& c, double d, double& res) const {
-        const int n = unknowns();
-        for (int it = 1; it <= 12; ++it) {
-            Eigen::VectorXd f;
-            Eigen::MatrixXd j;
-            if (!residual(u, f) || !jacobian(u, j)) return -1;
-            Eigen::MatrixXd a(n, n);
-            Eigen::VectorXd r(n);
-            a.topRows(n - 1) = j;
-            a.row(n - 1) = c.transpose();
-            r.head(n - 1) = f;
-            r(n - 1) = c.dot(u) - d;
-            const Eigen::VectorXd du = a.fullPivLu().solve(r);
-            if (!du.allFinite()) return -1;
-            u -= du;
-            if (du.norm() <= 1e-13 * std::max(1.0, u.norm())) {
-                if (!residual(u, f)) return -1;
-                res = f.norm();
-                return it;
-            }
-        }
-        return -1;
-    }
+    /// A branch keeps the sign of its crossing frequency (it ends where the frequency reaches 0).
+    bool in_domain(const Eigen::VectorXd& u) const override { return unknowns() == 2 || m_omega_sign * u(2) > 0.0; }
+    void keep_omega_sign(const Eigen::VectorXd& u) { m_omega_sign = unknowns() == 3 && u(2) < 0.0 ? -1.0 : 1.0; }
 
 private:
     const SweepSpec& m_spec;
     BoundaryKind m_kind;
     int m_mode;
+    double m_omega_sign = 1.0;
 };
 
 bool inside(const Eigen::VectorXd& u) { return u(0) >= 0.0 && u(0) <= 1.0 && u(1) >= 0.0 && u(1) <= 1.0; }
 
-/// One direction from the seed. Appends points (not the seed) to `out`.
-void trace_direction(const Problem& p, Eigen::VectorXd u, Eigen::VectorXd t, const BoundaryOptions& o,
-                     std::vector<Eigen::VectorXd>& out, bool& closed, double& max_res) {
-    const Eigen::VectorXd start = u;
-    double h = o.initial_step;
-    const bool has_omega = p.unknowns() == 3;
-    const double omega_sign = has_omega && u(2) < 0.0 ? -1.0 : 1.0;
-    while (static_cast<int>(out.size()) < o.max_points) {
-        Eigen::VectorXd v = u + h * t;
-        double res = 0.0;
-        const int its = p.correct(v, t, t.dot(v), res);
-        if (its < 0 || (v - u).norm() > 3.0 * h) {
-            h *= 0.5;
-            if (h < o.min_step) return;
-            continue;
-        }
-        if (!inside(v)) {
-            // exact crossing of the window edge: the violated coordinate fixed at the edge
-            Eigen::VectorXd w = u;
-            const int c = (v(0) < 0.0 || v(0) > 1.0) ? 0 : 1;
-            const double edge = v(c) < 0.0 ? 0.0 : 1.0;
-            Eigen::VectorXd e = Eigen::VectorXd::Zero(p.unknowns());
-            e(c) = 1.0;
-            w(c) = edge;
-            if (p.correct(w, e, edge, res) >= 0 && (w - u).norm() <= 3.0 * h) {
-                const int other = 1 - c;
-                if (w(other) >= -1e-12 && w(other) <= 1.0 + 1e-12) {
-                    out.push_back(w);
-                    max_res = std::max(max_res, res);
-                }
-            }
-            return;
-        }
-        if (has_omega && omega_sign * v(2) <= 0.0) return;  // the crossing frequency reached 0
-        Eigen::VectorXd tn;
-        if (!p.tangent(v, tn)) return;
-        if (tn.dot(t) < 0.0) tn = -tn;
-        out.push_back(v);
-        max_res = std::max(max_res, res);
-        if (out.size() > 8 && (v.head(2) - start.head(2)).norm() < 0.75 * h) {
-            closed = true;
-            return;
-        }
-        u = v;
-        t = tn;
-        if (its <= 3) h = std::min(o.max_step, 1.5 * h);
-    }
+/// The engine's options for a branch in the unit window: BoundaryOptions' steps, at most
+/// max_points points each way from the seed, no angle test, the window as the box.
+ContinuationOptions engine_options(const BoundaryOptions& o, int unknowns) {
+    ContinuationOptions c;
+    c.initial_step = o.initial_step;
+    c.max_step = o.max_step;
+    c.min_step = o.min_step;
+    c.max_points = o.max_points + 1;
+    c.max_angle = std::acos(0.0);
+    c.lower = Eigen::VectorXd::Constant(unknowns, -std::numeric_limits<double>::infinity());
+    c.upper = Eigen::VectorXd::Constant(unknowns, std::numeric_limits<double>::infinity());
+    c.lower.head(2).setZero();
+    c.upper.head(2).setOnes();
+    return c;
 }
 
 double segment_distance(double px, double py, const BoundaryPoint& a, const BoundaryPoint& b, const Problem& p) {
@@ -276,7 +196,7 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
     const double cell = 1.0 / std::min(nx - 1, ny - 1);
     std::vector<int> traced_mode;  // the seed's mode of every curve (before relabelling)
     for (const Seed& sd : seeds) {
-        const Problem p(spec, sd.kind, sd.mode);
+        Problem p(spec, sd.kind, sd.mode);
         // already on a traced curve of the same kind and mode?
         bool known = false;
         for (std::size_t ci = 0; ci < set.curves.size(); ++ci) {
@@ -289,32 +209,35 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
         }
         if (known) continue;
         Eigen::VectorXd u = sd.u;
-        Eigen::VectorXd e = Eigen::VectorXd::Zero(p.unknowns());
-        e(sd.fixed) = 1.0;
-        double res = 0.0;
-        if (p.correct(u, e, u(sd.fixed), res) < 0 || !inside(u) || (u.head(2) - sd.u.head(2)).norm() > 2.0 * cell ||
+        const CorrectorResult seed = correct(p, u, Eigen::VectorXd::Unit(p.unknowns(), sd.fixed), u(sd.fixed));
+        if (!converged(seed.status) || !inside(u) || (u.head(2) - sd.u.head(2)).norm() > 2.0 * cell ||
             (u.size() == 3 && sd.kind != BoundaryKind::RingHopf && u(2) <= 0.0)) {
             ++set.rejected;
             continue;
         }
         Eigen::VectorXd t;
-        if (!p.tangent(u, t)) {
+        if (!tangent(p, u, Eigen::VectorXd(), t)) {
             ++set.rejected;
             continue;
         }
-        std::vector<Eigen::VectorXd> fwd, bwd;
-        bool closed = false;
-        double max_res = res;
-        trace_direction(p, u, t, options, fwd, closed, max_res);
-        if (!closed) trace_direction(p, u, -t, options, bwd, closed, max_res);
+        p.keep_omega_sign(u);
+        const ContinuationOptions eo = engine_options(options, p.unknowns());
+        const ContinuationResult fwd = continue_branch(p, u, t, eo);
+        if (fwd.points.empty()) {  // no tangent at the seed after all
+            ++set.rejected;
+            continue;
+        }
+        ContinuationResult bwd;
+        if (fwd.stop != ContinuationStop::ClosedLoop) bwd = continue_branch(p, u, -t, eo);
         BoundaryCurve curve;
         curve.kind = sd.kind;
         curve.mode = sd.mode;
-        curve.closed = closed;
-        curve.max_residual = max_res;
-        std::vector<Eigen::VectorXd> all(bwd.rbegin(), bwd.rend());
-        all.push_back(u);
-        all.insert(all.end(), fwd.begin(), fwd.end());
+        curve.closed = fwd.stop == ContinuationStop::ClosedLoop || bwd.stop == ContinuationStop::ClosedLoop;
+        curve.max_residual = std::max(fwd.max_residual, bwd.max_residual);
+        // the backward branch reversed, the seed, the forward branch
+        std::vector<Eigen::VectorXd> all;
+        if (!bwd.points.empty()) all.assign(bwd.points.rbegin(), bwd.points.rend() - 1);
+        all.insert(all.end(), fwd.points.begin(), fwd.points.end());
         for (const auto& v : all) {
             BoundaryPoint bp{p.x(v(0)), p.y(v(1)), v.size() == 3 ? v(2) : 0.0};
             if (!curve.points.empty()) {

@@ -10,7 +10,8 @@
 /// Parameters are scaled to the unit window; the Jacobian is taken by central differences, so
 /// any model works, linear in its parameters or not. Branches are seeded where the sweep's
 /// verdicts change between neighbouring grid points, corrected by Newton, traced both ways
-/// with step control through turning points, and clipped exactly at the window edges.
+/// with step control through turning points, and clipped exactly at the window edges (by the
+/// continuation engine of ddemap/solve/continuation.hpp, the window being its box).
 
 #include <string>
 #include <vector>
