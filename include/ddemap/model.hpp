@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/parameters.hpp"
 #include "ddemap/expoly.hpp"
 
 namespace ddemap {
@@ -49,8 +50,6 @@ struct ParameterSpec {
     double lower = 0.0;          ///< smallest valid value
     bool lower_open = false;     ///< lower bound excluded (value must be > lower)
 };
-
-using ParameterMap = std::map<std::string, double>;
 
 /// The car-following law. Implementations validate their parameters on construction and
 /// throw std::invalid_argument with a one-line message naming the value and what was expected.
