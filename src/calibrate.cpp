@@ -107,7 +107,9 @@ void CalibrationOptions::validate() const {
 
 void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double step, std::vector<double>& speed,
                        std::vector<double>& gap) {
-    const double k1 = p.at("k1"), k2 = p.at("k2"), th = p.at("th"), tau = p.at("tau"), eta = p.at("eta");
+    // OVRV's law parameters in its order (k1, k2, th, tau, eta)
+    const double law[5] = {p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta")};
+    const double tau = law[3];
     const double t0 = t_a + tau;
     auto history = [&](double t, double* y) {
         y[0] = interp(tr.t, tr.gap, t);
@@ -118,7 +120,8 @@ void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, doubl
         dy[0] = vl - y[1];
         const double sd = tau > 0.0 ? sol.value(0, t - tau) : y[0];
         const double vd = tau > 0.0 ? interp(tr.t, tr.lead, t - tau) : vl;
-        double a = k1 * (sd - eta - th * y[1]) + k2 * (vd - y[1]);
+        const double in[3] = {sd, y[1], vd};
+        double a = OvrvModel::law(in, law);
         if (y[1] <= 0.0 && a < 0.0) a = 0.0;  // standing cars do not roll backwards
         dy[1] = a;
     };
