@@ -40,7 +40,7 @@ void name_parameters(std::vector<std::unique_ptr<CarModel>>& types, std::vector<
 
 }  // namespace
 
-RingSystem::RingSystem(const Fleet& fleet)
+RingSystem::RingSystem(const Fleet& fleet, double speed)
     : RingSystem([&] {
           if (fleet.size() < 2) throw std::invalid_argument("a ring needs at least 2 cars, got " + std::to_string(fleet.size()));
           Init init;
@@ -53,7 +53,7 @@ RingSystem::RingSystem(const Fleet& fleet)
               auto it = index.find(key);
               if (it == index.end()) {
                   ParameterMap p = car.parameters;
-                  p["speed"] = 0.0;  // the law does not use it
+                  p["speed"] = speed;  // the law does not use it
                   try {
                       init.types.push_back(make_model(car.model, p));
                   } catch (const std::invalid_argument& e) {

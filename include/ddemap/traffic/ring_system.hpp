@@ -32,7 +32,9 @@ public:
     /// A mixed ring (N = fleet.size() >= 2). Parameters: with one type its law parameters by name
     /// (k1, k2, ...); with several, NAME[j] for type j = 1, 2, ... (types numbered in order of
     /// first appearance, see type_of()). Invalid cars throw std::invalid_argument naming the car.
-    explicit RingSystem(const Fleet& fleet);
+    /// The models are built (and validated) at the operating speed `speed`: the law does not
+    /// depend on it, but a model's admissible parameters may (IDM: speed < v0, eta + th speed > 0).
+    explicit RingSystem(const Fleet& fleet, double speed = 0.0);
     /// N identical cars of one model (its law parameters; the operating speed is not used).
     RingSystem(const CarModel& model, int cars);
 
