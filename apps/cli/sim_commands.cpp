@@ -174,9 +174,8 @@ struct SimCommands::Impl {
                 const std::string name = item.substr(0, eq);
                 const auto it = std::find_if(std::begin(names), std::end(names), [&](const char* n) { return name == n; });
                 if (it == std::end(names)) throw BadInput("--bounds item '" + item + "': expected one of k1, k2, th, tau, eta");
-                const int i = static_cast<int>(it - std::begin(names));
-                o.lower[i] = parse_number("--bounds " + name, item.substr(eq + 1, colon - eq - 1));
-                o.upper[i] = parse_number("--bounds " + name, item.substr(colon + 1));
+                o.set_bounds(name, parse_number("--bounds " + name, item.substr(eq + 1, colon - eq - 1)),
+                             parse_number("--bounds " + name, item.substr(colon + 1)));
             }
         }
         o.validate();
@@ -212,8 +211,8 @@ struct SimCommands::Impl {
         j["command"] = "calibrate";
         j["version"] = DDEMAP_VERSION;
         j["gap_weight"] = o.gap_weight;
-        j["bounds"] = {{"k1", {o.lower[0], o.upper[0]}}, {"k2", {o.lower[1], o.upper[1]}}, {"th", {o.lower[2], o.upper[2]}},
-                       {"tau", {o.lower[3], o.upper[3]}}, {"eta", {o.lower[4], o.upper[4]}}};
+        j["bounds"] = json::object();
+        for (const auto& name : calibration_parameter_names()) j["bounds"][name] = {o.bound(name).lower, o.bound(name).upper};
         if (!c_out.empty()) {
             std::vector<PlotPanel> panels;
             for (std::size_t i = 0; i < fits.size(); ++i) {

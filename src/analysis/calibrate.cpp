@@ -66,14 +66,40 @@ Trace read_trace_csv(const std::string& text, const std::string& source) {
     return tr;
 }
 
-void CalibrationOptions::validate() const {
-    for (int i = 0; i < 5; ++i) {
-        if (!(std::isfinite(lower[i]) && std::isfinite(upper[i]) && lower[i] <= upper[i] && lower[i] >= 0.0)) {
-            throw std::invalid_argument(std::string("bounds for ") + names[i] + " = " + detail::format_number(lower[i]) + ":" + detail::format_number(upper[i]) +
-                                        ": expected finite 0 <= LO <= HI");
-        }
+const std::vector<std::string>& calibration_parameter_names() {
+    static const std::vector<std::string> n = {"k1", "k2", "th", "tau", "eta"};
+    return n;
+}
+
+ParameterBounds paper_calibration_bounds() {
+    return {{"k1", 0.0, 1.0}, {"k2", 0.0, 1.0}, {"th", 0.0, 3.0}, {"tau", 0.0, 1.0}, {"eta", 5.0, 15.0}};
+}
+
+BoundedParameter CalibrationOptions::bound(const std::string& name) const {
+    const ParameterBounds paper = paper_calibration_bounds();
+    const BoundedParameter* fallback = find_bound(paper, name);
+    if (!fallback) throw std::invalid_argument("bounds for '" + name + "': unknown parameter, expected one of k1, k2, th, tau, eta");
+    const BoundedParameter* b = find_bound(bounds, name);
+    return b ? *b : *fallback;
+}
+
+void CalibrationOptions::set_bounds(const std::string& name, double lower, double upper) {
+    if (BoundedParameter* b = find_bound(bounds, name)) {
+        b->lower = lower;
+        b->upper = upper;
+    } else {
+        bounds.push_back({name, lower, upper});
     }
-    if (upper[3] > 5.0) throw std::invalid_argument("upper bound for tau = " + detail::format_number(upper[3]) + ": expected at most 5 s");
+}
+
+void CalibrationOptions::validate() const {
+    validate_bounds(bounds, calibration_parameter_names());
+    for (const auto& b : bounds)
+        if (b.lower < 0.0)
+            throw std::invalid_argument("bounds for '" + b.name + "' = " + detail::format_number(b.lower) + ":" + detail::format_number(b.upper) +
+                                        ": expected lower >= 0");
+    const double tau_max = bound("tau").upper;
+    if (tau_max > 5.0) throw std::invalid_argument("bounds for 'tau': upper = " + detail::format_number(tau_max) + ": expected at most 5 s");
     if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected >= 0");
     if (global_evaluations < 0 || local_evaluations < 1) throw std::invalid_argument("evaluation budgets: expected global >= 0, local >= 1");
     if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 0.5 s");
@@ -81,7 +107,9 @@ void CalibrationOptions::validate() const {
 
 void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double step, std::vector<double>& speed,
                        std::vector<double>& gap) {
-    const double k1 = p.at("k1"), k2 = p.at("k2"), th = p.at("th"), tau = p.at("tau"), eta = p.at("eta");
+    // OVRV's law parameters in its order (k1, k2, th, tau, eta)
+    const double law[5] = {p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta")};
+    const double tau = law[3];
     const double t0 = t_a + tau;
     auto history = [&](double t, double* y) {
         y[0] = interp(tr.t, tr.gap, t);
@@ -92,7 +120,8 @@ void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, doubl
         dy[0] = vl - y[1];
         const double sd = tau > 0.0 ? sol.value(0, t - tau) : y[0];
         const double vd = tau > 0.0 ? interp(tr.t, tr.lead, t - tau) : vl;
-        double a = k1 * (sd - eta - th * y[1]) + k2 * (vd - y[1]);
+        const double in[3] = {sd, y[1], vd};
+        double a = OvrvModel::law(in, law);
         if (y[1] <= 0.0 && a < 0.0) a = 0.0;  // standing cars do not roll backwards
         dy[1] = a;
     };
@@ -159,11 +188,17 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
                                     detail::format_number(first) + ":" + detail::format_number(last) + " s");
     }
     // every candidate is scored on the same samples: those after the longest admissible delay
-    const double t_from = a + o.upper[3];
+    std::vector<double> lo(5), hi(5), x(5);
+    for (int i = 0; i < 5; ++i) {
+        const BoundedParameter b = o.bound(names[i]);
+        lo[i] = b.lower;
+        hi[i] = b.upper;
+    }
+    const double t_from = a + hi[3];
     CalibrationResult res;
     auto objective = [&](const std::vector<double>& x, std::vector<double>&, void*) -> double {
         ParameterMap p;
-        for (int i = 0; i < 5; ++i) p[names[i]] = std::clamp(x[i], o.lower[i], o.upper[i]);
+        for (int i = 0; i < 5; ++i) p[names[i]] = std::clamp(x[i], lo[i], hi[i]);
         const FitErrors e = errors_over(tr, p, a, b, t_from, o.step);
         ++res.evaluations;
         const double f = e.rmse_speed * e.rmse_speed + o.gap_weight * e.rmse_gap * e.rmse_gap;
@@ -175,7 +210,6 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     auto thunk = [](const std::vector<double>& x, std::vector<double>& g, void* data) {
         return (*static_cast<Fn*>(data)->f)(x, g, nullptr);
     };
-    std::vector<double> lo(o.lower, o.lower + 5), hi(o.upper, o.upper + 5), x(5);
     for (int i = 0; i < 5; ++i) x[i] = 0.5 * (lo[i] + hi[i]);
     double fx = 0.0;
     // bounds with zero width are fixed parameters

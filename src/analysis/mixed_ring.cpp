@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ddemap/traffic/ring_determinant.hpp"
+#include "ddemap/traffic/ring_system.hpp"
 
 namespace ddemap {
 
@@ -19,7 +20,9 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     MixedRingResult out;
     out.equilibrium = std::isnan(options.length) ? ring_equilibrium_at_speed(fleet, options.speed)
                                                  : ring_equilibrium_at_length(fleet, options.length);
-    const std::vector<Linearisation> lins = linearise_fleet(fleet, out.equilibrium.speed);
+    // the linearisation of the nonlinear ring at its equilibrium, car by car (sparse: O(N))
+    const RingSystem ring(fleet, out.equilibrium.speed);
+    const std::vector<Linearisation> lins = ring.car_linearisations(ring.equilibrium(out.equilibrium.speed));
     SparseRootOptions ro = options.roots;
     ro.count = options.roots.count + 1;  // room for the trivial root
     const bool one_leader = std::all_of(lins.begin(), lins.end(), [](const Linearisation& l) { return l.leaders() == 1; });

@@ -157,7 +157,8 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
                 gap_d = sol.value(2 * i, td);
                 lead_d = i == 0 ? lead.speed(td) : sol.value(2 * i - 1, td);
             }
-            dy[2 * i + 1] = cars[i].model->acceleration(gap_d, y[2 * i + 1], lead_d);
+            const double in[3] = {gap_d, y[2 * i + 1], lead_d};  // one leader (checked above)
+            dy[2 * i + 1] = cars[i].model->acceleration(in);
         }
     };
     detail::DdeSolver solver(2 * n, 0.0, history, rhs);

@@ -95,6 +95,50 @@ ParameterMap resolve(const std::string& model, const std::vector<ParameterSpec>&
 
 }  // namespace
 
+// ---------------------------------------------------------------- the law
+
+double CarModel::acceleration(double gap, double speed, const std::vector<double>& leader_speeds) const {
+    if (static_cast<int>(leader_speeds.size()) != leaders())
+        throw std::invalid_argument("model " + name() + " uses the speeds of " + std::to_string(leaders()) + " cars ahead; " +
+                                    std::to_string(leader_speeds.size()) + " given");
+    std::vector<double> in{gap, speed};
+    in.insert(in.end(), leader_speeds.begin(), leader_speeds.end());
+    return evaluate(in.data(), m_law.data());
+}
+
+Linearisation CarModel::linearise_at(double gap, double speed, const std::vector<double>& leader_speeds) const {
+    if (static_cast<int>(leader_speeds.size()) != leaders())
+        throw std::invalid_argument("model " + name() + " uses the speeds of " + std::to_string(leaders()) + " cars ahead; " +
+                                    std::to_string(leader_speeds.size()) + " given");
+    const int k = inputs();
+    std::vector<Dual<double>> in(k), p(m_law.begin(), m_law.end());
+    in[0] = gap;
+    in[1] = speed;
+    for (int j = 0; j < leaders(); ++j) in[2 + j] = leader_speeds[j];
+    std::vector<double> partial(k);
+    for (int i = 0; i < k; ++i) {
+        in[i].deriv = 1.0;
+        partial[i] = evaluate(in.data(), p.data()).deriv;
+        in[i].deriv = 0.0;
+    }
+    const std::vector<double> d = input_delays();
+    Linearisation l;
+    l.gap.add(partial[0], d[0]);
+    l.own.add(partial[1], d[1]);
+    l.lead.add(partial[2], d[2]);
+    for (int j = 1; j < leaders(); ++j) {
+        ExpPoly e;
+        e.add(partial[2 + j], d[2 + j]);
+        l.further.push_back(e);
+    }
+    return l;
+}
+
+Linearisation CarModel::linearise() const {
+    const double v = operating_speed();
+    return linearise_at(equilibrium_gap(v), v, std::vector<double>(leaders(), v));
+}
+
 // ---------------------------------------------------------------- OVRV
 
 OvrvModel::OvrvModel(const ParameterMap& values) {
@@ -105,6 +149,7 @@ OvrvModel::OvrvModel(const ParameterMap& values) {
     m_tau = p.at("tau");
     m_eta = p.at("eta");
     m_speed = p.at("speed");
+    m_law = {m_k1, m_k2, m_th, m_tau, m_eta};
 }
 
 std::string OvrvModel::law() const {
@@ -113,18 +158,6 @@ std::string OvrvModel::law() const {
 
 ParameterMap OvrvModel::parameters() const {
     return {{"k1", m_k1}, {"k2", m_k2}, {"th", m_th}, {"tau", m_tau}, {"eta", m_eta}, {"speed", m_speed}};
-}
-
-double OvrvModel::acceleration(double gap, double speed, double lead_speed) const {
-    return m_k1 * (gap - m_eta - m_th * speed) + m_k2 * (lead_speed - speed);
-}
-
-Linearisation OvrvModel::linearise() const {
-    Linearisation l;
-    l.gap.add(m_k1, m_tau);
-    l.own.add(-(m_k1 * m_th + m_k2), 0.0);
-    l.lead.add(m_k2, m_tau);
-    return l;
 }
 
 // ---------------------------------------------------------------- CCC
@@ -139,6 +172,7 @@ CccModel::CccModel(const ParameterMap& values) {
     m_tau2 = p.at("tau2");
     m_eta = p.at("eta");
     m_speed = p.at("speed");
+    m_law = {m_k1, m_k2, m_k3, m_th, m_tau, m_tau2, m_eta};
 }
 
 std::string CccModel::law() const {
@@ -147,21 +181,6 @@ std::string CccModel::law() const {
 
 ParameterMap CccModel::parameters() const {
     return {{"k1", m_k1}, {"k2", m_k2}, {"k3", m_k3}, {"th", m_th}, {"tau", m_tau}, {"tau2", m_tau2}, {"eta", m_eta}, {"speed", m_speed}};
-}
-
-double CccModel::acceleration(double gap, double speed, double lead_speed) const {
-    return m_k1 * (gap - m_eta - m_th * speed) + (m_k2 + m_k3) * (lead_speed - speed);
-}
-
-Linearisation CccModel::linearise() const {
-    Linearisation l;
-    l.gap.add(m_k1, m_tau);
-    l.own.add(-(m_k1 * m_th + m_k2 + m_k3), 0.0);
-    l.lead.add(m_k2, m_tau);
-    ExpPoly two;
-    two.add(m_k3, m_tau2);
-    l.further.push_back(two);
-    return l;
 }
 
 // ---------------------------------------------------------------- IDM
@@ -182,6 +201,7 @@ IdmModel::IdmModel(const ParameterMap& values) {
     if (m_eta + m_th * m_speed <= 0.0) {
         throw std::invalid_argument("eta + th * speed = 0: the IDM equilibrium gap vanishes; expected eta > 0 or th * speed > 0");
     }
+    m_law = {m_a, m_b, m_v0, m_delta, m_th, m_eta, m_tau};
 }
 
 std::string IdmModel::law() const {
@@ -193,30 +213,8 @@ ParameterMap IdmModel::parameters() const {
             {"eta", m_eta}, {"tau", m_tau}, {"speed", m_speed}};
 }
 
-double IdmModel::acceleration(double gap, double speed, double lead_speed) const {
-    const double s_star = m_eta + m_th * speed + speed * (speed - lead_speed) / (2.0 * std::sqrt(m_a * m_b));
-    const double r = s_star / gap;
-    return m_a * (1.0 - std::pow(speed / m_v0, m_delta) - r * r);
-}
-
 double IdmModel::equilibrium_gap(double speed) const {
     return (m_eta + m_th * speed) / std::sqrt(1.0 - std::pow(speed / m_v0, m_delta));
-}
-
-Linearisation IdmModel::linearise() const {
-    const double v = m_speed;
-    const double s = equilibrium_gap(v);
-    const double sd = m_eta + m_th * v;  // desired gap S at equilibrium
-    const double sab = 2.0 * std::sqrt(m_a * m_b);
-    const double f_s = 2.0 * m_a * sd * sd / (s * s * s);
-    const double dpow = v > 0.0 ? m_delta * std::pow(v, m_delta - 1.0) / std::pow(m_v0, m_delta) : 0.0;
-    const double f_v = -m_a * (dpow + 2.0 * sd / (s * s) * (m_th + v / sab));
-    const double f_l = m_a * 2.0 * sd / (s * s) * (v / sab);
-    Linearisation l;
-    l.gap.add(f_s, m_tau);
-    l.own.add(f_v, 0.0);
-    l.lead.add(f_l, m_tau);
-    return l;
 }
 
 // ---------------------------------------------------------------- registry

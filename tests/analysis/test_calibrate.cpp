@@ -84,8 +84,62 @@ TEST_CASE("bad traces are rejected with the line and column") {
     CHECK_THROWS_WITH_AS(read_trace_csv("time_s,lead_speed_mps,follower_speed_mps,gap_m\n0,1,1,1\n0.1,1,1,1\n", "d.csv"),
                          "d.csv: 2 rows over 0.1 s: expected at least 100 rows and 20 s", std::invalid_argument);
     CalibrationOptions o;
-    o.lower[4] = 20;
+    o.set_bounds("eta", 20, 15);
     CHECK_THROWS_AS(o.validate(), std::invalid_argument);
+}
+
+TEST_CASE("calibration bounds are named: defaults are the paper's, errors name the parameter") {
+    CalibrationOptions o;
+    CHECK_NOTHROW(o.validate());
+    const double expect[5][2] = {{0, 1}, {0, 1}, {0, 3}, {0, 1}, {5, 15}};
+    for (int i = 0; i < 5; ++i) {
+        const BoundedParameter b = o.bound(calibration_parameter_names()[i]);
+        CHECK(b.lower == expect[i][0]);
+        CHECK(b.upper == expect[i][1]);
+    }
+    o.set_bounds("eta", 0, 15);
+    CHECK(o.bound("eta").lower == 0.0);
+    CHECK(o.bounds.size() == 5);  // replaced, not added
+    CHECK_NOTHROW(o.validate());
+    {
+        CalibrationOptions u;
+        u.set_bounds("k4", 0, 1);
+        CHECK_THROWS_WITH_AS(u.validate(), "bounds for 'k4': unknown parameter, expected one of k1, k2, th, tau, eta", std::invalid_argument);
+        CHECK_THROWS_WITH_AS(u.bound("k4"), doctest::Contains("'k4'"), std::invalid_argument);
+    }
+    {
+        CalibrationOptions u;
+        u.set_bounds("th", 2, 1);
+        CHECK_THROWS_WITH_AS(u.validate(), "bounds for 'th' = 2:1: expected lower <= upper", std::invalid_argument);
+    }
+    {
+        CalibrationOptions u;
+        u.set_bounds("k2", 0, INFINITY);
+        CHECK_THROWS_WITH_AS(u.validate(), "bounds for 'k2' = 0:inf: expected finite bounds", std::invalid_argument);
+        u.set_bounds("k2", NAN, 1);
+        CHECK_THROWS_WITH_AS(u.validate(), doctest::Contains("bounds for 'k2'"), std::invalid_argument);
+    }
+    {
+        CalibrationOptions u;
+        u.set_bounds("k1", -1, 1);
+        CHECK_THROWS_WITH_AS(u.validate(), "bounds for 'k1' = -1:1: expected lower >= 0", std::invalid_argument);
+        u.set_bounds("k1", 0, 1);
+        u.set_bounds("tau", 0, 6);
+        CHECK_THROWS_WITH_AS(u.validate(), "bounds for 'tau': upper = 6: expected at most 5 s", std::invalid_argument);
+    }
+    {
+        CalibrationOptions u;
+        u.bounds.push_back({"k1", 0.1, 0.2});
+        CHECK_THROWS_WITH_AS(u.validate(), "bounds for 'k1' are given twice", std::invalid_argument);
+    }
+    {
+        // listing only some parameters keeps the paper's bounds for the rest
+        CalibrationOptions u;
+        u.bounds = {{"tau", 0.2, 0.2}};
+        CHECK_NOTHROW(u.validate());
+        CHECK(u.bound("eta").lower == 5.0);
+        CHECK(u.bound("tau").upper == 0.2);
+    }
 }
 
 TEST_CASE("real OpenACC traces: every fit finishes, the model beats the naive predictor, th(L) > th(S)" * doctest::test_suite("reference")) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/parameters.hpp"
 #include "ddemap/traffic/model.hpp"
 
 namespace ddemap {
@@ -23,10 +24,22 @@ struct Trace {
 /// or repeated times, fewer than 100 rows or less than 20 s).
 Trace read_trace_csv(const std::string& text, const std::string& source);
 
+/// The calibrated parameters, in order: k1, k2, th, tau, eta.
+const std::vector<std::string>& calibration_parameter_names();
+/// The paper's bounds: k1, k2 in [0, 1], th in [0, 3], tau in [0, 1], eta in [5, 15].
+ParameterBounds paper_calibration_bounds();
+
 struct CalibrationOptions {
-    /// bounds for k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]: the paper's by default
-    double lower[5] = {0.0, 0.0, 0.0, 0.0, 5.0};
-    double upper[5] = {1.0, 1.0, 3.0, 1.0, 15.0};
+    /// Bounds by name for k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]: the paper's by default
+    /// (paper_calibration_bounds()). A parameter not listed keeps the paper's bounds; lower = upper
+    /// fixes it. validate() rejects unknown names, repeats, non-finite bounds, lower > upper,
+    /// lower < 0 and tau above 5 s, naming the parameter.
+    ParameterBounds bounds = paper_calibration_bounds();
+    /// The bounds in force for `name` (listed, else the paper's; std::invalid_argument for a name
+    /// that is not an OVRV calibration parameter).
+    BoundedParameter bound(const std::string& name) const;
+    /// Sets the bounds of one parameter (replacing a listed entry or adding one); checked by validate().
+    void set_bounds(const std::string& name, double lower, double upper);
     double train_start = -1.0, train_end = -1.0;  ///< training window [s]; negative: whole file
     /// objective = MSE(speed) + gap_weight * MSE(gap) [1/s^2]. 0 is the paper's speed-only
     /// objective; the default 0.02 lets the measured gap pin th and eta (see README).

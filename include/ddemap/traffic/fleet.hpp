@@ -61,7 +61,10 @@ RingEquilibrium ring_equilibrium_at_speed(const Fleet& fleet, double speed);
 /// (s_i* increases with v). Errors when L is below the standstill gaps or beyond every speed.
 RingEquilibrium ring_equilibrium_at_length(const Fleet& fleet, double length);
 
-/// The 2N-dimensional linearised ring (see the file comment); N >= 2.
+/// The 2N-dimensional linearised ring (see the file comment) assembled sparse from the cars'
+/// linearisations; N >= 2. With the cars' partials at the equilibrium it is the linearisation of
+/// the nonlinear ring (traffic/ring_system.hpp: RingSystem::sparse_linearise, equal to
+/// linearise(RingSystem, equilibrium) entrywise); analyse_mixed_ring takes them from there.
 SparseDDE mixed_ring_dde(const std::vector<Linearisation>& cars);
 
 /// |prod_i Gamma_i(lambda) - 1| for laws of the car ahead only (sums of logarithms, so no

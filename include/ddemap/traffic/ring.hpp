@@ -26,7 +26,9 @@ cplx ring_zeta(int m, int cars);
 LinearDDE ring_mode_dde(const Linearisation& lin, cplx zeta);
 /// Mode 0 with the trivial factor lambda removed: v' = (own + lead) * v.
 LinearDDE ring_mode0_dde(const Linearisation& lin);
-/// The whole 2N-dimensional ring, state (s_1, v_1, ..., s_N, v_N), assembled directly.
+/// The whole 2N-dimensional ring, state (s_1, v_1, ..., s_N, v_N), assembled directly from one
+/// car's Linearisation; for the car's law at its equilibrium it equals
+/// linearise(RingSystem(model, N), equilibrium) entrywise (traffic/ring_system.hpp, tests).
 LinearDDE full_ring_dde(const Linearisation& lin, int cars);
 
 
