@@ -65,8 +65,8 @@ const std::vector<ParameterSpec>& idm_specs() {
 
 /// Fills every parameter from `values` or its default, validating finiteness and the bound.
 ParameterMap resolve(const std::string& model, const std::vector<ParameterSpec>& specs, const ParameterMap& values) {
-    for (const auto& [name, value] : values) {
-        (void)value;
+    for (const auto& entry : values) {
+        const std::string& name = entry.first;
         if (std::none_of(specs.begin(), specs.end(), [&](const ParameterSpec& s) { return s.name == name; })) {
             std::string known;
             for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
