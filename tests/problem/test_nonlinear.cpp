@@ -110,7 +110,7 @@ TEST_CASE("Mackey-Glass: linearisation at the positive equilibrium is the analyt
     CHECK(mg.parameters().at("tau") == 0.5);
 }
 
-TEST_CASE("tanh feedback: A_0 = -1, A_1 = a at 0; roots are those of the scalar DDE") {
+TEST_CASE("tanh feedback: A_0 = -1, A_1 = a at 0, and the roots are those of the scalar DDE") {
     // x' = -x + a x(t - tau) with a = -2: Hopf at w = sqrt(a^2 - 1), tau = arccos(1/a) / w
     const double a = -2.0, w = std::sqrt(a * a - 1.0), tau_h = std::acos(1.0 / a) / w;
     TanhFeedback sys(a, tau_h / a);
