@@ -23,6 +23,12 @@ constexpr double order_matters = 1e-4;
 /// |prod Gamma_i(lambda) - 1| at a refined root of a ring of N <= 60 cars: the sum of N
 /// logarithms loses about N eps |d log Gamma / d lambda| ~ 1e-13.
 constexpr double product_residual = 1e-10;
+/// A sweep point's spectral abscissa against the per-point computation (README claim: exact to
+/// 1e-8; both certify the same rightmost root, which agrees to ~1e-14 in practice).
+constexpr double sweep_vs_point = 1e-8;
+/// Continued ring Hopf curves against the closed-form D-subdivision curves (README claim: 1e-8;
+/// points are corrected by Newton to 1e-13 relative in the unit window).
+constexpr double boundary_closed_form = 1e-8;
 /// Coefficients computed two ways in double precision (series vs closed form).
 constexpr double coefficient_rel = 1e-13;
 /// Linearisation against central finite differences with step 1e-5 (error O(h^2) ~ 1e-10).

@@ -1,12 +1,16 @@
 // Boundary continuation against the closed-form D-subdivision curves of OVRV (MATH.md sec. 4).
 #include <doctest/doctest.h>
 
+#include "tolerances.hpp"
+
 #include <cmath>
 
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "chart_helpers.hpp"
+
+namespace tol = ddemap::test::tol;
 
 TEST_SUITE_BEGIN("fast");
 
@@ -42,8 +46,8 @@ TEST_CASE("ring Hopf curves equal the closed-form D-subdivision curves to 1e-8")
                 closed_form(p.omega, zeta, th, tau, k1, k2);
                 CAPTURE(c.mode);
                 CAPTURE(p.omega);
-                CHECK(std::abs(k1 - p.x) < 1e-8);
-                CHECK(std::abs(k2 - p.y) < 1e-8);
+                CHECK(std::abs(k1 - p.x) < tol::boundary_closed_form);
+                CHECK(std::abs(k2 - p.y) < tol::boundary_closed_form);
                 ++ring_points;
             }
         }

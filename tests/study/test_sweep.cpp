@@ -1,6 +1,8 @@
 // Sweeps against the plain per-point computation (collocation for every mode, no continuation).
 #include <doctest/doctest.h>
 
+#include "tolerances.hpp"
+
 #include <cmath>
 #include <random>
 
@@ -8,6 +10,8 @@
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "chart_helpers.hpp"
+
+namespace tol = ddemap::test::tol;
 
 TEST_SUITE_BEGIN("fast");
 
@@ -47,13 +51,13 @@ TEST_CASE("sweep points equal the per-point computation (random points, boundari
         const StringResult s = analyse_string(lin);
         CAPTURE(p.x);
         CAPTURE(p.y);
-        CHECK(std::abs(p.spectral_abscissa - ring.spectral_abscissa) < 1e-8);
+        CHECK(std::abs(p.spectral_abscissa - ring.spectral_abscissa) < tol::sweep_vs_point);
         CHECK(p.unstable_roots == ring.unstable_roots);
         CHECK(p.ring_stable == ring.stable);
         CHECK(p.plant_stable == s.plant_stable);
         CHECK(p.string_stable == s.string_stable);
         CHECK(std::abs(p.sup_gamma - s.sup_gamma) < 1e-10 * s.sup_gamma);
-        CHECK(std::abs(p.plant_abscissa - s.plant_abscissa) < 1e-8);
+        CHECK(std::abs(p.plant_abscissa - s.plant_abscissa) < tol::sweep_vs_point);
     }
 }
 
