@@ -31,30 +31,12 @@ LeadProfile lead_from(const std::string& profile, const std::string& file, std::
     return LeadProfile::builtin(name);
 }
 
-const CalibratedVehicle& builtin_vehicle(const std::string& name) {
-    for (const auto& v : paper_calibration_table())
-        if (v.name == name) return v;
-    throw BadInput("vehicle '" + name + "': expected a name of the calibration table (A_min .. G_max) or a fleet CSV file");
-}
-
-/// --fleet "A_min*3,C_max" (built-in names, *K repeats) or a CSV file (name,k1,k2,th,tau[,eta][,min_speed])
+/// --fleet "A_min*3,C_max" (built-in names, *K repeats) or a CSV file (name,k1,k2,th,tau[,eta][,min_acc_speed])
 std::vector<SimCar> fleet_from(const std::string& text) {
-    std::vector<SimCar> cars;
-    if (text.size() > 4 && text.substr(text.size() - 4) == ".csv") {
-        const std::string body = read_input_file("--fleet", text);
-        const auto vehicles = read_vehicles_csv(body, text);
-        for (const auto& v : vehicles) {
-            std::shared_ptr<const CarModel> m = make_model("ovrv", v.parameters);
-            cars.push_back({m, 0.0, v.name});
-        }
-        return cars;
-    }
-    for (const FleetCar& car : fleet_from_pattern(text, 0))
-        for (auto& c : platoon_of(builtin_vehicle(car.label), 1)) cars.push_back(c);
-    if (cars.empty()) throw BadInput("--fleet = '" + text + "': expected vehicle names such as A_min*7");
-    return cars;
+    if (text.size() > 4 && text.substr(text.size() - 4) == ".csv")
+        return platoon_from(read_vehicles_csv(read_input_file("--fleet", text), text));
+    return platoon_from(vehicles_from_pattern(text));
 }
-
 }  // namespace
 
 std::string growth_table(const std::vector<GrowthResult>& g) {
@@ -182,11 +164,7 @@ struct SimCommands::Impl {
         o.validate();
         std::vector<Trace> traces;
         for (const auto& f : c_files) traces.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
-        std::vector<CalibrationResult> fits(traces.size());
-#ifdef DDEMAP_WITH_OPENMP
-#pragma omp parallel for schedule(dynamic, 1)
-#endif
-        for (std::size_t i = 0; i < traces.size(); ++i) fits[i] = ddemap::calibrate(traces[i], o);
+        const std::vector<CalibrationResult> fits = calibrate_many(traces, o);
 
         std::ostringstream csv;
         csv << "name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,"

@@ -1,5 +1,7 @@
 #include "ddemap/analysis/calibrate.hpp"
 
+#include <exception>
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -244,6 +246,26 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     res.naive.rmse_speed = best;
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return res;
+}
+
+std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options) {
+    options.validate();
+    std::vector<CalibrationResult> fits(traces.size());
+    std::vector<std::exception_ptr> errors(traces.size());
+    const long n = static_cast<long>(traces.size());
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+    for (long i = 0; i < n; ++i) {
+        try {
+            fits[i] = calibrate(traces[i], options);
+        } catch (...) {
+            errors[i] = std::current_exception();
+        }
+    }
+    for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
+    return fits;
 }
 
 }  // namespace ddemap

@@ -57,6 +57,11 @@ struct CalibrationResult {
 
 CalibrationResult calibrate(const Trace& trace, const CalibrationOptions& options = {});
 
+/// calibrate() for every trace, in parallel over the traces (OpenMP when built with it); the
+/// results are in the traces' order. The first error (by trace index) is rethrown after all
+/// traces ran.
+std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options = {});
+
 /// Simulates the follower over [t_a, t_b] of the trace (history from the data on
 /// [t_a, t_a + tau]); speed and gap at the trace's sample times in the window (data values
 /// before t_a + tau). A car at standstill does not roll backwards (v' = 0 when v <= 0 and
