@@ -346,17 +346,17 @@ void write_file_atomic(const std::string& path, const std::string& text) {
     const std::string tmp = path + ".tmp";
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw std::runtime_error("cannot write " + path + ": the folder does not exist or is not writable");
+        if (!out) throw WriteError("cannot write " + path + ": the folder does not exist or is not writable");
         out << text;
         out.flush();
         if (!out) {
             std::remove(tmp.c_str());
-            throw std::runtime_error("cannot write " + path);
+            throw WriteError("cannot write " + path);
         }
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         std::remove(tmp.c_str());
-        throw std::runtime_error("cannot write " + path);
+        throw WriteError("cannot write " + path);
     }
 }
 
@@ -372,7 +372,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         throw;
     }
     for (const auto& [path, text] : files) {
-        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) throw std::runtime_error("cannot write " + path);
+        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) throw WriteError("cannot write " + path);
     }
 }
 
