@@ -66,7 +66,8 @@ int run_system(Format format, const std::string& prefix) {
     out << "solver     " << to_string(s.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << "trusted    " << r.reason << "\n";
     out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";
-    out << "verdict    " << (s.stable ? "STABLE" : "NOT asymptotically stable") << "\n\n";
+    out << "verdict    " << (r.status != RootStatus::Converged ? "UNDECIDED (" + to_string(r.status) + ")"
+                             : s.stable ? std::string("STABLE") : std::string("NOT asymptotically stable")) << "\n\n";
     out << roots_table(r.roots);
     emit(e, roots_csv(r.roots), out.str(), format, prefix);
     return exit_code(r.status);
@@ -124,8 +125,10 @@ int run_fleet(Format format, const std::string& prefix) {
         << "\n";
     if (!std::isnan(r.product_residual)) out << "check      max |prod Gamma_i(lambda) - 1| = " << rounded(r.product_residual, 3) << "\n";
     out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
-    out << "verdict    " << (r.stable ? "STABLE" : "UNSTABLE") << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
-        << " unstable roots)\n\n";
+    if (rr.status != RootStatus::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
+    else
+        out << "verdict    " << (r.stable ? "STABLE" : "UNSTABLE") << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
+            << " unstable roots)\n\n";
     out << roots_table(rr.roots);
     emit(e, roots_csv(rr.roots), out.str(), format, prefix);
     return exit_code(rr.status);
@@ -156,8 +159,12 @@ int run_ring(Format format, const std::string& prefix) {
     if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
     else out << " (mode " << r.abscissa_mode << ")";
     out << "\n";
-    out << "verdict    ring " << (r.stable ? "STABLE" : "UNSTABLE");
-    if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
+    if (r.status != RootStatus::Converged) {
+        out << "verdict    ring UNDECIDED (" << to_string(r.status) << ")";
+    } else {
+        out << "verdict    ring " << (r.stable ? "STABLE" : "UNSTABLE");
+        if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
+    }
     out << "\n\n";
     out << "  #   mode        theta                re                 im    residual\n";
     int i = 0;

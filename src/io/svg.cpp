@@ -371,8 +371,14 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         for (const auto& w : written) std::remove(w.c_str());
         throw;
     }
-    for (const auto& [path, text] : files) {
-        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) throw WriteError("cannot write " + path);
+    // a rename can still fail (e.g. the target is a folder): then no .part file is left and none
+    // of the files of this call remains, so that the set is never half new
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        const std::string& path = files[i].first;
+        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) {
+            for (std::size_t j = 0; j < files.size(); ++j) std::remove((files[j].first + (j < i ? "" : ".part")).c_str());
+            throw WriteError("cannot write " + path);
+        }
     }
 }
 

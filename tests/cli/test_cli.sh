@@ -298,6 +298,51 @@ else bad "mix"; fi
 expect_error "p = 1.5" mix --x E_min --y A_min --ring 10 --p 0:1.5:3 --out "$tmp/mix2"
 [ ! -e "$tmp/mix2.csv" ] && ok || bad "mix wrote output after an error"
 
+# exit codes (README "Exit codes"): 0 success, 2 bad input, 3 internal error, 4 not converged, 5 write failed
+expect_code() {  # expect_code CODE args...
+    local code="$1"; shift
+    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
+    local rc=$?
+    [ $rc -eq "$code" ] && ok || bad "exit $rc (expected $code) for: $*: $(cat "$tmp/e.txt")"
+}
+expect_code 0 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1
+expect_code 2 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --format xml
+DDEMAP_TEST_FAULT=internal expect_code 3 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1
+grep -q 'internal error' "$tmp/e.txt" && ok || bad "internal error message"
+# a collocation degree far too low for a 20-state system: printed, undecided, exit 4
+expect_code 4 roots --system "$tmp/cyc.json" --degree 2 --count 10 --format json
+python3 - "$tmp/o.txt" <<'PY' && ok || bad "not converged: status and message in the envelope"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "max_degree_reached" and d["message"], d
+assert d["result"]["stable"] is False
+PY
+"$bin" roots --system "$tmp/cyc.json" --degree 2 --count 10 | grep -q 'UNDECIDED' && ok || bad "not converged: the table says undecided"
+# the folder is fine, but PREFIX.json is a folder: the write fails after the computation, nothing half-written
+mkdir -p "$tmp/w.json"
+expect_code 5 classify --out "$tmp/w"
+grep -q "cannot write" "$tmp/e.txt" && ok || bad "write failure message"
+[ ! -e "$tmp/w.csv" ] && ! ls "$tmp" | grep -q '\.part$' && ok || bad "a failed write left files"
+
+# --format on every command; a format without meaning is a clear error naming the accepted ones
+for c in roots string classify sweep boundary chart paper simulate growth calibrate mix; do
+    "$bin" $c --help | grep -q -- '--format' && ok || bad "$c has no --format"
+done
+expect_error "--format = 'csv': this command has no csv output; expected table or json" chart "$tmp/bad.toml" --out "$tmp/c" --format csv
+expect_error "--format = 'csv'" paper --out "$tmp/p" --format csv
+# --out PREFIX: folders created as needed; the old file spelling --out FILE.csv still writes FILE.csv
+"$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --seed-grid 11 --out "$tmp/new/dir/b.csv" >/dev/null &&
+    [ -s "$tmp/new/dir/b.csv" ] && [ -s "$tmp/new/dir/b.json" ] && ok || bad "--out creates folders"
+"$bin" string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --out "$tmp/st" >/dev/null && [ -s "$tmp/st.csv" ] && json_has "$tmp/st.json" sup_gamma && ok || bad "string --out"
+# the old spelling --cars of a ring size still works
+"$bin" roots --fleet-pattern "A_min,E_min" --cars 6 --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['result']['ring'] == 6 else 1)" && ok || bad "--cars (old spelling of --ring)"
+expect_error "--ring = 'inf'" mix --x E_min --y A_min --ring inf --out "$tmp/mix3"
+# JSON on every command: the envelope
+"$bin" growth --followers 2 --format json >"$tmp/g.json" && json_has "$tmp/g.json" vehicles lead && ok || bad "growth json"
+"$bin" classify --format json >"$tmp/c.json" && json_has "$tmp/c.json" vehicles ring && ok || bad "classify json"
+"$bin" mix --x E_min --y A_min --ring 6 --p 0:1:2 --out "$tmp/mixj" --format json >"$tmp/m.json" && json_has "$tmp/m.json" points &&
+    python3 -c "import json; d=json.load(open('$tmp/m.json')); assert d['solver']['used'] == 'product' and 'spectral_abscissa' in d['result']['points'][0]" && ok || bad "mix json"
+
 # help on every command, with units
 for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi

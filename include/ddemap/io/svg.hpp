@@ -83,7 +83,8 @@ struct WriteError : std::runtime_error {
 void write_file_atomic(const std::string& path, const std::string& text);
 
 /// Writes several files so that either all appear or none is left half-written: all are
-/// written to temporary files first, then renamed into place.
+/// written to temporary files first, then renamed into place; on a failure (WriteError) none
+/// of them is left, nor any temporary file.
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace ddemap
