@@ -116,7 +116,7 @@ namespace {
 const char* format_name(Format f) { return f == Format::Table ? "table" : f == Format::Json ? "json" : "csv"; }
 std::string format_list(const std::vector<Format>& fs) {
     std::string s;
-    for (std::size_t i = 0; i < fs.size(); ++i) s += std::string(i == 0 ? "" : i + 1 == fs.size() ? (fs.size() > 2 ? ", or " : " or ") : ", ") + format_name(fs[i]);
+    for (std::size_t i = 0; i < fs.size(); ++i) s += std::string(i == 0 ? "" : i + 1 == fs.size() ? " or " : ", ") + format_name(fs[i]);
     return s;
 }
 }  // namespace
