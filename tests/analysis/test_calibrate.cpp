@@ -70,7 +70,7 @@ TEST_CASE("calibration recovers known parameters from noisy synthetic data" * do
     }
 }
 
-TEST_CASE("calibrate_many: each trace's fit in the traces' order, as calibrate alone; errors rethrown") {
+TEST_CASE("calibrate_many gives each trace the fit of calibrate alone, in order, and rethrows errors") {
     CalibrationOptions o;
     o.global_evaluations = 20;
     o.local_evaluations = 20;
