@@ -1,6 +1,6 @@
 #pragma once
-// Formatting helpers of the command-line front: round-trip numbers for machine output,
-// rounded numbers for tables. Formatting only; no numerics here.
+// Formatting helpers of the command-line front's tables: rounded numbers for reading.
+// Formatting only; the machine formats (JSON, CSV) come from the library's io/ layer.
 #include <string>
 #include <vector>
 
@@ -8,15 +8,11 @@
 
 namespace ddemap::cli {
 
-/// %.17g: round-trip exact. Non-finite values never reach output (callers check).
-std::string exact(double v);
 /// %.*g for human tables.
 std::string rounded(double v, int digits = 6);
-/// Quotes a CSV field if needed.
-std::string csv_field(const std::string& s);
-/// Roots as CSV: re,im,residual,newton_step (round-trip exact).
-std::string roots_csv(const std::vector<Root>& roots);
 /// Roots as a numbered human table (rounded).
 std::string roots_table(const std::vector<Root>& roots);
+/// N, or "inf" for 0.
+inline std::string ring_name(int cars) { return cars == 0 ? "inf" : std::to_string(cars); }
 
 }  // namespace ddemap::cli

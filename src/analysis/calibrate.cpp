@@ -1,5 +1,9 @@
 #include "ddemap/analysis/calibrate.hpp"
 
+#include "ddemap/core/execution.hpp"
+
+#include <exception>
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -278,6 +282,15 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     res.naive.rmse_speed = best;
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return res;
+}
+
+std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options,
+                                             const ExecutionPolicy& policy) {
+    options.validate();
+    std::vector<CalibrationResult> fits(traces.size());
+    // an error in any trace is rethrown here (the lowest index first), never inside the loop
+    parallel_for(static_cast<long>(traces.size()), [&](long i) { fits[i] = calibrate(traces[i], options); }, policy);
+    return fits;
 }
 
 }  // namespace ddemap

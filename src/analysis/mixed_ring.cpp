@@ -38,9 +38,17 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
         po.count = ro.count;
         po.residual_tolerance = ro.residual_tolerance;
         r = product_ring_roots(lins, po);
+        out.method_used = SolverMethod::Product;
     } else {
-        r = system_rightmost_roots(mixed_ring_dde(lins), ro, options.method);
+        const SparseDDE dde = mixed_ring_dde(lins);
+        constexpr int dense_limit = 16;  // system_rightmost_roots' default
+        out.method_used = options.method == SolverMethod::Sparse ||
+                                  (options.method == SolverMethod::Automatic && dde.a0.rows() > dense_limit)
+                              ? SolverMethod::Sparse
+                              : SolverMethod::Dense;
+        r = system_rightmost_roots(dde, ro, options.method, dense_limit);
     }
+    out.method_given = options.method;
     // the trivial root: lambda = 0 to rounding
     for (std::size_t i = 0; i < r.roots.size(); ++i) {
         if (std::abs(r.roots[i].value) <= 1e-8) {

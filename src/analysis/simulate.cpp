@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ddemap/solve/integrate.hpp"
+#include "ddemap/traffic/fleet.hpp"
 #include "ddemap/core/text.hpp"
 
 namespace ddemap {
@@ -108,11 +109,24 @@ void SimOptions::validate() const {
     if (!(std::isfinite(output_dt) && output_dt > 0.0)) throw std::invalid_argument("output_dt = " + detail::format_number(output_dt) + ": expected > 0");
 }
 
-std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers) {
-    std::shared_ptr<const CarModel> m = make_model("ovrv", v.parameters);
+std::vector<SimCar> platoon_from(const std::vector<CalibratedVehicle>& vehicles) {
     std::vector<SimCar> cars;
-    for (int i = 0; i < followers; ++i) cars.push_back({m, v.min_acc_speed, v.name});
+    for (const auto& v : vehicles) {
+        std::shared_ptr<const CarModel> m = make_model("ovrv", v.parameters);
+        cars.push_back({m, v.min_acc_speed, v.name});
+    }
     return cars;
+}
+
+std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers) {
+    return platoon_from(std::vector<CalibratedVehicle>(static_cast<std::size_t>(std::max(followers, 0)), v));
+}
+
+std::vector<CalibratedVehicle> vehicles_from_pattern(const std::string& pattern) {
+    std::vector<CalibratedVehicle> out;
+    for (const FleetCar& car : fleet_from_pattern(pattern, 0)) out.push_back(builtin_vehicle(car.label));
+    if (out.empty()) throw std::invalid_argument("fleet pattern '" + pattern + "': expected vehicle names such as A_min*7");
+    return out;
 }
 
 SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options) {

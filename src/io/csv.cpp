@@ -43,4 +43,125 @@ std::string boundary_csv(const SweepSpec& spec, const BoundarySet& set) {
     return s.str();
 }
 
+namespace {
+const char* tf(bool v) { return v ? "true" : "false"; }
+}  // namespace
+
+std::string csv_field(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"') out += '"';
+        out += c;
+    }
+    return out + "\"";
+}
+
+std::string roots_csv(const std::vector<Root>& roots) {
+    std::string out = "re,im,residual,newton_step\n";
+    for (const auto& x : roots)
+        out += format_exact(x.value.real()) + "," + format_exact(x.value.imag()) + "," + format_exact(x.residual) + "," +
+               format_exact(x.newton_step) + "\n";
+    return out;
+}
+
+std::string ring_roots_csv(const RingResult& r) {
+    std::ostringstream out;
+    out << "mode,theta,re,im,residual,newton_step\n";
+    for (const auto& x : r.roots) {
+        out << (x.mode < 0 ? std::string() : std::to_string(x.mode)) << "," << format_exact(x.theta) << ","
+            << format_exact(x.root.value.real()) << "," << format_exact(x.root.value.imag()) << ","
+            << format_exact(x.root.residual) << "," << format_exact(x.root.newton_step) << "\n";
+    }
+    return out.str();
+}
+
+std::string string_csv(const StringResult& s, const RingResult* ring) {
+    std::ostringstream out;
+    out << "plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable";
+    if (ring) out << ",ring,ring_stable,spectral_abscissa";
+    out << "\n";
+    out << tf(s.plant_stable) << "," << format_exact(s.plant_abscissa) << "," << format_exact(s.sup_gamma) << ","
+        << format_exact(s.omega_peak) << "," << format_exact(s.peak_margin) << "," << format_exact(s.lowfreq_margin) << ","
+        << tf(s.string_stable);
+    if (ring)
+        out << "," << (ring->cars == 0 ? std::string("inf") : std::to_string(ring->cars)) << "," << tf(ring->stable) << ","
+            << format_exact(ring->spectral_abscissa);
+    out << "\n";
+    return out.str();
+}
+
+std::string classification_csv(const std::vector<Classification>& rows) {
+    std::ostringstream out;
+    out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
+           "spectral_abscissa,plant_abscissa\n";
+    for (const auto& row : rows) {
+        out << csv_field(row.vehicle.name);
+        for (const char* k : {"k1", "k2", "th", "tau", "eta"}) out << "," << format_exact(row.vehicle.parameters.at(k));
+        out << "," << tf(row.string.plant_stable) << "," << tf(row.ring.stable) << "," << tf(row.string.string_stable) << ","
+            << format_exact(row.string.sup_gamma) << "," << format_exact(row.string.omega_peak) << ","
+            << format_exact(row.string.lowfreq_margin) << "," << format_exact(row.ring.spectral_abscissa) << ","
+            << format_exact(row.string.plant_abscissa) << "\n";
+    }
+    return out.str();
+}
+
+std::string simulation_csv(const SimResult& r) {
+    std::ostringstream csv;
+    csv << "time,car,position,speed,gap\n";
+    for (std::size_t k = 0; k < r.time.size(); ++k)
+        for (std::size_t c = 0; c < r.speed.size(); ++c) {
+            csv << format_exact(r.time[k]) << "," << c << "," << format_exact(r.position[c][k]) << "," << format_exact(r.speed[c][k]) << ",";
+            if (c > 0) csv << format_exact(r.gap[c][k]);
+            csv << "\n";
+        }
+    return csv.str();
+}
+
+std::string growth_csv(const std::vector<GrowthResult>& g) {
+    std::ostringstream out;
+    out << "name,position,speed_drop,amplification,min_gap,failure\n";
+    for (const auto& r : g) {
+        for (std::size_t i = 0; i < r.amplification.size(); ++i) {
+            out << r.name << "," << i + 1 << "," << format_exact(r.speed_drop[i]) << "," << format_exact(r.amplification[i]) << ","
+                << format_exact(r.min_gap[i]) << ",\n";
+        }
+        if (r.failed_at) {
+            out << r.name << "," << r.failed_at << ",," << format_exact(r.failure_amplification) << "," << format_exact(r.failure_gap)
+                << "," << r.failure << "\n";
+        }
+    }
+    return out.str();
+}
+
+std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits) {
+    std::ostringstream csv;
+    csv << "name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,"
+           "naive_rmse_speed,status\n";
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        const auto& r = fits[i];
+        csv << csv_field(i < names.size() ? names[i] : std::string());
+        for (const char* k : {"k1", "k2", "th", "tau", "eta"}) csv << "," << format_exact(r.parameters.at(k));
+        csv << "," << format_exact(r.all.rmse_speed) << "," << format_exact(r.all.rmse_gap) << "," << format_exact(r.train.rmse_speed)
+            << "," << format_exact(r.train.rmse_gap) << ",";
+        if (r.test.samples > 0) csv << format_exact(r.test.rmse_speed) << "," << format_exact(r.test.rmse_gap);
+        else csv << ",";
+        csv << "," << format_exact(r.naive.rmse_speed) << "," << r.status << "\n";
+    }
+    return csv.str();
+}
+
+std::string mix_csv(const std::vector<MixPoint>& points) {
+    std::ostringstream csv;
+    csv << "p,x_cars,spectral_abscissa,spectral_abscissa_min,spectral_abscissa_max,speed,ring_stable,unstable_roots,"
+           "arrangements,max_residual,status\n";
+    for (const auto& pt : points) {
+        csv << format_exact(pt.fraction) << "," << pt.x_cars << "," << format_exact(pt.abscissa) << "," << format_exact(pt.abscissa_min)
+            << "," << format_exact(pt.abscissa_max) << "," << format_exact(pt.speed) << "," << tf(pt.stable) << ","
+            << pt.unstable_roots << "," << pt.arrangements << "," << format_exact(pt.max_residual) << "," << to_string(pt.status)
+            << "\n";
+    }
+    return csv.str();
+}
+
 }  // namespace ddemap

@@ -32,6 +32,7 @@ std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, co
                 pt.abscissa = pt.abscissa_min = pt.abscissa_max = a;
                 pt.speed = r.equilibrium.speed;
                 pt.unstable_roots = r.unstable_roots;
+                pt.method_used = r.method_used;
             }
             pt.abscissa_min = std::min(pt.abscissa_min, a);
             pt.abscissa_max = std::max(pt.abscissa_max, a);

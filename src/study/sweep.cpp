@@ -27,7 +27,7 @@ Axis parse_axis(const std::string& name, const std::string& text) {
     a.name = name;
     const auto c1 = text.find(':');
     const auto c2 = c1 == std::string::npos ? std::string::npos : text.find(':', c1 + 1);
-    const std::string what = "--" + name + " = '" + text + "': expected LO:HI:COUNT with finite LO < HI and an integer COUNT >= 2";
+    const std::string what = name + " = '" + text + "': expected LO:HI:COUNT with finite LO < HI and an integer COUNT >= 2";
     if (c1 == std::string::npos || c2 == std::string::npos || text.find(':', c2 + 1) != std::string::npos) {
         throw std::invalid_argument(what);
     }
@@ -260,7 +260,7 @@ void SweepSpec::validate() const {
     for (const auto& a : {x, y}) {
         if (fixed.count(a.name)) throw std::invalid_argument("parameter '" + a.name + "' is both swept and fixed");
         if (!(std::isfinite(a.lo) && std::isfinite(a.hi) && a.lo < a.hi)) {
-            throw std::invalid_argument("--" + a.name + " range " + detail::format_number(a.lo) + ":" + detail::format_number(a.hi) + ": expected finite LO < HI");
+            throw std::invalid_argument(a.name + " range " + detail::format_number(a.lo) + ":" + detail::format_number(a.hi) + ": expected finite LO < HI");
         }
     }
     for (double xv : {x.lo, x.hi})

@@ -44,12 +44,19 @@ const std::vector<CalibratedVehicle>& paper_calibration_table() {
     return table;
 }
 
+const CalibratedVehicle& builtin_vehicle(const std::string& name) {
+    for (const auto& v : paper_calibration_table())
+        if (v.name == name) return v;
+    throw std::invalid_argument("vehicle '" + name + "': expected a name of the calibration table (A_min .. G_max)");
+}
+
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
     detail::CsvReader csv(text, source, "name,k1,k2,th,tau[,eta]");
     const int c_name = csv.column("name");
     const char* params[] = {"k1", "k2", "th", "tau", "eta"};
     int c_param[5];
     for (int i = 0; i < 5; ++i) c_param[i] = csv.column(params[i], i < 4);
+    const int c_min_speed = csv.column("min_acc_speed", false);
     std::vector<CalibratedVehicle> out;
     while (csv.next()) {
         CalibratedVehicle v;
@@ -59,6 +66,10 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
         v.parameters["eta"] = 10.0;
         for (int i = 0; i < 5; ++i)
             if (c_param[i] >= 0) v.parameters[params[i]] = csv.number(c_param[i], params[i]);
+        if (c_min_speed >= 0 && !csv.fields()[c_min_speed].empty()) {
+            v.min_acc_speed = csv.number(c_min_speed, "min_acc_speed");
+            if (v.min_acc_speed < 0.0) csv.fail("min_acc_speed = " + csv.fields()[c_min_speed] + ": expected >= 0 m/s");
+        }
         try {
             (void)make_model("ovrv", v.parameters);
         } catch (const std::invalid_argument& e) {

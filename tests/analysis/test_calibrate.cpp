@@ -70,6 +70,23 @@ TEST_CASE("calibration recovers known parameters from noisy synthetic data" * do
     }
 }
 
+TEST_CASE("calibrate_many gives each trace the fit of calibrate alone, in order, and rethrows errors") {
+    CalibrationOptions o;
+    o.global_evaluations = 20;
+    o.local_evaluations = 20;
+    const std::vector<Trace> traces = {synthetic({{"k1", 0.05}, {"k2", 0.3}, {"th", 1.2}, {"tau", 0.4}, {"eta", 8}}, 1),
+                                       synthetic({{"k1", 0.1}, {"k2", 0.2}, {"th", 1.8}, {"tau", 0.9}, {"eta", 6}}, 2)};
+    const auto fits = calibrate_many(traces, o);
+    REQUIRE(fits.size() == 2);
+    for (std::size_t i = 0; i < 2; ++i) {
+        const CalibrationResult one = calibrate(traces[i], o);
+        for (const char* k : {"k1", "k2", "th", "tau", "eta"}) CHECK(fits[i].parameters.at(k) == one.parameters.at(k));
+    }
+    o.train_start = 0.0;
+    o.train_end = 5.0;  // shorter than 20 s: every trace is rejected inside the parallel loop
+    CHECK_THROWS_AS(calibrate_many(traces, o), std::invalid_argument);
+}
+
 TEST_CASE("bad traces are rejected with the line and column") {
     std::string ok = "time_s,lead_speed_mps,follower_speed_mps,gap_m\n";
     for (int k = 0; k < 300; ++k) ok += std::to_string(0.1 * k) + ",20,20,30\n";

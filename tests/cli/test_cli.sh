@@ -11,7 +11,9 @@ json_has() {  # json_has FILE key1 key2 ...
     python3 - "$@" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
-missing = [k for k in sys.argv[2:] if k not in d]
+for k in ("command", "version", "inputs", "solver", "status", "message", "result"):  # the one envelope
+    assert k in d, "envelope lacks " + k
+missing = [k for k in sys.argv[2:] if k not in d and k not in d["result"]]
 if missing:
     print("missing keys:", missing); sys.exit(1)
 PY
@@ -25,7 +27,7 @@ if "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 22 --format json >"$
     json_has "$tmp/r.json" roots spectral_abscissa ring_stable degree && ok || bad "roots json keys"
     python3 - "$tmp/r.json" <<'PY' && ok || bad "roots json content"
 import json, sys
-d = json.load(open(sys.argv[1]))
+d = json.load(open(sys.argv[1]))["result"]
 r = d["roots"]
 assert len(r) >= 6, r
 for x in r:
@@ -45,7 +47,7 @@ if "$bin" string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --format json >"$tmp/s.jso
     json_has "$tmp/s.json" plant_stable sup_gamma omega_peak lowfreq_margin string_stable && ok || bad "string json keys"
     python3 - "$tmp/s.json" <<'PY' && ok || bad "string json content"
 import json, sys
-d = json.load(open(sys.argv[1]))
+d = json.load(open(sys.argv[1]))["result"]
 assert d["plant_stable"] is True and d["string_stable"] is False
 assert d["sup_gamma"] > 1 and d["omega_peak"] > 0 and d["lowfreq_margin"] < 0
 PY
@@ -111,11 +113,12 @@ fi
 expect_error "exactly two swept" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --out "$tmp/x"
 expect_error "LO:HI:COUNT" sweep --th 1.5 --tau 0.5 --k1 0.01:1:1 --k2 0:1:4 --out "$tmp/x"
 expect_error "k1 = -1" sweep --th 1.5 --tau 0.5 --k1 -1:1:4 --k2 0:1:4 --out "$tmp/x"
-expect_error "does not exist" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out /nonexistent/x
+: >"$tmp/afile"
+expect_error "does not exist" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$tmp/afile/x"
 [ ! -e "$tmp/x.csv" ] && ok || bad "a failed sweep left output"
 
 # boundary
-if "$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --seed-grid 21 --out "$tmp/b.csv" >/dev/null; then
+if "$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --seed-grid 21 --out "$tmp/b" >/dev/null; then
     grep -q ',hopf,ring,' "$tmp/b.csv" && grep -q ',string,lowfreq,' "$tmp/b.csv" && ok || bad "boundary kinds"
 else
     bad "boundary exit status"
@@ -130,7 +133,7 @@ printf 'name,k1,k2,th,tau,eta
 mine,0.2,0.6,1.5,0.1,10
 ' >"$tmp/v.csv"
 "$bin" classify "$tmp/v.csv" --format json >"$tmp/v.json" && python3 -c "
-import json,sys; d=json.load(open('$tmp/v.json')); v=d['vehicles'][0]
+import json,sys; d=json.load(open('$tmp/v.json')); v=d['result']['vehicles'][0]
 assert v['name']=='mine' and v['string_stable'] is True, v" && ok || bad "classify file"
 printf 'name,k1,k2,th,tau
 A,0.1,0.2,1,0.3
@@ -166,11 +169,11 @@ if "$bin" simulate --fleet 'B_min*6' --lead-profile dip --out "$tmp/sim" >/dev/n
     head -1 "$tmp/sim.csv" | grep -q '^time,car,position,speed,gap$' && ok || bad "simulate CSV header"
     python3 - "$tmp/sim.json" <<'PY' && ok || bad "simulate JSON"
 import json, sys
-d = json.load(open(sys.argv[1]))
+d = json.load(open(sys.argv[1]))["result"]
 cars = d["cars"]
 assert len(cars) == 6
 for c in cars:
-    for k in ("min_speed", "speed_drop", "min_gap", "events"):
+    for k in ("lowest_speed", "speed_drop", "min_gap", "events"):
         assert k in c, k
 assert any(e["type"] == "collision" for c in cars for e in c["events"])  # B_min fails within 6 cars
 PY
@@ -200,7 +203,7 @@ expect_error "badlead.csv:3: time_s = 0" simulate --fleet A_min --lead "$tmp/bad
 # calibrate: an excerpt of real data (tests/data), JSON keys, the table goes into classify
 excerpt="$(dirname "$0")/../data/openacc_excerpt_rav4_to_etron.csv"
 if "$bin" calibrate "$excerpt" --format json --out "$tmp/cal" >"$tmp/cal.json"; then
-    json_has "$tmp/cal.json" k1 k2 th tau eta rmse_speed rmse_gap status && ok || bad "calibrate JSON keys"
+    python3 -c "import json,sys; f=json.load(open('$tmp/cal.json'))['result']['fits'][0]; missing=[k for k in 'k1 k2 th tau eta rmse_speed rmse_gap status'.split() if k not in f]; sys.exit(1 if missing else 0)" && ok || bad "calibrate JSON keys"
     "$bin" classify "$tmp/cal.csv" --format csv >/dev/null && ok || bad "calibrate table into classify"
     xmllint --noout "$tmp/cal.svg" && ok || bad "calibrate SVG"
 else
@@ -224,7 +227,7 @@ printf '{"dimension": 2, "A0": [[1, 2], [3]]}' >"$tmp/bad.json"
 expect_error "bad.json: A0\[1\]: expected 2 entries" roots --system "$tmp/bad.json"
 expect_error "expected no model parameters" roots --system "$tmp/sys.json" --k1 0.3
 expect_error "the sparse path needs real coefficients" roots --system "$tmp/sys.json" --solver sparse
-expect_error "--solver product goes with --fleet" roots --system "$tmp/sys.json" --solver product
+expect_error "solver 'product' goes with fleet rings" roots --system "$tmp/sys.json" --solver product
 # a real 20-dimensional cyclic system: auto takes the sparse path; the dense path agrees
 python3 - >"$tmp/cyc.json" <<'PY'
 import json
@@ -237,20 +240,21 @@ PY
     python3 - "$tmp/cyc_s.json" "$tmp/cyc_d.json" <<'PY' && ok || bad "roots --system: sparse (auto) against dense"
 import json, sys
 s, d = (json.load(open(f)) for f in sys.argv[1:3])
-assert s["solver"] == "sparse" and d["solver"] == "dense", (s["solver"], d["solver"])
+assert s["solver"]["used"] == "sparse" and d["solver"]["used"] == "dense", (s["solver"], d["solver"])
 assert s["status"] == d["status"] == "converged"
-zs = [complex(r["re"], r["im"]) for r in s["roots"]]
-zd = [complex(r["re"], r["im"]) for r in d["roots"]]
+zs = [complex(r["re"], r["im"]) for r in s["result"]["roots"]]
+zd = [complex(r["re"], r["im"]) for r in d["result"]["roots"]]
 assert len(zs) >= 6 and all(min(abs(z - w) for w in zd) < 1e-9 for z in zs), (zs, zd)
 PY
 
 # mixed fleets: roots --fleet-pattern / --fleet, bad fleet files, mix
-"$bin" roots --fleet-pattern "A_min,E_min*2" --cars 12 --count 4 --format json >"$tmp/fleet.json" &&
-    json_has "$tmp/fleet.json" roots spectral_abscissa stable trivial_root_found product_residual strip_floor status reason && ok || bad "roots --fleet-pattern json"
+"$bin" roots --fleet-pattern "A_min,E_min*2" --ring 12 --count 4 --format json >"$tmp/fleet.json" &&
+    json_has "$tmp/fleet.json" roots spectral_abscissa ring_stable trivial_root_found product_residual strip_floor status degree_reason && ok || bad "roots --fleet-pattern json"
 python3 - "$tmp/fleet.json" <<'PY' && ok || bad "roots --fleet-pattern content"
 import json, sys
-d = json.load(open(sys.argv[1]))
-assert d["status"] == "converged" and d["cars"] == 12, d
+e = json.load(open(sys.argv[1]))
+d = e["result"]
+assert e["status"] == "converged" and d["ring"] == 12, d
 assert len(d["roots"]) >= 4 and all(r["residual"] < 1e-12 for r in d["roots"]), d["roots"]
 assert d["product_residual"] < 1e-10, d["product_residual"]
 PY
@@ -264,24 +268,26 @@ A_min,0.1
 B_mx,0.2
 ' >"$tmp/badfleet.csv"
 expect_error "badfleet.csv:3: column 'vehicle' = 'B_mx'" roots --fleet "$tmp/badfleet.csv"
-expect_error "fleet pattern entry 'Q'" roots --fleet-pattern "A_min,Q" --cars 4
+expect_error "fleet pattern entry 'Q'" roots --fleet-pattern "A_min,Q" --ring 4
 # the product path (automatic for cars of the car ahead) against the sparse path
-"$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --cars 40 --count 6 --format json >"$tmp/prod.json" &&
-    "$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --cars 40 --count 6 --solver sparse --format json >"$tmp/spar.json" &&
+"$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --ring 40 --count 6 --format json >"$tmp/prod.json" &&
+    "$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --ring 40 --count 6 --solver sparse --format json >"$tmp/spar.json" &&
     python3 - "$tmp/prod.json" "$tmp/spar.json" <<'PY' && ok || bad "roots --fleet-pattern: product against sparse"
 import json, sys
 p, s = (json.load(open(f)) for f in sys.argv[1:3])
 assert p["status"] == s["status"] == "converged"
+assert p["solver"]["used"] == "product" and s["solver"]["used"] == "sparse", (p["solver"], s["solver"])
+p, s = p["result"], s["result"]
 assert p["shifts"] == 0 and s["shifts"] > 0, (p["shifts"], s["shifts"])
 zp = [complex(r["re"], r["im"]) for r in p["roots"]]
 zs = [complex(r["re"], r["im"]) for r in s["roots"]]
 assert len(zp) == len(zs) >= 6 and all(abs(a - b) < 1e-10 for a, b in zip(zp, zs)), (zp, zs)
 PY
 expect_error "react only to the car ahead" roots --fleet "$tmp/fleet.csv" --solver product
-expect_error "the product path has no collocation degree" roots --fleet-pattern "A_min,E_min" --cars 6 --solver product --degree 20
-"$bin" roots --fleet-pattern "A_min,E_min" --cars 6 --degree 20 --format json | grep -q '"degree": 20' && ok || bad "--degree selects a collocation path"
-expect_error "expected at least" roots --fleet-pattern "A_min" --cars 4 --length 5
-if "$bin" mix --x E_min --y A_min --cars 10 --p 0:1:3 --out "$tmp/mix" >/dev/null && [ -s "$tmp/mix.csv" ] && xmllint --noout "$tmp/mix.svg"; then
+expect_error "the product path has no collocation degree" roots --fleet-pattern "A_min,E_min" --ring 6 --solver product --degree 20
+"$bin" roots --fleet-pattern "A_min,E_min" --ring 6 --degree 20 --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['result']['degree'] == 20 else 1)" && ok || bad "--degree selects a collocation path"
+expect_error "expected at least" roots --fleet-pattern "A_min" --ring 4 --length 5
+if "$bin" mix --x E_min --y A_min --ring 10 --p 0:1:3 --out "$tmp/mix" >/dev/null && [ -s "$tmp/mix.csv" ] && xmllint --noout "$tmp/mix.svg"; then
     python3 - "$tmp/mix.csv" <<'PY' && ok || bad "mix csv"
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
@@ -289,8 +295,53 @@ assert [r["x_cars"] for r in rows] == ["0", "5", "10"], rows
 assert all(r["status"] == "converged" for r in rows), rows
 PY
 else bad "mix"; fi
-expect_error "p = 1.5" mix --x E_min --y A_min --cars 10 --p 0:1.5:3 --out "$tmp/mix2"
+expect_error "p = 1.5" mix --x E_min --y A_min --ring 10 --p 0:1.5:3 --out "$tmp/mix2"
 [ ! -e "$tmp/mix2.csv" ] && ok || bad "mix wrote output after an error"
+
+# exit codes (README "Exit codes"): 0 success, 2 bad input, 3 internal error, 4 not converged, 5 write failed
+expect_code() {  # expect_code CODE args...
+    local code="$1"; shift
+    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
+    local rc=$?
+    [ $rc -eq "$code" ] && ok || bad "exit $rc (expected $code) for: $*: $(cat "$tmp/e.txt")"
+}
+expect_code 0 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1
+expect_code 2 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --format xml
+DDEMAP_TEST_FAULT=internal expect_code 3 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1
+grep -q 'internal error' "$tmp/e.txt" && ok || bad "internal error message"
+# a collocation degree far too low for a 20-state system: printed, undecided, exit 4
+expect_code 4 roots --system "$tmp/cyc.json" --degree 2 --count 10 --format json
+python3 - "$tmp/o.txt" <<'PY' && ok || bad "not converged: status and message in the envelope"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "max_degree_reached" and d["message"], d
+assert d["result"]["stable"] is False
+PY
+"$bin" roots --system "$tmp/cyc.json" --degree 2 --count 10 | grep -q 'UNDECIDED' && ok || bad "not converged: the table says undecided"
+# the folder is fine, but PREFIX.json is a folder: the write fails after the computation, nothing half-written
+mkdir -p "$tmp/w.json"
+expect_code 5 classify --out "$tmp/w"
+grep -q "cannot write" "$tmp/e.txt" && ok || bad "write failure message"
+[ ! -e "$tmp/w.csv" ] && ! ls "$tmp" | grep -q '\.part$' && ok || bad "a failed write left files"
+
+# --format on every command; a format without meaning is a clear error naming the accepted ones
+for c in roots string classify sweep boundary chart paper simulate growth calibrate mix; do
+    "$bin" $c --help | grep -q -- '--format' && ok || bad "$c has no --format"
+done
+expect_error "--format = 'csv': this command has no csv output; expected table or json" chart "$tmp/bad.toml" --out "$tmp/c" --format csv
+expect_error "--format = 'csv'" paper --out "$tmp/p" --format csv
+# --out PREFIX: folders created as needed; the old file spelling --out FILE.csv still writes FILE.csv
+"$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --seed-grid 11 --out "$tmp/new/dir/b.csv" >/dev/null &&
+    [ -s "$tmp/new/dir/b.csv" ] && [ -s "$tmp/new/dir/b.json" ] && ok || bad "--out creates folders"
+"$bin" string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --out "$tmp/st" >/dev/null && [ -s "$tmp/st.csv" ] && json_has "$tmp/st.json" sup_gamma && ok || bad "string --out"
+# the old spelling --cars of a ring size still works
+"$bin" roots --fleet-pattern "A_min,E_min" --cars 6 --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['result']['ring'] == 6 else 1)" && ok || bad "--cars (old spelling of --ring)"
+expect_error "--ring = 'inf'" mix --x E_min --y A_min --ring inf --out "$tmp/mix3"
+# JSON on every command: the envelope
+"$bin" growth --followers 2 --format json >"$tmp/g.json" && json_has "$tmp/g.json" vehicles lead && ok || bad "growth json"
+"$bin" classify --format json >"$tmp/c.json" && json_has "$tmp/c.json" vehicles ring && ok || bad "classify json"
+"$bin" mix --x E_min --y A_min --ring 6 --p 0:1:2 --out "$tmp/mixj" --format json >"$tmp/m.json" && json_has "$tmp/m.json" points &&
+    python3 -c "import json; d=json.load(open('$tmp/m.json')); assert d['solver']['used'] == 'product' and 'spectral_abscissa' in d['result']['points'][0]" && ok || bad "mix json"
 
 # help on every command, with units
 for c in roots string sweep boundary; do

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/core/parameters.hpp"
 #include "ddemap/traffic/model.hpp"
 
@@ -69,6 +70,11 @@ struct CalibrationResult {
 };
 
 CalibrationResult calibrate(const Trace& trace, const CalibrationOptions& options = {});
+
+/// calibrate() for every trace, in parallel over the traces under `policy`; the results are in
+/// the traces' order. The error of the lowest failing trace is rethrown after the loop.
+std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options,
+                                             const ExecutionPolicy& policy = {});
 
 /// Simulates the follower over [t_a, t_b] of the trace (history from the data on
 /// [t_a, t_a + tau]); speed and gap at the trace's sample times in the window (data values

@@ -28,6 +28,8 @@ struct MixedRingResult {
     bool unstable_count_complete = false;  ///< the list reaches left of the axis, so the count is all of them
     bool stable = false;             ///< converged and the rightmost non-trivial root has Re < -band
     double product_residual = std::numeric_limits<double>::quiet_NaN();  ///< max |prod Gamma_i - 1| (predecessor laws)
+    SolverMethod method_given = SolverMethod::Automatic;  ///< the path asked for
+    SolverMethod method_used = SolverMethod::Product;     ///< the path taken (product, dense or sparse)
 };
 
 MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& options);

@@ -90,7 +90,16 @@ struct SimResult {
 
 SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options = {});
 
-/// Followers of one calibrated vehicle setting (OVRV), with the paper's minimum ACC speed.
+/// The one construction of simulated followers (OVRV), in platoon order. The minimum ACC speed
+/// rule: every car takes its record's `min_acc_speed`, whatever the source. Built-in settings
+/// carry the paper's value (makes A-D: 25 mph = 11.176 m/s; E-G: 0); vehicles read by
+/// read_vehicles_csv carry their optional `min_acc_speed` column (default 0: never disengages).
+std::vector<SimCar> platoon_from(const std::vector<CalibratedVehicle>& vehicles);
+
+/// `followers` cars of one setting: platoon_from({v, v, ...}).
 std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers);
+
+/// The settings of a pattern of built-in names, "A_min*3,C_max" (*k repeats), in order.
+std::vector<CalibratedVehicle> vehicles_from_pattern(const std::string& pattern);
 
 }  // namespace ddemap

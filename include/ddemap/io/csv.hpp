@@ -4,7 +4,16 @@
 
 #include <string>
 
+#include <vector>
+
+#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/study/boundary.hpp"
+#include "ddemap/study/growth.hpp"
+#include "ddemap/study/penetration.hpp"
 #include "ddemap/study/sweep.hpp"
 
 namespace ddemap {
@@ -20,5 +29,29 @@ std::string sweep_csv(const SweepResult& sweep);
 /// One row per curve point: branch, kind (hopf|string), subkind (plant|ring|lowfreq|peak),
 /// mode (empty unless ring), the two parameters by name, omega.
 std::string boundary_csv(const SweepSpec& spec, const BoundarySet& set);
+
+/// Quotes a CSV field if needed.
+std::string csv_field(const std::string& s);
+
+/// re,im,residual,newton_step
+std::string roots_csv(const std::vector<Root>& roots);
+/// mode,theta,re,im,residual,newton_step (mode empty for N = inf)
+std::string ring_roots_csv(const RingResult& r);
+/// plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable
+/// [,ring,ring_stable,spectral_abscissa]
+std::string string_csv(const StringResult& s, const RingResult* ring);
+/// name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,
+/// lowfreq_margin,spectral_abscissa,plant_abscissa
+std::string classification_csv(const std::vector<Classification>& rows);
+/// time,car,position,speed,gap (car 0 = lead, no gap)
+std::string simulation_csv(const SimResult& r);
+/// name,position,speed_drop,amplification,min_gap,failure
+std::string growth_csv(const std::vector<GrowthResult>& g);
+/// name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,
+/// test_rmse_gap,naive_rmse_speed,status (a vehicle table for read_vehicles_csv)
+std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits);
+/// p,x_cars,spectral_abscissa,spectral_abscissa_min,spectral_abscissa_max,speed,ring_stable,
+/// unstable_roots,arrangements,max_residual,status
+std::string mix_csv(const std::vector<MixPoint>& points);
 
 }  // namespace ddemap

@@ -5,6 +5,7 @@
 /// ticks and labels in units, a legend, titles and optional labelled markers; one or more
 /// panels (small multiples). The writer only formats what it is given.
 
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -72,12 +73,18 @@ struct PlotOptions {
 
 std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& options);
 
+/// A file could not be written (the message names the path).
+struct WriteError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 /// Writes `text` to `path` atomically (a temporary file renamed into place); throws
-/// std::runtime_error naming the path on failure.
+/// WriteError naming the path on failure.
 void write_file_atomic(const std::string& path, const std::string& text);
 
 /// Writes several files so that either all appear or none is left half-written: all are
-/// written to temporary files first, then renamed into place.
+/// written to temporary files first, then renamed into place; on a failure (WriteError) none
+/// of them is left, nor any temporary file.
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace ddemap

@@ -34,6 +34,7 @@ struct MixPoint {
     int unstable_roots = 0;      ///< spread arrangement, among the listed roots
     double max_residual = 0.0;
     RootStatus status = RootStatus::Converged;  ///< worst over the arrangements
+    SolverMethod method_used = SolverMethod::Product;  ///< the solver path of the spread arrangement
 };
 
 std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, const MixOptions& options);

@@ -23,8 +23,13 @@ struct CalibratedVehicle {
 /// The 14 settings of the paper's calibration table, in the paper's order.
 const std::vector<CalibratedVehicle>& paper_calibration_table();
 
+/// One setting of the built-in table by name ("A_min" .. "G_max"); std::invalid_argument
+/// naming the name otherwise.
+const CalibratedVehicle& builtin_vehicle(const std::string& name);
+
 /// Reads vehicles from CSV text: a header with at least name, k1, k2, th, tau (eta optional,
-/// default 10; other columns are ignored), one vehicle per line. Errors name `source`, the line
+/// default 10; min_acc_speed [m/s] optional, default 0 = the ACC never disengages; other
+/// columns are ignored), one vehicle per line. Errors name `source`, the line
 /// and the column (std::invalid_argument).
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source);
 

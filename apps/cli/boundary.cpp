@@ -1,0 +1,65 @@
+// boundary: stability boundaries in a window of two parameters (LO:HI) by continuation.
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "sweep_flags.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/svg.hpp"
+#include "ddemap/study/boundary.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+struct Args {
+    ModelArgs model;
+    RingArg ring;
+    std::string grid = "41";
+    FormatArg format;
+    OutArg out;
+} args;
+}  // namespace
+
+void add_boundary_flags(CLI::App& app) {
+    args.model.add_to(app);
+    args.ring.add_to(app, "22", "ring size N >= 2, or inf");
+    args.out.add_to(app, "PREFIX.csv (one row per curve point) and PREFIX.json", true);
+    app.add_option("--seed-grid", args.grid, "grid points per axis used to seed the branches")->capture_default_str();
+    args.format.add_to(app);
+}
+
+int run_boundary() {
+    const Format format = args.format.parse();
+    const int grid = static_cast<int>(parse_integer("--seed-grid", args.grid, 5, 2001, "an integer between 5 and 2001"));
+    const SweepSpec spec = sweep_spec(args.model, args.ring, "", false, grid);
+    const std::string prefix = args.out.prepare("boundary");
+    const SweepResult sw = run_sweep(spec);
+    const BoundarySet b = trace_boundaries(sw);
+    JsonEnvelope e;
+    e.command = "boundary";
+    e.inputs = sweep_inputs(spec).integer("seed_grid", grid).str();
+        e.message = b.rejected > 0 ? std::to_string(b.rejected) + " seeds failed their Newton correction (the branches through the others were traced)" : "";
+    e.result = boundary_json(b);
+    const std::string csv = boundary_csv(spec, b);
+    write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    if (format == Format::Json) {
+        print_json(e);
+    } else if (format == Format::Csv) {
+        std::cout << csv;
+    } else {
+        std::ostringstream out;
+        out << "boundaries " << b.curves.size() << " curves (" << b.seeds << " seeds on a " << grid << " x " << grid << " grid)\n";
+        for (std::size_t i = 0; i < b.curves.size(); ++i) {
+            const auto& c = b.curves[i];
+            out << "  " << i + 1 << "  " << kind_name(c.kind) << "/" << subkind_name(c.kind);
+            if (c.kind == BoundaryKind::RingHopf) out << " mode " << c.mode;
+            out << ": " << c.points.size() << " points, max residual " << rounded(c.max_residual, 2) << (c.closed ? ", closed" : "") << "\n";
+        }
+        out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
+        std::cout << out.str();
+    }
+    return exit_ok;
+}
+
+}  // namespace ddemap::cli

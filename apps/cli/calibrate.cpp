@@ -1,0 +1,114 @@
+// calibrate: fit OVRV to measured car-following traces (analysis/calibrate: calibrate_many).
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/figures.hpp"
+#include "ddemap/io/svg.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+struct Args {
+    std::vector<std::string> files;
+    std::string train, model = "ovrv", bounds, gap_weight = "0.02";
+    FormatArg format;
+    OutArg out;
+} args;
+
+std::string base_name(const std::string& path) {
+    std::string b = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+    if (b.size() > 4 && b.substr(b.size() - 4) == ".csv") b.resize(b.size() - 4);
+    return b;
+}
+
+CalibrationOptions options() {
+    if (args.model != "ovrv") throw BadInput("--model = '" + args.model + "': calibration supports ovrv");
+    CalibrationOptions o;
+    o.gap_weight = parse_number("--gap-weight", args.gap_weight);
+    if (!args.train.empty()) {
+        const auto colon = args.train.find(':');
+        if (colon == std::string::npos) throw BadInput("--train = '" + args.train + "': expected T0:T1 in seconds");
+        o.train_start = parse_number("--train", args.train.substr(0, colon));
+        o.train_end = parse_number("--train", args.train.substr(colon + 1));
+        if (!(o.train_start >= 0 && o.train_end > o.train_start)) throw BadInput("--train = '" + args.train + "': expected 0 <= T0 < T1");
+    }
+    if (!args.bounds.empty()) {
+        std::stringstream ss(args.bounds);
+        std::string item;
+        const char* names[5] = {"k1", "k2", "th", "tau", "eta"};
+        while (std::getline(ss, item, ',')) {
+            const auto eq = item.find('='), colon = item.find(':');
+            if (eq == std::string::npos || colon == std::string::npos || colon < eq)
+                throw BadInput("--bounds item '" + item + "': expected NAME=LO:HI, e.g. eta=0:15");
+            const std::string name = item.substr(0, eq);
+            const auto it = std::find_if(std::begin(names), std::end(names), [&](const char* n) { return name == n; });
+            if (it == std::end(names)) throw BadInput("--bounds item '" + item + "': expected one of k1, k2, th, tau, eta");
+            o.set_bounds(name, parse_number("--bounds " + name, item.substr(eq + 1, colon - eq - 1)),
+                         parse_number("--bounds " + name, item.substr(colon + 1)));
+        }
+    }
+    o.validate();
+    return o;
+}
+}  // namespace
+
+void add_calibrate_flags(CLI::App& app) {
+    app.add_option("DATA.csv", args.files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m")->required();
+    app.add_option("--train", args.train, "training window T0:T1 [s] (default: the whole file; the rest is the test part)");
+    app.add_option("--model", args.model, "the model to fit (ovrv)")->capture_default_str();
+    app.add_option("--bounds", args.bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
+    app.add_option("--gap-weight", args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
+    args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
+    args.format.add_to(app);
+}
+
+int run_calibrate() {
+    const Format format = args.format.parse();
+    const CalibrationOptions o = options();
+    const std::string prefix = args.out.given() ? args.out.prepare("calibrate") : std::string();
+    std::vector<Trace> traces;
+    std::vector<std::string> names;
+    for (const auto& f : args.files) {
+        traces.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
+        names.push_back(base_name(f));
+    }
+    const std::vector<CalibrationResult> fits = calibrate_many(traces, o);
+    JsonEnvelope e;
+    e.command = "calibrate";
+    std::vector<std::string> files;
+    for (const auto& f : args.files) files.push_back(json_string(f));
+    JsonObject in;
+    in.json("traces", json_array(files)).string("model", args.model).number("gap_weight", o.gap_weight);
+    if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
+    e.inputs = in.str();
+    e.result = calibration_json(names, fits, o);
+    const std::string csv = calibration_csv(names, fits);
+    if (!prefix.empty())
+        write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}});
+    if (format == Format::Json) {
+        print_json(e);
+    } else if (format == Format::Csv) {
+        std::cout << csv;
+    } else {
+        std::ostringstream out;
+        out << "file                                         k1      k2     th     tau    eta   rmse_v  rmse_gap  naive_v  status\n";
+        for (std::size_t i = 0; i < fits.size(); ++i) {
+            const auto& r = fits[i];
+            const auto& p = r.parameters;
+            char line[300];
+            std::snprintf(line, sizeof line, "%-42.42s %7.4f %7.4f %6.3f %6.3f %6.2f %7.3f %8.3f %8.3f  %s\n", names[i].c_str(), p.at("k1"),
+                          p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"), r.all.rmse_speed, r.all.rmse_gap, r.naive.rmse_speed,
+                          r.status.c_str());
+            out << line;
+        }
+        std::cout << out.str();
+    }
+    return exit_ok;
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,47 @@
+// chart: render a chart spec (TOML) to PREFIX.svg.
+#include <iostream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "ddemap/io/chart_spec.hpp"
+#include "ddemap/io/svg.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+struct Args {
+    std::string spec;
+    FormatArg format;
+    OutArg out;
+} args;
+}  // namespace
+
+void add_chart_flags(CLI::App& app) {
+    app.add_option("SPEC", args.spec, "chart specification (TOML)")->required();
+    args.out.add_to(app, "PREFIX.svg", true);
+    args.format.add_to(app, {Format::Table, Format::Json});
+}
+
+int run_chart() {
+    const Format format = args.format.parse();
+    const std::string prefix = args.out.prepare("chart");
+    const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", args.spec), args.spec);
+    const RenderedChart r = render_chart(spec);
+    write_files_atomic({{prefix + ".svg", r.svg}});
+    if (format == Format::Json) {
+        JsonEnvelope e;
+        e.command = "chart";
+        e.inputs = JsonObject().string("spec", args.spec).string("out", prefix).str();
+        e.result = JsonObject()
+                       .integer("panels", static_cast<long long>(spec.panels.size()))
+                       .number("seconds", r.seconds)
+                       .json("files", json_array({json_string(prefix + ".svg")}))
+                       .str();
+        print_json(e);
+    } else {
+        std::cout << "chart      " << spec.panels.size() << " panels in " << rounded(r.seconds, 3) << " s\nwrote      " << prefix << ".svg\n";
+    }
+    return exit_ok;
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,35 @@
+#include "commands.hpp"
+
+namespace ddemap::cli {
+
+const std::vector<Command>& command_table() {
+    static const std::vector<Command> table = {
+        {"roots", "rightmost characteristic roots of a ring of N identical cars, a mixed fleet, or any linear DDE",
+         add_roots_flags, run_roots},
+        {"string", "plant and string stability from the head-to-tail transfer function", add_string_flags, run_string},
+        {"classify", "plant, ring and string verdicts of calibrated vehicles (default: the paper's 14 settings)",
+         add_classify_flags, run_classify},
+        {"sweep",
+         "grid sweep over two model parameters (each given as LO:HI:COUNT): spectral abscissa, unstable roots, sup|Gamma| "
+         "and verdicts per point; writes PREFIX.csv, .json, .svg, -boundaries.csv",
+         add_sweep_flags, run_sweep},
+        {"boundary",
+         "stability boundaries in a window of two parameters (each given as LO:HI) by pseudo-arclength continuation; "
+         "writes PREFIX.csv, .json",
+         add_boundary_flags, run_boundary},
+        {"chart", "render a chart spec (TOML, see maps/) to PREFIX.svg", add_chart_flags, run_chart},
+        {"paper", "the seed paper's main job: classification table on stdout, figures and data under PREFIX", add_paper_flags,
+         run_paper},
+        {"simulate", "nonlinear platoon simulation behind a lead speed profile; writes PREFIX.csv, .json, .svg",
+         add_simulate_flags, run_simulate},
+        {"growth", "disturbance growth for every setting of the calibration table: platoons of 1 to 15 followers",
+         add_growth_flags, run_growth},
+        {"calibrate", "fit OVRV (k1, k2, th, tau, eta) to measured car-following traces (NLopt: DIRECT-L, then BOBYQA)",
+         add_calibrate_flags, run_calibrate},
+        {"mix", "penetration-rate study: spectral abscissa of a ring with a fraction p of type X among type Y",
+         add_mix_flags, run_mix},
+    };
+    return table;
+}
+
+}  // namespace ddemap::cli

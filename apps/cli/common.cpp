@@ -1,0 +1,174 @@
+#include "common.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include <unistd.h>
+
+namespace ddemap::cli {
+
+std::string read_input_file(const std::string& flag, const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+double parse_number(const std::string& flag, const std::string& text) {
+    const char* s = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(s, &end);
+    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+        throw BadInput(flag + " = '" + text + "': expected a finite number");
+    }
+    return v;
+}
+
+long parse_integer(const std::string& flag, const std::string& text, long lo, long hi, const std::string& what) {
+    const char* s = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long v = std::strtol(s, &end, 10);
+    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
+        throw BadInput(flag + " = '" + text + "': expected " + what);
+    }
+    return v;
+}
+
+void ModelArgs::add_to(CLI::App& app) {
+    app.add_option("--model", model,
+                   "car-following model: ovrv (paper eq. 3), idm (intelligent driver model) or ccc (connected cruise control: "
+                   "ovrv + the car two ahead)")
+        ->capture_default_str()
+        ->group("Model");
+    struct P {
+        const char* name;
+        const char* help;
+    };
+    static const P params[] = {
+        {"k1", "OVRV gain on the gap error [1/s^2]"},
+        {"k2", "OVRV gain on the speed difference [1/s]"},
+        {"th", "time headway [s]"},
+        {"tau", "sensing delay [s] (0 gives the ODE)"},
+        {"eta", "jam gap [m] (ovrv default 10, idm default 2; does not enter the linearisation of ovrv)"},
+        {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20; for a fleet: the common speed)"},
+        {"a", "IDM maximum acceleration [m/s^2] (default 1)"},
+        {"b", "IDM comfortable deceleration [m/s^2] (default 1.5)"},
+        {"v0", "IDM desired speed [m/s] (default 33.3)"},
+        {"delta", "IDM acceleration exponent [1] (default 4)"},
+        {"k3", "CCC gain on the speed difference to the car two ahead [1/s]"},
+        {"tau2", "CCC delay of the V2V signal from the car two ahead [s]"},
+    };
+    for (const auto& p : params) {
+        const std::string name = p.name;
+        app.add_option_function<std::string>("--" + name, [this, name](const std::string& v) { raw[name] = v; }, p.help)->group("Model");
+    }
+}
+
+void ModelArgs::split(ParameterMap& fixed, std::vector<std::pair<std::string, std::string>>& axes) const {
+    for (const auto& [name, text] : raw) {
+        if (text.find(':') != std::string::npos) axes.emplace_back(name, text);
+        else fixed[name] = parse_number("--" + name, text);
+    }
+    check_model();
+}
+
+void ModelArgs::check_model() const {
+    const auto names = model_names();
+    if (std::find(names.begin(), names.end(), model) == names.end()) {
+        std::string list;
+        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+        throw BadInput("--model = '" + model + "': expected one of " + list);
+    }
+}
+
+std::unique_ptr<CarModel> ModelArgs::build() const {
+    ParameterMap values;
+    for (const auto& [name, text] : raw) values[name] = parse_number("--" + name, text);
+    check_model();
+    return make_model(model, values);
+}
+
+JsonObject model_inputs(const CarModel& m) {
+    JsonObject o;
+    o.string("model", m.name()).json("parameters", json_parameters(m.parameters()));
+    return o;
+}
+
+void RingArg::add_to(CLI::App& app, const std::string& fallback, const std::string& help) {
+    text = fallback;
+    option = app.add_option("--ring", text, help);
+    if (!fallback.empty()) option->capture_default_str();
+}
+
+int RingArg::parse(bool allow_inf) const {
+    if (allow_inf && (text == "inf" || text == "infinity")) return 0;
+    return static_cast<int>(parse_integer("--ring", text, 2, 1000000,
+                                          allow_inf ? "an integer N >= 2 (at most 1000000) or 'inf'"
+                                                    : "an integer N >= 2 (at most 1000000); this ring is finite"));
+}
+
+namespace {
+const char* format_name(Format f) { return f == Format::Table ? "table" : f == Format::Json ? "json" : "csv"; }
+std::string format_list(const std::vector<Format>& fs) {
+    std::string s;
+    for (std::size_t i = 0; i < fs.size(); ++i) s += std::string(i == 0 ? "" : i + 1 == fs.size() ? " or " : ", ") + format_name(fs[i]);
+    return s;
+}
+}  // namespace
+
+void FormatArg::add_to(CLI::App& app, std::initializer_list<Format> formats) {
+    accepted = formats;
+    app.add_option("--format", text, "output on stdout: " + format_list(accepted))->capture_default_str();
+}
+
+Format FormatArg::parse() const {
+    for (Format f : {Format::Table, Format::Json, Format::Csv}) {
+        if (text != format_name(f)) continue;
+        if (std::find(accepted.begin(), accepted.end(), f) == accepted.end())
+            throw BadInput("--format = '" + text + "': this command has no " + text + " output; expected " + format_list(accepted));
+        return f;
+    }
+    throw BadInput("--format = '" + text + "': expected " + format_list(accepted));
+}
+
+void OutArg::add_to(CLI::App& app, const std::string& writes, bool required) {
+    auto* o = app.add_option("--out", text, "output prefix PREFIX (folders created as needed): writes " + writes);
+    if (required) o->required();
+}
+
+std::string OutArg::prepare(const std::string& command) const {
+    namespace fs = std::filesystem;
+    if (text.empty()) throw BadInput("--out PREFIX is required");
+    std::string prefix = text;
+    std::error_code ec;
+    if (prefix.back() == '/' || fs::is_directory(prefix, ec)) {
+        if (prefix.back() != '/') prefix += '/';
+        prefix += command;
+    } else {
+        for (const char* ext : {".csv", ".json", ".svg"}) {
+            const std::string e = ext;
+            if (prefix.size() > e.size() && prefix.compare(prefix.size() - e.size(), e.size(), e) == 0) {
+                prefix.resize(prefix.size() - e.size());
+                break;
+            }
+        }
+    }
+    const auto slash = prefix.find_last_of('/');
+    const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : prefix.substr(0, slash));
+    if (!fs::is_directory(dir, ec)) {
+        fs::create_directories(dir, ec);
+        if (ec || !fs::is_directory(dir))
+            throw BadInput("--out = '" + text + "': the folder '" + dir + "' does not exist and cannot be created");
+    }
+    if (access(dir.c_str(), W_OK) != 0) throw BadInput("--out = '" + text + "': the folder '" + dir + "' is not writable");
+    return prefix;
+}
+
+void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }
+
+}  // namespace ddemap::cli

@@ -1,0 +1,101 @@
+// mix: the penetration-rate study (study/penetration) on a ring of N cars.
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "fleet_flags.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/figures.hpp"
+#include "ddemap/io/svg.hpp"
+#include "ddemap/study/penetration.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+struct Args {
+    std::string x, y, cars, p = "0:1:11", draws = "0", seed = "1", speed, length, solver = "auto";
+    RingArg ring;
+    FormatArg format;
+    OutArg out;
+} args;
+}  // namespace
+
+void add_mix_flags(CLI::App& app) {
+    app.add_option("--x", args.x, "type X: a calibrated vehicle (e.g. E_min) or MODEL:NAME=VALUE,...")->required();
+    app.add_option("--y", args.y, "type Y: as --x")->required();
+    args.ring.add_to(app, "40", "ring size N >= 2 (finite)");
+    app.add_option("--cars", args.cars, "old spelling of --ring")->group("");
+    app.add_option("--p", args.p, "fractions of X as LO:HI:COUNT in [0, 1]")->capture_default_str();
+    app.add_option("--draws", args.draws, "random arrangements per p besides the evenly spread one (order matters only for CCC)")->capture_default_str();
+    app.add_option("--seed", args.seed, "seed of the random arrangements")->capture_default_str();
+    app.add_option("--speed", args.speed, "common equilibrium speed [m/s] (default 20)");
+    app.add_option("--length", args.length, "ring length [m]; the speed follows for each mix");
+    app.add_option("--solver", args.solver, "auto, product, dense or sparse (as roots --fleet)")->capture_default_str();
+    args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", true);
+    args.format.add_to(app);
+}
+
+int run_mix() {
+    const Format format = args.format.parse();
+    const FleetCar x = parse_fleet_car(args.x), y = parse_fleet_car(args.y);
+    if (args.ring.given() && !args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
+    RingArg ring = args.ring;
+    if (!args.cars.empty()) ring.text = args.cars;
+    MixOptions o;
+    o.cars = ring.parse(false);
+    const Axis axis = parse_axis("p", args.p);
+    for (int i = 0; i < axis.count; ++i) o.fractions.push_back(axis.value(i));
+    o.draws = static_cast<int>(parse_integer("--draws", args.draws, 0, 10000, "an integer 0..10000"));
+    o.seed = static_cast<unsigned>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
+    set_equilibrium(o.ring, args.speed, args.length);
+    o.ring.method = parse_solver_method(args.solver);
+    o.ring.roots.count = 4;
+    o.validate();
+    const std::string prefix = args.out.prepare("mix");
+    const std::vector<MixPoint> pts = penetration_study(x, y, o);
+    RootStatus status = RootStatus::Converged;
+    std::string used;
+    for (const auto& pt : pts) {
+        if (pt.status != RootStatus::Converged) status = pt.status;
+        const std::string u = to_string(pt.method_used);
+        if (used.find(u) == std::string::npos) used += (used.empty() ? "" : ",") + u;
+    }
+    JsonEnvelope e;
+    e.command = "mix";
+    JsonObject in;
+    in.string("x", args.x).string("y", args.y).integer("ring", o.cars).json("p", json_array([&] {
+        std::vector<std::string> v;
+        for (double f : o.fractions) v.push_back(json_number(f));
+        return v;
+    }()));
+    in.integer("draws", o.draws).integer("seed", o.seed);
+    equilibrium_inputs(in, o.ring);
+    e.inputs = in.str();
+    e.has_solver = true;
+    e.solver_given = to_string(o.ring.method);
+    e.solver_used = used;
+    e.status = to_string(status);
+    e.result = mix_json(pts, o.cars);
+    const std::string csv = mix_csv(pts);
+    write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", mix_svg(pts, o, x.label, y.label)}});
+    if (format == Format::Json) {
+        print_json(e);
+    } else if (format == Format::Csv) {
+        std::cout << csv;
+    } else {
+        std::ostringstream out;
+        out << "p      k   abscissa        stable\n";
+        for (const auto& pt : pts) {
+            char line[160];
+            std::snprintf(line, sizeof line, "%-6.3f %-3d %-15.8f %s\n", pt.fraction, pt.x_cars, pt.abscissa, pt.stable ? "yes" : "no");
+            out << line;
+        }
+        out << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
+        std::cout << out.str();
+    }
+    return exit_code(status);
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,212 @@
+// roots: rightmost characteristic roots of a ring of identical cars (model flags, --ring),
+// a mixed ring (--fleet FILE.csv or --fleet-pattern), or any linear DDE (--system FILE.json).
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "fleet_flags.hpp"
+#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/system_roots.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/svg.hpp"
+#include "ddemap/io/system_json.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+
+struct Args {
+    ModelArgs model;
+    RingArg ring;
+    std::string count = "6", system, fleet, pattern, cars, length, solver = "auto", degree = "0";
+    FormatArg format;
+    OutArg out;
+} args;
+
+int parse_count() { return static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000")); }
+
+int parse_degree() {
+    const int d = static_cast<int>(parse_integer("--degree", args.degree, 0, 200, "0 (automatic) or an integer 2..200"));
+    if (d == 1) throw BadInput("--degree = '1': expected 0 (automatic) or an integer 2..200");
+    return d;
+}
+
+/// Prints (and with --out writes PREFIX.csv, PREFIX.json) the command's output.
+void emit(const JsonEnvelope& e, const std::string& csv, const std::string& table, Format format, const std::string& prefix) {
+    if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    if (format == Format::Json) print_json(e);
+    else if (format == Format::Csv) std::cout << csv;
+    else std::cout << table;
+}
+
+int run_system(Format format, const std::string& prefix) {
+    if (args.model.given() || args.ring.given())
+        throw BadInput("--system takes the whole problem from the file: expected no model parameters, --model or --ring");
+    SystemRootOptions o;
+    o.count = parse_count();
+    o.degree = parse_degree();
+    o.method = parse_solver_method(args.solver);
+    const LinearDDE dde = read_linear_dde_json(read_input_file("--system", args.system), args.system);
+    const SystemRootResult s = analyse_system(dde, o);
+    const RootResult& r = s.roots;
+    JsonEnvelope e;
+    e.command = "roots";
+    e.inputs = JsonObject().string("system", args.system).integer("count", o.count).integer("degree", o.degree).str();
+    e.has_solver = true;
+    e.solver_given = to_string(s.method_given);
+    e.solver_used = to_string(s.method_used);
+    e.status = to_string(r.status);
+    e.message = r.reason;
+    e.result = system_roots_json(dde, s);
+    std::ostringstream out;
+    out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
+    out << "solver     " << to_string(s.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
+    out << "trusted    " << r.reason << "\n";
+    out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";
+    out << "verdict    " << (r.status != RootStatus::Converged ? "UNDECIDED (" + to_string(r.status) + ")"
+                             : s.stable ? std::string("STABLE") : std::string("NOT asymptotically stable")) << "\n\n";
+    out << roots_table(r.roots);
+    emit(e, roots_csv(r.roots), out.str(), format, prefix);
+    return exit_code(r.status);
+}
+
+int run_fleet(Format format, const std::string& prefix) {
+    auto raw = args.model.raw;
+    const std::string speed = raw.count("speed") ? raw.at("speed") : "";
+    raw.erase("speed");
+    if (!args.fleet.empty() && !args.pattern.empty()) throw BadInput("--fleet and --fleet-pattern: expected only one of them");
+    if (!args.system.empty() || !raw.empty() || args.model.model != "ovrv")
+        throw BadInput("--fleet/--fleet-pattern define the ring: expected no --system, --model or model parameters "
+                       "(--speed or --length set the equilibrium, --ring the size of a pattern ring)");
+    if (args.ring.given() && !args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
+    const std::string ring_text = args.ring.given() ? args.ring.text : args.cars;
+    Fleet fleet;
+    if (!args.fleet.empty()) {
+        if (!ring_text.empty()) throw BadInput("--ring goes with --fleet-pattern; a --fleet file lists every car (use its count column)");
+        fleet = read_fleet_csv(read_input_file("--fleet", args.fleet), args.fleet);
+    } else {
+        RingArg n;
+        n.text = ring_text;
+        fleet = fleet_from_pattern(args.pattern, ring_text.empty() ? 0 : n.parse(false));
+    }
+    MixedRingOptions o;
+    set_equilibrium(o, speed, args.length);
+    o.method = parse_solver_method(args.solver);
+    o.roots.count = parse_count();
+    o.roots.degree = parse_degree();
+    const MixedRingResult r = analyse_mixed_ring(fleet, o);
+    const SparseRootResult& rr = r.roots;
+    JsonEnvelope e;
+    e.command = "roots";
+    JsonObject in;
+    in.string(args.fleet.empty() ? "fleet_pattern" : "fleet", args.fleet.empty() ? args.pattern : args.fleet)
+        .integer("ring", static_cast<long long>(fleet.size()));
+    equilibrium_inputs(in, o);
+    in.integer("count", o.roots.count).integer("degree", o.roots.degree);
+    e.inputs = in.str();
+    e.has_solver = true;
+    e.solver_given = to_string(r.method_given);
+    e.solver_used = to_string(r.method_used);
+    e.status = to_string(rr.status);
+    e.message = rr.reason;
+    e.result = mixed_ring_json(r, fleet.size());
+    std::ostringstream out;
+    out << "fleet      " << (args.fleet.empty() ? args.pattern : args.fleet) << ": " << fleet.size() << " cars, speed "
+        << rounded(r.equilibrium.speed, 6) << " m/s, ring length " << rounded(r.equilibrium.length, 8) << " m\n";
+    out << "solver     " << to_string(r.method_used) << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations
+        << " LU factorisations (" << to_string(rr.status) << ")\n";
+    out << "trusted    " << rr.reason << "\n";
+    out << "trivial    "
+        << (r.trivial_found ? "lambda = 0 found (|lambda| = " + rounded(r.trivial_root, 3) + "), left out"
+                            : std::string("not among the rightmost roots"))
+        << "\n";
+    if (!std::isnan(r.product_residual)) out << "check      max |prod Gamma_i(lambda) - 1| = " << rounded(r.product_residual, 3) << "\n";
+    out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
+    if (rr.status != RootStatus::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
+    else
+        out << "verdict    " << (r.stable ? "STABLE" : "UNSTABLE") << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
+            << " unstable roots)\n\n";
+    out << roots_table(rr.roots);
+    emit(e, roots_csv(rr.roots), out.str(), format, prefix);
+    return exit_code(rr.status);
+}
+
+int run_ring(Format format, const std::string& prefix) {
+    if (args.solver != "auto" || args.degree != "0" || !args.length.empty() || !args.cars.empty())
+        throw BadInput("--solver, --degree, --length and --cars go with --fleet, --fleet-pattern or --system; a ring of identical cars has one method");
+    const auto model = args.model.build();
+    const int cars = args.ring.parse();
+    RingOptions opt;
+    opt.roots.count = parse_count();
+    const RingResult r = analyse_ring(model->linearise(), cars, opt);
+    JsonEnvelope e;
+    e.command = "roots";
+    e.inputs = model_inputs(*model).json("ring", json_ring(cars)).integer("count", opt.roots.count).str();
+    e.status = to_string(r.status);
+    e.message = r.reason;
+    e.result = ring_roots_json(r);
+    std::ostringstream out;
+    out << "model      " << model->name();
+    for (const auto& [k, v] : model->parameters()) out << " " << k << "=" << rounded(v, 6);
+    out << "\n";
+    out << "ring       N = " << ring_name(cars) << "\n";
+    out << "degree     M = " << r.degree << " (" << to_string(r.status) << ")\n";
+    out << "trivial    lambda = 0 in mode 0 (ring-length invariance), excluded from the verdict\n";
+    out << "abscissa   " << rounded(r.spectral_abscissa, 10);
+    if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
+    else out << " (mode " << r.abscissa_mode << ")";
+    out << "\n";
+    if (r.status != RootStatus::Converged) {
+        out << "verdict    ring UNDECIDED (" << to_string(r.status) << ")";
+    } else {
+        out << "verdict    ring " << (r.stable ? "STABLE" : "UNSTABLE");
+        if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
+    }
+    out << "\n\n";
+    out << "  #   mode        theta                re                 im    residual\n";
+    int i = 0;
+    for (const auto& x : r.roots) {
+        char line[200];
+        std::snprintf(line, sizeof line, "%3d %6s %12.6f %17.12f %18.12f %11.2e\n", ++i, x.mode < 0 ? "-" : std::to_string(x.mode).c_str(),
+                      x.theta, x.root.value.real(), x.root.value.imag(), x.root.residual);
+        out << line;
+    }
+    emit(e, ring_roots_csv(r), out.str(), format, prefix);
+    return exit_code(r.status);
+}
+
+}  // namespace
+
+void add_roots_flags(CLI::App& app) {
+    args.model.add_to(app);
+    args.ring.add_to(app, "22",
+                     "ring size N >= 2 (time grows linearly: about 0.3 ms per mode, N/2+1 modes), or inf for all wave numbers; "
+                     "with --fleet-pattern: the number of cars (default: the pattern once)");
+    app.add_option("--count", args.count, "how many rightmost roots to list")->capture_default_str();
+    app.add_option("--system", args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
+    app.add_option("--fleet", args.fleet, "a mixed ring from a CSV file (one row per car: vehicle and/or model and parameters, optional count; see README)");
+    app.add_option("--fleet-pattern", args.pattern, "a mixed ring from calibrated vehicles, e.g. \"A_min,C_max*3,E_min\", repeated to --ring cars");
+    app.add_option("--cars", args.cars, "old spelling of --ring for --fleet-pattern")->group("");
+    app.add_option("--length", args.length, "fleet: ring length [m] (sum of the gaps); the speed follows");
+    app.add_option("--solver", args.solver,
+                   "--fleet: auto (product for cars that react only to the car ahead, else dense up to 8 cars and sparse beyond), "
+                   "product, dense or sparse; --system: auto (dense up to 16 states), dense or sparse")
+        ->capture_default_str();
+    app.add_option("--degree", args.degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")
+        ->capture_default_str();
+    args.format.add_to(app);
+    args.out.add_to(app, "PREFIX.csv (the roots) and PREFIX.json", false);
+}
+
+int run_roots() {
+    const Format format = args.format.parse();
+    const std::string prefix = args.out.given() ? args.out.prepare("roots") : std::string();
+    if (!args.fleet.empty() || !args.pattern.empty()) return run_fleet(format, prefix);
+    if (!args.system.empty()) return run_system(format, prefix);
+    return run_ring(format, prefix);
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,85 @@
+// string: plant and string stability of identical cars (model flags), optionally the ring
+// verdict for --ring N|inf.
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/svg.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+struct Args {
+    ModelArgs model;
+    RingArg ring;
+    FormatArg format;
+    OutArg out;
+} args;
+}  // namespace
+
+void add_string_flags(CLI::App& app) {
+    args.model.add_to(app);
+    args.ring.add_to(app, "", "also decide ring stability for N cars (N >= 2 or inf)");
+    args.format.add_to(app);
+    args.out.add_to(app, "PREFIX.csv and PREFIX.json", false);
+}
+
+int run_string() {
+    const auto model = args.model.build();
+    const Format format = args.format.parse();
+    std::optional<int> cars;
+    if (!args.ring.empty()) cars = args.ring.parse();
+    const std::string prefix = args.out.given() ? args.out.prepare("string") : std::string();
+    const Linearisation lin = model->linearise();
+    const StringResult s = analyse_string(lin);
+    std::optional<RingResult> ring;
+    if (cars) ring = analyse_ring(lin, *cars);
+    const RingResult* rp = ring ? &*ring : nullptr;
+    RootStatus status = s.plant_roots.status;
+    if (ring && ring->status != RootStatus::Converged) status = ring->status;
+
+    JsonEnvelope e;
+    e.command = "string";
+    JsonObject in = model_inputs(*model);
+    if (cars) in.json("ring", json_ring(*cars));
+    e.inputs = in.str();
+    e.status = to_string(status);
+    e.message = ring && ring->status != RootStatus::Converged ? ring->reason : s.plant_roots.reason;
+    e.result = string_json(s, rp);
+    const std::string csv = string_csv(s, rp);
+    if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    if (format == Format::Json) {
+        print_json(e);
+    } else if (format == Format::Csv) {
+        std::cout << csv;
+    } else {
+        std::ostringstream out;
+        out << "model            " << model->name();
+        for (const auto& [k, v] : model->parameters()) out << " " << k << "=" << rounded(v, 6);
+        out << "\n";
+        out << "plant            " << (s.plant_stable ? "stable" : "UNSTABLE") << "   (rightmost root of D: Re = " << rounded(s.plant_abscissa, 6)
+            << ")\n";
+        out << "sup |Gamma(iw)|  " << rounded(s.sup_gamma, 10);
+        if (s.omega_peak > 0.0) out << " at w = " << rounded(s.omega_peak, 8) << " rad/s";
+        else out << " (only approached as w -> 0)";
+        out << "\n";
+        out << "low frequency    c" << s.lowfreq.decisive_order << " = " << rounded(s.lowfreq_margin, 6)
+            << (s.lowfreq.attenuates ? "  (attenuates as w -> 0)" : "  (AMPLIFIES as w -> 0)") << "\n";
+        if (ring) {
+            char label[32];
+            std::snprintf(label, sizeof label, "%-17s", ("ring N=" + ring_name(*cars)).c_str());
+            out << label << (ring->stable ? "stable" : "UNSTABLE") << "   (spectral abscissa " << rounded(ring->spectral_abscissa, 6) << ")\n";
+        }
+        out << "verdict          string " << (s.string_stable ? "STABLE" : "UNSTABLE") << "\n";
+        std::cout << out.str();
+    }
+    return exit_code(status);
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,95 @@
+// sweep: a grid over two model parameters (LO:HI:COUNT), the boundaries, the chart.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "sweep_flags.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/svg.hpp"
+#include "ddemap/study/boundary.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+struct Args {
+    ModelArgs model;
+    RingArg ring;
+    std::string x;
+    bool no_boundaries = false;
+    FormatArg format;
+    OutArg out;
+} args;
+
+void progress_line(int done, int total) {
+    std::fprintf(stderr, "\rsweep: %d/%d rows", done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+}
+}  // namespace
+
+void add_sweep_flags(CLI::App& app) {
+    args.model.add_to(app);
+    args.ring.add_to(app, "22", "ring size N >= 2, or inf");
+    args.out.add_to(app, "PREFIX.csv, PREFIX.json, PREFIX.svg, PREFIX-boundaries.csv", true);
+    app.add_option("--x", args.x, "which swept parameter is the horizontal axis (default: alphabetical)");
+    app.add_flag("--no-boundaries", args.no_boundaries, "skip the boundary continuation");
+    args.format.add_to(app);
+}
+
+int run_sweep() {
+    const Format format = args.format.parse();
+    const SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
+    const std::string prefix = args.out.prepare("sweep");
+    ExecutionPolicy policy;
+    if (isatty(2)) policy.progress = progress_line;
+    const SweepResult sw = run_sweep(spec, policy);
+    BoundarySet b;
+    if (!args.no_boundaries) b = trace_boundaries(sw);
+    const BoundarySet* bp = args.no_boundaries ? nullptr : &b;
+    ChartOptions co;
+    co.title = "Stability chart: " + fixed_title(spec);
+    co.columns = 1;
+    co.panel_width = 520;
+    co.panel_height = 440;
+    ChartPanel panel;
+    panel.title = fixed_title(spec);
+    panel.sweep = &sw;
+    panel.boundaries = bp;
+    JsonEnvelope e;
+    e.command = "sweep";
+    e.inputs = sweep_inputs(spec).boolean("boundaries", !args.no_boundaries).str();
+    e.status = sw.uncertified > 0 ? "uncertified" : "converged";
+    e.message = sw.uncertified > 0 ? std::to_string(sw.uncertified) + " points have no certificate even after collocation (see their 'certified' column)" : "";
+    e.result = sweep_json(sw, bp);
+    const std::string csv = sweep_csv(sw);
+    std::vector<std::pair<std::string, std::string>> files = {
+        {prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", render_chart_svg({panel}, co)}};
+    if (bp) files.emplace_back(prefix + "-boundaries.csv", boundary_csv(spec, b));
+    write_files_atomic(files);
+    if (format == Format::Json) {
+        print_json(e);
+    } else if (format == Format::Csv) {
+        std::cout << csv;
+    } else {
+        int classes[4] = {0, 0, 0, 0};
+        for (const auto& p : sw.points) ++classes[region_class(p)];
+        std::ostringstream out;
+        out << "sweep      " << sw.points.size() << " points in " << rounded(sw.seconds, 3) << " s ("
+            << static_cast<long>(std::lround(sw.points.size() / std::max(sw.seconds, 1e-9))) << " points/s, " << sw.threads << " threads)\n";
+        out << "regions    plant unstable " << classes[0] << ", ring unstable " << classes[1] << ", string unstable " << classes[2]
+            << ", string stable " << classes[3] << "\n";
+        if (bp) out << "boundaries " << b.curves.size() << " curves\n";
+        out << "wrote      ";
+        for (const auto& f : files) out << f.first << " ";
+        out << "\n";
+        std::cout << out.str();
+    }
+    return sw.uncertified > 0 ? exit_not_converged : exit_ok;
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,54 @@
+#include "sweep_flags.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+namespace ddemap::cli {
+
+SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::string& x_name, bool counts, int grid) {
+    SweepSpec spec;
+    spec.model = margs.model;
+    std::vector<std::pair<std::string, std::string>> axes;
+    margs.split(spec.fixed, axes);
+    if (axes.size() != 2) {
+        throw BadInput(std::string("expected exactly two swept parameters given as ") + (counts ? "LO:HI:COUNT" : "LO:HI") + " (e.g. --k1 0.01:1" +
+                       (counts ? ":200" : "") + " --k2 0.01:1" + (counts ? ":200" : "") + "), got " + std::to_string(axes.size()));
+    }
+    if (!x_name.empty()) {
+        if (axes[1].first == x_name) std::swap(axes[0], axes[1]);
+        if (axes[0].first != x_name) throw BadInput("--x = '" + x_name + "': expected one of the swept parameters");
+    }
+    for (int i = 0; i < 2; ++i) {
+        if (!counts && std::count(axes[i].second.begin(), axes[i].second.end(), ':') != 1)
+            throw BadInput("--" + axes[i].first + " = '" + axes[i].second + "': expected LO:HI with finite LO < HI");
+        const std::string text = counts ? axes[i].second : axes[i].second + ":" + std::to_string(grid);
+        try {
+            (i == 0 ? spec.x : spec.y) = parse_axis(axes[i].first, text);
+        } catch (const std::invalid_argument& e) {
+            throw BadInput("--" + std::string(e.what()));  // the library names the parameter; the flag is --NAME
+        }
+    }
+    spec.cars = ring.parse();
+    spec.validate();
+    return spec;
+}
+
+std::string fixed_title(const SweepSpec& spec) {
+    std::ostringstream t;
+    t << spec.model;
+    for (const auto& [k, v] : spec.fixed) t << ", " << k << " = " << rounded(v, 4);
+    t << ", N = " << ring_name(spec.cars);
+    return t.str();
+}
+
+JsonObject sweep_inputs(const SweepSpec& spec) {
+    auto axis = [](const Axis& a) {
+        return JsonObject().string("name", a.name).number("lo", a.lo).number("hi", a.hi).integer("count", a.count).str();
+    };
+    JsonObject o;
+    o.string("model", spec.model).json("fixed", json_parameters(spec.fixed)).json("x", axis(spec.x)).json("y", axis(spec.y))
+        .json("ring", json_ring(spec.cars));
+    return o;
+}
+
+}  // namespace ddemap::cli

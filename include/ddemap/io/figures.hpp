@@ -1,0 +1,31 @@
+#pragma once
+/// \file figures.hpp
+/// The figures of the studies (SVG text; formatting only): platoon speeds, disturbance growth,
+/// calibration fits, the penetration-rate study, and the classification chart's spec.
+
+#include <string>
+#include <vector>
+
+#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/io/chart_spec.hpp"
+#include "ddemap/study/growth.hpp"
+#include "ddemap/study/penetration.hpp"
+
+namespace ddemap {
+
+/// Speeds of every car over time, events marked.
+std::string simulation_svg(const SimResult& r, const std::string& lead);
+/// Minimum gap and amplification by position, failures marked.
+std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& lead);
+/// Measured and simulated follower speed and gap, one pair of panels per trace.
+std::string calibration_svg(const std::vector<std::string>& names, const std::vector<Trace>& traces,
+                            const std::vector<CalibrationResult>& fits);
+/// Spectral abscissa against the fraction of X cars (min/max over arrangements when drawn).
+std::string mix_svg(const std::vector<MixPoint>& points, const MixOptions& options, const std::string& x_label,
+                    const std::string& y_label);
+/// The classification figure's spec: `base` (maps/classification.toml) with one panel per
+/// vehicle and the ring size `cars`.
+ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars);
+
+}  // namespace ddemap

@@ -1,0 +1,96 @@
+#pragma once
+/// \file json.hpp
+/// JSON writers (formatting only), shared by the command-line front and any other front end:
+/// a small object builder, the one envelope of every command's JSON output, and the `result`
+/// member of each analysis. Every builder returns JSON text; numbers are written so that they
+/// read back to the same double, non-finite numbers as null. One set of key names for one
+/// quantity: spectral_abscissa, ring_stable, string_stable, plant_stable, sup_gamma,
+/// degree, degree_reason, status, ...
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/system_roots.hpp"
+#include "ddemap/study/boundary.hpp"
+#include "ddemap/study/growth.hpp"
+#include "ddemap/study/penetration.hpp"
+#include "ddemap/study/sweep.hpp"
+
+namespace ddemap {
+
+/// A JSON object built key by key, keys in insertion order.
+class JsonObject {
+public:
+    JsonObject& number(const std::string& key, double v);  ///< non-finite: null
+    JsonObject& integer(const std::string& key, long long v);
+    JsonObject& boolean(const std::string& key, bool v);
+    JsonObject& string(const std::string& key, const std::string& v);
+    JsonObject& null(const std::string& key);
+    JsonObject& json(const std::string& key, const std::string& json_text);  ///< JSON text from another builder
+    bool empty() const { return m_items.empty(); }
+    std::string str() const;  ///< compact JSON text
+
+private:
+    std::vector<std::pair<std::string, std::string>> m_items;  // key, JSON text
+};
+
+/// A JSON array of JSON texts.
+std::string json_array(const std::vector<std::string>& items);
+/// A JSON number (non-finite: null).
+std::string json_number(double v);
+/// A JSON string (quoted and escaped).
+std::string json_string(const std::string& s);
+/// A ring size: N, or "inf" for 0.
+std::string json_ring(int cars);
+/// A model's parameters as an object.
+std::string json_parameters(const ParameterMap& p);
+
+/// The one envelope of every command's JSON output:
+/// {"command", "version", "inputs", "solver": {"given", "used"} or null, "status", "message", "result"}.
+struct JsonEnvelope {
+    std::string command;
+    std::string inputs = "{}";       ///< JSON text: the parsed inputs
+    bool has_solver = false;         ///< false: "solver": null (no solver choice)
+    std::string solver_given, solver_used;
+    std::string status = "converged";
+    std::string message;
+    std::string result = "{}";       ///< JSON text
+};
+
+/// Pretty-printed (indent 2) with a trailing newline.
+std::string envelope_json(const JsonEnvelope& e);
+
+// ------------------------------------------------------------------ results
+
+/// roots of a ring of identical cars (analyse_ring)
+std::string ring_roots_json(const RingResult& r);
+/// roots of any linear DDE (analyse_system)
+std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& r);
+/// roots of a mixed ring (analyse_mixed_ring)
+std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars);
+/// string stability, with the ring verdict when `ring` is given
+std::string string_json(const StringResult& s, const RingResult* ring);
+/// one object per vehicle: parameters, the three verdicts, sup_gamma, ...
+std::string classification_json(const std::vector<Classification>& rows, int cars, const std::string& source);
+/// the summary of a sweep (and its boundaries): inputs, method, degree, timings, region counts
+std::string sweep_json(const SweepResult& sw, const BoundarySet* b);
+/// the boundary curves' summary
+std::string boundary_json(const BoundarySet& b);
+/// a platoon simulation's summary: per car lowest_speed, speed_drop, min_gap, events
+std::string simulation_json(const SimResult& r, const std::string& lead);
+/// the growth study: per vehicle setting amplification by position and the failure
+std::string growth_json(const std::vector<GrowthResult>& g, const std::string& lead);
+/// calibration fits: {"fits": [...], "gap_weight", "bounds"}
+std::string calibration_json(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
+                             const CalibrationOptions& o);
+/// the penetration-rate study: one object per p
+std::string mix_json(const std::vector<MixPoint>& points, int cars);
+
+}  // namespace ddemap

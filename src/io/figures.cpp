@@ -1,0 +1,128 @@
+#include "ddemap/io/figures.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "ddemap/io/svg.hpp"
+
+namespace ddemap {
+
+namespace {
+std::string rounded(double v, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v == 0.0 ? 0.0 : v);
+    return buf;
+}
+}  // namespace
+
+std::string simulation_svg(const SimResult& r, const std::string& lead) {
+    PlotPanel p{"Speeds", "time [s]", "speed [m/s]", {}, {}};
+    for (std::size_t c = 0; c < r.speed.size(); ++c) {
+        PlotSeries sr{c == 0 ? "lead" : "car " + std::to_string(c) + " (" + r.cars[c - 1].name + ")", r.time, r.speed[c],
+                      c == 0 ? "#000000" : "", c == 0};
+        p.series.push_back(sr);
+    }
+    for (const auto& ev : r.events)
+        p.markers.push_back({ev.time, ev.speed, ev.type == "collision" ? "#d62728" : "#000000", ev.type + " car " + std::to_string(ev.car)});
+    PlotOptions po;
+    po.title = "Platoon behind the '" + lead + "' lead profile";
+    po.columns = 1;
+    po.panel_width = 760;
+    po.panel_height = 340;
+    return render_line_plots_svg({p}, po);
+}
+
+std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& lead) {
+    PlotPanel gap{"Minimum gap", "position in the platoon", "minimum gap [m]", {}, {}};
+    PlotPanel amp{"Disturbance amplification", "position in the platoon", "speed drop / lead's drop [1]", {}, {}};
+    for (const auto& r : g) {
+        PlotSeries a{r.name, {}, {}, "", r.name.find("max") != std::string::npos};
+        PlotSeries b = a;
+        for (std::size_t i = 0; i < r.amplification.size(); ++i) {
+            a.x.push_back(i + 1.0);
+            a.y.push_back(r.min_gap[i]);
+            b.x.push_back(i + 1.0);
+            b.y.push_back(r.amplification[i]);
+        }
+        if (r.failed_at) {
+            const std::string colour = r.failure == "collision" ? "#d62728" : "#000000";
+            a.x.push_back(r.failed_at);
+            a.y.push_back(r.failure_gap);
+            b.x.push_back(r.failed_at);
+            b.y.push_back(r.failure_amplification);
+            gap.markers.push_back({double(r.failed_at), r.failure_gap, colour, ""});
+            amp.markers.push_back({double(r.failed_at), r.failure_amplification, colour, ""});
+        }
+        gap.series.push_back(a);
+        amp.series.push_back(b);
+    }
+    PlotOptions o;
+    o.title = "Disturbance growth behind the '" + lead + "' lead profile (calibrated OVRV platoons)";
+    o.note = "black x: ACC disengages (speed below the minimum ACC speed); red x: gap reaches zero (collision); dashed: max setting";
+    return render_line_plots_svg({gap, amp}, o);
+}
+
+std::string calibration_svg(const std::vector<std::string>& names, const std::vector<Trace>& traces,
+                            const std::vector<CalibrationResult>& fits) {
+    std::vector<PlotPanel> panels;
+    for (std::size_t i = 0; i < fits.size() && i < traces.size(); ++i) {
+        const Trace& t = traces[i];
+        const std::string name = i < names.size() ? names[i] : t.source;
+        PlotPanel sp{name + ": speed", "time [s]", "speed [m/s]", {}, {}};
+        sp.series.push_back({"lead (measured)", t.t, t.lead, "#7f7f7f", true});
+        sp.series.push_back({"follower (measured)", t.t, t.speed, "#000000", false});
+        sp.series.push_back({"follower (model)", t.t, fits[i].sim_speed, "#d62728", false});
+        PlotPanel gp{name + ": gap", "time [s]", "gap [m]", {}, {}};
+        gp.series.push_back({"follower (measured)", t.t, t.gap, "#000000", false});
+        gp.series.push_back({"follower (model)", t.t, fits[i].sim_gap, "#d62728", false});
+        panels.push_back(sp);
+        panels.push_back(gp);
+    }
+    PlotOptions po;
+    po.title = "Calibrated OVRV: measured and simulated follower";
+    po.columns = 2;
+    return render_line_plots_svg(panels, po);
+}
+
+std::string mix_svg(const std::vector<MixPoint>& pts, const MixOptions& o, const std::string& x_label,
+                    const std::string& y_label) {
+    PlotSeries spread{"evenly spread", {}, {}, "#1f77b4", false}, lo{"min over arrangements", {}, {}, "#7f7f7f", true},
+        hi{"max over arrangements", {}, {}, "#7f7f7f", true}, zero{"stability boundary", {}, {}, "#000000", true};
+    for (const auto& pt : pts) {
+        const double p = static_cast<double>(pt.x_cars) / o.cars;
+        spread.x.push_back(p);
+        spread.y.push_back(pt.abscissa);
+        lo.x.push_back(p);
+        lo.y.push_back(pt.abscissa_min);
+        hi.x.push_back(p);
+        hi.y.push_back(pt.abscissa_max);
+    }
+    zero.x = {0.0, 1.0};
+    zero.y = {0.0, 0.0};
+    PlotPanel panel{"Ring of " + std::to_string(o.cars) + " cars: X = " + x_label + ", Y = " + y_label, "fraction of X cars p = k / N",
+                    "spectral abscissa [1/s] (trivial root excluded)", {spread}, {}};
+    if (o.draws > 0) {
+        panel.series.push_back(lo);
+        panel.series.push_back(hi);
+    }
+    panel.series.push_back(zero);
+    PlotOptions po;
+    po.columns = 1;
+    po.panel_width = 560.0;
+    po.panel_height = 320.0;
+    po.title = "Penetration-rate study (" +
+               std::string(std::isnan(o.ring.length) ? "speed " + rounded(o.ring.speed, 4) + " m/s" : "length " + rounded(o.ring.length, 6) + " m") + ")";
+    po.note = "above 0: the ring is unstable (a small disturbance grows)";
+    return render_line_plots_svg({panel}, po);
+}
+
+ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars) {
+    ChartSpec spec = base;
+    spec.panels = vehicle_panels(vehicles);
+    spec.cars = cars;
+    if (cars != 22)
+        spec.title = "Calibrated vehicles on their own stability charts, N = " + (cars == 0 ? std::string("inf") : std::to_string(cars));
+    return spec;
+}
+
+}  // namespace ddemap

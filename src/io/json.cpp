@@ -1,0 +1,330 @@
+#include "ddemap/io/json.hpp"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "ddemap/io/svg.hpp"  // region_class
+
+namespace ddemap {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json ring_value(int cars) { return cars == 0 ? json("inf") : json(cars); }
+json params(const ParameterMap& p) {
+    json o = json::object();
+    for (const auto& [k, v] : p) o[k] = num(v);
+    return o;
+}
+std::string text(const json& j) { return j.dump(); }
+
+}  // namespace
+
+JsonObject& JsonObject::number(const std::string& key, double v) {
+    m_items.emplace_back(key, num(v).dump());
+    return *this;
+}
+JsonObject& JsonObject::integer(const std::string& key, long long v) {
+    m_items.emplace_back(key, nlohmann::ordered_json(v).dump());
+    return *this;
+}
+JsonObject& JsonObject::boolean(const std::string& key, bool v) {
+    m_items.emplace_back(key, v ? "true" : "false");
+    return *this;
+}
+JsonObject& JsonObject::string(const std::string& key, const std::string& v) {
+    m_items.emplace_back(key, nlohmann::ordered_json(v).dump());
+    return *this;
+}
+JsonObject& JsonObject::null(const std::string& key) {
+    m_items.emplace_back(key, "null");
+    return *this;
+}
+JsonObject& JsonObject::json(const std::string& key, const std::string& json_text) {
+    m_items.emplace_back(key, json_text);
+    return *this;
+}
+std::string JsonObject::str() const {
+    std::string s = "{";
+    for (std::size_t i = 0; i < m_items.size(); ++i) {
+        if (i) s += ",";
+        s += ddemap::json_string(m_items[i].first) + ":" + m_items[i].second;
+    }
+    return s + "}";
+}
+
+std::string json_array(const std::vector<std::string>& items) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < items.size(); ++i) s += (i ? "," : "") + items[i];
+    return s + "]";
+}
+std::string json_number(double v) { return num(v).dump(); }
+std::string json_string(const std::string& s) { return nlohmann::json(s).dump(); }
+std::string json_ring(int cars) { return ring_value(cars).dump(); }
+std::string json_parameters(const ParameterMap& p) { return params(p).dump(); }
+
+std::string envelope_json(const JsonEnvelope& e) {
+    json j;
+    j["command"] = e.command;
+    j["version"] = DDEMAP_VERSION;
+    j["inputs"] = json::parse(e.inputs);
+    j["solver"] = e.has_solver ? json{{"given", e.solver_given}, {"used", e.solver_used}} : json(nullptr);
+    j["status"] = e.status;
+    j["message"] = e.message;
+    j["result"] = json::parse(e.result);
+    return j.dump(2) + "\n";
+}
+
+namespace {
+json root_json(const Root& x) {
+    return {{"re", num(x.value.real())}, {"im", num(x.value.imag())}, {"residual", num(x.residual)}, {"newton_step", num(x.newton_step)}};
+}
+}  // namespace
+
+std::string ring_roots_json(const RingResult& r) {
+    json j;
+    j["ring"] = ring_value(r.cars);
+    json roots = json::array();
+    for (const auto& x : r.roots) {
+        json o;
+        o["re"] = num(x.root.value.real());
+        o["im"] = num(x.root.value.imag());
+        o["mode"] = x.mode < 0 ? json(nullptr) : json(x.mode);
+        o["theta"] = num(x.theta);
+        o["residual"] = num(x.root.residual);
+        o["newton_step"] = num(x.root.newton_step);
+        roots.push_back(o);
+    }
+    j["roots"] = roots;
+    j["spectral_abscissa"] = num(r.spectral_abscissa);
+    j["abscissa_mode"] = r.abscissa_mode < 0 ? json(nullptr) : json(r.abscissa_mode);
+    j["abscissa_theta"] = num(r.abscissa_theta);
+    j["abscissa_is_limit"] = r.abscissa_is_limit;
+    j["ring_stable"] = r.stable;
+    j["ring_margin"] = num(-r.spectral_abscissa);
+    j["unstable_roots"] = r.unstable_roots < 0 ? json(nullptr) : json(r.unstable_roots);
+    j["marginal_roots"] = r.marginal_roots;
+    j["trivial_root"] = {{"re", 0.0}, {"im", 0.0}, {"mode", 0}, {"excluded", true},
+                         {"meaning", "ring-length invariance (family of equilibria)"}};
+    j["degree"] = r.degree;
+    j["degree_reason"] = r.reason;
+    j["modes_solved"] = r.modes_solved;
+    return text(j);
+}
+
+std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& s) {
+    const RootResult& r = s.roots;
+    json j;
+    j["dimension"] = dde.dimension();
+    json delays = json::array();
+    for (const auto& t : dde.delayed()) delays.push_back(t.delay);
+    j["delays"] = delays;
+    json roots = json::array();
+    for (const auto& x : r.roots) roots.push_back(root_json(x));
+    j["roots"] = roots;
+    j["spectral_abscissa"] = num(s.spectral_abscissa);
+    j["stable"] = s.stable;
+    j["degree"] = r.degree;
+    j["degree_reason"] = r.reason;
+    j["strip_floor"] = num(r.strip_floor);
+    return text(j);
+}
+
+std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
+    const SparseRootResult& rr = r.roots;
+    json j;
+    j["ring"] = cars;
+    j["speed"] = num(r.equilibrium.speed);
+    j["length"] = num(r.equilibrium.length);
+    json roots = json::array();
+    for (std::size_t i = 0; i < rr.roots.size(); ++i) {
+        json o = root_json(rr.roots[i]);
+        const cplx eig = i < rr.eigenvalues.size() ? rr.eigenvalues[i] : rr.roots[i].value;
+        o["eigenvalue_re"] = num(eig.real());
+        o["eigenvalue_im"] = num(eig.imag());
+        roots.push_back(o);
+    }
+    j["roots"] = roots;
+    j["trivial_root_found"] = r.trivial_found;
+    j["trivial_root_abs"] = num(r.trivial_root);
+    j["spectral_abscissa"] = num(r.spectral_abscissa);
+    j["ring_stable"] = r.stable;
+    j["ring_margin"] = num(-r.spectral_abscissa);
+    j["unstable_roots"] = r.unstable_roots;
+    j["unstable_count_complete"] = r.unstable_count_complete;
+    j["product_residual"] = num(r.product_residual);
+    j["degree"] = rr.degree;
+    j["degree_reason"] = rr.reason;
+    j["strip_floor"] = num(rr.strip_floor);
+    j["right_bound"] = num(rr.right_bound);
+    j["shifts"] = rr.shifts;
+    j["factorizations"] = rr.factorizations;
+    j["max_residual"] = num(rr.max_residual);
+    j["collocation_error"] = num(rr.collocation_error);
+    return text(j);
+}
+
+std::string string_json(const StringResult& s, const RingResult* ring) {
+    json j;
+    j["plant_stable"] = s.plant_stable;
+    j["plant_abscissa"] = num(s.plant_abscissa);
+    j["plant_margin"] = num(-s.plant_abscissa);
+    j["sup_gamma"] = num(s.sup_gamma);
+    j["omega_peak"] = num(s.omega_peak);
+    j["peak_margin"] = num(s.peak_margin);
+    j["lowfreq_margin"] = num(s.lowfreq_margin);
+    j["lowfreq"] = {{"c2", num(s.lowfreq.c2)}, {"c4", num(s.lowfreq.c4)}, {"c6", num(s.lowfreq.c6)},
+                    {"c8", num(s.lowfreq.c8)}, {"decisive_order", s.lowfreq.decisive_order},
+                    {"attenuates", s.lowfreq.attenuates}};
+    j["string_stable"] = s.string_stable;
+    json peaks = json::array();
+    for (const auto& p : s.peaks) peaks.push_back({{"omega", num(p.omega)}, {"gain", num(p.gain)}});
+    j["peaks"] = peaks;
+    j["omega_search_max"] = num(s.omega_search_max);
+    j["plant_degree"] = s.plant_roots.degree;
+    if (ring) {
+        j["ring"] = ring_value(ring->cars);
+        j["ring_stable"] = ring->stable;
+        j["spectral_abscissa"] = num(ring->spectral_abscissa);
+        j["ring_margin"] = num(-ring->spectral_abscissa);
+    }
+    return text(j);
+}
+
+std::string classification_json(const std::vector<Classification>& rows, int cars, const std::string& source) {
+    json j;
+    j["source"] = source;
+    j["ring"] = ring_value(cars);
+    json arr = json::array();
+    for (const auto& row : rows) {
+        json o;
+        o["name"] = row.vehicle.name;
+        for (const char* k : {"k1", "k2", "th", "tau", "eta"}) o[k] = num(row.vehicle.parameters.at(k));
+        o["plant_stable"] = row.string.plant_stable;
+        o["ring_stable"] = row.ring.stable;
+        o["string_stable"] = row.string.string_stable;
+        o["sup_gamma"] = num(row.string.sup_gamma);
+        o["omega_peak"] = num(row.string.omega_peak);
+        o["lowfreq_margin"] = num(row.string.lowfreq_margin);
+        o["spectral_abscissa"] = num(row.ring.spectral_abscissa);
+        o["plant_abscissa"] = num(row.string.plant_abscissa);
+        arr.push_back(o);
+    }
+    j["vehicles"] = arr;
+    return text(j);
+}
+
+std::string sweep_json(const SweepResult& sw, const BoundarySet* b) {
+    json j;
+    j["model"] = sw.spec.model;
+    json fixed = json::object();
+    for (const auto& [k, v] : sw.spec.fixed) fixed[k] = num(v);
+    j["fixed"] = fixed;
+    for (const auto* a : {&sw.spec.x, &sw.spec.y}) {
+        j[a == &sw.spec.x ? "x" : "y"] = {{"name", a->name}, {"lo", a->lo}, {"hi", a->hi}, {"count", a->count}};
+    }
+    j["ring"] = ring_value(sw.spec.cars);
+    j["points"] = sw.points.size();
+    int classes[4] = {0, 0, 0, 0};
+    for (const auto& p : sw.points) ++classes[region_class(p)];
+    j["regions"] = {{"plant_unstable", classes[0]}, {"ring_unstable", classes[1]}, {"string_unstable", classes[2]},
+                    {"string_stable", classes[3]}};
+    j["method"] =
+        "rightmost root of every ring mode and of the plant continued by Newton along grid rows, each certified by an "
+        "argument-principle count (no zero right of Re + 1e-10 max(1,|lambda|)); Chebyshev collocation where a "
+        "certificate fails";
+    j["degree"] = sw.degree_max;
+    j["fallbacks"] = sw.fallbacks;
+    j["uncertified_points"] = sw.uncertified;
+    j["threads"] = sw.threads;
+    j["seconds"] = sw.seconds;
+    j["points_per_second"] = sw.seconds > 0 ? sw.points.size() / sw.seconds : 0.0;
+    if (b) {
+        j["boundaries"] = {{"curves", b->curves.size()}, {"seeds", b->seeds}, {"rejected_seeds", b->rejected},
+                           {"seconds", b->seconds}};
+    }
+    return text(j);
+}
+
+std::string boundary_json(const BoundarySet& b) {
+    json curves = json::array();
+    for (std::size_t i = 0; i < b.curves.size(); ++i) {
+        const auto& c = b.curves[i];
+        curves.push_back({{"branch", i + 1}, {"kind", kind_name(c.kind)}, {"subkind", subkind_name(c.kind)},
+                          {"mode", c.kind == BoundaryKind::RingHopf ? json(c.mode) : json(nullptr)},
+                          {"points", c.points.size()}, {"max_residual", num(c.max_residual)}, {"closed", c.closed}});
+    }
+    return text(json{{"curves", curves}, {"seeds", b.seeds}, {"rejected_seeds", b.rejected}, {"seconds", b.seconds}});
+}
+
+std::string simulation_json(const SimResult& r, const std::string& lead) {
+    json j;
+    j["lead"] = lead;
+    j["initial_speed"] = num(r.initial_speed);
+    j["t_end"] = num(r.t_end);
+    j["stopped_at_event"] = r.stopped;
+    j["steps"] = r.steps;
+    json cs = json::array();
+    for (const auto& c : r.cars) {
+        json e = json::array();
+        for (const auto& ev : c.events)
+            e.push_back({{"type", ev.type}, {"time", num(ev.time)}, {"speed", num(ev.speed)}, {"gap", num(ev.gap)}});
+        cs.push_back({{"car", c.car}, {"name", c.name}, {"lowest_speed", num(c.min_speed)}, {"speed_drop", num(c.speed_drop)},
+                      {"min_gap", num(c.min_gap)}, {"events", e}});
+    }
+    j["cars"] = cs;
+    return text(j);
+}
+
+std::string growth_json(const std::vector<GrowthResult>& g, const std::string& lead) {
+    json arr = json::array();
+    for (const auto& r : g) {
+        arr.push_back({{"name", r.name}, {"speed_drop", r.speed_drop}, {"amplification", r.amplification}, {"min_gap", r.min_gap},
+                       {"failed_at", r.failed_at}, {"failure", r.failure}, {"failure_time", num(r.failure_time)}});
+    }
+    return text(json{{"lead", lead}, {"vehicles", arr}});
+}
+
+std::string calibration_json(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
+                             const CalibrationOptions& o) {
+    json arr = json::array();
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        const CalibrationResult& r = fits[i];
+        json j;
+        j["name"] = i < names.size() ? names[i] : std::string();
+        for (const char* k : {"k1", "k2", "th", "tau", "eta"}) j[k] = num(r.parameters.at(k));
+        j["rmse_speed"] = num(r.all.rmse_speed);
+        j["rmse_gap"] = num(r.all.rmse_gap);
+        j["train"] = {{"rmse_speed", num(r.train.rmse_speed)}, {"rmse_gap", num(r.train.rmse_gap)}, {"samples", r.train.samples}};
+        if (r.test.samples > 0)
+            j["test"] = {{"rmse_speed", num(r.test.rmse_speed)}, {"rmse_gap", num(r.test.rmse_gap)}, {"samples", r.test.samples}};
+        j["naive_rmse_speed"] = num(r.naive.rmse_speed);
+        j["naive_delay"] = num(r.naive_delay);
+        j["status"] = r.status;
+        j["evaluations"] = r.evaluations;
+        j["seconds"] = r.seconds;
+        arr.push_back(j);
+    }
+    json j;
+    j["fits"] = arr;
+    j["gap_weight"] = o.gap_weight;
+    j["bounds"] = json::object();
+    for (const auto& name : calibration_parameter_names()) j["bounds"][name] = {o.bound(name).lower, o.bound(name).upper};
+    return text(j);
+}
+
+std::string mix_json(const std::vector<MixPoint>& points, int cars) {
+    json arr = json::array();
+    for (const auto& pt : points) {
+        arr.push_back({{"p", num(pt.fraction)}, {"x_cars", pt.x_cars}, {"spectral_abscissa", num(pt.abscissa)},
+                       {"spectral_abscissa_min", num(pt.abscissa_min)}, {"spectral_abscissa_max", num(pt.abscissa_max)},
+                       {"speed", num(pt.speed)}, {"ring_stable", pt.stable}, {"unstable_roots", pt.unstable_roots},
+                       {"arrangements", pt.arrangements}, {"max_residual", num(pt.max_residual)}, {"status", to_string(pt.status)}});
+    }
+    return text(json{{"ring", cars}, {"points", arr}});
+}
+
+}  // namespace ddemap

@@ -1,0 +1,57 @@
+#include "ddemap/io/paper.hpp"
+
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/figures.hpp"
+#include "ddemap/io/json.hpp"
+
+namespace ddemap {
+
+namespace {
+const char* table_source = "the paper's calibration table (built in)";
+}
+
+PaperJob run_paper_job(const std::string& paper_toml, const std::string& paper_source, const std::string& classification_toml,
+                       const std::string& classification_source, const PaperStudyOptions& options) {
+    PaperJob job;
+    job.study = run_paper_study(options);
+    const ChartSpec base = parse_chart_spec(classification_toml, classification_source);
+    job.classification = render_chart(classification_chart(base, paper_calibration_table(), options.cars));
+    job.figure_spec = parse_chart_spec(paper_toml, paper_source);
+    job.figure = render_chart(job.figure_spec);
+    job.seconds = job.figure.seconds + job.classification.seconds;
+    return job;
+}
+
+std::vector<std::pair<std::string, std::string>> paper_files(const PaperJob& job, const std::string& prefix) {
+    std::vector<std::pair<std::string, std::string>> files;
+    const PaperStudy& s = job.study;
+    files.emplace_back(prefix + "-classification.csv", classification_csv(s.classification));
+    JsonEnvelope e;
+    e.command = "classify";
+    e.inputs = JsonObject().string("vehicles", table_source).json("ring", json_ring(s.options.cars)).str();
+    e.result = classification_json(s.classification, s.options.cars, table_source);
+    files.emplace_back(prefix + "-classification.json", envelope_json(e));
+    files.emplace_back(prefix + "-classification.svg", job.classification.svg);
+    files.emplace_back(prefix + ".svg", job.figure.svg);
+    for (std::size_t i = 0; i < job.figure.sweeps.size(); ++i) {
+        const std::string base = prefix + "-panel" + std::to_string(i + 1);
+        files.emplace_back(base + ".csv", sweep_csv(job.figure.sweeps[i]));
+        files.emplace_back(base + "-boundaries.csv", boundary_csv(job.figure.specs[i], job.figure.boundaries[i]));
+    }
+    files.emplace_back(prefix + "-growth.csv", growth_csv(s.growth));
+    files.emplace_back(prefix + "-growth.svg", growth_svg(s.growth, s.options.lead));
+    return files;
+}
+
+std::string paper_json(const PaperJob& job) {
+    std::vector<std::string> panels;
+    for (std::size_t i = 0; i < job.figure.sweeps.size(); ++i) panels.push_back(sweep_json(job.figure.sweeps[i], &job.figure.boundaries[i]));
+    return JsonObject()
+        .json("panels", json_array(panels))
+        .json("classification", classification_json(job.study.classification, job.study.options.cars, table_source))
+        .json("growth", growth_json(job.study.growth, job.study.options.lead))
+        .number("seconds", job.seconds)
+        .str();
+}
+
+}  // namespace ddemap
