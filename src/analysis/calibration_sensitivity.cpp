@@ -87,6 +87,12 @@ public:
                 for (int i = 0; i < m_n; ++i) y[i] = yc[i] + hh / 6.0 * (fc[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
                 // the derivative at the step's end, with the delayed inputs of this step (left limits)
                 rhs(te, y.data(), sd, f.data());
+                // a car that has come to rest stays at v = 0 whatever theta: S_v jumps to 0 there
+                // (S_v(t_e-) = -v'(t_e-) dt_e/dtheta; s is C^1, so S_s is continuous)
+                if (m_sens && m_stopped) {
+                    for (int i = 0; i < P; ++i) y[SS + P + i] = 0.0;
+                    rhs(te, y.data(), sd, f.data());
+                }
                 push(te, y.data(), f.data());
             }
             prev = target;
@@ -210,6 +216,7 @@ private:
         dy[0] = vl - y[1];
         double a = k1 * (s_d - eta - th * y[1]) + k2 * (vld - y[1]);
         const bool stopped = y[1] <= 0.0 && a < 0.0;  // standing cars do not roll backwards
+        m_stopped = stopped;
         if (stopped) a = 0.0;
         dy[1] = a;
         if (!m_sens) return;
@@ -233,6 +240,7 @@ private:
     double m_ta = 0.0, m_t0 = 0.0;
     std::vector<double> m_T, m_Y, m_F;
     std::size_t m_cur = 0;
+    bool m_stopped = false;  // at the last rhs evaluation
 };
 
 }  // namespace

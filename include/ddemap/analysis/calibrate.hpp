@@ -62,11 +62,11 @@ struct CalibrationOptions {
     int design_points = 64;
     int starts = 6;
     unsigned seed = 1;
-    int max_iterations = 100;  ///< Levenberg-Marquardt iterations per start
+    int max_iterations = 50;   ///< Levenberg-Marquardt iterations per start
     /// Convergence: the scaled projected gradient |P(z - g) - z|_inf <= gradient_tolerance, or a
     /// relative decrease of the objective below function_tolerance, or a scaled step below
     /// step_tolerance (z: parameters scaled to [0, 1] by their bounds).
-    double gradient_tolerance = 1e-10, function_tolerance = 1e-12, step_tolerance = 1e-9;
+    double gradient_tolerance = 1e-10, function_tolerance = 1e-9, step_tolerance = 1e-9;
     /// Profile likelihoods on request: for each name listed (e.g. "tau", "th") the objective
     /// minimised over the other free parameters at `profile_points` values of that one.
     std::vector<std::string> profile;
