@@ -386,9 +386,10 @@ std::string fmt3(double x) {
 
 }  // namespace
 
-CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
-    o.validate();
-    const auto t_start = std::chrono::steady_clock::now();
+namespace {
+
+/// The problem of `calibrate`: bounds, training window, residual samples (t >= t_a + tau_max).
+void set_up(LsqProblem& pb, const Trace& tr, const CalibrationOptions& o) {
     const double first = tr.t.front(), last = tr.t.back();
     double a = o.train_start < 0.0 ? first : o.train_start;
     double b = o.train_end < 0.0 ? last : o.train_end;
@@ -396,7 +397,6 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         throw std::invalid_argument("training window " + detail::format_number(a) + ":" + detail::format_number(b) + " s: expected at least 20 s within the file's " +
                                     detail::format_number(first) + ":" + detail::format_number(last) + " s");
     }
-    LsqProblem pb(tr);
     for (int i = 0; i < 5; ++i) {
         const BoundedParameter bd = o.bound(names[i]);
         pb.lo[i] = bd.lower;
@@ -411,6 +411,26 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     pb.first = static_cast<std::size_t>(std::lower_bound(tr.t.begin(), tr.t.end(), a) - tr.t.begin());
     for (std::size_t k = pb.first; k < tr.t.size() && tr.t[k] <= b; ++k)
         if (tr.t[k] >= pb.t_from) pb.rows.push_back(k - pb.first);
+}
+
+}  // namespace
+
+double calibration_objective(const Trace& tr, const ParameterMap& p, const CalibrationOptions& o) {
+    o.validate();
+    LsqProblem pb(tr);
+    set_up(pb, tr, o);
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    return pb.ssr(theta) / std::max(pb.samples(), 1);
+}
+
+CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
+    o.validate();
+    const auto t_start = std::chrono::steady_clock::now();
+    const double first = tr.t.front(), last = tr.t.back();
+    LsqProblem pb(tr);
+    set_up(pb, tr, o);
+    const double a = pb.a, b = pb.b;
     const int n = pb.samples();
     std::vector<int> free;
     for (int i = 0; i < 5; ++i)

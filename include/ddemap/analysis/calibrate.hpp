@@ -149,6 +149,12 @@ struct CalibrationResult {
 
 CalibrationResult calibrate(const Trace& trace, const CalibrationOptions& options = {});
 
+/// The objective `calibrate` minimises, at given parameters (k1, k2, th, tau, eta, each inside
+/// or outside the bounds): MSE(speed) + gap_weight MSE(gap) over the training samples at or
+/// after t_a + tau_max (tau_max: the upper bound of tau), so fits and other candidates (e.g.
+/// the true parameters of a synthetic trace) compare on the same samples.
+double calibration_objective(const Trace& trace, const ParameterMap& parameters, const CalibrationOptions& options = {});
+
 /// Simulates the follower over [t_a, t_b] of the trace (history from the data on
 /// [t_a, t_a + tau]); speed and gap at the trace's sample times in the window (data values
 /// before t_a + tau). A car at standstill does not roll backwards (v' = 0 when v <= 0 and
