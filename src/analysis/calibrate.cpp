@@ -150,7 +150,7 @@ struct LsqProblem {
 
     /// r (and J if asked); false when the simulation is not finite
     bool eval(const CalibrationVector& th, Eigen::VectorXd& r, Eigen::MatrixXd* J) const {
-        const FollowerTrajectory f = simulate_follower(tr, th, a, b, step, J != nullptr);
+        const FollowerTrajectory f = simulate_follower(tr, th, a, b, step, J != nullptr, t_from);
         ++evaluations;
         if (J) ++jacobians;
         const int n = samples();
@@ -325,10 +325,14 @@ std::vector<Eigen::VectorXd> latin_hypercube(int n, int p, unsigned seed) {
 }
 
 /// Errors over the samples of [t_a, t_b] at or after t_from.
+/// The simulation starts at max(t_start, t_a + tau).
 FitErrors errors_over(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double t_from, double step,
-                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr) {
-    std::vector<double> v, s;
-    simulate_follower(tr, p, t_a, t_b, step, v, s);
+                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr, double t_start = -1e300) {
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    FollowerTrajectory f = simulate_follower(tr, theta, t_a, t_b, step, false, t_start);
+    const std::vector<double>& v = f.speed;
+    const std::vector<double>& s = f.gap;
     FitErrors e;
     double sv = 0.0, sg = 0.0;
     std::size_t j = 0;
@@ -568,7 +572,7 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     }
 
     // 4. errors and the naive predictor
-    res.train = errors_over(tr, res.parameters, a, b, pb.t_from, o.step);
+    res.train = errors_over(tr, res.parameters, a, b, pb.t_from, o.step, nullptr, nullptr, pb.t_from);  // as the objective
     res.all = errors_over(tr, res.parameters, first, last, first + res.parameters.at("tau"), o.step, &res.sim_speed, &res.sim_gap);
     // the test part: the file outside the training window, each piece simulated from its own start
     FitErrors test;

@@ -37,10 +37,12 @@ class Integrator {
 public:
     Integrator(const Trace& tr, const CalibrationVector& th, bool sens) : m_tr(tr), m_p(th), m_n(sens ? NSENS : 2), m_sens(sens) {}
 
-    FollowerTrajectory run(double t_a, double t_b, double h_max) {
+    FollowerTrajectory run(double t_a, double t_b, double h_max, double t_start) {
         const double tau = m_p[3];
         m_ta = t_a;
-        m_t0 = t_a + tau;
+        // the start moves with tau only when the history window [t_a, t_a + tau] reaches past t_start
+        const bool moving = t_a + tau >= t_start;
+        m_t0 = moving ? t_a + tau : t_start;
         // breakpoints: samples and their delayed echoes in (t0, t_b], t0 + tau, t_b
         std::vector<double> bp;
         for (double t : m_tr.t) {
@@ -61,7 +63,7 @@ public:
         double prev = m_t0;
         StepData sd = step_data(m_t0, std::min(h_max, bp.empty() ? h_max : bp.front() - m_t0));
         rhs(m_t0, y.data(), sd, f.data());
-        if (m_sens) {
+        if (m_sens && moving) {
             y[SS + 3] = g0.slope - f[0];
             y[SS + P + 3] = v0.slope - f[1];
             rhs(m_t0, y.data(), sd, f.data());
@@ -246,9 +248,9 @@ private:
 }  // namespace
 
 FollowerTrajectory simulate_follower(const Trace& trace, const CalibrationVector& theta, double t_a, double t_b, double step,
-                                     bool sensitivities) {
+                                     bool sensitivities, double t_start) {
     Integrator in(trace, theta, sensitivities);
-    return in.run(t_a, t_b, step);
+    return in.run(t_a, t_b, step, t_start);
 }
 
 }  // namespace ddemap

@@ -2,7 +2,9 @@
 /// \file calibrate.hpp
 /// Calibration of OVRV with sensing delay from a measured car-following trace (the seed paper's
 /// eq. 7, MATH.md section 9): the follower is simulated from the measured history on
-/// [t_a, t_a + tau], driven by the measured lead speed, and the sum of squares of the residuals
+/// [t_a, t_a + tau_max] (tau_max: the upper bound of tau; a start that does not move with tau
+/// keeps the objective smooth in tau), driven by the measured lead speed, and the sum of
+/// squares of the residuals at the samples after t_a + tau_max
 ///     r_j = ( v(t_j) - v_m(t_j),  sqrt(w_gap) (s(t_j) - s_m(t_j)) )
 /// (objective = MSE(speed) + w_gap MSE(gap)) is minimised over theta = (k1, k2, th, tau, eta)
 /// within bounds by a bounded Levenberg-Marquardt method with exact derivatives (the forward
@@ -131,7 +133,10 @@ struct CalibrationResult {
     /// Plain-text warnings: a parameter on a bound, a parameter (or combination) the trace does
     /// not determine, a model no better than the naive delayed-lead predictor, non-convergence.
     std::vector<std::string> warnings;
-    FitErrors train, test, all;  ///< test: the file outside the training window (samples 0 if none)
+    /// train: the fitted samples, simulated as the objective does (from t_a + tau_max); all: the
+    /// whole file simulated from its start (history on [t_0, t_0 + tau]); test: the file outside
+    /// the training window, each piece simulated from its own start (samples 0 if none)
+    FitErrors train, test, all;
     FitErrors naive;             ///< v_follower(t) = v_lead(t - d) with the best constant d
     double naive_delay = 0.0;
     double rmse_speed = 0.0, rmse_gap = 0.0;  ///< = all: the whole-file simulation [m/s, m]
@@ -169,12 +174,15 @@ void simulate_follower(const Trace& trace, const ParameterMap& ovrv, double t_a,
 ///     S_v' = k1 (dsd - th S_v) - k2 S_v + dF/dtheta (explicit),
 /// where sd = s(t - tau) and dsd = S_s(t - tau) (zero on the data history), plus for tau
 ///     d sd/d tau = S_s,tau(t - tau) - s'(t - tau),  d v_l(t - tau)/d tau = -v_l'(t - tau),
-/// and the start t0 = t_a + tau moving with tau: S_tau(t0) = x_data'(t0) - x'(t0).
+/// The simulation starts at t0 = max(t_start, t_a + tau) from the data (the data are the history
+/// for t <= t0). With t_start >= t_a + tau_max (as `calibrate` does) t0 does not depend on theta;
+/// otherwise t0 = t_a + tau moves with tau: S_tau(t0) = x_data'(t0) - x'(t0), and where t0 is a
+/// sample time the trajectory has a kink in tau (the sensitivities give the right derivative).
 struct FollowerTrajectory {
     std::vector<double> time, speed, gap;  ///< at the samples in [t_a, t_b]
     Eigen::MatrixXd dspeed, dgap;          ///< rows: samples, columns: theta (empty unless asked)
 };
 FollowerTrajectory simulate_follower(const Trace& trace, const CalibrationVector& theta, double t_a, double t_b, double step,
-                                     bool sensitivities);
+                                     bool sensitivities, double t_start = -1e300);
 
 }  // namespace ddemap
