@@ -532,8 +532,13 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         const int cap = std::max(1, n / 4);
         int lag = decorrelation_lag(r.head(n), cap);
         if (m > n) lag = std::max(lag, decorrelation_lag(r.tail(n), cap));
-        const int L = std::min(3 * lag, cap);
+        const int L = std::min(5 * lag, cap);
         res.bandwidth = L;
+        // fixed-b critical value of the Bartlett HAC t-statistic (Kiefer & Vogelsang 2005, the
+        // 97.5 % quantile as a cubic in b = L / n): wider than 1.96 when the bandwidth is a
+        // sizeable part of the trace, as it is for 10 Hz residuals
+        const double bb = static_cast<double>(L) / n;
+        res.critical_value = 1.96 + 2.9694 * bb + 0.4160 * bb * bb - 0.5324 * bb * bb * bb;
         Eigen::MatrixXd Omega = G.transpose() * G;
         for (int l = 1; l <= L; ++l) {
             const double wl = 1.0 - static_cast<double>(l) / (L + 1);
@@ -567,8 +572,8 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         const double width = pb.hi[i] - pb.lo[i];
         e.at_bound = !e.fixed && (theta[i] - pb.lo[i] <= 1e-6 * width || pb.hi[i] - theta[i] <= 1e-6 * width);
         e.standard_error = e.fixed ? 0.0 : (undetermined[static_cast<std::size_t>(i)] || !finite ? kInf : std::sqrt(std::max(cov(i, i), 0.0)));
-        e.lower95 = e.value - 1.96 * e.standard_error;
-        e.upper95 = e.value + 1.96 * e.standard_error;
+        e.lower95 = e.value - res.critical_value * e.standard_error;
+        e.upper95 = e.value + res.critical_value * e.standard_error;
     }
 
     // 4. errors and the naive predictor
@@ -642,7 +647,7 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
             }
         }
         const double var_ratio = cov_iid(k, k) > 0.0 ? std::max(cov(k, k) / cov_iid(k, k), 1.0) : 1.0;
-        const double threshold = 3.84 * sigma2 * var_ratio / std::max(n, 1);
+        const double threshold = res.critical_value * res.critical_value * sigma2 * var_ratio / std::max(n, 1);
         const double omin = std::min(res.objective, *std::min_element(pl.objective.begin(), pl.objective.end()));
         if (omin < res.objective * (1.0 - 1e-9))
             res.warnings.push_back("the profile of " + name + " found a lower objective (" + fmt3(omin) + " < " + fmt3(res.objective) +

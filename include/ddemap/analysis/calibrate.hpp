@@ -96,7 +96,8 @@ struct ParameterEstimate {
     /// sqrt of the corrected covariance's diagonal (0 for a fixed parameter; inf when the
     /// trace does not determine it)
     double standard_error = 0.0;
-    double lower95 = 0.0, upper95 = 0.0;  ///< value -+ 1.96 standard_error (not clipped to the bounds)
+    /// value -+ q standard_error, q = CalibrationResult::critical_value (not clipped to the bounds)
+    double lower95 = 0.0, upper95 = 0.0;
     bool fixed = false;                    ///< lower bound = upper bound
     bool at_bound = false;                 ///< on (within 1e-6 of the width of) a bound
 };
@@ -105,7 +106,7 @@ struct ParameterEstimate {
 struct ProfileLikelihood {
     std::string parameter;
     std::vector<double> values, objective;
-    /// {theta_i : n (objective - objective_min) <= 3.84 sigma^2 c_i} where n = samples,
+    /// {theta_i : n (objective - objective_min) <= q^2 sigma^2 c_i} where n = samples, q = the critical value,
     /// sigma^2 = the residual variance and c_i = the parameter's corrected over uncorrected
     /// variance; an end that reaches the profiled range is `open`.
     double lower95 = 0.0, upper95 = 0.0;
@@ -126,7 +127,10 @@ struct CalibrationResult {
     /// residuals (kept for comparison; too small for 10 Hz data).
     CalibrationMatrix covariance_independent = CalibrationMatrix::Zero();
     CalibrationMatrix correlation = CalibrationMatrix::Identity();  ///< of `covariance`
-    int bandwidth = 0;                ///< L [samples]
+    int bandwidth = 0;                ///< L [samples]: 5 times the lag where the residuals' autocorrelation falls below 0.05, at most n/4
+    /// q of the 95 % intervals: the fixed-b critical value of the Bartlett-HAC t-statistic,
+    /// q = 1.96 + 2.9694 b + 0.4160 b^2 - 0.5324 b^3, b = L / n (Kiefer & Vogelsang 2005)
+    double critical_value = 1.96;
     double effective_samples = 0.0;   ///< n / (1 + 2 sum_l (1 - l/(L+1)) rho_l) of the speed residuals
     double condition_number = 0.0;    ///< of J^T J with unit-scaled columns (free parameters)
     std::vector<ProfileLikelihood> profiles;  ///< one per CalibrationOptions::profile name
