@@ -91,8 +91,11 @@ public:
                 rhs(te, y.data(), sd, f.data());
                 // a car that has come to rest stays at v = 0 whatever theta: S_v jumps to 0 there
                 // (S_v(t_e-) = -v'(t_e-) dt_e/dtheta; s is C^1, so S_s is continuous)
-                if (m_sens && m_stopped) {
-                    for (int i = 0; i < P; ++i) y[SS + P + i] = 0.0;
+                // (the overshoot of the step below 0 is cut: the car rests at v = 0 exactly)
+                if (m_stopped) {
+                    y[1] = 0.0;
+                    if (m_sens)
+                        for (int i = 0; i < P; ++i) y[SS + P + i] = 0.0;
                     rhs(te, y.data(), sd, f.data());
                 }
                 push(te, y.data(), f.data());

@@ -61,6 +61,51 @@ TEST_CASE("calibration sensitivities agree with finite differences of the simula
     check_against_differences(tr, theta, 2e-2);
 }
 
+TEST_CASE("calibration sensitivities through a stop: the car rests at v = 0 and S_v resets to 0") {
+    // the lead brakes to a stop, waits 10 s and drives off; the follower data from the model
+    const LeadProfile lead({0, 20, 30, 40, 55, 120}, {10, 10, 0, 0, 10, 10});
+    Trace tr;
+    for (int k = 0; k <= 1200; ++k) {
+        tr.t.push_back(0.1 * k);
+        tr.lead.push_back(lead.speed(0.1 * k));
+        tr.speed.push_back(lead.speed(0.1 * k));
+        tr.gap.push_back(15.0);
+    }
+    CalibrationVector truth;
+    truth << 0.08, 0.4, 1.0, 0.5, 5;
+    const FollowerTrajectory data = simulate_follower(tr, truth, 0.0, 120.0, 0.05, false, 1.0);
+    int resting = 0;
+    for (std::size_t k = 0; k < tr.t.size(); ++k) {
+        tr.speed[k] = data.speed[k];
+        tr.gap[k] = data.gap[k];
+        CHECK(data.speed[k] >= 0.0);
+        resting += data.speed[k] == 0.0;
+    }
+    CHECK(resting > 50);
+    CalibrationVector theta;
+    theta << 0.1, 0.35, 1.1, 0.6, 6;
+    const FollowerTrajectory f = simulate_follower(tr, theta, 0.0, 120.0, 0.05, true, 1.0);
+    for (int i = 0; i < 5; ++i) {
+        const double h = 1e-6 * std::max(1.0, std::abs(theta[i]));
+        CalibrationVector up = theta, down = theta;
+        up[i] += h;
+        down[i] -= h;
+        const FollowerTrajectory fu = simulate_follower(tr, up, 0.0, 120.0, 0.05, false, 1.0);
+        const FollowerTrajectory fd = simulate_follower(tr, down, 0.0, 120.0, 0.05, false, 1.0);
+        double err = 0.0, scale = 0.0;
+        for (std::size_t k = 0; k < f.speed.size(); ++k) {
+            const auto r = static_cast<Eigen::Index>(k);
+            const double dv = (fu.speed[k] - fd.speed[k]) / (2 * h), ds = (fu.gap[k] - fd.gap[k]) / (2 * h);
+            err = std::max({err, std::abs(dv - f.dspeed(r, i)), std::abs(ds - f.dgap(r, i))});
+            scale = std::max({scale, std::abs(dv), std::abs(ds)});
+            if (f.speed[k] == 0.0) CHECK(f.dspeed(r, i) == 0.0);
+        }
+        CAPTURE(i);
+        CAPTURE(err);
+        CHECK(err <= (i == 3 ? 5e-3 : 1e-5) * scale);
+    }
+}
+
 TEST_CASE("calibration sensitivities: the plain simulation is the same with and without them") {
     const double truth[5] = {0.052, 0.338, 0.819, 0.948, 8.03};
     const Trace tr = calib_test::clean_trace(calib_test::ovrv(truth), ddemap::LeadProfile::builtin("dip"), 90);
