@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(g++ make cmake python3 pkg-config
           libeigen3-dev libspectra-dev libsuitesparse-dev doctest-dev
-          libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libnlopt-cxx-dev
+          libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
           libxml2-utils librsvg2-bin)
 missing=()
 for p in "${packages[@]}"; do

@@ -24,7 +24,7 @@ const std::vector<Command>& command_table() {
          add_simulate_flags, run_simulate},
         {"growth", "disturbance growth for every setting of the calibration table: platoons of 1 to 15 followers",
          add_growth_flags, run_growth},
-        {"calibrate", "fit OVRV (k1, k2, th, tau, eta) to measured car-following traces (NLopt: DIRECT-L, then BOBYQA)",
+        {"calibrate", "fit OVRV (k1, k2, th, tau, eta) to measured car-following traces (least squares with exact sensitivities, multistart Levenberg-Marquardt)",
          add_calibrate_flags, run_calibrate},
         {"mix", "penetration-rate study: spectral abscissa of a ring with a fraction p of type X among type Y",
          add_mix_flags, run_mix},

@@ -5,6 +5,10 @@
 #include <exception>
 
 #include <algorithm>
+#include <atomic>
+#include <limits>
+#include <numeric>
+#include <random>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -12,9 +16,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <nlopt.hpp>
-
-#include "ddemap/solve/integrate.hpp"
 #include "ddemap/core/text.hpp"
 
 namespace ddemap {
@@ -31,18 +32,6 @@ double interp(const std::vector<double>& t, const std::vector<double>& y, double
 }
 
 const char* names[5] = {"k1", "k2", "th", "tau", "eta"};
-
-std::string nlopt_status(nlopt::result r) {
-    switch (r) {
-        case nlopt::SUCCESS: return "success";
-        case nlopt::STOPVAL_REACHED: return "stopval_reached";
-        case nlopt::FTOL_REACHED: return "ftol_reached";
-        case nlopt::XTOL_REACHED: return "xtol_reached";
-        case nlopt::MAXEVAL_REACHED: return "maxeval_reached";
-        case nlopt::MAXTIME_REACHED: return "maxtime_reached";
-        default: return "failure";
-    }
-}
 
 }  // namespace
 
@@ -107,55 +96,247 @@ void CalibrationOptions::validate() const {
     if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected >= 0");
     if (global_evaluations < 0 || local_evaluations < 1) throw std::invalid_argument("evaluation budgets: expected global >= 0, local >= 1");
     if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 0.5 s");
+    if (design_points < 1) throw std::invalid_argument("design points = " + std::to_string(design_points) + ": expected at least 1");
+    if (starts < 1 || starts > design_points)
+        throw std::invalid_argument("starts = " + std::to_string(starts) + ": expected 1 to design points (" + std::to_string(design_points) + ")");
+    if (max_iterations < 1) throw std::invalid_argument("max iterations = " + std::to_string(max_iterations) + ": expected at least 1");
+    for (double tol : {gradient_tolerance, function_tolerance, step_tolerance})
+        if (!(tol >= 0.0 && std::isfinite(tol))) throw std::invalid_argument("tolerance = " + detail::format_number(tol) + ": expected a finite value >= 0");
+    for (std::size_t i = 0; i < profile.size(); ++i) {
+        const auto& n = calibration_parameter_names();
+        if (std::find(n.begin(), n.end(), profile[i]) == n.end())
+            throw std::invalid_argument("profile '" + profile[i] + "': unknown parameter, expected one of k1, k2, th, tau, eta");
+        if (std::find(profile.begin(), profile.begin() + static_cast<std::ptrdiff_t>(i), profile[i]) != profile.begin() + static_cast<std::ptrdiff_t>(i))
+            throw std::invalid_argument("profile '" + profile[i] + "' is requested twice");
+        const BoundedParameter b = bound(profile[i]);
+        if (!(b.upper > b.lower)) throw std::invalid_argument("profile '" + profile[i] + "': the parameter is fixed by its bounds");
+    }
+    if (!profile.empty() && profile_points < 3)
+        throw std::invalid_argument("profile points = " + std::to_string(profile_points) + ": expected at least 3");
+}
+
+bool CalibrationOptions::is_valid() const {
+    try {
+        validate();
+        return true;
+    } catch (const std::exception&) {
+        return false;
+    }
 }
 
 void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double step, std::vector<double>& speed,
                        std::vector<double>& gap) {
-    // OVRV's law parameters in its order (k1, k2, th, tau, eta)
-    const double law[5] = {p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta")};
-    const double tau = law[3];
-    const double t0 = t_a + tau;
-    auto history = [&](double t, double* y) {
-        y[0] = interp(tr.t, tr.gap, t);
-        y[1] = interp(tr.t, tr.speed, t);
-    };
-    auto rhs = [&](double t, const double* y, const detail::DdeSolver& sol, double* dy) {
-        const double vl = interp(tr.t, tr.lead, t);
-        dy[0] = vl - y[1];
-        const double sd = tau > 0.0 ? sol.value(0, t - tau) : y[0];
-        const double vd = tau > 0.0 ? interp(tr.t, tr.lead, t - tau) : vl;
-        const double in[3] = {sd, y[1], vd};
-        double a = OvrvModel::law(in, law);
-        if (y[1] <= 0.0 && a < 0.0) a = 0.0;  // standing cars do not roll backwards
-        dy[1] = a;
-    };
-    detail::DdeSolver sol(2, t0, history, rhs);
-    std::vector<double> marks;
-    for (double t : tr.t)
-        if (t > t0 && t < t_b) marks.push_back(t);
-    if (t_b > t0) sol.integrate(t_b, step, marks);
-    speed.clear();
-    gap.clear();
-    for (std::size_t k = 0; k < tr.t.size(); ++k) {
-        const double t = tr.t[k];
-        if (t < t_a || t > t_b) continue;
-        if (t <= t0) {
-            speed.push_back(tr.speed[k]);
-            gap.push_back(tr.gap[k]);
-        } else {
-            speed.push_back(sol.value(1, t));
-            gap.push_back(sol.value(0, t));
-        }
-    }
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    FollowerTrajectory f = simulate_follower(tr, theta, t_a, t_b, step, false);
+    speed = std::move(f.speed);
+    gap = std::move(f.gap);
 }
+
 
 namespace {
 
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The least-squares problem on the training window: residuals (speeds, then sqrt(w) gaps) at
+/// the samples t_j >= t_from of [a, b].
+struct LsqProblem {
+    const Trace& tr;
+    double a = 0.0, b = 0.0, t_from = 0.0, step = 0.05, wg = 0.0;
+    CalibrationVector lo, hi;
+    std::size_t first = 0;             // data index of the trajectory's first row
+    std::vector<std::size_t> rows;     // trajectory rows of the residual samples
+    mutable std::atomic<int> evaluations{0}, jacobians{0};
+
+    LsqProblem(const Trace& trace) : tr(trace) {}
+    int samples() const { return static_cast<int>(rows.size()); }
+    int residuals() const { return samples() * (wg > 0.0 ? 2 : 1); }
+
+    /// r (and J if asked); false when the simulation is not finite
+    bool eval(const CalibrationVector& th, Eigen::VectorXd& r, Eigen::MatrixXd* J) const {
+        const FollowerTrajectory f = simulate_follower(tr, th, a, b, step, J != nullptr, t_from);
+        ++evaluations;
+        if (J) ++jacobians;
+        const int n = samples();
+        r.resize(residuals());
+        if (J) J->resize(residuals(), 5);
+        for (int j = 0; j < n; ++j) {
+            const std::size_t k = rows[static_cast<std::size_t>(j)], d = first + k;
+            r[j] = f.speed[k] - tr.speed[d];
+            if (J) J->row(j) = f.dspeed.row(static_cast<Eigen::Index>(k));
+            if (wg > 0.0) {
+                r[n + j] = wg * (f.gap[k] - tr.gap[d]);
+                if (J) J->row(n + j) = wg * f.dgap.row(static_cast<Eigen::Index>(k));
+            }
+        }
+        return r.allFinite() && (!J || J->allFinite());
+    }
+    double ssr(const CalibrationVector& th) const {
+        Eigen::VectorXd r;
+        return eval(th, r, nullptr) ? r.squaredNorm() : kInf;
+    }
+};
+
+struct LmResult {
+    CalibrationVector theta;
+    double ssr = kInf;
+    Status status = Status::NumericalIssue;
+    std::string message;
+    int iterations = 0;
+};
+
+/// Levenberg-Marquardt with bounds on the free parameters `free` (the others stay at theta0):
+/// z = (theta - lo) / (hi - lo) in [0, 1]; a parameter on a bound whose gradient points
+/// outwards is held (active set); steps are projected onto the box; Nielsen's damping update.
+LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& theta0, const std::vector<int>& free,
+                             const CalibrationOptions& o) {
+    const int p = static_cast<int>(free.size());
+    LmResult res;
+    res.theta = theta0;
+    Eigen::VectorXd w(p), z(p);
+    for (int i = 0; i < p; ++i) {
+        const int k = free[static_cast<std::size_t>(i)];
+        w[i] = pb.hi[k] - pb.lo[k];
+        z[i] = std::clamp((theta0[k] - pb.lo[k]) / w[i], 0.0, 1.0);
+    }
+    auto theta_of = [&](const Eigen::VectorXd& zz) {
+        CalibrationVector th = theta0;
+        for (int i = 0; i < p; ++i) {
+            const int k = free[static_cast<std::size_t>(i)];
+            th[k] = std::clamp(pb.lo[k] + zz[i] * w[i], pb.lo[k], pb.hi[k]);
+        }
+        return th;
+    };
+    Eigen::VectorXd r, r_new;
+    Eigen::MatrixXd Jf, Jf_new;
+    auto scaled = [&](const Eigen::MatrixXd& J) {
+        Eigen::MatrixXd S(J.rows(), p);
+        for (int i = 0; i < p; ++i) S.col(i) = J.col(free[static_cast<std::size_t>(i)]) * w[i];
+        return S;
+    };
+    res.theta = theta_of(z);
+    if (!pb.eval(res.theta, r, &Jf)) {
+        res.message = "the simulation is not finite at the start";
+        return res;
+    }
+    Eigen::MatrixXd J = scaled(Jf);
+    double cost = r.squaredNorm();
+    res.ssr = cost;
+    if (p == 0) {
+        res.status = Status::Converged;
+        res.message = "no free parameter";
+        return res;
+    }
+    Eigen::MatrixXd A = J.transpose() * J;
+    Eigen::VectorXd g = J.transpose() * r;
+    double mu = 1e-3 * std::max(A.diagonal().maxCoeff(), 1e-300), nu = 2.0;
+    res.status = Status::MaxIterations;
+    res.message = "the iteration limit (" + std::to_string(o.max_iterations) + ") was reached";
+    for (int it = 0; it < o.max_iterations; ++it) {
+        res.iterations = it + 1;
+        // first-order optimality on the box
+        double pg = 0.0;
+        for (int i = 0; i < p; ++i) pg = std::max(pg, std::abs(std::clamp(z[i] - g[i], 0.0, 1.0) - z[i]));
+        if (pg <= o.gradient_tolerance * (1.0 + cost)) {
+            res.status = Status::Converged;
+            res.message = "projected gradient below tolerance";
+            break;
+        }
+        std::vector<int> act;  // free in this iteration
+        for (int i = 0; i < p; ++i)
+            if (!((z[i] <= 0.0 && g[i] > 0.0) || (z[i] >= 1.0 && g[i] < 0.0))) act.push_back(i);
+        const int q = static_cast<int>(act.size());
+        if (q == 0) {
+            res.status = Status::Converged;
+            res.message = "every parameter held at a bound";
+            break;
+        }
+        Eigen::MatrixXd Aq(q, q);
+        Eigen::VectorXd gq(q), dg(q);
+        const double dmax = A.diagonal().maxCoeff();
+        for (int i = 0; i < q; ++i) {
+            gq[i] = g[act[static_cast<std::size_t>(i)]];
+            for (int j = 0; j < q; ++j) Aq(i, j) = A(act[static_cast<std::size_t>(i)], act[static_cast<std::size_t>(j)]);
+            dg[i] = std::max(Aq(i, i), 1e-9 * dmax + 1e-300);
+        }
+        bool accepted = false, stop = false;
+        while (!accepted) {
+            Eigen::MatrixXd M = Aq;
+            M.diagonal() += mu * dg;
+            const Eigen::VectorXd dq = M.ldlt().solve(-gq);
+            Eigen::VectorXd d = Eigen::VectorXd::Zero(p);
+            for (int i = 0; i < q; ++i) d[act[static_cast<std::size_t>(i)]] = dq[i];
+            Eigen::VectorXd z_new = (z + d).cwiseMax(0.0).cwiseMin(1.0);
+            d = z_new - z;
+            if (!d.allFinite() || d.lpNorm<Eigen::Infinity>() <= o.step_tolerance) {
+                res.status = Status::Converged;
+                res.message = "step below tolerance";
+                stop = true;
+                break;
+            }
+            const double pred = -(g.dot(d) + 0.5 * d.dot(A * d));
+            const CalibrationVector th_new = theta_of(z_new);
+            const bool ok = pb.eval(th_new, r_new, &Jf_new);
+            const double cost_new = ok ? r_new.squaredNorm() : kInf;
+            const double rho = pred > 0.0 ? (cost - cost_new) / pred : -1.0;
+            if (ok && cost_new < cost && rho > 1e-4) {
+                const double decrease = cost - cost_new;
+                z = z_new;
+                r.swap(r_new);
+                J = scaled(Jf_new);
+                A = J.transpose() * J;
+                g = J.transpose() * r;
+                cost = cost_new;
+                res.theta = th_new;
+                res.ssr = cost;
+                mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+                nu = 2.0;
+                accepted = true;
+                if (decrease <= o.function_tolerance * cost) {
+                    res.status = Status::Converged;
+                    res.message = "relative decrease of the objective below tolerance";
+                    stop = true;
+                }
+            } else {
+                mu *= nu;
+                nu *= 2.0;
+                if (!(mu < 1e30)) {
+                    res.status = Status::Converged;
+                    res.message = "no descent step left (damping at its limit)";
+                    stop = true;
+                    break;
+                }
+            }
+        }
+        if (stop) break;
+    }
+    return res;
+}
+
+/// Latin hypercube in [0, 1]^p: n points, one in each of the n slices of every axis (fixed seed;
+/// a portable generator and no std distribution, so the design is the same on every platform).
+std::vector<Eigen::VectorXd> latin_hypercube(int n, int p, unsigned seed) {
+    std::mt19937 rng(seed);
+    auto uniform = [&] { return (static_cast<double>(rng()) + 0.5) / 4294967296.0; };
+    std::vector<Eigen::VectorXd> pts(static_cast<std::size_t>(n), Eigen::VectorXd(p));
+    std::vector<int> perm(static_cast<std::size_t>(n));
+    for (int j = 0; j < p; ++j) {
+        std::iota(perm.begin(), perm.end(), 0);
+        for (int i = n - 1; i > 0; --i) std::swap(perm[static_cast<std::size_t>(i)], perm[static_cast<std::size_t>(rng() % static_cast<unsigned>(i + 1))]);
+        for (int i = 0; i < n; ++i) pts[static_cast<std::size_t>(i)][j] = (perm[static_cast<std::size_t>(i)] + uniform()) / n;
+    }
+    return pts;
+}
+
 /// Errors over the samples of [t_a, t_b] at or after t_from.
+/// The simulation starts at max(t_start, t_a + tau).
 FitErrors errors_over(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double t_from, double step,
-                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr) {
-    std::vector<double> v, s;
-    simulate_follower(tr, p, t_a, t_b, step, v, s);
+                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr, double t_start = -1e300) {
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    FollowerTrajectory f = simulate_follower(tr, theta, t_a, t_b, step, false, t_start);
+    const std::vector<double>& v = f.speed;
+    const std::vector<double>& s = f.gap;
     FitErrors e;
     double sv = 0.0, sg = 0.0;
     std::size_t j = 0;
@@ -179,11 +360,44 @@ FitErrors errors_over(const Trace& tr, const ParameterMap& p, double t_a, double
     return e;
 }
 
+/// autocorrelation of x at lags 0..max_lag (normalised by the lag-0 sum)
+std::vector<double> autocorrelation(const Eigen::VectorXd& x, int max_lag) {
+    const Eigen::Index n = x.size();
+    const Eigen::VectorXd c = x.array() - x.mean();
+    const double c0 = c.squaredNorm();
+    std::vector<double> rho(static_cast<std::size_t>(max_lag + 1), 0.0);
+    rho[0] = 1.0;
+    if (!(c0 > 0.0)) return rho;
+    for (int l = 1; l <= max_lag && l < n; ++l) rho[static_cast<std::size_t>(l)] = c.head(n - l).dot(c.tail(n - l)) / c0;
+    return rho;
+}
+
+/// first lag at which the autocorrelation falls below 0.05 (computed lag by lag up to cap)
+int decorrelation_lag(const Eigen::VectorXd& x, int cap) {
+    const Eigen::Index n = x.size();
+    const Eigen::VectorXd c = x.array() - x.mean();
+    const double c0 = c.squaredNorm();
+    if (!(c0 > 0.0)) return 1;
+    for (int l = 1; l <= cap && l < n; ++l)
+        if (c.head(n - l).dot(c.tail(n - l)) / c0 < 0.05) return l;
+    return cap;
+}
+
+std::string fmt(double x) { return detail::format_number(x); }
+
+std::string fmt3(double x) {
+    std::ostringstream s;
+    s.precision(3);
+    s << x;
+    return s.str();
+}
+
 }  // namespace
 
-CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
-    o.validate();
-    const auto t_start = std::chrono::steady_clock::now();
+namespace {
+
+/// The problem of `calibrate`: bounds, training window, residual samples (t >= t_a + tau_max).
+void set_up(LsqProblem& pb, const Trace& tr, const CalibrationOptions& o) {
     const double first = tr.t.front(), last = tr.t.back();
     double a = o.train_start < 0.0 ? first : o.train_start;
     double b = o.train_end < 0.0 ? last : o.train_end;
@@ -191,61 +405,183 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         throw std::invalid_argument("training window " + detail::format_number(a) + ":" + detail::format_number(b) + " s: expected at least 20 s within the file's " +
                                     detail::format_number(first) + ":" + detail::format_number(last) + " s");
     }
-    // every candidate is scored on the same samples: those after the longest admissible delay
-    std::vector<double> lo(5), hi(5), x(5);
     for (int i = 0; i < 5; ++i) {
-        const BoundedParameter b = o.bound(names[i]);
-        lo[i] = b.lower;
-        hi[i] = b.upper;
+        const BoundedParameter bd = o.bound(names[i]);
+        pb.lo[i] = bd.lower;
+        pb.hi[i] = bd.upper;
     }
-    const double t_from = a + hi[3];
+    // every candidate is scored on the same samples: those after the longest admissible delay
+    pb.a = a;
+    pb.b = b;
+    pb.t_from = a + pb.hi[3];
+    pb.step = o.step;
+    pb.wg = std::sqrt(o.gap_weight);
+    pb.first = static_cast<std::size_t>(std::lower_bound(tr.t.begin(), tr.t.end(), a) - tr.t.begin());
+    for (std::size_t k = pb.first; k < tr.t.size() && tr.t[k] <= b; ++k)
+        if (tr.t[k] >= pb.t_from) pb.rows.push_back(k - pb.first);
+}
+
+}  // namespace
+
+double calibration_objective(const Trace& tr, const ParameterMap& p, const CalibrationOptions& o) {
+    o.validate();
+    LsqProblem pb(tr);
+    set_up(pb, tr, o);
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    return pb.ssr(theta) / std::max(pb.samples(), 1);
+}
+
+CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
+    o.validate();
+    const auto t_start = std::chrono::steady_clock::now();
+    const double first = tr.t.front(), last = tr.t.back();
+    LsqProblem pb(tr);
+    set_up(pb, tr, o);
+    const double a = pb.a, b = pb.b;
+    const int n = pb.samples();
+    std::vector<int> free;
+    for (int i = 0; i < 5; ++i)
+        if (pb.hi[i] > pb.lo[i]) free.push_back(i);
+    const int p = static_cast<int>(free.size());
+
     CalibrationResult res;
-    auto objective = [&](const std::vector<double>& x, std::vector<double>&, void*) -> double {
-        ParameterMap p;
-        for (int i = 0; i < 5; ++i) p[names[i]] = std::clamp(x[i], lo[i], hi[i]);
-        const FitErrors e = errors_over(tr, p, a, b, t_from, o.step);
-        ++res.evaluations;
-        const double f = e.rmse_speed * e.rmse_speed + o.gap_weight * e.rmse_gap * e.rmse_gap;
-        return std::isfinite(f) ? f : 1e30;
-    };
-    struct Fn {
-        decltype(objective)* f;
-    } fn{&objective};
-    auto thunk = [](const std::vector<double>& x, std::vector<double>& g, void* data) {
-        return (*static_cast<Fn*>(data)->f)(x, g, nullptr);
-    };
-    for (int i = 0; i < 5; ++i) x[i] = 0.5 * (lo[i] + hi[i]);
-    double fx = 0.0;
-    // bounds with zero width are fixed parameters
-    if (o.global_evaluations > 0) {
-        nlopt::opt global(nlopt::GN_DIRECT_L, 5);
-        global.set_lower_bounds(lo);
-        global.set_upper_bounds(hi);
-        global.set_min_objective(thunk, &fn);
-        global.set_maxeval(o.global_evaluations);
-        try {
-            global.optimize(x, fx);
-        } catch (const std::exception&) {
-            // keep the best point found so far (NLopt returns it in x)
+    // 1. the design: Latin hypercube (plus the centre of the box), scored by the objective
+    CalibrationVector centre = 0.5 * (pb.lo + pb.hi);
+    std::vector<CalibrationVector> design(1, centre);
+    for (const auto& u : latin_hypercube(o.design_points - 1, p, o.seed)) {
+        CalibrationVector th = centre;
+        for (int i = 0; i < p; ++i) {
+            const int k = free[static_cast<std::size_t>(i)];
+            th[k] = pb.lo[k] + u[i] * (pb.hi[k] - pb.lo[k]);
         }
+        design.push_back(th);
     }
-    nlopt::opt local(nlopt::LN_BOBYQA, 5);
-    local.set_lower_bounds(lo);
-    local.set_upper_bounds(hi);
-    local.set_min_objective(thunk, &fn);
-    local.set_maxeval(o.local_evaluations);
-    local.set_xtol_rel(1e-6);
-    local.set_ftol_rel(1e-10);
-    nlopt::result r = nlopt::FAILURE;
-    try {
-        r = local.optimize(x, fx);
-    } catch (const std::exception&) {
-        r = nlopt::FAILURE;
+    std::vector<double> score(design.size());
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 4)
+#endif
+    for (std::size_t i = 0; i < design.size(); ++i) score[i] = pb.ssr(design[i]);
+    std::vector<std::size_t> order(design.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return score[x] < score[y]; });
+    // 2. Levenberg-Marquardt from the best design points; keep the best end point
+    const int n_starts = std::min<int>(o.starts, static_cast<int>(design.size()));
+    std::vector<LmResult> fits(static_cast<std::size_t>(n_starts));
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+    for (int s = 0; s < n_starts; ++s) fits[static_cast<std::size_t>(s)] = levenberg_marquardt(pb, design[order[static_cast<std::size_t>(s)]], free, o);
+    std::size_t best = 0;
+    for (std::size_t s = 1; s < fits.size(); ++s)
+        if (fits[s].ssr < fits[best].ssr) best = s;
+    LmResult fit = fits[best];
+    res.starts = n_starts;
+    if (!std::isfinite(fit.ssr)) {
+        // no start could be simulated: report the best design point
+        fit.theta = design[order[0]];
+        fit.ssr = score[order[0]];
     }
-    res.status = nlopt_status(r);
-    res.objective = fx;
-    for (int i = 0; i < 5; ++i) res.parameters[names[i]] = std::clamp(x[i], lo[i], hi[i]);
-    res.train = errors_over(tr, res.parameters, a, b, t_from, o.step);
+    res.status_code = fit.status;
+    res.status = to_string(fit.status);
+    res.message = fit.message;
+    const CalibrationVector theta = fit.theta;
+    res.objective = fit.ssr / std::max(n, 1);
+    for (int i = 0; i < 5; ++i) res.parameters[names[i]] = theta[i];
+    res.k1 = theta[0];
+    res.k2 = theta[1];
+    res.th = theta[2];
+    res.tau = theta[3];
+    res.eta = theta[4];
+
+    // 3. uncertainty at the optimum
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    const bool finite = pb.eval(theta, r, &J);
+    CalibrationMatrix cov = CalibrationMatrix::Zero(), cov_iid = CalibrationMatrix::Zero();
+    std::vector<bool> undetermined(5, false);
+    double sigma2 = 0.0;
+    if (finite && p > 0 && n > p) {
+        const int m = static_cast<int>(r.size());
+        Eigen::MatrixXd JF(m, p);
+        for (int i = 0; i < p; ++i) JF.col(i) = J.col(free[static_cast<std::size_t>(i)]);
+        const Eigen::MatrixXd H = JF.transpose() * JF;
+        Eigen::VectorXd D = H.diagonal().cwiseSqrt();
+        for (int i = 0; i < p; ++i)
+            if (!(D[i] > 0.0)) D[i] = 1.0;
+        const Eigen::MatrixXd Hs = D.asDiagonal().inverse() * H * D.asDiagonal().inverse();
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hs);
+        const Eigen::VectorXd lam = es.eigenvalues();
+        const double lmax = lam.maxCoeff();
+        res.condition_number = lam.minCoeff() > 0.0 ? lmax / lam.minCoeff() : kInf;
+        // pseudo-inverse: directions below 1e-12 lmax are not determined
+        Eigen::MatrixXd Hinv_s = Eigen::MatrixXd::Zero(p, p);
+        for (int k = 0; k < p; ++k) {
+            if (lam[k] > 1e-12 * lmax) {
+                Hinv_s += es.eigenvectors().col(k) * es.eigenvectors().col(k).transpose() / lam[k];
+            } else {
+                for (int i = 0; i < p; ++i)
+                    if (std::abs(es.eigenvectors()(i, k)) >= 0.3) undetermined[static_cast<std::size_t>(free[static_cast<std::size_t>(i)])] = true;
+            }
+        }
+        const Eigen::MatrixXd Hinv = D.asDiagonal().inverse() * Hinv_s * D.asDiagonal().inverse();
+        sigma2 = r.squaredNorm() / (m - p);
+        // scores per sample time (speed and gap residual of the same time together)
+        Eigen::MatrixXd G(n, p);
+        for (int t = 0; t < n; ++t) {
+            G.row(t) = JF.row(t) * r[t];
+            if (m > n) G.row(t) += JF.row(n + t) * r[n + t];
+        }
+        // bandwidth: three times the lag at which the residuals decorrelate (the slower stream)
+        const int cap = std::max(1, n / 4);
+        int lag = decorrelation_lag(r.head(n), cap);
+        if (m > n) lag = std::max(lag, decorrelation_lag(r.tail(n), cap));
+        const int L = std::min(5 * lag, cap);
+        res.bandwidth = L;
+        // fixed-b critical value of the Bartlett HAC t-statistic (Kiefer & Vogelsang 2005, the
+        // 97.5 % quantile as a cubic in b = L / n): wider than 1.96 when the bandwidth is a
+        // sizeable part of the trace, as it is for 10 Hz residuals
+        const double bb = static_cast<double>(L) / n;
+        res.critical_value = 1.96 + 2.9694 * bb + 0.4160 * bb * bb - 0.5324 * bb * bb * bb;
+        Eigen::MatrixXd Omega = G.transpose() * G;
+        for (int l = 1; l <= L; ++l) {
+            const double wl = 1.0 - static_cast<double>(l) / (L + 1);
+            const Eigen::MatrixXd Gl = G.bottomRows(n - l).transpose() * G.topRows(n - l);
+            Omega += wl * (Gl + Gl.transpose());
+        }
+        const Eigen::MatrixXd C = Hinv * Omega * Hinv;
+        const Eigen::MatrixXd Ci = sigma2 * Hinv;
+        for (int i = 0; i < p; ++i)
+            for (int j = 0; j < p; ++j) {
+                cov(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = C(i, j);
+                cov_iid(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = Ci(i, j);
+            }
+        const std::vector<double> rho = autocorrelation(r.head(n), L);
+        double f = 1.0;
+        for (int l = 1; l <= L; ++l) f += 2.0 * (1.0 - static_cast<double>(l) / (L + 1)) * rho[static_cast<std::size_t>(l)];
+        res.effective_samples = n / std::max(f, 1.0);
+    }
+    res.covariance = cov;
+    res.covariance_independent = cov_iid;
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) {
+            const double d = std::sqrt(cov(i, i) * cov(j, j));
+            res.correlation(i, j) = i == j ? 1.0 : (d > 0.0 ? cov(i, j) / d : 0.0);
+        }
+    for (int i = 0; i < 5; ++i) {
+        ParameterEstimate& e = res.estimates[static_cast<std::size_t>(i)];
+        e.name = names[i];
+        e.value = theta[i];
+        e.fixed = !(pb.hi[i] > pb.lo[i]);
+        const double width = pb.hi[i] - pb.lo[i];
+        e.at_bound = !e.fixed && (theta[i] - pb.lo[i] <= 1e-6 * width || pb.hi[i] - theta[i] <= 1e-6 * width);
+        e.standard_error = e.fixed ? 0.0 : (undetermined[static_cast<std::size_t>(i)] || !finite ? kInf : std::sqrt(std::max(cov(i, i), 0.0)));
+        e.lower95 = e.value - res.critical_value * e.standard_error;
+        e.upper95 = e.value + res.critical_value * e.standard_error;
+    }
+
+    // 4. errors and the naive predictor
+    res.train = errors_over(tr, res.parameters, a, b, pb.t_from, o.step, nullptr, nullptr, pb.t_from);  // as the objective
     res.all = errors_over(tr, res.parameters, first, last, first + res.parameters.at("tau"), o.step, &res.sim_speed, &res.sim_gap);
     // the test part: the file outside the training window, each piece simulated from its own start
     FitErrors test;
@@ -263,23 +599,107 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     }
     res.test = test;
     // the naive predictor v(t) = v_lead(t - d), best constant d in [0, 5] s, same samples as `all`
-    double best = 1e300;
+    double best_naive = 1e300;
     for (double d = 0.0; d <= 5.0 + 1e-9; d += 0.1) {
         double s = 0.0;
-        int n = 0;
+        int cnt = 0;
         for (std::size_t k = 0; k < tr.t.size(); ++k) {
             if (tr.t[k] < first + res.parameters.at("tau")) continue;
             const double e = interp(tr.t, tr.lead, tr.t[k] - d) - tr.speed[k];
             s += e * e;
-            ++n;
+            ++cnt;
         }
-        const double rmse = std::sqrt(s / std::max(n, 1));
-        if (rmse < best) {
-            best = rmse;
+        const double rmse = std::sqrt(s / std::max(cnt, 1));
+        if (rmse < best_naive) {
+            best_naive = rmse;
             res.naive_delay = d;
         }
     }
-    res.naive.rmse_speed = best;
+    res.naive.rmse_speed = best_naive;
+    res.naive.samples = res.all.samples;
+    res.rmse_speed = res.all.rmse_speed;
+    res.rmse_gap = res.all.rmse_gap;
+    res.naive_rmse_speed = res.naive.rmse_speed;
+
+    // 5. profile likelihoods on request
+    for (const std::string& name : o.profile) {
+        const int k = static_cast<int>(std::find(names, names + 5, name) - names);
+        ProfileLikelihood pl;
+        pl.parameter = name;
+        const double se = res.estimates[static_cast<std::size_t>(k)].standard_error;
+        double lo = pb.lo[k], hi = pb.hi[k];
+        if (std::isfinite(se) && se > 0.0) {
+            lo = std::max(lo, theta[k] - 4.0 * se);
+            hi = std::min(hi, theta[k] + 4.0 * se);
+        }
+        const int K = o.profile_points;
+        pl.values.resize(static_cast<std::size_t>(K));
+        pl.objective.assign(static_cast<std::size_t>(K), kInf);
+        for (int j = 0; j < K; ++j) pl.values[static_cast<std::size_t>(j)] = lo + (hi - lo) * j / (K - 1);
+        std::vector<int> others;
+        for (int i : free)
+            if (i != k) others.push_back(i);
+        // walk outwards from the optimum, each point started from its neighbour's solution
+        const int j0 = static_cast<int>(std::lower_bound(pl.values.begin(), pl.values.end(), theta[k]) - pl.values.begin());
+        for (int dir : {-1, 1}) {
+            CalibrationVector start = theta;
+            for (int j = dir < 0 ? j0 - 1 : j0; j >= 0 && j < K; j += dir) {
+                start[k] = pl.values[static_cast<std::size_t>(j)];
+                const LmResult lm = levenberg_marquardt(pb, start, others, o);
+                if (std::isfinite(lm.ssr)) start = lm.theta;
+                pl.objective[static_cast<std::size_t>(j)] = lm.ssr / std::max(n, 1);
+            }
+        }
+        const double var_ratio = cov_iid(k, k) > 0.0 ? std::max(cov(k, k) / cov_iid(k, k), 1.0) : 1.0;
+        const double threshold = res.critical_value * res.critical_value * sigma2 * var_ratio / std::max(n, 1);
+        const double omin = std::min(res.objective, *std::min_element(pl.objective.begin(), pl.objective.end()));
+        if (omin < res.objective * (1.0 - 1e-9))
+            res.warnings.push_back("the profile of " + name + " found a lower objective (" + fmt3(omin) + " < " + fmt3(res.objective) +
+                                   "): the fit is not the global minimum");
+        int jm = static_cast<int>(std::min_element(pl.objective.begin(), pl.objective.end()) - pl.objective.begin());
+        auto crossing = [&](int dir, double& out, bool& open) {
+            int j = jm;
+            while (j + dir >= 0 && j + dir < K && pl.objective[static_cast<std::size_t>(j + dir)] - omin <= threshold) j += dir;
+            if (j + dir < 0 || j + dir >= K) {
+                out = pl.values[static_cast<std::size_t>(j)];
+                open = true;
+                return;
+            }
+            const double f0 = pl.objective[static_cast<std::size_t>(j)] - omin, f1 = pl.objective[static_cast<std::size_t>(j + dir)] - omin;
+            const double s = std::isfinite(f1) && f1 > f0 ? (threshold - f0) / (f1 - f0) : 0.0;
+            out = pl.values[static_cast<std::size_t>(j)] + s * (pl.values[static_cast<std::size_t>(j + dir)] - pl.values[static_cast<std::size_t>(j)]);
+        };
+        crossing(-1, pl.lower95, pl.lower_open);
+        crossing(1, pl.upper95, pl.upper_open);
+        res.profiles.push_back(pl);
+    }
+
+    // 6. warnings
+    if (!converged(res.status_code)) res.warnings.push_back("the fit did not converge (" + res.status + "): " + res.message);
+    if (!finite) res.warnings.push_back("the simulation at the fitted parameters is not finite: no uncertainty");
+    for (const auto& e : res.estimates) {
+        const int i = static_cast<int>(&e - res.estimates.data());
+        if (e.at_bound) {
+            const bool upper = pb.hi[i] - e.value <= e.value - pb.lo[i];
+            res.warnings.push_back(e.name + " = " + fmt3(e.value) + " is at its " + (upper ? "upper" : "lower") + " bound (" +
+                                   fmt(upper ? pb.hi[i] : pb.lo[i]) + "): the best fit may lie outside the bounds; its interval is not reliable");
+        }
+        if (!e.fixed && finite && !(e.upper95 - e.lower95 <= pb.hi[i] - pb.lo[i]))
+            res.warnings.push_back(e.name + " is not determined by this trace: its 95 % interval [" + fmt3(e.lower95) + ", " + fmt3(e.upper95) +
+                                   "] is wider than its bounds [" + fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) + "]");
+    }
+    if (res.condition_number > 1e8) {
+        std::string which;
+        for (int i = 0; i < 5; ++i)
+            if (undetermined[static_cast<std::size_t>(i)]) which += (which.empty() ? "" : ", ") + std::string(names[i]);
+        res.warnings.push_back("J^T J is nearly singular (condition number " + fmt3(res.condition_number) + ")" +
+                               (which.empty() ? std::string(": the parameters are strongly correlated") : ": " + which + " not determined by this trace"));
+    }
+    if (!(res.all.rmse_speed < res.naive.rmse_speed))
+        res.warnings.push_back("the model (speed RMSE " + fmt3(res.all.rmse_speed) + " m/s) is no better than the naive predictor v(t) = v_lead(t - " +
+                               fmt3(res.naive_delay) + " s) (" + fmt3(res.naive.rmse_speed) + " m/s)");
+    res.evaluations = pb.evaluations;
+    res.jacobian_evaluations = pb.jacobians;
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     return res;
 }

@@ -1,0 +1,66 @@
+// Calibration on the 12 measured OpenACC traces (../shared/data/acc, or the folder named by the
+// environment variable DDEMAP_ACC_DATA): every fit converges, other design seeds find the
+// same minimum, every fit reports intervals and its warnings.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "ddemap/analysis/calibrate.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+
+TEST_CASE("real OpenACC traces: converged fits, repeatable over design seeds, intervals and warnings" * doctest::test_suite("reference")) {
+    const char* env = std::getenv("DDEMAP_ACC_DATA");
+    const std::string dir = env ? std::string(env) : std::string(DDEMAP_TEST_DATA) + "/../../../shared/data/acc/openacc_zalazone";
+    if (!std::filesystem::exists(dir)) {
+        MESSAGE("shared data not found at " << dir << " (set DDEMAP_ACC_DATA): skipped");
+        return;
+    }
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        if (e.path().extension() == ".csv") files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    REQUIRE(files.size() == 12);
+    std::vector<Trace> traces;
+    for (const auto& f : files) {
+        std::ifstream in(f);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        traces.push_back(read_trace_csv(ss.str(), f));
+    }
+    std::vector<CalibrationResult> a(files.size()), b(files.size());
+    CalibrationOptions other;
+    other.seed = 7;
+#ifdef DDEMAP_WITH_OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+    for (std::size_t i = 0; i < 2 * files.size(); ++i) {
+        if (i < files.size()) a[i] = calibrate(traces[i]);
+        else b[i - files.size()] = calibrate(traces[i - files.size()], other);
+    }
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        CAPTURE(files[i]);
+        CHECK(a[i].status_code == Status::Converged);
+        CHECK(b[i].objective == doctest::Approx(a[i].objective).epsilon(1e-4));
+        // the fit is never worse than the objective at the other seed's parameters
+        CHECK(a[i].objective <= calibration_objective(traces[i], b[i].parameters) * (1.0 + 1e-4));
+        for (const auto& e : a[i].estimates) {
+            CHECK(!(e.lower95 > e.value));
+            CHECK(!(e.upper95 < e.value));
+            const bool warned = std::any_of(a[i].warnings.begin(), a[i].warnings.end(),
+                                            [&](const std::string& w) { return w.rfind(e.name + " ", 0) == 0; });
+            if (e.at_bound) CHECK(warned);
+        }
+        CHECK((a[i].rmse_speed >= a[i].naive_rmse_speed) ==
+              std::any_of(a[i].warnings.begin(), a[i].warnings.end(), [](const std::string& w) { return w.find("naive predictor") != std::string::npos; }));
+    }
+}
+
+TEST_SUITE_END();
