@@ -33,6 +33,19 @@ json root_json(const Root& x, cplx eig) {
 
 }  // namespace
 
+std::string root_method(const std::string& solver) {
+    if (solver == "sparse") return "shift_invert";
+    if (solver == "product") return "contour";
+    if (solver == "auto" || solver == "dense" || solver == "shift_invert" || solver == "contour") return solver;
+    throw BadInput("--solver = '" + solver + "': expected auto, dense, sparse or product");
+}
+
+std::string solver_name(const std::string& method) {
+    if (method == "shift_invert") return "sparse";
+    if (method == "contour") return "product";
+    return method;
+}
+
 void FleetArgs::add_to(CLI::App* roots) {
     roots->add_option("--fleet", fleet, "a mixed ring from a CSV file (one row per car: vehicle and/or model and parameters, optional count; see README)");
     roots->add_option("--fleet-pattern", pattern, "a mixed ring from calibrated vehicles, e.g. \"A_min,C_max*3,E_min\", repeated to --cars");
@@ -56,12 +69,12 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
     }
     MixedRingOptions o;
     set_equilibrium(o, speed, args.length);
-    o.method = parse_solver_method(args.solver);
+    o.roots.method = root_method(args.solver);
     o.roots.count = count;
     o.roots.degree = static_cast<int>(parse_integer("--degree", args.degree, 0, 200, "0 (automatic) or an integer 2..200"));
     if (o.roots.degree == 1) throw BadInput("--degree = '1': expected 0 (automatic) or an integer 2..200");
     const MixedRingResult r = analyse_mixed_ring(fleet, o);
-    const SparseRootResult& rr = r.roots;
+    const RootResult& rr = r.roots;
     std::ostringstream out;
     if (format == Format::Json) {
         json j;
@@ -72,7 +85,7 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
         j["speed"] = num(r.equilibrium.speed);
         j["length"] = num(r.equilibrium.length);
         json roots = json::array();
-        for (std::size_t i = 0; i < rr.roots.size(); ++i) roots.push_back(root_json(rr.roots[i], i < rr.eigenvalues.size() ? rr.eigenvalues[i] : rr.roots[i].value));
+        for (std::size_t i = 0; i < rr.roots.size(); ++i) roots.push_back(root_json(rr.roots[i], rr.roots[i].eigenvalue));
         j["roots"] = roots;
         j["trivial_root_found"] = r.trivial_found;
         j["trivial_root_abs"] = num(r.trivial_root);
@@ -81,6 +94,7 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
         j["unstable_roots"] = r.unstable_roots;
         j["unstable_count_complete"] = r.unstable_count_complete;
         j["product_residual"] = std::isnan(r.product_residual) ? json(nullptr) : num(r.product_residual);
+        j["solver"] = solver_name(rr.method_used);
         j["degree"] = rr.degree;
         j["strip_floor"] = num(rr.strip_floor);
         j["right_bound"] = num(rr.right_bound);
@@ -89,16 +103,16 @@ void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std:
         j["max_residual"] = num(rr.max_residual);
         j["collocation_error"] = num(rr.collocation_error);
         j["status"] = to_string(rr.status);
-        j["reason"] = rr.reason;
+        j["reason"] = rr.message;
         out << j.dump(2) << "\n";
     } else if (format == Format::Csv) {
         out << roots_csv(rr.roots);
     } else {
         out << "fleet      " << (args.fleet.empty() ? args.pattern : args.fleet) << ": " << fleet.size() << " cars, speed "
             << rounded(r.equilibrium.speed, 6) << " m/s, ring length " << rounded(r.equilibrium.length, 8) << " m\n";
-        out << "solver     M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations << " LU factorisations ("
+        out << "solver     " << solver_name(rr.method_used) << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations << " LU factorisations ("
             << to_string(rr.status) << ")\n";
-        out << "trusted    " << rr.reason << "\n";
+        out << "trusted    " << rr.message << "\n";
         out << "trivial    " << (r.trivial_found ? "lambda = 0 found (|lambda| = " + rounded(r.trivial_root, 3) + "), left out"
                                                   : std::string("not among the rightmost roots")) << "\n";
         if (!std::isnan(r.product_residual)) out << "check      max |prod Gamma_i(lambda) - 1| = " << rounded(r.product_residual, 3) << "\n";
@@ -141,7 +155,7 @@ bool MixCommand::run() const {
     o.draws = static_cast<int>(parse_integer("--draws", m->draws, 0, 10000, "an integer 0..10000"));
     o.seed = static_cast<unsigned>(parse_integer("--seed", m->seed, 0, 4294967295L, "an integer 0..4294967295"));
     set_equilibrium(o.ring, m->speed, m->length);
-    o.ring.method = parse_solver_method(m->solver);
+    o.ring.roots.method = root_method(m->solver);
     o.ring.roots.count = 4;
     o.validate();
     const std::vector<MixPoint> pts = penetration_study(x, y, o);

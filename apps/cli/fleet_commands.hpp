@@ -14,6 +14,12 @@ struct FleetArgs {
     bool given() const { return !fleet.empty() || !pattern.empty(); }
 };
 
+/// --solver NAME to the library's root method: auto, dense, sparse (shift_invert) or product
+/// (contour); the library's own names are accepted too. BadInput otherwise.
+std::string root_method(const std::string& solver);
+/// The method a result used, in --solver words (shift_invert -> sparse, contour -> product).
+std::string solver_name(const std::string& method);
+
 /// roots --fleet/--fleet-pattern: prints the result in `format` (table, json or csv).
 void run_fleet_roots(const FleetArgs& args, const std::string& speed, const std::string& count, const std::string& format);
 

@@ -18,7 +18,7 @@
 
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/solve/shift_invert.hpp"
+#include "ddemap/solve/roots.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/io/system_json.hpp"
 #include "ddemap/analysis/classify.hpp"
@@ -54,37 +54,16 @@ void run_system_roots(const RootsArgs& args) {
     const int count = static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000"));
     const Format format = parse_format(args.format);
     const LinearDDE dde = read_linear_dde_json(read_input_file("--system", args.system), args.system);
-    const SolverMethod method = parse_solver_method(args.fleet.solver);
-    if (method == SolverMethod::Product) throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
-    const bool sparse = dde.is_real() && !dde.is_ode() &&
-                        (method == SolverMethod::Sparse || (method == SolverMethod::Automatic && dde.dimension() > 16));
-    if (method == SolverMethod::Sparse && !sparse)
-        throw BadInput("--solver sparse: the sparse path needs real coefficients and at least one delay; expected auto or dense for this system");
-    // one result layout for both paths
-    RootResult r;
-    std::string path = "dense";
-    if (sparse) {
-        SparseDDE s;
-        s.a0 = dde.a0().real().sparseView();
-        for (const auto& t : dde.delayed()) s.delayed.push_back({Eigen::MatrixXd(t.matrix.real()).sparseView(), t.delay});
-        SparseRootOptions so;
-        so.count = count;
-        so.degree = static_cast<int>(parse_integer("--degree", args.fleet.degree, 0, 200, "0 (automatic) or an integer 2..200"));
-        if (so.degree == 1) throw BadInput("--degree = '1': expected 0 (automatic) or an integer 2..200");
-        const SparseRootResult sr = system_rightmost_roots(s, so, SolverMethod::Sparse);
-        r.roots = sr.roots;
-        r.degree = sr.degree;
-        r.status = sr.status;
-        r.reason = sr.reason;
-        r.strip_floor = sr.strip_floor;
-        path = "sparse";
-    } else {
-        RootOptions opt;
-        opt.count = count;
-        r = rightmost_roots(dde, opt);
-    }
+    if (args.fleet.solver == "product") throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
+    RootOptions opt;
+    opt.method = root_method(args.fleet.solver);
+    opt.count = count;
+    opt.degree = static_cast<int>(parse_integer("--degree", args.fleet.degree, 0, 200, "0 (automatic) or an integer 2..200"));
+    if (opt.degree == 1) throw BadInput("--degree = '1': expected 0 (automatic) or an integer 2..200");
+    const RootResult r = rightmost_roots(dde, opt);  // the library chooses (auto) or checks the method
+    const std::string path = solver_name(r.method_used);
     const double a = r.spectral_abscissa();
-    const bool stable = r.status == RootStatus::Converged && !r.roots.empty() && a < -marginal_band(r.roots.front().value);
+    const bool stable = r.status == Status::Converged && !r.roots.empty() && a < -marginal_band(r.roots.front().value);
     std::ostringstream out;
     if (format == Format::Json) {
         json j;
@@ -105,7 +84,7 @@ void run_system_roots(const RootsArgs& args) {
         j["stable"] = stable;
         j["solver"] = path;
         j["degree"] = r.degree;
-        j["degree_reason"] = r.reason;
+        j["degree_reason"] = r.message;
         j["status"] = to_string(r.status);
         out << j.dump(2) << "\n";
     } else if (format == Format::Csv) {
@@ -113,7 +92,7 @@ void run_system_roots(const RootsArgs& args) {
     } else {
         out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
         out << "solver     " << path << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
-        out << "trusted    " << r.reason << "\n";
+        out << "trusted    " << r.message << "\n";
         out << "abscissa   " << rounded(a, 10) << "\n";
         out << "verdict    " << (stable ? "STABLE" : "NOT asymptotically stable") << "\n\n";
         out << roots_table(r.roots);

@@ -37,7 +37,7 @@ std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, co
             pt.abscissa_max = std::max(pt.abscissa_max, a);
             pt.stable = pt.stable && r.stable;
             pt.max_residual = std::max(pt.max_residual, r.roots.max_residual);
-            if (r.roots.status != RootStatus::Converged) pt.status = r.roots.status;
+            if (r.roots.status != Status::Converged) pt.status = r.roots.status;
             ++pt.arrangements;
         }
     }

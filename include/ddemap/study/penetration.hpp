@@ -33,7 +33,7 @@ struct MixPoint {
     bool stable = false;         ///< every arrangement stable
     int unstable_roots = 0;      ///< spread arrangement, among the listed roots
     double max_residual = 0.0;
-    RootStatus status = RootStatus::Converged;  ///< worst over the arrangements
+    Status status = Status::Converged;  ///< worst over the arrangements
 };
 
 std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, const MixOptions& options);

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "ddemap/traffic/model.hpp"
-#include "ddemap/solve/shift_invert.hpp"
+#include "ddemap/problem/linear_dde.hpp"
 
 namespace ddemap {
 
@@ -62,7 +62,7 @@ RingEquilibrium ring_equilibrium_at_speed(const Fleet& fleet, double speed);
 RingEquilibrium ring_equilibrium_at_length(const Fleet& fleet, double length);
 
 /// The 2N-dimensional linearised ring (see the file comment); N >= 2.
-SparseDDE mixed_ring_dde(const std::vector<Linearisation>& cars);
+LinearDDE mixed_ring_dde(const std::vector<Linearisation>& cars);
 
 /// |prod_i Gamma_i(lambda) - 1| for laws of the car ahead only (sums of logarithms, so no
 /// overflow for long rings): 0 at every non-trivial root of the ring.
