@@ -217,6 +217,7 @@ bool RingDeterminant::arg_change(cplx a, cplx b, double theta, double& total, lo
             step_arg = darg + dg;
             return accept;
         }
+        bool failed() const { return false; }
         void accept() {
             std::swap(cp, np);
             std::swap(cr, nr);
