@@ -1,6 +1,7 @@
 #pragma once
 /// \file shift_invert.hpp
-/// The shift_invert backend of rightmost_roots (roots.hpp): large real linear DDEs x' = A0 x + sum_k A_k x(t - tau_k) with sparse matrices: the rightmost
+/// The shift_invert backend of rightmost_roots (roots.hpp, implemented in shift_invert.cpp):
+/// large real linear DDEs x' = A0 x + sum_k A_k x(t - tau_k) with sparse matrices. The rightmost
 /// eigenvalues of their Chebyshev collocation matrix A_M (see collocation.hpp) by shift-and-invert
 /// Arnoldi (Spectra) on a structured operator, each refined by Newton on the DDE itself.
 ///
@@ -15,8 +16,8 @@
 ///
 /// Shift strategy (completeness). Every root with Re(lambda) >= alpha satisfies
 /// Re(lambda) <= beta and |Im(lambda)| <= R(alpha), with (RootBounds, problem/root_bounds.hpp)
-///     beta:  the fixed point of x = mu(A0) + || sum_k |A_k| e^{-x tau_k} ||  (mu the log-norm),
-///     R(a) = ||A0|| + || sum_k |A_k| e^{-a tau_k} ||.
+///     beta:  the fixed point of x = mu(A0) + N(x)  (mu the log-norm),
+///     R(a) = ||A0|| + N(a),   N(a) = min(|| sum_k |A_k| e^{-a tau_k} ||, sum_k ||A_k|| e^{-a tau_k}).
 /// The rectangle [alpha, beta] x [0, R(alpha)] (real problems: the lower half is its mirror) is
 /// covered by discs: a shift sigma whose Arnoldi run returns the nev eigenvalues of largest
 /// |nu(lambda)|, nu = (1/(lambda - sigma) + 1/(lambda - conj sigma)) / 2 (Spectra's operator

@@ -1,6 +1,8 @@
 #pragma once
 // The root backends behind rightmost_roots (roots.hpp); registered in roots.cpp, one per file.
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "ddemap/solve/roots.hpp"
