@@ -41,17 +41,18 @@ int main(int argc, char** argv) {
     std::printf("pattern %s, %d rightmost roots, speed 20 m/s\n", pattern.c_str(), count);
     std::printf("%7s %7s %9s %9s %4s %6s %6s %10s %10s %22s %s\n", "N", "path", "time_s", "peak_MiB", "M", "shifts", "LUs", "residual",
                 "vs_first", "abscissa", "status");
-    const SolverMethod paths[] = {SolverMethod::Product, SolverMethod::Sparse, SolverMethod::Dense};
+    // the paths by their old names: product = contour, sparse = shift_invert
+    const std::pair<const char*, const char*> paths[] = {{"product", "contour"}, {"sparse", "shift_invert"}, {"dense", "dense"}};
     for (int n : sizes) {
         const Fleet fleet = fleet_from_pattern(pattern, n);
         std::vector<Root> first;
-        for (SolverMethod path : paths) {
-            if (path == SolverMethod::Sparse && n > sparse_max) continue;
-            if (path == SolverMethod::Dense && n > dense_max) continue;
+        for (const auto& [label, method] : paths) {
+            if (std::string(method) == "shift_invert" && n > sparse_max) continue;
+            if (std::string(method) == "dense" && n > dense_max) continue;
             MixedRingOptions o;
             o.speed = 20.0;
             o.roots.count = count;
-            o.method = path;
+            o.roots.method = method;
             const auto t0 = std::chrono::steady_clock::now();
             const MixedRingResult r = analyse_mixed_ring(fleet, o);
             const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -63,7 +64,7 @@ int main(int argc, char** argv) {
                     diff = std::max(diff, std::abs(first[i].value - r.roots.roots[i].value));
                 if (first.size() != r.roots.roots.size()) diff = std::numeric_limits<double>::infinity();
             }
-            std::printf("%7d %7s %9.3f %9.1f %4d %6d %6d %10.2e %10.2e %22.17g %s\n", n, to_string(path).c_str(), dt, peak_mib(),
+            std::printf("%7d %7s %9.3f %9.1f %4d %6d %6d %10.2e %10.2e %22.17g %s\n", n, label, dt, peak_mib(),
                         r.roots.degree, r.roots.shifts, r.roots.factorizations, r.roots.max_residual, diff, r.spectral_abscissa,
                         to_string(r.roots.status).c_str());
             std::fflush(stdout);

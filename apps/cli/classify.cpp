@@ -56,10 +56,10 @@ int run_classify() {
     e.command = "classify";
     e.inputs = JsonObject().string("vehicles", source).json("ring", json_ring(cars)).str();
     e.result = classification_json(rows, cars, source);
-    RootStatus status = RootStatus::Converged;
+    Status status = Status::Converged;
     for (const auto& r : rows) {
-        if (r.ring.status != RootStatus::Converged) status = r.ring.status;
-        if (r.string.plant_roots.status != RootStatus::Converged) status = r.string.plant_roots.status;
+        if (r.ring.status != Status::Converged) status = r.ring.status;
+        if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
     }
     e.status = to_string(status);
     const std::string csv = classification_csv(rows);

@@ -171,4 +171,17 @@ std::string OutArg::prepare(const std::string& command) const {
 
 void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }
 
+std::string root_method(const std::string& solver) {
+    if (solver == "sparse") return "shift_invert";
+    if (solver == "product") return "contour";
+    if (solver == "auto" || solver == "dense" || solver == "shift_invert" || solver == "contour") return solver;
+    throw BadInput("--solver = '" + solver + "': expected auto, dense, sparse or product");
+}
+
+std::string solver_name(const std::string& method) {
+    if (method == "shift_invert") return "sparse";
+    if (method == "contour") return "product";
+    return method;
+}
+
 }  // namespace ddemap::cli

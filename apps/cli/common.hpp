@@ -42,7 +42,13 @@ double parse_number(const std::string& flag, const std::string& text);
 long parse_integer(const std::string& flag, const std::string& text, long lo, long hi, const std::string& what);
 
 /// 0 when `s` converged, else exit_not_converged.
-inline int exit_code(RootStatus s) { return s == RootStatus::Converged ? exit_ok : exit_not_converged; }
+inline int exit_code(Status s) { return s == Status::Converged ? exit_ok : exit_not_converged; }
+
+/// --solver NAME to the library's root method: auto, dense, sparse (shift_invert) or product
+/// (contour); the library's own names are accepted too. BadInput otherwise.
+std::string root_method(const std::string& solver);
+/// A method in --solver words (shift_invert -> sparse, contour -> product).
+std::string solver_name(const std::string& method);
 
 /// The model flags: --model and one flag per model parameter.
 struct ModelArgs {

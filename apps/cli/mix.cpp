@@ -50,16 +50,16 @@ int run_mix() {
     o.draws = static_cast<int>(parse_integer("--draws", args.draws, 0, 10000, "an integer 0..10000"));
     o.seed = static_cast<unsigned>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
     set_equilibrium(o.ring, args.speed, args.length);
-    o.ring.method = parse_solver_method(args.solver);
+    o.ring.roots.method = root_method(args.solver);
     o.ring.roots.count = 4;
     o.validate();
     const std::string prefix = args.out.prepare("mix");
     const std::vector<MixPoint> pts = penetration_study(x, y, o);
-    RootStatus status = RootStatus::Converged;
+    Status status = Status::Converged;
     std::string used;
     for (const auto& pt : pts) {
-        if (pt.status != RootStatus::Converged) status = pt.status;
-        const std::string u = to_string(pt.method_used);
+        if (pt.status != Status::Converged) status = pt.status;
+        const std::string u = solver_name(pt.method_used);
         if (used.find(u) == std::string::npos) used += (used.empty() ? "" : ",") + u;
     }
     JsonEnvelope e;
@@ -74,7 +74,7 @@ int run_mix() {
     equilibrium_inputs(in, o.ring);
     e.inputs = in.str();
     e.has_solver = true;
-    e.solver_given = to_string(o.ring.method);
+    e.solver_given = solver_name(o.ring.roots.method);
     e.solver_used = used;
     e.status = to_string(status);
     e.result = mix_json(pts, o.cars);

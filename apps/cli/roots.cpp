@@ -45,10 +45,11 @@ void emit(const JsonEnvelope& e, const std::string& csv, const std::string& tabl
 int run_system(Format format, const std::string& prefix) {
     if (args.model.given() || args.ring.given())
         throw BadInput("--system takes the whole problem from the file: expected no model parameters, --model or --ring");
-    SystemRootOptions o;
+    RootOptions o;
     o.count = parse_count();
     o.degree = parse_degree();
-    o.method = parse_solver_method(args.solver);
+    o.method = root_method(args.solver);
+    if (o.method == "contour") throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
     const LinearDDE dde = read_linear_dde_json(read_input_file("--system", args.system), args.system);
     const SystemRootResult s = analyse_system(dde, o);
     const RootResult& r = s.roots;
@@ -56,17 +57,17 @@ int run_system(Format format, const std::string& prefix) {
     e.command = "roots";
     e.inputs = JsonObject().string("system", args.system).integer("count", o.count).integer("degree", o.degree).str();
     e.has_solver = true;
-    e.solver_given = to_string(s.method_given);
-    e.solver_used = to_string(s.method_used);
+    e.solver_given = solver_name(r.method_given);
+    e.solver_used = solver_name(r.method_used);
     e.status = to_string(r.status);
-    e.message = r.reason;
+    e.message = r.message;
     e.result = system_roots_json(dde, s);
     std::ostringstream out;
     out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
-    out << "solver     " << to_string(s.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
-    out << "trusted    " << r.reason << "\n";
+    out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
+    out << "trusted    " << r.message << "\n";
     out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";
-    out << "verdict    " << (r.status != RootStatus::Converged ? "UNDECIDED (" + to_string(r.status) + ")"
+    out << "verdict    " << (r.status != Status::Converged ? "UNDECIDED (" + to_string(r.status) + ")"
                              : s.stable ? std::string("STABLE") : std::string("NOT asymptotically stable")) << "\n\n";
     out << roots_table(r.roots);
     emit(e, roots_csv(r.roots), out.str(), format, prefix);
@@ -94,11 +95,11 @@ int run_fleet(Format format, const std::string& prefix) {
     }
     MixedRingOptions o;
     set_equilibrium(o, speed, args.length);
-    o.method = parse_solver_method(args.solver);
+    o.roots.method = root_method(args.solver);
     o.roots.count = parse_count();
     o.roots.degree = parse_degree();
     const MixedRingResult r = analyse_mixed_ring(fleet, o);
-    const SparseRootResult& rr = r.roots;
+    const RootResult& rr = r.roots;
     JsonEnvelope e;
     e.command = "roots";
     JsonObject in;
@@ -108,24 +109,24 @@ int run_fleet(Format format, const std::string& prefix) {
     in.integer("count", o.roots.count).integer("degree", o.roots.degree);
     e.inputs = in.str();
     e.has_solver = true;
-    e.solver_given = to_string(r.method_given);
-    e.solver_used = to_string(r.method_used);
+    e.solver_given = solver_name(rr.method_given);
+    e.solver_used = solver_name(rr.method_used);
     e.status = to_string(rr.status);
-    e.message = rr.reason;
+    e.message = rr.message;
     e.result = mixed_ring_json(r, fleet.size());
     std::ostringstream out;
     out << "fleet      " << (args.fleet.empty() ? args.pattern : args.fleet) << ": " << fleet.size() << " cars, speed "
         << rounded(r.equilibrium.speed, 6) << " m/s, ring length " << rounded(r.equilibrium.length, 8) << " m\n";
-    out << "solver     " << to_string(r.method_used) << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations
+    out << "solver     " << solver_name(rr.method_used) << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations
         << " LU factorisations (" << to_string(rr.status) << ")\n";
-    out << "trusted    " << rr.reason << "\n";
+    out << "trusted    " << rr.message << "\n";
     out << "trivial    "
         << (r.trivial_found ? "lambda = 0 found (|lambda| = " + rounded(r.trivial_root, 3) + "), left out"
                             : std::string("not among the rightmost roots"))
         << "\n";
     if (!std::isnan(r.product_residual)) out << "check      max |prod Gamma_i(lambda) - 1| = " << rounded(r.product_residual, 3) << "\n";
     out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
-    if (rr.status != RootStatus::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
+    if (rr.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
     else
         out << "verdict    " << (r.stable ? "STABLE" : "UNSTABLE") << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
             << " unstable roots)\n\n";
@@ -159,7 +160,7 @@ int run_ring(Format format, const std::string& prefix) {
     if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
     else out << " (mode " << r.abscissa_mode << ")";
     out << "\n";
-    if (r.status != RootStatus::Converged) {
+    if (r.status != Status::Converged) {
         out << "verdict    ring UNDECIDED (" << to_string(r.status) << ")";
     } else {
         out << "verdict    ring " << (r.stable ? "STABLE" : "UNSTABLE");

@@ -41,8 +41,8 @@ int run_string() {
     std::optional<RingResult> ring;
     if (cars) ring = analyse_ring(lin, *cars);
     const RingResult* rp = ring ? &*ring : nullptr;
-    RootStatus status = s.plant_roots.status;
-    if (ring && ring->status != RootStatus::Converged) status = ring->status;
+    Status status = s.plant_roots.status;
+    if (ring && ring->status != Status::Converged) status = ring->status;
 
     JsonEnvelope e;
     e.command = "string";
@@ -50,7 +50,7 @@ int run_string() {
     if (cars) in.json("ring", json_ring(*cars));
     e.inputs = in.str();
     e.status = to_string(status);
-    e.message = ring && ring->status != RootStatus::Converged ? ring->reason : s.plant_roots.reason;
+    e.message = ring && ring->status != Status::Converged ? ring->reason : s.plant_roots.message;
     e.result = string_json(s, rp);
     const std::string csv = string_csv(s, rp);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});

@@ -21,11 +21,11 @@ bool rightmost_first(const RingRoot& a, const RingRoot& b) {
 void absorb_status(RingResult& r, const RootResult& rr) {
     r.degree = std::max(r.degree, rr.degree);
     ++r.modes_solved;
-    if (rr.status != RootStatus::Converged) {
+    if (rr.status != Status::Converged) {
         r.status = rr.status;
-        r.reason = rr.reason;
+        r.reason = rr.message;
     } else if (r.reason.empty()) {
-        r.reason = rr.reason;
+        r.reason = rr.message;
     }
 }
 
@@ -33,7 +33,7 @@ void absorb_status(RingResult& r, const RootResult& rr) {
 /// left of the axis so that every unstable root is found.
 RootResult solve_mode(const LinearDDE& dde, RootOptions opts, bool all_unstable) {
     RootResult rr = rightmost_roots(dde, opts);
-    while (all_unstable && rr.status == RootStatus::Converged && static_cast<int>(rr.roots.size()) >= opts.count &&
+    while (all_unstable && rr.status == Status::Converged && static_cast<int>(rr.roots.size()) >= opts.count &&
            !rr.roots.empty() && rr.roots.back().value.real() > -marginal_band(rr.roots.back().value) &&
            opts.count < 512) {
         opts.count *= 2;
@@ -118,7 +118,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             if (x.root.value.real() > band) ++r.unstable_roots;
             else if (x.root.value.real() >= -band) ++r.marginal_roots;
         }
-        r.stable = r.status == RootStatus::Converged && r.unstable_roots == 0 && r.marginal_roots == 0;
+        r.stable = r.status == Status::Converged && r.unstable_roots == 0 && r.marginal_roots == 0;
         r.trivial_branch_stable = r.stable;
     } else {
         // N = infinity: maximise the rightmost real part over wave numbers theta in (0, pi]
@@ -195,7 +195,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
         }
         r.abscissa_mode = -1;
         r.unstable_roots = -1;
-        r.stable = r.status == RootStatus::Converged && grid_stable && r.trivial_branch_stable;
+        r.stable = r.status == Status::Converged && grid_stable && r.trivial_branch_stable;
     }
     // report the `count` rightmost, plus a conjugate partner that ties with the last one
     std::size_t keep = std::min<std::size_t>(all.size(), count);

@@ -137,7 +137,7 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     StringResult r;
     r.plant_roots = std::move(plant);
     r.plant_abscissa = r.plant_roots.spectral_abscissa();
-    r.plant_stable = r.plant_roots.status == RootStatus::Converged && !r.plant_roots.roots.empty() &&
+    r.plant_stable = r.plant_roots.status == Status::Converged && !r.plant_roots.roots.empty() &&
                      r.plant_abscissa < -marginal_band(r.plant_roots.roots.front().value);
 
     r.lowfreq = low_frequency_expansion(lin);

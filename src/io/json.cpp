@@ -128,13 +128,13 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& s) {
     j["spectral_abscissa"] = num(s.spectral_abscissa);
     j["stable"] = s.stable;
     j["degree"] = r.degree;
-    j["degree_reason"] = r.reason;
+    j["degree_reason"] = r.message;
     j["strip_floor"] = num(r.strip_floor);
     return text(j);
 }
 
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
-    const SparseRootResult& rr = r.roots;
+    const RootResult& rr = r.roots;
     json j;
     j["ring"] = cars;
     j["speed"] = num(r.equilibrium.speed);
@@ -142,7 +142,7 @@ std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
     json roots = json::array();
     for (std::size_t i = 0; i < rr.roots.size(); ++i) {
         json o = root_json(rr.roots[i]);
-        const cplx eig = i < rr.eigenvalues.size() ? rr.eigenvalues[i] : rr.roots[i].value;
+        const cplx eig = rr.roots[i].eigenvalue;
         o["eigenvalue_re"] = num(eig.real());
         o["eigenvalue_im"] = num(eig.imag());
         roots.push_back(o);
@@ -157,7 +157,7 @@ std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
     j["unstable_count_complete"] = r.unstable_count_complete;
     j["product_residual"] = num(r.product_residual);
     j["degree"] = rr.degree;
-    j["degree_reason"] = rr.reason;
+    j["degree_reason"] = rr.message;
     j["strip_floor"] = num(rr.strip_floor);
     j["right_bound"] = num(rr.right_bound);
     j["shifts"] = rr.shifts;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "ddemap/core/newton.hpp"
+
 namespace ddemap {
 
 using cplx = std::complex<double>;
@@ -61,17 +63,20 @@ cplx QuasiPolynomial::operator()(cplx lambda) const {
 }
 
 bool QuasiPolynomial::newton(cplx& lambda, int max_iterations) const {
-    for (int it = 0; it < max_iterations; ++it) {
-        cplx f, fp;
-        evaluate(lambda, f, fp);
-        if (f == cplx(0.0)) return true;
-        if (fp == cplx(0.0)) return false;
-        const cplx step = f / fp;
-        lambda -= step;
-        if (!std::isfinite(lambda.real()) || !std::isfinite(lambda.imag())) return false;
-        if (std::abs(step) <= 4.0 * 2.220446049250313e-16 * std::max(1.0, std::abs(lambda))) return true;
-    }
-    return false;
+    NewtonOptions o;
+    o.max_iterations = max_iterations;  // step tolerance 4 eps
+    const NewtonSummary s = ddemap::newton(
+        lambda,
+        [&](const cplx& z, cplx& dz) {
+            cplx f, fp;
+            evaluate(z, f, fp);
+            if (f == cplx(0.0)) return NewtonStep::Exact;
+            if (fp == cplx(0.0)) return NewtonStep::Singular;
+            dz = f / fp;
+            return NewtonStep::Ok;
+        },
+        o);
+    return s.status == Status::Converged;
 }
 
 namespace {

@@ -12,38 +12,9 @@
 #include <Spectra/GenEigsComplexShiftSolver.h>
 
 #include "ddemap/discretize/chebyshev.hpp"
+#include "internal/backends.hpp"
 
 namespace ddemap {
-
-double SparseDDE::max_delay() const {
-    double d = 0.0;
-    for (const auto& t : delayed) d = std::max(d, t.delay);
-    return d;
-}
-
-void SparseDDE::validate() const {
-    const auto n = a0.rows();
-    if (n < 1 || a0.cols() != n) throw std::invalid_argument("A0 must be square with dimension >= 1");
-    auto finite = [](const Eigen::SparseMatrix<double>& m) {
-        for (int k = 0; k < m.outerSize(); ++k)
-            for (Eigen::SparseMatrix<double>::InnerIterator it(m, k); it; ++it)
-                if (!std::isfinite(it.value())) return false;
-        return true;
-    };
-    if (!finite(a0)) throw std::invalid_argument("A0 has a non-finite entry");
-    for (std::size_t k = 0; k < delayed.size(); ++k) {
-        const auto& t = delayed[k];
-        if (t.matrix.rows() != n || t.matrix.cols() != n) throw std::invalid_argument("delayed matrix " + std::to_string(k + 1) + " has the wrong size");
-        if (!finite(t.matrix)) throw std::invalid_argument("delayed matrix " + std::to_string(k + 1) + " has a non-finite entry");
-        if (!(std::isfinite(t.delay) && t.delay > 0.0)) throw std::invalid_argument("delay " + std::to_string(k + 1) + ": expected a finite delay > 0");
-    }
-}
-
-LinearDDE SparseDDE::to_dense() const {
-    std::vector<DelayTerm> terms;
-    for (const auto& t : delayed) terms.push_back({MatrixXc(Eigen::MatrixXd(t.matrix).cast<cplx>()), t.delay});
-    return LinearDDE(MatrixXc(Eigen::MatrixXd(a0).cast<cplx>()), terms);
-}
 
 namespace {
 
@@ -52,12 +23,12 @@ using SpD = Eigen::SparseMatrix<double>;
 
 /// The union of the patterns of A0, I and every A_k (compressed): the pattern of Delta(z) and
 /// of the shifted matrix S, analysed once for every sparse LU and Gershgorin test.
-SpD union_pattern(const SparseDDE& dde) {
-    SpD pattern = dde.a0;
+SpD union_pattern(const LinearDDE& dde) {
+    SpD pattern = dde.sparse_a0();
     SpD eye(dde.dimension(), dde.dimension());
     eye.setIdentity();
     pattern += eye;
-    for (const auto& t : dde.delayed) pattern += t.matrix;
+    for (const auto& t : dde.sparse_delayed()) pattern += t.matrix;
     pattern.makeCompressed();
     return pattern;
 }
@@ -67,14 +38,14 @@ class StructuredShiftInvert {
 public:
     using Scalar = double;
 
-    StructuredShiftInvert(const SparseDDE& dde, int degree) : m_dde(dde), m_m(degree), m_n(dde.dimension()) {
+    StructuredShiftInvert(const LinearDDE& dde, int degree) : m_dde(dde), m_m(degree), m_n(dde.dimension()) {
         const double tau = dde.max_delay();
         m_d = detail::chebyshev_differentiation(degree) * (2.0 / tau);
-        for (const auto& t : dde.delayed) {
+        for (const auto& t : dde.sparse_delayed()) {
             m_l.push_back(detail::chebyshev_lagrange_row(degree, 1.0 - 2.0 * t.delay / tau));
             m_ak.push_back(t.matrix.cast<cplx>());
         }
-        m_a0 = dde.a0.cast<cplx>();
+        m_a0 = dde.sparse_a0().cast<cplx>();
         m_pattern = union_pattern(dde).cast<cplx>();
         m_pattern.makeCompressed();
         m_eye.resize(m_n, m_n);
@@ -142,7 +113,7 @@ public:
     int factorizations() const { return m_factorizations; }
 
 private:
-    const SparseDDE& m_dde;
+    const LinearDDE& m_dde;
     int m_m, m_n;
     Eigen::MatrixXd m_d;
     std::vector<Eigen::VectorXd> m_l;
@@ -161,9 +132,9 @@ private:
 
 }  // namespace
 
-SparseEigenResult sparse_collocation_eigenvalues(const SparseDDE& dde, int degree, const std::vector<cplx>& shifts, int nev) {
-    dde.validate();
-    if (dde.delayed.empty()) throw std::invalid_argument("the sparse path needs at least one delay");
+SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int degree, const std::vector<cplx>& shifts, int nev) {
+    const LinearDDE dde = input.to_sparse();
+    if (dde.is_ode()) throw std::invalid_argument("the sparse path needs at least one delay");
     if (degree < 2) throw std::invalid_argument("collocation degree must be >= 2");
     StructuredShiftInvert op(dde, degree);
     const Eigen::Index size = op.rows();
@@ -174,7 +145,7 @@ SparseEigenResult sparse_collocation_eigenvalues(const SparseDDE& dde, int degre
         Spectra::GenEigsComplexShiftSolver<StructuredShiftInvert> solver(op, nev, ncv, sigma.real(), sigma.imag());
         solver.init();
         solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-        if (solver.info() != Spectra::CompInfo::Successful) out.status = RootStatus::EigenFailure;
+        if (solver.info() != Spectra::CompInfo::Successful) out.status = Status::NumericalIssue;
         const Eigen::VectorXcd ev = solver.eigenvalues();
         for (Eigen::Index i = 0; i < ev.size(); ++i) {
             const cplx z = ev(i);
@@ -188,138 +159,13 @@ SparseEigenResult sparse_collocation_eigenvalues(const SparseDDE& dde, int degre
 }
 
 
-Eigen::SparseMatrix<cplx> SparseDDE::characteristic_matrix(cplx lambda) const {
-    const int n = dimension();
-    Eigen::SparseMatrix<cplx> eye(n, n);
-    eye.setIdentity();
-    Eigen::SparseMatrix<cplx> d = lambda * eye - a0.cast<cplx>();
-    for (const auto& t : delayed) d -= std::exp(-lambda * t.delay) * t.matrix.cast<cplx>();
-    return d;
-}
-
-Eigen::SparseMatrix<cplx> SparseDDE::characteristic_derivative(cplx lambda) const {
-    const int n = dimension();
-    Eigen::SparseMatrix<cplx> d(n, n);
-    d.setIdentity();
-    for (const auto& t : delayed) d += (t.delay * std::exp(-lambda * t.delay)) * t.matrix.cast<cplx>();
-    return d;
-}
-
-SparseDDE normalised(const SparseDDE& dde) {
-    dde.validate();
-    SparseDDE out;
-    out.a0 = dde.a0;
-    std::vector<SparseDDE::Term> terms;
-    for (const auto& t : dde.delayed) {
-        auto same = std::find_if(terms.begin(), terms.end(), [&](const SparseDDE::Term& u) { return u.delay == t.delay; });
-        if (same != terms.end())
-            same->matrix += t.matrix;
-        else
-            terms.push_back(t);
-    }
-    std::sort(terms.begin(), terms.end(), [](const SparseDDE::Term& a, const SparseDDE::Term& b) { return a.delay < b.delay; });
-    for (auto& t : terms) {
-        t.matrix.prune(0.0);
-        if (t.matrix.nonZeros() > 0) out.delayed.push_back(std::move(t));
-    }
-    out.a0.prune(0.0);
-    return out;
-}
-
-void SparseRootOptions::validate() const {
-    auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
-    if (count < 1) fail("count = " + std::to_string(count) + ": expected an integer >= 1");
-    if (degree < 0 || degree == 1) fail("degree = " + std::to_string(degree) + ": expected 0 (automatic) or >= 2");
-    if (max_degree < 2) fail("max_degree = " + std::to_string(max_degree) + ": expected an integer >= 2");
-    if (degree > max_degree) fail("degree exceeds max_degree");
-    if (eigenvalues_per_shift < 2) fail("eigenvalues_per_shift = " + std::to_string(eigenvalues_per_shift) + ": expected >= 2");
-    if (max_shifts < 1) fail("max_shifts: expected >= 1");
-    if (arnoldi_max_restarts < 1) fail("arnoldi_max_restarts: expected >= 1");
-    if (newton_max_iterations < 1) fail("newton_max_iterations: expected >= 1");
-    auto positive = [&](double v, const char* name) {
-        if (!(std::isfinite(v) && v > 0.0)) fail(std::string(name) + ": expected a finite value > 0");
-    };
-    positive(arnoldi_tolerance, "arnoldi_tolerance");
-    positive(newton_tolerance, "newton_tolerance");
-    positive(residual_tolerance, "residual_tolerance");
-    positive(collocation_tolerance, "collocation_tolerance");
-}
-
-double SparseRootResult::spectral_abscissa() const {
-    double a = -std::numeric_limits<double>::infinity();
-    for (const auto& r : roots) a = std::max(a, r.value.real());
-    return a;
-}
-
 namespace {
 
 double scale_of(cplx z) { return std::max(1.0, std::abs(z)); }
 
-/// ||A||_2 <= sqrt(||A||_1 ||A||_inf)
-double norm2_bound(const SpD& a) {
-    Eigen::VectorXd rows = Eigen::VectorXd::Zero(a.rows()), cols = Eigen::VectorXd::Zero(a.cols());
-    for (int k = 0; k < a.outerSize(); ++k)
-        for (SpD::InnerIterator it(a, k); it; ++it) {
-            rows(it.row()) += std::abs(it.value());
-            cols(it.col()) += std::abs(it.value());
-        }
-    const double r = rows.size() ? rows.maxCoeff() : 0.0, c = cols.size() ? cols.maxCoeff() : 0.0;
-    return std::sqrt(r * c);
-}
-
-/// mu_2(A) = lambda_max((A + A^T)/2) <= max_i (a_ii + sum_{j != i} |a_ij + a_ji| / 2) (Gershgorin)
-double log_norm_bound(const SpD& a) {
-    const SpD sym = 0.5 * (a + SpD(a.transpose()));
-    Eigen::VectorXd bound = Eigen::VectorXd::Zero(a.rows());
-    for (int k = 0; k < sym.outerSize(); ++k)
-        for (SpD::InnerIterator it(sym, k); it; ++it) bound(it.row()) += it.row() == it.col() ? it.value() : std::abs(it.value());
-    return bound.size() ? bound.maxCoeff() : 0.0;
-}
-
-using Bounds = detail::RootBounds;
+using Bounds = RootBounds;
 
 }  // namespace
-
-namespace detail {
-
-double RootBounds::delayed_norm(double a) const {
-    if (entries.empty()) return 0.0;
-    std::vector<double> rows(static_cast<std::size_t>(n), 0.0), cols(static_cast<std::size_t>(n), 0.0);
-    for (const auto& e : entries) {
-        const double v = e.value * std::exp(-a * e.delay);
-        rows[static_cast<std::size_t>(e.row)] += v;
-        cols[static_cast<std::size_t>(e.col)] += v;
-    }
-    return std::sqrt(*std::max_element(rows.begin(), rows.end()) * *std::max_element(cols.begin(), cols.end()));
-}
-
-double RootBounds::radius(double a) const { return n0 + delayed_norm(a); }
-
-double RootBounds::right_bound() const {
-    auto f = [&](double x) { return mu - x + delayed_norm(x); };
-    double lo = mu, hi = mu + 1.0 + delayed_norm(mu);
-    while (f(lo) < 0.0) lo -= std::max(1.0, std::abs(lo));
-    while (f(hi) > 0.0) hi += std::max(1.0, std::abs(hi));
-    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(hi)); ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (f(mid) > 0.0 ? lo : hi) = mid;
-    }
-    return hi;
-}
-
-RootBounds root_bounds(const SparseDDE& dde) {
-    RootBounds b;
-    b.n = dde.dimension();
-    b.n0 = norm2_bound(dde.a0);
-    b.mu = log_norm_bound(dde.a0);
-    for (const auto& t : dde.delayed)
-        for (int k = 0; k < t.matrix.outerSize(); ++k)
-            for (SpD::InnerIterator it(t.matrix, k); it; ++it)
-                if (it.value() != 0.0) b.entries.push_back({static_cast<int>(it.row()), static_cast<int>(it.col()), std::abs(it.value()), t.delay});
-    return b;
-}
-
-}  // namespace detail
 
 namespace {
 
@@ -351,14 +197,14 @@ bool inside(const Cell& c, const Disc& d) {
 /// diag^{-1} W (power iteration), the best scaling when one exists.
 class Gershgorin {
 public:
-    explicit Gershgorin(const SparseDDE& dde) : m_n(dde.dimension()), m_p(union_pattern(dde)) {
+    explicit Gershgorin(const LinearDDE& dde) : m_n(dde.dimension()), m_p(union_pattern(dde)) {
         auto aligned = [&](const SpD& m) {
             SpD a = m + 0.0 * m_p;
             a.makeCompressed();
             return std::vector<double>(a.valuePtr(), a.valuePtr() + a.nonZeros());
         };
-        m_a0 = aligned(dde.a0);
-        for (const auto& t : dde.delayed) {
+        m_a0 = aligned(dde.sparse_a0());
+        for (const auto& t : dde.sparse_delayed()) {
             m_ak.push_back(aligned(t.matrix));
             m_tau.push_back(t.delay);
         }
@@ -429,7 +275,7 @@ private:
 /// the distinct eigenvalues met.
 class Covering {
 public:
-    Covering(StructuredShiftInvert& op, const Gershgorin& gersh, const SparseRootOptions& o) : m_op(op), m_gersh(gersh), m_o(o) {}
+    Covering(StructuredShiftInvert& op, const Gershgorin& gersh, const ShiftInvertRootOptions& o) : m_op(op), m_gersh(gersh), m_o(o) {}
 
     /// Runs one shift (nudged off a singular point); false after max_shifts.
     bool shift_at(cplx sigma) {
@@ -551,7 +397,7 @@ private:
 
     StructuredShiftInvert& m_op;
     const Gershgorin& m_gersh;
-    const SparseRootOptions& m_o;
+    const ShiftInvertRootOptions& m_o;
     std::vector<Disc> m_discs;
     std::vector<cplx> m_values;
     int m_shifts = 0;
@@ -573,17 +419,17 @@ private:
     }
 };
 
-/// Newton on [Delta(lambda) v = 0, c^H v = 1] (nonlinear inverse iteration):
+/// Newton on [Delta(lambda) v = 0, c^H v = 1] (nonlinear inverse iteration, the one Newton loop):
 ///     u = Delta(lambda)^{-1} Delta'(lambda) v,  lambda <- lambda - 1 / (c^H u),  v <- u / (c^H u).
 class SparseNewton {
 public:
-    SparseNewton(const SparseDDE& dde, const Bounds& bounds) : m_dde(dde), m_bounds(bounds) {
+    explicit SparseNewton(const LinearDDE& dde) : m_dde(dde) {
         m_pattern = union_pattern(dde).cast<cplx>();
         m_pattern.makeCompressed();
         m_lu.analyzePattern(m_pattern);
     }
 
-    bool refine(cplx guess, const SparseRootOptions& o, Root& out) {
+    bool refine(cplx guess, const RootOptions& o, Root& out) {
         const int n = m_dde.dimension();
         const bool real = guess.imag() == 0.0;
         std::mt19937 rng(12345);
@@ -596,66 +442,58 @@ public:
         if (!v.allFinite() || v.norm() == 0.0) return finish(guess, lambda, Eigen::VectorXcd(), 0.0, true, o, out);
         v /= v.norm();
         const Eigen::VectorXcd c = v;  // c^H v = 1
-        double step_size = std::numeric_limits<double>::infinity();
-        bool converged = false;
-        for (int it = 0; it < o.newton_max_iterations; ++it) {
-            if (it > 0 && !factor(lambda)) {
-                converged = true;  // Delta(lambda) singular: lambda is a root to working precision
-                break;
-            }
-            const Eigen::VectorXcd dv = m_dde.characteristic_derivative(lambda) * v;
-            const Eigen::VectorXcd w = m_lu.solve(dv);
-            const cplx chu = c.dot(w);
-            if (!w.allFinite() || chu == cplx(0.0)) {
-                converged = true;
-                break;
-            }
-            const cplx step = 1.0 / chu;
-            lambda -= step;
-            v = w / chu;
-            step_size = std::abs(step);
-            if (real) lambda.imag(0.0);
-            if (step_size <= o.newton_tolerance * scale_of(lambda)) {
-                converged = true;
-                break;
-            }
-        }
-        if (converged && step_size == std::numeric_limits<double>::infinity()) step_size = 0.0;
-        return finish(guess, lambda, v, step_size, converged, o, out);
+        bool first = true;
+        const NewtonSummary s = newton(
+            lambda,
+            [&](const cplx& z, cplx& dz) {
+                // Delta(lambda) singular: lambda is a root to working precision
+                if (!first && !factor(z)) return NewtonStep::Exact;
+                first = false;
+                const Eigen::VectorXcd dv = m_dde.sparse_characteristic_derivative(z) * v;
+                const Eigen::VectorXcd w = m_lu.solve(dv);
+                const cplx chu = c.dot(w);
+                if (!w.allFinite() || chu == cplx(0.0)) return NewtonStep::Exact;
+                dz = 1.0 / chu;
+                if (real) dz.imag(0.0);
+                v = w / chu;
+                return NewtonStep::Ok;
+            },
+            o.shift_invert.newton);
+        m_iterations += s.iterations;
+        const double step = s.status == Status::Converged && s.iterations == 0 ? 0.0 : s.last_step;
+        return finish(guess, lambda, v, step, s.status == Status::Converged, o, out);
     }
 
     int factorizations() const { return m_factorizations; }
+    int iterations() const { return m_iterations; }
 
 private:
     bool factor(cplx lambda) {
-        m_d = m_dde.characteristic_matrix(lambda) + cplx(0.0) * m_pattern;
+        m_d = m_dde.sparse_characteristic_matrix(lambda) + cplx(0.0) * m_pattern;
         m_d.makeCompressed();
         m_lu.factorize(m_d);
         ++m_factorizations;
         return m_lu.info() == Eigen::Success;
     }
-    bool finish(cplx guess, cplx lambda, const Eigen::VectorXcd& v, double step, bool converged, const SparseRootOptions& o,
-                Root& out) {
+    bool finish(cplx guess, cplx lambda, const Eigen::VectorXcd& v, double step, bool converged, const RootOptions& o, Root& out) {
         out.value = lambda;
+        out.eigenvalue = guess;
         out.newton_step = step;
         out.collocation_error = std::abs(lambda - guess);
-        if (v.size() > 0 && v.norm() > 0.0) {
-            out.residual = (m_dde.characteristic_matrix(lambda) * v).norm() / (v.norm() * m_bounds.scale(lambda));
-        } else {
-            out.residual = 0.0;  // Delta(lambda) singular to working precision
-        }
+        // Delta(lambda) singular to working precision: residual 0
+        out.residual = v.size() > 0 && v.norm() > 0.0 ? relative_residual(m_dde, lambda, v) : 0.0;
         return (converged || step <= 1e-6 * scale_of(lambda)) && out.residual <= o.residual_tolerance &&
                std::isfinite(lambda.real()) && std::isfinite(lambda.imag());
     }
 
-    const SparseDDE& m_dde;
-    const Bounds& m_bounds;
+    const LinearDDE& m_dde;
     SpC m_pattern, m_d;
     Eigen::UmfPackLU<SpC> m_lu;
     int m_factorizations = 0;
+    int m_iterations = 0;
 };
 
-bool rightmost_first(cplx a, cplx b) {
+bool rightmost_first_value(cplx a, cplx b) {
     if (a.real() != b.real()) return a.real() > b.real();
     return a.imag() > b.imag();
 }
@@ -668,34 +506,44 @@ std::vector<cplx> with_conjugates(const std::vector<cplx>& upper, double alpha) 
         out.push_back(z);
         if (z.imag() > 0.0) out.push_back(std::conj(z));
     }
-    std::sort(out.begin(), out.end(), rightmost_first);
+    std::sort(out.begin(), out.end(), rightmost_first_value);
     return out;
 }
 
 }  // namespace
 
-SparseRootResult sparse_rightmost_roots(const SparseDDE& input, const SparseRootOptions& options) {
-    options.validate();
-    const SparseDDE dde = normalised(input);
-    if (dde.delayed.empty()) throw std::invalid_argument("the sparse path needs at least one delay > 0 (an ODE: use the dense path)");
+namespace detail {
+
+std::string shift_invert_why_not(const RootProblem& problem, const RootOptions& options) {
+    const LinearDDE& dde = problem.dde;
+    if (!dde.is_real() || dde.is_ode())
+        return "method 'shift_invert': the sparse path needs real coefficients and at least one delay; expected auto or dense for this problem";
+    const int m = options.degree > 0 ? options.degree : 8;
+    if (static_cast<long>(m + 1) * dde.dimension() < 8)
+        return "method 'shift_invert' needs (M+1) n >= 8; expected dense for n = " + std::to_string(dde.dimension());
+    return {};
+}
+
+RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& options) {
+    const LinearDDE dde = problem.dde.to_sparse();
+    const ShiftInvertRootOptions& so = options.shift_invert;
+    const int max_degree = std::max(so.max_degree, options.degree);
     const int n = dde.dimension();
-    const Bounds bounds = detail::root_bounds(dde);
+    const Bounds& bounds = dde.bounds();
     const double tau = dde.max_delay();
-    SparseRootResult result;
+    RootResult result;
     result.right_bound = bounds.right_bound();
     const double beta = result.right_bound;
-    // the first strip is cheap (few eigenvalues); it is widened until `count` eigenvalues lie in it
     // a deep first strip: the floor rises as soon as `count` eigenvalues are known
     double alpha = std::min(0.0, beta) - 1.0 / tau;
     int m = options.degree > 0 ? options.degree
-                               : std::clamp(detail::degree_for_radius(bounds.radius(std::min(0.0, beta) - 1.0 / tau), tau), 8,
-                                            options.max_degree);
+                               : std::clamp(degree_for_radius(bounds.radius(std::min(0.0, beta) - 1.0 / tau), tau), 8, max_degree);
     const Gershgorin gersh(dde);
     for (;;) {
         StructuredShiftInvert op(dde, m);
         if (op.rows() < 8)
             throw std::invalid_argument("the sparse path needs (M+1) n >= 8; use the dense path for n = " + std::to_string(n));
-        Covering cover(op, gersh, options);
+        Covering cover(op, gersh, so);
         bool budget = true;
         std::vector<cplx> right;
         for (;;) {
@@ -710,10 +558,10 @@ SparseRootResult sparse_rightmost_roots(const SparseDDE& input, const SparseRoot
         result.factorizations += op.factorizations();
         result.eigenvalues_found = static_cast<int>(cover.values().size());
         const double height = bounds.radius(alpha);
-        const double resolved = detail::radius_for_degree(m, tau);
+        const double resolved = radius_for_degree(m, tau);
         // M must resolve every eigenvalue of the rectangle; otherwise raise M and cover again
-        if (budget && options.degree == 0 && resolved < height && m < options.max_degree) {
-            m = std::min(options.max_degree, std::max(detail::degree_for_radius(height, tau), static_cast<int>(std::ceil(1.5 * m))));
+        if (budget && options.degree == 0 && resolved < height && m < max_degree) {
+            m = std::min(max_degree, std::max(degree_for_radius(height, tau), static_cast<int>(std::ceil(1.5 * m))));
             continue;
         }
         // the `count` rightmost (plus a cut-off conjugate partner)
@@ -727,135 +575,76 @@ SparseRootResult sparse_rightmost_roots(const SparseDDE& input, const SparseRoot
         result.height = height;
         result.covered_radius = resolved;
         result.roots.clear();
-        result.eigenvalues.clear();
         result.collocation_error = 0.0;
-        result.max_residual = 0.0;
         int failed_newton = 0;
-        if (options.refine) {
-            SparseNewton newton(dde, bounds);
+        if (so.refine) {
+            SparseNewton newton(dde);
             for (cplx z : right) {
                 if (z.imag() < 0.0) continue;
                 Root r;
                 if (!newton.refine(z, options, r)) ++failed_newton;
                 result.roots.push_back(r);
-                result.eigenvalues.push_back(z);
                 if (z.imag() > 0.0) {
                     Root c = r;
                     c.value = std::conj(r.value);
+                    c.eigenvalue = std::conj(z);
                     result.roots.push_back(c);
-                    result.eigenvalues.push_back(std::conj(z));
                 }
             }
             result.factorizations += newton.factorizations();
+            result.newton_iterations += newton.iterations();
         } else {
             for (cplx z : right) {
                 Root r;
                 r.value = z;
+                r.eigenvalue = z;
                 r.newton_step = std::numeric_limits<double>::quiet_NaN();
                 result.roots.push_back(r);
-                result.eigenvalues.push_back(z);
             }
         }
+        double max_residual = 0.0;
         for (const auto& r : result.roots) {
-            if (options.refine) result.collocation_error = std::max(result.collocation_error, r.collocation_error / scale_of(r.value));
-            result.max_residual = std::max(result.max_residual, r.residual);
+            if (so.refine) result.collocation_error = std::max(result.collocation_error, r.collocation_error / scale_of(r.value));
+            max_residual = std::max(max_residual, r.residual);
         }
         // two refined roots on one root: a duplicate, the collocation did not separate them
         int duplicates = 0;
         for (std::size_t i = 0; i < result.roots.size(); ++i)
             for (std::size_t j = i + 1; j < result.roots.size(); ++j)
                 if (std::abs(result.roots[i].value - result.roots[j].value) <= 1e-10 * scale_of(result.roots[i].value)) ++duplicates;
-        const bool accurate = result.collocation_error <= options.collocation_tolerance;
-        if (options.refine && options.degree == 0 && budget && (!accurate || duplicates > 0) && m < options.max_degree) {
-            m = std::min(options.max_degree, static_cast<int>(std::ceil(1.5 * m)));
+        const bool accurate = result.collocation_error <= so.collocation_tolerance;
+        if (so.refine && options.degree == 0 && budget && (!accurate || duplicates > 0) && m < max_degree) {
+            m = std::min(max_degree, static_cast<int>(std::ceil(1.5 * m)));
             continue;
         }
-        // sort the refined roots
-        std::vector<std::size_t> order(result.roots.size());
-        for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-        std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-            return rightmost_first(result.roots[a].value, result.roots[b].value);
-        });
-        std::vector<Root> roots;
-        std::vector<cplx> eigs;
-        for (std::size_t i : order) {
-            roots.push_back(result.roots[i]);
-            eigs.push_back(result.eigenvalues[i]);
-        }
-        result.roots = roots;
-        result.eigenvalues = eigs;
+        std::stable_sort(result.roots.begin(), result.roots.end(),
+                         [](const Root& a, const Root& b) { return rightmost_first_value(a.value, b.value); });
         std::ostringstream os;
         os.precision(3);
         if (!budget) {
-            result.status = RootStatus::EigenFailure;
-            os << "the shift budget (" << options.max_shifts << ") ran out before the strip Re >= " << alpha << " was covered";
-        } else if (options.refine && (failed_newton > 0 || duplicates > 0)) {
-            result.status = RootStatus::MaxDegreeReached;
+            result.status = Status::BudgetExhausted;
+            os << "the shift budget (" << so.max_shifts << ") ran out before the strip Re >= " << alpha << " was covered";
+        } else if (so.refine && (failed_newton > 0 || duplicates > 0)) {
+            result.status = Status::MaxDegreeReached;
             os << failed_newton << " Newton refinements failed and " << duplicates << " roots coincide at M=" << m;
-        } else if (options.refine && !accurate) {
-            result.status = RootStatus::MaxDegreeReached;
+        } else if (so.refine && !accurate) {
+            result.status = Status::MaxDegreeReached;
             os << "max degree M=" << m << " reached with eigenvalues " << result.collocation_error << " from the roots";
         } else {
-            result.status = RootStatus::Converged;
+            result.status = Status::Converged;
             os << "every collocation eigenvalue (M=" << m << ") with Re >= " << alpha << " found by " << result.shifts
                << " shifts covering [" << alpha << ", " << beta << "] x [0, " << height << "] (no root lies right of " << beta
                << " or above " << height << " there)";
-            if (options.refine)
-                os << "; each refined by Newton (max residual " << result.max_residual << ", eigenvalues within "
+            if (so.refine)
+                os << "; each refined by Newton (max residual " << max_residual << ", eigenvalues within "
                    << result.collocation_error << ")";
         }
         if (cover.failed() > 0) os << "; " << cover.failed() << " Arnoldi runs did not converge and were replaced by smaller cells";
-        result.reason = os.str();
+        result.message = os.str();
         return result;
     }
 }
 
-SolverMethod parse_solver_method(const std::string& name) {
-    if (name == "auto") return SolverMethod::Automatic;
-    if (name == "dense") return SolverMethod::Dense;
-    if (name == "sparse") return SolverMethod::Sparse;
-    if (name == "product") return SolverMethod::Product;
-    throw std::invalid_argument("solver '" + name + "': expected auto, dense, sparse or product");
-}
-
-std::string to_string(SolverMethod m) {
-    switch (m) {
-        case SolverMethod::Automatic: return "auto";
-        case SolverMethod::Dense: return "dense";
-        case SolverMethod::Sparse: return "sparse";
-        case SolverMethod::Product: return "product";
-    }
-    return "auto";
-}
-
-SparseRootResult system_rightmost_roots(const SparseDDE& dde, const SparseRootOptions& options, SolverMethod method,
-                                        int dense_limit) {
-    options.validate();
-    dde.validate();
-    if (method == SolverMethod::Product)
-        throw std::invalid_argument("solver 'product' solves rings of cars that react only to the car ahead, not a general system: expected auto, dense or sparse");
-    const bool dense = method == SolverMethod::Dense ||
-                       (method == SolverMethod::Automatic && (dde.dimension() <= dense_limit || dde.delayed.empty()));
-    if (!dense) return sparse_rightmost_roots(dde, options);
-    RootOptions ro;
-    ro.count = options.count;
-    ro.max_degree = options.max_degree;
-    if (options.degree > 0) ro.initial_degree = options.degree;
-    ro.residual_tolerance = options.residual_tolerance;
-    const RootResult r = rightmost_roots(dde.to_dense(), ro);
-    SparseRootResult out;
-    out.roots = r.roots;
-    for (const auto& root : r.roots) {
-        out.eigenvalues.push_back(root.value);  // (dense path: the refined root; its distance is collocation_error)
-        out.max_residual = std::max(out.max_residual, root.residual);
-    }
-    out.degree = r.degree;
-    out.strip_floor = r.strip_floor;
-    out.covered_radius = r.covered_radius;
-    out.collocation_error = r.collocation_error;
-    out.status = r.status;
-    out.reason = "dense collocation: " + r.reason;
-    return out;
-}
+}  // namespace detail
 
 }  // namespace ddemap

@@ -32,13 +32,13 @@ std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, co
                 pt.abscissa = pt.abscissa_min = pt.abscissa_max = a;
                 pt.speed = r.equilibrium.speed;
                 pt.unstable_roots = r.unstable_roots;
-                pt.method_used = r.method_used;
+                pt.method_used = r.roots.method_used;
             }
             pt.abscissa_min = std::min(pt.abscissa_min, a);
             pt.abscissa_max = std::max(pt.abscissa_max, a);
             pt.stable = pt.stable && r.stable;
             pt.max_residual = std::max(pt.max_residual, r.roots.max_residual);
-            if (r.roots.status != RootStatus::Converged) pt.status = r.roots.status;
+            if (r.roots.status != Status::Converged) pt.status = r.roots.status;
             ++pt.arrangements;
         }
     }

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "ddemap/solve/eigensolver.hpp"
+#include "ddemap/solve/roots.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/core/text.hpp"
@@ -86,9 +86,8 @@ CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<
     // a cheap low-degree collocation gives the guesses; the certificate decides
     const LinearDDE problem = dde();
     {
-        DenseEigenSolver dense;
-        const EigenResult eig = dense.eigenvalues(problem, 8, 1);
-        std::vector<cplx> ev = eig.values;
+        std::vector<cplx> ev;
+        detail::collocation_eigenvalues(problem, 8, ev);
         std::sort(ev.begin(), ev.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
         bool have = false;
         cplx best;
@@ -248,8 +247,8 @@ RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
         c2.value = std::conj(r.value);
         rr.roots.push_back(c2);
     }
-    rr.status = RootStatus::Converged;
-    rr.reason = "continued by Newton and certified by the argument principle";
+    rr.status = Status::Converged;
+    rr.message = "continued by Newton and certified by the argument principle";
     return rr;
 }
 

@@ -259,7 +259,7 @@ RingEquilibrium ring_equilibrium_at_length(const Fleet& fleet, double length) {
     return ring_equilibrium_at_speed(fleet, v);
 }
 
-SparseDDE mixed_ring_dde(const std::vector<Linearisation>& cars) {
+LinearDDE mixed_ring_dde(const std::vector<Linearisation>& cars) {
     const int n = static_cast<int>(cars.size());
     if (n < 2) throw std::invalid_argument("a ring needs at least 2 cars, got " + std::to_string(n));
     using T = Eigen::Triplet<double>;
@@ -285,17 +285,17 @@ SparseDDE mixed_ring_dde(const std::vector<Linearisation>& cars) {
             place(cars[i].further[j], v, 2 * far + 1);
         }
     }
-    SparseDDE dde;
-    dde.a0.resize(2 * n, 2 * n);
-    dde.a0.setFromTriplets(a0.begin(), a0.end());
+    SparseMatrixXd m0(2 * n, 2 * n);
+    m0.setFromTriplets(a0.begin(), a0.end());
+    std::vector<SparseDelayTerm> terms;
     for (auto& [delay, trip] : by_delay) {
-        SparseDDE::Term term;
+        SparseDelayTerm term;
         term.delay = delay;
         term.matrix.resize(2 * n, 2 * n);
         term.matrix.setFromTriplets(trip.begin(), trip.end());
-        dde.delayed.push_back(std::move(term));
+        terms.push_back(std::move(term));
     }
-    return dde;
+    return LinearDDE(std::move(m0), std::move(terms));
 }
 
 double ring_product_residual(const std::vector<Linearisation>& cars, cplx lambda) {

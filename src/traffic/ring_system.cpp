@@ -170,7 +170,7 @@ std::vector<Linearisation> RingSystem::car_linearisations(const Eigen::VectorXd&
     return out;
 }
 
-SparseDDE RingSystem::sparse_linearise(const Eigen::VectorXd& state) const { return mixed_ring_dde(car_linearisations(state)); }
+LinearDDE RingSystem::sparse_linearise(const Eigen::VectorXd& state) const { return mixed_ring_dde(car_linearisations(state)); }
 
 // ---------------------------------------------------------------- one follower
 

@@ -29,17 +29,23 @@ double nearest(const std::vector<cplx>& set, cplx z) {
     return d;
 }
 
+std::vector<cplx> eigenvalues_of(const std::vector<Root>& roots) {
+    std::vector<cplx> v;
+    for (const auto& r : roots) v.push_back(r.eigenvalue);
+    return v;
+}
+
 std::vector<cplx> values(const std::vector<Root>& roots) {
     std::vector<cplx> v;
     for (const auto& r : roots) v.push_back(r.value);
     return v;
 }
 
-MixedRingOptions at_speed(int count, SolverMethod method) {
+MixedRingOptions at_speed(int count, const std::string& method) {
     MixedRingOptions o;
     o.speed = 20.0;
     o.roots.count = count;
-    o.method = method;
+    o.roots.method = method;
     return o;
 }
 
@@ -73,8 +79,8 @@ TEST_CASE("homogeneous ring: the sparse path equals the Fourier-mode roots (N up
     const Linearisation lin = make_model("ovrv", fleet_from_pattern("C_max", 1)[0].parameters)->linearise();
     for (int n : {12, 60, 200}) {
         CAPTURE(n);
-        const MixedRingResult sparse = analyse_mixed_ring(fleet_from_pattern("C_max", n), at_speed(10, SolverMethod::Sparse));
-        REQUIRE(sparse.roots.status == RootStatus::Converged);
+        const MixedRingResult sparse = analyse_mixed_ring(fleet_from_pattern("C_max", n), at_speed(10, "shift_invert"));
+        REQUIRE(sparse.roots.status == Status::Converged);
         RingOptions ro;
         ro.roots.count = 12;
         const RingResult modes = analyse_ring(lin, n, ro);
@@ -99,14 +105,15 @@ void check_sparse_against_dense(std::mt19937& rng, int n, int degree) {
     for (int i = 0; i < n; ++i) {
         lins.push_back(linearised(random_car(rng, i % 3 == 2)));
     }
-    const SparseDDE dde = mixed_ring_dde(lins);
-    SparseRootOptions o;
+    const LinearDDE dde = mixed_ring_dde(lins);
+    RootOptions o;
+    o.method = "shift_invert";
     o.count = 6;
     o.degree = degree;
-    o.refine = false;
-    o.arnoldi_tolerance = 1e-13;
-    const SparseRootResult sp = sparse_rightmost_roots(dde, o);
-    REQUIRE(sp.status == RootStatus::Converged);
+    o.shift_invert.refine = false;
+    o.shift_invert.arnoldi_tolerance = 1e-13;
+    const RootResult sp = rightmost_roots(dde, o);
+    REQUIRE(sp.status == Status::Converged);
     const MatrixXc a = collocation_matrix(dde.to_dense(), sp.degree);
     Eigen::EigenSolver<Eigen::MatrixXd> es(a.real(), false);
     std::vector<cplx> dense(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
@@ -125,11 +132,11 @@ void check_sparse_against_dense(std::mt19937& rng, int n, int degree) {
         if (z.real() < sp.strip_floor - tol::sparse_vs_dense) break;  // the floor is the last listed one
         ++in_strip;
         CAPTURE(z);
-        CHECK(nearest(sp.eigenvalues, z) < tol::sparse_vs_dense);
+        CHECK(nearest(eigenvalues_of(sp.roots), z) < tol::sparse_vs_dense);
     }
     // the same set: the sparse eigenvalues inside the resolved rectangle are exactly these
     std::vector<cplx> listed;
-    for (cplx z : sp.eigenvalues)
+    for (cplx z : eigenvalues_of(sp.roots))
         if (std::abs(z.imag()) <= sp.height && std::abs(z) <= sp.covered_radius) listed.push_back(z);
     CHECK(listed.size() >= 2);
     CHECK(in_strip == static_cast<int>(listed.size()));
@@ -163,11 +170,11 @@ TEST_CASE("predecessor-only mixed ring: permuting the cars leaves the spectrum u
     for (int i = 0; i < 14; ++i) fleet.push_back(random_car(rng, false));
     Fleet shuffled = fleet;
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
-    for (SolverMethod method : {SolverMethod::Sparse, SolverMethod::Dense, SolverMethod::Product}) {
+    for (const char* method : {"shift_invert", "dense", "contour"}) {
         const MixedRingResult a = analyse_mixed_ring(fleet, at_speed(8, method));
         const MixedRingResult b = analyse_mixed_ring(shuffled, at_speed(8, method));
-        REQUIRE(a.roots.status == RootStatus::Converged);
-        REQUIRE(b.roots.status == RootStatus::Converged);
+        REQUIRE(a.roots.status == Status::Converged);
+        REQUIRE(b.roots.status == Status::Converged);
         REQUIRE(a.roots.roots.size() == b.roots.roots.size());
         for (const auto& r : a.roots.roots) CHECK(nearest(values(b.roots.roots), r.value) < tol::same_root);
         CHECK(a.product_residual < tol::product_residual);
@@ -190,10 +197,10 @@ TEST_CASE("connected cruise control: the order matters, and sparse agrees with d
     double abscissa[2];
     int k = 0;
     for (const Fleet* f : {&fleet, &alternating}) {
-        const MixedRingResult s = analyse_mixed_ring(*f, at_speed(8, SolverMethod::Sparse));
-        const MixedRingResult d = analyse_mixed_ring(*f, at_speed(8, SolverMethod::Dense));
-        REQUIRE(s.roots.status == RootStatus::Converged);
-        REQUIRE(d.roots.status == RootStatus::Converged);
+        const MixedRingResult s = analyse_mixed_ring(*f, at_speed(8, "shift_invert"));
+        const MixedRingResult d = analyse_mixed_ring(*f, at_speed(8, "dense"));
+        REQUIRE(s.roots.status == Status::Converged);
+        REQUIRE(d.roots.status == Status::Converged);
         CHECK(std::isnan(s.product_residual));  // no transfer-function product for CCC
         for (const auto& r : d.roots.roots) CHECK(nearest(values(s.roots.roots), r.value) < tol::same_root);
         CHECK(std::abs(s.spectral_abscissa - d.spectral_abscissa) < tol::same_root);
@@ -213,8 +220,8 @@ TEST_CASE("CCC homogeneous ring: the full system equals the Fourier modes with z
     for (const auto& r : modes.roots) CHECK(nearest(all, r.root.value) < tol::same_root);
     ParameterMap p = model->parameters();
     p.erase("speed");
-    const MixedRingResult sparse = analyse_mixed_ring(Fleet(9, FleetCar{"c", "ccc", p}), at_speed(8, SolverMethod::Sparse));
-    REQUIRE(sparse.roots.status == RootStatus::Converged);
+    const MixedRingResult sparse = analyse_mixed_ring(Fleet(9, FleetCar{"c", "ccc", p}), at_speed(8, "shift_invert"));
+    REQUIRE(sparse.roots.status == Status::Converged);
     std::vector<cplx> fourier;
     for (const auto& r : modes.roots) fourier.push_back(r.root.value);
     for (const auto& r : sparse.roots.roots) CHECK(nearest(fourier, r.value) < tol::same_root);
@@ -252,7 +259,7 @@ TEST_CASE("fleet input: patterns and CSV files, errors name the line and the col
     bad("model,k1,k2,th,tau\nidm,0.1,0.2,1,0.5\n", "f.csv:2: parameter 'k1' does not belong to model idm");
     bad("vehicle\n", "no cars");
     CHECK_THROWS_WITH_AS(parse_fleet_car("ccc:k1=0.1,k2"), doctest::Contains("'k2'"), std::invalid_argument);
-    CHECK_THROWS_WITH_AS(analyse_mixed_ring(fleet_from_pattern("A_min", 1), at_speed(4, SolverMethod::Automatic)),
+    CHECK_THROWS_WITH_AS(analyse_mixed_ring(fleet_from_pattern("A_min", 1), at_speed(4, "auto")),
                          doctest::Contains("at least 2 cars"), std::invalid_argument);
 }
 
@@ -274,7 +281,7 @@ TEST_CASE("penetration study: the end points are the homogeneous rings, the spre
     CHECK(std::abs(pts[0].abscissa - ya.spectral_abscissa) < tol::same_root);
     CHECK(std::abs(pts[2].abscissa - xa.spectral_abscissa) < tol::same_root);
     CHECK(pts[1].x_cars == 5);
-    for (const auto& p : pts) CHECK(p.status == RootStatus::Converged);
+    for (const auto& p : pts) CHECK(p.status == Status::Converged);
 }
 
 TEST_SUITE_END();

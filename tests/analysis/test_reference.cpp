@@ -69,7 +69,7 @@ TEST_CASE("ring roots agree with the 40-digit reference to 1e-10 (N = 2 .. 50)" 
         RingOptions ro;
         ro.roots.count = 6;
         const RingResult ring = analyse_ring(lin, n, ro);
-        REQUIRE(ring.status == RootStatus::Converged);
+        REQUIRE(ring.status == Status::Converged);
         // per mode: the reference's ranked roots equal ours
         std::map<int, std::vector<cplx>> ref_by_mode;
         std::vector<cplx> ref_all;

@@ -33,7 +33,7 @@ TEST_CASE("the full 2N-dimensional ring has the roots of the Fourier modes plus 
             RootOptions fo;
             fo.count = 9;  // one more: the trivial zero is a root of the full system
             const RootResult full = rightmost_roots(full_ring_dde(lin, n), fo);
-            REQUIRE(full.status == RootStatus::Converged);
+            REQUIRE(full.status == Status::Converged);
             // every full-system root is a mode root or the trivial zero
             int trivial = 0;
             std::size_t matched = 0;

@@ -227,7 +227,7 @@ printf '{"dimension": 2, "A0": [[1, 2], [3]]}' >"$tmp/bad.json"
 expect_error "bad.json: A0\[1\]: expected 2 entries" roots --system "$tmp/bad.json"
 expect_error "expected no model parameters" roots --system "$tmp/sys.json" --k1 0.3
 expect_error "the sparse path needs real coefficients" roots --system "$tmp/sys.json" --solver sparse
-expect_error "solver 'product' goes with fleet rings" roots --system "$tmp/sys.json" --solver product
+expect_error "solver product goes with --fleet rings" roots --system "$tmp/sys.json" --solver product
 # a real 20-dimensional cyclic system: auto takes the sparse path; the dense path agrees
 python3 - >"$tmp/cyc.json" <<'PY'
 import json

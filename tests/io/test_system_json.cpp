@@ -25,7 +25,7 @@ TEST_CASE("a JSON system with two delays has the union of the blocks' Lambert W 
     RootOptions o;
     o.count = 6;
     const RootResult r = rightmost_roots(dde, o);
-    REQUIRE(r.status == RootStatus::Converged);
+    REQUIRE(r.status == Status::Converged);
     std::vector<cplx> ref;
     for (int k = -6; k <= 6; ++k) {
         ref.push_back(ddemap::test::lambert_w(cplx(-1.0, 0.0), k) / 1.0);

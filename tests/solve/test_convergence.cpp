@@ -39,19 +39,19 @@ TEST_CASE("the adaptive degree reports why it is trusted") {
     a1(0, 0) = -2.0;
     const LinearDDE dde(a0, {{a1, 1.5}});
     const RootResult r = rightmost_roots(dde);
-    CHECK(r.status == RootStatus::Converged);
+    CHECK(r.status == Status::Converged);
     CHECK(r.collocation_error <= 1e-10);
-    CHECK(r.reason.find("spectral accuracy") != std::string::npos);
+    CHECK(r.message.find("spectral accuracy") != std::string::npos);
     // forced to start low, the same roots come out through the two-degree certificate
     RootOptions low;
-    low.initial_degree = 4;
-    low.spectral_tolerance = 1e-300;
+    low.degree = 4;
+    low.dense.spectral_tolerance = 1e-300;
     const RootResult r2 = rightmost_roots(dde, low);
-    CHECK(r2.status == RootStatus::Converged);
+    CHECK(r2.status == Status::Converged);
     CHECK(r2.previous_degree > 0);
     CHECK(r2.degree > r2.previous_degree);
     CHECK(r2.degree_change <= 1e-11);
-    CHECK(r2.reason.find("agree between") != std::string::npos);
+    CHECK(r2.message.find("agree between") != std::string::npos);
     REQUIRE(r2.roots.size() == r.roots.size());
     for (std::size_t i = 0; i < r.roots.size(); ++i) CHECK(std::abs(r.roots[i].value - r2.roots[i].value) < 1e-12);
 }

@@ -49,7 +49,7 @@ TEST_CASE("x'(t) = a x(t - tau): rightmost roots are W_k(a tau)/tau") {
         RootOptions opt;
         opt.count = 6;
         const RootResult r = rightmost_roots(scalar_delayed(a, tau), opt);
-        REQUIRE(r.status == RootStatus::Converged);
+        REQUIRE(r.status == Status::Converged);
         REQUIRE(r.roots.size() >= 6);
         const auto ref = lambert_roots(a, tau, 6);
         for (int i = 0; i < 6; ++i) {
@@ -94,7 +94,7 @@ TEST_CASE("tau = 0 is the ODE and small tau converges to it") {
     double previous = 1e300;
     for (double tau : {1e-2, 1e-4, 1e-6, 1e-8}) {
         const RootResult r = rightmost_roots(LinearDDE(a0, {{a1, tau}}));
-        REQUIRE(r.status == RootStatus::Converged);
+        REQUIRE(r.status == Status::Converged);
         const double err = std::abs(r.roots[0].value - exact);
         CAPTURE(tau);
         CHECK(err < previous);
@@ -111,7 +111,7 @@ TEST_CASE("complex coefficients and several delays: residuals and Newton refinem
     const LinearDDE dde(a0, {{a1, 0.4}, {a2, 1.1}});
     CHECK_FALSE(dde.is_real());
     const RootResult r = rightmost_roots(dde);
-    REQUIRE(r.status == RootStatus::Converged);
+    REQUIRE(r.status == Status::Converged);
     for (const auto& root : r.roots) {
         CHECK(root.residual < 1e-13);
         // the determinant vanishes at the root

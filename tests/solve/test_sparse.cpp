@@ -17,7 +17,7 @@ using namespace ddemap;
 
 namespace {
 /// A ring of N OVRV cars with their own parameters (random, fixed seed), car i following i-1.
-SparseDDE random_ring(int cars, unsigned seed, std::vector<double>& delays_out) {
+LinearDDE random_ring(int cars, unsigned seed, std::vector<double>& delays_out) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     const int n = 2 * cars;
@@ -35,27 +35,27 @@ SparseDDE random_ring(int cars, unsigned seed, std::vector<double>& delays_out) 
         by_delay[d].emplace_back(v, s, k1);
         by_delay[d].emplace_back(v, va, k2);
     }
-    SparseDDE dde;
-    dde.a0.resize(n, n);
-    dde.a0.setFromTriplets(a0.begin(), a0.end());
+    SparseMatrixXd m0(n, n);
+    m0.setFromTriplets(a0.begin(), a0.end());
+    std::vector<SparseDelayTerm> terms;
     for (int d = 0; d < 3; ++d) {
         if (by_delay[d].empty()) continue;
         Eigen::SparseMatrix<double> m(n, n);
         m.setFromTriplets(by_delay[d].begin(), by_delay[d].end());
-        dde.delayed.push_back({m, delays[d]});
+        terms.push_back({m, delays[d]});
         delays_out.push_back(delays[d]);
     }
-    return dde;
+    return LinearDDE(m0, terms);
 }
 }  // namespace
 
 TEST_CASE("structured shift-invert eigenvalues equal the dense collocation eigenvalues") {
     for (unsigned seed : {1u, 2u, 3u}) {
         std::vector<double> delays;
-        const SparseDDE dde = random_ring(8, seed, delays);
+        const LinearDDE dde = random_ring(8, seed, delays);
         const int degree = 12;
         const SparseEigenResult sp = sparse_collocation_eigenvalues(dde, degree, {cplx(0.1, 0.0), cplx(0.1, 0.6)}, 8);
-        CHECK(sp.status == RootStatus::Converged);
+        CHECK(sp.status == Status::Converged);
         REQUIRE(sp.values.size() >= 8);
         const MatrixXc a = collocation_matrix(dde.to_dense(), degree);
         Eigen::ComplexEigenSolver<MatrixXc> es(a, false);

@@ -45,7 +45,7 @@ std::vector<Linearisation> random_ring(std::mt19937& rng, int n) {
     return out;
 }
 
-Eigen::MatrixXcd dense_delta(const SparseDDE& dde, cplx z) { return Eigen::MatrixXcd(dde.characteristic_matrix(z)); }
+Eigen::MatrixXcd dense_delta(const LinearDDE& dde, cplx z) { return Eigen::MatrixXcd(dde.characteristic_matrix(z)); }
 
 }  // namespace
 
@@ -56,7 +56,7 @@ TEST_CASE("ring determinant: D = prod P_i - prod Q_i is det Delta of the 2N syst
     for (int n : {2, 3, 5, 9}) {
         const std::vector<Linearisation> cars = random_ring(rng, n);
         const RingDeterminant det(cars);
-        const SparseDDE dde = mixed_ring_dde(cars);
+        const LinearDDE dde = mixed_ring_dde(cars);
         for (int k = 0; k < 40; ++k) {
             const cplx z(re(rng), im(rng));
             CAPTURE(n);
@@ -86,7 +86,7 @@ TEST_CASE("ring determinant: argument-principle counts equal the dense roots ins
         RootOptions ro;
         ro.count = 14;
         const RootResult dense = rightmost_roots(mixed_ring_dde(cars).to_dense(), ro);
-        REQUIRE(dense.status == RootStatus::Converged);
+        REQUIRE(dense.status == Status::Converged);
         const double floor = dense.strip_floor;
         std::uniform_real_distribution<double> x(floor, 0.5), y(-2.0, 2.0);
         for (int k = 0; k < 40; ++k) {
@@ -130,15 +130,17 @@ TEST_CASE("product path: the same rightmost roots as the sparse path for random 
     std::mt19937 rng(20261121);
     for (int n : {4, 7, 12, 30, 60}) {
         const std::vector<Linearisation> cars = random_ring(rng, n);
-        ProductRootOptions po;
+        RootOptions po;
+        po.method = "contour";
         po.count = 9;
-        const SparseRootResult p = product_ring_roots(cars, po);
-        SparseRootOptions so;
+        const RootResult p = rightmost_roots(ring_root_problem(cars), po);
+        RootOptions so;
+        so.method = "shift_invert";
         so.count = 9;
-        const SparseRootResult s = sparse_rightmost_roots(mixed_ring_dde(cars), so);
+        const RootResult s = rightmost_roots(mixed_ring_dde(cars), so);
         CAPTURE(n);
-        REQUIRE(p.status == RootStatus::Converged);
-        REQUIRE(s.status == RootStatus::Converged);
+        REQUIRE(p.status == Status::Converged);
+        REQUIRE(s.status == Status::Converged);
         REQUIRE(p.roots.size() == s.roots.size());
         for (std::size_t i = 0; i < p.roots.size(); ++i) {
             CAPTURE(p.roots[i].value);
@@ -155,14 +157,15 @@ TEST_CASE("product path: a homogeneous ring equals the Fourier-mode roots (N up 
     const Linearisation lin = make_model("ovrv", fleet_from_pattern("E_min", 1)[0].parameters)->linearise();
     for (int n : {3, 40, 2000}) {
         CAPTURE(n);
-        ProductRootOptions po;
+        RootOptions po;
+        po.method = "contour";
         po.count = 8;
-        const SparseRootResult p = product_ring_roots(std::vector<Linearisation>(n, lin), po);
-        REQUIRE(p.status == RootStatus::Converged);
+        const RootResult p = rightmost_roots(ring_root_problem(std::vector<Linearisation>(n, lin)), po);
+        REQUIRE(p.status == Status::Converged);
         RingOptions ro;
         ro.roots.count = 8;
         const RingResult modes = analyse_ring(lin, n, ro);
-        REQUIRE(modes.status == RootStatus::Converged);
+        REQUIRE(modes.status == Status::Converged);
         // the mode solver leaves the trivial root out, the product path lists it: every mode root
         // right of the product path's certified floor is a product root
         int matched = 0;
@@ -188,7 +191,7 @@ TEST_CASE("product path: long mixed rings stay certified, and a multi-leader car
     o.speed = 20.0;
     o.roots.count = 10;
     const MixedRingResult r = analyse_mixed_ring(fleet, o);  // automatic: the product path
-    REQUIRE(r.roots.status == RootStatus::Converged);
+    REQUIRE(r.roots.status == Status::Converged);
     CHECK(r.roots.roots.size() >= 10);
     CHECK(r.roots.max_residual < 1e-11);
     CHECK(r.product_residual < 1e-8);  // sum of 20000 logarithms: ~N eps |Phi'| lost
@@ -197,13 +200,13 @@ TEST_CASE("product path: long mixed rings stay certified, and a multi-leader car
     for (const char* name : {"A_min", "C_max", "E_min", "G_max"})
         for (int i = 0; i < 5000; ++i) grouped.push_back(fleet_from_pattern(name, 1)[0]);
     const MixedRingResult g = analyse_mixed_ring(grouped, o);
-    REQUIRE(g.roots.status == RootStatus::Converged);
+    REQUIRE(g.roots.status == Status::Converged);
     REQUIRE(g.roots.roots.size() == r.roots.roots.size());
     for (std::size_t i = 0; i < g.roots.roots.size(); ++i) CHECK(std::abs(g.roots.roots[i].value - r.roots.roots[i].value) < 1e-12);
 
     Fleet ccc = fleet_from_pattern("A_min", 6);
     ccc[2] = parse_fleet_car("ccc:k1=0.1,k2=0.3,k3=0.2,th=1.2,tau=0.3,tau2=0.2");
-    o.method = SolverMethod::Product;
+    o.roots.method = "contour";
     CHECK_THROWS_WITH_AS(analyse_mixed_ring(ccc, o), doctest::Contains("react only to the car ahead"), std::invalid_argument);
     CHECK_THROWS_AS(RingDeterminant(linearise_fleet(ccc, 20.0)), std::invalid_argument);
 }
@@ -260,13 +263,14 @@ TEST_CASE("product path: a delay-free ring (2N roots in all) and a double root a
     // tau = 0: D is a polynomial of degree 2N; the product path lists the whole spectrum,
     // which must equal the eigenvalues of the ODE matrix
     std::vector<Linearisation> cars{ovrv(0.2, 0.5, 1.2, 0.0), ovrv(0.2, 0.5, 1.2, 0.0), ovrv(0.3, 0.4, 1.0, 0.0)};
-    ProductRootOptions po;
+    RootOptions po;
+    po.method = "contour";
     po.count = 20;  // more than the 6 roots there are
-    const SparseRootResult p = product_ring_roots(cars, po);
-    REQUIRE(p.status == RootStatus::Converged);
-    const SparseDDE dde = normalised(mixed_ring_dde(cars));
-    REQUIRE(dde.delayed.empty());
-    Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(dde.a0), false);
+    const RootResult p = rightmost_roots(ring_root_problem(cars), po);
+    REQUIRE(p.status == Status::Converged);
+    const LinearDDE dde = mixed_ring_dde(cars);
+    REQUIRE(dde.is_ode());
+    Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(dde.sparse_a0()), false);
     REQUIRE(p.roots.size() == 6);
     for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) CHECK(nearest(p.roots, es.eigenvalues()(i)) < 1e-9);
     // the dense path's ODE branch lists the same six, lambda = 0 included (a real eigenvalue
@@ -281,9 +285,9 @@ TEST_CASE("product path: a delay-free ring (2N roots in all) and a double root a
     // the cluster is reported as such and the other roots are still found
     std::vector<Linearisation> flat(4, ovrv(0.2, 0.5, 0.0, 0.5));
     po.count = 8;
-    const SparseRootResult f = product_ring_roots(flat, po);
-    CHECK(f.status == RootStatus::MaxDegreeReached);
-    CHECK(f.reason.find("cluster") != std::string::npos);
+    const RootResult f = rightmost_roots(ring_root_problem(flat), po);
+    CHECK(f.status == Status::MaxDegreeReached);
+    CHECK(f.message.find("cluster") != std::string::npos);
     RootOptions ro;
     ro.count = 8;
     const RootResult d = rightmost_roots(mixed_ring_dde(flat).to_dense(), ro);

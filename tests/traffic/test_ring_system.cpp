@@ -87,7 +87,7 @@ TEST_CASE("ring system of a mixed fleet: linearisation equals mixed_ring_dde, de
     for (int i = 0; i < ring.cars(); ++i) CHECK(eq[2 * i] == doctest::Approx(re.gaps[i]).epsilon(1e-15));
     CHECK(equilibrium_residual(ring, eq) < 1e-12);
     const LinearDDE dense = linearise(ring, eq);
-    const SparseDDE assembled = mixed_ring_dde(linearise_fleet(fleet, v));
+    const LinearDDE assembled = mixed_ring_dde(linearise_fleet(fleet, v));
     check_same_dde(dense, assembled.to_dense());
     check_same_dde(dense, ring.sparse_linearise(eq).to_dense());
     // away from the equilibrium the sparse path still equals the dense Jacobians
@@ -113,7 +113,7 @@ TEST_CASE("ring system: rightmost roots of the linearised system equal those of 
             RootOptions fo;
             fo.count = 7;  // the trivial zero as well
             const RootResult full = rightmost_roots(linearise(ring, ring.equilibrium(15.0)), fo);
-            REQUIRE(full.status == RootStatus::Converged);
+            REQUIRE(full.status == Status::Converged);
             std::vector<cplx> nontrivial;
             int trivial = 0;
             for (const auto& r : full.roots) {

@@ -37,7 +37,7 @@ struct RingResult {
     bool trivial_branch_stable = false;  ///< N = infinity: the branch through the trivial root bends left
     int degree = 0;                  ///< the largest collocation degree used over the modes
     int modes_solved = 0;            ///< mode (or wave-number) problems solved
-    RootStatus status = RootStatus::Converged;  ///< worst status over the modes
+    Status status = Status::Converged;  ///< worst status over the modes
     std::string reason;              ///< how the degree was chosen and trusted
 };
 

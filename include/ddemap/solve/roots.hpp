@@ -1,26 +1,40 @@
 #pragma once
 /// \file roots.hpp
-/// Rightmost characteristic roots of a linear DDE: eigenvalues of the Chebyshev collocation
-/// of the infinitesimal generator, each refined by Newton on det Delta(lambda),
-///     lambda <- lambda - 1 / trace( Delta(lambda)^{-1} Delta'(lambda) ),
-/// with the degree M increased until the rightmost roots are unchanged between two degrees.
+/// Rightmost characteristic roots of a linear DDE: ONE facade over registered backends.
+///
+///     RootResult r = rightmost_roots(problem, options);   // options.method = "auto" by default
+///
+/// Backends (each in its own file, registered in src/solve/roots.cpp):
+///  - "dense": all eigenvalues of the Chebyshev collocation of the generator (MATH.md 5), each
+///    refined by Newton on det Delta, lambda <- lambda - 1 / trace(Delta^{-1} Delta'), with the
+///    degree M increased until the rightmost roots are unchanged between two degrees (or equal
+///    the eigenvalues to spectral accuracy). Any coefficients, ODEs included.
+///  - "shift_invert": the rightmost eigenvalues of the collocation matrix by shift-and-invert
+///    Arnoldi on a structured operator, every eigenvalue of a rectangle [alpha, beta] x
+///    [-R(alpha), R(alpha)] found (discs of completeness), each refined by Newton on the DDE.
+///    Large real systems with delays (shift_invert.hpp).
+///  - "contour": the argument principle on a scalar characteristic function D = det Delta
+///    (problem/characteristic_function.hpp): all zeros of the rectangle counted and located.
+///
+/// Dispatch of "auto": contour when the problem has a characteristic function and no
+/// collocation degree is asked (degree = 0); otherwise dense for at most `dense_limit` states,
+/// complex coefficients or an ODE; otherwise shift_invert. A forced method that does not apply
+/// throws std::invalid_argument saying why.
 
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "ddemap/solve/eigensolver.hpp"
+#include "ddemap/core/newton.hpp"
+#include "ddemap/core/status.hpp"
+#include "ddemap/problem/characteristic_function.hpp"
 #include "ddemap/problem/linear_dde.hpp"
 
 namespace ddemap {
 
-/// Options with validation (validate() throws std::invalid_argument naming the field).
-struct RootOptions {
-    int count = 6;                  ///< rightmost roots wanted (a conjugate partner may be added)
-    int initial_degree = 0;         ///< first collocation degree M; 0 = from the root bound
-    int max_degree = 400;           ///< never exceed this M
-    int newton_max_iterations = 60;
-    double newton_tolerance = 4e-16;   ///< stop when |step| <= tol * max(1, |lambda|)
-    double residual_tolerance = 1e-9;  ///< accept a root when its relative residual is below
+/// Options of the dense backend.
+struct DenseRootOptions {
+    int max_degree = 400;                ///< never exceed this collocation degree M
     double agreement_tolerance = 1e-11;  ///< roots equal between degrees (relative to max(1,|lambda|))
     double collocation_tolerance = 1e-5; ///< |eigenvalue - refined root| <= tol * max(1,|lambda|)
     /// One degree suffices when every eigenvalue is already this close (relative) to its refined
@@ -29,46 +43,106 @@ struct RootOptions {
     /// When fewer than `count` roots are found, the result is certified complete in the strip
     /// Re(lambda) >= alpha - depth (alpha the rightmost root). 0 = automatic: 2 / tau_max.
     double depth = 0.0;
+    /// Newton on det Delta: stop when |step| <= step_tolerance max(1, |lambda|).
+    NewtonOptions newton{60, 4e-16};
+};
+
+/// Options of the shift-invert backend.
+struct ShiftInvertRootOptions {
+    int max_degree = 200;
+    int eigenvalues_per_shift = 32;    ///< nev of each Arnoldi run (ncv = 5 nev / 2 + 20)
+    int max_shifts = 5000;             ///< give up (BudgetExhausted) after this many shifts
+    int arnoldi_max_restarts = 400;
+    double arnoldi_tolerance = 1e-10;  ///< Spectra: |residual| <= tol |Ritz value|
+    bool refine = true;                ///< Newton refinement on Delta(lambda) (off: eigenvalues only)
+    double collocation_tolerance = 1e-8; ///< |eigenvalue - root| / max(1, |lambda|) accepted
+    NewtonOptions newton{30, 1e-14};
+};
+
+/// Options of the contour backend.
+struct ContourRootOptions {
+    double max_arg_step = 0.5;          ///< radians per step along a contour
+    int max_cells = 200000;             ///< give up (BudgetExhausted) after this many cell counts
+    double max_type_evaluations = 2e9;  ///< or after this many evaluations (times evaluation_cost)
+    NewtonOptions newton{60, 1e-14};    ///< Newton on D; a root is accepted at |step| <= 1e-8 max(1,|lambda|)
+};
+
+/// The options of rightmost_roots: what is asked (shared) and how each backend works.
+struct RootOptions {
+    std::string method = "auto";       ///< "auto", "dense", "shift_invert" or "contour"
+    int count = 6;                     ///< rightmost roots wanted (a conjugate partner may be added)
+    int degree = 0;                    ///< collocation degree M: 0 = automatic (dense: the first degree)
+    double residual_tolerance = 1e-9;  ///< accept a root when its relative residual is below
+    int dense_limit = 16;              ///< auto: dense up to this many states
+    DenseRootOptions dense;
+    ShiftInvertRootOptions shift_invert;
+    ContourRootOptions contour;
+    /// True when the options are usable; otherwise `why` (if given) names the field, e.g.
+    /// "count = 0: expected an integer >= 1", "dense.max_degree: ...".
+    bool is_valid(std::string* why = nullptr) const;
+    /// Throws std::invalid_argument with the is_valid message.
     void validate() const;
+};
+
+/// The problem: a linear DDE and, when det Delta has a factored scalar form, that function.
+struct RootProblem {
+    LinearDDE dde;
+    std::shared_ptr<const CharacteristicFunction> characteristic;  ///< may be null
 };
 
 /// One refined characteristic root.
 struct Root {
     cplx value;                 ///< the root lambda
-    double residual = 0.0;      ///< sigma_min(Delta(lambda)) / (|lambda| + ||A0|| + sum ||A_k|| e^{-Re(lambda) tau_k})
+    double residual = 0.0;      ///< relative backward error (root_bounds.hpp)
     double newton_step = 0.0;   ///< size of the last Newton step (an error estimate)
-    double collocation_error = 0.0;  ///< |collocation eigenvalue - refined root|
+    double collocation_error = 0.0;  ///< |eigenvalue - refined root| (0 for the contour backend)
+    cplx eigenvalue;            ///< the estimate it was refined from (a collocation eigenvalue; contour: the root)
 };
 
-enum class RootStatus {
-    Converged,         ///< rightmost roots certified (spectral accuracy or two degrees), disc covered
-    MaxDegreeReached,  ///< the degree cap was hit before the roots settled
-    EigenFailure       ///< the eigen-solver backend failed
-};
-
-std::string to_string(RootStatus s);
-
+/// What rightmost_roots did (cf. Ceres' Summary).
 struct RootResult {
     std::vector<Root> roots;  ///< rightmost first (ties: larger imaginary part first)
-    int degree = 0;           ///< the collocation degree M used (0 for an ODE)
-    int previous_degree = 0;  ///< the degree it was checked against (0 when one degree sufficed)
-    double degree_change = 0.0;  ///< max relative change of the roots between the two degrees (inf if one degree)
-    double collocation_error = 0.0;  ///< max |eigenvalue - refined root| / max(1, |lambda|) over the roots
+    Status status = Status::Converged;
+    std::string message;      ///< why the result is trusted (or why not)
+    std::string method_given; ///< the method asked for ("auto", ...)
+    std::string method_used;  ///< the backend that ran ("dense", "shift_invert", "contour")
+
+    // the certificate
+    int degree = 0;              ///< collocation degree M (0 for an ODE or the contour backend)
+    int previous_degree = 0;     ///< dense: the degree it was checked against (0 when one degree sufficed)
+    double degree_change = 0.0;  ///< dense: max relative change of the roots between the two degrees
+    double collocation_error = 0.0;  ///< max |eigenvalue - refined root| / max(1, |lambda|)
     double covered_radius = 0.0; ///< |lambda| up to which the collocation resolves e^{lambda theta}
-    double strip_floor = 0.0;    ///< every root with Re >= strip_floor is in `roots` or right of them
-    int dropped = 0;          ///< candidates dropped (Newton failed, spurious or duplicate)
-    RootStatus status = RootStatus::Converged;
-    std::string reason;       ///< why the result is trusted (or why not)
+    double strip_floor = 0.0;    ///< alpha: every root with Re >= alpha is in `roots` or right of them
+    double right_bound = 0.0;    ///< beta: no root has Re > beta (shift_invert, contour)
+    double height = 0.0;         ///< R(alpha): no root with Re >= alpha has |Im| > height (shift_invert, contour)
+    int eigenvalues_found = 0;   ///< shift_invert: distinct eigenvalues met; contour: zeros counted in the rectangle
+    double max_residual = 0.0;   ///< max residual over the roots
+    int dropped = 0;             ///< dense: candidates dropped (Newton failed, spurious or duplicate)
+
+    // counters
+    int shifts = 0;              ///< Arnoldi runs
+    int factorizations = 0;      ///< sparse LU factorisations (shifts and Newton)
+    long evaluations = 0;        ///< contour: evaluations of D along contours
+    int contour_counts = 0;      ///< contour: rectangles counted
+    int newton_iterations = 0;   ///< Newton steps over all refinements
+
     /// max Re(lambda) over roots (-inf if none)
     double spectral_abscissa() const;
 };
 
-/// Rightmost roots of `dde`. `backend` defaults to DenseEigenSolver.
-RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options = {},
-                           const EigenSolverBackend* backend = nullptr);
+/// Rightmost roots of `problem` by the backend options.method names (see the file comment).
+/// Throws std::invalid_argument for invalid options or a forced method that does not apply.
+RootResult rightmost_roots(const RootProblem& problem, const RootOptions& options = {});
+/// The same for a problem without a characteristic function.
+RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options = {});
 
-/// Newton refinement of one root estimate. Returns false when it did not converge.
-bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, Root& out);
+/// The backend "auto" would choose for this problem (or the forced one, checked); throws
+/// std::invalid_argument when options.method does not apply to the problem.
+std::string choose_root_method(const RootProblem& problem, const RootOptions& options);
+
+/// The registered backend names ("dense", "shift_invert", "contour").
+std::vector<std::string> root_methods();
 
 /// A root within this distance of the imaginary axis is marginal, neither stable nor
 /// unstable: 1e-13 max(1, |lambda|) (roots are refined to about 1e-15).
@@ -84,9 +158,12 @@ double radius_for_degree(int degree, double tau);
 /// The first `count` roots (sorted rightmost first), plus the conjugate partner of the last one
 /// when the cut would separate a pair.
 std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count);
+/// All eigenvalues of the degree-M dense collocation matrix (real arithmetic for a real DDE);
+/// false when the QR algorithm failed. (The dense backend's eigen-solver, also used for the
+/// cheap guesses of the sweep's certified roots.)
+bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out);
+/// Rightmost first, ties: larger imaginary part first.
+bool rightmost_first(const Root& a, const Root& b);
 }  // namespace detail
-
-/// Relative residual sigma_min(Delta(lambda)) / scale(lambda) (see Root::residual).
-double relative_residual(const LinearDDE& dde, cplx lambda);
 
 }  // namespace ddemap

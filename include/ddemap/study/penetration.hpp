@@ -33,8 +33,8 @@ struct MixPoint {
     bool stable = false;         ///< every arrangement stable
     int unstable_roots = 0;      ///< spread arrangement, among the listed roots
     double max_residual = 0.0;
-    RootStatus status = RootStatus::Converged;  ///< worst over the arrangements
-    SolverMethod method_used = SolverMethod::Product;  ///< the solver path of the spread arrangement
+    Status status = Status::Converged;  ///< worst over the arrangements
+    std::string method_used;  ///< the root method of the spread arrangement (contour, dense or shift_invert)
 };
 
 std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, const MixOptions& options);

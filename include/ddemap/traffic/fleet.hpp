@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "ddemap/traffic/model.hpp"
-#include "ddemap/solve/shift_invert.hpp"
+#include "ddemap/problem/linear_dde.hpp"
 
 namespace ddemap {
 
@@ -65,7 +65,7 @@ RingEquilibrium ring_equilibrium_at_length(const Fleet& fleet, double length);
 /// linearisations; N >= 2. With the cars' partials at the equilibrium it is the linearisation of
 /// the nonlinear ring (traffic/ring_system.hpp: RingSystem::sparse_linearise, equal to
 /// linearise(RingSystem, equilibrium) entrywise); analyse_mixed_ring takes them from there.
-SparseDDE mixed_ring_dde(const std::vector<Linearisation>& cars);
+LinearDDE mixed_ring_dde(const std::vector<Linearisation>& cars);
 
 /// |prod_i Gamma_i(lambda) - 1| for laws of the car ahead only (sums of logarithms, so no
 /// overflow for long rings): 0 at every non-trivial root of the ring.

@@ -1,5 +1,5 @@
 #pragma once
-/// \file ring_product.hpp
+/// \file ring_determinant.hpp
 /// Rings of cars that react only to the car ahead, solved through the scalar characteristic
 /// function instead of an eigenvalue problem. With
 ///     P_i(lambda) = lambda^2 - lambda own_i(lambda) + gap_i(lambda),
@@ -14,45 +14,51 @@
 /// winding number of D along its boundary, tracked in the factored form: sum_t n_t arg P_t
 /// (each P_t followed with steps of at most max_arg_step radians) plus the unwrapped arg of
 /// 1 - e^Phi (followed through Im Phi where |Re Phi| is large, and with |delta Phi| <=
-/// max_arg_step near |e^Phi| = 1, where the roots are). The rightmost roots: the strip floor
-/// alpha is lowered (bisection) until at least `count` roots lie in [alpha, beta] x
-/// [-R(alpha), R(alpha)] (no root with Re >= alpha lies outside it, sparse.hpp); the rectangle
-/// is split into cells with their counts until each holds one root, which Newton on D finds.
-/// The listed roots are then certified complete by the count, not only by the discretisation.
+/// max_arg_step near |e^Phi| = 1, where the roots are), by the one phase tracker
+/// (solve/argument_principle.hpp). RingDeterminant is a CharacteristicFunction: the contour
+/// backend of rightmost_roots (solve/roots.hpp) finds the rightmost roots from it, certified
+/// complete by the count, not only by a discretisation; ring_root_problem builds that problem.
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "ddemap/problem/characteristic_function.hpp"
+#include "ddemap/solve/argument_principle.hpp"
+#include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/model.hpp"
-#include "ddemap/solve/shift_invert.hpp"
 #include "ddemap/traffic/transfer_function.hpp"
 
 namespace ddemap {
 
 /// D(lambda) of a ring of one-leader cars, in the factored form above.
-class RingDeterminant {
+class RingDeterminant final : public CharacteristicFunction {
 public:
     /// Groups identical linearisations; throws std::invalid_argument for fewer than 2 cars or
-    /// a car with more than one leader.
+    /// a car with more than one leader. Cars in ring order, car i following car i-1.
     explicit RingDeterminant(const std::vector<Linearisation>& cars);
     int types() const { return static_cast<int>(m_types.size()); }
     /// log D(lambda) (imaginary part modulo 2 pi); -inf real part at an exact root.
     cplx log_value(cplx lambda) const;
     /// D'(lambda) / D(lambda).
-    cplx log_derivative(cplx lambda) const;
+    cplx log_derivative(cplx lambda) const override;
     /// Phi(lambda) = sum_i log Gamma_i(lambda) (imaginary part modulo 2 pi).
     cplx phi(cplx lambda) const;
 
-    /// Zeros of D inside a rectangle by the argument principle.
-    struct Count {
-        int zeros = 0;         ///< with multiplicity
-        long evaluations = 0;  ///< contour points (each O(types))
-        bool ok = false;       ///< false: a zero on (or within rounding of) the boundary
-    };
-    /// [x0, x1] x [y0, y1], counter-clockwise boundary.
+    using Count = ZeroCount;
+    /// Zeros in [x0, x1] x [y0, y1] (count_zeros of argument_principle.hpp).
     Count count(double x0, double x1, double y0, double y1, double max_arg_step = 0.5) const;
-    /// [x0, x1] x [-y, y] for this real problem: twice the change of arg D along the upper half.
+    /// Zeros in [x0, x1] x [-y, y] (count_zeros_symmetric).
     Count count_symmetric(double x0, double x1, double y, double max_arg_step = 0.5) const;
+
+    // CharacteristicFunction
+    bool arg_change(cplx a, cplx b, double max_arg_step, double& total, long& evaluations) const override;
+    double evaluation_cost() const override { return static_cast<double>(m_types.size()); }
+    bool is_real() const override { return true; }
+    /// The ring eigenvector x with speeds x_v,i = Gamma_i x_v,i-1 (and gaps from the rows of Delta).
+    VectorXc null_vector(cplx lambda) const override;
+    std::string description() const override { return "det Delta = prod P_i - prod Q_i"; }
+    std::string cost_description() const override;
 
 private:
     struct Type {
@@ -61,27 +67,13 @@ private:
     };
     /// P, Q (and P', Q' when dp is given) of one type at z.
     void factors(const Type& t, cplx z, cplx& p, cplx& q, cplx* dp, cplx* dq) const;
-    /// Adds the change of arg D along the segment a -> b to `total`; false if the step underflowed.
-    bool follow(cplx a, cplx b, double max_arg_step, double& total, long& evaluations) const;
     std::vector<Type> m_types;
+    std::vector<TransferFunction> m_gamma;  ///< every car in ring order (for the null vector)
 };
 
-struct ProductRootOptions {
-    int count = 10;                     ///< rightmost roots wanted (a conjugate partner may be added)
-    double max_arg_step = 0.5;          ///< radians per step along a contour
-    int max_cells = 200000;             ///< give up (EigenFailure) after this many cell counts
-    double max_type_evaluations = 2e9;  ///< or after this many evaluations of one car type's factors
-    int newton_max_iterations = 60;
-    double newton_tolerance = 1e-14;    ///< stop when |step| <= tol max(1, |lambda|)
-    double residual_tolerance = 1e-9;   ///< accept a root below this relative residual
-    void validate() const;
-};
-
-/// The rightmost roots of D (the trivial root lambda = 0 included; cars in ring order, car i
-/// following car i-1). Result in the sparse layout: strip_floor = alpha, right_bound = beta,
-/// height = R(alpha), eigenvalues_found = the count in the rectangle, degree = 0, shifts = 0;
-/// each root's residual is ||Delta(lambda) x|| / (||x|| (|lambda| + R(Re lambda))) for the
-/// eigenvector x built from x_i = Gamma_i x_{i-1}.
-SparseRootResult product_ring_roots(const std::vector<Linearisation>& cars, const ProductRootOptions& options = {});
+/// The root problem of a ring of cars (ring order, car i following car i-1): the 2N-state
+/// sparse LinearDDE (mixed_ring_dde) and, when every car reacts only to the car ahead, its
+/// RingDeterminant as the characteristic function (then "auto" takes the contour backend).
+RootProblem ring_root_problem(const std::vector<Linearisation>& cars);
 
 }  // namespace ddemap

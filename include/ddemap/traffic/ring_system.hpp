@@ -55,9 +55,9 @@ public:
     /// The partials of each car's law at the constant history `state` (dual numbers, the current
     /// parameters), car by car: O(N) work.
     std::vector<Linearisation> car_linearisations(const Eigen::VectorXd& state) const;
-    /// The same linearisation as linearise(*this, state), assembled sparse (mixed_ring_dde of
+    /// The same linearisation as linearise(*this, state), assembled with sparse storage (mixed_ring_dde of
     /// car_linearisations): for long rings, where the dense one costs O(N^2).
-    SparseDDE sparse_linearise(const Eigen::VectorXd& state) const;
+    LinearDDE sparse_linearise(const Eigen::VectorXd& state) const;
 
     void evaluate(const double* u, const double* p, double* out) const override;
     void evaluate(const Dual<double>* u, const Dual<double>* p, Dual<double>* out) const override;

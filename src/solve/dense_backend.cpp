@@ -1,0 +1,244 @@
+// The dense backend of rightmost_roots: all eigenvalues of the Chebyshev collocation matrix
+// (Eigen's QR algorithm, real arithmetic for real problems), each refined by Newton on det Delta,
+// with the degree raised until the rightmost roots settle (MATH.md section 5).
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+
+#include "ddemap/discretize/collocation.hpp"
+#include "internal/backends.hpp"
+
+namespace ddemap::detail {
+
+bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out) {
+    const MatrixXc a = collocation_matrix(dde.is_sparse() ? dde.to_dense() : dde, degree);
+    if (dde.is_real()) {
+        Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(a.real()), /*computeEigenvectors=*/false);
+        if (es.info() != Eigen::Success) return false;
+        out.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+    } else {
+        Eigen::ComplexEigenSolver<MatrixXc> es(a, /*computeEigenvectors=*/false);
+        if (es.info() != Eigen::Success) return false;
+        out.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+    }
+    return true;
+}
+
+namespace {
+
+/// Newton on det Delta from `guess` (the one Newton loop); true when converged (or stalled
+/// near a multiple root) with a residual below the tolerance.
+bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, Root& out, int& iterations) {
+    cplx lambda = guess;
+    const NewtonSummary s = newton(
+        lambda,
+        [&](const cplx& z, cplx& dz) {
+            Eigen::PartialPivLU<MatrixXc> lu(dde.characteristic_matrix(z));
+            const cplx t = lu.solve(dde.characteristic_derivative(z)).trace();
+            // Delta(lambda) exactly singular: lambda is a root to machine precision
+            if (!std::isfinite(t.real()) || !std::isfinite(t.imag()) || t == cplx(0.0)) return NewtonStep::Exact;
+            dz = 1.0 / t;
+            return NewtonStep::Ok;
+        },
+        options.dense.newton);
+    iterations += s.iterations;
+    if (s.status == Status::NumericalIssue) return false;
+    out.value = lambda;
+    out.eigenvalue = guess;
+    out.newton_step = s.last_step;
+    out.residual = relative_residual(dde, lambda);
+    out.collocation_error = std::abs(lambda - guess);
+    // A multiple root converges only linearly and stalls near sqrt(eps): accept it on the residual.
+    return (s.status == Status::Converged || s.last_step <= 1e-6 * scale_of(lambda)) && out.residual <= options.residual_tolerance;
+}
+
+/// Refine candidates, merge duplicates, return sorted rightmost first.
+std::vector<Root> refine_all(const LinearDDE& dde, const std::vector<cplx>& candidates, const RootOptions& options, int& dropped,
+                             int& iterations) {
+    const bool real = dde.is_real();
+    std::vector<Root> found;
+    for (cplx c : candidates) {
+        if (real && c.imag() < 0.0) continue;  // the conjugate partner is (or will be) refined instead
+        Root r;
+        if (!refine_root(dde, c, options, r, iterations)) {
+            ++dropped;
+            continue;
+        }
+        if (real) {
+            if (r.value.imag() < 0.0) r.value = std::conj(r.value);
+            if (std::abs(r.value.imag()) <= 1e-12 * scale_of(r.value) && r.value.imag() != 0.0) {
+                Root rr;
+                if (refine_root(dde, cplx(r.value.real(), 0.0), options, rr, iterations) && rr.value.imag() == 0.0) {
+                    rr.collocation_error = std::abs(rr.value - c);
+                    rr.eigenvalue = c;
+                    r = rr;
+                }
+            }
+        }
+        bool dup = false;
+        for (auto& f : found) {
+            if (std::abs(f.value - r.value) <= 1e-9 * scale_of(r.value)) {
+                dup = true;
+                ++dropped;
+                f.collocation_error = std::min(f.collocation_error, r.collocation_error);
+                if (r.residual < f.residual) {
+                    const double ce = f.collocation_error;
+                    f = r;
+                    f.collocation_error = ce;
+                }
+                break;
+            }
+        }
+        if (!dup) found.push_back(r);
+    }
+    if (real) {
+        const std::size_t n = found.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            if (found[i].value.imag() > 0.0) {
+                Root c = found[i];
+                c.value = std::conj(c.value);
+                c.eigenvalue = std::conj(c.eigenvalue);
+                found.push_back(c);
+            }
+        }
+    }
+    std::sort(found.begin(), found.end(), rightmost_first);
+    return found;
+}
+
+}  // namespace
+
+std::string dense_why_not(const RootProblem& problem, const RootOptions& /*options*/) {
+    if (problem.dde.dimension() > 4000)
+        return "method 'dense': " + std::to_string(problem.dde.dimension()) +
+               " states are too many for dense collocation (at most 4000): expected auto or shift_invert";
+    return {};
+}
+
+RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
+    const LinearDDE dde = problem.dde.to_dense();
+    const DenseRootOptions& o = options.dense;
+    RootResult result;
+
+    if (dde.is_ode()) {
+        const MatrixXc a = dde.a0();
+        std::vector<cplx> ev;
+        if (dde.is_real()) {
+            // real arithmetic: exact conjugate pairs and real eigenvalues with zero imaginary part
+            // (refine_all skips Im < 0, so a real eigenvalue computed as x - 1e-18 i would be lost)
+            Eigen::EigenSolver<Eigen::MatrixXd> es(a.real(), false);
+            ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        } else {
+            Eigen::ComplexEigenSolver<MatrixXc> es(a, false);
+            ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        }
+        result.roots = cut_rightmost(refine_all(dde, ev, options, result.dropped, result.newton_iterations), options.count);
+        result.degree = 0;
+        result.status = Status::Converged;
+        result.covered_radius = std::numeric_limits<double>::infinity();
+        result.message = "no delay: the eigenvalues of the ODE matrix A0 + sum A_k, refined by Newton";
+        return result;
+    }
+
+    const double tau = dde.max_delay();
+    const int max_degree = std::max(o.max_degree, options.degree);
+    int m = options.degree > 0 ? options.degree : std::clamp(degree_for_radius(dde.root_bound(0.0), tau), 8, max_degree);
+    std::vector<Root> previous;
+    std::size_t previous_in_strip = 0;
+    int previous_degree = 0;
+    for (;;) {
+        std::vector<cplx> values;
+        if (!collocation_eigenvalues(dde, m, values)) {
+            result.status = Status::NumericalIssue;
+            result.degree = m;
+            result.roots = previous;
+            result.message = "the dense eigen-solver failed at degree " + std::to_string(m);
+            return result;
+        }
+        const double covered = radius_for_degree(m, tau);
+        // eigenvalues beyond the resolved radius are discretisation artefacts, not roots
+        std::vector<cplx> ev;
+        for (cplx z : values)
+            if (std::abs(z) <= 1.5 * covered + 1.0) ev.push_back(z);
+        std::sort(ev.begin(), ev.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
+        const std::size_t k = std::min<std::size_t>(ev.size(), 2 * options.count + 8);
+        ev.resize(k);
+        int dropped = 0;
+        std::vector<Root> current = cut_rightmost(refine_all(dde, ev, options, dropped, result.newton_iterations), options.count);
+        // Completeness is certified right of sigma: the last of the `count` roots, or, when fewer
+        // were found, the floor of the strip Re >= alpha - depth (all roots there are listed).
+        const double depth = o.depth > 0.0 ? o.depth : 2.0 / tau;
+        const bool full = current.size() >= std::size_t(options.count);
+        const double floor = current.empty() ? -depth : current.front().value.real() - depth;
+        const double sigma = full ? current.back().value.real() : floor;
+        std::size_t in_strip = 0;
+        while (in_strip < current.size() && current[in_strip].value.real() >= sigma) ++in_strip;
+        // every root right of sigma is within the bound; M must resolve that disc
+        const double needed = dde.root_bound(sigma);
+        double change = std::numeric_limits<double>::infinity();
+        bool collocated = true;
+        if (previous_degree > 0 && previous_in_strip == in_strip) {
+            change = 0.0;
+            for (std::size_t i = 0; i < in_strip; ++i) {
+                change = std::max(change, std::abs(current[i].value - previous[i].value) / scale_of(current[i].value));
+            }
+        }
+        double worst_collocation = 0.0;
+        for (std::size_t i = 0; i < in_strip; ++i) {
+            const double e = current[i].collocation_error / scale_of(current[i].value);
+            worst_collocation = std::max(worst_collocation, e);
+            if (e > o.collocation_tolerance) collocated = false;
+        }
+        // Two certificates: the eigenvalues themselves already equal the Newton-refined roots
+        // (spectral accuracy reached at this M), or the refined roots agree between two degrees.
+        const bool covers = covered >= needed;
+        // (With fewer than `count` roots found only the second certificate applies: a larger M
+        // may reveal more roots, so the same set must come out of two degrees.)
+        const bool spectral = full && worst_collocation <= o.spectral_tolerance && covers;
+        const bool agreed = change <= o.agreement_tolerance && collocated && covers;
+        const bool settled = spectral || agreed;
+        if (settled || m >= max_degree) {
+            result.roots = current;
+            result.degree = m;
+            result.previous_degree = previous_degree;
+            result.degree_change = change;
+            result.collocation_error = worst_collocation;
+            result.covered_radius = covered;
+            result.strip_floor = sigma;
+            result.dropped = dropped;
+            std::ostringstream os;
+            os.precision(3);
+            if (settled) {
+                result.status = Status::Converged;
+                os << "the " << in_strip << " rightmost roots" << (full ? "" : " (all with Re >= " + std::to_string(floor) + ")");
+                if (spectral) {
+                    os << " equal collocation eigenvalues at M=" << m << " to " << worst_collocation
+                       << " (relative; spectral accuracy reached)";
+                } else {
+                    os << " agree between M=" << previous_degree << " and M=" << m << " (max relative change " << change
+                       << "; eigenvalues within " << worst_collocation << ")";
+                }
+                os << ", and M resolves |lambda| <= " << covered << ", beyond the bound " << needed
+                   << " on any root with Re >= " << sigma;
+            } else {
+                result.status = Status::MaxDegreeReached;
+                os << "max degree M=" << m << " reached before the roots settled (change " << change
+                   << ", resolved radius " << covered << " of needed " << needed << ")";
+            }
+            result.message = os.str();
+            return result;
+        }
+        previous = current;
+        previous_in_strip = in_strip;
+        previous_degree = m;
+        int next = static_cast<int>(std::ceil(1.5 * m));
+        if (covered < needed) next = std::max(next, degree_for_radius(needed, tau));
+        m = std::min(next, max_degree);
+    }
+}
+
+}  // namespace ddemap::detail
