@@ -12,7 +12,7 @@ for i in "${!layers[@]}"; do
         higher=${layers[$j]}
         for dir in include/ddemap/$layer src/$layer; do
             [ -d "$dir" ] || continue
-            if hits=$(grep -rn "#include \"ddemap/$higher/" "$dir"); then
+            if hits=$(grep -rnE "#include \"(ddemap/)?$higher/" "$dir"); then
                 echo "layer violation: $layer includes $higher:"; echo "$hits"; status=1
             fi
         done

@@ -16,7 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 

@@ -1,5 +1,5 @@
 // The follower simulation of the calibration with its forward sensitivities (calibrate.hpp).
-// A dedicated RK4 (not detail::DdeSolver): the state is augmented with S = d(s, v)/d theta,
+// A dedicated RK4 (not DdeSolver): the state is augmented with S = d(s, v)/d theta,
 // the steps land on the samples t_k (kinks of the interpolated lead) and on their delayed echoes
 // t_k + tau, and the data history needs its slopes for the tau-sensitivity.
 #include <algorithm>

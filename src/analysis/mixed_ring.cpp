@@ -38,7 +38,7 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
             break;
         }
     }
-    r.roots = detail::cut_rightmost(r.roots, options.roots.count);
+    r.roots = cut_rightmost(r.roots, options.roots.count);
     out.spectral_abscissa = r.spectral_abscissa();
     for (const auto& x : r.roots) {
         if (x.value.real() > marginal_band(x.value)) ++out.unstable_roots;

@@ -13,7 +13,7 @@ namespace ddemap {
 
 namespace {
 
-bool rightmost_first(const RingRoot& a, const RingRoot& b) {
+bool ring_root_first(const RingRoot& a, const RingRoot& b) {
     if (a.root.value.real() != b.root.value.real()) return a.root.value.real() > b.root.value.real();
     return a.root.value.imag() > b.root.value.imag();
 }
@@ -109,7 +109,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
                 }
             }
         }
-        std::sort(all.begin(), all.end(), rightmost_first);
+        std::sort(all.begin(), all.end(), ring_root_first);
         r.spectral_abscissa = all.empty() ? -std::numeric_limits<double>::infinity() : all.front().root.value.real();
         r.abscissa_mode = all.empty() ? 0 : all.front().mode;
         r.abscissa_theta = all.empty() ? 0.0 : all.front().theta;
@@ -172,7 +172,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
         RootResult at_best;
         alpha(best_theta, &at_best);
         for (const auto& root : at_best.roots) all.push_back({root, -1, best_theta});
-        std::sort(all.begin(), all.end(), rightmost_first);
+        std::sort(all.begin(), all.end(), ring_root_first);
 
         // the branch through the trivial root: Re lambda(theta) ~ c_k w^k / (2 D(0)^2 Gamma'(0))
         const LowFrequency& lf = sr.lowfreq;

@@ -9,7 +9,7 @@
 
 #include "ddemap/solve/integrate.hpp"
 #include "ddemap/traffic/fleet.hpp"
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 
@@ -158,7 +158,7 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
             y[2 * i + 1] = v0;
         }
     };
-    auto rhs = [&](double t, const double* y, const detail::DdeSolver& sol, double* dy) {
+    auto rhs = [&](double t, const double* y, const DdeSolver& sol, double* dy) {
         for (int i = 0; i < n; ++i) {
             const double v_ahead = i == 0 ? lead.speed(t) : y[2 * i - 1];
             dy[2 * i] = v_ahead - y[2 * i + 1];
@@ -175,7 +175,7 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
             dy[2 * i + 1] = cars[i].model->acceleration(in);
         }
     };
-    detail::DdeSolver solver(2 * n, 0.0, history, rhs);
+    DdeSolver solver(2 * n, 0.0, history, rhs);
 
     SimResult r;
     r.initial_speed = v0;
@@ -190,7 +190,7 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
     std::vector<double> prev(solver.state(), solver.state() + 2 * n);
     double t_prev = 0.0;
     bool stop = false;
-    auto after = [&](const detail::DdeSolver& sol) {
+    auto after = [&](const DdeSolver& sol) {
         const double t = sol.time();
         const double* y = sol.state();
         for (int i = 0; i < n; ++i) {

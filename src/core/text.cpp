@@ -1,4 +1,4 @@
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 #include <cerrno>
 #include <cmath>

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace ddemap::detail {
+namespace ddemap {
 
 Eigen::VectorXd chebyshev_points(int degree) {
     if (degree < 1) throw std::invalid_argument("Chebyshev degree must be >= 1");
@@ -57,4 +57,4 @@ Eigen::VectorXd chebyshev_lagrange_row(int degree, double x) {
     return l / denom;
 }
 
-}  // namespace ddemap::detail
+}  // namespace ddemap

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 #include "ddemap/solve/argument_principle.hpp"
 #include "internal/backends.hpp"
 

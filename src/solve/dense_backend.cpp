@@ -12,7 +12,7 @@
 #include "ddemap/discretize/collocation.hpp"
 #include "internal/backends.hpp"
 
-namespace ddemap::detail {
+namespace ddemap {
 
 bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out) {
     const MatrixXc a = collocation_matrix(dde.is_sparse() ? dde.to_dense() : dde, degree);
@@ -27,6 +27,11 @@ bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>
     }
     return true;
 }
+
+}  // namespace ddemap
+
+namespace ddemap::detail {
+
 
 namespace {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace ddemap::detail {
+namespace ddemap {
 
 DdeSolver::DdeSolver(int dimension, double t0, History history, Rhs rhs)
     : m_n(dimension), m_history(std::move(history)), m_rhs(std::move(rhs)) {
@@ -82,4 +82,4 @@ void DdeSolver::integrate(double t_end, double h_max, std::vector<double> breakp
     }
 }
 
-}  // namespace ddemap::detail
+}  // namespace ddemap

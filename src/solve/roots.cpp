@@ -10,18 +10,17 @@
 
 namespace ddemap {
 
-namespace detail {
 
 namespace {
 
 /// THE registry: every backend of rightmost_roots, in one place.
-const RootBackend kBackends[] = {
-    {"dense", dense_why_not, dense_roots},
-    {"shift_invert", shift_invert_why_not, shift_invert_roots},
-    {"contour", contour_why_not, contour_roots},
+const detail::RootBackend kBackends[] = {
+    {"dense", detail::dense_why_not, detail::dense_roots},
+    {"shift_invert", detail::shift_invert_why_not, detail::shift_invert_roots},
+    {"contour", detail::contour_why_not, detail::contour_roots},
 };
 
-const RootBackend* find_backend(const std::string& name) {
+const detail::RootBackend* find_backend(const std::string& name) {
     for (const auto& b : kBackends)
         if (name == b.name) return &b;
     return nullptr;
@@ -51,11 +50,10 @@ std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count) {
     return out;
 }
 
-}  // namespace detail
 
 std::vector<std::string> root_methods() {
     std::vector<std::string> names;
-    for (const auto& b : detail::kBackends) names.emplace_back(b.name);
+    for (const auto& b : kBackends) names.emplace_back(b.name);
     return names;
 }
 
@@ -73,7 +71,7 @@ bool RootOptions::is_valid(std::string* why) const {
         return false;
     };
     bool ok = true;
-    if (method != "auto" && detail::find_backend(method) == nullptr) {
+    if (method != "auto" && find_backend(method) == nullptr) {
         os << "method = '" << method << "': expected auto, dense, shift_invert or contour";
         ok = false;
     } else if (count < 1) {
@@ -151,7 +149,7 @@ double RootResult::spectral_abscissa() const {
 std::string choose_root_method(const RootProblem& problem, const RootOptions& options) {
     options.validate();
     if (options.method != "auto") {
-        const detail::RootBackend* b = detail::find_backend(options.method);
+        const detail::RootBackend* b = find_backend(options.method);
         const std::string why = b->why_not(problem, options);
         if (!why.empty()) throw std::invalid_argument(why);
         return options.method;
@@ -164,7 +162,7 @@ std::string choose_root_method(const RootProblem& problem, const RootOptions& op
 
 RootResult rightmost_roots(const RootProblem& problem, const RootOptions& options) {
     const std::string method = choose_root_method(problem, options);
-    RootResult r = detail::find_backend(method)->solve(problem, options);
+    RootResult r = find_backend(method)->solve(problem, options);
     r.method_given = options.method;
     r.method_used = method;
     r.max_residual = 0.0;

@@ -40,9 +40,9 @@ public:
 
     StructuredShiftInvert(const LinearDDE& dde, int degree) : m_dde(dde), m_m(degree), m_n(dde.dimension()) {
         const double tau = dde.max_delay();
-        m_d = detail::chebyshev_differentiation(degree) * (2.0 / tau);
+        m_d = chebyshev_differentiation(degree) * (2.0 / tau);
         for (const auto& t : dde.sparse_delayed()) {
-            m_l.push_back(detail::chebyshev_lagrange_row(degree, 1.0 - 2.0 * t.delay / tau));
+            m_l.push_back(chebyshev_lagrange_row(degree, 1.0 - 2.0 * t.delay / tau));
             m_ak.push_back(t.matrix.cast<cplx>());
         }
         m_a0 = dde.sparse_a0().cast<cplx>();

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 

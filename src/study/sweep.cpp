@@ -12,7 +12,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 
@@ -87,7 +87,7 @@ CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<
     const LinearDDE problem = dde();
     {
         std::vector<cplx> ev;
-        detail::collocation_eigenvalues(problem, 8, ev);
+        collocation_eigenvalues(problem, 8, ev);
         std::sort(ev.begin(), ev.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
         bool have = false;
         cplx best;

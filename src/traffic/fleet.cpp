@@ -10,7 +10,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/transfer_function.hpp"
 #include "ddemap/traffic/vehicles.hpp"
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 

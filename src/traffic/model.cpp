@@ -1,6 +1,6 @@
 #include "ddemap/traffic/model.hpp"
 
-#include "ddemap/core/text.hpp"
+#include "core/internal/text.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -24,9 +24,9 @@ double exact(double t, double tau) {
 }
 
 double solve(double tau, double h, double t_end) {
-    detail::DdeSolver s(
+    DdeSolver s(
         1, 0.0, [](double, double* y) { y[0] = 1.0; },
-        [tau](double t, const double* y, const detail::DdeSolver& sol, double* dy) {
+        [tau](double t, const double* y, const DdeSolver& sol, double* dy) {
             (void)y;
             dy[0] = -sol.value(0, t - tau);
         });

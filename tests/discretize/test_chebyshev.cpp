@@ -6,7 +6,7 @@
 
 TEST_SUITE_BEGIN("fast");
 
-using namespace ddemap::detail;
+using namespace ddemap;
 
 TEST_CASE("Chebyshev differentiation is exact for polynomials up to the degree") {
     for (int m : {4, 9, 16}) {

@@ -4,7 +4,7 @@
 /// with its own car-following law and delay,
 ///     s_i' = v_{i-1} - v_i,   v_i' = F_i(s_i(t - tau_i), v_i(t), v_{i-1}(t - tau_i)),
 /// starting from equilibrium at the lead's initial speed (s_i = s*_i(v0), v_i = v0 for t <= 0),
-/// integrated by detail::DdeSolver (RK4 with a Hermite continuous extension, steps aligned
+/// integrated by DdeSolver (RK4 with a Hermite continuous extension, steps aligned
 /// with the lead profile's breakpoints and their first delayed echoes). Events: a follower
 /// below its minimum ACC speed disengages; a gap reaching zero is a collision.
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-namespace ddemap::detail {
+namespace ddemap {
 
 /// x_j = cos(j pi / M), j = 0..M (x_0 = 1, x_M = -1). Requires M >= 1.
 Eigen::VectorXd chebyshev_points(int degree);
@@ -19,4 +19,4 @@ Eigen::MatrixXd chebyshev_differentiation(int degree);
 /// formula with weights w_j = (-1)^j (halved at both ends).
 Eigen::VectorXd chebyshev_lagrange_row(int degree, double x);
 
-}  // namespace ddemap::detail
+}  // namespace ddemap

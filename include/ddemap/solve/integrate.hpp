@@ -10,7 +10,7 @@
 #include <functional>
 #include <vector>
 
-namespace ddemap::detail {
+namespace ddemap {
 
 class DdeSolver {
 public:
@@ -48,4 +48,4 @@ private:
     mutable std::size_t m_cursor = 0;
 };
 
-}  // namespace ddemap::detail
+}  // namespace ddemap

@@ -148,7 +148,6 @@ std::vector<std::string> root_methods();
 /// unstable: 1e-13 max(1, |lambda|) (roots are refined to about 1e-15).
 double marginal_band(cplx lambda);
 
-namespace detail {
 /// Degree needed so that Chebyshev interpolation of e^{lambda theta} on [-tau, 0] is accurate
 /// to rounding for |lambda| <= radius (interpolating e^{z x} on [-1, 1], |z| = radius tau / 2,
 /// converges once M exceeds about e|z|/2 + 15): M = ceil(0.7 radius tau + 15).
@@ -164,6 +163,5 @@ std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count);
 bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out);
 /// Rightmost first, ties: larger imaginary part first.
 bool rightmost_first(const Root& a, const Root& b);
-}  // namespace detail
 
 }  // namespace ddemap

@@ -1,5 +1,6 @@
 #pragma once
-// Internal text helpers shared by the readers and the error messages of the library.
+// Internal text helpers shared by the readers and the error messages of the library (private:
+// not installed; the layers include it as "core/internal/text.hpp").
 #include <string>
 #include <vector>
 
