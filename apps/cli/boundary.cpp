@@ -43,11 +43,7 @@ int run_boundary() {
     e.result = boundary_json(b);
     const std::string csv = boundary_csv(spec, b);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
-    if (format == Format::Json) {
-        print_json(e);
-    } else if (format == Format::Csv) {
-        std::cout << csv;
-    } else {
+    print_output(format, e, csv, [&] {
         std::ostringstream out;
         out << "boundaries " << b.curves.size() << " curves (" << b.seeds << " seeds on a " << grid << " x " << grid << " grid)\n";
         for (std::size_t i = 0; i < b.curves.size(); ++i) {
@@ -58,7 +54,7 @@ int run_boundary() {
         }
         out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
         std::cout << out.str();
-    }
+        });
     return exit_ok;
 }
 

@@ -90,11 +90,7 @@ int run_calibrate() {
     const std::string csv = calibration_csv(names, fits);
     if (!prefix.empty())
         write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}});
-    if (format == Format::Json) {
-        print_json(e);
-    } else if (format == Format::Csv) {
-        std::cout << csv;
-    } else {
+    print_output(format, e, csv, [&] {
         std::ostringstream out;
         out << "file                                         k1      k2     th     tau    eta   rmse_v  rmse_gap  naive_v  status\n";
         for (std::size_t i = 0; i < fits.size(); ++i) {
@@ -107,7 +103,7 @@ int run_calibrate() {
             out << line;
         }
         std::cout << out.str();
-    }
+        });
     return exit_ok;
 }
 

@@ -69,9 +69,7 @@ int run_classify() {
         if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", svg}});
         else write_files_atomic({{svg_file, svg}});
     }
-    if (format == Format::Json) print_json(e);
-    else if (format == Format::Csv) std::cout << csv;
-    else std::cout << classification_table(rows, cars, source);
+    print_output(format, e, csv, [&] { std::cout << classification_table(rows, cars, source); });
     return exit_code(status);
 }
 

@@ -171,6 +171,12 @@ std::string OutArg::prepare(const std::string& command) const {
 
 void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }
 
+void print_output(Format format, const JsonEnvelope& e, const std::string& csv, const std::function<void()>& print_table) {
+    if (format == Format::Json) print_json(e);
+    else if (format == Format::Csv) std::cout << csv;
+    else print_table();
+}
+
 std::string root_method(const std::string& solver) {
     if (solver == "sparse") return "shift_invert";
     if (solver == "product") return "contour";

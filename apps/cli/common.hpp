@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <initializer_list>
 #include <iostream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -102,5 +103,8 @@ struct OutArg {
 
 /// Prints the envelope of a command's JSON output.
 void print_json(const JsonEnvelope& e);
+/// The command's output on stdout in the chosen format: the JSON envelope, the CSV text, or
+/// the human table (print_table writes it).
+void print_output(Format format, const JsonEnvelope& e, const std::string& csv, const std::function<void()>& print_table);
 
 }  // namespace ddemap::cli

@@ -41,9 +41,7 @@ int run_growth() {
     e.result = growth_json(g, label);
     const std::string csv = growth_csv(g);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", growth_svg(g, label)}});
-    if (format == Format::Csv) std::cout << csv;
-    else if (format == Format::Json) print_json(e);
-    else std::cout << growth_table(g);
+    print_output(format, e, csv, [&] { std::cout << growth_table(g); });
     return exit_ok;
 }
 

@@ -80,11 +80,7 @@ int run_mix() {
     e.result = mix_json(pts, o.cars);
     const std::string csv = mix_csv(pts);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", mix_svg(pts, o, x.label, y.label)}});
-    if (format == Format::Json) {
-        print_json(e);
-    } else if (format == Format::Csv) {
-        std::cout << csv;
-    } else {
+    print_output(format, e, csv, [&] {
         std::ostringstream out;
         out << "p      k   abscissa        stable\n";
         for (const auto& pt : pts) {
@@ -94,7 +90,7 @@ int run_mix() {
         }
         out << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << out.str();
-    }
+        });
     return exit_code(status);
 }
 

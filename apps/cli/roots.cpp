@@ -37,9 +37,7 @@ int parse_degree() {
 /// Prints (and with --out writes PREFIX.csv, PREFIX.json) the command's output.
 void emit(const JsonEnvelope& e, const std::string& csv, const std::string& table, Format format, const std::string& prefix) {
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
-    if (format == Format::Json) print_json(e);
-    else if (format == Format::Csv) std::cout << csv;
-    else std::cout << table;
+    print_output(format, e, csv, [&] { std::cout << table; });
 }
 
 int run_system(Format format, const std::string& prefix) {

@@ -64,11 +64,7 @@ int run_simulate() {
     e.result = simulation_json(r, label);
     const std::string csv = simulation_csv(r);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", simulation_svg(r, label)}});
-    if (format == Format::Json) {
-        print_json(e);
-    } else if (format == Format::Csv) {
-        std::cout << csv;
-    } else {
+    print_output(format, e, csv, [&] {
         std::ostringstream s;
         s << "simulated  " << cars.size() << " followers to t = " << rounded(r.t_end, 5) << " s (" << r.steps << " steps)\n";
         s << "car  name      min speed  speed drop  min gap   events\n";
@@ -81,7 +77,7 @@ int run_simulate() {
         }
         s << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << s.str();
-    }
+        });
     return exit_ok;
 }
 

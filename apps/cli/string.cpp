@@ -54,11 +54,7 @@ int run_string() {
     e.result = string_json(s, rp);
     const std::string csv = string_csv(s, rp);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
-    if (format == Format::Json) {
-        print_json(e);
-    } else if (format == Format::Csv) {
-        std::cout << csv;
-    } else {
+    print_output(format, e, csv, [&] {
         std::ostringstream out;
         out << "model            " << model->name();
         for (const auto& [k, v] : model->parameters()) out << " " << k << "=" << rounded(v, 6);
@@ -78,7 +74,7 @@ int run_string() {
         }
         out << "verdict          string " << (s.string_stable ? "STABLE" : "UNSTABLE") << "\n";
         std::cout << out.str();
-    }
+        });
     return exit_code(status);
 }
 

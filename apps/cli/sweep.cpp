@@ -71,11 +71,7 @@ int run_sweep() {
         {prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", render_chart_svg({panel}, co)}};
     if (bp) files.emplace_back(prefix + "-boundaries.csv", boundary_csv(spec, b));
     write_files_atomic(files);
-    if (format == Format::Json) {
-        print_json(e);
-    } else if (format == Format::Csv) {
-        std::cout << csv;
-    } else {
+    print_output(format, e, csv, [&] {
         int classes[4] = {0, 0, 0, 0};
         for (const auto& p : sw.points) ++classes[region_class(p)];
         std::ostringstream out;
@@ -88,7 +84,7 @@ int run_sweep() {
         for (const auto& f : files) out << f.first << " ";
         out << "\n";
         std::cout << out.str();
-    }
+        });
     return sw.uncertified > 0 ? exit_not_converged : exit_ok;
 }
 
