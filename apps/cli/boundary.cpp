@@ -54,7 +54,7 @@ int run_boundary() {
         }
         out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
         std::cout << out.str();
-        });
+    });
     return exit_ok;
 }
 

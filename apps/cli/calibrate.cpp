@@ -103,7 +103,7 @@ int run_calibrate() {
             out << line;
         }
         std::cout << out.str();
-        });
+    });
     return exit_ok;
 }
 

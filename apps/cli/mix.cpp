@@ -90,7 +90,7 @@ int run_mix() {
         }
         out << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << out.str();
-        });
+    });
     return exit_code(status);
 }
 

@@ -77,7 +77,7 @@ int run_simulate() {
         }
         s << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << s.str();
-        });
+    });
     return exit_ok;
 }
 

@@ -74,7 +74,7 @@ int run_string() {
         }
         out << "verdict          string " << (s.string_stable ? "STABLE" : "UNSTABLE") << "\n";
         std::cout << out.str();
-        });
+    });
     return exit_code(status);
 }
 

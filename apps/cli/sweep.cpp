@@ -84,7 +84,7 @@ int run_sweep() {
         for (const auto& f : files) out << f.first << " ";
         out << "\n";
         std::cout << out.str();
-        });
+    });
     return sw.uncertified > 0 ? exit_not_converged : exit_ok;
 }
 
