@@ -14,10 +14,8 @@
 #include <string>
 #include <vector>
 
-#ifdef DDEMAP_WITH_OPENMP
-#include <omp.h>
-#endif
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/study/sweep.hpp"
@@ -70,17 +68,14 @@ int main(int argc, char** argv) {
     std::vector<double> abscissa(idx.size());
     std::vector<int> verdict_ok(idx.size());
     const auto t0 = clock_type::now();
-#ifdef DDEMAP_WITH_OPENMP
-#pragma omp parallel for schedule(dynamic, 1)
-#endif
-    for (std::size_t j = 0; j < idx.size(); ++j) {
+    parallel_for(static_cast<long>(idx.size()), [&](long j) {
         const SweepPoint& p = result.points[idx[j]];
         const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
         const RingResult ring = analyse_ring(lin, cars);
         const StringResult s = analyse_string(lin);
         abscissa[j] = ring.spectral_abscissa;
         verdict_ok[j] = ring.stable == p.ring_stable && s.string_stable == p.string_stable && s.plant_stable == p.plant_stable;
-    }
+    });
     const double base_s = std::chrono::duration<double>(clock_type::now() - t0).count();
     double max_diff = 0.0;
     int mismatches = 0;
@@ -89,10 +84,7 @@ int main(int argc, char** argv) {
         mismatches += !verdict_ok[j];
     }
     const double base_rate = idx.size() / base_s;
-    int threads = 1;
-#ifdef DDEMAP_WITH_OPENMP
-    threads = omp_get_max_threads();
-#endif
+    const int threads = thread_count();
     std::printf("grid %dx%d, ring N=%d, tau=%g, th=%g, threads=%d\n", grid, grid, cars, tau, th, threads);
     std::printf("sweep     median %.3f s over %d runs (min %.3f, max %.3f): %.0f points/s, %d collocation fallbacks, %d uncertified\n",
                 sweep_s, repeats, times.front(), times.back(), n / sweep_s, result.fallbacks, result.uncertified);

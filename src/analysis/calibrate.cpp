@@ -458,20 +458,14 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         design.push_back(th);
     }
     std::vector<double> score(design.size());
-#ifdef DDEMAP_WITH_OPENMP
-#pragma omp parallel for schedule(dynamic, 4)
-#endif
-    for (std::size_t i = 0; i < design.size(); ++i) score[i] = pb.ssr(design[i]);
+    parallel_for(static_cast<long>(design.size()), [&](long i) { score[i] = pb.ssr(design[i]); });
     std::vector<std::size_t> order(design.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return score[x] < score[y]; });
     // 2. Levenberg-Marquardt from the best design points; keep the best end point
     const int n_starts = std::min<int>(o.starts, static_cast<int>(design.size()));
     std::vector<LmResult> fits(static_cast<std::size_t>(n_starts));
-#ifdef DDEMAP_WITH_OPENMP
-#pragma omp parallel for schedule(dynamic, 1)
-#endif
-    for (int s = 0; s < n_starts; ++s) fits[static_cast<std::size_t>(s)] = levenberg_marquardt(pb, design[order[static_cast<std::size_t>(s)]], free, o);
+    parallel_for(n_starts, [&](long s) { fits[s] = levenberg_marquardt(pb, design[order[s]], free, o); });
     std::size_t best = 0;
     for (std::size_t s = 1; s < fits.size(); ++s)
         if (fits[s].ssr < fits[best].ssr) best = s;
