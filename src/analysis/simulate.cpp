@@ -76,7 +76,7 @@ std::string LeadProfile::describe_builtin(const std::string& name) {
     if (name == "oscillatory") return "24.5 and 21.9 m/s alternately, each held 30 s, three cycles; ramps 0.5 m/s^2";
     if (name == "step-low") return "11.2 m/s for 20 s, up to 15.6 m/s, held 60 s; ramp 0.5 m/s^2";
     if (name == "step-high") return "22.4 m/s for 20 s, up to 26.8 m/s, held 60 s; ramp 0.5 m/s^2";
-    throw std::invalid_argument("lead profile '" + name + "': expected one of dip, oscillatory, step-low, step-high");
+    throw std::invalid_argument("lead profile " + detail::quoted(name) + ": expected one of dip, oscillatory, step-low, step-high");
 }
 
 LeadProfile LeadProfile::builtin(const std::string& name) {
@@ -125,7 +125,7 @@ std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers) {
 std::vector<CalibratedVehicle> vehicles_from_pattern(const std::string& pattern) {
     std::vector<CalibratedVehicle> out;
     for (const FleetCar& car : fleet_from_pattern(pattern, 0)) out.push_back(builtin_vehicle(car.label));
-    if (out.empty()) throw std::invalid_argument("fleet pattern '" + pattern + "': expected vehicle names such as A_min*7");
+    if (out.empty()) throw std::invalid_argument("fleet pattern " + detail::quoted(pattern) + ": expected vehicle names such as A_min*7");
     return out;
 }
 

@@ -9,6 +9,31 @@
 
 namespace ddemap::detail {
 
+std::string quoted(const std::string& text) {
+    std::string out = "'";
+    std::size_t shown = 0;
+    for (const char ch : text) {
+        if (shown >= 80) {
+            out += "...";
+            break;
+        }
+        const auto c = static_cast<unsigned char>(ch);
+        if (c == '\n') out += "\\n";
+        else if (c == '\r') out += "\\r";
+        else if (c == '\t') out += "\\t";
+        else if (c < 0x20 || c == 0x7f) {
+            static const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        } else {
+            out += ch;
+        }
+        ++shown;
+    }
+    return out + "'";
+}
+
 std::string format_number(double v) {
     char buf[40];
     for (int p = 15; p <= 17; ++p) {
@@ -80,7 +105,7 @@ int CsvReader::column(const std::string& name, bool required) const {
     for (std::size_t i = 0; i < m_header.size(); ++i)
         if (m_header[i] == name) return static_cast<int>(i);
     if (required) {
-        throw std::invalid_argument(m_source + ":" + std::to_string(m_header_line) + ": missing column '" + name + "' (expected " +
+        throw std::invalid_argument(m_source + ":" + std::to_string(m_header_line) + ": missing column " + quoted(name) + " (expected " +
                                     m_expected + ")");
     }
     return -1;
@@ -105,7 +130,7 @@ std::string CsvReader::where() const { return m_source + ":" + std::to_string(m_
 double CsvReader::number(int column, const std::string& name) const {
     const std::string& x = m_fields.at(static_cast<std::size_t>(column));
     double v = 0.0;
-    if (!parse_finite(x, v)) fail("column '" + name + "' = '" + x + "': expected a finite number");
+    if (!parse_finite(x, v)) fail("column " + quoted(name) + " = " + quoted(x) + ": expected a finite number");
     return v;
 }
 

@@ -1,5 +1,7 @@
 #include "ddemap/io/chart_spec.hpp"
 
+#include "core/internal/text.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -92,7 +94,7 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     for (const auto& [k, v] : root) {
         const std::string key(k.str());
         if (std::find_if(std::begin(known), std::end(known), [&](const char* s) { return key == s; }) == std::end(known)) {
-            throw std::invalid_argument(where(source, v) + ": unknown key '" + key + "'");
+            throw std::invalid_argument(where(source, v) + ": unknown key " + detail::quoted(key));
         }
     }
     if (auto t = root["title"].value<std::string>()) spec.title = *t;

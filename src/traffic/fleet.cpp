@@ -90,7 +90,7 @@ Fleet fleet_from_pattern(const std::string& pattern, int cars) {
         const std::size_t comma = pattern.find(',', start);
         const std::string token = trim(pattern.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
         start = comma == std::string::npos ? pattern.size() + 1 : comma + 1;
-        if (token.empty()) throw std::invalid_argument("fleet pattern '" + pattern + "': empty entry; expected NAME or NAME*COUNT separated by commas");
+        if (token.empty()) throw std::invalid_argument("fleet pattern " + detail::quoted(pattern) + ": empty entry; expected NAME or NAME*COUNT separated by commas");
         std::string name = token;
         long repeat = 1;
         const auto star = token.find('*');
@@ -100,11 +100,11 @@ Fleet fleet_from_pattern(const std::string& pattern, int cars) {
             char* end = nullptr;
             repeat = std::strtol(k.c_str(), &end, 10);
             if (k.empty() || *end != '\0' || repeat < 1 || repeat > 1000000)
-                throw std::invalid_argument("fleet pattern entry '" + token + "': expected NAME*COUNT with COUNT an integer 1..1000000");
+                throw std::invalid_argument("fleet pattern entry " + detail::quoted(token) + ": expected NAME*COUNT with COUNT an integer 1..1000000");
         }
         const CalibratedVehicle* v = find_vehicle(name);
-        if (!v) throw std::invalid_argument("fleet pattern entry '" + name + "': expected a calibrated vehicle (" + vehicle_names() + ")");
-        if (unit.size() + static_cast<std::size_t>(repeat) > 1000000) throw std::invalid_argument("fleet pattern '" + pattern + "': more than 1000000 cars");
+        if (!v) throw std::invalid_argument("fleet pattern entry " + detail::quoted(name) + ": expected a calibrated vehicle (" + vehicle_names() + ")");
+        if (unit.size() + static_cast<std::size_t>(repeat) > 1000000) throw std::invalid_argument("fleet pattern " + detail::quoted(pattern) + ": more than 1000000 cars");
         for (long r = 0; r < repeat; ++r) unit.push_back({v->name, "ovrv", v->parameters});
     }
     if (cars == 0) return unit;
@@ -125,7 +125,7 @@ Fleet read_fleet_csv(const std::string& text, const std::string& source) {
     for (const auto& h : csv.header()) {
         if (h == "speed") throw std::invalid_argument(source + ": column 'speed': the equilibrium speed is set by the ring (give --speed or --length)");
         if (h != "vehicle" && h != "model" && h != "count" && !params.count(h))
-            throw std::invalid_argument(source + ": column '" + h + "': expected vehicle, model, count" + known);
+            throw std::invalid_argument(source + ": column " + detail::quoted(h) + ": expected vehicle, model, count" + known);
     }
     const int c_vehicle = csv.column("vehicle", false), c_model = csv.column("model", false), c_count = csv.column("count", false);
     if (c_vehicle < 0 && c_model < 0) throw std::invalid_argument(source + ": the header needs a 'vehicle' or a 'model' column");
@@ -142,7 +142,7 @@ Fleet read_fleet_csv(const std::string& text, const std::string& source) {
         const std::string vehicle = field(c_vehicle), model = field(c_model);
         if (!vehicle.empty()) {
             const CalibratedVehicle* v = find_vehicle(vehicle);
-            if (!v) csv.fail("column 'vehicle' = '" + vehicle + "': expected a calibrated vehicle (" + vehicle_names() + ") or a blank with a model");
+            if (!v) csv.fail("column 'vehicle' = " + detail::quoted(vehicle) + ": expected a calibrated vehicle (" + vehicle_names() + ") or a blank with a model");
             car.label = v->name;
             car.model = model.empty() ? "ovrv" : model;
             car.parameters = v->parameters;
@@ -157,7 +157,7 @@ Fleet read_fleet_csv(const std::string& text, const std::string& source) {
         long count = 1;
         if (!field(c_count).empty()) {
             const double k = csv.number(c_count, "count");
-            if (!(k >= 1 && k <= 1000000 && k == std::floor(k))) csv.fail("column 'count' = '" + field(c_count) + "': expected an integer 1..1000000");
+            if (!(k >= 1 && k <= 1000000 && k == std::floor(k))) csv.fail("column 'count' = " + detail::quoted(field(c_count)) + ": expected an integer 1..1000000");
             count = static_cast<long>(k);
         }
         try {
@@ -179,7 +179,7 @@ FleetCar parse_fleet_car(const std::string& text) {
     const auto colon = spec.find(':');
     if (colon == std::string::npos) {
         const CalibratedVehicle* v = find_vehicle(spec);
-        if (!v) throw std::invalid_argument("car '" + spec + "': expected a calibrated vehicle (" + vehicle_names() + ") or MODEL:NAME=VALUE,...");
+        if (!v) throw std::invalid_argument("car " + detail::quoted(spec) + ": expected a calibrated vehicle (" + vehicle_names() + ") or MODEL:NAME=VALUE,...");
         return {v->name, "ovrv", v->parameters};
     }
     FleetCar car;
@@ -193,9 +193,9 @@ FleetCar parse_fleet_car(const std::string& text) {
         const auto eq = item.find('=');
         double value = 0.0;
         if (eq == std::string::npos || !detail::parse_finite(trim(item.substr(eq + 1)), value))
-            throw std::invalid_argument("car '" + spec + "': entry '" + item + "': expected NAME=VALUE with a finite number");
+            throw std::invalid_argument("car " + detail::quoted(spec) + ": entry " + detail::quoted(item) + ": expected NAME=VALUE with a finite number");
         const std::string name = trim(item.substr(0, eq));
-        if (name == "speed") throw std::invalid_argument("car '" + spec + "': the speed is set by the ring, not per car");
+        if (name == "speed") throw std::invalid_argument("car " + detail::quoted(spec) + ": the speed is set by the ring, not per car");
         car.parameters[name] = value;
     }
     ParameterMap p = car.parameters;
@@ -203,7 +203,7 @@ FleetCar parse_fleet_car(const std::string& text) {
     try {
         (void)make_model(car.model, p);
     } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument("car '" + spec + "': " + e.what());
+        throw std::invalid_argument("car " + detail::quoted(spec) + ": " + e.what());
     }
     return car;
 }

@@ -70,7 +70,7 @@ ParameterMap resolve(const std::string& model, const std::vector<ParameterSpec>&
         if (std::none_of(specs.begin(), specs.end(), [&](const ParameterSpec& s) { return s.name == name; })) {
             std::string known;
             for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
-            throw std::invalid_argument("parameter '" + name + "' does not belong to model " + model +
+            throw std::invalid_argument("parameter " + detail::quoted(name) + " does not belong to model " + model +
                                         ": expected one of " + known);
         }
     }
@@ -225,14 +225,14 @@ std::vector<ParameterSpec> model_parameters(const std::string& model) {
     if (model == "ovrv") return ovrv_specs();
     if (model == "idm") return idm_specs();
     if (model == "ccc") return ccc_specs();
-    throw std::invalid_argument("model '" + model + "': expected one of ovrv, idm, ccc");
+    throw std::invalid_argument("model " + detail::quoted(model) + ": expected one of ovrv, idm, ccc");
 }
 
 std::unique_ptr<CarModel> make_model(const std::string& model, const ParameterMap& values) {
     if (model == "ovrv") return std::make_unique<OvrvModel>(values);
     if (model == "idm") return std::make_unique<IdmModel>(values);
     if (model == "ccc") return std::make_unique<CccModel>(values);
-    throw std::invalid_argument("model '" + model + "': expected one of ovrv, idm, ccc");
+    throw std::invalid_argument("model " + detail::quoted(model) + ": expected one of ovrv, idm, ccc");
 }
 
 }  // namespace ddemap

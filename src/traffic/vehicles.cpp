@@ -47,7 +47,7 @@ const std::vector<CalibratedVehicle>& paper_calibration_table() {
 const CalibratedVehicle& builtin_vehicle(const std::string& name) {
     for (const auto& v : paper_calibration_table())
         if (v.name == name) return v;
-    throw std::invalid_argument("vehicle '" + name + "': expected a name of the calibration table (A_min .. G_max)");
+    throw std::invalid_argument("vehicle " + detail::quoted(name) + ": expected a name of the calibration table (A_min .. G_max)");
 }
 
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {

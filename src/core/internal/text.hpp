@@ -9,6 +9,10 @@ namespace ddemap::detail {
 /// The shortest of %.15g, %.16g, %.17g that reads back to the same double (for messages).
 std::string format_number(double v);
 
+/// Input text for an error message: in single quotes, control characters escaped (\n, \r,
+/// \t, \xNN) so that a message stays one line, and cut to 80 characters ("...").
+std::string quoted(const std::string& text);
+
 /// Splits one CSV line: commas, double-quoted fields ("" for a quote), fields trimmed of
 /// blanks and carriage returns.
 std::vector<std::string> split_csv_line(const std::string& line);
