@@ -87,6 +87,15 @@ int run_calibrate() {
     if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
     e.inputs = in.str();
     e.result = calibration_json(names, fits, o);
+    Status status = Status::Converged;
+    for (std::size_t i = 0; i < fits.size(); ++i) {
+        if (fits[i].status_code != Status::Converged) {
+            status = fits[i].status_code;
+            e.message = names[i] + ": " + fits[i].message;
+        }
+        for (const auto& w : fits[i].warnings) std::cerr << "ddemap: calibrate: " << names[i] << ": warning: " << w << "\n";
+    }
+    e.status = to_string(status);
     const std::string csv = calibration_csv(names, fits);
     if (!prefix.empty())
         write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}});
@@ -102,9 +111,17 @@ int run_calibrate() {
                           r.status.c_str());
             out << line;
         }
+        for (std::size_t i = 0; i < fits.size(); ++i) {
+            out << names[i] << ": 95 % intervals";
+            for (const auto& est : fits[i].estimates)
+                out << "  " << est.name << " "
+                    << (std::isfinite(est.lower95) && std::isfinite(est.upper95) ? "[" + rounded(est.lower95, 3) + ", " + rounded(est.upper95, 3) + "]"
+                                                                                  : std::string("undetermined"));
+            out << "\n";
+        }
         std::cout << out.str();
     });
-    return exit_ok;
+    return exit_code(status);
 }
 
 }  // namespace ddemap::cli

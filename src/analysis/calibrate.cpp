@@ -543,8 +543,10 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
             const Eigen::MatrixXd Gl = G.bottomRows(n - l).transpose() * G.topRows(n - l);
             Omega += wl * (Gl + Gl.transpose());
         }
-        const Eigen::MatrixXd C = Hinv * Omega * Hinv;
-        const Eigen::MatrixXd Ci = sigma2 * Hinv;
+        // symmetric by construction; symmetrised so that rounding does not make C(i, j) != C(j, i)
+        const Eigen::MatrixXd C0 = Hinv * Omega * Hinv;
+        const Eigen::MatrixXd C = 0.5 * (C0 + C0.transpose());
+        const Eigen::MatrixXd Ci = 0.5 * sigma2 * (Hinv + Hinv.transpose());
         for (int i = 0; i < p; ++i)
             for (int j = 0; j < p; ++j) {
                 cov(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = C(i, j);

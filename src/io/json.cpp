@@ -303,7 +303,33 @@ std::string calibration_json(const std::vector<std::string>& names, const std::v
             j["test"] = {{"rmse_speed", num(r.test.rmse_speed)}, {"rmse_gap", num(r.test.rmse_gap)}, {"samples", r.test.samples}};
         j["naive_rmse_speed"] = num(r.naive.rmse_speed);
         j["naive_delay"] = num(r.naive_delay);
+        // uncertainty: 95 % intervals (null where the trace does not determine the parameter),
+        // standard errors, the covariance and correlation in the order k1, k2, th, tau, eta
+        json ci = json::object(), se = json::object();
+        for (const auto& est : r.estimates) {
+            ci[est.name] = {num(est.lower95), num(est.upper95)};
+            se[est.name] = num(est.standard_error);
+        }
+        j["ci95"] = ci;
+        j["standard_errors"] = se;
+        json cov = json::array(), cor = json::array();
+        for (int a = 0; a < 5; ++a) {
+            json rc = json::array(), rr = json::array();
+            for (int b = 0; b < 5; ++b) {
+                rc.push_back(num(r.covariance(a, b)));
+                rr.push_back(num(r.correlation(a, b)));
+            }
+            cov.push_back(rc);
+            cor.push_back(rr);
+        }
+        j["covariance"] = cov;
+        j["correlation"] = cor;
+        j["effective_samples"] = num(r.effective_samples);
+        j["warnings"] = r.warnings;
+        j["objective"] = num(r.objective);
+        j["starts"] = r.starts;
         j["status"] = r.status;
+        j["message"] = r.message;
         j["evaluations"] = r.evaluations;
         j["seconds"] = r.seconds;
         arr.push_back(j);

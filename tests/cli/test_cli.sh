@@ -204,6 +204,23 @@ expect_error "badlead.csv:3: time_s = 0" simulate --fleet A_min --lead "$tmp/bad
 excerpt="$(dirname "$0")/../data/openacc_excerpt_rav4_to_etron.csv"
 if "$bin" calibrate "$excerpt" --format json --out "$tmp/cal" >"$tmp/cal.json"; then
     python3 -c "import json,sys; f=json.load(open('$tmp/cal.json'))['result']['fits'][0]; missing=[k for k in 'k1 k2 th tau eta rmse_speed rmse_gap status'.split() if k not in f]; sys.exit(1 if missing else 0)" && ok || bad "calibrate JSON keys"
+    # the uncertainty keys scripts rely on: ci95 per parameter (lo <= value <= hi where given),
+    # a symmetric (exactly, as printed) 5 x 5 covariance with a non-negative diagonal, warnings as a list of strings
+    python3 - "$tmp/cal.json" <<'PY' && ok || bad "calibrate JSON uncertainty keys"
+import json, sys
+f = json.load(open(sys.argv[1]))['result']['fits'][0]
+names = ['k1', 'k2', 'th', 'tau', 'eta']
+assert all(k in f for k in ['ci95', 'covariance', 'warnings', 'naive_rmse_speed', 'objective', 'starts', 'status'])
+for n in names:
+    lo, hi = f['ci95'][n]
+    assert lo is None or hi is None or lo <= f[n] <= hi, n
+c = f['covariance']
+assert len(c) == 5 and all(len(r) == 5 for r in c)
+assert all(c[i][i] is None or c[i][i] >= 0 for i in range(5))
+assert all(c[i][j] == c[j][i] for i in range(5) for j in range(5))
+assert isinstance(f['warnings'], list) and all(isinstance(w, str) for w in f['warnings'])
+assert f['starts'] >= 1 and f['objective'] >= 0
+PY
     "$bin" classify "$tmp/cal.csv" --format csv >/dev/null && ok || bad "calibrate table into classify"
     xmllint --noout "$tmp/cal.svg" && ok || bad "calibrate SVG"
 else
