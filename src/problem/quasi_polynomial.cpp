@@ -1,5 +1,7 @@
 #include "ddemap/problem/quasi_polynomial.hpp"
 
+#include "ddemap/core/phase_tracking.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -84,26 +86,13 @@ namespace {
 /// arg(b / a) without a complex division
 double arg_ratio(cplx b, cplx a) { return std::arg(b * std::conj(a)); }
 
-/// |arg(b / a)| < pi/4, without atan2: Re(b conj a) > |Im(b conj a)|
-bool within_quarter(cplx b, cplx a) {
-    const cplx w = b * std::conj(a);
-    return w.real() > std::abs(w.imag());
-}
-
-/// A sample of f on the line: value and |f'/f|, which bounds the phase speed
-/// |d/dw arg f(sigma + i w)| = |Re(f'/f)| and is at least 1/distance to a nearby zero.
-struct Sample {
-    double w;
-    cplx f;
-    double speed2;  // |f'/f|^2
-};
-
-struct Tracker {
+/// Samples f on the line Re(lambda) = sigma for the shared phase tracker.
+struct LineSampler {
     const QuasiPolynomial& f;
     double sigma;
-    int budget = 20000;
     bool failed = false;
-    Sample at(double w) {
+    int budget = 20000;
+    PhaseSample operator()(double w) {
         cplx v, d;
         f.evaluate(cplx(sigma, w), v, d);
         if (v == cplx(0.0)) {
@@ -111,24 +100,6 @@ struct Tracker {
             return {w, cplx(1.0), 0.0};
         }
         return {w, v, std::norm(d) / std::norm(v)};
-    }
-    /// Continuous change of arg f from a to b. A piece is accepted when, on each of its halves,
-    /// the phase turns by less than pi/4 between the samples and |f'/f| at the three samples
-    /// times the half length is below pi/8. A zero within the piece's reach lies within about
-    /// half its length of some sample, where |f'/f| >= 1/distance, so it forces subdivision
-    /// until the pieces near it are shorter than its distance to the line.
-    double change(const Sample& a, const Sample& b, int depth) {
-        if (--budget < 0 || depth > 80) {
-            failed = true;
-            return 0.0;
-        }
-        const Sample m = at(0.5 * (a.w + b.w));
-        if (failed) return 0.0;
-        const double h = 0.5 * (b.w - a.w);
-        const double limit = (M_PI / 8) * (M_PI / 8) / (h * h);
-        const bool slow = a.speed2 < limit && m.speed2 < limit && b.speed2 < limit;
-        if (slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f)) return arg_ratio(b.f, a.f);
-        return change(a, m, depth + 1) + change(m, b, depth + 1);
     }
 };
 
@@ -155,16 +126,16 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     int pieces = 8;
     if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
     pieces = std::min(pieces, 4096);
-    Tracker tr{*this, sigma};
+    LineSampler line{*this, sigma};
     double total = 0.0;
-    Sample a = tr.at(-r);
-    if (tr.failed) return -1;
+    PhaseSample a = line(-r);
+    if (line.failed) return -1;
     const cplx first = a.f;
     for (int i = 1; i <= pieces; ++i) {
-        const Sample b = tr.at(-r + 2.0 * r * i / pieces);
-        if (tr.failed) return -1;
-        total += tr.change(a, b, 0);
-        if (tr.failed) return -1;
+        const PhaseSample b = line(-r + 2.0 * r * i / pieces);
+        if (line.failed) return -1;
+        total += bisect_phase(line, a, b);
+        if (line.failed) return -1;
         a = b;
     }
     const cplx fa = a.f;

@@ -15,11 +15,15 @@
 ///     bool failed() const;                   // give up now (a zero met exactly, a budget used up)
 /// Accepted steps grow by 1.6 (up to cap()), rejected ones shrink by 0.35; a step below `tiny`
 /// ends the tracking as failed (a zero on or within rounding of the path).
-/// Used by RingDeterminant::arg_change (traffic/). QuasiPolynomial::zeros_right_of (problem/,
-/// the sweep's hot path) keeps its recursive bisection of fixed pieces: expressed through this
-/// stepper it evaluated f exactly as often but cost 3.6% more instructions in bench_sweep.
+/// Two step strategies share that contract:
+///   * follow_phase: adaptive steps along a path (RingDeterminant::arg_change, traffic/);
+///   * bisect_phase: recursive bisection of a piece (QuasiPolynomial::zeros_right_of,
+///     problem/, the sweep's hot path; expressed through follow_phase it evaluated f as often
+///     but cost 3.6% more instructions in bench_sweep).
 
 #include <algorithm>
+#include <cmath>
+#include <complex>
 
 namespace ddemap {
 
@@ -44,6 +48,43 @@ bool follow_phase(Path& path, double length, double tiny, double& total) {
         }
     }
     return true;
+}
+
+/// A sample of f on a path parametrised by t: the value and |f'/f|^2 (|f'/f| bounds the phase
+/// speed |d/dt arg f| and is at least 1 / the distance to a nearby zero).
+struct PhaseSample {
+    double t = 0.0;
+    std::complex<double> f;
+    double speed2 = 0.0;
+};
+
+/// The continuous change of arg f from sample a to sample b by bisection: a piece is accepted
+/// when, on each of its halves, the phase turns by less than pi/4 between the samples and
+/// |f'/f| at the three samples times the half length is below pi/8; otherwise it is split. A
+/// zero within the piece's reach lies within about half its length of some sample, where
+/// |f'/f| >= 1/distance, so it forces subdivision until the pieces near it are shorter than its
+/// distance to the path. The sampler provides `PhaseSample operator()(double t)`, `bool failed`
+/// (set when a zero is met exactly) and `int budget` (samples left); the budget and depth 80
+/// bound the work, setting `failed`.
+template <class Sampler>
+double bisect_phase(Sampler& sample, const PhaseSample& a, const PhaseSample& b, int depth = 0) {
+    if (--sample.budget < 0 || depth > 80) {
+        sample.failed = true;
+        return 0.0;
+    }
+    const PhaseSample m = sample(0.5 * (a.t + b.t));
+    if (sample.failed) return 0.0;
+    const double h = 0.5 * (b.t - a.t);
+    constexpr double kEighth = 0.39269908169872414;  // pi / 8
+    const double limit = kEighth * kEighth / (h * h);
+    // |arg(b / a)| < pi/4 without atan2: Re(b conj a) > |Im(b conj a)|
+    auto within_quarter = [](std::complex<double> y, std::complex<double> x) {
+        const std::complex<double> w = y * std::conj(x);
+        return w.real() > std::abs(w.imag());
+    };
+    const bool slow = a.speed2 < limit && m.speed2 < limit && b.speed2 < limit;
+    if (slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f)) return std::arg(b.f * std::conj(a.f));
+    return bisect_phase(sample, a, m, depth + 1) + bisect_phase(sample, m, b, depth + 1);
 }
 
 }  // namespace ddemap
