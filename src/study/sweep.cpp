@@ -1,5 +1,7 @@
 #include "ddemap/study/sweep.hpp"
 
+#include "study/internal/trackers.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -67,6 +69,8 @@ bool is_rightmost(const QuasiPolynomial& f, cplx z) {
 }
 
 }  // namespace
+
+namespace detail {
 
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
                                   const std::optional<cplx>& guess) {
@@ -252,6 +256,8 @@ RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
     return rr;
 }
 
+}  // namespace detail
+
 void SweepSpec::validate() const {
     if (x.name == y.name) throw std::invalid_argument("the two swept parameters are both '" + x.name + "': expected two different parameters");
     if (x.count < 2 || y.count < 2) throw std::invalid_argument("a swept axis needs COUNT >= 2");
@@ -286,14 +292,14 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
     // The first column is continued sequentially (one collocation solve at its first point);
     // each row then starts from the roots of its first point. The path of every point is thus
     // fixed, whatever the number of threads.
-    std::vector<RingTracker> ring_seed;
-    std::vector<PlantTracker> plant_seed;
+    std::vector<detail::RingTracker> ring_seed;
+    std::vector<detail::PlantTracker> plant_seed;
     {
-        RingTracker ring(spec.cars);
-        PlantTracker plant;
+        detail::RingTracker ring(spec.cars);
+        detail::PlantTracker plant;
         for (int iy = 0; iy < ny; ++iy) {
             const Linearisation lin = model_at(spec, spec.x.value(0), spec.y.value(iy))->linearise();
-            const RingSummary rs = ring.evaluate(lin);
+            const detail::RingSummary rs = ring.evaluate(lin);
             fallbacks += rs.fallbacks;
             degree = std::max(degree, rs.degree);
             plant.evaluate(lin, fallbacks);
@@ -309,8 +315,8 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
         int& fallbacks = row_fallbacks[iy];
         int& uncertified = row_uncertified[iy];
         int& degree = row_degree[iy];
-        RingTracker ring = ring_seed[iy];
-        PlantTracker plant = plant_seed[iy];
+        detail::RingTracker ring = ring_seed[iy];
+        detail::PlantTracker plant = plant_seed[iy];
         StringOptions so;
         so.grid_points = 120;
         for (int ix = 0; ix < nx; ++ix) {
@@ -318,7 +324,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
             p.x = spec.x.value(ix);
             p.y = spec.y.value(iy);
             const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
-            const RingSummary rs = ring.evaluate(lin);
+            const detail::RingSummary rs = ring.evaluate(lin);
             int fb = rs.fallbacks;
             const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
             p.spectral_abscissa = rs.spectral_abscissa;

@@ -1,0 +1,66 @@
+#pragma once
+// The sweep's per-point trackers (private to study/): along a grid row the rightmost root of
+// every ring mode and of the plant is continued by Newton on its quasi-polynomial from the
+// previous point and certified by the argument principle (a fast path of the one root facade
+// for this hot loop: a result vector per point would allocate; collocation through the facade's
+// dense eigenvalues is the fallback).
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "ddemap/problem/linear_dde.hpp"
+#include "ddemap/problem/quasi_polynomial.hpp"
+#include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/model.hpp"
+
+namespace ddemap::detail {
+
+/// Certified rightmost root of a quasi-polynomial: Newton from `guess`, certificate, fallback.
+struct CertifiedRoot {
+    cplx value;
+    bool certified = false;  ///< no zero right of Re(value) + 1e-10 max(1, |value|)
+    bool fell_back = false;  ///< collocation was needed
+    int degree = 0;          ///< collocation degree used (0 if none)
+};
+/// `dde` builds the same problem as a LinearDDE for the collocation fallback.
+CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
+                                  const std::optional<cplx>& guess);
+
+/// Ring (N >= 2) or N = infinity summary at one point, continuing from the previous point.
+struct RingSummary {
+    double spectral_abscissa = 0.0;  ///< trivial zero excluded
+    int abscissa_mode = 0;           ///< -1 for N = infinity
+    double abscissa_theta = 0.0;
+    int unstable_roots = 0;          ///< over all modes (-1 for N = infinity)
+    bool stable = false;
+    bool certified = true;           ///< every mode's rightmost root certified
+    int fallbacks = 0;
+    int degree = 0;                  ///< largest collocation degree used
+};
+
+class RingTracker {
+public:
+    explicit RingTracker(int cars);  ///< cars >= 2, or 0 for infinity
+    RingSummary evaluate(const Linearisation& lin);
+    void reset();
+    /// The rightmost root of every mode (wave number) at the last point evaluated.
+    const std::vector<std::optional<cplx>>& roots() const { return m_guess; }
+    const std::vector<double>& thetas() const { return m_thetas; }
+
+private:
+    int m_cars;
+    std::vector<double> m_thetas;            // wave numbers of the modes (or samples for N = inf)
+    std::vector<std::optional<cplx>> m_guess;
+};
+
+/// The plant's rightmost root, continued the same way.
+class PlantTracker {
+public:
+    RootResult evaluate(const Linearisation& lin, int& fallbacks);
+    void reset() { m_guess.reset(); }
+
+private:
+    std::optional<cplx> m_guess;
+};
+
+}  // namespace ddemap::detail
