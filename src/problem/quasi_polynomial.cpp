@@ -47,6 +47,32 @@ void QuasiPolynomial::evaluate(cplx lambda, cplx& f, cplx& fp) const {
     }
 }
 
+void QuasiPolynomial::evaluate(cplx lambda, const double* magnitudes, cplx& f, cplx& fp) const {
+    if (m_degree == 2) {
+        f = lambda * lambda;
+        fp = 2.0 * lambda;
+    } else {
+        f = lambda;
+        fp = 1.0;
+    }
+    for (std::size_t j = 0; j < m_terms.size(); ++j) {
+        const Term& t = m_terms[j];
+        cplx p = 0.0, dp = 0.0;
+        for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) {
+            dp = dp * lambda + p;
+            p = p * lambda + t.poly[k];
+        }
+        if (t.delay == 0.0) {
+            f += p;
+            fp += dp;
+        } else {
+            const cplx e = std::polar(magnitudes[j], -lambda.imag() * t.delay);
+            f += p * e;
+            fp += (dp - t.delay * p) * e;
+        }
+    }
+}
+
 bool QuasiPolynomial::is_real() const {
     for (const auto& t : m_terms)
         for (cplx c : t.poly)
@@ -86,15 +112,16 @@ namespace {
 /// arg(b / a) without a complex division
 double arg_ratio(cplx b, cplx a) { return std::arg(b * std::conj(a)); }
 
-/// Samples f on the line Re(lambda) = sigma for the shared phase tracker.
+/// Samples f on the line Re(lambda) = sigma for the shared phase tracker; eval(w, f, f')
+/// evaluates at sigma + i w.
+template <class Evaluate>
 struct LineSampler {
-    const QuasiPolynomial& f;
-    double sigma;
+    Evaluate& eval;
     bool failed = false;
     int budget = 20000;
     PhaseSample operator()(double w) {
         cplx v, d;
-        f.evaluate(cplx(sigma, w), v, d);
+        eval(w, v, d);
         if (v == cplx(0.0)) {
             failed = true;
             return {w, cplx(1.0), 0.0};
@@ -126,7 +153,17 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     int pieces = 8;
     if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
     pieces = std::min(pieces, 4096);
-    LineSampler line{*this, sigma};
+    // e^{-sigma d_j} is the same at every sample of the line: computed once per term
+    double small[8];
+    std::vector<double> large;
+    double* mags = small;
+    if (m_terms.size() > 8) {
+        large.resize(m_terms.size());
+        mags = large.data();
+    }
+    for (std::size_t j = 0; j < m_terms.size(); ++j) mags[j] = std::exp(-sigma * m_terms[j].delay);
+    auto eval = [&](double w, cplx& v, cplx& d) { evaluate(cplx(sigma, w), mags, v, d); };
+    LineSampler<decltype(eval)> line{eval};
     double total = 0.0;
     PhaseSample a = line(-r);
     if (line.failed) return -1;

@@ -24,7 +24,6 @@ public:
     /// and every term's polynomial has degree < n (retarded type).
     QuasiPolynomial(int degree, std::vector<Term> terms);
 
-
     int degree() const { return m_degree; }
     /// True when every coefficient is real (zeros then come in conjugate pairs).
     bool is_real() const;
@@ -39,6 +38,10 @@ public:
     int zeros_right_of(double sigma) const;
 
 private:
+    /// f and f' at lambda with e^{-Re(lambda) d_j} given per term (`magnitudes`, in term order):
+    /// on a vertical line they do not change, so a line is sampled without an exp per term.
+    void evaluate(std::complex<double> lambda, const double* magnitudes, std::complex<double>& f,
+                  std::complex<double>& fp) const;
     int m_degree;
     std::vector<Term> m_terms;
     double m_max_delay = 0.0;
