@@ -38,7 +38,7 @@ class StructuredShiftInvert {
 public:
     using Scalar = double;
 
-    StructuredShiftInvert(const LinearDDE& dde, int degree) : m_dde(dde), m_m(degree), m_n(dde.dimension()) {
+    StructuredShiftInvert(const LinearDDE& dde, int degree) : m_m(degree), m_n(dde.dimension()) {
         const double tau = dde.max_delay();
         m_d = chebyshev_differentiation(degree) * (2.0 / tau);
         for (const auto& t : dde.sparse_delayed()) {
@@ -113,7 +113,6 @@ public:
     int factorizations() const { return m_factorizations; }
 
 private:
-    const LinearDDE& m_dde;
     int m_m, m_n;
     Eigen::MatrixXd m_d;
     std::vector<Eigen::VectorXd> m_l;
