@@ -66,6 +66,9 @@ LinearDDE read_linear_dde_json(const std::string& text, const std::string& sourc
         j = json::parse(text);
     } catch (const json::parse_error& e) {
         throw std::invalid_argument(source + ": not valid JSON (" + std::string(e.what()) + ")");
+    } catch (const json::out_of_range& e) {
+        // e.g. 1e400: a number outside the double range is bad input, not an internal error
+        throw std::invalid_argument(source + ": a number outside the range of doubles (" + std::string(e.what()) + ")");
     }
     if (!j.is_object()) fail(source, "top level", "expected an object with dimension, delays, A0, A");
     for (auto it = j.begin(); it != j.end(); ++it) {

@@ -245,6 +245,8 @@ expect_error "bad.json: A0\[1\]: expected 2 entries" roots --system "$tmp/bad.js
 expect_error "expected no model parameters" roots --system "$tmp/sys.json" --k1 0.3
 expect_error "the sparse path needs real coefficients" roots --system "$tmp/sys.json" --solver sparse
 expect_error "solver product goes with --fleet rings" roots --system "$tmp/sys.json" --solver product
+printf '{"dimension": 1, "delays": [1], "A0": [[1e400]], "A": [[[0.5]]]}' >"$tmp/huge.json"
+expect_error "a number outside the range of doubles" roots --system "$tmp/huge.json"
 # a real 20-dimensional cyclic system: auto takes the sparse path; the dense path agrees
 python3 - >"$tmp/cyc.json" <<'PY'
 import json
