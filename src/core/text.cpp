@@ -9,11 +9,11 @@
 
 namespace ddemap::detail {
 
-std::string quoted(const std::string& text) {
-    std::string out = "'";
+std::string escaped(const std::string& text, std::size_t max_chars) {
+    std::string out;
     std::size_t shown = 0;
     for (const char ch : text) {
-        if (shown >= 80) {
+        if (shown >= max_chars) {
             out += "...";
             break;
         }
@@ -31,8 +31,10 @@ std::string quoted(const std::string& text) {
         }
         ++shown;
     }
-    return out + "'";
+    return out;
 }
+
+std::string quoted(const std::string& text) { return "'" + escaped(text, 80) + "'"; }
 
 std::string format_number(double v) {
     char buf[40];

@@ -85,7 +85,7 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
         root = toml::parse(text, source);
     } catch (const toml::parse_error& e) {
         std::ostringstream os;
-        os << source << ":" << e.source().begin.line << ": " << e.description();
+        os << source << ":" << e.source().begin.line << ": " << detail::escaped(std::string(e.description()));
         throw std::invalid_argument(os.str());
     }
     ChartSpec spec;

@@ -13,6 +13,10 @@ std::string format_number(double v);
 /// \t, \xNN) so that a message stays one line, and cut to 80 characters ("...").
 std::string quoted(const std::string& text);
 
+/// The same without the quotes, cut to `max_chars`: for a third-party message that may echo
+/// input (a parser's error description).
+std::string escaped(const std::string& text, std::size_t max_chars = 200);
+
 /// Splits one CSV line: commas, double-quoted fields ("" for a quote), fields trimmed of
 /// blanks and carriage returns.
 std::vector<std::string> split_csv_line(const std::string& line);
