@@ -30,7 +30,7 @@
 #include <Eigen/Core>
 
 #include "ddemap/core/status.hpp"
-#include "ddemap/solve/newton.hpp"
+#include "ddemap/core/newton.hpp"
 
 namespace ddemap {
 
