@@ -22,29 +22,31 @@ QuasiPolynomial::QuasiPolynomial(int degree, std::vector<Term> terms) : m_degree
     }
 }
 
+namespace {
+
+/// e^{-x d_j} for every term (1 for d_j = 0), without a heap allocation for up to 8 terms.
+class Magnitudes {
+public:
+    Magnitudes(const std::vector<QuasiPolynomial::Term>& terms, double x) {
+        double* out = m_small;
+        if (terms.size() > 8) {
+            m_large.resize(terms.size());
+            out = m_large.data();
+        }
+        for (std::size_t j = 0; j < terms.size(); ++j) out[j] = terms[j].delay == 0.0 ? 1.0 : std::exp(-x * terms[j].delay);
+    }
+    const double* data() const { return m_large.empty() ? m_small : m_large.data(); }
+
+private:
+    double m_small[8];
+    std::vector<double> m_large;
+};
+
+}  // namespace
+
 void QuasiPolynomial::evaluate(cplx lambda, cplx& f, cplx& fp) const {
-    if (m_degree == 2) {
-        f = lambda * lambda;
-        fp = 2.0 * lambda;
-    } else {
-        f = lambda;
-        fp = 1.0;
-    }
-    for (const auto& t : m_terms) {
-        cplx p = 0.0, dp = 0.0;
-        for (int k = static_cast<int>(t.poly.size()) - 1; k >= 0; --k) {
-            dp = dp * lambda + p;
-            p = p * lambda + t.poly[k];
-        }
-        if (t.delay == 0.0) {
-            f += p;
-            fp += dp;
-        } else {
-            const cplx e = std::polar(std::exp(-lambda.real() * t.delay), -lambda.imag() * t.delay);
-            f += p * e;
-            fp += (dp - t.delay * p) * e;
-        }
-    }
+    const Magnitudes mags(m_terms, lambda.real());
+    evaluate(lambda, mags.data(), f, fp);
 }
 
 void QuasiPolynomial::evaluate(cplx lambda, const double* magnitudes, cplx& f, cplx& fp) const {
@@ -154,15 +156,8 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
     pieces = std::min(pieces, 4096);
     // e^{-sigma d_j} is the same at every sample of the line: computed once per term
-    double small[8];
-    std::vector<double> large;
-    double* mags = small;
-    if (m_terms.size() > 8) {
-        large.resize(m_terms.size());
-        mags = large.data();
-    }
-    for (std::size_t j = 0; j < m_terms.size(); ++j) mags[j] = std::exp(-sigma * m_terms[j].delay);
-    auto eval = [&](double w, cplx& v, cplx& d) { evaluate(cplx(sigma, w), mags, v, d); };
+    const Magnitudes mags(m_terms, sigma);
+    auto eval = [&](double w, cplx& v, cplx& d) { evaluate(cplx(sigma, w), mags.data(), v, d); };
     LineSampler<decltype(eval)> line{eval};
     double total = 0.0;
     PhaseSample a = line(-r);
