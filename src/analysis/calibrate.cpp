@@ -94,7 +94,6 @@ void CalibrationOptions::validate() const {
     const double tau_max = bound("tau").upper;
     if (tau_max > 5.0) throw std::invalid_argument("bounds for 'tau': upper = " + detail::format_number(tau_max) + ": expected at most 5 s");
     if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected >= 0");
-    if (global_evaluations < 0 || local_evaluations < 1) throw std::invalid_argument("evaluation budgets: expected global >= 0, local >= 1");
     if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 0.5 s");
     if (design_points < 1) throw std::invalid_argument("design points = " + std::to_string(design_points) + ": expected at least 1");
     if (starts < 1 || starts > design_points)

@@ -1,18 +1,14 @@
 #include "ddemap/core/parameters.hpp"
 
+#include "core/internal/text.hpp"
+
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 namespace ddemap {
 
 namespace {
-std::string number(double x) {
-    std::ostringstream os;
-    os.precision(15);
-    os << x;
-    return os.str();
-}
+std::string number(double x) { return detail::format_number(x); }
 }  // namespace
 
 void validate_bounds(const ParameterBounds& bounds, const std::vector<std::string>& known) {

@@ -72,7 +72,9 @@ bool RootOptions::is_valid(std::string* why) const {
     };
     bool ok = true;
     if (method != "auto" && find_backend(method) == nullptr) {
-        os << "method = '" << method << "': expected auto, dense, shift_invert or contour";
+        os << "method = '" << method << "': expected auto";
+        const std::vector<std::string> names = root_methods();
+        for (std::size_t i = 0; i < names.size(); ++i) os << (i + 1 < names.size() ? ", " : " or ") << names[i];
         ok = false;
     } else if (count < 1) {
         os << "count = " << count << ": expected an integer >= 1";

@@ -66,8 +66,6 @@ TEST_CASE("calibration recovers known parameters from noisy synthetic data" * do
 
 TEST_CASE("calibrate_many gives each trace the fit of calibrate alone, in order, and rethrows errors") {
     CalibrationOptions o;
-    o.global_evaluations = 20;
-    o.local_evaluations = 20;
     const std::vector<Trace> traces = {synthetic({{"k1", 0.05}, {"k2", 0.3}, {"th", 1.2}, {"tau", 0.4}, {"eta", 8}}, 1),
                                        synthetic({{"k1", 0.1}, {"k2", 0.2}, {"th", 1.8}, {"tau", 0.9}, {"eta", 6}}, 2)};
     const auto fits = calibrate_many(traces, o);

@@ -78,9 +78,6 @@ struct CalibrationOptions {
     /// standard error is not finite), each point started from its neighbour's solution.
     std::vector<std::string> profile;
     int profile_points = 21;
-    /// Unused since the least-squares method replaced NLopt (kept so that code setting them compiles).
-    int global_evaluations = 1200;
-    int local_evaluations = 600;
     double step = 0.05;  ///< largest integration step [s]
     /// True when validate() would not throw.
     bool is_valid() const;
