@@ -8,6 +8,7 @@
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "tolerances.hpp"
+#include "fleet_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -15,9 +16,7 @@ using namespace ddemap;
 namespace tol = ddemap::test::tol;
 
 namespace {
-Linearisation ovrv(double k1, double k2, double th, double tau) {
-    return make_model("ovrv", {{"k1", k1}, {"k2", k2}, {"th", th}, {"tau", tau}})->linearise();
-}
+using test::ovrv;
 }  // namespace
 
 TEST_CASE("the full 2N-dimensional ring has the roots of the Fourier modes plus the trivial zero") {

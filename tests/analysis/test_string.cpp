@@ -6,6 +6,7 @@
 #include "ddemap/analysis/classify.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "tolerances.hpp"
+#include "fleet_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -13,9 +14,7 @@ using namespace ddemap;
 namespace tol = ddemap::test::tol;
 
 namespace {
-Linearisation ovrv(double k1, double k2, double th, double tau) {
-    return make_model("ovrv", {{"k1", k1}, {"k2", k2}, {"th", th}, {"tau", tau}})->linearise();
-}
+using test::ovrv;
 /// Closed form for OVRV: c2 = 2 k1 [k1 th^2 / 2 + k2 th - 1 - tau (k1 th + k2)].
 double c2_closed(double k1, double k2, double th, double tau) {
     return 2.0 * k1 * (k1 * th * th / 2.0 + k2 * th - 1.0 - tau * (k1 * th + k2));

@@ -6,15 +6,14 @@
 #include "ddemap/problem/quasi_polynomial.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
+#include "fleet_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
 
 namespace {
-Linearisation ovrv(double k1, double k2, double th, double tau) {
-    return make_model("ovrv", {{"k1", k1}, {"k2", k2}, {"th", th}, {"tau", tau}})->linearise();
-}
+using test::ovrv;
 }  // namespace
 
 TEST_CASE("quasi-polynomials equal det Delta of the mode DDEs") {
