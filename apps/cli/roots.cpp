@@ -115,8 +115,12 @@ int run_fleet(Format format, const std::string& prefix) {
     std::ostringstream out;
     out << "fleet      " << (args.fleet.empty() ? args.pattern : args.fleet) << ": " << fleet.size() << " cars, speed "
         << rounded(r.equilibrium.speed, 6) << " m/s, ring length " << rounded(r.equilibrium.length, 8) << " m\n";
-    out << "solver     " << solver_name(rr.method_used) << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations
-        << " LU factorisations (" << to_string(rr.status) << ")\n";
+    out << "solver     " << solver_name(rr.method_used);
+    if (rr.method_used == "contour")  // no collocation: the counts of the argument principle
+        out << ", " << rr.contour_counts << " contour counts, " << rr.evaluations << " evaluations";
+    else
+        out << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations << " LU factorisations";
+    out << " (" << to_string(rr.status) << ")\n";
     out << "trusted    " << rr.message << "\n";
     out << "trivial    "
         << (r.trivial_found ? "lambda = 0 found (|lambda| = " + rounded(r.trivial_root, 3) + "), left out"
