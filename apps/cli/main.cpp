@@ -18,9 +18,10 @@
 using namespace ddemap::cli;
 
 namespace {
+/// A message on one line: line breaks and other control characters become spaces.
 std::string one_line(std::string s) {
     for (auto& c : s)
-        if (c == '\n') c = ' ';
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
     return s;
 }
 }  // namespace
