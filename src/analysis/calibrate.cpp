@@ -858,4 +858,29 @@ std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, 
     return fits;
 }
 
+std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
+                                           const ExecutionPolicy& policy) {
+    options.validate();
+    for (const CarRuns& c : cars) {
+        if (c.train.empty()) throw std::invalid_argument("car " + detail::quoted(c.car) + ": expected at least one training run");
+        if (c.test_types.size() != c.test.size())
+            throw std::invalid_argument("car " + detail::quoted(c.car) + ": " + std::to_string(c.test_types.size()) + " test types for " +
+                                        std::to_string(c.test.size()) + " test runs: expected one per test run");
+    }
+    std::vector<CarCalibration> out(cars.size());
+    parallel_for(
+        static_cast<long>(cars.size()),
+        [&](long i) {
+            const CarRuns& c = cars[static_cast<std::size_t>(i)];
+            CarCalibration& r = out[static_cast<std::size_t>(i)];
+            r.car = c.car;
+            for (const Trace& t : c.train) r.train_sources.push_back(t.source);
+            r.fit = c.train.size() == 1 ? calibrate(c.train[0], options) : calibrate_joint(c.train, options);
+            for (std::size_t k = 0; k < c.test.size(); ++k)
+                r.tests.push_back({c.test[k].source, c.test_types[k], evaluate_fit(c.test[k], r.fit.parameters, options.step)});
+        },
+        policy);
+    return out;
+}
+
 }  // namespace ddemap

@@ -188,6 +188,34 @@ CalibrationResult calibrate_joint(const std::vector<Trace>& runs, const Calibrat
 /// the traces' order. The error of the lowest failing trace is rethrown after the loop.
 std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options,
                                              const ExecutionPolicy& policy = {});
+/// A car of a calibration study (the seed paper's Tables 1 and 2): one parameter set fitted to
+/// its training runs (calibrate for one run, calibrate_joint for several) and tested on its
+/// other runs, each labelled with its test type (e.g. "oscillatory", "dips", "handling").
+struct CarRuns {
+    std::string car;
+    std::vector<Trace> train, test;
+    std::vector<std::string> test_types;  ///< one per test run
+};
+
+/// A test run simulated over its whole file with the car's fitted parameters.
+struct TestRun {
+    std::string source, type;
+    FitEvaluation evaluation;
+};
+
+struct CarCalibration {
+    std::string car;
+    std::vector<std::string> train_sources;
+    CalibrationResult fit;
+    std::vector<TestRun> tests;  ///< in the order of CarRuns::test
+};
+
+/// Fits every car (in parallel over the cars under `policy`; `policy.progress` after each car)
+/// and evaluates its test runs. std::invalid_argument for a car without training runs or with
+/// test_types not one per test run (naming the car); a fit's own errors as in calibrate.
+std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
+                                           const ExecutionPolicy& policy = {});
+
 /// The objective `calibrate` minimises, at given parameters (k1, k2, th, tau, eta, each inside
 /// or outside the bounds): MSE(speed) + gap_weight MSE(gap) over the training samples at or
 /// after t_a + tau_max (tau_max: the upper bound of tau), so fits and other candidates (e.g.
