@@ -39,4 +39,10 @@ constexpr double finite_difference = 1e-7;
 /// terms in double precision agree to ~1e-15 relative; 1e-12 leaves a wide margin.
 constexpr double regrouped_sum = 1e-12;
 
+/// Coverage of nominal 95 % intervals estimated from 1000 intervals (200 noise realisations x 5
+/// parameters): the binomial standard error is sqrt(0.95 * 0.05 / 1000) = 0.007, about 0.011
+/// with the five intervals of one realisation correlated (design effect ~2.5); the band is
+/// 0.95 -+ 3 of those. A method that undercovers by 5 points or more falls outside it.
+constexpr double coverage_band = 0.035;
+
 }  // namespace ddemap::test::tol
