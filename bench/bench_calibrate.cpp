@@ -4,7 +4,9 @@
 //    of three sines, noise 0.05 m/s on the speed and 0.2 m on the gap, AR(1) 0.9) fitted with
 //    the default options: the median wall time of one fit (with covariance and intervals), the
 //    starts, the evaluations (simulations) and those with sensitivities.
-// 2. The time of one objective-and-Jacobian evaluation (the simulation with the forward
+// Wall times and the process's CPU time (all threads): on a shared machine the wall time
+// depends on the load, the CPU time much less.
+// 2. The CPU time of one objective-and-Jacobian evaluation (the simulation with the forward
 //    sensitivities) against one plain simulation of the same trace (medians of 50 calls).
 // 3. With files: calibrate_many over them (in parallel over the files), the median wall time.
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -32,11 +35,21 @@ double median(std::vector<double> v) {
     return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+double cpu_now(clockid_t id) {
+    timespec ts{};
+    clock_gettime(id, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+/// wall seconds of f(); the CPU seconds (all threads of the process) in *cpu
 template <class F>
-double seconds(F&& f) {
+double seconds(F&& f, double* cpu = nullptr, clockid_t id = CLOCK_PROCESS_CPUTIME_ID) {
+    const double c0 = cpu_now(id);
     const auto t0 = clock_type::now();
     f();
-    return std::chrono::duration<double>(clock_type::now() - t0).count();
+    const double wall = std::chrono::duration<double>(clock_type::now() - t0).count();
+    if (cpu) *cpu = cpu_now(id) - c0;
+    return wall;
 }
 
 Trace synthetic(double duration) {
@@ -93,10 +106,15 @@ int main(int argc, char** argv) {
     const Trace tr = synthetic(duration);
     const CalibrationOptions o;
     CalibrationResult fit;
-    std::vector<double> tf;
-    for (int r = 0; r < repeats; ++r) tf.push_back(seconds([&] { fit = calibrate(tr, o); }));
-    std::printf("synthetic %.0f s trace (%zu samples): fit with uncertainty median %.3f s over %d runs (min %.3f, max %.3f)\n", duration,
-                tr.t.size(), median(tf), repeats, *std::min_element(tf.begin(), tf.end()), *std::max_element(tf.begin(), tf.end()));
+    std::vector<double> tf, cf;
+    for (int r = 0; r < repeats; ++r) {
+        double c = 0.0;
+        tf.push_back(seconds([&] { fit = calibrate(tr, o); }, &c));
+        cf.push_back(c);
+    }
+    std::printf("synthetic %.0f s trace (%zu samples): fit with uncertainty median %.3f s wall over %d runs (min %.3f, max %.3f), CPU %.3f s\n",
+                duration, tr.t.size(), median(tf), repeats, *std::min_element(tf.begin(), tf.end()), *std::max_element(tf.begin(), tf.end()),
+                median(cf));
     std::printf("  design points %d, starts %d, evaluations %d (with sensitivities %d), status %s\n", o.design_points, fit.starts,
                 fit.evaluations, fit.jacobian_evaluations, fit.status.c_str());
     CalibrationVector theta;
@@ -104,10 +122,13 @@ int main(int argc, char** argv) {
     const double t_from = tr.t.front() + o.bound("tau").upper;
     std::vector<double> plain, jac;
     for (int r = 0; r < 50; ++r) {
-        plain.push_back(seconds([&] { (void)simulate_follower(tr, theta, tr.t.front(), tr.t.back(), o.step, false, t_from); }));
-        jac.push_back(seconds([&] { (void)simulate_follower(tr, theta, tr.t.front(), tr.t.back(), o.step, true, t_from); }));
+        double c = 0.0;
+        (void)seconds([&] { (void)simulate_follower(tr, theta, tr.t.front(), tr.t.back(), o.step, false, t_from); }, &c, CLOCK_THREAD_CPUTIME_ID);
+        plain.push_back(c);
+        (void)seconds([&] { (void)simulate_follower(tr, theta, tr.t.front(), tr.t.back(), o.step, true, t_from); }, &c, CLOCK_THREAD_CPUTIME_ID);
+        jac.push_back(c);
     }
-    std::printf("  one plain simulation %.3f ms, one simulation with sensitivities (objective and Jacobian) %.3f ms, ratio %.2f\n",
+    std::printf("  CPU time of one plain simulation %.3f ms, one simulation with sensitivities (objective and Jacobian) %.3f ms, ratio %.2f\n",
                 1e3 * median(plain), 1e3 * median(jac), median(jac) / median(plain));
     if (!files.empty()) {
         std::vector<Trace> traces;
@@ -117,16 +138,20 @@ int main(int argc, char** argv) {
             ss << in.rdbuf();
             traces.push_back(read_trace_csv(ss.str(), f));
         }
-        std::vector<double> tm;
+        std::vector<double> tm, cm;
         std::vector<CalibrationResult> fits;
-        for (int r = 0; r < repeats; ++r) tm.push_back(seconds([&] { fits = calibrate_many(traces, o); }));
+        for (int r = 0; r < repeats; ++r) {
+            double c = 0.0;
+            tm.push_back(seconds([&] { fits = calibrate_many(traces, o); }, &c));
+            cm.push_back(c);
+        }
         long ev = 0, jv = 0;
         for (const auto& f : fits) {
             ev += f.evaluations;
             jv += f.jacobian_evaluations;
         }
-        std::printf("%zu files: calibrate_many median %.3f s over %d runs (min %.3f, max %.3f); evaluations %ld (with sensitivities %ld)\n",
-                    files.size(), median(tm), repeats, *std::min_element(tm.begin(), tm.end()), *std::max_element(tm.begin(), tm.end()), ev, jv);
+        std::printf("%zu files: calibrate_many median %.3f s wall over %d runs (min %.3f, max %.3f), CPU %.3f s; evaluations %ld (with sensitivities %ld)\n",
+                    files.size(), median(tm), repeats, *std::min_element(tm.begin(), tm.end()), *std::max_element(tm.begin(), tm.end()), median(cm), ev, jv);
     }
     return 0;
 }
