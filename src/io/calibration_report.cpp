@@ -193,7 +193,7 @@ std::string calibration_report_markdown(const CalibrationReport& rep, const Cali
         md << " " << round3(f.train.rmse_speed) << " / " << round3(f.naive.rmse_speed) << " | " << f.warnings.size() << " |\n";
     }
     md << "\n| car | speed train [m/s]";
-    for (const auto& t : rep.test_types) md << " | speed " << t;
+    for (const auto& t : rep.test_types) md << " | speed " << t << " / naive";
     md << " | spacing train [m]";
     for (const auto& t : rep.test_types) md << " | spacing " << t;
     md << " |\n|---|---";
@@ -202,7 +202,11 @@ std::string calibration_report_markdown(const CalibrationReport& rep, const Cali
     for (const auto& row : rep.rows) {
         const CalibrationResult& f = *row.fit;
         md << "| " << row.car << " | " << round3(f.train.rmse_speed);
-        for (const auto& e : row.test) md << " | " << (e.samples > 0 ? round3(e.rmse_speed) : "-");
+        for (std::size_t k = 0; k < row.test.size(); ++k) {
+            const FitErrors& e = row.test[k];
+            const double nv = row.naive_test[k].rmse_speed;
+            md << " | " << (e.samples > 0 ? round3(e.rmse_speed) + (std::isfinite(nv) ? " / " + round3(nv) : std::string()) : std::string("-"));
+        }
         md << " | " << round3(f.train.rmse_gap);
         for (const auto& e : row.test) md << " | " << (e.samples > 0 ? round3(e.rmse_gap) : "-");
         md << " |\n";

@@ -270,7 +270,7 @@ assert float(rows[0]['k1']) == f['k1'] and float(rows[0]['k1_lo']) == f['ci95'][
 j = json.load(open(sys.argv[2] + '/table.json'))
 assert j['test_types'] == ['same'] and j['cars'][0]['test']['same']['rmse_gap'] == t['rmse_gap']
 md = open(sys.argv[2] + '/table.md').read()
-assert '| car | train runs | k1 [1/s^2]' in md and '| car | speed train [m/s] | speed same | spacing train [m] | spacing same |' in md
+assert '| car | train runs | k1 [1/s^2]' in md and '| car | speed train [m/s] | speed same / naive | spacing train [m] | spacing same |' in md
 PY
     for svg in "$tmp"/report/fit_rav4_*.svg; do xmllint --noout "$svg" || bad "report figure $svg"; done
     [ "$(ls "$tmp"/report/fit_rav4_*.svg | wc -l)" -eq 2 ] && ok || bad "report: one figure per run"

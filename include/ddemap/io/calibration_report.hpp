@@ -54,7 +54,8 @@ std::string calibration_report_csv(const CalibrationReport& report);
 /// "samples"}, ...}, "warnings": [...], "status"}]}
 std::string calibration_report_json(const CalibrationReport& report);
 /// Two Markdown tables (rounded): parameters with intervals (bold: on a bound; "n.d.": the
-/// interval is wider than the bounds), and speed and spacing RMSE, train and per test type.
+/// interval is wider than the bounds), and speed and spacing RMSE, train and per test type
+/// (the test speed RMSE next to the naive predictor's on the same runs).
 std::string calibration_report_markdown(const CalibrationReport& report, const CalibrationOptions& options);
 
 /// The fit figure of one run (the paper's Figures 3 and 4): measured lead and follower speed
