@@ -140,10 +140,13 @@ int run_calibrate() {
     } else {
         for (const auto& f : args.files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_input_file("DATA.csv", f), f)}, {}, {}});
     }
-    ExecutionPolicy policy;
+    // one progress line per finished fit: ddemap: calibrate: 3/12 fits done (NAME, 0.41 s)
+    CarFinished finished;
     if (cars.size() > 1)
-        policy.progress = [](long done, long total) { std::cerr << "ddemap: calibrate: " << done << "/" << total << " fits done\n"; };
-    const std::vector<CarCalibration> results = calibrate_cars(cars, o, policy);
+        finished = [](const CarCalibration& c, long done, long total) {
+            std::cerr << "ddemap: calibrate: " << done << "/" << total << " fits done (" << c.car << ", " << rounded(c.fit.seconds, 2) << " s)\n";
+        };
+    const std::vector<CarCalibration> results = calibrate_cars(cars, o, ExecutionPolicy{}, finished);
     std::vector<CalibrationResult> fits;
     std::vector<std::string> names;
     std::vector<Trace> traces;  // one per fit for the overview figure (its first training run)

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <cerrno>
@@ -859,7 +860,7 @@ std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, 
 }
 
 std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
-                                           const ExecutionPolicy& policy) {
+                                           const ExecutionPolicy& policy, const CarFinished& finished) {
     options.validate();
     for (const CarRuns& c : cars) {
         if (c.train.empty()) throw std::invalid_argument("car " + detail::quoted(c.car) + ": expected at least one training run");
@@ -868,6 +869,8 @@ std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, con
                                         std::to_string(c.test.size()) + " test runs: expected one per test run");
     }
     std::vector<CarCalibration> out(cars.size());
+    std::mutex lock;
+    long done = 0;
     parallel_for(
         static_cast<long>(cars.size()),
         [&](long i) {
@@ -878,6 +881,10 @@ std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, con
             r.fit = c.train.size() == 1 ? calibrate(c.train[0], options) : calibrate_joint(c.train, options);
             for (std::size_t k = 0; k < c.test.size(); ++k)
                 r.tests.push_back({c.test[k].source, c.test_types[k], evaluate_fit(c.test[k], r.fit.parameters, options.step)});
+            if (finished) {
+                std::lock_guard<std::mutex> guard(lock);
+                finished(r, ++done, static_cast<long>(cars.size()));
+            }
         },
         policy);
     return out;

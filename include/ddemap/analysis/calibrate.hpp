@@ -13,6 +13,7 @@
 /// corrected for correlated residuals (Newey-West), 95 % intervals, correlations, optional
 /// profile likelihoods and warnings.
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -210,11 +211,16 @@ struct CarCalibration {
     std::vector<TestRun> tests;  ///< in the order of CarRuns::test
 };
 
-/// Fits every car (in parallel over the cars under `policy`; `policy.progress` after each car)
-/// and evaluates its test runs. std::invalid_argument for a car without training runs or with
-/// test_types not one per test run (naming the car); a fit's own errors as in calibrate.
+/// Called after each car is done (one call at a time, in the order the cars finish): the car's
+/// result, how many cars are done and how many there are.
+using CarFinished = std::function<void(const CarCalibration& car, long done, long total)>;
+
+/// Fits every car (in parallel over the cars under `policy`; `policy.progress` and `finished`
+/// after each car) and evaluates its test runs. std::invalid_argument for a car without
+/// training runs or with test_types not one per test run (naming the car); a fit's own errors
+/// as in calibrate.
 std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
-                                           const ExecutionPolicy& policy = {});
+                                           const ExecutionPolicy& policy = {}, const CarFinished& finished = {});
 
 /// The objective `calibrate` minimises, at given parameters (k1, k2, th, tau, eta, each inside
 /// or outside the bounds): MSE(speed) + gap_weight MSE(gap) over the training samples at or
