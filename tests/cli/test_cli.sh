@@ -283,6 +283,8 @@ printf 'car,file,role\nrav4,%s,test\n' "$excerpt" >"$tmp/badruns2.csv"
 expect_error "car 'rav4' has no run with role train" calibrate --runs "$tmp/badruns2.csv"
 expect_error "--joint: not with --runs" calibrate --joint --runs "$tmp/runs.csv"
 expect_error "expected at least one trace" calibrate
+touch "$tmp/notadir"
+expect_error "--report = '$tmp/notadir': the folder does not exist and cannot be created" calibrate "$excerpt" --report "$tmp/notadir"
 
 # roots --system: any linear DDE from JSON
 cat >"$tmp/sys.json" <<'JSON'
