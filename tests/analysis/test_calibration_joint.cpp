@@ -4,6 +4,7 @@
 // the truth on the stacked objective, and is better determined than either run alone.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "analysis/calibration_helpers.hpp"
@@ -88,3 +89,26 @@ TEST_CASE("joint calibration: the stacked objective is the sample-weighted mean 
 }
 
 TEST_SUITE_END();
+
+TEST_CASE("joint calibration: a run stacked with itself halves the covariance (no lags across runs)") {
+    const Trace tr = calib_test::noisy(calib_test::clean_trace(calib_test::ovrv(kTruth), calib_test::three_sines(90), 90), 41u, 0.05, 0.2, 0.9);
+    const CalibrationOptions o;
+    const CalibrationResult one = calibrate(tr, o), twice = calibrate_joint({tr, tr}, o);
+    REQUIRE(one.status_code == Status::Converged);
+    REQUIRE(twice.status_code == Status::Converged);
+    // the same objective (the mean over identical runs), so the same minimum
+    CHECK(twice.objective == doctest::Approx(one.objective).epsilon(test::tol::regrouped_sum));
+    // H and Omega both double when the runs are independent: C = (2H)^-1 (2 Omega) (2H)^-1 = C / 2
+    // (a Newey-West sum across the two copies would have kept C)
+    double worst = 0.0;
+    for (int i = 0; i < 5; ++i) {
+        worst = std::max({worst, std::abs(twice.estimates[static_cast<std::size_t>(i)].value / one.estimates[static_cast<std::size_t>(i)].value - 1.0),
+                          std::abs(twice.covariance(i, i) / (0.5 * one.covariance(i, i)) - 1.0)});
+        CAPTURE(i);
+        CHECK(twice.estimates[static_cast<std::size_t>(i)].value == doctest::Approx(one.estimates[static_cast<std::size_t>(i)].value).epsilon(test::tol::same_fit));
+        CHECK(twice.covariance(i, i) == doctest::Approx(0.5 * one.covariance(i, i)).epsilon(test::tol::same_fit));
+    }
+    MESSAGE("largest relative difference from the exact relations: " << worst);
+    CHECK(twice.critical_value == one.critical_value);
+    CHECK(twice.bandwidth == one.bandwidth);
+}
