@@ -34,4 +34,22 @@ constexpr double coefficient_rel = 1e-13;
 /// Linearisation against central finite differences with step 1e-5 (error O(h^2) ~ 1e-10).
 constexpr double finite_difference = 1e-7;
 
+/// The same sum of squares accumulated in a different order or grouping (a stacked objective
+/// against the sample-weighted mean of its parts, an RMSE pooled from one run): a few thousand
+/// terms in double precision agree to ~1e-15 relative; 1e-12 leaves a wide margin.
+constexpr double regrouped_sum = 1e-12;
+
+/// Coverage of nominal 95 % intervals estimated from 1000 intervals (200 noise realisations x 5
+/// parameters): the binomial standard error is sqrt(0.95 * 0.05 / 1000) = 0.007, about 0.011
+/// with the five intervals of one realisation correlated (design effect ~2.5); the band is
+/// 0.95 -+ 3 of those. A method that undercovers by 5 points or more falls outside it.
+constexpr double coverage_band = 0.035;
+
+/// Two least-squares fits of problems that are equal in exact arithmetic (a run stacked with
+/// itself: every sum doubles) and differ only in the rounding of their sums. Both stop at a
+/// relative decrease of the objective below 1e-9, which pins a parameter only to about
+/// sqrt(1e-9) ~ 3e-5 relative along the flattest direction (measured: 1.7e-7); 1e-4 is above
+/// that bound and far below the factor 2 the covariance test tells apart.
+constexpr double same_fit = 1e-4;
+
 }  // namespace ddemap::test::tol

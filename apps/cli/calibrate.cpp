@@ -1,11 +1,18 @@
-// calibrate: fit OVRV to measured car-following traces (analysis/calibrate: calibrate_many).
+// calibrate: fit OVRV to measured car-following traces (analysis/calibrate: calibrate_cars):
+// one fit per file, one joint fit of all files (--joint), or one joint fit per car of a run
+// list with test runs (--runs); --report DIR writes the Tables 1/2 report and fit figures.
+#include <unistd.h>
+
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/io/calibration_report.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
 #include "ddemap/io/svg.hpp"
@@ -15,7 +22,8 @@ namespace ddemap::cli {
 namespace {
 struct Args {
     std::vector<std::string> files;
-    std::string train, model = "ovrv", bounds, gap_weight = "0.02";
+    std::string train, model = "ovrv", bounds, gap_weight = "0.02", runs, report, car = "joint", data_dir;
+    bool joint = false;
     FormatArg format;
     OutArg out;
 } args;
@@ -58,7 +66,14 @@ CalibrationOptions options() {
 }  // namespace
 
 void add_calibrate_flags(CLI::App& app) {
-    app.add_option("DATA.csv", args.files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m")->required();
+    app.add_option("DATA.csv", args.files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one fit per file)");
+    app.add_flag("--joint", args.joint, "fit one parameter set to all DATA files (runs of the same car)");
+    app.add_option("--car", args.car, "the car's name for --joint")->capture_default_str();
+    app.add_option("--runs", args.runs,
+                   "RUNS.csv with columns car,file,role[,type]: each car fitted jointly on its role=train files, "
+                   "tested on its role=test files (errors per type; files relative to the current folder)");
+    app.add_option("--data-dir", args.data_dir, "folder the relative file names of RUNS.csv are read from (default: the current folder)");
+    app.add_option("--report", args.report, "folder: table.csv, table.json, table.md (parameters, train and test errors) and fit_FILE.svg per run");
     app.add_option("--train", args.train, "training window T0:T1 [s] (default: the whole file; the rest is the test part)");
     app.add_option("--model", args.model, "the model to fit (ovrv)")->capture_default_str();
     app.add_option("--bounds", args.bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
@@ -67,26 +82,95 @@ void add_calibrate_flags(CLI::App& app) {
     args.format.add_to(app);
 }
 
+namespace {
+
+/// the cars of --runs RUNS.csv (car,file,role[,type]), in order of first appearance
+std::vector<CarRuns> read_runs(const std::string& path) {
+    std::vector<CarRuns> cars;
+    for (const RunListEntry& e : read_run_list_csv(read_input_file("--runs", path), path)) {
+        auto it = std::find_if(cars.begin(), cars.end(), [&](const CarRuns& c) { return c.car == e.car; });
+        if (it == cars.end()) {
+            cars.push_back(CarRuns{e.car, {}, {}, {}});
+            it = cars.end() - 1;
+        }
+        const std::string file = args.data_dir.empty() || e.file.front() == '/' ? e.file : (std::filesystem::path(args.data_dir) / e.file).string();
+        Trace tr = read_trace_csv(read_input_file("--runs " + path + ": file", file), file);
+        if (e.role == "train") {
+            it->train.push_back(std::move(tr));
+        } else {
+            it->test.push_back(std::move(tr));
+            it->test_types.push_back(e.type);
+        }
+    }
+    for (const CarRuns& c : cars)
+        if (c.train.empty()) throw BadInput("--runs " + path + ": car '" + c.car + "' has no run with role train");
+    return cars;
+}
+
+/// the --report folder, created as needed and writable (bad input otherwise, before any work)
+std::string prepare_report_dir(const std::string& dir) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+        fs::create_directories(dir, ec);
+        if (ec || !fs::is_directory(dir)) throw BadInput("--report = '" + dir + "': the folder does not exist and cannot be created");
+    }
+    if (access(dir.c_str(), W_OK) != 0) throw BadInput("--report = '" + dir + "': the folder is not writable");
+    return dir.back() == '/' ? dir : dir + "/";
+}
+
+}  // namespace
+
 int run_calibrate() {
     const Format format = args.format.parse();
     const CalibrationOptions o = options();
+    const int modes = (args.joint ? 1 : 0) + (!args.runs.empty() ? 1 : 0);
+    if (!args.runs.empty() && !args.files.empty()) throw BadInput("--runs " + args.runs + ": give the files in RUNS.csv, not also as DATA.csv");
+    if (args.runs.empty() && args.files.empty()) throw BadInput("DATA.csv: expected at least one trace (or --runs RUNS.csv)");
+    if (!args.data_dir.empty() && args.runs.empty()) throw BadInput("--data-dir " + args.data_dir + ": only with --runs RUNS.csv");
+    if (modes > 1) throw BadInput("--joint: not with --runs (RUNS.csv groups the runs into cars)");
     const std::string prefix = args.out.given() ? args.out.prepare("calibrate") : std::string();
-    std::vector<Trace> traces;
-    std::vector<std::string> names;
-    for (const auto& f : args.files) {
-        traces.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
-        names.push_back(base_name(f));
+    const std::string report_dir = args.report.empty() ? std::string() : prepare_report_dir(args.report);
+    std::vector<CarRuns> cars;
+    if (!args.runs.empty()) {
+        cars = read_runs(args.runs);
+    } else if (args.joint) {
+        cars.push_back(CarRuns{args.car, {}, {}, {}});
+        for (const auto& f : args.files) cars[0].train.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
+    } else {
+        for (const auto& f : args.files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_input_file("DATA.csv", f), f)}, {}, {}});
     }
-    const std::vector<CalibrationResult> fits = calibrate_many(traces, o);
+    // one progress line per finished fit: ddemap: calibrate: 3/12 fits done (NAME, 0.41 s)
+    CarFinished finished;
+    if (cars.size() > 1)
+        finished = [](const CarCalibration& c, long done, long total) {
+            std::cerr << "ddemap: calibrate: " << done << "/" << total << " fits done (" << c.car << ", " << rounded(c.fit.seconds, 2) << " s)\n";
+        };
+    const std::vector<CarCalibration> results = calibrate_cars(cars, o, ExecutionPolicy{}, finished);
+    std::vector<CalibrationResult> fits;
+    std::vector<std::string> names;
+    std::vector<Trace> traces;  // one per fit for the overview figure (its first training run)
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        fits.push_back(results[i].fit);
+        names.push_back(results[i].car);
+        traces.push_back(cars[i].train.front());
+        if (fits.back().sim_speed.empty() && !fits.back().runs.empty()) {
+            fits.back().sim_speed = fits.back().runs.front().sim_speed;
+            fits.back().sim_gap = fits.back().runs.front().sim_gap;
+        }
+    }
     JsonEnvelope e;
     e.command = "calibrate";
     std::vector<std::string> files;
-    for (const auto& f : args.files) files.push_back(json_string(f));
+    for (const auto& c : cars)
+        for (const auto& t : c.train) files.push_back(json_string(t.source));
     JsonObject in;
     in.json("traces", json_array(files)).string("model", args.model).number("gap_weight", o.gap_weight);
+    if (!args.runs.empty()) in.string("runs", args.runs);
+    if (args.joint) in.string("joint", args.car);
     if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
     e.inputs = in.str();
-    e.result = calibration_json(names, fits, o);
+    e.result = calibration_json(names, fits, o, &results);
     Status status = Status::Converged;
     for (std::size_t i = 0; i < fits.size(); ++i) {
         if (fits[i].status_code != Status::Converged) {
@@ -97,8 +181,31 @@ int run_calibrate() {
     }
     e.status = to_string(status);
     const std::string csv = calibration_csv(names, fits);
+    std::vector<std::pair<std::string, std::string>> outputs;
     if (!prefix.empty())
-        write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}});
+        outputs = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}};
+    if (!report_dir.empty()) {
+        const CalibrationReport rep = calibration_report(results);
+        outputs.push_back({report_dir + "table.csv", calibration_report_csv(rep)});
+        outputs.push_back({report_dir + "table.json", calibration_report_json(rep)});
+        outputs.push_back({report_dir + "table.md", calibration_report_markdown(rep, o)});
+        // one figure per run and car: fit_CAR_FILE.svg (CAR with every character but letters,
+        // digits, '-' and '.' replaced by '_'; CAR_ left out when each car is one file)
+        auto figure = [&](const std::string& car, const std::string& title, const Trace& tr, const FitEvaluation& ev) {
+            std::string slug;
+            for (char ch : car) slug += std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '.' ? ch : '_';
+            const bool plain = args.runs.empty() && !args.joint;
+            outputs.push_back({report_dir + "fit_" + (plain ? std::string() : slug + "_") + base_name(tr.source) + ".svg", calibration_fit_svg(title, tr, ev, "run: " + tr.source)});
+        };
+        for (std::size_t i = 0; i < results.size(); ++i) {
+            const auto& r = results[i];
+            for (std::size_t k = 0; k < cars[i].train.size() && k < r.fit.runs.size(); ++k)
+                figure(r.car, r.car + ": training run " + std::to_string(k + 1) + " of " + std::to_string(cars[i].train.size()), cars[i].train[k], r.fit.runs[k]);
+            for (std::size_t k = 0; k < r.tests.size(); ++k)
+                figure(r.car, r.car + ": test run (" + r.tests[k].type + ")", cars[i].test[k], r.tests[k].evaluation);
+        }
+    }
+    if (!outputs.empty()) write_files_atomic(outputs);
     print_output(format, e, csv, [&] {
         std::ostringstream out;
         out << "file                                         k1      k2     th     tau    eta   rmse_v  rmse_gap  naive_v  status\n";

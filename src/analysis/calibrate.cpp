@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <cerrno>
@@ -137,36 +138,53 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// The least-squares problem on the training window: residuals (speeds, then sqrt(w) gaps) at
-/// the samples t_j >= t_from of [a, b].
-struct LsqProblem {
-    const Trace& tr;
-    double a = 0.0, b = 0.0, t_from = 0.0, step = 0.05, wg = 0.0;
-    CalibrationVector lo, hi;
+/// One run of a (joint) least-squares problem: residuals (speeds, then sqrt(w) gaps) at the
+/// samples t_j >= t_from of the window [a, b] of its trace.
+struct Segment {
+    const Trace* tr = nullptr;
+    double a = 0.0, b = 0.0, t_from = 0.0;
     std::size_t first = 0;             // data index of the trajectory's first row
     std::vector<std::size_t> rows;     // trajectory rows of the residual samples
+    int samples() const { return static_cast<int>(rows.size()); }
+};
+
+/// The least-squares problem on the training windows of one or more runs: the residual vector
+/// is the runs' blocks one after the other, each block (speeds, then sqrt(w) gaps) of its run.
+struct LsqProblem {
+    std::vector<Segment> seg;
+    double step = 0.05, wg = 0.0;
+    CalibrationVector lo, hi;
     mutable std::atomic<int> evaluations{0}, jacobians{0};
 
-    LsqProblem(const Trace& trace) : tr(trace) {}
-    int samples() const { return static_cast<int>(rows.size()); }
-    int residuals() const { return samples() * (wg > 0.0 ? 2 : 1); }
+    int samples() const {
+        int n = 0;
+        for (const auto& s : seg) n += s.samples();
+        return n;
+    }
+    int per_sample() const { return wg > 0.0 ? 2 : 1; }
+    int residuals() const { return samples() * per_sample(); }
 
-    /// r (and J if asked); false when the simulation is not finite
+    /// r (and J if asked); false when a simulation is not finite
     bool eval(const CalibrationVector& th, Eigen::VectorXd& r, Eigen::MatrixXd* J) const {
-        const FollowerTrajectory f = simulate_follower(tr, th, a, b, step, J != nullptr, t_from);
-        ++evaluations;
-        if (J) ++jacobians;
-        const int n = samples();
         r.resize(residuals());
         if (J) J->resize(residuals(), 5);
-        for (int j = 0; j < n; ++j) {
-            const std::size_t k = rows[static_cast<std::size_t>(j)], d = first + k;
-            r[j] = f.speed[k] - tr.speed[d];
-            if (J) J->row(j) = f.dspeed.row(static_cast<Eigen::Index>(k));
-            if (wg > 0.0) {
-                r[n + j] = wg * (f.gap[k] - tr.gap[d]);
-                if (J) J->row(n + j) = wg * f.dgap.row(static_cast<Eigen::Index>(k));
+        Eigen::Index off = 0;
+        for (const Segment& sg : seg) {
+            const Trace& tr = *sg.tr;
+            const FollowerTrajectory f = simulate_follower(tr, th, sg.a, sg.b, step, J != nullptr, sg.t_from);
+            ++evaluations;
+            if (J) ++jacobians;
+            const int n = sg.samples();
+            for (int j = 0; j < n; ++j) {
+                const std::size_t k = sg.rows[static_cast<std::size_t>(j)], d = sg.first + k;
+                r[off + j] = f.speed[k] - tr.speed[d];
+                if (J) J->row(off + j) = f.dspeed.row(static_cast<Eigen::Index>(k));
+                if (wg > 0.0) {
+                    r[off + n + j] = wg * (f.gap[k] - tr.gap[d]);
+                    if (J) J->row(off + n + j) = wg * f.dgap.row(static_cast<Eigen::Index>(k));
+                }
             }
+            off += static_cast<Eigen::Index>(n) * per_sample();
         }
         return r.allFinite() && (!J || J->allFinite());
     }
@@ -395,55 +413,63 @@ std::string fmt3(double x) {
 
 namespace {
 
-/// The problem of `calibrate`: bounds, training window, residual samples (t >= t_a + tau_max).
-void set_up(LsqProblem& pb, const Trace& tr, const CalibrationOptions& o) {
-    const double first = tr.t.front(), last = tr.t.back();
-    double a = o.train_start < 0.0 ? first : o.train_start;
-    double b = o.train_end < 0.0 ? last : o.train_end;
-    if (!(a >= first && b <= last && b - a >= 20.0)) {
-        throw std::invalid_argument("training window " + detail::format_number(a) + ":" + detail::format_number(b) + " s: expected at least 20 s within the file's " +
-                                    detail::format_number(first) + ":" + detail::format_number(last) + " s");
-    }
+/// The problem of `calibrate` (one run) or `calibrate_joint` (several): bounds, each run's
+/// training window and residual samples (t >= t_a + tau_max).
+void set_up(LsqProblem& pb, const std::vector<const Trace*>& traces, const CalibrationOptions& o) {
     for (int i = 0; i < 5; ++i) {
         const BoundedParameter bd = o.bound(names[i]);
         pb.lo[i] = bd.lower;
         pb.hi[i] = bd.upper;
     }
-    // every candidate is scored on the same samples: those after the longest admissible delay
-    pb.a = a;
-    pb.b = b;
-    pb.t_from = a + pb.hi[3];
     pb.step = o.step;
     pb.wg = std::sqrt(o.gap_weight);
-    pb.first = static_cast<std::size_t>(std::lower_bound(tr.t.begin(), tr.t.end(), a) - tr.t.begin());
-    for (std::size_t k = pb.first; k < tr.t.size() && tr.t[k] <= b; ++k)
-        if (tr.t[k] >= pb.t_from) pb.rows.push_back(k - pb.first);
+    for (const Trace* trp : traces) {
+        const Trace& tr = *trp;
+        const double first = tr.t.front(), last = tr.t.back();
+        const double a = o.train_start < 0.0 ? first : o.train_start;
+        const double b = o.train_end < 0.0 ? last : o.train_end;
+        if (!(a >= first && b <= last && b - a >= 20.0)) {
+            throw std::invalid_argument((traces.size() > 1 ? tr.source + ": " : std::string()) + "training window " + detail::format_number(a) + ":" +
+                                        detail::format_number(b) + " s: expected at least 20 s within the file's " + detail::format_number(first) +
+                                        ":" + detail::format_number(last) + " s");
+        }
+        // every candidate is scored on the same samples: those after the longest admissible delay
+        Segment sg;
+        sg.tr = trp;
+        sg.a = a;
+        sg.b = b;
+        sg.t_from = a + pb.hi[3];
+        sg.first = static_cast<std::size_t>(std::lower_bound(tr.t.begin(), tr.t.end(), a) - tr.t.begin());
+        for (std::size_t k = sg.first; k < tr.t.size() && tr.t[k] <= b; ++k)
+            if (tr.t[k] >= sg.t_from) sg.rows.push_back(k - sg.first);
+        pb.seg.push_back(std::move(sg));
+    }
 }
 
-}  // namespace
-
-double calibration_objective(const Trace& tr, const ParameterMap& p, const CalibrationOptions& o) {
-    o.validate();
-    LsqProblem pb(tr);
-    set_up(pb, tr, o);
-    CalibrationVector theta;
-    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
-    return pb.ssr(theta) / std::max(pb.samples(), 1);
+/// The naive predictor v(t) = v_lead(t - d) at the samples t >= t_from, the best constant d in
+/// [0, 5] s: the RMSE per d on the 0.1 s grid (sum of squares and count, for pooling runs)
+void naive_sums(const Trace& tr, double t_from, std::vector<double>& sum, std::vector<int>& count) {
+    sum.assign(51, 0.0);
+    count.assign(51, 0);
+    for (int id = 0; id <= 50; ++id) {
+        const double d = 0.1 * id;
+        for (std::size_t k = 0; k < tr.t.size(); ++k) {
+            if (tr.t[k] < t_from) continue;
+            const double e = interp(tr.t, tr.lead, tr.t[k] - d) - tr.speed[k];
+            sum[static_cast<std::size_t>(id)] += e * e;
+            ++count[static_cast<std::size_t>(id)];
+        }
+    }
 }
 
-CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
-    o.validate();
-    const auto t_start = std::chrono::steady_clock::now();
-    const double first = tr.t.front(), last = tr.t.back();
-    LsqProblem pb(tr);
-    set_up(pb, tr, o);
-    const double a = pb.a, b = pb.b;
+/// the fit of a problem: design, Levenberg-Marquardt starts, the uncertainty at the optimum,
+/// profiles and the warnings that do not depend on the whole-file errors
+CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o) {
     const int n = pb.samples();
     std::vector<int> free;
     for (int i = 0; i < 5; ++i)
         if (pb.hi[i] > pb.lo[i]) free.push_back(i);
     const int p = static_cast<int>(free.size());
-
     CalibrationResult res;
     // 1. the design: Latin hypercube (plus the centre of the box), scored by the objective
     CalibrationVector centre = 0.5 * (pb.lo + pb.hi);
@@ -519,29 +545,50 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         }
         const Eigen::MatrixXd Hinv = D.asDiagonal().inverse() * Hinv_s * D.asDiagonal().inverse();
         sigma2 = r.squaredNorm() / (m - p);
-        // scores per sample time (speed and gap residual of the same time together)
-        Eigen::MatrixXd G(n, p);
-        for (int t = 0; t < n; ++t) {
-            G.row(t) = JF.row(t) * r[t];
-            if (m > n) G.row(t) += JF.row(n + t) * r[n + t];
+        // per run: scores per sample time (speed and gap residual of the same time together),
+        // the bandwidth from the run's residual autocorrelation and its Newey-West sum; runs are
+        // independent, so Omega is the sum over runs (no cross-run lags)
+        Eigen::MatrixXd Omega = Eigen::MatrixXd::Zero(p, p);
+        double b_max = 0.0, eff = 0.0;
+        Eigen::Index off = 0;
+        for (const Segment& sg : pb.seg) {
+            const int ns = sg.samples();
+            const Eigen::Index ms = static_cast<Eigen::Index>(ns) * pb.per_sample();
+            if (ns < 2) {
+                off += ms;
+                continue;
+            }
+            const Eigen::VectorXd rv = r.segment(off, ns);
+            Eigen::MatrixXd G(ns, p);
+            for (int t = 0; t < ns; ++t) {
+                G.row(t) = JF.row(off + t) * r[off + t];
+                if (pb.wg > 0.0) G.row(t) += JF.row(off + ns + t) * r[off + ns + t];
+            }
+            // bandwidth: five times the lag at which the residuals decorrelate (the slower stream)
+            const int cap = std::max(1, ns / 4);
+            int lag = decorrelation_lag(rv, cap);
+            if (pb.wg > 0.0) lag = std::max(lag, decorrelation_lag(r.segment(off + ns, ns), cap));
+            const int L = std::min(5 * lag, cap);
+            res.bandwidth = std::max(res.bandwidth, L);
+            b_max = std::max(b_max, static_cast<double>(L) / ns);
+            Omega += G.transpose() * G;
+            for (int l = 1; l <= L; ++l) {
+                const double wl = 1.0 - static_cast<double>(l) / (L + 1);
+                const Eigen::MatrixXd Gl = G.bottomRows(ns - l).transpose() * G.topRows(ns - l);
+                Omega += wl * (Gl + Gl.transpose());
+            }
+            const std::vector<double> rho = autocorrelation(rv, L);
+            double f = 1.0;
+            for (int l = 1; l <= L; ++l) f += 2.0 * (1.0 - static_cast<double>(l) / (L + 1)) * rho[static_cast<std::size_t>(l)];
+            eff += ns / std::max(f, 1.0);
+            off += ms;
         }
-        // bandwidth: three times the lag at which the residuals decorrelate (the slower stream)
-        const int cap = std::max(1, n / 4);
-        int lag = decorrelation_lag(r.head(n), cap);
-        if (m > n) lag = std::max(lag, decorrelation_lag(r.tail(n), cap));
-        const int L = std::min(5 * lag, cap);
-        res.bandwidth = L;
+        res.effective_samples = eff;
         // fixed-b critical value of the Bartlett HAC t-statistic (Kiefer & Vogelsang 2005, the
-        // 97.5 % quantile as a cubic in b = L / n): wider than 1.96 when the bandwidth is a
-        // sizeable part of the trace, as it is for 10 Hz residuals
-        const double bb = static_cast<double>(L) / n;
+        // 97.5 % quantile as a cubic in b = L / n; the largest b over the runs): wider than 1.96
+        // when the bandwidth is a sizeable part of the trace, as it is for 10 Hz residuals
+        const double bb = b_max;
         res.critical_value = 1.96 + 2.9694 * bb + 0.4160 * bb * bb - 0.5324 * bb * bb * bb;
-        Eigen::MatrixXd Omega = G.transpose() * G;
-        for (int l = 1; l <= L; ++l) {
-            const double wl = 1.0 - static_cast<double>(l) / (L + 1);
-            const Eigen::MatrixXd Gl = G.bottomRows(n - l).transpose() * G.topRows(n - l);
-            Omega += wl * (Gl + Gl.transpose());
-        }
         // symmetric by construction; symmetrised so that rounding does not make C(i, j) != C(j, i)
         const Eigen::MatrixXd C0 = Hinv * Omega * Hinv;
         const Eigen::MatrixXd C = 0.5 * (C0 + C0.transpose());
@@ -551,10 +598,6 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
                 cov(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = C(i, j);
                 cov_iid(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = Ci(i, j);
             }
-        const std::vector<double> rho = autocorrelation(r.head(n), L);
-        double f = 1.0;
-        for (int l = 1; l <= L; ++l) f += 2.0 * (1.0 - static_cast<double>(l) / (L + 1)) * rho[static_cast<std::size_t>(l)];
-        res.effective_samples = n / std::max(f, 1.0);
     }
     res.covariance = cov;
     res.covariance_independent = cov_iid;
@@ -574,47 +617,6 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         e.lower95 = e.value - res.critical_value * e.standard_error;
         e.upper95 = e.value + res.critical_value * e.standard_error;
     }
-
-    // 4. errors and the naive predictor
-    res.train = errors_over(tr, res.parameters, a, b, pb.t_from, o.step, nullptr, nullptr, pb.t_from);  // as the objective
-    res.all = errors_over(tr, res.parameters, first, last, first + res.parameters.at("tau"), o.step, &res.sim_speed, &res.sim_gap);
-    // the test part: the file outside the training window, each piece simulated from its own start
-    FitErrors test;
-    double sv = 0.0, sg = 0.0;
-    for (auto [ta, tb] : {std::pair{first, a}, std::pair{b, last}}) {
-        if (tb - ta < 5.0) continue;
-        const FitErrors e = errors_over(tr, res.parameters, ta, tb, ta + res.parameters.at("tau"), o.step);
-        sv += e.rmse_speed * e.rmse_speed * e.samples;
-        sg += e.rmse_gap * e.rmse_gap * e.samples;
-        test.samples += e.samples;
-    }
-    if (test.samples > 0) {
-        test.rmse_speed = std::sqrt(sv / test.samples);
-        test.rmse_gap = std::sqrt(sg / test.samples);
-    }
-    res.test = test;
-    // the naive predictor v(t) = v_lead(t - d), best constant d in [0, 5] s, same samples as `all`
-    double best_naive = 1e300;
-    for (double d = 0.0; d <= 5.0 + 1e-9; d += 0.1) {
-        double s = 0.0;
-        int cnt = 0;
-        for (std::size_t k = 0; k < tr.t.size(); ++k) {
-            if (tr.t[k] < first + res.parameters.at("tau")) continue;
-            const double e = interp(tr.t, tr.lead, tr.t[k] - d) - tr.speed[k];
-            s += e * e;
-            ++cnt;
-        }
-        const double rmse = std::sqrt(s / std::max(cnt, 1));
-        if (rmse < best_naive) {
-            best_naive = rmse;
-            res.naive_delay = d;
-        }
-    }
-    res.naive.rmse_speed = best_naive;
-    res.naive.samples = res.all.samples;
-    res.rmse_speed = res.all.rmse_speed;
-    res.rmse_gap = res.all.rmse_gap;
-    res.naive_rmse_speed = res.naive.rmse_speed;
 
     // 5. profile likelihoods on request
     for (const std::string& name : o.profile) {
@@ -690,9 +692,158 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
         res.warnings.push_back("J^T J is nearly singular (condition number " + fmt3(res.condition_number) + ")" +
                                (which.empty() ? std::string(": the parameters are strongly correlated") : ": " + which + " not determined by this trace"));
     }
+    res.evaluations = pb.evaluations;
+    res.jacobian_evaluations = pb.jacobians;
+    return res;
+}
+
+/// the naive predictor's warning (appended once the whole-file errors are known)
+void warn_naive(CalibrationResult& res) {
     if (!(res.all.rmse_speed < res.naive.rmse_speed))
         res.warnings.push_back("the model (speed RMSE " + fmt3(res.all.rmse_speed) + " m/s) is no better than the naive predictor v(t) = v_lead(t - " +
                                fmt3(res.naive_delay) + " s) (" + fmt3(res.naive.rmse_speed) + " m/s)");
+}
+
+}  // namespace
+
+double calibration_objective(const Trace& tr, const ParameterMap& p, const CalibrationOptions& o) {
+    o.validate();
+    LsqProblem pb;
+    set_up(pb, {&tr}, o);
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    return pb.ssr(theta) / std::max(pb.samples(), 1);
+}
+
+double calibration_objective(const std::vector<Trace>& runs, const ParameterMap& p, const CalibrationOptions& o) {
+    o.validate();
+    if (runs.empty()) throw std::invalid_argument("joint objective: expected at least one run");
+    LsqProblem pb;
+    std::vector<const Trace*> ptr;
+    for (const auto& t : runs) ptr.push_back(&t);
+    set_up(pb, ptr, o);
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    return pb.ssr(theta) / std::max(pb.samples(), 1);
+}
+
+FitEvaluation evaluate_fit(const Trace& tr, const ParameterMap& p, double step) {
+    FitEvaluation ev;
+    const double first = tr.t.front(), last = tr.t.back(), t_from = first + p.at("tau");
+    ev.errors = errors_over(tr, p, first, last, t_from, step, &ev.sim_speed, &ev.sim_gap);
+    std::vector<double> sum;
+    std::vector<int> count;
+    naive_sums(tr, t_from, sum, count);
+    double best = kInf;
+    for (std::size_t id = 0; id < sum.size(); ++id) {
+        const double rmse = std::sqrt(sum[id] / std::max(count[id], 1));
+        if (rmse < best) {
+            best = rmse;
+            ev.naive_delay = 0.1 * static_cast<double>(id);
+        }
+    }
+    ev.naive.rmse_speed = best;
+    ev.naive.samples = ev.errors.samples;
+    return ev;
+}
+
+CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
+    o.validate();
+    const auto t_start = std::chrono::steady_clock::now();
+    const double first = tr.t.front(), last = tr.t.back();
+    LsqProblem pb;
+    set_up(pb, {&tr}, o);
+    const double a = pb.seg[0].a, b = pb.seg[0].b;
+    CalibrationResult res = fit_problem(pb, o);
+    // 4. errors and the naive predictor
+    res.train = errors_over(tr, res.parameters, a, b, pb.seg[0].t_from, o.step, nullptr, nullptr, pb.seg[0].t_from);  // as the objective
+    res.all = errors_over(tr, res.parameters, first, last, first + res.parameters.at("tau"), o.step, &res.sim_speed, &res.sim_gap);
+    // the test part: the file outside the training window, each piece simulated from its own start
+    FitErrors test;
+    double sv = 0.0, sg = 0.0;
+    for (auto [ta, tb] : {std::pair{first, a}, std::pair{b, last}}) {
+        if (tb - ta < 5.0) continue;
+        const FitErrors e = errors_over(tr, res.parameters, ta, tb, ta + res.parameters.at("tau"), o.step);
+        sv += e.rmse_speed * e.rmse_speed * e.samples;
+        sg += e.rmse_gap * e.rmse_gap * e.samples;
+        test.samples += e.samples;
+    }
+    if (test.samples > 0) {
+        test.rmse_speed = std::sqrt(sv / test.samples);
+        test.rmse_gap = std::sqrt(sg / test.samples);
+    }
+    res.test = test;
+    // the naive predictor v(t) = v_lead(t - d), best constant d in [0, 5] s, same samples as `all`
+    const FitEvaluation naive = evaluate_fit(tr, res.parameters, o.step);
+    res.naive = naive.naive;
+    res.naive_delay = naive.naive_delay;
+    res.rmse_speed = res.all.rmse_speed;
+    res.rmse_gap = res.all.rmse_gap;
+    res.naive_rmse_speed = res.naive.rmse_speed;
+    res.runs.push_back({res.all, res.naive, res.naive_delay, res.sim_speed, res.sim_gap});
+    warn_naive(res);
+    res.evaluations = pb.evaluations;
+    res.jacobian_evaluations = pb.jacobians;
+    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    return res;
+}
+
+CalibrationResult calibrate_joint(const std::vector<Trace>& runs, const CalibrationOptions& o) {
+    o.validate();
+    if (runs.empty()) throw std::invalid_argument("joint calibration: expected at least one run");
+    const auto t_start = std::chrono::steady_clock::now();
+    LsqProblem pb;
+    std::vector<const Trace*> ptr;
+    for (const auto& t : runs) ptr.push_back(&t);
+    set_up(pb, ptr, o);
+    CalibrationResult res = fit_problem(pb, o);
+    // pooled errors: train as the objective (each run's window), all and naive over whole files
+    double tv = 0.0, tg = 0.0, av = 0.0, ag = 0.0, nv = 0.0;
+    for (const Segment& sg : pb.seg) {
+        const FitErrors e = errors_over(*sg.tr, res.parameters, sg.a, sg.b, sg.t_from, o.step, nullptr, nullptr, sg.t_from);
+        tv += e.rmse_speed * e.rmse_speed * e.samples;
+        tg += e.rmse_gap * e.rmse_gap * e.samples;
+        res.train.samples += e.samples;
+        const FitEvaluation ev = evaluate_fit(*sg.tr, res.parameters, o.step);
+        av += ev.errors.rmse_speed * ev.errors.rmse_speed * ev.errors.samples;
+        ag += ev.errors.rmse_gap * ev.errors.rmse_gap * ev.errors.samples;
+        res.all.samples += ev.errors.samples;
+        res.runs.push_back(ev);
+    }
+    // the naive predictor pooled over the runs: one delay d for all of them
+    std::vector<double> total(51, 0.0);
+    std::vector<int> cnt(51, 0);
+    for (const Trace& tr : runs) {
+        std::vector<double> sum;
+        std::vector<int> count;
+        naive_sums(tr, tr.t.front() + res.tau, sum, count);
+        for (std::size_t id = 0; id < sum.size(); ++id) {
+            total[id] += sum[id];
+            cnt[id] += count[id];
+        }
+    }
+    nv = kInf;
+    for (std::size_t id = 0; id < total.size(); ++id) {
+        const double rmse = std::sqrt(total[id] / std::max(cnt[id], 1));
+        if (rmse < nv) {
+            nv = rmse;
+            res.naive_delay = 0.1 * static_cast<double>(id);
+        }
+    }
+    if (res.train.samples > 0) {
+        res.train.rmse_speed = std::sqrt(tv / res.train.samples);
+        res.train.rmse_gap = std::sqrt(tg / res.train.samples);
+    }
+    if (res.all.samples > 0) {
+        res.all.rmse_speed = std::sqrt(av / res.all.samples);
+        res.all.rmse_gap = std::sqrt(ag / res.all.samples);
+    }
+    res.naive.rmse_speed = nv;
+    res.naive.samples = res.all.samples;
+    res.rmse_speed = res.all.rmse_speed;
+    res.rmse_gap = res.all.rmse_gap;
+    res.naive_rmse_speed = nv;
+    warn_naive(res);
     res.evaluations = pb.evaluations;
     res.jacobian_evaluations = pb.jacobians;
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -706,6 +857,37 @@ std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, 
     // an error in any trace is rethrown here (the lowest index first), never inside the loop
     parallel_for(static_cast<long>(traces.size()), [&](long i) { fits[i] = calibrate(traces[i], options); }, policy);
     return fits;
+}
+
+std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
+                                           const ExecutionPolicy& policy, const CarFinished& finished) {
+    options.validate();
+    for (const CarRuns& c : cars) {
+        if (c.train.empty()) throw std::invalid_argument("car " + detail::quoted(c.car) + ": expected at least one training run");
+        if (c.test_types.size() != c.test.size())
+            throw std::invalid_argument("car " + detail::quoted(c.car) + ": " + std::to_string(c.test_types.size()) + " test types for " +
+                                        std::to_string(c.test.size()) + " test runs: expected one per test run");
+    }
+    std::vector<CarCalibration> out(cars.size());
+    std::mutex lock;
+    long done = 0;
+    parallel_for(
+        static_cast<long>(cars.size()),
+        [&](long i) {
+            const CarRuns& c = cars[static_cast<std::size_t>(i)];
+            CarCalibration& r = out[static_cast<std::size_t>(i)];
+            r.car = c.car;
+            for (const Trace& t : c.train) r.train_sources.push_back(t.source);
+            r.fit = c.train.size() == 1 ? calibrate(c.train[0], options) : calibrate_joint(c.train, options);
+            for (std::size_t k = 0; k < c.test.size(); ++k)
+                r.tests.push_back({c.test[k].source, c.test_types[k], evaluate_fit(c.test[k], r.fit.parameters, options.step)});
+            if (finished) {
+                std::lock_guard<std::mutex> guard(lock);
+                finished(r, ++done, static_cast<long>(cars.size()));
+            }
+        },
+        policy);
+    return out;
 }
 
 }  // namespace ddemap

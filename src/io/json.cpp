@@ -289,7 +289,7 @@ std::string growth_json(const std::vector<GrowthResult>& g, const std::string& l
 }
 
 std::string calibration_json(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
-                             const CalibrationOptions& o) {
+                             const CalibrationOptions& o, const std::vector<CarCalibration>* cars) {
     json arr = json::array();
     for (std::size_t i = 0; i < fits.size(); ++i) {
         const CalibrationResult& r = fits[i];
@@ -332,6 +332,26 @@ std::string calibration_json(const std::vector<std::string>& names, const std::v
         j["message"] = r.message;
         j["evaluations"] = r.evaluations;
         j["seconds"] = r.seconds;
+        if (cars && i < cars->size()) {
+            // the fitted runs (whole files) and the test runs, each simulated from its own start
+            const CarCalibration& c = (*cars)[i];
+            auto run = [](const std::string& file, const FitEvaluation& ev) {
+                return json{{"file", file},
+                            {"rmse_speed", num(ev.errors.rmse_speed)},
+                            {"rmse_gap", num(ev.errors.rmse_gap)},
+                            {"naive_rmse_speed", num(ev.naive.rmse_speed)},
+                            {"samples", ev.errors.samples}};
+            };
+            json tr = json::array(), te = json::array();
+            for (std::size_t k = 0; k < c.train_sources.size() && k < r.runs.size(); ++k) tr.push_back(run(c.train_sources[k], r.runs[k]));
+            for (const TestRun& t : c.tests) {
+                json x = run(t.source, t.evaluation);
+                x["type"] = t.type;
+                te.push_back(x);
+            }
+            j["train_runs"] = tr;
+            j["tests"] = te;
+        }
         arr.push_back(j);
     }
     json j;

@@ -234,6 +234,58 @@ expect_error "badtrace.csv:3: column 'follower_speed_mps' = 'x'" calibrate "$tmp
 expect_error "--bounds item 'eta=15'" calibrate "$excerpt" --bounds eta=15
 expect_error "--train = '5'" calibrate "$excerpt" --train 5
 
+# calibrate on several files: one progress line per finished fit on stderr, always {"fits": [...]}
+cp "$excerpt" "$tmp/run2.csv"
+if "$bin" calibrate "$excerpt" "$tmp/run2.csv" --format json >"$tmp/cal2.json" 2>"$tmp/cal2.err"; then
+    grep -q '^ddemap: calibrate: 2/2 fits done (\(run2\|openacc_excerpt_rav4_to_etron\), [0-9.]* s)$' "$tmp/cal2.err" && ok || bad "calibrate progress lines"
+    python3 -c "import json; r=json.load(open('$tmp/cal2.json'))['result']; assert len(r['fits']) == 2 and r['fits'][1]['name'] == 'run2'" && ok || bad "calibrate two files JSON"
+else
+    bad "calibrate two files exit status"
+fi
+# --joint: one fit of the same shape, with its runs
+if "$bin" calibrate --joint --car rav4 "$excerpt" "$tmp/run2.csv" --format json >"$tmp/calj.json" 2>/dev/null; then
+    python3 - "$tmp/calj.json" <<'PY' && ok || bad "calibrate --joint JSON"
+import json, sys
+r = json.load(open(sys.argv[1]))['result']
+assert len(r['fits']) == 1
+f = r['fits'][0]
+assert f['name'] == 'rav4' and len(f['train_runs']) == 2 and f['tests'] == []
+assert all(k in f for k in ['k1', 'ci95', 'covariance', 'warnings', 'rmse_speed', 'naive_rmse_speed', 'objective', 'starts', 'status'])
+PY
+else
+    bad "calibrate --joint exit status"
+fi
+# --runs with a test run and --report: the tables and a figure per run; a test run that is the
+# training file itself has the training run's whole-file errors
+printf 'car,file,role,type\nrav4,%s,train,\nrav4,%s,test,same\n' "$excerpt" "$tmp/run2.csv" >"$tmp/runs.csv"
+if "$bin" calibrate --runs "$tmp/runs.csv" --report "$tmp/report" --format json >"$tmp/calr.json" 2>/dev/null; then
+    python3 - "$tmp/calr.json" "$tmp/report" <<'PY' && ok || bad "calibrate --runs --report"
+import csv, json, sys
+f = json.load(open(sys.argv[1]))['result']['fits'][0]
+t = f['tests'][0]
+assert t['type'] == 'same' and t['rmse_speed'] == f['train_runs'][0]['rmse_speed'] and t['rmse_gap'] == f['train_runs'][0]['rmse_gap']
+rows = list(csv.DictReader(open(sys.argv[2] + '/table.csv')))
+assert len(rows) == 1 and rows[0]['car'] == 'rav4' and float(rows[0]['same_rmse_speed']) == t['rmse_speed']
+assert float(rows[0]['k1']) == f['k1'] and float(rows[0]['k1_lo']) == f['ci95']['k1'][0]
+j = json.load(open(sys.argv[2] + '/table.json'))
+assert j['test_types'] == ['same'] and j['cars'][0]['test']['same']['rmse_gap'] == t['rmse_gap']
+md = open(sys.argv[2] + '/table.md').read()
+assert '| car | train runs | k1 [1/s^2]' in md and '| car | speed train [m/s] | speed same / naive | spacing train [m] | spacing same |' in md
+PY
+    for svg in "$tmp"/report/fit_rav4_*.svg; do xmllint --noout "$svg" || bad "report figure $svg"; done
+    [ "$(ls "$tmp"/report/fit_rav4_*.svg | wc -l)" -eq 2 ] && ok || bad "report: one figure per run"
+else
+    bad "calibrate --runs exit status"
+fi
+printf 'car,file,role\nrav4,%s,fit\n' "$excerpt" >"$tmp/badruns.csv"
+expect_error "badruns.csv:2: column 'role' = 'fit': expected train or test" calibrate --runs "$tmp/badruns.csv"
+printf 'car,file,role\nrav4,%s,test\n' "$excerpt" >"$tmp/badruns2.csv"
+expect_error "car 'rav4' has no run with role train" calibrate --runs "$tmp/badruns2.csv"
+expect_error "--joint: not with --runs" calibrate --joint --runs "$tmp/runs.csv"
+expect_error "expected at least one trace" calibrate
+touch "$tmp/notadir"
+expect_error "--report = '$tmp/notadir': the folder does not exist and cannot be created" calibrate "$excerpt" --report "$tmp/notadir"
+
 # roots --system: any linear DDE from JSON
 cat >"$tmp/sys.json" <<'JSON'
 {"dimension": 2, "delays": [1.0, 0.3], "A0": [[0, 0], [0, 0]],

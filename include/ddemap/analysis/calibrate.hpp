@@ -13,6 +13,7 @@
 /// corrected for correlated residuals (Newey-West), 95 % intervals, correlations, optional
 /// profile likelihoods and warnings.
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,16 @@ struct FitErrors {
     int samples = 0;
 };
 
+/// One fitted run simulated over its whole file with given parameters (history on
+/// [t_0, t_0 + tau]), and the naive predictor v(t) = v_lead(t - d) (best constant d in [0, 5] s
+/// on a 0.1 s grid) on the same samples: a training run's fit, or a test run's prediction.
+struct FitEvaluation {
+    FitErrors errors;                        ///< the model's speed and gap RMSE [m/s, m]
+    FitErrors naive;                         ///< the naive predictor's speed RMSE
+    double naive_delay = 0.0;                ///< its d [s]
+    std::vector<double> sim_speed, sim_gap;  ///< the simulation at the trace's times
+};
+
 /// One calibrated parameter with its uncertainty.
 struct ParameterEstimate {
     std::string name;
@@ -155,20 +166,74 @@ struct CalibrationResult {
     std::string status;          ///< to_string(status_code)
     std::string message;         ///< why the best start stopped
     double seconds = 0.0;
-    std::vector<double> sim_speed, sim_gap;  ///< whole-file simulation at the trace's times
+    std::vector<double> sim_speed, sim_gap;  ///< whole-file simulation at the trace's times (single-run fits)
+    /// per fitted run (one for `calibrate`, one per run for `calibrate_joint`): its whole-file
+    /// simulation, errors and naive predictor; `all` pools them (RMSE over all samples)
+    std::vector<FitEvaluation> runs;
 };
 
 CalibrationResult calibrate(const Trace& trace, const CalibrationOptions& options = {});
+
+/// One parameter set fitted to several runs of the same car: the residuals of every run
+/// (each simulated from its own measured history and driven by its own lead, on the same
+/// training window `train_start:train_end` if one is set) stacked into one least-squares
+/// problem, objective = (sum over runs of the squared residuals) / (all samples). The
+/// covariance is C = H^-1 (sum_runs Omega_run) H^-1 with each run's Newey-West Omega_run
+/// computed on that run's own scores and bandwidth (no lags across runs: runs are independent),
+/// the critical value from the largest b = L / n over the runs. train and all pool the runs;
+/// test is empty (test runs are evaluated with evaluate_fit); naive uses one delay for all
+/// runs. std::invalid_argument when `runs` is empty or a window does not fit a run.
+CalibrationResult calibrate_joint(const std::vector<Trace>& runs, const CalibrationOptions& options = {});
 
 /// calibrate() for every trace, in parallel over the traces under `policy`; the results are in
 /// the traces' order. The error of the lowest failing trace is rethrown after the loop.
 std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options,
                                              const ExecutionPolicy& policy = {});
+/// A car of a calibration study (the seed paper's Tables 1 and 2): one parameter set fitted to
+/// its training runs (calibrate for one run, calibrate_joint for several) and tested on its
+/// other runs, each labelled with its test type (e.g. "oscillatory", "dips", "handling").
+struct CarRuns {
+    std::string car;
+    std::vector<Trace> train, test;
+    std::vector<std::string> test_types;  ///< one per test run
+};
+
+/// A test run simulated over its whole file with the car's fitted parameters.
+struct TestRun {
+    std::string source, type;
+    FitEvaluation evaluation;
+};
+
+struct CarCalibration {
+    std::string car;
+    std::vector<std::string> train_sources;
+    CalibrationResult fit;
+    std::vector<TestRun> tests;  ///< in the order of CarRuns::test
+};
+
+/// Called after each car is done (one call at a time, in the order the cars finish): the car's
+/// result, how many cars are done and how many there are.
+using CarFinished = std::function<void(const CarCalibration& car, long done, long total)>;
+
+/// Fits every car (in parallel over the cars under `policy`; `policy.progress` and `finished`
+/// after each car) and evaluates its test runs. std::invalid_argument for a car without
+/// training runs or with test_types not one per test run (naming the car); a fit's own errors
+/// as in calibrate.
+std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
+                                           const ExecutionPolicy& policy = {}, const CarFinished& finished = {});
+
 /// The objective `calibrate` minimises, at given parameters (k1, k2, th, tau, eta, each inside
 /// or outside the bounds): MSE(speed) + gap_weight MSE(gap) over the training samples at or
 /// after t_a + tau_max (tau_max: the upper bound of tau), so fits and other candidates (e.g.
 /// the true parameters of a synthetic trace) compare on the same samples.
 double calibration_objective(const Trace& trace, const ParameterMap& parameters, const CalibrationOptions& options = {});
+/// The objective `calibrate_joint` minimises: the runs' squared residuals summed over all runs,
+/// divided by the number of samples of all runs.
+double calibration_objective(const std::vector<Trace>& runs, const ParameterMap& parameters, const CalibrationOptions& options = {});
+
+/// The whole-file simulation of `trace` with `parameters` (k1, k2, th, tau, eta), its errors
+/// and the naive predictor on the same samples (t >= t_0 + tau).
+FitEvaluation evaluate_fit(const Trace& trace, const ParameterMap& parameters, double step = 0.05);
 
 /// Simulates the follower over [t_a, t_b] of the trace (history from the data on
 /// [t_a, t_a + tau]); speed and gap at the trace's sample times in the window (data values

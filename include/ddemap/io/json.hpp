@@ -87,9 +87,12 @@ std::string boundary_json(const BoundarySet& b);
 std::string simulation_json(const SimResult& r, const std::string& lead);
 /// the growth study: per vehicle setting amplification by position and the failure
 std::string growth_json(const std::vector<GrowthResult>& g, const std::string& lead);
-/// calibration fits: {"fits": [...], "gap_weight", "bounds"}
+/// calibration fits: {"fits": [...], "gap_weight", "bounds"}, always this shape (one fit per
+/// file, or per car); with `cars` (fits[i] = cars[i].fit) each fit adds "train_runs" (file,
+/// rmse_speed, rmse_gap, naive_rmse_speed, samples per fitted run) and "tests" (the same and
+/// "type" per test run)
 std::string calibration_json(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
-                             const CalibrationOptions& o);
+                             const CalibrationOptions& options, const std::vector<CarCalibration>* cars = nullptr);
 /// the penetration-rate study: one object per p
 std::string mix_json(const std::vector<MixPoint>& points, int cars);
 
