@@ -37,12 +37,8 @@ int run_classify() {
     const Format format = args.format.parse();
     if (args.out.given() && !args.svg.empty()) throw BadInput("--out and --svg: expected only --out (--svg is its old spelling)");
     const std::string prefix = args.out.given() ? args.out.prepare("classify") : std::string();
-    std::string svg_file;
-    if (!args.svg.empty()) {
-        OutArg o;
-        o.text = args.svg;
-        svg_file = o.prepare("classify") + ".svg";
-    }
+    // --svg FILE writes exactly FILE (through a link; into a device such as /dev/null directly)
+    const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);
     std::vector<CalibratedVehicle> vehicles;
     std::string source = "the paper's calibration table (built in)";
     if (args.file.empty()) {

@@ -7,14 +7,16 @@
 
 #include <unistd.h>
 
+#include "ddemap/io/files.hpp"
+
 namespace ddemap::cli {
 
 std::string read_input_file(const std::string& flag, const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    try {
+        return read_text_file(path);
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + " = " + e.what());
+    }
 }
 
 double parse_number(const std::string& flag, const std::string& text) {
@@ -141,7 +143,7 @@ void OutArg::add_to(CLI::App& app, const std::string& writes, bool required) {
     if (required) o->required();
 }
 
-std::string OutArg::prepare(const std::string& command) const {
+std::string OutArg::prepare(const std::string& command, std::initializer_list<const char*> suffixes) const {
     namespace fs = std::filesystem;
     if (text.empty()) throw BadInput("--out PREFIX is required");
     std::string prefix = text;
@@ -160,13 +162,37 @@ std::string OutArg::prepare(const std::string& command) const {
     }
     const auto slash = prefix.find_last_of('/');
     const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : prefix.substr(0, slash));
+    // a regular file where a folder is needed: refused before anything is created
+    for (fs::path p = fs::path(dir); !p.empty(); p = p.parent_path()) {
+        if (fs::exists(p, ec) && !fs::is_directory(p, ec))
+            throw BadInput("--out = '" + text + "': '" + p.string() + "' is a file, not a folder");
+        if (p == p.parent_path()) break;
+    }
     if (!fs::is_directory(dir, ec)) {
         fs::create_directories(dir, ec);
         if (ec || !fs::is_directory(dir))
-            throw BadInput("--out = '" + text + "': the folder '" + dir + "' does not exist and cannot be created");
+            throw BadInput("--out = '" + text + "': the folder '" + dir + "' does not exist and cannot be created" +
+                           (ec ? " (" + ec.message() + ")" : std::string()));
     }
-    if (access(dir.c_str(), W_OK) != 0) throw BadInput("--out = '" + text + "': the folder '" + dir + "' is not writable");
+    if (access(dir.c_str(), W_OK | X_OK) != 0) throw BadInput("--out = '" + text + "': the folder '" + dir + "' is not writable");
+    for (const char* suffix : suffixes) {
+        try {
+            check_output_file(prefix + suffix);
+        } catch (const std::invalid_argument& e) {
+            throw BadInput("--out = '" + text + "': " + e.what());
+        }
+    }
     return prefix;
+}
+
+std::string output_file(const std::string& flag, const std::string& path) {
+    if (path.empty()) throw BadInput(flag + " = '': expected a file name");
+    try {
+        check_output_file(path);
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + " = " + e.what());
+    }
+    return path;
 }
 
 void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }

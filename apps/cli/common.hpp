@@ -37,7 +37,8 @@ struct BadInput : std::invalid_argument {
     using std::invalid_argument::invalid_argument;
 };
 
-/// The whole file as text; a file that cannot be opened is bad input naming the flag and path.
+/// The whole file as text (io read_text_file: a byte-order mark and CRLF line ends accepted); a
+/// folder or a file that cannot be opened is bad input naming the flag and path.
 std::string read_input_file(const std::string& flag, const std::string& path);
 double parse_number(const std::string& flag, const std::string& text);
 long parse_integer(const std::string& flag, const std::string& text, long lo, long hi, const std::string& what);
@@ -96,10 +97,15 @@ struct OutArg {
     std::string text;
     void add_to(CLI::App& app, const std::string& writes, bool required);
     bool given() const { return !text.empty(); }
-    /// Resolves the prefix and prepares its folder (created as needed, must be writable): bad
-    /// input otherwise, before any work.
-    std::string prepare(const std::string& command) const;
+    /// Resolves the prefix and prepares its folder (created as needed, must be writable) and
+    /// checks PREFIX + each suffix (not a folder, writable; check_output_file): bad input
+    /// otherwise, before any work.
+    std::string prepare(const std::string& command, std::initializer_list<const char*> suffixes = {".csv", ".json", ".svg"}) const;
 };
+
+/// A file the command writes under its own flag (e.g. classify --svg FILE), checked before any
+/// work (check_output_file): bad input naming the flag otherwise. Returns `path`.
+std::string output_file(const std::string& flag, const std::string& path);
 
 /// Prints the envelope of a command's JSON output.
 void print_json(const JsonEnvelope& e);

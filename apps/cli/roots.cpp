@@ -206,7 +206,7 @@ void add_roots_flags(CLI::App& app) {
 
 int run_roots() {
     const Format format = args.format.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("roots") : std::string();
+    const std::string prefix = args.out.given() ? args.out.prepare("roots", {".csv", ".json"}) : std::string();
     if (!args.fleet.empty() || !args.pattern.empty()) return run_fleet(format, prefix);
     if (!args.system.empty()) return run_system(format, prefix);
     return run_ring(format, prefix);

@@ -44,7 +44,7 @@ void add_sweep_flags(CLI::App& app) {
 int run_sweep() {
     const Format format = args.format.parse();
     const SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
-    const std::string prefix = args.out.prepare("sweep");
+    const std::string prefix = args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
     if (isatty(2)) policy.progress = progress_line;
     const SweepResult sw = run_sweep(spec, policy);
