@@ -7,7 +7,9 @@
 
 #include <unistd.h>
 
+#include "ddemap/analysis/simulate.hpp"
 #include "ddemap/io/files.hpp"
+#include "ddemap/io/vehicle_files.hpp"
 
 namespace ddemap::cli {
 
@@ -193,6 +195,40 @@ std::string output_file(const std::string& flag, const std::string& path) {
         throw BadInput(flag + " = " + e.what());
     }
     return path;
+}
+
+Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars) {
+    Fleet unit;
+    try {
+        unit = names_a_file(spec) ? read_fleet_table(read_input_file(flag, spec), spec) : fleet_from_pattern(spec, 0);
+    } catch (const BadInput&) {
+        throw;
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + ": " + e.what());
+    }
+    if (cars <= 0) return unit;
+    Fleet out;
+    out.reserve(static_cast<std::size_t>(cars));
+    for (int i = 0; i < cars; ++i) out.push_back(unit[static_cast<std::size_t>(i) % unit.size()]);
+    return out;
+}
+
+std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& spec) {
+    try {
+        return names_a_file(spec) ? read_vehicle_table(read_input_file(flag, spec), spec) : vehicles_from_pattern(spec);
+    } catch (const BadInput&) {
+        throw;
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + ": " + e.what());
+    }
+}
+
+FleetCar car_argument(const std::string& flag, const std::string& spec) {
+    try {
+        return fleet_car_from_argument(spec);
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + ": " + e.what());
+    }
 }
 
 void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }

@@ -19,7 +19,9 @@
 
 #include "ddemap/io/json.hpp"
 #include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/fleet.hpp"
 #include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/vehicles.hpp"
 #include "format.hpp"
 
 namespace ddemap::cli {
@@ -106,6 +108,15 @@ struct OutArg {
 /// A file the command writes under its own flag (e.g. classify --svg FILE), checked before any
 /// work (check_output_file): bad input naming the flag otherwise. Returns `path`.
 std::string output_file(const std::string& flag, const std::string& path);
+
+/// A command's cars, given the same way everywhere: a file (a vehicle or fleet CSV, e.g. what
+/// calibrate writes; io names_a_file) or a pattern of built-in names "A_min*3,C_max".
+/// `cars` > 0 repeats the cars to that many (the last repetition cut short).
+Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars = 0);
+/// The same as OVRV vehicles (classify, simulate).
+std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& spec);
+/// One car (mix --x/--y): NAME, MODEL:NAME=VALUE,..., FILE.csv (one kind of car) or FILE.csv:NAME.
+FleetCar car_argument(const std::string& flag, const std::string& spec);
 
 /// Prints the envelope of a command's JSON output.
 void print_json(const JsonEnvelope& e);

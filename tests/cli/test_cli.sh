@@ -114,7 +114,7 @@ expect_error "exactly two swept" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --out "
 expect_error "LO:HI:COUNT" sweep --th 1.5 --tau 0.5 --k1 0.01:1:1 --k2 0:1:4 --out "$tmp/x"
 expect_error "k1 = -1" sweep --th 1.5 --tau 0.5 --k1 -1:1:4 --k2 0:1:4 --out "$tmp/x"
 : >"$tmp/afile"
-expect_error "does not exist" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$tmp/afile/x"
+expect_error "is a file, not a folder" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$tmp/afile/x"
 [ ! -e "$tmp/x.csv" ] && ok || bad "a failed sweep left output"
 
 # boundary
@@ -337,11 +337,14 @@ assert d["status"] == "max_degree_reached" and d["message"], d
 assert d["result"]["stable"] is False
 PY
 "$bin" roots --system "$tmp/cyc.json" --degree 2 --count 10 | grep -q 'UNDECIDED' && ok || bad "not converged: the table says undecided"
-# the folder is fine, but PREFIX.json is a folder: the write fails after the computation, nothing half-written
+# the folder is fine, but PREFIX.json is a folder: refused before any work (exit 2); a move that
+# fails after the computation (test hook) is exit 5 with nothing half-written
 mkdir -p "$tmp/w.json"
-expect_code 5 classify --out "$tmp/w"
-grep -q "cannot write" "$tmp/e.txt" && ok || bad "write failure message"
-[ ! -e "$tmp/w.csv" ] && ! ls "$tmp" | grep -q '\.part$' && ok || bad "a failed write left files"
+expect_error "w.json' is a folder, expected a file" classify --out "$tmp/w"
+mkdir -p "$tmp/wf"
+DDEMAP_TEST_FAULT=move:2 expect_code 5 classify --out "$tmp/wf/w"
+grep -q "cannot write .*w.json: Input/output error" "$tmp/e.txt" && ok || bad "write failure message"
+[ -z "$(ls -A "$tmp/wf")" ] && ok || bad "a failed write left files"
 
 # --format on every command; a format without meaning is a clear error naming the accepted ones
 for c in roots string classify sweep boundary chart paper simulate growth calibrate mix; do
