@@ -43,33 +43,87 @@ long parse_integer(const std::string& flag, const std::string& text, long lo, lo
     return v;
 }
 
+namespace {
+std::string detail_number(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+}
+}  // namespace
+
+std::string model_list(const std::string& separator, const std::string& last_separator) {
+    const auto names = model_names();
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i) list += (i == 0 ? "" : i + 1 == names.size() ? last_separator : separator) + names[i];
+    return list;
+}
+
+void annotate_option_types(CLI::App& app, const std::string& command) {
+    // the kind of value of every flag that is not a model parameter (those are NUMBER, set where
+    // they are added); sweeps and boundaries take ranges for the model parameters
+    static const std::map<std::string, std::string> kinds = {
+        {"count", "INTEGER"}, {"degree", "INTEGER"}, {"draws", "INTEGER"}, {"followers", "INTEGER"}, {"seed", "INTEGER"},
+        {"seed-grid", "INTEGER"}, {"gap-weight", "NUMBER"}, {"output-dt", "NUMBER"}, {"step", "NUMBER"}, {"t-end", "NUMBER"},
+        {"length", "NUMBER"}, {"fleet", "FILE|PATTERN"}, {"fleet-pattern", "FILE|PATTERN"}, {"cars", "N"}, {"lead", "FILE"},
+        {"system", "FILE"}, {"svg", "FILE"}, {"lead-profile", "NAME"}, {"on-event", "stop|continue"}, {"out", "PREFIX"},
+        {"p", "LO:HI:COUNT"}, {"ring", "N|inf"}, {"solver", "auto|product|dense|sparse"}, {"train", "T0:T1"},
+        {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", command == "mix" ? "CAR" : "NAME"}, {"y", "CAR"}};
+    for (CLI::Option* o : app.get_options()) {
+        if (o->get_lnames().empty()) {  // a positional argument: a file
+            if (o->get_type_name() == "TEXT") o->type_name("FILE");
+            continue;
+        }
+        const std::string name = o->get_lnames().front();
+        if (o->get_group() == "Model" && name != "model" && (command == "sweep" || command == "boundary"))
+            o->type_name(command == "sweep" ? "NUMBER|LO:HI:COUNT" : "NUMBER|LO:HI");
+        if (o->get_type_name() != "TEXT") continue;
+        const auto k = kinds.find(name);
+        if (k != kinds.end()) o->type_name(name == "ring" && command == "mix" ? "N" : k->second);
+    }
+}
+
+namespace {
+/// The help of one model flag, from the model table: what it is, its unit, and per model
+/// whether it is required or its default ("required for ovrv, ccc; idm: default 2").
+std::string parameter_help(const std::string& name) {
+    std::string description, unit, required, defaults, absent;
+    for (const auto& m : model_names()) {
+        bool found = false;
+        for (const auto& p : model_parameters(m)) {
+            if (p.name != name) continue;
+            found = true;
+            if (description.empty()) {
+                description = p.description;
+                unit = p.unit;
+            }
+            if (p.required) required += (required.empty() ? "" : ", ") + m;
+            else defaults += (defaults.empty() ? "" : ", ") + m + " " + detail_number(p.default_value);
+        }
+        if (!found) absent += (absent.empty() ? "" : ", ") + m;
+    }
+    if (name == "speed") description = "equilibrium speed (idm is linearised about it; ovrv and ccc do not depend on it)";
+    std::string h = description + " [" + unit + "]";
+    if (!required.empty()) h += "; required for " + required;
+    if (!defaults.empty()) h += "; default: " + defaults;
+    if (!absent.empty()) h += "; not a parameter of " + absent;
+    if (name == "speed") h += " (for a fleet: the common speed)";
+    return h;
+}
+}  // namespace
+
 void ModelArgs::add_to(CLI::App& app) {
-    app.add_option("--model", model,
-                   "car-following model: ovrv (paper eq. 3), idm (intelligent driver model) or ccc (connected cruise control: "
-                   "ovrv + the car two ahead)")
+    app.add_option("--model", model, "car-following model: " + model_list(", ", " or ") + " (the model flags below say which parameters each needs)")
         ->capture_default_str()
+        ->type_name(model_list("|", "|"))
         ->group("Model");
-    struct P {
-        const char* name;
-        const char* help;
-    };
-    static const P params[] = {
-        {"k1", "OVRV gain on the gap error [1/s^2]"},
-        {"k2", "OVRV gain on the speed difference [1/s]"},
-        {"th", "time headway [s]"},
-        {"tau", "sensing delay [s] (0 gives the ODE)"},
-        {"eta", "jam gap [m] (ovrv default 10, idm default 2; does not enter the linearisation of ovrv)"},
-        {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20; for a fleet: the common speed)"},
-        {"a", "IDM maximum acceleration [m/s^2] (default 1)"},
-        {"b", "IDM comfortable deceleration [m/s^2] (default 1.5)"},
-        {"v0", "IDM desired speed [m/s] (default 33.3)"},
-        {"delta", "IDM acceleration exponent [1] (default 4)"},
-        {"k3", "CCC gain on the speed difference to the car two ahead [1/s]"},
-        {"tau2", "CCC delay of the V2V signal from the car two ahead [s]"},
-    };
-    for (const auto& p : params) {
-        const std::string name = p.name;
-        app.add_option_function<std::string>("--" + name, [this, name](const std::string& v) { raw[name] = v; }, p.help)->group("Model");
+    std::vector<std::string> names;  // every parameter of every model, in the order of first appearance
+    for (const auto& m : model_names())
+        for (const auto& p : model_parameters(m))
+            if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+    for (const auto& name : names) {
+        app.add_option_function<std::string>("--" + name, [this, name](const std::string& v) { raw[name] = v; }, parameter_help(name))
+            ->type_name("NUMBER")
+            ->group("Model");
     }
 }
 
@@ -83,11 +137,7 @@ void ModelArgs::split(ParameterMap& fixed, std::vector<std::pair<std::string, st
 
 void ModelArgs::check_model() const {
     const auto names = model_names();
-    if (std::find(names.begin(), names.end(), model) == names.end()) {
-        std::string list;
-        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-        throw BadInput("--model = '" + model + "': expected one of " + list);
-    }
+    if (std::find(names.begin(), names.end(), model) == names.end()) throw BadInput("--model = '" + model + "': expected one of " + model_list(", ", ", "));
 }
 
 std::unique_ptr<CarModel> ModelArgs::build() const {
@@ -127,7 +177,11 @@ std::string format_list(const std::vector<Format>& fs) {
 
 void FormatArg::add_to(CLI::App& app, std::initializer_list<Format> formats) {
     accepted = formats;
-    app.add_option("--format", text, "output on stdout: " + format_list(accepted))->capture_default_str();
+    app.add_option("--format", text, "output on stdout: " + format_list(accepted))->capture_default_str()->type_name([&] {
+        std::string t;
+        for (Format f : accepted) t += (t.empty() ? "" : "|") + std::string(format_name(f));
+        return t;
+    }());
 }
 
 Format FormatArg::parse() const {

@@ -54,7 +54,15 @@ std::string root_method(const std::string& solver);
 /// A method in --solver words (shift_invert -> sparse, contour -> product).
 std::string solver_name(const std::string& method);
 
-/// The model flags: --model and one flag per model parameter.
+/// The built-in model names from the model table, joined ("ovrv, idm or ccc").
+std::string model_list(const std::string& separator, const std::string& last_separator);
+
+/// Sets the value kind shown in --help (NUMBER, INTEGER, FILE, PREFIX, ...) of every flag of
+/// `app` still shown as TEXT, from one table of the shared flag names.
+void annotate_option_types(CLI::App& app, const std::string& command);
+
+/// The model flags: --model and one flag per model parameter (generated from the model table:
+/// unit, required or default per model).
 struct ModelArgs {
     std::string model = "ovrv";
     std::map<std::string, std::string> raw;  // parameter name -> text, only those given

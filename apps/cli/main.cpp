@@ -110,7 +110,23 @@ int main(int argc, char** argv) {
     for (const Command& c : command_table()) {
         CLI::App* sub = app.add_subcommand(c.name, c.description);
         c.add_flags(*sub);
+        annotate_option_types(*sub, c.name);
         commands.emplace_back(sub, &c);
+    }
+    // a first word that is neither a flag nor a command: name it and list the commands
+    std::string command_names;
+    for (const Command& c : command_table()) command_names += (command_names.empty() ? "" : ", ") + std::string(c.name);
+    if (argc > 1 && argv[1][0] != '-') {
+        bool known = false;
+        for (const Command& c : command_table()) known = known || std::strcmp(c.name, argv[1]) == 0;
+        if (!known) {
+            std::cerr << "ddemap: error: unknown command '" << one_line(argv[1]) << "': expected one of " << command_names << " (see ddemap --help)\n";
+            return exit_bad_input;
+        }
+    }
+    if (argc == 1) {
+        std::cerr << "ddemap: error: expected a command: one of " << command_names << " (see ddemap --help)\n";
+        return exit_bad_input;
     }
     try {
         app.parse(argc, argv);
