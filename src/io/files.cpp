@@ -154,6 +154,21 @@ std::string hidden_name(const std::string& base) {
     return "." + base + ".ddemap-" + std::to_string(::getpid()) + "-" + std::to_string(++g_counter) + ".tmp";
 }
 
+/// False when no process `pid` runs: none exists, or it is a zombie (killed, not yet reaped).
+bool process_alive(pid_t pid) {
+    if (::kill(pid, 0) != 0) return errno != ESRCH;
+    const std::string stat_path = "/proc/" + std::to_string(pid) + "/stat";
+    const int fd = ::open(stat_path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return true;
+    char buf[512];
+    const ssize_t n = ::read(fd, buf, sizeof buf - 1);
+    ::close(fd);
+    if (n <= 0) return true;
+    buf[n] = '\0';
+    const char* paren = std::strrchr(buf, ')');  // "PID (NAME) STATE ..."
+    return !(paren != nullptr && paren[1] == ' ' && paren[2] == 'Z');
+}
+
 /// Removes hidden temporary files of `base` in the folder left by a writer that was killed
 /// (SIGKILL, power loss) on a file system without O_TMPFILE: ".BASE.ddemap-PID-N.tmp" whose
 /// process PID no longer exists.
@@ -174,7 +189,7 @@ void remove_stale_temps(int dirfd, const std::string& base) {
         char* end = nullptr;
         const long pid = std::strtol(name.c_str() + head.size(), &end, 10);
         if (pid <= 0 || end == nullptr || *end != '-') continue;
-        if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) stale.push_back(name);
+        if (!process_alive(static_cast<pid_t>(pid))) stale.push_back(name);
     }
     ::closedir(d);
     for (const auto& name : stale) ::unlinkat(dirfd, name.c_str(), 0);
