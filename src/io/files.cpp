@@ -129,6 +129,7 @@ struct Target {
     int temp_slot = -1;
     bool swapped = false;  // temp now holds the old content (exchanged)
     bool placed = false;   // the new content is at base
+    bool remove = false;   // a stale member of the set: moved away with the set, removed after
 };
 
 unsigned g_counter = 0;
@@ -325,14 +326,22 @@ void check_output_file(const std::string& given) {
 
 void write_file_atomic(const std::string& path, const std::string& text) { write_files_atomic({{path, text}}); }
 
-void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
-    std::vector<Target> ts(files.size());
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files, const std::vector<std::string>& remove) {
+    static const std::string nothing;
+    std::vector<Target> ts(files.size() + remove.size());
+    for (std::size_t i = files.size(); i < ts.size(); ++i) {
+        ts[i].remove = true;
+        ts[i].given = remove[i - files.size()];
+        ts[i].text = &nothing;
+    }
     InterruptCleanup cleanup;
     // 1. resolve every path; write the special files; write the regular ones to temporary files
-    for (std::size_t i = 0; i < files.size(); ++i) {
+    for (std::size_t i = 0; i < ts.size(); ++i) {
         Target& t = ts[i];
-        t.given = files[i].first;
-        t.text = &files[i].second;
+        if (!t.remove) {
+            t.given = files[i].first;
+            t.text = &files[i].second;
+        }
         try {
             t.path = resolve_output_path(t.given);
         } catch (const std::invalid_argument&) {
@@ -341,6 +350,11 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         t.dir = dir_of(t.path);
         t.base = base_of(t.path);
         struct stat st {};
+        if (t.remove) {  // only a regular file is removed (a folder or a device is left alone)
+            t.existed = ::stat(t.path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+            t.special = !t.existed;
+            continue;
+        }
         if (::stat(t.path.c_str(), &st) == 0) {
             if (S_ISDIR(st.st_mode)) fail(ts, t.given, EISDIR);
             t.special = !S_ISREG(st.st_mode);
@@ -349,7 +363,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         }
     }
     for (auto& t : ts) {
-        if (!t.special) continue;
+        if (!t.special || t.remove) continue;
         const int fd = ::open(t.path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
         if (fd < 0) fail(ts, t.given, errno);
         int err = 0;
@@ -363,6 +377,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         t.dirfd = ::open(t.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (t.dirfd < 0) fail(ts, t.given, errno);
         remove_stale_temps(t.dirfd, t.base);
+        if (t.remove) continue;
         const mode_t mode = t.existed ? t.mode : 0666;
         t.fd = test_fault("named") ? -1 : ::openat(t.dirfd, ".", O_TMPFILE | O_WRONLY | O_CLOEXEC, mode);
         t.fd_unnamed = t.fd >= 0;
@@ -402,6 +417,26 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         if (test_fault_move(i)) {
             rc = -1;
             errno = EIO;
+        } else if (t.remove) {  // moved away to a hidden name, removed after the set is in place
+            for (int attempt = 0; attempt < 100; ++attempt) {
+                const std::string name = hidden_name(t.base);
+                const int slot = register_named(dir_path(t, name));
+                rc = ::renameat2(t.dirfd, t.base.c_str(), t.dirfd, name.c_str(), RENAME_NOREPLACE);
+                if (rc != 0 && (errno == EINVAL || errno == ENOSYS)) rc = ::renameat(t.dirfd, t.base.c_str(), t.dirfd, name.c_str());
+                if (rc == 0) {
+                    t.temp = name;
+                    t.temp_slot = slot;
+                    break;
+                }
+                err = errno;
+                unregister_named(slot);
+                if (err != EEXIST) break;
+            }
+            if (rc == 0) {
+                t.placed = t.swapped = true;
+                continue;
+            }
+            errno = err;
         } else if (t.existed) {
             rc = ::renameat2(t.dirfd, t.temp.c_str(), t.dirfd, t.base.c_str(), RENAME_EXCHANGE);
             if (rc == 0) t.swapped = true;
@@ -424,7 +459,8 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         for (std::size_t j = 0; j < i; ++j) {
             Target& u = ts[j];
             if (!u.placed) continue;
-            if (u.swapped) ::renameat2(u.dirfd, u.temp.c_str(), u.dirfd, u.base.c_str(), RENAME_EXCHANGE);
+            if (u.remove) ::renameat(u.dirfd, u.temp.c_str(), u.dirfd, u.base.c_str());
+            else if (u.swapped) ::renameat2(u.dirfd, u.temp.c_str(), u.dirfd, u.base.c_str(), RENAME_EXCHANGE);
             else if (!u.existed) ::unlinkat(u.dirfd, u.base.c_str(), 0);
         }
         fail(ts, t.given, err);

@@ -431,6 +431,13 @@ DDEMAP_TEST_FAULT=named,pause timeout -s KILL 1 "$bin" roots $rootsargs --out "$
 ls -A "$fio/set" | grep -q '^\.r\.csv\.ddemap-.*\.tmp$' && ok || bad "the test hook named,pause did not leave the killed writer's file"
 "$bin" roots $rootsargs --out "$fio/set/r" >/dev/null && [ "$(ls -A "$fio/set" | wc -l)" -eq 2 ] && head -1 "$fio/set/r.csv" | grep -q '^mode,' &&
     ok || bad "stale temporary files not removed: $(ls -A "$fio/set")"
+# a folder never holds old and new files of one command: a sweep without boundaries removes the
+# PREFIX-boundaries.csv of an earlier run with the set (and puts it back when the set fails)
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$fio/sw/x" >/dev/null && [ -f "$fio/sw/x-boundaries.csv" ] && ok || bad "sweep boundaries"
+DDEMAP_TEST_FAULT=move:4 expect_code 5 sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:5 --out "$fio/sw/x" --no-boundaries
+[ -f "$fio/sw/x-boundaries.csv" ] && [ "$(ls -A "$fio/sw" | wc -l)" -eq 4 ] && ! grep -q '^0,0.75,' "$fio/sw/x.csv" && ok || bad "a failed removal was not rolled back"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:5 --out "$fio/sw/x" --no-boundaries >/dev/null && [ ! -e "$fio/sw/x-boundaries.csv" ] &&
+    [ "$(ls -A "$fio/sw" | wc -l)" -eq 3 ] && ok || bad "an old PREFIX-boundaries.csv stayed beside a new chart: $(ls -A "$fio/sw")"
 # inputs: a folder given as a file says so; a byte-order mark and CRLF line ends are accepted everywhere
 expect_error "VEHICLES = '$fio' is a folder, expected a file" classify "$fio"
 expect_error "is a folder, expected a file" roots --system "$fio"

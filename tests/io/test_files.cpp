@@ -173,3 +173,21 @@ TEST_CASE("vehicle and fleet tables: one family, read by both readers") {
     CHECK_THROWS_WITH_AS(read_vehicle_table("vehicle,model,k1,k2,th,tau,k3,tau2\n,ccc,0.1,0.3,1.2,0.4,0.2,0.1\n", "c.csv"),
                          doctest::Contains("expected ovrv cars"), std::invalid_argument);
 }
+
+TEST_CASE("write_files_atomic: stale members of a set are removed with it, or kept when it fails") {
+    TempDir d;
+    spit(d / "x.csv", "old");
+    spit(d / "x-boundaries.csv", "old boundaries");
+    fs::create_directory(d / "x-dir.csv");
+    ::setenv("DDEMAP_TEST_FAULT", "move:2", 1);
+    CHECK_THROWS_AS(write_files_atomic({{d / "x.csv", "new"}}, {d / "x-boundaries.csv"}), WriteError);
+    ::unsetenv("DDEMAP_TEST_FAULT");
+    CHECK(slurp(d / "x.csv") == "old");
+    CHECK(slurp(d / "x-boundaries.csv") == "old boundaries");
+    CHECK(entries(d.path) == 3);
+    write_files_atomic({{d / "x.csv", "new"}}, {d / "x-boundaries.csv", d / "x-missing.csv", d / "x-dir.csv"});
+    CHECK(slurp(d / "x.csv") == "new");
+    CHECK(!fs::exists(d / "x-boundaries.csv"));
+    CHECK(fs::is_directory(d / "x-dir.csv"));  // only regular files are removed
+    CHECK(entries(d.path) == 2);
+}

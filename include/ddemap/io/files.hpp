@@ -46,8 +46,11 @@ void write_file_atomic(const std::string& path, const std::string& text);
 /// - a symbolic link is written through (its target is replaced, the link stays);
 /// - a special file (a device such as /dev/null, a FIFO) is never replaced: the text is written
 ///   into it directly, before any regular file is moved.
+/// - `remove`: files of an earlier run that are not part of this set (e.g. PREFIX-boundaries.csv
+///   of a sweep now run without boundaries): removed together with the move, so that a folder
+///   never holds old and new files of one command side by side (only regular files).
 /// On a failure the old files stay as they were and no temporary file is left; WriteError
 /// names the path and the system's reason (e.g. "No space left on device").
-void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files, const std::vector<std::string>& remove = {});
 
 }  // namespace ddemap
