@@ -67,7 +67,7 @@ void annotate_option_types(CLI::App& app, const std::string& command) {
         {"length", "NUMBER"}, {"fleet", "FILE|PATTERN"}, {"fleet-pattern", "FILE|PATTERN"}, {"cars", "N"}, {"lead", "FILE"},
         {"system", "FILE"}, {"svg", "FILE"}, {"lead-profile", "NAME"}, {"on-event", "stop|continue"}, {"out", "PREFIX"},
         {"p", "LO:HI:COUNT"}, {"ring", "N|inf"}, {"solver", "auto|product|dense|sparse"}, {"train", "T0:T1"},
-        {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", command == "mix" ? "CAR" : "NAME"}, {"y", "CAR"}};
+        {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", "NAME"}, {"y", "CAR"}};
     for (CLI::Option* o : app.get_options()) {
         if (o->get_lnames().empty()) {  // a positional argument: a file
             if (o->get_type_name() == "TEXT") o->type_name("FILE");
@@ -78,7 +78,9 @@ void annotate_option_types(CLI::App& app, const std::string& command) {
             o->type_name(command == "sweep" ? "NUMBER|LO:HI:COUNT" : "NUMBER|LO:HI");
         if (o->get_type_name() != "TEXT") continue;
         const auto k = kinds.find(name);
-        if (k != kinds.end()) o->type_name(name == "ring" && command == "mix" ? "N" : k->second);
+        if (k == kinds.end()) continue;
+        if (command == "mix" && (name == "ring" || name == "x")) o->type_name(name == "ring" ? "N" : "CAR");  // a finite ring; a car
+        else o->type_name(k->second);
     }
 }
 

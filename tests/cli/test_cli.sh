@@ -495,6 +495,7 @@ done
 "$bin" roots --help | grep -- '--th ' | grep -q 'required for ovrv, idm, ccc' && ok || bad "help: which model needs --th"
 "$bin" roots --help | grep -- '--v0 ' | grep -q 'default: idm 33.3' && ok || bad "help: the IDM defaults"
 "$bin" sweep --help | grep -q -- '--k1 NUMBER|LO:HI:COUNT' && ok || bad "sweep help: ranges"
+"$bin" mix --help | grep -q -- '--x CAR' && "$bin" sweep --help | grep -q -- '--x NAME' && ok || bad "help: the kind of --x per command"
 expect_error "unknown command 'rots': expected one of roots, string" rots --k1 0.2
 expect_error "expected a command" 
 python3 - "$bin" <<'PY' && ok || bad "the model list in errors is the model table"
