@@ -1,8 +1,7 @@
 #include "common.hpp"
 
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <system_error>
 
 #include <unistd.h>
