@@ -33,7 +33,7 @@ int run_boundary() {
     const Format format = args.format.parse();
     const int grid = static_cast<int>(parse_integer("--seed-grid", args.grid, 5, 2001, "an integer between 5 and 2001"));
     const SweepSpec spec = sweep_spec(args.model, args.ring, "", false, grid);
-    const std::string prefix = args.out.prepare("boundary");
+    const std::string prefix = args.out.prepare("boundary", {".csv", ".json"});
     const SweepResult sw = run_sweep(spec);
     const BoundarySet b = trace_boundaries(sw);
     JsonEnvelope e;

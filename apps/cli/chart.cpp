@@ -24,7 +24,7 @@ void add_chart_flags(CLI::App& app) {
 
 int run_chart() {
     const Format format = args.format.parse();
-    const std::string prefix = args.out.prepare("chart");
+    const std::string prefix = args.out.prepare("chart", {".svg"});
     const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", args.spec), args.spec);
     const RenderedChart r = render_chart(spec);
     write_files_atomic({{prefix + ".svg", r.svg}});

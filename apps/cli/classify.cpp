@@ -25,7 +25,10 @@ struct Args {
 }  // namespace
 
 void add_classify_flags(CLI::App& app) {
-    app.add_option("VEHICLES.csv", args.file, "CSV with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m)");
+    app.add_option("VEHICLES", args.file,
+                   "the vehicles: a CSV file with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m; other columns ignored, "
+                   "so calibrate's output works), a fleet table of ovrv cars (as roots --fleet), or built-in names \"A_min,E_max\"")
+        ->type_name("FILE|PATTERN");
     args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
@@ -37,18 +40,14 @@ int run_classify() {
     const Format format = args.format.parse();
     if (args.out.given() && !args.svg.empty()) throw BadInput("--out and --svg: expected only --out (--svg is its old spelling)");
     const std::string prefix = args.out.given() ? args.out.prepare("classify") : std::string();
-    std::string svg_file;
-    if (!args.svg.empty()) {
-        OutArg o;
-        o.text = args.svg;
-        svg_file = o.prepare("classify") + ".svg";
-    }
+    // --svg FILE writes exactly FILE (through a link; into a device such as /dev/null directly)
+    const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);
     std::vector<CalibratedVehicle> vehicles;
     std::string source = "the paper's calibration table (built in)";
     if (args.file.empty()) {
         vehicles = paper_calibration_table();
     } else {
-        vehicles = read_vehicles_csv(read_input_file("VEHICLES.csv", args.file), args.file);
+        vehicles = vehicles_argument("VEHICLES", args.file);
         source = args.file;
     }
     const auto rows = classify(vehicles, cars);

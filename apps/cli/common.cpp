@@ -1,20 +1,23 @@
 #include "common.hpp"
 
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <system_error>
 
 #include <unistd.h>
 
+#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/io/files.hpp"
+#include "ddemap/io/vehicle_files.hpp"
+
 namespace ddemap::cli {
 
 std::string read_input_file(const std::string& flag, const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput(flag + " = '" + path + "': cannot open the file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    try {
+        return read_text_file(path);
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + " = " + e.what());
+    }
 }
 
 double parse_number(const std::string& flag, const std::string& text) {
@@ -39,33 +42,89 @@ long parse_integer(const std::string& flag, const std::string& text, long lo, lo
     return v;
 }
 
+namespace {
+std::string detail_number(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+}
+}  // namespace
+
+std::string model_list(const std::string& separator, const std::string& last_separator) {
+    const auto names = model_names();
+    std::string list;
+    for (std::size_t i = 0; i < names.size(); ++i) list += (i == 0 ? "" : i + 1 == names.size() ? last_separator : separator) + names[i];
+    return list;
+}
+
+void annotate_option_types(CLI::App& app, const std::string& command) {
+    // the kind of value of every flag that is not a model parameter (those are NUMBER, set where
+    // they are added); sweeps and boundaries take ranges for the model parameters
+    static const std::map<std::string, std::string> kinds = {
+        {"count", "INTEGER"}, {"degree", "INTEGER"}, {"draws", "INTEGER"}, {"followers", "INTEGER"}, {"seed", "INTEGER"},
+        {"seed-grid", "INTEGER"}, {"gap-weight", "NUMBER"}, {"output-dt", "NUMBER"}, {"step", "NUMBER"}, {"t-end", "NUMBER"},
+        {"length", "NUMBER"}, {"fleet", "FILE|PATTERN"}, {"fleet-pattern", "FILE|PATTERN"}, {"cars", "N"}, {"lead", "FILE"},
+        {"system", "FILE"}, {"svg", "FILE"}, {"lead-profile", "NAME"}, {"on-event", "stop|continue"}, {"out", "PREFIX"},
+        {"p", "LO:HI:COUNT"}, {"ring", "N|inf"}, {"solver", "auto|product|dense|sparse"}, {"train", "T0:T1"},
+        {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", "NAME"}, {"y", "CAR"}};
+    for (CLI::Option* o : app.get_options()) {
+        if (o->get_lnames().empty()) {  // a positional argument: a file
+            if (o->get_type_name() == "TEXT") o->type_name("FILE");
+            continue;
+        }
+        const std::string name = o->get_lnames().front();
+        if (o->get_group() == "Model" && name != "model" && (command == "sweep" || command == "boundary"))
+            o->type_name(command == "sweep" ? "NUMBER|LO:HI:COUNT" : "NUMBER|LO:HI");
+        if (o->get_type_name() != "TEXT") continue;
+        const auto k = kinds.find(name);
+        if (k == kinds.end()) continue;
+        if (command == "mix" && (name == "ring" || name == "x")) o->type_name(name == "ring" ? "N" : "CAR");  // a finite ring; a car
+        else o->type_name(k->second);
+    }
+}
+
+namespace {
+/// The help of one model flag, from the model table: what it is, its unit, and per model
+/// whether it is required or its default ("required for ovrv, ccc; idm: default 2").
+std::string parameter_help(const std::string& name) {
+    std::string description, unit, required, defaults, absent;
+    for (const auto& m : model_names()) {
+        bool found = false;
+        for (const auto& p : model_parameters(m)) {
+            if (p.name != name) continue;
+            found = true;
+            if (description.empty()) {
+                description = p.description;
+                unit = p.unit;
+            }
+            if (p.required) required += (required.empty() ? "" : ", ") + m;
+            else defaults += (defaults.empty() ? "" : ", ") + m + " " + detail_number(p.default_value);
+        }
+        if (!found) absent += (absent.empty() ? "" : ", ") + m;
+    }
+    if (name == "speed") description = "equilibrium speed (idm is linearised about it; ovrv and ccc do not depend on it)";
+    std::string h = description + " [" + unit + "]";
+    if (!required.empty()) h += "; required for " + required;
+    if (!defaults.empty()) h += "; default: " + defaults;
+    if (!absent.empty()) h += "; not a parameter of " + absent;
+    if (name == "speed") h += " (for a fleet: the common speed)";
+    return h;
+}
+}  // namespace
+
 void ModelArgs::add_to(CLI::App& app) {
-    app.add_option("--model", model,
-                   "car-following model: ovrv (paper eq. 3), idm (intelligent driver model) or ccc (connected cruise control: "
-                   "ovrv + the car two ahead)")
+    app.add_option("--model", model, "car-following model: " + model_list(", ", " or ") + " (the model flags below say which parameters each needs)")
         ->capture_default_str()
+        ->type_name(model_list("|", "|"))
         ->group("Model");
-    struct P {
-        const char* name;
-        const char* help;
-    };
-    static const P params[] = {
-        {"k1", "OVRV gain on the gap error [1/s^2]"},
-        {"k2", "OVRV gain on the speed difference [1/s]"},
-        {"th", "time headway [s]"},
-        {"tau", "sensing delay [s] (0 gives the ODE)"},
-        {"eta", "jam gap [m] (ovrv default 10, idm default 2; does not enter the linearisation of ovrv)"},
-        {"speed", "equilibrium speed [m/s] (idm linearises about it; default 20; for a fleet: the common speed)"},
-        {"a", "IDM maximum acceleration [m/s^2] (default 1)"},
-        {"b", "IDM comfortable deceleration [m/s^2] (default 1.5)"},
-        {"v0", "IDM desired speed [m/s] (default 33.3)"},
-        {"delta", "IDM acceleration exponent [1] (default 4)"},
-        {"k3", "CCC gain on the speed difference to the car two ahead [1/s]"},
-        {"tau2", "CCC delay of the V2V signal from the car two ahead [s]"},
-    };
-    for (const auto& p : params) {
-        const std::string name = p.name;
-        app.add_option_function<std::string>("--" + name, [this, name](const std::string& v) { raw[name] = v; }, p.help)->group("Model");
+    std::vector<std::string> names;  // every parameter of every model, in the order of first appearance
+    for (const auto& m : model_names())
+        for (const auto& p : model_parameters(m))
+            if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+    for (const auto& name : names) {
+        app.add_option_function<std::string>("--" + name, [this, name](const std::string& v) { raw[name] = v; }, parameter_help(name))
+            ->type_name("NUMBER")
+            ->group("Model");
     }
 }
 
@@ -79,11 +138,7 @@ void ModelArgs::split(ParameterMap& fixed, std::vector<std::pair<std::string, st
 
 void ModelArgs::check_model() const {
     const auto names = model_names();
-    if (std::find(names.begin(), names.end(), model) == names.end()) {
-        std::string list;
-        for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-        throw BadInput("--model = '" + model + "': expected one of " + list);
-    }
+    if (std::find(names.begin(), names.end(), model) == names.end()) throw BadInput("--model = '" + model + "': expected one of " + model_list(", ", ", "));
 }
 
 std::unique_ptr<CarModel> ModelArgs::build() const {
@@ -123,7 +178,11 @@ std::string format_list(const std::vector<Format>& fs) {
 
 void FormatArg::add_to(CLI::App& app, std::initializer_list<Format> formats) {
     accepted = formats;
-    app.add_option("--format", text, "output on stdout: " + format_list(accepted))->capture_default_str();
+    app.add_option("--format", text, "output on stdout: " + format_list(accepted))->capture_default_str()->type_name([&] {
+        std::string t;
+        for (Format f : accepted) t += (t.empty() ? "" : "|") + std::string(format_name(f));
+        return t;
+    }());
 }
 
 Format FormatArg::parse() const {
@@ -141,7 +200,7 @@ void OutArg::add_to(CLI::App& app, const std::string& writes, bool required) {
     if (required) o->required();
 }
 
-std::string OutArg::prepare(const std::string& command) const {
+std::string OutArg::prepare(const std::string& command, std::initializer_list<const char*> suffixes) const {
     namespace fs = std::filesystem;
     if (text.empty()) throw BadInput("--out PREFIX is required");
     std::string prefix = text;
@@ -160,13 +219,71 @@ std::string OutArg::prepare(const std::string& command) const {
     }
     const auto slash = prefix.find_last_of('/');
     const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : prefix.substr(0, slash));
+    // a regular file where a folder is needed: refused before anything is created
+    for (fs::path p = fs::path(dir); !p.empty(); p = p.parent_path()) {
+        if (fs::exists(p, ec) && !fs::is_directory(p, ec))
+            throw BadInput("--out = '" + text + "': '" + p.string() + "' is a file, not a folder");
+        if (p == p.parent_path()) break;
+    }
     if (!fs::is_directory(dir, ec)) {
         fs::create_directories(dir, ec);
         if (ec || !fs::is_directory(dir))
-            throw BadInput("--out = '" + text + "': the folder '" + dir + "' does not exist and cannot be created");
+            throw BadInput("--out = '" + text + "': the folder '" + dir + "' does not exist and cannot be created" +
+                           (ec ? " (" + ec.message() + ")" : std::string()));
     }
-    if (access(dir.c_str(), W_OK) != 0) throw BadInput("--out = '" + text + "': the folder '" + dir + "' is not writable");
+    if (access(dir.c_str(), W_OK | X_OK) != 0) throw BadInput("--out = '" + text + "': the folder '" + dir + "' is not writable");
+    for (const char* suffix : suffixes) {
+        try {
+            check_output_file(prefix + suffix);
+        } catch (const std::invalid_argument& e) {
+            throw BadInput("--out = '" + text + "': " + e.what());
+        }
+    }
     return prefix;
+}
+
+std::string output_file(const std::string& flag, const std::string& path) {
+    if (path.empty()) throw BadInput(flag + " = '': expected a file name");
+    try {
+        check_output_file(path);
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + " = " + e.what());
+    }
+    return path;
+}
+
+Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars) {
+    Fleet unit;
+    try {
+        unit = names_a_file(spec) ? read_fleet_table(read_input_file(flag, spec), spec) : fleet_from_pattern(spec, 0);
+    } catch (const BadInput&) {
+        throw;
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + ": " + e.what());
+    }
+    if (cars <= 0) return unit;
+    Fleet out;
+    out.reserve(static_cast<std::size_t>(cars));
+    for (int i = 0; i < cars; ++i) out.push_back(unit[static_cast<std::size_t>(i) % unit.size()]);
+    return out;
+}
+
+std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& spec) {
+    try {
+        return names_a_file(spec) ? read_vehicle_table(read_input_file(flag, spec), spec) : vehicles_from_pattern(spec);
+    } catch (const BadInput&) {
+        throw;
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + ": " + e.what());
+    }
+}
+
+FleetCar car_argument(const std::string& flag, const std::string& spec) {
+    try {
+        return fleet_car_from_argument(spec);
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(flag + ": " + e.what());
+    }
 }
 
 void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }

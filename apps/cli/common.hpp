@@ -19,7 +19,9 @@
 
 #include "ddemap/io/json.hpp"
 #include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/fleet.hpp"
 #include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/vehicles.hpp"
 #include "format.hpp"
 
 namespace ddemap::cli {
@@ -37,7 +39,8 @@ struct BadInput : std::invalid_argument {
     using std::invalid_argument::invalid_argument;
 };
 
-/// The whole file as text; a file that cannot be opened is bad input naming the flag and path.
+/// The whole file as text (io read_text_file: a byte-order mark and CRLF line ends accepted); a
+/// folder or a file that cannot be opened is bad input naming the flag and path.
 std::string read_input_file(const std::string& flag, const std::string& path);
 double parse_number(const std::string& flag, const std::string& text);
 long parse_integer(const std::string& flag, const std::string& text, long lo, long hi, const std::string& what);
@@ -51,7 +54,15 @@ std::string root_method(const std::string& solver);
 /// A method in --solver words (shift_invert -> sparse, contour -> product).
 std::string solver_name(const std::string& method);
 
-/// The model flags: --model and one flag per model parameter.
+/// The built-in model names from the model table, joined ("ovrv, idm or ccc").
+std::string model_list(const std::string& separator, const std::string& last_separator);
+
+/// Sets the value kind shown in --help (NUMBER, INTEGER, FILE, PREFIX, ...) of every flag of
+/// `app` still shown as TEXT, from one table of the shared flag names.
+void annotate_option_types(CLI::App& app, const std::string& command);
+
+/// The model flags: --model and one flag per model parameter (generated from the model table:
+/// unit, required or default per model).
 struct ModelArgs {
     std::string model = "ovrv";
     std::map<std::string, std::string> raw;  // parameter name -> text, only those given
@@ -96,10 +107,24 @@ struct OutArg {
     std::string text;
     void add_to(CLI::App& app, const std::string& writes, bool required);
     bool given() const { return !text.empty(); }
-    /// Resolves the prefix and prepares its folder (created as needed, must be writable): bad
-    /// input otherwise, before any work.
-    std::string prepare(const std::string& command) const;
+    /// Resolves the prefix and prepares its folder (created as needed, must be writable) and
+    /// checks PREFIX + each suffix (not a folder, writable; check_output_file): bad input
+    /// otherwise, before any work.
+    std::string prepare(const std::string& command, std::initializer_list<const char*> suffixes = {".csv", ".json", ".svg"}) const;
 };
+
+/// A file the command writes under its own flag (e.g. classify --svg FILE), checked before any
+/// work (check_output_file): bad input naming the flag otherwise. Returns `path`.
+std::string output_file(const std::string& flag, const std::string& path);
+
+/// A command's cars, given the same way everywhere: a file (a vehicle or fleet CSV, e.g. what
+/// calibrate writes; io names_a_file) or a pattern of built-in names "A_min*3,C_max".
+/// `cars` > 0 repeats the cars to that many (the last repetition cut short).
+Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars = 0);
+/// The same as OVRV vehicles (classify, simulate).
+std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& spec);
+/// One car (mix --x/--y): NAME, MODEL:NAME=VALUE,..., FILE.csv (one kind of car) or FILE.csv:NAME.
+FleetCar car_argument(const std::string& flag, const std::string& spec);
 
 /// Prints the envelope of a command's JSON output.
 void print_json(const JsonEnvelope& e);

@@ -1,7 +1,13 @@
 // ddemap: a thin command-line front. It parses, calls the library, formats.
 // main builds the app from the command table, runs the parsed command and maps exceptions to
 // the exit codes of common.hpp (README "Exit codes").
+#include <cerrno>
+#include <cstdio>
 #include <cstdlib>
+#include <algorithm>
+#include <streambuf>
+
+#include <unistd.h>
 #include <cstring>
 #include <iostream>
 #include <stdexcept>
@@ -24,9 +30,77 @@ std::string one_line(std::string s) {
         if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
     return s;
 }
+/// The buffer of std::cout: writes to file descriptor 1 and keeps the reason of the first failed
+/// write (a full disk, /dev/full, a closed pipe), so that it can be reported at the end.
+class StdoutBuffer : public std::streambuf {
+public:
+    StdoutBuffer() { setp(m_buf, m_buf + sizeof m_buf); }
+    int error() const { return m_error; }
+
+protected:
+    int_type overflow(int_type c) override {
+        if (!flush_buffer()) return traits_type::eof();
+        if (!traits_type::eq_int_type(c, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(c);
+            pbump(1);
+        }
+        return traits_type::not_eof(c);
+    }
+    int sync() override { return flush_buffer() ? 0 : -1; }
+    /// Line by line: a write that ends a line goes out at once.
+    std::streamsize xsputn(const char* s, std::streamsize n) override {
+        std::streamsize done = 0;
+        while (done < n) {
+            if (pptr() == epptr() && !flush_buffer()) return done;
+            const std::streamsize k = std::min<std::streamsize>(n - done, epptr() - pptr());
+            traits_type::copy(pptr(), s + done, static_cast<std::size_t>(k));
+            pbump(static_cast<int>(k));
+            done += k;
+        }
+        if (n > 0 && traits_type::find(s, static_cast<std::size_t>(n), '\n') != nullptr && !flush_buffer()) return n;
+        return n;
+    }
+
+private:
+    bool flush_buffer() {
+        const char* p = pbase();
+        while (p < pptr()) {
+            const ssize_t n = ::write(1, p, static_cast<std::size_t>(pptr() - p));
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                if (m_error == 0) m_error = n < 0 ? errno : EIO;
+                setp(m_buf, m_buf + sizeof m_buf);
+                return false;
+            }
+            p += n;
+        }
+        setp(m_buf, m_buf + sizeof m_buf);
+        return true;
+    }
+    char m_buf[1 << 16];
+    int m_error = 0;
+};
+
+/// Never destroyed: the standard streams are flushed into it at exit.
+StdoutBuffer& stdout_buffer() {
+    static StdoutBuffer* buffer = new StdoutBuffer;
+    return *buffer;
+}
+
+/// `code`, unless stdout could not be written: then the error with the system's reason and
+/// exit_write_failed.
+int finish_stdout(int code) {
+    std::cout.flush();
+    if (stdout_buffer().error() != 0 || !std::cout) {
+        std::cerr << "ddemap: error: cannot write standard output: " << std::strerror(stdout_buffer().error() != 0 ? stdout_buffer().error() : EIO) << "\n";
+        return exit_write_failed;
+    }
+    return code;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
+    std::cout.rdbuf(&stdout_buffer());
     CLI::App app{"ddemap: stability of delay differential car-following models.\n"
                  "Rightmost characteristic roots of rings of cars, string stability verdicts."};
     app.require_subcommand(1);
@@ -36,7 +110,23 @@ int main(int argc, char** argv) {
     for (const Command& c : command_table()) {
         CLI::App* sub = app.add_subcommand(c.name, c.description);
         c.add_flags(*sub);
+        annotate_option_types(*sub, c.name);
         commands.emplace_back(sub, &c);
+    }
+    // a first word that is neither a flag nor a command: name it and list the commands
+    std::string command_names;
+    for (const Command& c : command_table()) command_names += (command_names.empty() ? "" : ", ") + std::string(c.name);
+    if (argc > 1 && argv[1][0] != '-') {
+        bool known = false;
+        for (const Command& c : command_table()) known = known || std::strcmp(c.name, argv[1]) == 0;
+        if (!known) {
+            std::cerr << "ddemap: error: unknown command '" << one_line(argv[1]) << "': expected one of " << command_names << " (see ddemap --help)\n";
+            return exit_bad_input;
+        }
+    }
+    if (argc == 1) {
+        std::cerr << "ddemap: error: expected a command: one of " << command_names << " (see ddemap --help)\n";
+        return exit_bad_input;
     }
     try {
         app.parse(argc, argv);
@@ -55,7 +145,7 @@ int main(int argc, char** argv) {
         const char* fault = std::getenv("DDEMAP_TEST_FAULT");
         if (fault && std::strcmp(fault, "internal") == 0) throw std::logic_error("DDEMAP_TEST_FAULT=internal");
         for (const auto& [sub, command] : commands)
-            if (sub->parsed()) return command->run();
+            if (sub->parsed()) return finish_stdout(command->run());
         throw std::logic_error("no command was parsed");
     } catch (const ddemap::WriteError& e) {
         std::cerr << "ddemap: error: " << one_line(e.what()) << "\n";

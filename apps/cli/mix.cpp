@@ -23,7 +23,7 @@ struct Args {
 }  // namespace
 
 void add_mix_flags(CLI::App& app) {
-    app.add_option("--x", args.x, "type X: a calibrated vehicle (e.g. E_min) or MODEL:NAME=VALUE,...")->required();
+    app.add_option("--x", args.x, "type X: a calibrated vehicle (e.g. E_min), MODEL:NAME=VALUE,..., a CSV file of one kind of car (e.g. calibrate's output) or FILE.csv:NAME (the car NAME of the file)")->required();
     app.add_option("--y", args.y, "type Y: as --x")->required();
     args.ring.add_to(app, "40", "ring size N >= 2 (finite)");
     app.add_option("--cars", args.cars, "old spelling of --ring")->group("");
@@ -39,7 +39,7 @@ void add_mix_flags(CLI::App& app) {
 
 int run_mix() {
     const Format format = args.format.parse();
-    const FleetCar x = parse_fleet_car(args.x), y = parse_fleet_car(args.y);
+    const FleetCar x = car_argument("--x", args.x), y = car_argument("--y", args.y);
     if (args.ring.given() && !args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
     RingArg ring = args.ring;
     if (!args.cars.empty()) ring.text = args.cars;

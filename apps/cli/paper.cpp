@@ -29,7 +29,7 @@ void add_paper_flags(CLI::App& app) {
 
 int run_paper() {
     const Format format = args.format.parse();
-    const std::string prefix = args.out.prepare("paper");
+    const std::string prefix = args.out.prepare("paper", {".svg", ".json", "-classification.csv", "-classification.json", "-classification.svg", "-growth.csv", "-growth.svg"});
     const PaperJob job = run_paper_job(builtin_paper_toml, "maps/paper.toml", builtin_classification_toml, "maps/classification.toml");
     JsonEnvelope e;
     e.command = "paper";

@@ -82,15 +82,13 @@ int run_fleet(Format format, const std::string& prefix) {
                        "(--speed or --length set the equilibrium, --ring the size of a pattern ring)");
     if (args.ring.given() && !args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
     const std::string ring_text = args.ring.given() ? args.ring.text : args.cars;
-    Fleet fleet;
-    if (!args.fleet.empty()) {
-        if (!ring_text.empty()) throw BadInput("--ring goes with --fleet-pattern; a --fleet file lists every car (use its count column)");
-        fleet = read_fleet_csv(read_input_file("--fleet", args.fleet), args.fleet);
-    } else {
-        RingArg n;
-        n.text = ring_text;
-        fleet = fleet_from_pattern(args.pattern, ring_text.empty() ? 0 : n.parse(false));
-    }
+    // a file or a pattern, the same way in --fleet and --fleet-pattern (its old spelling);
+    // --ring N repeats the cars to N
+    const std::string flag = args.fleet.empty() ? "--fleet-pattern" : "--fleet";
+    const std::string spec = args.fleet.empty() ? args.pattern : args.fleet;
+    RingArg n;
+    n.text = ring_text;
+    const Fleet fleet = fleet_argument(flag, spec, ring_text.empty() ? 0 : n.parse(false));
     MixedRingOptions o;
     set_equilibrium(o, speed, args.length);
     o.roots.method = root_method(args.solver);
@@ -101,7 +99,7 @@ int run_fleet(Format format, const std::string& prefix) {
     JsonEnvelope e;
     e.command = "roots";
     JsonObject in;
-    in.string(args.fleet.empty() ? "fleet_pattern" : "fleet", args.fleet.empty() ? args.pattern : args.fleet)
+    in.string(args.fleet.empty() ? "fleet_pattern" : "fleet", spec)
         .integer("ring", static_cast<long long>(fleet.size()));
     equilibrium_inputs(in, o);
     in.integer("count", o.roots.count).integer("degree", o.roots.degree);
@@ -113,7 +111,7 @@ int run_fleet(Format format, const std::string& prefix) {
     e.message = rr.message;
     e.result = mixed_ring_json(r, fleet.size());
     std::ostringstream out;
-    out << "fleet      " << (args.fleet.empty() ? args.pattern : args.fleet) << ": " << fleet.size() << " cars, speed "
+    out << "fleet      " << spec << ": " << fleet.size() << " cars, speed "
         << rounded(r.equilibrium.speed, 6) << " m/s, ring length " << rounded(r.equilibrium.length, 8) << " m\n";
     out << "solver     " << solver_name(rr.method_used);
     if (rr.method_used == "contour")  // no collocation: the counts of the argument principle
@@ -187,11 +185,13 @@ void add_roots_flags(CLI::App& app) {
     args.model.add_to(app);
     args.ring.add_to(app, "22",
                      "ring size N >= 2 (time grows linearly: about 0.3 ms per mode, N/2+1 modes), or inf for all wave numbers; "
-                     "with --fleet-pattern: the number of cars (default: the pattern once)");
+                     "with --fleet: the number of cars, the fleet repeated (default: the fleet once)");
     app.add_option("--count", args.count, "how many rightmost roots to list")->capture_default_str();
     app.add_option("--system", args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
-    app.add_option("--fleet", args.fleet, "a mixed ring from a CSV file (one row per car: vehicle and/or model and parameters, optional count; see README)");
-    app.add_option("--fleet-pattern", args.pattern, "a mixed ring from calibrated vehicles, e.g. \"A_min,C_max*3,E_min\", repeated to --ring cars");
+    app.add_option("--fleet", args.fleet,
+                   "a mixed ring: a CSV file (a fleet table: vehicle and/or model, parameters, optional count; or a vehicle table "
+                   "name,k1,k2,th,tau[,eta] as calibrate writes; see README) or built-in names \"A_min,C_max*3,E_min\"; repeated to --ring cars");
+    app.add_option("--fleet-pattern", args.pattern, "the same as --fleet (kept for old scripts)");
     app.add_option("--cars", args.cars, "old spelling of --ring for --fleet-pattern")->group("");
     app.add_option("--length", args.length, "fleet: ring length [m] (sum of the gaps); the speed follows");
     app.add_option("--solver", args.solver,
@@ -206,7 +206,7 @@ void add_roots_flags(CLI::App& app) {
 
 int run_roots() {
     const Format format = args.format.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("roots") : std::string();
+    const std::string prefix = args.out.given() ? args.out.prepare("roots", {".csv", ".json"}) : std::string();
     if (!args.fleet.empty() || !args.pattern.empty()) return run_fleet(format, prefix);
     if (!args.system.empty()) return run_system(format, prefix);
     return run_ring(format, prefix);

@@ -24,7 +24,8 @@ struct Args {
 
 void add_simulate_flags(CLI::App& app) {
     app.add_option("--fleet", args.fleet,
-                   "followers in platoon order: built-in names with repeats (A_min*7,C_max) or a CSV name,k1,k2,th,tau[,eta][,min_acc_speed]");
+                   "followers in platoon order: built-in names with repeats (A_min*7,C_max) or a CSV file: a vehicle table "
+                   "name,k1,k2,th,tau[,eta][,min_acc_speed] (as calibrate writes) or a fleet table of ovrv cars (as roots --fleet)");
     args.lead.add_to(app);
     args.out.add_to(app, "PREFIX.csv (time series), PREFIX.json, PREFIX.svg (speeds)", true);
     app.add_option("--on-event", args.on_event, "stop or continue at the first disengagement or collision")->capture_default_str();
@@ -47,9 +48,7 @@ int run_simulate() {
     const std::string prefix = args.out.prepare("simulate");
     std::string label;
     const LeadProfile lead = args.lead.parse(label);
-    const bool csv_file = args.fleet.size() > 4 && args.fleet.compare(args.fleet.size() - 4, 4, ".csv") == 0;
-    const std::vector<SimCar> cars = platoon_from(csv_file ? read_vehicles_csv(read_input_file("--fleet", args.fleet), args.fleet)
-                                                           : vehicles_from_pattern(args.fleet));
+    const std::vector<SimCar> cars = platoon_from(vehicles_argument("--fleet", args.fleet));
     const SimResult r = simulate_platoon(lead, cars, o);
     JsonEnvelope e;
     e.command = "simulate";

@@ -35,7 +35,7 @@ int run_string() {
     const Format format = args.format.parse();
     std::optional<int> cars;
     if (!args.ring.empty()) cars = args.ring.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("string") : std::string();
+    const std::string prefix = args.out.given() ? args.out.prepare("string", {".csv", ".json"}) : std::string();
     const Linearisation lin = model->linearise();
     const StringResult s = analyse_string(lin);
     std::optional<RingResult> ring;

@@ -44,7 +44,7 @@ void add_sweep_flags(CLI::App& app) {
 int run_sweep() {
     const Format format = args.format.parse();
     const SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
-    const std::string prefix = args.out.prepare("sweep");
+    const std::string prefix = args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
     if (isatty(2)) policy.progress = progress_line;
     const SweepResult sw = run_sweep(spec, policy);
@@ -70,7 +70,8 @@ int run_sweep() {
     std::vector<std::pair<std::string, std::string>> files = {
         {prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", render_chart_svg({panel}, co)}};
     if (bp) files.emplace_back(prefix + "-boundaries.csv", boundary_csv(spec, b));
-    write_files_atomic(files);
+    // without boundaries an earlier run's PREFIX-boundaries.csv is not left beside the new chart
+    write_files_atomic(files, bp ? std::vector<std::string>{} : std::vector<std::string>{prefix + "-boundaries.csv"});
     print_output(format, e, csv, [&] {
         int classes[4] = {0, 0, 0, 0};
         for (const auto& p : sw.points) ++classes[region_class(p)];

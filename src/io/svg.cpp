@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -340,46 +339,6 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     }
     s << "</svg>\n";
     return s.str();
-}
-
-void write_file_atomic(const std::string& path, const std::string& text) {
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw WriteError("cannot write " + path + ": the folder does not exist or is not writable");
-        out << text;
-        out.flush();
-        if (!out) {
-            std::remove(tmp.c_str());
-            throw WriteError("cannot write " + path);
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw WriteError("cannot write " + path);
-    }
-}
-
-void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
-    std::vector<std::string> written;
-    try {
-        for (const auto& [path, text] : files) {
-            write_file_atomic(path + ".part", text);
-            written.push_back(path + ".part");
-        }
-    } catch (...) {
-        for (const auto& w : written) std::remove(w.c_str());
-        throw;
-    }
-    // a rename can still fail (e.g. the target is a folder): then no .part file is left and none
-    // of the files of this call remains, so that the set is never half new
-    for (std::size_t i = 0; i < files.size(); ++i) {
-        const std::string& path = files[i].first;
-        if (std::rename((path + ".part").c_str(), path.c_str()) != 0) {
-            for (std::size_t j = 0; j < files.size(); ++j) std::remove((files[j].first + (j < i ? "" : ".part")).c_str());
-            throw WriteError("cannot write " + path);
-        }
-    }
 }
 
 }  // namespace ddemap

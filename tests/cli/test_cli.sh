@@ -114,7 +114,7 @@ expect_error "exactly two swept" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --out "
 expect_error "LO:HI:COUNT" sweep --th 1.5 --tau 0.5 --k1 0.01:1:1 --k2 0:1:4 --out "$tmp/x"
 expect_error "k1 = -1" sweep --th 1.5 --tau 0.5 --k1 -1:1:4 --k2 0:1:4 --out "$tmp/x"
 : >"$tmp/afile"
-expect_error "does not exist" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$tmp/afile/x"
+expect_error "is a file, not a folder" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$tmp/afile/x"
 [ ! -e "$tmp/x.csv" ] && ok || bad "a failed sweep left output"
 
 # boundary
@@ -389,11 +389,14 @@ assert d["status"] == "max_degree_reached" and d["message"], d
 assert d["result"]["stable"] is False
 PY
 "$bin" roots --system "$tmp/cyc.json" --degree 2 --count 10 | grep -q 'UNDECIDED' && ok || bad "not converged: the table says undecided"
-# the folder is fine, but PREFIX.json is a folder: the write fails after the computation, nothing half-written
+# the folder is fine, but PREFIX.json is a folder: refused before any work (exit 2); a move that
+# fails after the computation (test hook) is exit 5 with nothing half-written
 mkdir -p "$tmp/w.json"
-expect_code 5 classify --out "$tmp/w"
-grep -q "cannot write" "$tmp/e.txt" && ok || bad "write failure message"
-[ ! -e "$tmp/w.csv" ] && ! ls "$tmp" | grep -q '\.part$' && ok || bad "a failed write left files"
+expect_error "w.json' is a folder, expected a file" classify --out "$tmp/w"
+mkdir -p "$tmp/wf"
+DDEMAP_TEST_FAULT=move:2 expect_code 5 roots --k1 0.2 --k2 0.4 --th 1.5 --tau 0.3 --out "$tmp/wf/w"
+grep -q "cannot write .*w.json: Input/output error" "$tmp/e.txt" && ok || bad "write failure message"
+[ -z "$(ls -A "$tmp/wf")" ] && ok || bad "a failed write left files"
 
 # --format on every command; a format without meaning is a clear error naming the accepted ones
 for c in roots string classify sweep boundary chart paper simulate growth calibrate mix; do
@@ -419,6 +422,142 @@ for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi
 done
 "$bin" --help >/dev/null && ok || bad "--help"
+
+# ---- files in and out (issue 15) ---------------------------------------------------------------
+fio="$tmp/fio"
+mkdir -p "$fio"
+rootsargs="--k1 0.2 --k2 0.4 --th 1.5 --tau 0.3"
+# a full stdout is a write error with the system's reason (exit 5), in every format
+for fmt in table json csv; do
+    "$bin" roots $rootsargs --format $fmt >/dev/full 2>"$fio/e.txt"
+    rc=$?
+    [ $rc -eq 5 ] && grep -q "cannot write standard output: No space left on device" "$fio/e.txt" && ok || bad "roots --format $fmt > /dev/full: exit $rc"
+done
+# devices are written into, never replaced; a write error carries the reason (one vehicle: a small figure)
+printf 'name,k1,k2,th,tau\none,0.2,0.4,1.5,0.3\n' >"$fio/one.csv"
+"$bin" classify "$fio/one.csv" --svg /dev/full >/dev/null 2>"$fio/e.txt"
+rc=$?
+[ $rc -eq 5 ] && [ -c /dev/full ] && grep -q "/dev/full: No space left on device" "$fio/e.txt" && ok || bad "classify --svg /dev/full: exit $rc, $(cat "$fio/e.txt")"
+"$bin" classify "$fio/one.csv" --svg /dev/null >/dev/null && [ -c /dev/null ] && ok || bad "classify --svg /dev/null"
+# outputs are written through links: the target is replaced, the link stays
+mkdir -p "$fio/real"
+echo old >"$fio/real/r.csv"
+ln -s real/r.csv "$fio/r.csv"
+"$bin" roots $rootsargs --out "$fio/r" >/dev/null && [ -L "$fio/r.csv" ] && head -1 "$fio/real/r.csv" | grep -q '^mode,' &&
+    [ -z "$(ls -A "$fio/real" | grep -v '^r.csv$')" ] && ok || bad "write through a link"
+# a regular file where a folder is needed, a folder where a file is needed: refused before any work
+: >"$fio/plain"
+expect_error "'$fio/plain' is a file, not a folder" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$fio/plain/sub/x"
+[ -f "$fio/plain" ] && ok || bad "the file in the way is left alone"
+mkdir -p "$fio/d.svg"
+expect_error "d.svg' is a folder, expected a file" chart maps/none.toml --out "$fio/d"
+expect_error "is a folder, expected a file" classify --svg "$fio/d.svg"
+# every command that writes files checks its folder before the work (paper takes many seconds)
+mkdir -p "$fio/ro"
+chmod 555 "$fio/ro"
+if [ -w "$fio/ro" ]; then ro_dir="$fio/plain"; ro_msg="is a file, not a folder"; else ro_dir="$fio/ro"; ro_msg="is not writable"; fi  # root writes anywhere
+for c in "roots $rootsargs" "string $rootsargs" "classify" "mix --x E_min --y A_min --ring 6 --p 0:1:2" "growth --followers 2" \
+             "simulate --fleet A_min" "boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1" "paper" "sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4"; do
+    start=$(date +%s%N)
+    expect_error "$ro_msg" $c --out "$ro_dir/x"
+    [ $(( ($(date +%s%N) - start) / 1000000 )) -lt 2000 ] && ok || bad "$c: the unusable folder was found only after the work"
+done
+chmod 755 "$fio/ro"
+# an output set is all new or all old: a failed move puts every old file back, leaves no temporary file
+mkdir -p "$fio/set"
+echo old-csv >"$fio/set/r.csv"
+echo old-json >"$fio/set/r.json"
+DDEMAP_TEST_FAULT=move:2 expect_code 5 roots $rootsargs --out "$fio/set/r"
+[ "$(cat "$fio/set/r.csv")" = old-csv ] && [ "$(cat "$fio/set/r.json")" = old-json ] && [ "$(ls -A "$fio/set" | wc -l)" -eq 2 ] && ok ||
+    bad "a failed move left a half-replaced set: $(ls -A "$fio/set")"
+# interrupted while the files are written (test hook: a pause there): the old set stays, nothing else
+for fault in pause named,pause; do
+    for sig in INT TERM KILL; do
+        [ "$fault" = named,pause ] && [ $sig = KILL ] && continue  # named files cannot survive SIGKILL: see below
+        DDEMAP_TEST_FAULT=$fault timeout -s $sig 1 "$bin" roots $rootsargs --out "$fio/set/r" >/dev/null 2>&1
+        [ "$(cat "$fio/set/r.csv")" = old-csv ] && [ "$(ls -A "$fio/set" | wc -l)" -eq 2 ] && ok || bad "$fault $sig left: $(ls -A "$fio/set")"
+    done
+done
+# named temporary files of a killed writer are removed by the next write into that folder
+DDEMAP_TEST_FAULT=named,pause timeout -s KILL 1 "$bin" roots $rootsargs --out "$fio/set/r" >/dev/null 2>&1
+ls -A "$fio/set" | grep -q '^\.r\.csv\.ddemap-.*\.tmp$' && ok || bad "the test hook named,pause did not leave the killed writer's file"
+"$bin" roots $rootsargs --out "$fio/set/r" >/dev/null && [ "$(ls -A "$fio/set" | wc -l)" -eq 2 ] && head -1 "$fio/set/r.csv" | grep -q '^mode,' &&
+    ok || bad "stale temporary files not removed: $(ls -A "$fio/set")"
+# a folder never holds old and new files of one command: a sweep without boundaries removes the
+# PREFIX-boundaries.csv of an earlier run with the set (and puts it back when the set fails)
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$fio/sw/x" >/dev/null && [ -f "$fio/sw/x-boundaries.csv" ] && ok || bad "sweep boundaries"
+DDEMAP_TEST_FAULT=move:4 expect_code 5 sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:5 --out "$fio/sw/x" --no-boundaries
+[ -f "$fio/sw/x-boundaries.csv" ] && [ "$(ls -A "$fio/sw" | wc -l)" -eq 4 ] && ! grep -q '^0,0.75,' "$fio/sw/x.csv" && ok || bad "a failed removal was not rolled back"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:5 --out "$fio/sw/x" --no-boundaries >/dev/null && [ ! -e "$fio/sw/x-boundaries.csv" ] &&
+    [ "$(ls -A "$fio/sw" | wc -l)" -eq 3 ] && ok || bad "an old PREFIX-boundaries.csv stayed beside a new chart: $(ls -A "$fio/sw")"
+# inputs: a folder given as a file says so; a byte-order mark and CRLF line ends are accepted everywhere
+expect_error "VEHICLES = '$fio' is a folder, expected a file" classify "$fio"
+expect_error "is a folder, expected a file" roots --system "$fio"
+expect_error "is a folder, expected a file" chart "$fio" --out "$fio/c"
+expect_error "is a folder, expected a file" calibrate "$fio"
+crlf() { python3 -c "import sys; t=sys.stdin.read().replace('\n','\r\n'); sys.stdout.buffer.write(b'\xef\xbb\xbf'+t.encode())" >"$1"; }
+printf 'name,k1,k2,th,tau,eta\nmine,0.2,0.4,1.5,0.3,10\n' | crlf "$fio/v.csv"
+"$bin" classify "$fio/v.csv" --format csv | grep -q '^mine,0.2' && ok || bad "classify: BOM + CRLF"
+"$bin" simulate --fleet "$fio/v.csv" --out "$fio/sim" >/dev/null && ok || bad "simulate: BOM + CRLF"
+printf 'vehicle,model,k1,k2,th,tau,count\nA_min,,,,,,2\n,ovrv,0.2,0.4,1.5,0.3,1\n' | crlf "$fio/f.csv"
+"$bin" roots --fleet "$fio/f.csv" --count 2 >/dev/null && ok || bad "roots --fleet: BOM + CRLF"
+printf '{"dimension": 1, "delays": [1.0], "A": [[[-1]]]}\n' | crlf "$fio/s.json"
+"$bin" roots --system "$fio/s.json" --count 2 >/dev/null && ok || bad "roots --system: BOM + CRLF"
+printf 'time_s,lead_speed_mps\n0,20\n10,20\n20,18\n40,20\n' | crlf "$fio/lead.csv"
+"$bin" simulate --fleet A_min --lead "$fio/lead.csv" --out "$fio/sim2" >/dev/null && ok || bad "simulate --lead: BOM + CRLF"
+# (the classification spec with a 5 x 5 grid: the parse is what is checked, not the figure)
+sed 's/^count = 61/count = 5/' "$(dirname "$0")/../../maps/classification.toml" | crlf "$fio/spec.toml"
+"$bin" chart "$fio/spec.toml" --out "$fio/spec" >/dev/null && ok || bad "chart: BOM + CRLF"
+python3 - "$fio/t.csv" <<'PY'
+import math, sys
+rows = ["time_s,lead_speed_mps,follower_speed_mps,gap_m"]
+for k in range(0, 601):
+    t = k / 10
+    v = 20 + math.sin(t / 5)
+    rows.append(f"{t},{v},{v},{30 + 0.5 * math.cos(t / 5)}")
+open(sys.argv[1], "wb").write(b"\xef\xbb\xbf" + "\r\n".join(rows).encode() + b"\r\n")
+PY
+"$bin" calibrate "$fio/t.csv" --out "$fio/fits" >/dev/null 2>&1; rc=$?
+[ $rc -eq 0 ] || [ $rc -eq 4 ] && ok || bad "calibrate: BOM + CRLF (exit $rc)"
+# one vehicle/fleet format family: what calibrate writes goes into classify, simulate, roots and mix
+if [ -s "$fio/fits.csv" ]; then
+    "$bin" classify "$fio/fits.csv" --format csv | grep -q '^t,' && ok || bad "classify takes calibrate's output"
+    "$bin" simulate --fleet "$fio/fits.csv" --out "$fio/sim3" >/dev/null && ok || bad "simulate takes calibrate's output"
+    "$bin" roots --fleet "$fio/fits.csv" --ring 8 --count 2 >/dev/null && ok || bad "roots --fleet takes calibrate's output"
+    "$bin" mix --x "$fio/fits.csv" --y A_min --ring 6 --p 0:1:2 --out "$fio/mix" >/dev/null && ok || bad "mix --x takes calibrate's output"
+    "$bin" mix --x "$fio/fits.csv:t" --y A_min --ring 6 --p 0:1:2 --out "$fio/mix" >/dev/null && ok || bad "mix --x FILE.csv:NAME"
+    expect_error "no car named 'nope'" mix --x "$fio/fits.csv:nope" --y A_min --ring 6 --p 0:1:2 --out "$fio/mix"
+else
+    bad "calibrate wrote no fits.csv"
+fi
+# patterns and files the same way: a pattern in classify and roots --fleet, a fleet table in classify and simulate
+"$bin" classify "A_min,E_max" --format csv | grep -c '^[AE]_' | grep -q '^2$' && ok || bad "classify PATTERN"
+"$bin" roots --fleet "A_min,E_min" --ring 6 --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['result']['ring'] == 6 else 1)" && ok || bad "roots --fleet PATTERN --ring"
+"$bin" classify "$fio/f.csv" --format csv | grep -c '^' | grep -q '^4$' && ok || bad "classify a fleet table (3 cars)"
+"$bin" simulate --fleet "$fio/f.csv" --out "$fio/sim4" >/dev/null && ok || bad "simulate a fleet table"
+printf 'vehicle,model,k1,k2,th,tau,k3,tau2\n,ccc,0.1,0.3,1.2,0.4,0.2,0.1\n' >"$fio/ccc.csv"
+expect_error "has model 'ccc': expected ovrv cars" classify "$fio/ccc.csv"
+
+# ---- one consistent command line: help and errors -----------------------------------------------
+for c in roots string classify sweep boundary chart paper simulate growth calibrate mix; do
+    "$bin" $c --help >"$fio/h.txt" 2>&1
+    grep -q ' TEXT' "$fio/h.txt" && bad "$c --help has an option without its kind: $(grep ' TEXT' "$fio/h.txt" | head -1)" || ok
+done
+"$bin" roots --help | grep -q -- '--count INTEGER=6' && ok || bad "help shows kinds and defaults"
+"$bin" roots --help | grep -- '--th ' | grep -q 'required for ovrv, idm, ccc' && ok || bad "help: which model needs --th"
+"$bin" roots --help | grep -- '--v0 ' | grep -q 'default: idm 33.3' && ok || bad "help: the IDM defaults"
+"$bin" sweep --help | grep -q -- '--k1 NUMBER|LO:HI:COUNT' && ok || bad "sweep help: ranges"
+"$bin" mix --help | grep -q -- '--x CAR' && "$bin" sweep --help | grep -q -- '--x NAME' && ok || bad "help: the kind of --x per command"
+expect_error "unknown command 'rots': expected one of roots, string" rots --k1 0.2
+expect_error "expected a command" 
+python3 - "$bin" <<'PY' && ok || bad "the model list in errors is the model table"
+import subprocess, sys
+e = subprocess.run([sys.argv[1], "roots", "--model", "nope"], capture_output=True, text=True).stderr
+h = subprocess.run([sys.argv[1], "roots", "--help"], capture_output=True, text=True).stdout
+models = [l.split()[1].split("=")[0] for l in h.splitlines() if l.strip().startswith("--model ")][0].split("|")
+assert set(models) >= {"ovrv", "idm", "ccc"}, models
+assert all(m in e for m in models), (e, models)
+PY
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "ddemap/io/files.hpp"  // WriteError, write_files_atomic (the writers of the figures)
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
 
@@ -72,19 +73,5 @@ struct PlotOptions {
 };
 
 std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& options);
-
-/// A file could not be written (the message names the path).
-struct WriteError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-/// Writes `text` to `path` atomically (a temporary file renamed into place); throws
-/// WriteError naming the path on failure.
-void write_file_atomic(const std::string& path, const std::string& text);
-
-/// Writes several files so that either all appear or none is left half-written: all are
-/// written to temporary files first, then renamed into place; on a failure (WriteError) none
-/// of them is left, nor any temporary file.
-void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace ddemap

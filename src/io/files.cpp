@@ -1,0 +1,482 @@
+#include "ddemap/io/files.hpp"
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+namespace ddemap {
+
+namespace {
+
+std::string reason(int err) { return std::strerror(err); }
+
+std::string dir_of(const std::string& path) {
+    const auto slash = path.find_last_of('/');
+    if (slash == std::string::npos) return ".";
+    if (slash == 0) return "/";
+    return path.substr(0, slash);
+}
+
+std::string base_of(const std::string& path) {
+    const auto slash = path.find_last_of('/');
+    return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// ---- hidden temporary files named on disk, removed by an interrupt -------------------------
+// Only async-signal-safe calls in the handler: unlink, sigaction, raise.
+
+constexpr int max_named = 64;
+char g_named[max_named][PATH_MAX];
+volatile std::sig_atomic_t g_named_used[max_named];
+const int g_signals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+
+extern "C" void remove_named_and_reraise(int sig) {
+    for (int i = 0; i < max_named; ++i)
+        if (g_named_used[i]) ::unlink(g_named[i]);
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    ::sigaction(sig, &dfl, nullptr);
+    ::raise(sig);
+}
+
+/// Registers an absolute or relative path for removal on an interrupt; -1 when the table is full.
+int register_named(const std::string& path) {
+    if (path.size() >= PATH_MAX) return -1;
+    for (int i = 0; i < max_named; ++i) {
+        if (g_named_used[i]) continue;
+        std::memcpy(g_named[i], path.c_str(), path.size() + 1);
+        g_named_used[i] = 1;
+        return i;
+    }
+    return -1;
+}
+
+void unregister_named(int slot) {
+    if (slot >= 0) g_named_used[slot] = 0;
+}
+
+/// Installs the interrupt handler for the lifetime of the object (the previous ones after).
+struct InterruptCleanup {
+    struct sigaction old[4];
+    InterruptCleanup() {
+        struct sigaction sa {};
+        sa.sa_handler = remove_named_and_reraise;
+        sigemptyset(&sa.sa_mask);
+        for (int i = 0; i < 4; ++i) ::sigaction(g_signals[i], &sa, &old[i]);
+    }
+    ~InterruptCleanup() {
+        for (int i = 0; i < 4; ++i) ::sigaction(g_signals[i], &old[i], nullptr);
+    }
+    InterruptCleanup(const InterruptCleanup&) = delete;
+    InterruptCleanup& operator=(const InterruptCleanup&) = delete;
+};
+
+/// Holds the interrupt signals back for the lifetime of the object (delivered afterwards).
+struct HoldSignals {
+    sigset_t old;
+    HoldSignals() {
+        sigset_t s;
+        sigemptyset(&s);
+        for (int sig : g_signals) sigaddset(&s, sig);
+        ::sigprocmask(SIG_BLOCK, &s, &old);
+    }
+    ~HoldSignals() { ::sigprocmask(SIG_SETMASK, &old, nullptr); }
+    HoldSignals(const HoldSignals&) = delete;
+    HoldSignals& operator=(const HoldSignals&) = delete;
+};
+
+bool write_all(int fd, const std::string& text, int& err) {
+    const char* p = text.data();
+    std::size_t left = text.size();
+    while (left > 0) {
+        const ssize_t n = ::write(fd, p, left);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            err = errno;
+            return false;
+        }
+        p += n;
+        left -= static_cast<std::size_t>(n);
+    }
+    return true;
+}
+
+/// One file of an output set.
+struct Target {
+    std::string given;     // the path as given (messages)
+    std::string path;      // after links
+    std::string dir, base;
+    const std::string* text = nullptr;
+    bool special = false;  // device, FIFO, socket: written in place
+    bool existed = false;
+    mode_t mode = 0;       // of the existing file
+    int dirfd = -1;
+    int fd = -1;           // the new content (O_TMPFILE or a named temporary file)
+    bool fd_unnamed = false;
+    std::string temp;      // hidden name of the new content in dir ("" while unnamed)
+    int temp_slot = -1;
+    bool swapped = false;  // temp now holds the old content (exchanged)
+    bool placed = false;   // the new content is at base
+    bool remove = false;   // a stale member of the set: moved away with the set, removed after
+};
+
+unsigned g_counter = 0;
+
+// Test hooks (tests/cli/test_cli.sh), a comma-separated list in DDEMAP_TEST_FAULT: "named"
+// writes through hidden named temporary files as on a file system without O_TMPFILE; "pause"
+// sleeps 30 s after the temporary files are written (a test interrupts the program there);
+// "move:K" makes the move of the K-th file (1-based) of a set fail with EIO (the roll-back runs).
+bool test_fault(const char* what) {
+    const char* f = std::getenv("DDEMAP_TEST_FAULT");
+    if (f == nullptr) return false;
+    const std::string list = std::string(",") + f + ",";
+    return list.find(std::string(",") + what + ",") != std::string::npos;
+}
+bool test_fault_move(std::size_t index) {
+    const char* f = std::getenv("DDEMAP_TEST_FAULT");
+    if (f == nullptr) return false;
+    const char* m = std::strstr(f, "move:");
+    return m != nullptr && std::strtoul(m + 5, nullptr, 10) == index + 1;
+}
+
+std::string hidden_name(const std::string& base) {
+    return "." + base + ".ddemap-" + std::to_string(::getpid()) + "-" + std::to_string(++g_counter) + ".tmp";
+}
+
+/// False when no process `pid` runs: none exists, or it is a zombie (killed, not yet reaped).
+bool process_alive(pid_t pid) {
+    if (::kill(pid, 0) != 0) return errno != ESRCH;
+    const std::string stat_path = "/proc/" + std::to_string(pid) + "/stat";
+    const int fd = ::open(stat_path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return true;
+    char buf[512];
+    const ssize_t n = ::read(fd, buf, sizeof buf - 1);
+    ::close(fd);
+    if (n <= 0) return true;
+    buf[n] = '\0';
+    const char* paren = std::strrchr(buf, ')');  // "PID (NAME) STATE ..."
+    return !(paren != nullptr && paren[1] == ' ' && paren[2] == 'Z');
+}
+
+/// Removes hidden temporary files of `base` in the folder left by a writer that was killed
+/// (SIGKILL, power loss) on a file system without O_TMPFILE: ".BASE.ddemap-PID-N.tmp" whose
+/// process PID no longer exists.
+void remove_stale_temps(int dirfd, const std::string& base) {
+    const int fd = ::dup(dirfd);
+    if (fd < 0) return;
+    DIR* d = ::fdopendir(fd);
+    if (d == nullptr) {
+        ::close(fd);
+        return;
+    }
+    ::rewinddir(d);
+    const std::string head = "." + base + ".ddemap-";
+    std::vector<std::string> stale;
+    while (const dirent* e = ::readdir(d)) {
+        const std::string name = e->d_name;
+        if (name.compare(0, head.size(), head) != 0 || name.size() < head.size() + 5 || name.compare(name.size() - 4, 4, ".tmp") != 0) continue;
+        char* end = nullptr;
+        const long pid = std::strtol(name.c_str() + head.size(), &end, 10);
+        if (pid <= 0 || end == nullptr || *end != '-') continue;
+        if (!process_alive(static_cast<pid_t>(pid))) stale.push_back(name);
+    }
+    ::closedir(d);
+    for (const auto& name : stale) ::unlinkat(dirfd, name.c_str(), 0);
+}
+
+std::string dir_path(const Target& t, const std::string& name) { return t.dir == "/" ? "/" + name : t.dir + "/" + name; }
+
+void close_all(std::vector<Target>& ts) {
+    for (auto& t : ts) {
+        if (t.fd >= 0) ::close(t.fd);
+        if (t.dirfd >= 0) ::close(t.dirfd);
+        t.fd = t.dirfd = -1;
+    }
+}
+
+/// Removes the named temporary files (and unregisters them).
+void remove_temps(std::vector<Target>& ts) {
+    for (auto& t : ts) {
+        if (!t.temp.empty() && t.dirfd >= 0) ::unlinkat(t.dirfd, t.temp.c_str(), 0);
+        unregister_named(t.temp_slot);
+        t.temp_slot = -1;
+        t.temp.clear();
+    }
+}
+
+[[noreturn]] void fail(std::vector<Target>& ts, const std::string& path, int err, const std::string& what = "cannot write") {
+    remove_temps(ts);
+    close_all(ts);
+    throw WriteError(what + " " + path + ": " + reason(err));
+}
+
+/// Gives the new content of `t` a hidden name in its folder (for the move into place).
+bool name_temp(Target& t, int& err) {
+    if (!t.fd_unnamed) return true;
+    const std::string proc = "/proc/self/fd/" + std::to_string(t.fd);
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        const std::string name = hidden_name(t.base);
+        const int slot = register_named(dir_path(t, name));
+        if (::linkat(AT_FDCWD, proc.c_str(), t.dirfd, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+            t.temp = name;
+            t.temp_slot = slot;
+            return true;
+        }
+        err = errno;
+        unregister_named(slot);
+        if (err != EEXIST) return false;
+    }
+    return false;
+}
+
+}  // namespace
+
+std::string normalize_input_text(std::string text) {
+    if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF && static_cast<unsigned char>(text[1]) == 0xBB &&
+        static_cast<unsigned char>(text[2]) == 0xBF)
+        text.erase(0, 3);
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') continue;
+        out += text[i];
+    }
+    if (!out.empty() && out.back() == '\r') out.pop_back();
+    return out;
+}
+
+std::string read_text_file(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
+    if (S_ISDIR(st.st_mode)) throw std::invalid_argument("'" + path + "' is a folder, expected a file");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
+    std::string text;
+    char buf[65536];
+    for (;;) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            const int err = errno;
+            ::close(fd);
+            throw std::invalid_argument("'" + path + "': cannot read the file (" + reason(err) + ")");
+        }
+        if (n == 0) break;
+        text.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    return normalize_input_text(std::move(text));
+}
+
+std::string resolve_output_path(const std::string& path) {
+    std::string p = path;
+    for (int hops = 0; hops < 40; ++hops) {
+        struct stat st {};
+        if (::lstat(p.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return p;
+        std::string link(PATH_MAX, '\0');
+        const ssize_t n = ::readlink(p.c_str(), &link[0], link.size());
+        if (n <= 0) return p;
+        link.resize(static_cast<std::size_t>(n));
+        p = link[0] == '/' ? link : (dir_of(p) == "." && p.find('/') == std::string::npos ? link : dir_of(p) + "/" + link);
+    }
+    throw std::invalid_argument("'" + path + "': too many levels of symbolic links");
+}
+
+void check_output_file(const std::string& given) {
+    const std::string path = resolve_output_path(given);
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0) {
+        if (S_ISDIR(st.st_mode)) throw std::invalid_argument("'" + given + "' is a folder, expected a file to write");
+        if (!S_ISREG(st.st_mode)) {
+            if (::access(path.c_str(), W_OK) != 0) throw std::invalid_argument("'" + given + "' is not writable (" + reason(errno) + ")");
+            return;
+        }
+    }
+    // the folder: every existing part must be a folder
+    const std::string dir = dir_of(path);
+    std::string part;
+    std::size_t pos = 0;
+    while (pos != std::string::npos) {
+        const auto next = dir.find('/', pos + 1);
+        part = dir.substr(0, next);
+        pos = next;
+        if (part.empty()) continue;
+        struct stat ds {};
+        if (::stat(part.c_str(), &ds) != 0) {
+            if (errno == ENOENT) throw std::invalid_argument("'" + given + "': the folder '" + part + "' does not exist");
+            throw std::invalid_argument("'" + given + "': the folder '" + part + "' cannot be used (" + reason(errno) + ")");
+        }
+        if (!S_ISDIR(ds.st_mode)) throw std::invalid_argument("'" + given + "': '" + part + "' is a file, not a folder");
+    }
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw std::invalid_argument("'" + given + "': the folder '" + dir + "' is not writable (" + reason(errno) + ")");
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) { write_files_atomic({{path, text}}); }
+
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files, const std::vector<std::string>& remove) {
+    static const std::string nothing;
+    std::vector<Target> ts(files.size() + remove.size());
+    for (std::size_t i = files.size(); i < ts.size(); ++i) {
+        ts[i].remove = true;
+        ts[i].given = remove[i - files.size()];
+        ts[i].text = &nothing;
+    }
+    InterruptCleanup cleanup;
+    // 1. resolve every path; write the special files; write the regular ones to temporary files
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+        Target& t = ts[i];
+        if (!t.remove) {
+            t.given = files[i].first;
+            t.text = &files[i].second;
+        }
+        try {
+            t.path = resolve_output_path(t.given);
+        } catch (const std::invalid_argument&) {
+            fail(ts, t.given, ELOOP);
+        }
+        t.dir = dir_of(t.path);
+        t.base = base_of(t.path);
+        struct stat st {};
+        if (t.remove) {  // only a regular file is removed (a folder or a device is left alone)
+            t.existed = ::stat(t.path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+            t.special = !t.existed;
+            continue;
+        }
+        if (::stat(t.path.c_str(), &st) == 0) {
+            if (S_ISDIR(st.st_mode)) fail(ts, t.given, EISDIR);
+            t.special = !S_ISREG(st.st_mode);
+            t.existed = true;
+            t.mode = st.st_mode & 07777;
+        }
+    }
+    for (auto& t : ts) {
+        if (!t.special || t.remove) continue;
+        const int fd = ::open(t.path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+        if (fd < 0) fail(ts, t.given, errno);
+        int err = 0;
+        const bool ok = write_all(fd, *t.text, err);
+        if (ok && ::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) err = errno;
+        if (::close(fd) != 0 && ok && err == 0 && errno != EINTR) err = errno;
+        if (!ok || err != 0) fail(ts, t.given, err);
+    }
+    for (auto& t : ts) {
+        if (t.special) continue;
+        t.dirfd = ::open(t.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (t.dirfd < 0) fail(ts, t.given, errno);
+        remove_stale_temps(t.dirfd, t.base);
+        if (t.remove) continue;
+        const mode_t mode = t.existed ? t.mode : 0666;
+        t.fd = test_fault("named") ? -1 : ::openat(t.dirfd, ".", O_TMPFILE | O_WRONLY | O_CLOEXEC, mode);
+        t.fd_unnamed = t.fd >= 0;
+        if (t.fd < 0) {  // no O_TMPFILE on this file system: a hidden named file, removed on interrupt
+            for (int attempt = 0; attempt < 100 && t.fd < 0; ++attempt) {
+                const std::string name = hidden_name(t.base);
+                const int slot = register_named(dir_path(t, name));
+                t.fd = ::openat(t.dirfd, name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
+                if (t.fd >= 0) {
+                    t.temp = name;
+                    t.temp_slot = slot;
+                } else {
+                    const int err = errno;
+                    unregister_named(slot);
+                    if (err != EEXIST) fail(ts, t.given, err);
+                }
+            }
+            if (t.fd < 0) fail(ts, t.given, EEXIST);
+        }
+        if (t.existed) ::fchmod(t.fd, t.mode);  // the umask does not narrow an existing file's mode
+        int err = 0;
+        if (!write_all(t.fd, *t.text, err)) fail(ts, t.given, err);
+        if (::fsync(t.fd) != 0) fail(ts, t.given, errno);
+    }
+    if (test_fault("pause")) ::sleep(30);
+    // 2. move every file into place with the interrupts held back; roll back on a failure
+    HoldSignals hold;
+    for (auto& t : ts) {
+        if (t.special) continue;
+        int err = 0;
+        if (!name_temp(t, err)) fail(ts, t.given, err);
+    }
+    for (std::size_t i = 0; i < ts.size(); ++i) {
+        Target& t = ts[i];
+        if (t.special) continue;
+        int rc = -1, err = 0;
+        if (test_fault_move(i)) {
+            rc = -1;
+            errno = EIO;
+        } else if (t.remove) {  // moved away to a hidden name, removed after the set is in place
+            for (int attempt = 0; attempt < 100; ++attempt) {
+                const std::string name = hidden_name(t.base);
+                const int slot = register_named(dir_path(t, name));
+                rc = ::renameat2(t.dirfd, t.base.c_str(), t.dirfd, name.c_str(), RENAME_NOREPLACE);
+                if (rc != 0 && (errno == EINVAL || errno == ENOSYS)) rc = ::renameat(t.dirfd, t.base.c_str(), t.dirfd, name.c_str());
+                if (rc == 0) {
+                    t.temp = name;
+                    t.temp_slot = slot;
+                    break;
+                }
+                err = errno;
+                unregister_named(slot);
+                if (err != EEXIST) break;
+            }
+            if (rc == 0) {
+                t.placed = t.swapped = true;
+                continue;
+            }
+            errno = err;
+        } else if (t.existed) {
+            rc = ::renameat2(t.dirfd, t.temp.c_str(), t.dirfd, t.base.c_str(), RENAME_EXCHANGE);
+            if (rc == 0) t.swapped = true;
+            else if (errno == EINVAL || errno == ENOSYS) rc = ::renameat(t.dirfd, t.temp.c_str(), t.dirfd, t.base.c_str());
+        } else {
+            rc = ::renameat2(t.dirfd, t.temp.c_str(), t.dirfd, t.base.c_str(), RENAME_NOREPLACE);
+            if (rc != 0 && (errno == EINVAL || errno == ENOSYS)) rc = ::renameat(t.dirfd, t.temp.c_str(), t.dirfd, t.base.c_str());
+        }
+        if (rc != 0) err = errno;
+        if (rc == 0) {
+            t.placed = true;
+            if (!t.swapped) {  // the temporary name is gone
+                unregister_named(t.temp_slot);
+                t.temp_slot = -1;
+                t.temp.clear();
+            }
+            continue;
+        }
+        // roll back the files already moved: the old content back in place, new files removed
+        for (std::size_t j = 0; j < i; ++j) {
+            Target& u = ts[j];
+            if (!u.placed) continue;
+            if (u.remove) ::renameat(u.dirfd, u.temp.c_str(), u.dirfd, u.base.c_str());
+            else if (u.swapped) ::renameat2(u.dirfd, u.temp.c_str(), u.dirfd, u.base.c_str(), RENAME_EXCHANGE);
+            else if (!u.existed) ::unlinkat(u.dirfd, u.base.c_str(), 0);
+        }
+        fail(ts, t.given, err);
+    }
+    int err = 0;
+    std::string bad;
+    for (auto& t : ts) {
+        if (t.special || t.dirfd < 0) continue;
+        if (::fsync(t.dirfd) != 0 && err == 0 && errno != EINVAL) {
+            err = errno;
+            bad = t.given;
+        }
+    }
+    remove_temps(ts);  // the old contents
+    close_all(ts);
+    if (err != 0) throw WriteError("cannot write " + bad + ": " + reason(err));
+}
+
+}  // namespace ddemap
