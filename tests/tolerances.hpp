@@ -34,4 +34,15 @@ constexpr double coefficient_rel = 1e-13;
 /// Linearisation against central finite differences with step 1e-5 (error O(h^2) ~ 1e-10).
 constexpr double finite_difference = 1e-7;
 
+/// A parsed expression against the same formula written in C++, relative: both evaluate the
+/// same operations in double precision, possibly in another order (a few ulps, |values| <= ~1e3).
+constexpr double expression_vs_hand = 1e-13;
+/// Nested dual numbers (second, third derivatives) against central differences of the exact
+/// derivative one order lower, step 1e-4: error O(h^2) ~ 1e-8 times the next derivative (<= ~10 here).
+constexpr double higher_derivative_fd = 1e-6;
+/// Fold and Hopf points located by Newton on their defining systems (residual <= 1e-9, the
+/// Jacobian by central differences) against closed forms: the points are regular zeros, so the
+/// error is of the order of the residual times the condition (~10 here).
+constexpr double special_point = 1e-8;
+
 }  // namespace ddemap::test::tol
