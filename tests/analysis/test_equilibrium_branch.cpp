@@ -1,0 +1,169 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "../tolerances.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/problem/expression_system.hpp"
+#include "ddemap/solve/equilibrium.hpp"
+#include "ddemap/traffic/ov_ring.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+
+const double pi = 3.14159265358979323846;
+
+/// The root of a continuous g on [lo, hi] with g(lo) g(hi) < 0, by bisection to rounding.
+template <class G>
+double bisect(G g, double lo, double hi) {
+    double glo = g(lo);
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(lo)); ++i) {
+        const double mid = 0.5 * (lo + hi), gm = g(mid);
+        if ((gm < 0) == (glo < 0)) lo = mid, glo = gm;
+        else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+TEST_CASE("x' = -a sin(x(t - 1)) + x^3: Hopf at a tau = pi/2 with omega = a") {
+    // the linearisation at x = 0 is y' = -a y(t - tau): lambda = i omega needs a cos(omega tau) = 0,
+    // a sin(omega tau) = omega, so omega = a and a tau = pi/2 (the first crossing)
+    ExpressionSystem sys({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*sin(x(t - tau)) + x^3"});
+    EquilibriumBranchOptions o;
+    o.parameter = "a";
+    o.from = 0.5;
+    o.to = 2.5;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.1), o);
+    CHECK(br.status == Status::Converged);
+    CHECK(br.stop == ContinuationStop::Bound);
+    CHECK(br.points.front().stable);
+    CHECK(!br.points.back().stable);
+    CHECK(br.folds.empty());
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(br.hopf[0].status == Status::Converged);
+    CHECK(std::abs(br.hopf[0].par - pi / 2) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - pi / 2) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].x[0]) < tol::special_point);
+    // the second crossing a tau = 5 pi / 2 is outside the range
+}
+
+TEST_CASE("x' = p - x(t - 1)^2: a fold at p = 0 and a Hopf point at p = (pi/4)^2 with omega = pi/2") {
+    // equilibria x = +-sqrt(p); linearisation y' = -2 x y(t - 1): Hopf where 2 x = pi/2, omega = pi/2;
+    // the fold (x, p) = (0, 0) is where d/dx (p - x^2) = 0
+    ExpressionSystem sys({"x"}, {"p"}, {1.0}, {"p - x(t - 1)^2"});
+    EquilibriumBranchOptions o;
+    o.parameter = "p";
+    o.from = 0.9;
+    o.to = -1.0;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 1.0), o);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.folds.size() == 1);
+    CHECK(br.folds[0].status == Status::Converged);
+    CHECK(std::abs(br.folds[0].par) < tol::special_point);
+    CHECK(std::abs(br.folds[0].x[0]) < tol::special_point);
+    // the branch turns at the fold and comes back on x < 0 to the face p = 0.9
+    CHECK(br.points.back().x[0] < 0.0);
+    CHECK(br.points.back().par == doctest::Approx(0.9).epsilon(1e-12));
+    CHECK(br.points.back().unstable == 1);  // a real positive root: a saddle
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(std::abs(br.hopf[0].par - pi * pi / 16) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].x[0] - pi / 4) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - pi / 2) < tol::special_point);
+}
+
+TEST_CASE("Mackey-Glass continued in the exponent n: the Hopf point of its linearisation's closed form") {
+    // x' = beta x(t - tau) / (1 + x(t - tau)^n) - gamma x, positive equilibrium x*^n = beta/gamma - 1
+    // (here 2: x* = 2^(1/n) moves along the branch). Linearisation y' = -gamma y + b y(t - tau) with
+    // b = beta (1 + (1 - n) x*^n) / (1 + x*^n)^2 = (3 - 2 n) / 3 (beta = 3, gamma = 1). For b < -gamma a
+    // pair crosses at omega = sqrt(b^2 - gamma^2), omega tau = arccos(gamma / b): solve for b at tau = 2.
+    const double beta = 3.0, gamma = 1.0, tau = 2.0;
+    ExpressionSystem mg({"x"}, {"beta", "gamma", "n", "tau"}, {beta, gamma, 4.0, tau},
+                        {"beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"});
+    const double b = bisect([&](double bb) { return std::acos(gamma / bb) / std::sqrt(bb * bb - gamma * gamma) - tau; }, -50.0, -1.0 - 1e-9);
+    const double n_hopf = (3.0 - 3.0 * b) / 2.0, omega = std::sqrt(b * b - gamma * gamma);
+    EquilibriumBranchOptions o;
+    o.parameter = "n";
+    o.from = 2.0;
+    o.to = 6.0;
+    const EquilibriumBranch br = equilibrium_branch(mg, Eigen::VectorXd::Constant(1, 1.3), o);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(std::abs(br.hopf[0].par - n_hopf) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - omega) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].x[0] - std::pow(2.0, 1.0 / n_hopf)) < tol::special_point);
+    // every branch point is an equilibrium of the analytic family
+    for (const EquilibriumPoint& p : br.points) CHECK(std::abs(p.x[0] - std::pow(2.0, 1.0 / p.par)) < 1e-10);
+}
+
+TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy the ring modes' closed form") {
+    // Linearising the ring at the uniform flow with f = V'(h*) and a Fourier mode v_i ~ z^i e^{lambda t},
+    // z = exp(i theta_k), theta_k = 2 pi k / N, gives h_i = (z - 1) v_i / lambda and
+    //     lambda^2 + alpha lambda + alpha f (1 - z) e^{-lambda tau} = 0
+    // (Orosz, Wilson, Stepan, Phys. Rev. E 70, 026207 (2004), the characteristic equation of their
+    // eq. (2.1) at the uniform flow). With lambda = i omega, 1 - z = 2 sin(theta/2) e^{i(theta/2 - pi/2)}:
+    //     modulus  omega sqrt(omega^2 + alpha^2) = 2 alpha f sin(theta_k / 2),
+    //     phase    omega tau = theta_k / 2 - pi/2 + arctan(alpha / omega)   (first crossing).
+    // So each mode loses stability at f_k = omega_k sqrt(omega_k^2 + alpha^2) / (2 alpha sin(theta_k/2)).
+    const int N = 5;
+    const double alpha = 1.0, tau = 1.0;
+    OvRing ring(N, alpha, tau, 1.0, 1.0, 1.2);
+    // regular equilibrium: the Jacobian of the equilibrium equation is invertible
+    const EquilibriumResult e = find_equilibrium(ring, ring.uniform_flow() + Eigen::VectorXd::Constant(2 * N - 1, 0.01));
+    REQUIRE(e.status == Status::Converged);
+    CHECK((e.x - ring.uniform_flow()).cwiseAbs().maxCoeff() < 1e-12);
+    EquilibriumBranchOptions o;
+    o.parameter = "headway";
+    o.from = 1.2;
+    o.to = 3.0;
+    const EquilibriumBranch br = equilibrium_branch(ring, ring.uniform_flow(), o);
+    CHECK(br.status == Status::Converged);
+    CHECK(br.points.front().stable);
+    CHECK(br.points.back().stable);
+    CHECK(br.folds.empty());
+    // Mode N - k at -i omega is the conjugate of mode k at +i omega, so the crossings with omega > 0
+    // are those of k = 1..N-1. Here f_k < max V' = 3 (1/2)^(2/3) / (3/2)^2 ~ 0.84 for k = 1, 2, 3
+    // (f_4 ~ 2.3): two crossings each, one on either side of the inflection of V.
+    REQUIRE(br.hopf.size() == 6);
+    for (const HopfPoint& h : br.hopf) {
+        CHECK(h.status == Status::Converged);
+        const double f = ring.optimal_velocity_slope(h.par);
+        bool matched = false;
+        for (int k = 1; k < N; ++k) {
+            const double th = 2 * pi * k / N;
+            const double w = bisect([&](double ww) { return ww * tau - th / 2 + pi / 2 - std::atan(alpha / ww); }, 1e-9, 10.0);
+            const double fk = w * std::sqrt(w * w + alpha * alpha) / (2 * alpha * std::sin(th / 2));
+            if (std::abs(h.omega - w) < tol::special_point && std::abs(f - fk) < tol::special_point) matched = true;
+        }
+        CHECK_MESSAGE(matched, "Hopf point at headway " << h.par << ", omega " << h.omega << ", V' " << f);
+        // on the uniform flow
+        CHECK((h.x.head(N - 1).array() - h.par).abs().maxCoeff() < 1e-10);
+    }
+}
+
+TEST_CASE("equilibrium branch inputs and failures") {
+    ExpressionSystem sys({"x"}, {"p"}, {1.0}, {"p - x^2"});
+    EquilibriumBranchOptions o;
+    o.parameter = "q";
+    o.from = 0.5;
+    o.to = 1.0;
+    CHECK_THROWS_WITH_AS(equilibrium_branch(sys, Eigen::VectorXd::Ones(1), o),
+                         "parameter 'q' is not a parameter of this system: expected one of p", std::invalid_argument);
+    o.parameter = "p";
+    o.to = 0.5;
+    CHECK_THROWS_AS(equilibrium_branch(sys, Eigen::VectorXd::Ones(1), o), std::invalid_argument);
+    // no equilibrium for p < 0: a status, not an exception
+    o.from = -1.0;
+    o.to = 1.0;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Ones(1), o);
+    CHECK(br.status != Status::Converged);
+    CHECK(br.points.empty());
+    CHECK(br.message.find("no equilibrium at p = -1") == 0);
+}
+
+TEST_SUITE_END();
