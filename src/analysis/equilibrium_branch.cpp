@@ -250,7 +250,14 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         EquilibriumPoint pt;
         pt.par = u[n];
         pt.x = u.head(n);
-        const RootResult rr = rightmost_roots(linearise(system, pt.x, curve.values(u)), options.roots);
+        // every root with Re >= 0 is counted: the request grows until the leftmost root found is stable
+        const LinearDDE lin = linearise(system, pt.x, curve.values(u));
+        RootOptions ro = options.roots;
+        RootResult rr = rightmost_roots(lin, ro);
+        while (converged(rr.status) && !rr.roots.empty() && rr.roots.back().value.real() >= 0.0 && ro.count < 256) {
+            ro.count *= 2;
+            rr = rightmost_roots(lin, ro);
+        }
         pt.roots_status = rr.status;
         roots_ok = roots_ok && converged(rr.status);
         pt.abscissa = rr.spectral_abscissa();
@@ -293,6 +300,9 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         special_ok = special_ok && converged(h.status);
         br.hopf.push_back(std::move(h));
     }
+
+    for (EquilibriumPoint& p : br.points)
+        if (static_cast<int>(p.roots.size()) > options.roots.count) p.roots.resize(static_cast<std::size_t>(options.roots.count));
 
     const bool ended_well = c.stop == ContinuationStop::Bound || c.stop == ContinuationStop::ClosedLoop || c.stop == ContinuationStop::LeftDomain;
     br.status = !ended_well ? (converged(c.status) ? Status::NumericalIssue : c.status)

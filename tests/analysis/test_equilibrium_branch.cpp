@@ -119,6 +119,7 @@ TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy t
     CHECK((e.x - ring.uniform_flow()).cwiseAbs().maxCoeff() < 1e-12);
     EquilibriumBranchOptions o;
     o.parameter = "headway";
+    o.roots.count = 2;  // fewer than the unstable roots: the request must grow to count them all
     o.from = 1.2;
     o.to = 3.0;
     const EquilibriumBranch br = equilibrium_branch(ring, ring.uniform_flow(), o);

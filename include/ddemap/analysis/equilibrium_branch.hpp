@@ -42,7 +42,9 @@ struct EquilibriumBranchOptions {
         c.max_points = 400;
         return c;
     }();
-    RootOptions roots;                 ///< at every point (count: roots reported)
+    /// At every point; count: the roots reported (more are computed, count doubled up to 256,
+    /// while the leftmost one found has Re >= 0, so that every unstable root is counted).
+    RootOptions roots;
     EquilibriumOptions equilibrium;    ///< the first point
     NewtonOptions special{40, 1e-12};  ///< Newton on the fold and Hopf systems
     double special_residual = 1e-9;    ///< accept a fold/Hopf point with residual at most this
@@ -52,9 +54,9 @@ struct EquilibriumBranchOptions {
 struct EquilibriumPoint {
     double par = 0.0;
     Eigen::VectorXd x;
-    std::vector<cplx> roots;  ///< rightmost first
+    std::vector<cplx> roots;  ///< rightmost first (options.roots.count of them)
     double abscissa = 0.0;    ///< max Re over the roots
-    int unstable = 0;         ///< roots with Re > 0 (counted with conjugates, among those computed)
+    int unstable = 0;         ///< roots with Re > 0 (counted with conjugates)
     bool stable = false;      ///< roots converged and every Re < -marginal band
     Status roots_status = Status::Converged;
 };
