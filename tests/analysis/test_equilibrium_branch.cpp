@@ -1,6 +1,8 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <random>
+#include <string>
 
 #include "../tolerances.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
@@ -145,6 +147,63 @@ TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy t
         // on the uniform flow
         CHECK((h.x.head(N - 1).array() - h.par).abs().maxCoeff() < 1e-10);
     }
+}
+
+TEST_CASE("continuation in a delay: x' = -x(t - 2 c) + x^3 continued in c, Hopf at 2 c = pi/2, omega = 1") {
+    // linearisation y' = -y(t - tau) with tau = 2 c: Hopf at tau = pi/2, omega = 1 (a = 1 above)
+    ExpressionSystem sys({"x"}, {"c"}, {0.2}, {"-x(t - 2*c) + x^3"});
+    EquilibriumBranchOptions o;
+    o.parameter = "c";
+    o.from = 0.2;
+    o.to = 1.5;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Zero(1), o);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(std::abs(br.hopf[0].par - pi / 4) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - 1.0) < tol::special_point);
+}
+
+TEST_CASE("ov ring: the eliminated headway against the ring written as expressions, and the structural zero of the full ring") {
+    // three cars; V written out for h > h_st (every point used here has h > h_st)
+    const std::string V = "vmax*(H/hs - 1)^3/(1 + (H/hs - 1)^3)";
+    auto v_of = [&](const std::string& h) {
+        std::string s = V;
+        for (std::size_t at; (at = s.find('H')) != std::string::npos;) s.replace(at, 1, h);
+        return s;
+    };
+    const std::vector<std::string> pars{"alpha", "tau", "vmax", "hs", "hm"};
+    const std::vector<double> vals{1.3, 0.9, 1.1, 1.0, 2.1};
+    // reduced: h2 = 3 hm - h0 - h1
+    ExpressionSystem reduced({"h0", "h1", "u0", "u1", "u2"}, pars, vals,
+                             {"u1 - u0", "u2 - u1", "alpha*(" + v_of("h0(t - tau)") + " - u0)", "alpha*(" + v_of("h1(t - tau)") + " - u1)",
+                              "alpha*(" + v_of("(3*hm - h0(t - tau) - h1(t - tau))") + " - u2)"});
+    OvRing ring(3, 1.3, 0.9, 1.1, 1.0, 2.1);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(1.5, 2.5);
+    for (int trial = 0; trial < 10; ++trial) {
+        Eigen::VectorXd u(10);
+        for (int i = 0; i < 10; ++i) u[i] = U(rng);
+        CHECK((ring.f(u) - reduced.f(u)).cwiseAbs().maxCoeff() < 1e-14);
+        const auto a = ring.jacobians(u), b = reduced.jacobians(u);
+        CHECK((a[0] - b[0]).cwiseAbs().maxCoeff() < 1e-14);
+        CHECK((a[1] - b[1]).cwiseAbs().maxCoeff() < 1e-14);
+    }
+    // the full ring (three headways): its equilibria are not isolated, so Newton meets a singular
+    // Jacobian and the linearisation has the root 0; the reduced ring converges
+    ExpressionSystem full({"h0", "h1", "h2", "u0", "u1", "u2"}, pars, vals,
+                          {"u1 - u0", "u2 - u1", "u0 - u2", "alpha*(" + v_of("h0(t - tau)") + " - u0)",
+                           "alpha*(" + v_of("h1(t - tau)") + " - u1)", "alpha*(" + v_of("h2(t - tau)") + " - u2)"});
+    Eigen::VectorXd xf(6);
+    xf << 2.1, 2.1, 2.1, 0.0, 0.0, 0.0;
+    xf.tail(3).setConstant(ring.optimal_velocity(2.1));
+    CHECK(find_equilibrium(full, xf + Eigen::VectorXd::Constant(6, 0.01)).status == Status::NumericalIssue);
+    const RootResult rf = rightmost_roots(linearise(full, xf));
+    bool zero = false;
+    for (const Root& r : rf.roots) zero = zero || std::abs(r.value) < 1e-12;
+    CHECK(zero);
+    CHECK(find_equilibrium(ring, ring.uniform_flow() + Eigen::VectorXd::Constant(5, 0.01)).status == Status::Converged);
+    const RootResult rr = rightmost_roots(linearise(ring, ring.uniform_flow()));
+    for (const Root& r : rr.roots) CHECK(std::abs(r.value) > 1e-6);
 }
 
 TEST_CASE("equilibrium branch inputs and failures") {

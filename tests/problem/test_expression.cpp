@@ -29,7 +29,6 @@ struct Case {
 
 TEST_CASE("parsed expressions equal the hand-written formulas at random points") {
     const Case cases[] = {
-        {"-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))", nullptr},  // the system, checked below
         {"x + 2*a - b/3", [](double x, double, double a, double b) { return x + 2 * a - b / 3; }},
         {"-x^2", [](double x, double, double, double) { return -(x * x); }},
         {"2^-1 * x", [](double x, double, double, double) { return 0.5 * x; }},
@@ -52,7 +51,6 @@ TEST_CASE("parsed expressions equal the hand-written formulas at random points")
     std::uniform_real_distribution<double> U(-2.0, 2.0), P(0.3, 3.0);
     ExpressionNames names{{"x"}, {"a", "b"}};
     for (const Case& c : cases) {
-        if (!c.hand) continue;
         CAPTURE(c.text);
         const ParsedEquations pe = parse_equations({c.text}, names);
         REQUIRE(pe.equations.size() == 1);
