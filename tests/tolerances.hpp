@@ -45,4 +45,8 @@ constexpr double higher_derivative_fd = 1e-6;
 /// error is of the order of the residual times the condition (~10 here).
 constexpr double special_point = 1e-8;
 
+/// A published number printed with 5 significant digits, value in [0.1, 10): half a unit of the
+/// last printed digit is at most 5e-6 (values < 1) or 5e-5 (values in [1, 10)), relative 5e-5.
+constexpr double published_5_digits_rel = 5e-5;
+
 }  // namespace ddemap::test::tol

@@ -253,8 +253,15 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         // every root with Re >= 0 is counted: the request grows until the leftmost root found is stable
         const LinearDDE lin = linearise(system, pt.x, curve.values(u));
         RootOptions ro = options.roots;
+        ro.count = std::max(ro.count, 8);
         RootResult rr = rightmost_roots(lin, ro);
-        while (converged(rr.status) && !rr.roots.empty() && rr.roots.back().value.real() >= 0.0 && ro.count < 256) {
+        auto stable_found = [](const RootResult& r) {
+            int c = 0;
+            for (const Root& x : r.roots) c += x.value.real() < 0.0 ? 1 : 0;
+            return c;
+        };
+        while (converged(rr.status) && !rr.roots.empty() && stable_found(rr) < 6 && ro.count < 256 &&
+               static_cast<int>(rr.roots.size()) >= ro.count) {
             ro.count *= 2;
             rr = rightmost_roots(lin, ro);
         }
@@ -278,28 +285,48 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         br.folds.push_back(std::move(f));
     }
 
+    // Hopf candidates between consecutive points: a complex root (Im > 0) whose nearest partner at
+    // the next point has a real part of the other sign; and, where no such pair is matched, a
+    // change in the number of roots with Re > 0, Im > 0 (the root nearest the axis).
     auto complex_unstable = [](const EquilibriumPoint& p) {
         int c = 0;
         for (const cplx& r : p.roots)
             if (r.imag() > 0.0 && r.real() > marginal_band(r)) ++c;
         return c;
     };
+    auto add_hopf = [&](const EquilibriumPoint& from, double omega, int after) {
+        HopfPoint h = correct_hopf(system, j, from.x, from.par, omega, {}, options.special, options.special_residual);
+        h.after = after;
+        for (const HopfPoint& o : br.hopf)
+            if (converged(h.status) && converged(o.status) && std::abs(o.par - h.par) <= 1e-8 * std::max(1.0, std::abs(h.par)) &&
+                std::abs(o.omega - h.omega) <= 1e-8 * std::max(1.0, h.omega))
+                return;  // the same point from two candidates
+        special_ok = special_ok && converged(h.status);
+        br.hopf.push_back(std::move(h));
+    };
     for (std::size_t k = 0; k + 1 < br.points.size(); ++k) {
         const EquilibriumPoint& a = br.points[k];
         const EquilibriumPoint& b = br.points[k + 1];
-        if (complex_unstable(a) == complex_unstable(b)) continue;
-        // the complex root nearest the imaginary axis at either end
+        int net = 0;  // matched crossings: +1 to the right, -1 to the left
+        for (const cplx& ra : a.roots) {
+            if (!(ra.imag() > 0.0)) continue;
+            const cplx* nearest = nullptr;
+            for (const cplx& rb : b.roots)
+                if (rb.imag() > 0.0 && (!nearest || std::abs(rb - ra) < std::abs(*nearest - ra))) nearest = &rb;
+            if (!nearest || (ra.real() > 0.0) == (nearest->real() > 0.0)) continue;
+            net += nearest->real() > 0.0 ? 1 : -1;
+            const bool from_a = std::abs(ra.real()) <= std::abs(nearest->real());
+            add_hopf(from_a ? a : b, from_a ? ra.imag() : nearest->imag(), static_cast<int>(k));
+        }
+        if (complex_unstable(b) - complex_unstable(a) == net) continue;
         const EquilibriumPoint* from = nullptr;
         cplx best(std::numeric_limits<double>::infinity(), 0.0);
         for (const EquilibriumPoint* p : {&a, &b})
             for (const cplx& r : p->roots)
                 if (r.imag() > 0.0 && std::abs(r.real()) < std::abs(best.real())) best = r, from = p;
-        if (!from) continue;
-        HopfPoint h = correct_hopf(system, j, from->x, from->par, best.imag(), {}, options.special, options.special_residual);
-        h.after = static_cast<int>(k);
-        special_ok = special_ok && converged(h.status);
-        br.hopf.push_back(std::move(h));
+        if (from) add_hopf(*from, best.imag(), static_cast<int>(k));
     }
+    std::sort(br.hopf.begin(), br.hopf.end(), [](const HopfPoint& x, const HopfPoint& y) { return x.after < y.after; });
 
     for (EquilibriumPoint& p : br.points)
         if (static_cast<int>(p.roots.size()) > options.roots.count) p.roots.resize(static_cast<std::size_t>(options.roots.count));

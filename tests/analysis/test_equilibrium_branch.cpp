@@ -206,6 +206,37 @@ TEST_CASE("ov ring: the eliminated headway against the ring written as expressio
     for (const Root& r : rr.roots) CHECK(std::abs(r.value) > 1e-6);
 }
 
+TEST_CASE("DDE-BIFTOOL demo 1 (neuron): the published Hopf points" * doctest::test_suite("reference")) {
+    // DDE-Biftool, demos/neuron/html/demo1_hopf.html (published output of demo1_hopf.m): the
+    // system of Shayer and Campbell with kappa = 0.5, beta = -1, a12 = 1, tau1 = tau2 = 0.2 at
+    // the trivial equilibrium. With tau_s = 1.5 the Hopf point is at a21 = 0.80712, omega = 0.78197;
+    // with a21 = 0.207 the second Hopf point (corrected in tau_s) at tau_s = 8.6341, omega = 0.91575.
+    const std::vector<std::string> eqs{"-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                                       "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"};
+    ExpressionSystem neuron({"x1", "x2"}, {"kappa", "beta", "a12", "a21", "tau1", "tau2", "taus"}, {0.5, -1, 1, 0.5, 0.2, 0.2, 1.5}, eqs);
+    EquilibriumBranchOptions o;
+    o.parameter = "a21";
+    o.from = 0.3;
+    o.to = 2.0;
+    const EquilibriumBranch b1 = equilibrium_branch(neuron, Eigen::VectorXd::Zero(2), o);
+    CHECK(b1.status == Status::Converged);
+    REQUIRE(b1.hopf.size() == 1);
+    CHECK(std::abs(b1.hopf[0].par / 0.80712 - 1) < tol::published_5_digits_rel);
+    CHECK(std::abs(b1.hopf[0].omega / 0.78197 - 1) < tol::published_5_digits_rel);
+    neuron.set_parameter("a21", 0.207);
+    o.parameter = "taus";
+    o.from = 5.0;
+    o.to = 10.0;
+    const EquilibriumBranch b2 = equilibrium_branch(neuron, Eigen::VectorXd::Zero(2), o);
+    CHECK(b2.status == Status::Converged);
+    bool found = false;
+    for (const HopfPoint& h : b2.hopf)
+        found = found || (std::abs(h.par / 8.6341 - 1) < tol::published_5_digits_rel && std::abs(h.omega / 0.91575 - 1) < tol::published_5_digits_rel);
+    CHECK(found);
+    // the other pair crosses close by (a double Hopf point nearby, as the demo notes): two Hopf points
+    CHECK(b2.hopf.size() == 2);
+}
+
 TEST_CASE("equilibrium branch inputs and failures") {
     ExpressionSystem sys({"x"}, {"p"}, {1.0}, {"p - x^2"});
     EquilibriumBranchOptions o;

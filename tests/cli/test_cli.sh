@@ -436,5 +436,16 @@ else
 fi
 "$bin" equilibria --model ov --ring 5 --par headway --from 1.2 --to 3 | grep -q '^hopf' && ok || bad "equilibria table"
 
+# a published model as a system file: DDE-BIFTOOL's neuron demo (demo1_hopf: Hopf at a21 = 0.80712, omega = 0.78197)
+cat >"$tmp/neuron.json" <<'EOF2'
+{ "variables": ["x1", "x2"],
+  "parameters": {"kappa": 0.5, "beta": -1, "a12": 1, "a21": 0.5, "tau1": 0.2, "tau2": 0.2, "taus": 1.5},
+  "equations": ["-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"] }
+EOF2
+"$bin" equilibria --system "$tmp/neuron.json" --par a21 --from 0.3 --to 2 --format json |
+    python3 -c "import json,sys; h=json.load(sys.stdin)['result']['hopf']; assert len(h) == 1 and abs(h[0]['par']/0.80712-1) < 5e-5 and abs(h[0]['omega']/0.78197-1) < 5e-5, h" &&
+    ok || bad "equilibria: DDE-BIFTOOL neuron Hopf point"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

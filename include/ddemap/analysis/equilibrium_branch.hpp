@@ -7,7 +7,10 @@
 /// Special points:
 ///  - fold: the tangent's parameter component changes sign (a test function of the engine); then
 ///    Newton on the fold system  g(x, p) = 0,  (sum_k A_k) v = 0,  v0 . v = 1  (2n + 1 unknowns);
-///  - Hopf: the number of roots with Re > 0 and Im > 0 changes between two points; then Newton on
+///  - Hopf: a root with Im > 0 and its nearest partner at the next point have real parts of
+///    opposite signs (and, when these matched crossings do not account for the change in the
+///    number of roots with Re > 0 and Im > 0, the root nearest the axis; two crossings of one
+///    pair between two points are not seen); then Newton on
 ///    the Hopf system  g(x, p) = 0,  Delta(i omega; x, p) q = 0,  q0^H q = 1  (x, p, q in C^n,
 ///    omega > 0: 3n + 2 real unknowns), from the root nearest the imaginary axis. The residuals
 ///    use the exact characteristic matrix; Newton's Jacobian of these augmented systems is taken
@@ -42,8 +45,9 @@ struct EquilibriumBranchOptions {
         c.max_points = 400;
         return c;
     }();
-    /// At every point; count: the roots reported (more are computed, count doubled up to 256,
-    /// while the leftmost one found has Re >= 0, so that every unstable root is counted).
+    /// At every point; count: the roots reported. More are computed for the detection of Hopf
+    /// points: at least 8, doubled (up to 256) until 6 of them have Re < 0, so that every
+    /// unstable root and the stable ones nearest the axis are seen.
     RootOptions roots;
     EquilibriumOptions equilibrium;    ///< the first point
     NewtonOptions special{40, 1e-12};  ///< Newton on the fold and Hopf systems
