@@ -52,4 +52,19 @@ constexpr double coverage_band = 0.035;
 /// that bound and far below the factor 2 the covariance test tells apart.
 constexpr double same_fit = 1e-4;
 
+/// A parsed expression against the same formula written in C++, relative: both evaluate the
+/// same operations in double precision, possibly in another order (a few ulps, |values| <= ~1e3).
+constexpr double expression_vs_hand = 1e-13;
+/// Nested dual numbers (second, third derivatives) against central differences of the exact
+/// derivative one order lower, step 1e-4: error O(h^2) ~ 1e-8 times the next derivative (<= ~10 here).
+constexpr double higher_derivative_fd = 1e-6;
+/// Fold and Hopf points located by Newton on their defining systems (residual <= 1e-9, the
+/// Jacobian by central differences) against closed forms: the points are regular zeros, so the
+/// error is of the order of the residual times the condition (~10 here).
+constexpr double special_point = 1e-8;
+
+/// A published number printed with 5 significant digits, value in [0.1, 10): half a unit of the
+/// last printed digit is at most 5e-6 (values < 1) or 5e-5 (values in [1, 10)), relative 5e-5.
+constexpr double published_5_digits_rel = 5e-5;
+
 }  // namespace ddemap::test::tol

@@ -28,6 +28,9 @@ const std::vector<Command>& command_table() {
          add_calibrate_flags, run_calibrate},
         {"mix", "penetration-rate study: spectral abscissa of a ring with a fraction p of type X among type Y",
          add_mix_flags, run_mix},
+        {"equilibria", "a branch of equilibria of a nonlinear DDE (--system FILE with expressions, or --model ov --ring N) in one parameter: "
+         "stability at every point, folds and Hopf points",
+         add_equilibria_flags, run_equilibria},
     };
     return table;
 }

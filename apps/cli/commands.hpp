@@ -30,6 +30,7 @@ DDEMAP_COMMAND(simulate)
 DDEMAP_COMMAND(growth)
 DDEMAP_COMMAND(calibrate)
 DDEMAP_COMMAND(mix)
+DDEMAP_COMMAND(equilibria)
 #undef DDEMAP_COMMAND
 
 }  // namespace ddemap::cli

@@ -2,6 +2,7 @@
 // a mixed ring (--fleet FILE.csv or --fleet-pattern), or any linear DDE (--system FILE.json).
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "commands.hpp"
@@ -13,6 +14,7 @@
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
+#include "ddemap/solve/equilibrium.hpp"
 
 namespace ddemap::cli {
 
@@ -48,7 +50,45 @@ int run_system(Format format, const std::string& prefix) {
     o.degree = parse_degree();
     o.method = root_method(args.solver);
     if (o.method == "contour") throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
-    const LinearDDE dde = read_linear_dde_json(read_input_file("--system", args.system), args.system);
+    const std::string text = read_input_file("--system", args.system);
+    std::string equilibrium_json, equilibrium_line;
+    Status eq_status = Status::Converged;
+    const std::optional<LinearDDE> lin = [&] {
+        if (!is_nonlinear_system_json(text)) return std::optional<LinearDDE>(read_linear_dde_json(text, args.system));
+        // a nonlinear file: its equilibrium by Newton from the file's guess, then the linearisation there
+        const NonlinearSystemFile file = read_nonlinear_system_json(text, args.system);
+        const EquilibriumResult eq = find_equilibrium(*file.system, file.equilibrium);
+        eq_status = eq.status;
+        std::vector<std::string> xs;
+        for (Eigen::Index i = 0; i < eq.x.size(); ++i) xs.push_back(json_number(eq.x[i]));
+        equilibrium_json = JsonObject()
+                               .json("x", json_array(xs))
+                               .number("residual", eq.residual)
+                               .integer("iterations", eq.iterations)
+                               .string("status", to_string(eq.status))
+                               .string("message", eq.message)
+                               .str();
+        equilibrium_line = "equilibrium";
+        for (Eigen::Index i = 0; i < eq.x.size(); ++i)
+            equilibrium_line += (i ? ", " : " ") + file.system->variables()[static_cast<std::size_t>(i)] + " = " + rounded(eq.x[i], 10);
+        equilibrium_line += " (" + eq.message + ")\n";
+        if (!converged(eq.status)) return std::optional<LinearDDE>();
+        return std::optional<LinearDDE>(linearise(*file.system, eq.x));
+    }();
+    if (!lin) {
+        // no equilibrium: undecided, the Newton result printed
+        JsonEnvelope e;
+        e.command = "roots";
+        e.inputs = JsonObject().string("system", args.system).integer("count", o.count).integer("degree", o.degree).str();
+        e.status = to_string(eq_status);
+        e.message = "no equilibrium found from the guess";
+        e.result = JsonObject().json("equilibrium", equilibrium_json).str();
+        emit(e, roots_csv({}), equilibrium_line + "verdict    UNDECIDED (no equilibrium: " + to_string(eq_status) + ")\n", format, prefix);
+        std::cerr << "ddemap: undecided: " << args.system << ": Newton found no equilibrium from the guess (" << to_string(eq_status)
+                  << "); give a better \"equilibrium\" guess in the file\n";
+        return exit_not_converged;
+    }
+    const LinearDDE& dde = *lin;
     const SystemRootResult s = analyse_system(dde, o);
     const RootResult& r = s.roots;
     JsonEnvelope e;
@@ -60,8 +100,10 @@ int run_system(Format format, const std::string& prefix) {
     e.status = to_string(r.status);
     e.message = r.message;
     e.result = system_roots_json(dde, s);
+    if (!equilibrium_json.empty()) e.result = JsonObject().json("equilibrium", equilibrium_json).json("linearisation", e.result).str();
     std::ostringstream out;
     out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
+    out << equilibrium_line;
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << "trusted    " << r.message << "\n";
     out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";

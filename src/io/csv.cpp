@@ -57,6 +57,24 @@ std::string csv_field(const std::string& s) {
     return out + "\"";
 }
 
+std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables) {
+    std::string out = "kind," + csv_field(b.parameter);
+    for (const auto& v : variables) out += "," + csv_field(v);
+    out += ",abscissa,unstable,stable,omega,status\n";
+    auto xs = [](const Eigen::VectorXd& x) {
+        std::string s;
+        for (Eigen::Index i = 0; i < x.size(); ++i) s += "," + format_exact(x[i]);
+        return s;
+    };
+    for (const EquilibriumPoint& p : b.points)
+        out += "point," + format_exact(p.par) + xs(p.x) + "," + format_exact(p.abscissa) + "," + std::to_string(p.unstable) + "," +
+               (p.stable ? "true" : "false") + ",," + to_string(p.roots_status) + "\n";
+    for (const FoldPoint& f : b.folds) out += "fold," + format_exact(f.par) + xs(f.x) + ",,,,," + to_string(f.status) + "\n";
+    for (const HopfPoint& h : b.hopf)
+        out += "hopf," + format_exact(h.par) + xs(h.x) + ",,,," + format_exact(h.omega) + "," + to_string(h.status) + "\n";
+    return out;
+}
+
 std::string roots_csv(const std::vector<Root>& roots) {
     std::string out = "re,im,residual,newton_step\n";
     for (const auto& x : roots)

@@ -133,6 +133,55 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& s) {
     return text(j);
 }
 
+std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vector<std::string>& variables) {
+    auto vec = [](const Eigen::VectorXd& x) {
+        json a = json::array();
+        for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(num(x[i]));
+        return a;
+    };
+    json j;
+    j["parameter"] = b.parameter;
+    j["variables"] = variables;
+    json points = json::array();
+    for (const EquilibriumPoint& p : b.points) {
+        json o;
+        o["par"] = num(p.par);
+        o["x"] = vec(p.x);
+        o["abscissa"] = num(p.abscissa);
+        o["unstable"] = p.unstable;
+        o["stable"] = p.stable;
+        o["roots_status"] = to_string(p.roots_status);
+        json roots = json::array();
+        for (const cplx& r : p.roots) roots.push_back(json::array({num(r.real()), num(r.imag())}));
+        o["roots"] = roots;
+        points.push_back(o);
+    }
+    j["points"] = points;
+    json folds = json::array();
+    for (const FoldPoint& f : b.folds) {
+        json o;
+        o["par"] = num(f.par);
+        o["x"] = vec(f.x);
+        o["status"] = to_string(f.status);
+        o["residual"] = num(f.residual);
+        folds.push_back(o);
+    }
+    j["folds"] = folds;
+    json hopf = json::array();
+    for (const HopfPoint& h : b.hopf) {
+        json o;
+        o["par"] = num(h.par);
+        o["omega"] = num(h.omega);
+        o["x"] = vec(h.x);
+        o["status"] = to_string(h.status);
+        o["residual"] = num(h.residual);
+        hopf.push_back(o);
+    }
+    j["hopf"] = hopf;
+    j["stop"] = to_string(b.stop);
+    return text(j);
+}
+
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
     const RootResult& rr = r.roots;
     json j;

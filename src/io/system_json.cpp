@@ -105,4 +105,75 @@ LinearDDE read_linear_dde_json(const std::string& text, const std::string& sourc
     return LinearDDE(a0, terms);
 }
 
+bool is_nonlinear_system_json(const std::string& text) {
+    const nlohmann::ordered_json j = nlohmann::ordered_json::parse(text, nullptr, false);
+    return !j.is_discarded() && j.is_object() && j.contains("equations");
+}
+
+NonlinearSystemFile read_nonlinear_system_json(const std::string& text, const std::string& source) {
+    using ojson = nlohmann::ordered_json;
+    ojson j;
+    try {
+        j = ojson::parse(text);
+    } catch (const ojson::parse_error& e) {
+        throw std::invalid_argument(source + ": not valid JSON (" + std::string(e.what()) + ")");
+    } catch (const ojson::out_of_range& e) {
+        throw std::invalid_argument(source + ": a number outside the range of doubles (" + std::string(e.what()) + ")");
+    }
+    if (!j.is_object()) fail(source, "top level", "expected an object with variables, parameters, equations");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& k = it.key();
+        if (k != "variables" && k != "parameters" && k != "equations" && k != "equilibrium" && k != "comment")
+            fail(source, k, "unknown field (expected variables, parameters, equations, equilibrium, comment)");
+    }
+    auto strings = [&](const char* field) {
+        std::vector<std::string> out;
+        if (!j.contains(field) || !j[field].is_array()) fail(source, field, "expected an array of strings");
+        for (std::size_t i = 0; i < j[field].size(); ++i) {
+            if (!j[field][i].is_string()) fail(source, std::string(field) + "[" + std::to_string(i) + "]", "expected a string");
+            out.push_back(j[field][i].get<std::string>());
+        }
+        return out;
+    };
+    const std::vector<std::string> variables = strings("variables");
+    if (variables.empty() || variables.size() > 10000) fail(source, "variables", "expected 1 to 10000 names");
+    const std::vector<std::string> equations = strings("equations");
+    if (equations.size() != variables.size())
+        fail(source, "equations", std::to_string(equations.size()) + " equations for " + std::to_string(variables.size()) +
+                                      " variables: expected one equation per variable");
+    std::vector<std::string> names;
+    std::vector<double> values;
+    if (j.contains("parameters")) {
+        if (!j["parameters"].is_object()) fail(source, "parameters", "expected an object {\"name\": value, ...}");
+        for (auto it = j["parameters"].begin(); it != j["parameters"].end(); ++it) {
+            if (!it.value().is_number()) fail(source, "parameters." + it.key(), "expected a number");
+            const double v = it.value().get<double>();
+            if (!std::isfinite(v)) fail(source, "parameters." + it.key(), "expected a finite number");
+            names.push_back(it.key());
+            values.push_back(v);
+        }
+    }
+    NonlinearSystemFile out;
+    try {
+        out.system = std::make_shared<ExpressionSystem>(variables, names, values, equations);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(source + ": " + e.what());
+    }
+    const std::size_t n = variables.size();
+    out.equilibrium = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+    if (j.contains("equilibrium")) {
+        const ojson& e = j["equilibrium"];
+        if (!e.is_array() || e.size() != n) fail(source, "equilibrium", "expected an array of " + std::to_string(n) + " numbers (one per variable)");
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::string f = "equilibrium[" + std::to_string(i) + "]";
+            if (!e[i].is_number()) fail(source, f, "expected a number");
+            const double v = e[i].get<double>();
+            if (!std::isfinite(v)) fail(source, f, "expected a finite number");
+            out.equilibrium[static_cast<Eigen::Index>(i)] = v;
+        }
+        out.equilibrium_given = true;
+    }
+    return out;
+}
+
 }  // namespace ddemap

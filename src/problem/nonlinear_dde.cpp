@@ -61,13 +61,33 @@ Eigen::VectorXd NonlinearDDE::f(const Eigen::VectorXd& stacked) const {
     return out;
 }
 
-std::vector<Eigen::MatrixXd> NonlinearDDE::jacobians(const Eigen::VectorXd& stacked) const {
+std::vector<Eigen::MatrixXd> NonlinearDDE::jacobians(const Eigen::VectorXd& stacked) const { return jacobians(stacked, m_values); }
+
+namespace {
+void check_values(const std::vector<double>& p, std::size_t count) {
+    if (p.size() != count)
+        throw std::invalid_argument(std::to_string(p.size()) + " parameter values: expected " + std::to_string(count) + " (one per parameter)");
+    for (double v : p)
+        if (!std::isfinite(v)) throw std::invalid_argument("a parameter value is not finite: expected finite values");
+}
+}  // namespace
+
+Eigen::VectorXd NonlinearDDE::f(const Eigen::VectorXd& stacked, const std::vector<double>& p) const {
     check_stacked(stacked, "the stacked argument");
+    check_values(p, m_names.size());
+    Eigen::VectorXd out(dimension());
+    evaluate(stacked.data(), p.data(), out.data());
+    return out;
+}
+
+std::vector<Eigen::MatrixXd> NonlinearDDE::jacobians(const Eigen::VectorXd& stacked, const std::vector<double>& values) const {
+    check_stacked(stacked, "the stacked argument");
+    check_values(values, m_names.size());
     const int n = dimension(), m = delay_count();
     const int size = n * (m + 1);
-    std::vector<Dual<double>> u(size), p(m_values.size()), out(n);
+    std::vector<Dual<double>> u(size), p(values.size()), out(n);
     for (int i = 0; i < size; ++i) u[i] = Dual<double>(stacked[i]);
-    for (std::size_t j = 0; j < m_values.size(); ++j) p[j] = Dual<double>(m_values[j]);
+    for (std::size_t j = 0; j < values.size(); ++j) p[j] = Dual<double>(values[j]);
     std::vector<Eigen::MatrixXd> a(m + 1, Eigen::MatrixXd::Zero(n, n));
     for (int c = 0; c < size; ++c) {
         u[c].deriv = 1.0;
@@ -76,6 +96,22 @@ std::vector<Eigen::MatrixXd> NonlinearDDE::jacobians(const Eigen::VectorXd& stac
         for (int r = 0; r < n; ++r) a[c / n](r, c % n) = out[r].deriv;
     }
     return a;
+}
+
+Eigen::VectorXd NonlinearDDE::parameter_derivative(const Eigen::VectorXd& stacked, int j, const std::vector<double>& values) const {
+    check_stacked(stacked, "the stacked argument");
+    check_values(values, m_names.size());
+    if (j < 0 || j >= static_cast<int>(values.size()))
+        throw std::invalid_argument("parameter index " + std::to_string(j) + ": expected 0.." + std::to_string(static_cast<int>(values.size()) - 1));
+    const int n = dimension(), size = n * (delay_count() + 1);
+    std::vector<Dual<double>> u(size), p(values.size()), out(n);
+    for (int i = 0; i < size; ++i) u[i] = Dual<double>(stacked[i]);
+    for (std::size_t k = 0; k < values.size(); ++k) p[k] = Dual<double>(values[k]);
+    p[j].deriv = 1.0;
+    evaluate(u.data(), p.data(), out.data());
+    Eigen::VectorXd d(n);
+    for (int r = 0; r < n; ++r) d[r] = out[r].deriv;
+    return d;
 }
 
 Eigen::MatrixXd NonlinearDDE::jacobian(const Eigen::VectorXd& stacked, int block) const {
@@ -119,13 +155,64 @@ Eigen::VectorXd NonlinearDDE::stack_constant(const Eigen::VectorXd& x) const {
     return x.replicate(delay_count() + 1, 1);
 }
 
+void NonlinearDDE::evaluate(const Dual2*, const Dual2*, Dual2*) const {
+    throw std::logic_error("this system has no second derivatives: expected a system built on NonlinearDDEOf");
+}
+
+void NonlinearDDE::evaluate(const Dual3*, const Dual3*, Dual3*) const {
+    throw std::logic_error("this system has no third derivatives: expected a system built on NonlinearDDEOf");
+}
+
+namespace {
+void check_direction(const Eigen::VectorXd& d, Eigen::Index size, const char* what) {
+    if (d.size() != size)
+        throw std::invalid_argument(std::string(what) + " has " + std::to_string(d.size()) + " entries: expected n (m + 1) = " + std::to_string(size));
+    if (!d.allFinite()) throw std::invalid_argument(std::string(what) + " has a non-finite entry: expected finite values");
+}
+}  // namespace
+
+Eigen::VectorXd NonlinearDDE::second_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b) const {
+    check_stacked(stacked, "the stacked argument");
+    check_direction(a, stacked.size(), "direction a");
+    check_direction(b, stacked.size(), "direction b");
+    std::vector<Dual2> u(stacked.size()), p(m_values.size()), out(dimension());
+    for (Eigen::Index i = 0; i < stacked.size(); ++i) u[i] = Dual2(Dual<double>(stacked[i], a[i]), Dual<double>(b[i], 0.0));
+    for (std::size_t j = 0; j < m_values.size(); ++j) p[j] = Dual2(m_values[j]);
+    evaluate(u.data(), p.data(), out.data());
+    Eigen::VectorXd d(dimension());
+    for (int r = 0; r < dimension(); ++r) d[r] = out[r].deriv.deriv;
+    return d;
+}
+
+Eigen::VectorXd NonlinearDDE::third_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                               const Eigen::VectorXd& c) const {
+    check_stacked(stacked, "the stacked argument");
+    check_direction(a, stacked.size(), "direction a");
+    check_direction(b, stacked.size(), "direction b");
+    check_direction(c, stacked.size(), "direction c");
+    using D1 = Dual<double>;
+    std::vector<Dual3> u(stacked.size()), p(m_values.size()), out(dimension());
+    // x + a e1 + b e2 + c e3: value part (x + a e1) + b e2, derivative part (c + 0 e1) + 0 e2
+    for (Eigen::Index i = 0; i < stacked.size(); ++i)
+        u[i] = Dual3(Dual2(D1(stacked[i], a[i]), D1(b[i], 0.0)), Dual2(D1(c[i], 0.0), D1(0.0, 0.0)));
+    for (std::size_t j = 0; j < m_values.size(); ++j) p[j] = Dual3(m_values[j]);
+    evaluate(u.data(), p.data(), out.data());
+    Eigen::VectorXd d(dimension());
+    for (int r = 0; r < dimension(); ++r) d[r] = out[r].deriv.deriv.deriv;
+    return d;
+}
+
 LinearDDE linearise(const NonlinearDDE& system, const Eigen::VectorXd& equilibrium) {
+    return linearise(system, equilibrium, system.parameter_values());
+}
+
+LinearDDE linearise(const NonlinearDDE& system, const Eigen::VectorXd& equilibrium, const std::vector<double>& p) {
     const Eigen::VectorXd u = system.stack_constant(equilibrium);
-    const std::vector<double> tau = system.delays();
+    const std::vector<double> tau = system.delays(p);
     if (static_cast<int>(tau.size()) != system.delay_count())
         throw std::invalid_argument("the system gives " + std::to_string(tau.size()) + " delays: expected delay_count() = " +
                                     std::to_string(system.delay_count()));
-    const std::vector<Eigen::MatrixXd> a = system.jacobians(u);
+    const std::vector<Eigen::MatrixXd> a = system.jacobians(u, p);
     std::vector<DelayTerm> terms;
     for (std::size_t k = 0; k < tau.size(); ++k) terms.push_back({a[k + 1].cast<cplx>(), tau[k]});
     return LinearDDE(a[0].cast<cplx>(), std::move(terms));

@@ -559,5 +559,84 @@ assert set(models) >= {"ovrv", "idm", "ccc"}, models
 assert all(m in e for m in models), (e, models)
 PY
 
+# ---- nonlinear systems with expressions: roots --system (linearised at the equilibrium) and equilibria
+cat >"$tmp/nl.json" <<'EOF2'
+{ "variables": ["x1", "x2"],
+  "parameters": {"a": 0.5, "b": 0.6, "d": 0.05, "tau": 2.0},
+  "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"],
+  "equilibrium": [0.1, 0.0] }
+EOF2
+if "$bin" roots --system "$tmp/nl.json" --format json >"$tmp/nl_r.json"; then
+    json_has "$tmp/nl_r.json" equilibrium linearisation && ok || bad "roots --system nonlinear json keys"
+    # every root against the characteristic equation of the linearisation at 0, written by hand:
+    # lambda^2 + d lambda + a + b - b exp(-lambda tau) = 0
+    python3 - "$tmp/nl_r.json" <<'PY' && ok || bad "roots --system nonlinear: roots solve the hand-derived characteristic equation"
+import json, sys, cmath
+d = json.load(open(sys.argv[1]))["result"]
+assert d["equilibrium"]["status"] == "converged" and max(abs(x) for x in d["equilibrium"]["x"]) < 1e-12
+a, b, dd, tau = 0.5, 0.6, 0.05, 2.0
+for r in d["linearisation"]["roots"]:
+    l = complex(r["re"], r["im"])
+    assert abs(l * l + dd * l + a + b - b * cmath.exp(-l * tau)) < 1e-10 * max(1, abs(l) ** 2), l
+assert d["linearisation"]["stable"] is True
+PY
+else
+    bad "roots --system nonlinear exit status"
+fi
+# no equilibrium from the guess (x' = x^2 + 1 has none): undecided, exit 4, the Newton result printed
+echo '{"variables": ["x"], "equations": ["x^2 + 1"], "equilibrium": [0.5]}' >"$tmp/noeq.json"
+"$bin" roots --system "$tmp/noeq.json" --format json >"$tmp/noeq.out" 2>"$tmp/noeq.err"
+rc=$?
+[ $rc -eq 4 ] && grep -q '"status"' "$tmp/noeq.out" && grep -q "undecided" "$tmp/noeq.err" && ok || bad "roots --system without equilibrium: exit $rc"
+# expression errors: the file, the equation and the character
+echo '{"variables": ["x"], "parameters": {"a": 1}, "equations": ["-a*x(t - x)"]}' >"$tmp/bad1.json"
+expect_error "bad1.json: equation 1 (dx/dt), character 10: the delay depends on the state (x)" roots --system "$tmp/bad1.json"
+echo '{"variables": ["x"], "parameters": {"a": 1}, "equations": ["-a*y"]}' >"$tmp/bad2.json"
+expect_error "character 4: unknown name 'y'" equilibria --system "$tmp/bad2.json" --par a --from 0 --to 1
+echo '{"variables": ["x"], "parameters": {"a": 1}, "equations": ["-a*(x + 1"]}' >"$tmp/bad3.json"
+expect_error "character 10: the expression ends early: expected ')'" equilibria --system "$tmp/bad3.json" --par a --from 0 --to 1 --out "$tmp/eqbad"
+[ ! -e "$tmp/eqbad.csv" ] && [ ! -e "$tmp/eqbad.json" ] && ok || bad "equilibria bad input wrote files"
+echo '{"variables": ["x"], "parameters": {"p": 1}, "equations": ["p - x(t - 1)^2"], "equilibrium": [1]}' >"$tmp/fold.json"
+expect_error "parameter 'q' is not a parameter of this system: expected one of p" equilibria --system "$tmp/fold.json" --par q --from 0 --to 1
+expect_error "expected one of --system FILE or --model ov" equilibria --system "$tmp/fold.json" --model ov --par p --from 0 --to 1
+expect_error "--model = 'idm'" equilibria --model idm --ring 5 --par v0 --from 0 --to 1
+expect_error "--ring" equilibria --model ov --par headway --from 1.2 --to 3
+# equilibria: a fold at p = 0 and a Hopf point at p = (pi/4)^2, omega = pi/2 (closed forms of x' = p - x(t-1)^2)
+if "$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 --format json --out "$tmp/eqf" >"$tmp/eqf.out"; then
+    json_has "$tmp/eqf.out" parameter points folds hopf && ok || bad "equilibria json keys"
+    python3 - "$tmp/eqf.out" "$tmp/eqf.csv" <<'PY' && ok || bad "equilibria fold and Hopf against the closed forms"
+import json, sys, math, csv
+d = json.load(open(sys.argv[1]))["result"]
+assert d["parameter"] == "p"
+assert len(d["folds"]) == 1 and abs(d["folds"][0]["par"]) < 1e-8 and d["folds"][0]["status"] == "converged"
+assert len(d["hopf"]) == 1 and abs(d["hopf"][0]["par"] - math.pi ** 2 / 16) < 1e-8 and abs(d["hopf"][0]["omega"] - math.pi / 2) < 1e-8
+for p in d["points"]:
+    assert abs(p["par"] - p["x"][0] ** 2) < 1e-10  # on the curve p = x^2
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert [r["kind"] for r in rows].count("hopf") == 1 and [r["kind"] for r in rows].count("fold") == 1
+assert float([r for r in rows if r["kind"] == "hopf"][0]["p"]) == d["hopf"][0]["par"]  # round trip exact
+PY
+else
+    bad "equilibria --system exit status"
+fi
+# the ov ring (5 cars, one headway eliminated): six Hopf points (modes 1, 2, 3 on both sides of the inflection of V)
+if "$bin" equilibria --model ov --ring 5 --par headway --from 1.2 --to 3 --format csv >"$tmp/ov.csv"; then
+    [ "$(grep -c '^hopf,' "$tmp/ov.csv")" -eq 6 ] && ! grep -qi 'nan\|inf' "$tmp/ov.csv" && ok || bad "equilibria ov ring: 6 Hopf points"
+else
+    bad "equilibria --model ov exit status"
+fi
+"$bin" equilibria --model ov --ring 5 --par headway --from 1.2 --to 3 | grep -q '^hopf' && ok || bad "equilibria table"
+
+# a published model as a system file: DDE-BIFTOOL's neuron demo (demo1_hopf: Hopf at a21 = 0.80712, omega = 0.78197)
+cat >"$tmp/neuron.json" <<'EOF2'
+{ "variables": ["x1", "x2"],
+  "parameters": {"kappa": 0.5, "beta": -1, "a12": 1, "a21": 0.5, "tau1": 0.2, "tau2": 0.2, "taus": 1.5},
+  "equations": ["-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"] }
+EOF2
+"$bin" equilibria --system "$tmp/neuron.json" --par a21 --from 0.3 --to 2 --format json |
+    python3 -c "import json,sys; h=json.load(sys.stdin)['result']['hopf']; assert len(h) == 1 and abs(h[0]['par']/0.80712-1) < 5e-5 and abs(h[0]['omega']/0.78197-1) < 5e-5, h" &&
+    ok || bad "equilibria: DDE-BIFTOOL neuron Hopf point"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

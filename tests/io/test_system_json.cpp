@@ -60,3 +60,39 @@ TEST_CASE("bad system files name the field") {
 }
 
 TEST_SUITE_END();
+
+TEST_CASE("a nonlinear system file: expressions, parameter order, equilibrium guess, errors naming the file and field") {
+    const std::string text = R"J({ "variables": ["x1", "x2"],
+      "parameters": {"tau": 2.0, "a": 0.5, "b": 0.6, "d": 0.05},
+      "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"],
+      "equilibrium": [0.1, -0.2] })J";
+    REQUIRE(ddemap::is_nonlinear_system_json(text));
+    const ddemap::NonlinearSystemFile f = ddemap::read_nonlinear_system_json(text, "f.json");
+    CHECK(f.system->dimension() == 2);
+    CHECK(f.system->parameter_names() == std::vector<std::string>{"tau", "a", "b", "d"});  // the file's order
+    CHECK(f.equilibrium_given);
+    CHECK(f.equilibrium[1] == -0.2);
+    CHECK(f.system->delays()[0] == 2.0);
+    // a linear file is not nonlinear, and invalid JSON neither (the linear reader reports it)
+    CHECK(!ddemap::is_nonlinear_system_json(R"J({"dimension": 1, "A0": [[-1]]})J"));
+    CHECK(!ddemap::is_nonlinear_system_json("{"));
+    auto error_of = [](const std::string& t) {
+        try {
+            ddemap::read_nonlinear_system_json(t, "f.json");
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    CHECK(error_of(R"J({"variables": ["x"], "parameters": {"a": 1}, "equations": ["-a*x(t - b)"]})J") ==
+          "f.json: equation 1 (dx/dt), character 10: unknown name 'b': expected a parameter (a) or a function");
+    CHECK(error_of(R"J({"variables": ["x"], "parameters": {"a": 1}, "equations": ["-a*x(t - x)"]})J") ==
+          "f.json: equation 1 (dx/dt), character 10: the delay depends on the state (x): expected an expression of parameters and numbers");
+    CHECK(error_of(R"J({"variables": ["x"], "equations": ["-x", "1"]})J") == "f.json: equations: 2 equations for 1 variables: expected one equation per variable");
+    CHECK(error_of(R"J({"variables": ["x"], "equations": ["-x"], "equilibrium": [1, 2]})J") ==
+          "f.json: equilibrium: expected an array of 1 numbers (one per variable)");
+    CHECK(error_of(R"J({"variables": ["x"], "parameters": {"a": "1"}, "equations": ["-x"]})J") == "f.json: parameters.a: expected a number");
+    CHECK(error_of(R"J({"variables": ["x"], "equations": ["-x"], "A0": 1})J") ==
+          "f.json: A0: unknown field (expected variables, parameters, equations, equilibrium, comment)");
+    CHECK(error_of(R"J({"variables": [1], "equations": ["-x"]})J") == "f.json: variables[0]: expected a string");
+}

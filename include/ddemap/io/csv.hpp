@@ -8,6 +8,7 @@
 
 #include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
@@ -32,6 +33,11 @@ std::string boundary_csv(const SweepSpec& spec, const BoundarySet& set);
 
 /// Quotes a CSV field if needed.
 std::string csv_field(const std::string& s);
+
+/// An equilibrium branch, one row per point and per special point:
+/// kind (point|fold|hopf),PARAMETER,<variables>,abscissa,unstable,stable,omega,status
+/// (abscissa, unstable, stable empty on special rows; omega only on hopf rows).
+std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables);
 
 /// re,im,residual,newton_step
 std::string roots_csv(const std::vector<Root>& roots);

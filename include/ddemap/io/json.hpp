@@ -13,6 +13,7 @@
 
 #include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/simulate.hpp"
@@ -73,6 +74,10 @@ std::string envelope_json(const JsonEnvelope& e);
 std::string ring_roots_json(const RingResult& r);
 /// roots of any linear DDE (analyse_system)
 std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& r);
+/// an equilibrium branch: {"parameter", "variables", "points": [{"par", "x", "abscissa",
+/// "unstable", "stable", "roots_status", "roots": [[re, im], ...]}], "folds": [{"par", "x", "status",
+/// "residual"}], "hopf": [{"par", "omega", "x", "status", "residual"}], "stop"}
+std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vector<std::string>& variables);
 /// roots of a mixed ring (analyse_mixed_ring)
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars);
 /// string stability, with the ring verdict when `ring` is given

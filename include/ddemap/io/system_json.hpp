@@ -10,13 +10,41 @@
 /// Each matrix is a dense array of rows or {"triplets": [[row, col, value], ...]} (0-based,
 /// repeated entries add up); a value is a number or [re, im]. "A0" may be omitted (zero).
 
+#include <memory>
 #include <string>
 
+#include <Eigen/Core>
+
+#include "ddemap/problem/expression_system.hpp"
 #include "ddemap/problem/linear_dde.hpp"
 
 namespace ddemap {
 
 /// Parses the JSON text; std::invalid_argument naming `source` and the field on error.
 LinearDDE read_linear_dde_json(const std::string& text, const std::string& source);
+
+/// A nonlinear DDE written with expressions (problem/expression.hpp):
+///
+///     { "variables": ["x1", "x2"],
+///       "parameters": {"a": 0.5, "b": 0.6, "d": 0.05, "tau": 2.0},
+///       "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"],
+///       "equilibrium": [0, 0] }
+///
+/// "equations"[i] is dx_i/dt; a delayed value is NAME(t - DELAY) with DELAY an expression of
+/// parameters and numbers. "equilibrium" (optional) is the starting guess of Newton (zeros when
+/// not given). Parameters keep the file's order. "comment" is allowed.
+struct NonlinearSystemFile {
+    std::shared_ptr<ExpressionSystem> system;
+    Eigen::VectorXd equilibrium;     ///< the guess (zeros when not given)
+    bool equilibrium_given = false;
+};
+
+/// True when the text is a JSON object with "equations" (a nonlinear file); false otherwise
+/// (invalid JSON included: read_linear_dde_json then says what is wrong).
+bool is_nonlinear_system_json(const std::string& text);
+
+/// Parses a nonlinear file; std::invalid_argument naming `source`, the field, and for an
+/// expression the equation and character.
+NonlinearSystemFile read_nonlinear_system_json(const std::string& text, const std::string& source);
 
 }  // namespace ddemap

@@ -25,6 +25,9 @@ namespace ddemap {
 /// see NonlinearDDEOf). Parameters are held by the object (names fixed, values settable).
 class NonlinearDDE {
 public:
+    using Dual2 = Dual<Dual<double>>;
+    using Dual3 = Dual<Dual<Dual<double>>>;
+
     NonlinearDDE(std::vector<std::string> names, std::vector<double> values);
     virtual ~NonlinearDDE() = default;
 
@@ -53,6 +56,12 @@ public:
     Eigen::MatrixXd jacobian(const Eigen::VectorXd& stacked, int block) const;
     /// All blocks A_0..A_m at once (n (m + 1) dual evaluations).
     std::vector<Eigen::MatrixXd> jacobians(const Eigen::VectorXd& stacked) const;
+    /// The same at parameter values p (in the order of parameter_names()), not the held ones.
+    std::vector<Eigen::MatrixXd> jacobians(const Eigen::VectorXd& stacked, const std::vector<double>& p) const;
+    /// f(u; p) at parameter values p.
+    Eigen::VectorXd f(const Eigen::VectorXd& stacked, const std::vector<double>& p) const;
+    /// df/dp_j at parameter values p (j the parameter's index), exact.
+    Eigen::VectorXd parameter_derivative(const Eigen::VectorXd& stacked, int j, const std::vector<double>& p) const;
     /// df/dp for the named parameter, exact.
     Eigen::VectorXd parameter_derivative(const Eigen::VectorXd& stacked, const std::string& name) const;
     /// The stacked argument (x, x, ..., x) of a constant history.
@@ -62,6 +71,19 @@ public:
     virtual void evaluate(const double* u, const double* p, double* out) const = 0;
     /// The same in dual numbers (derivatives along the seeded direction).
     virtual void evaluate(const Dual<double>* u, const Dual<double>* p, Dual<double>* out) const = 0;
+    /// Nested dual numbers (second and third derivatives). Systems built on NonlinearDDEOf have
+    /// them; the default throws std::logic_error (see has_higher_derivatives()).
+    virtual void evaluate(const Dual2* u, const Dual2* p, Dual2* out) const;
+    virtual void evaluate(const Dual3* u, const Dual3* p, Dual3* out) const;
+    /// True when the nested evaluate() overloads are implemented.
+    virtual bool has_higher_derivatives() const { return false; }
+
+    /// D^2_u f(u; p)[a, b] = sum_{ij} d^2 f / du_i du_j a_i b_j (stacked directions a, b), exact
+    /// (one evaluation in Dual<Dual<double>> seeded u + a e1 + b e2).
+    Eigen::VectorXd second_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b) const;
+    /// D^3_u f(u; p)[a, b, c], exact (one evaluation in three nested levels).
+    Eigen::VectorXd third_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                     const Eigen::VectorXd& c) const;
 
 protected:
     void check_stacked(const Eigen::VectorXd& stacked, const char* what) const;
@@ -85,6 +107,9 @@ public:
     void evaluate(const Dual<double>* u, const Dual<double>* p, Dual<double>* out) const override {
         static_cast<const Derived*>(this)->rhs(u, p, out);
     }
+    void evaluate(const Dual2* u, const Dual2* p, Dual2* out) const override { static_cast<const Derived*>(this)->rhs(u, p, out); }
+    void evaluate(const Dual3* u, const Dual3* p, Dual3* out) const override { static_cast<const Derived*>(this)->rhs(u, p, out); }
+    bool has_higher_derivatives() const override { return true; }
 };
 
 /// The linearisation at the equilibrium x*: A_k = D_{u_k} f(x*, ..., x*; p) with the delays
@@ -92,6 +117,8 @@ public:
 /// std::invalid_argument when x* has the wrong size or a non-finite entry. (x* need not be an
 /// equilibrium: see equilibrium_residual.)
 LinearDDE linearise(const NonlinearDDE& system, const Eigen::VectorXd& equilibrium);
+/// The same at parameter values p instead of the held ones.
+LinearDDE linearise(const NonlinearDDE& system, const Eigen::VectorXd& equilibrium, const std::vector<double>& p);
 
 /// max_i |f_i(x*, ..., x*; p)|: 0 at an equilibrium.
 double equilibrium_residual(const NonlinearDDE& system, const Eigen::VectorXd& equilibrium);

@@ -59,6 +59,7 @@ public:
     /// car_linearisations): for long rings, where the dense one costs O(N^2).
     LinearDDE sparse_linearise(const Eigen::VectorXd& state) const;
 
+    using NonlinearDDE::evaluate;
     void evaluate(const double* u, const double* p, double* out) const override;
     void evaluate(const Dual<double>* u, const Dual<double>* p, Dual<double>* out) const override;
 
@@ -89,6 +90,7 @@ public:
     /// (s*(v_l), v_l).
     Eigen::VectorXd equilibrium() const;
 
+    using NonlinearDDE::evaluate;
     void evaluate(const double* u, const double* p, double* out) const override;
     void evaluate(const Dual<double>* u, const Dual<double>* p, Dual<double>* out) const override;
 

@@ -1,0 +1,114 @@
+#pragma once
+/// \file equilibrium_branch.hpp
+/// Branches of equilibria of a nonlinear DDE in one parameter p (problem/nonlinear_dde.hpp):
+/// the curve g(x, p) = f(x, ..., x; p) = 0 in R^{n+1}, followed by pseudo-arclength continuation
+/// (solve/continuation.hpp, through folds) with the exact Jacobian [A_0 + ... + A_m, df/dp]; at
+/// every point the rightmost characteristic roots of the linearisation (solve/roots.hpp).
+/// Special points:
+///  - fold: the tangent's parameter component changes sign (a test function of the engine); then
+///    Newton on the fold system  g(x, p) = 0,  (sum_k A_k) v = 0,  v0 . v = 1  (2n + 1 unknowns);
+///  - Hopf: a root with Im > 0 and its nearest partner at the next point have real parts of
+///    opposite signs (and, when these matched crossings do not account for the change in the
+///    number of roots with Re > 0 and Im > 0, the root nearest the axis; two crossings of one
+///    pair between two points are not seen); then Newton on
+///    the Hopf system  g(x, p) = 0,  Delta(i omega; x, p) q = 0,  q0^H q = 1  (x, p, q in C^n,
+///    omega > 0: 3n + 2 real unknowns), from the root nearest the imaginary axis. The residuals
+///    use the exact characteristic matrix; Newton's Jacobian of these augmented systems is taken
+///    by central differences of those residuals.
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ddemap/core/status.hpp"
+#include "ddemap/core/types.hpp"
+#include "ddemap/problem/nonlinear_dde.hpp"
+#include "ddemap/solve/continuation.hpp"
+#include "ddemap/solve/equilibrium.hpp"
+#include "ddemap/solve/roots.hpp"
+
+namespace ddemap {
+
+struct EquilibriumBranchOptions {
+    std::string parameter;  ///< the free parameter (a name of the system)
+    double from = 0.0;      ///< the branch starts at p = from (the equilibrium found from the guess there)
+    double to = 1.0;        ///< and is followed towards p = to (it ends on the face p = to or min/max)
+    /// Steps, box and budget; initial_step/max_step 0 = automatic (|to - from| / 100 and / 20);
+    /// the box is set to p in [min(from, to), max(from, to)].
+    ContinuationOptions continuation = [] {
+        ContinuationOptions c;
+        c.initial_step = 0.0;
+        c.max_step = 0.0;
+        c.min_step = 1e-10;
+        c.max_points = 400;
+        return c;
+    }();
+    /// At every point; count: the roots reported. More are computed for the detection of Hopf
+    /// points: at least 8, doubled (up to 256) until 6 of them have Re < 0, so that every
+    /// unstable root and the stable ones nearest the axis are seen.
+    RootOptions roots;
+    EquilibriumOptions equilibrium;    ///< the first point
+    NewtonOptions special{40, 1e-12};  ///< Newton on the fold and Hopf systems
+    double special_residual = 1e-9;    ///< accept a fold/Hopf point with residual at most this
+    bool is_valid(std::string* why = nullptr) const;
+};
+
+struct EquilibriumPoint {
+    double par = 0.0;
+    Eigen::VectorXd x;
+    std::vector<cplx> roots;  ///< rightmost first (options.roots.count of them)
+    double abscissa = 0.0;    ///< max Re over the roots
+    int unstable = 0;         ///< roots with Re > 0 (counted with conjugates)
+    bool stable = false;      ///< roots converged and every Re < -marginal band
+    Status roots_status = Status::Converged;
+};
+
+struct FoldPoint {
+    double par = 0.0;
+    Eigen::VectorXd x;
+    Status status = Status::MaxIterations;
+    double residual = std::numeric_limits<double>::infinity();
+    int iterations = 0;
+    int after = 0;  ///< index of the branch point before it
+};
+
+struct HopfPoint {
+    double par = 0.0;
+    Eigen::VectorXd x;
+    double omega = 0.0;  ///< the crossing pair is +-i omega
+    VectorXc q;          ///< Delta(i omega) q = 0
+    Status status = Status::MaxIterations;
+    double residual = std::numeric_limits<double>::infinity();
+    int iterations = 0;
+    int after = 0;
+};
+
+struct EquilibriumBranch {
+    std::string parameter;
+    std::vector<EquilibriumPoint> points;
+    std::vector<FoldPoint> folds;
+    std::vector<HopfPoint> hopf;
+    ContinuationStop stop = ContinuationStop::MaxPoints;
+    /// Converged when the start converged, the branch reached the end of its range (or another
+    /// regular end), every root computation converged and every special point was located.
+    Status status = Status::Converged;
+    std::string message;
+};
+
+/// The branch through the equilibrium found from `guess` at p = from. std::invalid_argument for
+/// invalid options, an unknown parameter or a bad guess; non-convergence is a status.
+EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options);
+
+/// Newton on the Hopf system from (x0, p_j = par0, omega0), the other parameters as held;
+/// q0 is the starting null vector (empty: the right singular vector of Delta(i omega0) for its
+/// smallest singular value).
+HopfPoint correct_hopf(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& x0, double par0, double omega0,
+                       const VectorXc& q0 = {}, const NewtonOptions& newton = {40, 1e-12}, double residual_tolerance = 1e-9);
+
+/// Newton on the fold system from (x0, p_j = par0).
+FoldPoint correct_fold(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& x0, double par0,
+                       const NewtonOptions& newton = {40, 1e-12}, double residual_tolerance = 1e-9);
+
+}  // namespace ddemap

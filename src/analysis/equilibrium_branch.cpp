@@ -1,0 +1,346 @@
+#include "ddemap/analysis/equilibrium_branch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "core/internal/text.hpp"
+
+namespace ddemap {
+
+namespace {
+
+/// g(x, p) = f(x, ..., x; p) with p_j the last unknown.
+class EquilibriumCurve final : public ContinuationProblem {
+public:
+    EquilibriumCurve(const NonlinearDDE& s, int j) : m_s(s), m_j(j), m_p(s.parameter_values()) {}
+    int equations() const override { return m_s.dimension(); }
+    std::vector<double> values(const Eigen::VectorXd& u) const {
+        std::vector<double> p = m_p;
+        p[m_j] = u[u.size() - 1];
+        return p;
+    }
+    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
+        try {
+            f = m_s.f(m_s.stack_constant(u.head(m_s.dimension())), values(u));
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+        return f.allFinite();
+    }
+    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override {
+        const int n = m_s.dimension();
+        try {
+            const Eigen::VectorXd st = m_s.stack_constant(u.head(n));
+            const std::vector<double> p = values(u);
+            const std::vector<Eigen::MatrixXd> a = m_s.jacobians(st, p);
+            j.resize(n, n + 1);
+            j.leftCols(n) = a[0];
+            for (std::size_t k = 1; k < a.size(); ++k) j.leftCols(n) += a[k];
+            j.col(n) = m_s.parameter_derivative(st, m_j, p);
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+        return j.allFinite();
+    }
+    bool in_domain(const Eigen::VectorXd& u) const override {
+        try {
+            const std::vector<double> d = m_s.delays(values(u));
+            return std::all_of(d.begin(), d.end(), [](double t) { return std::isfinite(t) && t >= 0.0; });
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+    }
+
+private:
+    const NonlinearDDE& m_s;
+    int m_j;
+    std::vector<double> m_p;
+};
+
+/// Newton on a square system F(z) = 0 with a central-difference Jacobian of F.
+NewtonSummary newton_square(Eigen::VectorXd& z, const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&)>& F,
+                            const NewtonOptions& options) {
+    return newton(
+        z,
+        [&](const Eigen::VectorXd& x, Eigen::VectorXd& dx) {
+            Eigen::VectorXd f;
+            if (!F(x, f) || !f.allFinite()) return NewtonStep::Singular;
+            if (f.cwiseAbs().maxCoeff() == 0.0) return NewtonStep::Exact;
+            const Eigen::Index m = x.size();
+            Eigen::MatrixXd j(f.size(), m);
+            Eigen::VectorXd xp = x, fp, fm;
+            for (Eigen::Index c = 0; c < m; ++c) {
+                const double h = 1e-6 * std::max(1.0, std::abs(x[c]));
+                xp[c] = x[c] + h;
+                if (!F(xp, fp)) return NewtonStep::Singular;
+                xp[c] = x[c] - h;
+                if (!F(xp, fm)) return NewtonStep::Singular;
+                xp[c] = x[c];
+                j.col(c) = (fp - fm) / (2.0 * h);
+            }
+            const Eigen::FullPivLU<Eigen::MatrixXd> lu(j);
+            if (!j.allFinite() || !lu.isInvertible()) return NewtonStep::Singular;
+            dx = lu.solve(f);
+            return NewtonStep::Ok;
+        },
+        options);
+}
+
+std::vector<double> with(const NonlinearDDE& s, int j, double v) {
+    std::vector<double> p = s.parameter_values();
+    p[j] = v;
+    return p;
+}
+
+void check_parameter(const NonlinearDDE& s, int j) {
+    if (j < 0 || j >= static_cast<int>(s.parameter_names().size()))
+        throw std::invalid_argument("parameter index " + std::to_string(j) + ": expected 0.." +
+                                    std::to_string(static_cast<int>(s.parameter_names().size()) - 1));
+}
+
+}  // namespace
+
+bool EquilibriumBranchOptions::is_valid(std::string* why) const {
+    std::string m;
+    if (parameter.empty()) m = "parameter: expected the name of the free parameter";
+    else if (!std::isfinite(from) || !std::isfinite(to)) m = "from/to: expected finite values";
+    else if (from == to) m = "to = from = " + detail::format_number(from) + ": expected a range of the parameter";
+    else if (!roots.is_valid(&m)) m = "roots." + m;
+    else if (!equilibrium.is_valid(&m)) m = "equilibrium." + m;
+    else if (!special.is_valid(&m)) m = "special." + m;
+    else if (!(std::isfinite(special_residual) && special_residual > 0.0)) m = "special_residual: expected a finite value > 0";
+    else if (continuation.initial_step < 0.0 || continuation.max_step < 0.0) m = "continuation steps: expected values >= 0 (0 = automatic)";
+    if (!m.empty() && why) *why = m;
+    return m.empty();
+}
+
+FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, const NewtonOptions& options,
+                       double residual_tolerance) {
+    check_parameter(system, j);
+    const int n = system.dimension();
+    FoldPoint r;
+    r.x = x0;
+    r.par = par0;
+    // v0: the null vector of J_x at the start
+    const std::vector<Eigen::MatrixXd> a = system.jacobians(system.stack_constant(x0), with(system, j, par0));
+    Eigen::MatrixXd jx = a[0];
+    for (std::size_t k = 1; k < a.size(); ++k) jx += a[k];
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jx, Eigen::ComputeFullV);
+    const Eigen::VectorXd v0 = svd.matrixV().col(n - 1);
+    auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out) {
+        try {
+            const std::vector<double> p = with(system, j, z[n]);
+            const Eigen::VectorXd st = system.stack_constant(z.head(n));
+            const std::vector<Eigen::MatrixXd> b = system.jacobians(st, p);
+            Eigen::MatrixXd jj = b[0];
+            for (std::size_t k = 1; k < b.size(); ++k) jj += b[k];
+            out.resize(2 * n + 1);
+            out.head(n) = system.f(st, p);
+            out.segment(n, n) = jj * z.segment(n + 1, n);
+            out[2 * n] = v0.dot(z.segment(n + 1, n)) - 1.0;
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+        return out.allFinite();
+    };
+    Eigen::VectorXd z(2 * n + 1);
+    z << x0, par0, v0;
+    const NewtonSummary s = newton_square(z, F, options);
+    Eigen::VectorXd f;
+    r.iterations = s.iterations;
+    if (z.allFinite() && F(z, f)) r.residual = f.cwiseAbs().maxCoeff();
+    r.x = z.head(n);
+    r.par = z[n];
+    r.status = converged(s.status) && !(r.residual <= residual_tolerance) ? Status::NumericalIssue : s.status;
+    return r;
+}
+
+HopfPoint correct_hopf(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, double omega0, const VectorXc& q0in,
+                       const NewtonOptions& options, double residual_tolerance) {
+    check_parameter(system, j);
+    if (!(std::isfinite(omega0) && omega0 > 0.0)) throw std::invalid_argument("omega0 = " + detail::format_number(omega0) + ": expected a value > 0");
+    const int n = system.dimension();
+    HopfPoint r;
+    r.x = x0;
+    r.par = par0;
+    r.omega = omega0;
+    VectorXc q0 = q0in;
+    if (q0.size() == 0) {
+        const MatrixXc d = linearise(system, x0, with(system, j, par0)).characteristic_matrix(cplx(0.0, omega0));
+        const Eigen::JacobiSVD<MatrixXc> svd(d, Eigen::ComputeFullV);
+        q0 = svd.matrixV().col(n - 1);
+    }
+    if (q0.size() != n) throw std::invalid_argument("q0 has " + std::to_string(q0.size()) + " entries: expected the dimension " + std::to_string(n));
+    q0 /= q0.norm();
+    // unknowns z = (x, p, Re q, Im q, omega)
+    auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out) {
+        try {
+            const std::vector<double> p = with(system, j, z[n]);
+            const Eigen::VectorXd x = z.head(n);
+            const VectorXc q = z.segment(n + 1, n).cast<cplx>() + cplx(0.0, 1.0) * z.segment(2 * n + 1, n).cast<cplx>();
+            const double w = z[3 * n + 1];
+            const VectorXc dq = linearise(system, x, p).characteristic_matrix(cplx(0.0, w)) * q;
+            const cplx c = q0.dot(q) - 1.0;  // q0^H q - 1
+            out.resize(3 * n + 2);
+            out.head(n) = system.f(system.stack_constant(x), p);
+            out.segment(n, n) = dq.real();
+            out.segment(2 * n, n) = dq.imag();
+            out[3 * n] = c.real();
+            out[3 * n + 1] = c.imag();
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+        return out.allFinite();
+    };
+    Eigen::VectorXd z(3 * n + 2);
+    z << x0, par0, q0.real(), q0.imag(), omega0;
+    const NewtonSummary s = newton_square(z, F, options);
+    Eigen::VectorXd f;
+    r.iterations = s.iterations;
+    if (z.allFinite() && F(z, f)) r.residual = f.cwiseAbs().maxCoeff();
+    r.x = z.head(n);
+    r.par = z[n];
+    r.q = z.segment(n + 1, n).cast<cplx>() + cplx(0.0, 1.0) * z.segment(2 * n + 1, n).cast<cplx>();
+    r.omega = z[3 * n + 1];
+    r.status = converged(s.status) && !(r.residual <= residual_tolerance && r.omega > 0.0) ? Status::NumericalIssue : s.status;
+    return r;
+}
+
+EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options) {
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);
+    const int j = system.parameter_index(options.parameter);
+    const int n = system.dimension();
+    EquilibriumBranch br;
+    br.parameter = options.parameter;
+
+    const std::vector<double> p0 = with(system, j, options.from);
+    const EquilibriumResult e = find_equilibrium(system, guess, options.equilibrium, p0);
+    if (!converged(e.status)) {
+        br.status = e.status;
+        br.message = "no equilibrium at " + options.parameter + " = " + detail::format_number(options.from) + " from the guess: " + e.message;
+        return br;
+    }
+
+    ContinuationOptions co = options.continuation;
+    const double range = std::abs(options.to - options.from);
+    if (co.initial_step == 0.0) co.initial_step = range / 100.0;
+    if (co.max_step == 0.0) co.max_step = range / 20.0;
+    co.initial_step = std::min(co.initial_step, co.max_step);
+    co.min_step = std::min(co.min_step, co.initial_step);
+    co.lower = Eigen::VectorXd::Constant(n + 1, -std::numeric_limits<double>::infinity());
+    co.upper = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::infinity());
+    co.lower[n] = std::min(options.from, options.to);
+    co.upper[n] = std::max(options.from, options.to);
+
+    const EquilibriumCurve curve(system, j);
+    Eigen::VectorXd u0(n + 1), dir = Eigen::VectorXd::Zero(n + 1);
+    u0 << e.x, options.from;
+    dir[n] = options.to > options.from ? 1.0 : -1.0;
+    const std::vector<TestFunction> tests{{"fold", [n](const Eigen::VectorXd&, const Eigen::VectorXd& t) { return t[n]; }, false}};
+    const ContinuationResult c = continue_branch(curve, u0, dir, co, tests);
+    br.stop = c.stop;
+
+    bool roots_ok = true;
+    for (const Eigen::VectorXd& u : c.points) {
+        EquilibriumPoint pt;
+        pt.par = u[n];
+        pt.x = u.head(n);
+        // every root with Re >= 0 is counted: the request grows until the leftmost root found is stable
+        const LinearDDE lin = linearise(system, pt.x, curve.values(u));
+        RootOptions ro = options.roots;
+        ro.count = std::max(ro.count, 8);
+        RootResult rr = rightmost_roots(lin, ro);
+        auto stable_found = [](const RootResult& r) {
+            int c = 0;
+            for (const Root& x : r.roots) c += x.value.real() < 0.0 ? 1 : 0;
+            return c;
+        };
+        while (converged(rr.status) && !rr.roots.empty() && stable_found(rr) < 6 && ro.count < 256 &&
+               static_cast<int>(rr.roots.size()) >= ro.count) {
+            ro.count *= 2;
+            rr = rightmost_roots(lin, ro);
+        }
+        pt.roots_status = rr.status;
+        roots_ok = roots_ok && converged(rr.status);
+        pt.abscissa = rr.spectral_abscissa();
+        for (const Root& root : rr.roots) {
+            pt.roots.push_back(root.value);
+            if (root.value.real() > marginal_band(root.value)) ++pt.unstable;
+        }
+        pt.stable = converged(rr.status) && !rr.roots.empty() && pt.abscissa < -marginal_band(rr.roots.front().value);
+        br.points.push_back(std::move(pt));
+    }
+
+    bool special_ok = true;
+    for (const ContinuationEvent& ev : c.events) {
+        if (ev.kind != ContinuationEvent::Kind::Test) continue;
+        FoldPoint f = correct_fold(system, j, ev.u.head(n), ev.u[n], options.special, options.special_residual);
+        f.after = ev.after;
+        special_ok = special_ok && converged(f.status);
+        br.folds.push_back(std::move(f));
+    }
+
+    // Hopf candidates between consecutive points: a complex root (Im > 0) whose nearest partner at
+    // the next point has a real part of the other sign; and, where no such pair is matched, a
+    // change in the number of roots with Re > 0, Im > 0 (the root nearest the axis).
+    auto complex_unstable = [](const EquilibriumPoint& p) {
+        int c = 0;
+        for (const cplx& r : p.roots)
+            if (r.imag() > 0.0 && r.real() > marginal_band(r)) ++c;
+        return c;
+    };
+    auto add_hopf = [&](const EquilibriumPoint& from, double omega, int after) {
+        HopfPoint h = correct_hopf(system, j, from.x, from.par, omega, {}, options.special, options.special_residual);
+        h.after = after;
+        for (const HopfPoint& o : br.hopf)
+            if (converged(h.status) && converged(o.status) && std::abs(o.par - h.par) <= 1e-8 * std::max(1.0, std::abs(h.par)) &&
+                std::abs(o.omega - h.omega) <= 1e-8 * std::max(1.0, h.omega))
+                return;  // the same point from two candidates
+        special_ok = special_ok && converged(h.status);
+        br.hopf.push_back(std::move(h));
+    };
+    for (std::size_t k = 0; k + 1 < br.points.size(); ++k) {
+        const EquilibriumPoint& a = br.points[k];
+        const EquilibriumPoint& b = br.points[k + 1];
+        int net = 0;  // matched crossings: +1 to the right, -1 to the left
+        for (const cplx& ra : a.roots) {
+            if (!(ra.imag() > 0.0)) continue;
+            const cplx* nearest = nullptr;
+            for (const cplx& rb : b.roots)
+                if (rb.imag() > 0.0 && (!nearest || std::abs(rb - ra) < std::abs(*nearest - ra))) nearest = &rb;
+            if (!nearest || (ra.real() > 0.0) == (nearest->real() > 0.0)) continue;
+            net += nearest->real() > 0.0 ? 1 : -1;
+            const bool from_a = std::abs(ra.real()) <= std::abs(nearest->real());
+            add_hopf(from_a ? a : b, from_a ? ra.imag() : nearest->imag(), static_cast<int>(k));
+        }
+        if (complex_unstable(b) - complex_unstable(a) == net) continue;
+        const EquilibriumPoint* from = nullptr;
+        cplx best(std::numeric_limits<double>::infinity(), 0.0);
+        for (const EquilibriumPoint* p : {&a, &b})
+            for (const cplx& r : p->roots)
+                if (r.imag() > 0.0 && std::abs(r.real()) < std::abs(best.real())) best = r, from = p;
+        if (from) add_hopf(*from, best.imag(), static_cast<int>(k));
+    }
+    std::sort(br.hopf.begin(), br.hopf.end(), [](const HopfPoint& x, const HopfPoint& y) { return x.after < y.after; });
+
+    for (EquilibriumPoint& p : br.points)
+        if (static_cast<int>(p.roots.size()) > options.roots.count) p.roots.resize(static_cast<std::size_t>(options.roots.count));
+
+    const bool ended_well = c.stop == ContinuationStop::Bound || c.stop == ContinuationStop::ClosedLoop || c.stop == ContinuationStop::LeftDomain;
+    br.status = !ended_well ? (converged(c.status) ? Status::NumericalIssue : c.status)
+                : !roots_ok ? Status::MaxDegreeReached
+                : !special_ok ? Status::MaxIterations
+                              : Status::Converged;
+    br.message = std::to_string(br.points.size()) + " points, " + std::to_string(br.folds.size()) + " folds, " + std::to_string(br.hopf.size()) +
+                 " Hopf points; the branch ended: " + to_string(c.stop) + (c.message.empty() ? "" : " (" + c.message + ")");
+    if (!roots_ok) br.message += "; the roots did not converge at some points";
+    if (!special_ok) br.message += "; a fold or Hopf point was not located";
+    return br;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,260 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "../tolerances.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/problem/expression_system.hpp"
+#include "ddemap/solve/equilibrium.hpp"
+#include "ddemap/traffic/ov_ring.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+
+const double pi = 3.14159265358979323846;
+
+/// The root of a continuous g on [lo, hi] with g(lo) g(hi) < 0, by bisection to rounding.
+template <class G>
+double bisect(G g, double lo, double hi) {
+    double glo = g(lo);
+    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(lo)); ++i) {
+        const double mid = 0.5 * (lo + hi), gm = g(mid);
+        if ((gm < 0) == (glo < 0)) lo = mid, glo = gm;
+        else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+TEST_CASE("x' = -a sin(x(t - 1)) + x^3: Hopf at a tau = pi/2 with omega = a") {
+    // the linearisation at x = 0 is y' = -a y(t - tau): lambda = i omega needs a cos(omega tau) = 0,
+    // a sin(omega tau) = omega, so omega = a and a tau = pi/2 (the first crossing)
+    ExpressionSystem sys({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*sin(x(t - tau)) + x^3"});
+    EquilibriumBranchOptions o;
+    o.parameter = "a";
+    o.from = 0.5;
+    o.to = 2.5;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.1), o);
+    CHECK(br.status == Status::Converged);
+    CHECK(br.stop == ContinuationStop::Bound);
+    CHECK(br.points.front().stable);
+    CHECK(!br.points.back().stable);
+    CHECK(br.folds.empty());
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(br.hopf[0].status == Status::Converged);
+    CHECK(std::abs(br.hopf[0].par - pi / 2) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - pi / 2) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].x[0]) < tol::special_point);
+    // the second crossing a tau = 5 pi / 2 is outside the range
+}
+
+TEST_CASE("x' = p - x(t - 1)^2: a fold at p = 0 and a Hopf point at p = (pi/4)^2 with omega = pi/2") {
+    // equilibria x = +-sqrt(p); linearisation y' = -2 x y(t - 1): Hopf where 2 x = pi/2, omega = pi/2;
+    // the fold (x, p) = (0, 0) is where d/dx (p - x^2) = 0
+    ExpressionSystem sys({"x"}, {"p"}, {1.0}, {"p - x(t - 1)^2"});
+    EquilibriumBranchOptions o;
+    o.parameter = "p";
+    o.from = 0.9;
+    o.to = -1.0;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 1.0), o);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.folds.size() == 1);
+    CHECK(br.folds[0].status == Status::Converged);
+    CHECK(std::abs(br.folds[0].par) < tol::special_point);
+    CHECK(std::abs(br.folds[0].x[0]) < tol::special_point);
+    // the branch turns at the fold and comes back on x < 0 to the face p = 0.9
+    CHECK(br.points.back().x[0] < 0.0);
+    CHECK(br.points.back().par == doctest::Approx(0.9).epsilon(1e-12));
+    CHECK(br.points.back().unstable == 1);  // a real positive root: a saddle
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(std::abs(br.hopf[0].par - pi * pi / 16) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].x[0] - pi / 4) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - pi / 2) < tol::special_point);
+}
+
+TEST_CASE("Mackey-Glass continued in the exponent n: the Hopf point of its linearisation's closed form") {
+    // x' = beta x(t - tau) / (1 + x(t - tau)^n) - gamma x, positive equilibrium x*^n = beta/gamma - 1
+    // (here 2: x* = 2^(1/n) moves along the branch). Linearisation y' = -gamma y + b y(t - tau) with
+    // b = beta (1 + (1 - n) x*^n) / (1 + x*^n)^2 = (3 - 2 n) / 3 (beta = 3, gamma = 1). For b < -gamma a
+    // pair crosses at omega = sqrt(b^2 - gamma^2), omega tau = arccos(gamma / b): solve for b at tau = 2.
+    const double beta = 3.0, gamma = 1.0, tau = 2.0;
+    ExpressionSystem mg({"x"}, {"beta", "gamma", "n", "tau"}, {beta, gamma, 4.0, tau},
+                        {"beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"});
+    const double b = bisect([&](double bb) { return std::acos(gamma / bb) / std::sqrt(bb * bb - gamma * gamma) - tau; }, -50.0, -1.0 - 1e-9);
+    const double n_hopf = (3.0 - 3.0 * b) / 2.0, omega = std::sqrt(b * b - gamma * gamma);
+    EquilibriumBranchOptions o;
+    o.parameter = "n";
+    o.from = 2.0;
+    o.to = 6.0;
+    const EquilibriumBranch br = equilibrium_branch(mg, Eigen::VectorXd::Constant(1, 1.3), o);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(std::abs(br.hopf[0].par - n_hopf) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - omega) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].x[0] - std::pow(2.0, 1.0 / n_hopf)) < tol::special_point);
+    // every branch point is an equilibrium of the analytic family
+    for (const EquilibriumPoint& p : br.points) CHECK(std::abs(p.x[0] - std::pow(2.0, 1.0 / p.par)) < 1e-10);
+}
+
+TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy the ring modes' closed form") {
+    // Linearising the ring at the uniform flow with f = V'(h*) and a Fourier mode v_i ~ z^i e^{lambda t},
+    // z = exp(i theta_k), theta_k = 2 pi k / N, gives h_i = (z - 1) v_i / lambda and
+    //     lambda^2 + alpha lambda + alpha f (1 - z) e^{-lambda tau} = 0
+    // (Orosz, Wilson, Stepan, Phys. Rev. E 70, 026207 (2004), the characteristic equation of their
+    // eq. (2.1) at the uniform flow). With lambda = i omega, 1 - z = 2 sin(theta/2) e^{i(theta/2 - pi/2)}:
+    //     modulus  omega sqrt(omega^2 + alpha^2) = 2 alpha f sin(theta_k / 2),
+    //     phase    omega tau = theta_k / 2 - pi/2 + arctan(alpha / omega)   (first crossing).
+    // So each mode loses stability at f_k = omega_k sqrt(omega_k^2 + alpha^2) / (2 alpha sin(theta_k/2)).
+    const int N = 5;
+    const double alpha = 1.0, tau = 1.0;
+    OvRing ring(N, alpha, tau, 1.0, 1.0, 1.2);
+    // regular equilibrium: the Jacobian of the equilibrium equation is invertible
+    const EquilibriumResult e = find_equilibrium(ring, ring.uniform_flow() + Eigen::VectorXd::Constant(2 * N - 1, 0.01));
+    REQUIRE(e.status == Status::Converged);
+    CHECK((e.x - ring.uniform_flow()).cwiseAbs().maxCoeff() < 1e-12);
+    EquilibriumBranchOptions o;
+    o.parameter = "headway";
+    o.roots.count = 2;  // fewer than the unstable roots: the request must grow to count them all
+    o.from = 1.2;
+    o.to = 3.0;
+    const EquilibriumBranch br = equilibrium_branch(ring, ring.uniform_flow(), o);
+    CHECK(br.status == Status::Converged);
+    CHECK(br.points.front().stable);
+    CHECK(br.points.back().stable);
+    CHECK(br.folds.empty());
+    // Mode N - k at -i omega is the conjugate of mode k at +i omega, so the crossings with omega > 0
+    // are those of k = 1..N-1. Here f_k < max V' = 3 (1/2)^(2/3) / (3/2)^2 ~ 0.84 for k = 1, 2, 3
+    // (f_4 ~ 2.3): two crossings each, one on either side of the inflection of V.
+    REQUIRE(br.hopf.size() == 6);
+    for (const HopfPoint& h : br.hopf) {
+        CHECK(h.status == Status::Converged);
+        const double f = ring.optimal_velocity_slope(h.par);
+        bool matched = false;
+        for (int k = 1; k < N; ++k) {
+            const double th = 2 * pi * k / N;
+            const double w = bisect([&](double ww) { return ww * tau - th / 2 + pi / 2 - std::atan(alpha / ww); }, 1e-9, 10.0);
+            const double fk = w * std::sqrt(w * w + alpha * alpha) / (2 * alpha * std::sin(th / 2));
+            if (std::abs(h.omega - w) < tol::special_point && std::abs(f - fk) < tol::special_point) matched = true;
+        }
+        CHECK_MESSAGE(matched, "Hopf point at headway " << h.par << ", omega " << h.omega << ", V' " << f);
+        // on the uniform flow
+        CHECK((h.x.head(N - 1).array() - h.par).abs().maxCoeff() < 1e-10);
+    }
+}
+
+TEST_CASE("continuation in a delay: x' = -x(t - 2 c) + x^3 continued in c, Hopf at 2 c = pi/2, omega = 1") {
+    // linearisation y' = -y(t - tau) with tau = 2 c: Hopf at tau = pi/2, omega = 1 (a = 1 above)
+    ExpressionSystem sys({"x"}, {"c"}, {0.2}, {"-x(t - 2*c) + x^3"});
+    EquilibriumBranchOptions o;
+    o.parameter = "c";
+    o.from = 0.2;
+    o.to = 1.5;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Zero(1), o);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.hopf.size() == 1);
+    CHECK(std::abs(br.hopf[0].par - pi / 4) < tol::special_point);
+    CHECK(std::abs(br.hopf[0].omega - 1.0) < tol::special_point);
+}
+
+TEST_CASE("ov ring: the eliminated headway against the ring written as expressions, and the structural zero of the full ring") {
+    // three cars; V written out for h > h_st (every point used here has h > h_st)
+    const std::string V = "vmax*(H/hs - 1)^3/(1 + (H/hs - 1)^3)";
+    auto v_of = [&](const std::string& h) {
+        std::string s = V;
+        for (std::size_t at; (at = s.find('H')) != std::string::npos;) s.replace(at, 1, h);
+        return s;
+    };
+    const std::vector<std::string> pars{"alpha", "tau", "vmax", "hs", "hm"};
+    const std::vector<double> vals{1.3, 0.9, 1.1, 1.0, 2.1};
+    // reduced: h2 = 3 hm - h0 - h1
+    ExpressionSystem reduced({"h0", "h1", "u0", "u1", "u2"}, pars, vals,
+                             {"u1 - u0", "u2 - u1", "alpha*(" + v_of("h0(t - tau)") + " - u0)", "alpha*(" + v_of("h1(t - tau)") + " - u1)",
+                              "alpha*(" + v_of("(3*hm - h0(t - tau) - h1(t - tau))") + " - u2)"});
+    OvRing ring(3, 1.3, 0.9, 1.1, 1.0, 2.1);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(1.5, 2.5);
+    for (int trial = 0; trial < 10; ++trial) {
+        Eigen::VectorXd u(10);
+        for (int i = 0; i < 10; ++i) u[i] = U(rng);
+        CHECK((ring.f(u) - reduced.f(u)).cwiseAbs().maxCoeff() < 1e-14);
+        const auto a = ring.jacobians(u), b = reduced.jacobians(u);
+        CHECK((a[0] - b[0]).cwiseAbs().maxCoeff() < 1e-14);
+        CHECK((a[1] - b[1]).cwiseAbs().maxCoeff() < 1e-14);
+    }
+    // the full ring (three headways): its equilibria are not isolated, so Newton meets a singular
+    // Jacobian and the linearisation has the root 0; the reduced ring converges
+    ExpressionSystem full({"h0", "h1", "h2", "u0", "u1", "u2"}, pars, vals,
+                          {"u1 - u0", "u2 - u1", "u0 - u2", "alpha*(" + v_of("h0(t - tau)") + " - u0)",
+                           "alpha*(" + v_of("h1(t - tau)") + " - u1)", "alpha*(" + v_of("h2(t - tau)") + " - u2)"});
+    Eigen::VectorXd xf(6);
+    xf << 2.1, 2.1, 2.1, 0.0, 0.0, 0.0;
+    xf.tail(3).setConstant(ring.optimal_velocity(2.1));
+    CHECK(find_equilibrium(full, xf + Eigen::VectorXd::Constant(6, 0.01)).status == Status::NumericalIssue);
+    const RootResult rf = rightmost_roots(linearise(full, xf));
+    bool zero = false;
+    for (const Root& r : rf.roots) zero = zero || std::abs(r.value) < 1e-12;
+    CHECK(zero);
+    CHECK(find_equilibrium(ring, ring.uniform_flow() + Eigen::VectorXd::Constant(5, 0.01)).status == Status::Converged);
+    const RootResult rr = rightmost_roots(linearise(ring, ring.uniform_flow()));
+    for (const Root& r : rr.roots) CHECK(std::abs(r.value) > 1e-6);
+}
+
+TEST_CASE("DDE-BIFTOOL demo 1 (neuron): the published Hopf points" * doctest::test_suite("reference")) {
+    // DDE-Biftool, demos/neuron/html/demo1_hopf.html (published output of demo1_hopf.m): the
+    // system of Shayer and Campbell with kappa = 0.5, beta = -1, a12 = 1, tau1 = tau2 = 0.2 at
+    // the trivial equilibrium. With tau_s = 1.5 the Hopf point is at a21 = 0.80712, omega = 0.78197;
+    // with a21 = 0.207 the second Hopf point (corrected in tau_s) at tau_s = 8.6341, omega = 0.91575.
+    const std::vector<std::string> eqs{"-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                                       "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"};
+    ExpressionSystem neuron({"x1", "x2"}, {"kappa", "beta", "a12", "a21", "tau1", "tau2", "taus"}, {0.5, -1, 1, 0.5, 0.2, 0.2, 1.5}, eqs);
+    EquilibriumBranchOptions o;
+    o.parameter = "a21";
+    o.from = 0.3;
+    o.to = 2.0;
+    const EquilibriumBranch b1 = equilibrium_branch(neuron, Eigen::VectorXd::Zero(2), o);
+    CHECK(b1.status == Status::Converged);
+    REQUIRE(b1.hopf.size() == 1);
+    CHECK(std::abs(b1.hopf[0].par / 0.80712 - 1) < tol::published_5_digits_rel);
+    CHECK(std::abs(b1.hopf[0].omega / 0.78197 - 1) < tol::published_5_digits_rel);
+    neuron.set_parameter("a21", 0.207);
+    o.parameter = "taus";
+    o.from = 5.0;
+    o.to = 10.0;
+    const EquilibriumBranch b2 = equilibrium_branch(neuron, Eigen::VectorXd::Zero(2), o);
+    CHECK(b2.status == Status::Converged);
+    bool found = false;
+    for (const HopfPoint& h : b2.hopf)
+        found = found || (std::abs(h.par / 8.6341 - 1) < tol::published_5_digits_rel && std::abs(h.omega / 0.91575 - 1) < tol::published_5_digits_rel);
+    CHECK(found);
+    // the other pair crosses close by (a double Hopf point nearby, as the demo notes): two Hopf points
+    CHECK(b2.hopf.size() == 2);
+}
+
+TEST_CASE("equilibrium branch inputs and failures") {
+    ExpressionSystem sys({"x"}, {"p"}, {1.0}, {"p - x^2"});
+    EquilibriumBranchOptions o;
+    o.parameter = "q";
+    o.from = 0.5;
+    o.to = 1.0;
+    CHECK_THROWS_WITH_AS(equilibrium_branch(sys, Eigen::VectorXd::Ones(1), o),
+                         "parameter 'q' is not a parameter of this system: expected one of p", std::invalid_argument);
+    o.parameter = "p";
+    o.to = 0.5;
+    CHECK_THROWS_AS(equilibrium_branch(sys, Eigen::VectorXd::Ones(1), o), std::invalid_argument);
+    // no equilibrium for p < 0: a status, not an exception
+    o.from = -1.0;
+    o.to = 1.0;
+    const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Ones(1), o);
+    CHECK(br.status != Status::Converged);
+    CHECK(br.points.empty());
+    CHECK(br.message.find("no equilibrium at p = -1") == 0);
+}
+
+TEST_SUITE_END();
