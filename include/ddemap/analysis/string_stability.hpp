@@ -57,11 +57,19 @@ struct StringResult {
     double omega_peak = 0.0;           ///< where it is reached; 0 when only approached as w -> 0
     std::vector<GainPeak> peaks;       ///< every local maximum found, refined
     double peak_margin = 1.0;          ///< 1 - (highest local maximum at w > 0); 1 when there is none
+                                       ///< (formed as (1 - |Gamma|^2) / (1 + |Gamma|): no cancellation)
     LowFrequency lowfreq;
     double lowfreq_margin = 0.0;       ///< the decisive low-frequency coefficient (c2 unless it vanishes)
     double omega_search_max = 0.0;     ///< beyond it |Gamma(i w)| < sup_gamma is proven by a bound
     int evaluations = 0;               ///< evaluations of Gamma
     bool string_stable = false;
+    /// Stable, Marginal (a root of D on the axis to rounding), Unstable, or Undecided when the
+    /// plant roots did not converge.
+    Verdict plant_verdict = Verdict::Undecided;
+    /// Undecided with the plant; Unstable when the plant is, or |Gamma(i w)| > 1 somewhere
+    /// (a peak, or the low frequencies amplify); Stable when string_stable; Marginal otherwise
+    /// (plant marginal, or |Gamma| = 1 to the order of the series at w -> 0).
+    Verdict string_verdict = Verdict::Undecided;
 };
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options = {});
