@@ -52,6 +52,7 @@ void RingOptions::validate() const {
 RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& options) {
     options.validate();
     if (cars != 0 && cars < 2) throw std::invalid_argument("ring of " + std::to_string(cars) + " cars: expected N >= 2 or inf");
+    require_computable(lin);
     RingResult r;
     r.cars = cars;
     const int count = options.roots.count;
@@ -190,8 +191,17 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             best_theta = xr;
         }
         RootResult at_best;
-        per.count = count;  // --count roots at the wave number of the abscissa
         alpha(best_theta, &at_best);
+        if (count > 1) {  // --count roots at the wave number of the abscissa
+            per.count = count;
+            const RootResult more = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -best_theta)), per);
+            if (more.status == Status::Converged) {
+                absorb_status(r, more);
+                at_best = more;
+            } else {  // the verdict needs only the rightmost root; say why fewer are listed
+                r.reason += "; only the rightmost root is listed (" + std::to_string(count) + " did not settle: " + more.message + ")";
+            }
+        }
         for (const auto& root : at_best.roots) all.push_back({root, -1, best_theta});
         std::sort(all.begin(), all.end(), ring_root_first);
 

@@ -60,6 +60,36 @@ LowFrequency low_frequency_expansion(const Linearisation& lin) {
     return lf;
 }
 
+namespace {
+double coefficient_sum(const Linearisation& lin) {
+    double c = lin.gap.abs_sum() + lin.own.abs_sum() + lin.lead.abs_sum();
+    for (const auto& f : lin.further) c += f.abs_sum();
+    return c;
+}
+}  // namespace
+
+double scaled_delay(const Linearisation& lin) {
+    const double c = coefficient_sum(lin), tau = lin.max_delay();
+    return tau > 0.0 ? c * tau : c;
+}
+
+void require_computable(const Linearisation& lin) {
+    const double c = coefficient_sum(lin);
+    const double tau = lin.max_delay();
+    std::ostringstream os;
+    os.precision(4);
+    if (!(c <= kMaxCoefficientSum)) {
+        os << "the gains are outside the computable range: the sum of the absolute coefficients (OVRV: k1 (1 + th) + 2 k2) is "
+           << c << ": expected <= " << kMaxCoefficientSum;
+        throw std::invalid_argument(os.str());
+    }
+    if (!(c * tau <= kMaxScaledDelay)) {
+        os << "gains and delay outside the computable range: tau_max times the sum of the absolute coefficients (OVRV: tau (k1 (1 + th) + 2 k2)) is "
+           << c * tau << ": expected <= " << kMaxScaledDelay << " (the collocation degree grows with |lambda| tau)";
+        throw std::invalid_argument(os.str());
+    }
+}
+
 void StringOptions::validate() const {
     roots.validate();
     if (plant_roots < 1) throw std::invalid_argument("plant_roots = " + std::to_string(plant_roots) + ": expected >= 1");
@@ -125,6 +155,7 @@ double refine_peak(const TransferFunction& tf, double lo, double hi, int& evals)
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options) {
     options.validate();
+    require_computable(lin);
     // The rightmost plant roots decide plant stability; the last one found also bounds the width
     // of every resonance peak of roots further left (see the grid step below).
     RootOptions ro = options.roots;

@@ -34,6 +34,20 @@ struct LowFrequency {
 
 LowFrequency low_frequency_expansion(const Linearisation& lin);
 
+/// The computable range of the analyses of identical cars (analyse_string, analyse_ring; README
+/// "Computable range"). With c = the sum of the absolute coefficients of gap, own and lead
+/// (for OVRV c = k1 (1 + th) + 2 k2) and tau_max the largest delay:
+///     c <= kMaxCoefficientSum   and   c tau_max <= kMaxScaledDelay.
+/// Every root with Re >= sigma has |lambda| <= R(sigma) ~ c, and the collocation degree that
+/// resolves it grows like R tau_max (rescaling time by tau_max leaves c tau_max unchanged), so
+/// this product, not c or tau alone, bounds the work.
+constexpr double kMaxCoefficientSum = 1e8;
+constexpr double kMaxScaledDelay = 10.0;
+/// c tau_max of the range above (c alone when there is no delay).
+double scaled_delay(const Linearisation& lin);
+/// Throws std::invalid_argument stating the range when `lin` is outside it.
+void require_computable(const Linearisation& lin);
+
 struct StringOptions {
     RootOptions roots;            ///< for the plant roots (its count is replaced by plant_roots)
     int plant_roots = 2;          ///< rightmost roots of D computed (>= 1)
