@@ -33,6 +33,10 @@ constexpr double boundary_closed_form = 1e-8;
 constexpr double coefficient_rel = 1e-13;
 /// Linearisation against central finite differences with step 1e-5 (error O(h^2) ~ 1e-10).
 constexpr double finite_difference = 1e-7;
+/// |d alpha / d tau| at tau = 0 for the OVRV rings tested (alpha the spectral abscissa): the
+/// roots move by O(|lambda|^2 tau) with |lambda| < 1 there (measured ~0.06); 1 bounds it with
+/// margin, so |alpha(tau) - alpha(0)| <= tau_continuity tau (+ rounding) must hold.
+constexpr double tau_continuity = 1.0;
 
 /// The same sum of squares accumulated in a different order or grouping (a stacked objective
 /// against the sample-weighted mean of its parts, an RMSE pooled from one run): a few thousand

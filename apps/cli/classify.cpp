@@ -69,6 +69,10 @@ int run_classify() {
         else write_files_atomic({{svg_file, svg}});
     }
     print_output(format, e, csv, [&] { std::cout << classification_table(rows, cars, source); });
+    for (const auto& r : rows) {  // the reason of each UNDECIDED on stderr
+        report_undecided(r.string.plant_roots.status, "classify: " + r.vehicle.name + ": plant", r.string.plant_roots.message);
+        report_undecided(r.ring.status, "classify: " + r.vehicle.name + ": ring", r.ring.reason);
+    }
     return exit_code(status);
 }
 

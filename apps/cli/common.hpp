@@ -48,6 +48,24 @@ long parse_integer(const std::string& flag, const std::string& text, long lo, lo
 /// 0 when `s` converged, else exit_not_converged.
 inline int exit_code(Status s) { return s == Status::Converged ? exit_ok : exit_not_converged; }
 
+/// The verdict word of the human tables: STABLE, MARGINAL, UNSTABLE or UNDECIDED.
+inline std::string verdict_word(Verdict v) {
+    std::string w = to_string(v);
+    for (char& c : w) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return w;
+}
+
+/// When `s` is not converged, says why on stderr ("ddemap: WHAT undecided (status): reason")
+/// and returns exit_not_converged; else exit_ok.
+inline int report_undecided(Status s, const std::string& what, const std::string& reason) {
+    if (s == Status::Converged) return exit_ok;
+    std::string line = reason;
+    for (char& c : line)
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';  // one line
+    std::cerr << "ddemap: " << what << " undecided (" << to_string(s) << "): " << line << "\n";
+    return exit_not_converged;
+}
+
 /// --solver NAME to the library's root method: auto, dense, sparse (shift_invert) or product
 /// (contour); the library's own names are accepted too. BadInput otherwise.
 std::string root_method(const std::string& solver);

@@ -85,12 +85,15 @@ int run_mix() {
         out << "p      k   abscissa        stable\n";
         for (const auto& pt : pts) {
             char line[160];
-            std::snprintf(line, sizeof line, "%-6.3f %-3d %-15.8f %s\n", pt.fraction, pt.x_cars, pt.abscissa, pt.stable ? "yes" : "no");
+            std::snprintf(line, sizeof line, "%-6.3f %-3d %-15.8f %s\n", pt.fraction, pt.x_cars, pt.abscissa,
+                          pt.status != Status::Converged ? "UNDECIDED" : pt.stable ? "yes" : "no");
             out << line;
         }
         out << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << out.str();
     });
+    for (const auto& pt : pts)  // the reason of each UNDECIDED on stderr
+        report_undecided(pt.status, "mix: p = " + rounded(pt.fraction, 6), "an arrangement's roots did not converge");
     return exit_code(status);
 }
 

@@ -107,11 +107,13 @@ int run_system(Format format, const std::string& prefix) {
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << "trusted    " << r.message << "\n";
     out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";
-    out << "verdict    " << (r.status != Status::Converged ? "UNDECIDED (" + to_string(r.status) + ")"
-                             : s.stable ? std::string("STABLE") : std::string("NOT asymptotically stable")) << "\n\n";
+    out << "verdict    " << verdict_word(s.verdict);
+    if (s.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";
+    else if (s.verdict == Verdict::Marginal) out << " (roots on the imaginary axis to rounding: not asymptotically stable)";
+    out << "\n\n";
     out << roots_table(r.roots);
     emit(e, roots_csv(r.roots), out.str(), format, prefix);
-    return exit_code(r.status);
+    return report_undecided(r.status, "roots", r.message);
 }
 
 int run_fleet(Format format, const std::string& prefix) {
@@ -170,11 +172,11 @@ int run_fleet(Format format, const std::string& prefix) {
     out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
     if (rr.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
     else
-        out << "verdict    " << (r.stable ? "STABLE" : "UNSTABLE") << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
+        out << "verdict    " << verdict_word(r.verdict) << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
             << " unstable roots)\n\n";
     out << roots_table(rr.roots);
     emit(e, roots_csv(rr.roots), out.str(), format, prefix);
-    return exit_code(rr.status);
+    return report_undecided(rr.status, "roots", rr.message);
 }
 
 int run_ring(Format format, const std::string& prefix) {
@@ -202,12 +204,9 @@ int run_ring(Format format, const std::string& prefix) {
     if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
     else out << " (mode " << r.abscissa_mode << ")";
     out << "\n";
-    if (r.status != Status::Converged) {
-        out << "verdict    ring UNDECIDED (" << to_string(r.status) << ")";
-    } else {
-        out << "verdict    ring " << (r.stable ? "STABLE" : "UNSTABLE");
-        if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
-    }
+    out << "verdict    ring " << verdict_word(r.verdict);
+    if (r.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";
+    else if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
     out << "\n\n";
     out << "  #   mode        theta                re                 im    residual\n";
     int i = 0;
@@ -218,7 +217,7 @@ int run_ring(Format format, const std::string& prefix) {
         out << line;
     }
     emit(e, ring_roots_csv(r), out.str(), format, prefix);
-    return exit_code(r.status);
+    return report_undecided(r.status, "roots", r.reason);
 }
 
 }  // namespace

@@ -59,8 +59,8 @@ int run_string() {
         out << "model            " << model->name();
         for (const auto& [k, v] : model->parameters()) out << " " << k << "=" << rounded(v, 6);
         out << "\n";
-        out << "plant            " << (s.plant_stable ? "stable" : "UNSTABLE") << "   (rightmost root of D: Re = " << rounded(s.plant_abscissa, 6)
-            << ")\n";
+        out << "plant            " << (s.plant_stable ? std::string("stable") : verdict_word(s.plant_verdict))
+            << "   (rightmost root of D: Re = " << rounded(s.plant_abscissa, 6) << ")\n";
         out << "sup |Gamma(iw)|  " << rounded(s.sup_gamma, 10);
         if (s.omega_peak > 0.0) out << " at w = " << rounded(s.omega_peak, 8) << " rad/s";
         else out << " (only approached as w -> 0)";
@@ -70,12 +70,15 @@ int run_string() {
         if (ring) {
             char label[32];
             std::snprintf(label, sizeof label, "%-17s", ("ring N=" + ring_name(*cars)).c_str());
-            out << label << (ring->stable ? "stable" : "UNSTABLE") << "   (spectral abscissa " << rounded(ring->spectral_abscissa, 6) << ")\n";
+            out << label << (ring->stable ? std::string("stable") : verdict_word(ring->verdict)) << "   (spectral abscissa "
+                << rounded(ring->spectral_abscissa, 6) << ")\n";
         }
-        out << "verdict          string " << (s.string_stable ? "STABLE" : "UNSTABLE") << "\n";
+        out << "verdict          string " << verdict_word(s.string_verdict) << "\n";
         std::cout << out.str();
     });
-    return exit_code(status);
+    if (s.plant_roots.status != Status::Converged) return report_undecided(status, "string: plant", s.plant_roots.message);
+    if (ring) return report_undecided(status, "string: ring", ring->reason);
+    return exit_ok;
 }
 
 }  // namespace ddemap::cli

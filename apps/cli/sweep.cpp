@@ -79,13 +79,17 @@ int run_sweep() {
         out << "sweep      " << sw.points.size() << " points in " << rounded(sw.seconds, 3) << " s ("
             << static_cast<long>(std::lround(sw.points.size() / std::max(sw.seconds, 1e-9))) << " points/s, " << sw.threads << " threads)\n";
         out << "regions    plant unstable " << classes[0] << ", ring unstable " << classes[1] << ", string unstable " << classes[2]
-            << ", string stable " << classes[3] << "\n";
+            << ", string stable " << classes[3];
+        if (sw.uncertified > 0) out << " (" << sw.uncertified << " of them UNDECIDED: no certificate)";
+        out << "\n";
         if (bp) out << "boundaries " << b.curves.size() << " curves\n";
         out << "wrote      ";
         for (const auto& f : files) out << f.first << " ";
         out << "\n";
         std::cout << out.str();
     });
+    if (sw.uncertified > 0)  // the reason of the UNDECIDED points on stderr
+        std::cerr << "ddemap: sweep undecided (uncertified): " << e.message << "\n";
     return sw.uncertified > 0 ? exit_not_converged : exit_ok;
 }
 

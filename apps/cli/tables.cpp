@@ -3,9 +3,15 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common.hpp"
 #include "format.hpp"
 
 namespace ddemap::cli {
+
+namespace {
+/// The table's verdict words: stable in lower case (the common case), the others in capitals.
+std::string word(Verdict v) { return v == Verdict::Stable ? std::string("stable") : verdict_word(v); }
+}  // namespace
 
 std::string classification_table(const std::vector<Classification>& rows, int cars, const std::string& source) {
     std::ostringstream out;
@@ -16,8 +22,8 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
         const auto& p = row.vehicle.parameters;
         std::snprintf(line, sizeof line, "%-7s %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %9.6f %7.4f %9.2e\n",
                       row.vehicle.name.c_str(), p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
-                      row.string.plant_stable ? "stable" : "UNSTABLE", row.ring.stable ? "stable" : "UNSTABLE",
-                      row.string.string_stable ? "stable" : "UNSTABLE", row.string.sup_gamma, row.string.omega_peak,
+                      word(row.string.plant_verdict).c_str(), word(row.ring.verdict).c_str(),
+                      word(row.string.string_verdict).c_str(), row.string.sup_gamma, row.string.omega_peak,
                       row.string.lowfreq_margin);
         out << line;
     }

@@ -46,6 +46,9 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     }
     out.stable = r.status == Status::Converged && !r.roots.empty() && out.unstable_roots == 0 &&
                  r.roots.front().value.real() < -marginal_band(r.roots.front().value);
+    const int marginal = !r.roots.empty() && !out.stable && out.unstable_roots == 0 ? 1 : 0;
+    out.verdict = r.roots.empty() && r.status == Status::Converged ? Verdict::Undecided
+                                                                    : verdict_of(r.status, out.unstable_roots, marginal);
     if (one_leader) {
         out.product_residual = 0.0;
         for (const auto& x : r.roots) out.product_residual = std::max(out.product_residual, ring_product_residual(lins, x.value));

@@ -52,6 +52,7 @@ void RingOptions::validate() const {
 RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& options) {
     options.validate();
     if (cars != 0 && cars < 2) throw std::invalid_argument("ring of " + std::to_string(cars) + " cars: expected N >= 2 or inf");
+    require_computable(lin);
     RingResult r;
     r.cars = cars;
     const int count = options.roots.count;
@@ -118,26 +119,46 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             if (x.root.value.real() > band) ++r.unstable_roots;
             else if (x.root.value.real() >= -band) ++r.marginal_roots;
         }
-        r.stable = r.status == Status::Converged && r.unstable_roots == 0 && r.marginal_roots == 0;
+        r.verdict = verdict_of(r.status, r.unstable_roots, r.marginal_roots);
+        r.stable = r.verdict == Verdict::Stable;
         r.trivial_branch_stable = r.stable;
     } else {
         // N = infinity: maximise the rightmost real part over wave numbers theta in (0, pi]
         require_single_leader(lin, "the infinite ring (N = inf)");
         RootOptions per = options.roots;
         per.count = 1;  // the abscissa needs only the rightmost root
-        auto alpha = [&](double theta, RootResult* keep) {
-            const RootResult rr = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -theta)), per);
-            absorb_status(r, rr);
-            if (keep) *keep = rr;
-            return rr.spectral_abscissa();
-        };
-        std::vector<double> thetas;
-        for (int j = 1; j <= options.theta_grid; ++j) thetas.push_back(M_PI * j / options.theta_grid);
-        for (int k = 1; k <= 12; ++k) thetas.push_back(M_PI * std::ldexp(1.0, -k) / options.theta_grid);
         // the wave number that the peak of |Gamma| drives: Gamma(i w) = e^{i theta}
         StringOptions so;
         so.roots = options.roots;
         const StringResult sr = analyse_string(lin, so);
+        const LowFrequency& lf = sr.lowfreq;
+        const bool series = lf.decisive_order > 0 && lf.gamma_prime0 != 0.0 && lf.d0 != 0.0;
+        // On the branch through the trivial root, lambda ~ i theta / Gamma'(0) and
+        // Re lambda ~ c_k w^k / (2 D(0)^2 Gamma'(0)) (w = Im lambda, c_k the decisive coefficient).
+        // Where the computed real part is within the marginal band it is rounding noise, and this
+        // exact expansion gives it instead.
+        auto on_trivial_branch = [&](cplx z, double theta) {
+            if (!series || std::abs(z.real()) > marginal_band(z)) return false;
+            const cplx predicted(0.0, theta / lf.gamma_prime0);
+            return std::abs(z - predicted) <= 0.5 * std::abs(predicted);
+        };
+        auto branch_real = [&](cplx z) {
+            return sr.lowfreq_margin * std::pow(std::abs(z.imag()), lf.decisive_order) / (2.0 * lf.d0 * lf.d0 * lf.gamma_prime0);
+        };
+        bool met_marginal = false;  // a rightmost root within the band, not on the trivial branch
+        auto alpha = [&](double theta, RootResult* keep) {
+            const RootResult rr = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -theta)), per);
+            absorb_status(r, rr);
+            if (keep) *keep = rr;
+            if (rr.roots.empty()) return rr.spectral_abscissa();
+            const cplx z = rr.roots.front().value;
+            if (on_trivial_branch(z, theta)) return branch_real(z);
+            if (std::abs(z.real()) <= marginal_band(z)) met_marginal = true;
+            return z.real();
+        };
+        std::vector<double> thetas;
+        for (int j = 1; j <= options.theta_grid; ++j) thetas.push_back(M_PI * j / options.theta_grid);
+        for (int k = 1; k <= 12; ++k) thetas.push_back(M_PI * std::ldexp(1.0, -k) / options.theta_grid);
         if (sr.omega_peak > 0.0) {
             double th = std::arg(TransferFunction(lin)(cplx(0.0, sr.omega_peak)));
             th = std::abs(th);
@@ -171,35 +192,51 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
         }
         RootResult at_best;
         alpha(best_theta, &at_best);
+        if (count > 1) {  // --count roots at the wave number of the abscissa
+            per.count = count;
+            const RootResult more = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -best_theta)), per);
+            if (more.status == Status::Converged) {
+                absorb_status(r, more);
+                at_best = more;
+            } else {  // the verdict needs only the rightmost root; say why fewer are listed
+                r.reason += "; only the rightmost root is listed (" + std::to_string(count) + " did not settle: " + more.message + ")";
+            }
+        }
         for (const auto& root : at_best.roots) all.push_back({root, -1, best_theta});
         std::sort(all.begin(), all.end(), ring_root_first);
 
         // the branch through the trivial root: Re lambda(theta) ~ c_k w^k / (2 D(0)^2 Gamma'(0))
-        const LowFrequency& lf = sr.lowfreq;
-        if (lf.decisive_order > 0 && lf.gamma_prime0 != 0.0 && lf.d0 != 0.0) {
-            r.trivial_branch_stable = (sr.lowfreq_margin / lf.gamma_prime0) < 0.0;
+        r.trivial_branch_stable = series && (sr.lowfreq_margin / lf.gamma_prime0) < 0.0;
+        // the samples stop at theta ~ 1e-5, where the trivial branch is still resolved (Re ~ -theta^2)
+        // or given by the expansion above; below that the analytic sign decides
+        const double band = all.empty() ? marginal_band(0.0) : marginal_band(all.front().root.value);
+        const bool grid_stable = best_value < 0.0 && !met_marginal;
+        const int unstable = best_value > band || (series && !r.trivial_branch_stable) ? 1 : 0;
+        if (best_value > band || (unstable && best_value > 0.0)) {
+            r.spectral_abscissa = best_value;
+            r.abscissa_is_limit = false;
+            r.abscissa_theta = best_theta;
         } else {
-            r.trivial_branch_stable = false;  // undecided: report as not stable
-        }
-        // the samples stop at theta ~ 1e-5, where the trivial branch is still resolved (Re ~ -theta^2);
-        // below that the analytic sign above decides
-        const bool grid_stable = best_value < 0.0;
-        if (grid_stable && r.trivial_branch_stable) {
+            // sup 0: approached as theta -> 0 (or reached within the band by a marginal root)
             r.spectral_abscissa = 0.0;
-            r.abscissa_is_limit = true;
-            r.abscissa_theta = 0.0;
-        } else {
-            r.spectral_abscissa = std::max(best_value, 0.0);
-            r.abscissa_is_limit = best_value <= 0.0;
-            r.abscissa_theta = best_value <= 0.0 ? 0.0 : best_theta;
+            r.abscissa_is_limit = grid_stable;
+            r.abscissa_theta = grid_stable ? 0.0 : best_theta;
         }
+        const bool marginal = met_marginal && best_value <= band;
+        r.marginal_roots = marginal ? 1 : 0;
+        // no exact sign for the trivial branch (all of c2..c8 zero to rounding or D(0) = 0): the
+        // roots near 0 are on the axis to rounding, a marginal case
+        if (grid_stable && !series) r.marginal_roots = 1;
+        r.verdict = verdict_of(r.status, unstable, r.marginal_roots);
         r.abscissa_mode = -1;
         r.unstable_roots = -1;
-        r.stable = r.status == Status::Converged && grid_stable && r.trivial_branch_stable;
+        r.stable = r.verdict == Verdict::Stable;
     }
     // report the `count` rightmost, plus a conjugate partner that ties with the last one
     std::size_t keep = std::min<std::size_t>(all.size(), count);
-    while (keep < all.size() && keep > 0 && all[keep].root.value.real() == all[keep - 1].root.value.real()) ++keep;
+    if (keep < all.size() && keep > 0 && all[keep - 1].root.value.imag() > 0.0 &&
+        all[keep].root.value == std::conj(all[keep - 1].root.value))
+        ++keep;
     all.resize(keep);
     r.roots = std::move(all);
     return r;

@@ -60,6 +60,36 @@ LowFrequency low_frequency_expansion(const Linearisation& lin) {
     return lf;
 }
 
+namespace {
+double coefficient_sum(const Linearisation& lin) {
+    double c = lin.gap.abs_sum() + lin.own.abs_sum() + lin.lead.abs_sum();
+    for (const auto& f : lin.further) c += f.abs_sum();
+    return c;
+}
+}  // namespace
+
+double scaled_delay(const Linearisation& lin) {
+    const double c = coefficient_sum(lin), tau = lin.max_delay();
+    return tau > 0.0 ? c * tau : c;
+}
+
+void require_computable(const Linearisation& lin) {
+    const double c = coefficient_sum(lin);
+    const double tau = lin.max_delay();
+    std::ostringstream os;
+    os.precision(4);
+    if (!(c <= kMaxCoefficientSum)) {
+        os << "the gains are outside the computable range: the sum of the absolute coefficients (OVRV: k1 (1 + th) + 2 k2) is "
+           << c << ": expected <= " << kMaxCoefficientSum;
+        throw std::invalid_argument(os.str());
+    }
+    if (!(c * tau <= kMaxScaledDelay)) {
+        os << "gains and delay outside the computable range: tau_max times the sum of the absolute coefficients (OVRV: tau (k1 (1 + th) + 2 k2)) is "
+           << c * tau << ": expected <= " << kMaxScaledDelay << " (the collocation degree grows with |lambda| tau)";
+        throw std::invalid_argument(os.str());
+    }
+}
+
 void StringOptions::validate() const {
     roots.validate();
     if (plant_roots < 1) throw std::invalid_argument("plant_roots = " + std::to_string(plant_roots) + ": expected >= 1");
@@ -125,6 +155,7 @@ double refine_peak(const TransferFunction& tf, double lo, double hi, int& evals)
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options) {
     options.validate();
+    require_computable(lin);
     // The rightmost plant roots decide plant stability; the last one found also bounds the width
     // of every resonance peak of roots further left (see the grid step below).
     RootOptions ro = options.roots;
@@ -139,6 +170,12 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     r.plant_abscissa = r.plant_roots.spectral_abscissa();
     r.plant_stable = r.plant_roots.status == Status::Converged && !r.plant_roots.roots.empty() &&
                      r.plant_abscissa < -marginal_band(r.plant_roots.roots.front().value);
+    if (r.plant_roots.status != Status::Converged || r.plant_roots.roots.empty()) {
+        r.plant_verdict = Verdict::Undecided;
+    } else {
+        const double band = marginal_band(r.plant_roots.roots.front().value);
+        r.plant_verdict = r.plant_abscissa > band ? Verdict::Unstable : r.plant_stable ? Verdict::Stable : Verdict::Marginal;
+    }
 
     r.lowfreq = low_frequency_expansion(lin);
     switch (r.lowfreq.decisive_order) {
@@ -188,36 +225,66 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     }
     std::sort(grid.begin(), grid.end());
     grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-    std::vector<double> g(grid.size());
-    for (std::size_t i = 0; i < grid.size(); ++i) g[i] = tf.gain2(grid[i]);
-    r.evaluations += static_cast<int>(grid.size());
 
-    // a maximum at the first sample when low frequencies amplify: move the bracket towards 0
-    std::vector<std::pair<double, double>> brackets;
-    if (grid.size() >= 2 && g[0] > g[1] && g[0] > 1.0) brackets.emplace_back(0.0, grid[1]);
-    for (std::size_t i = 1; i + 1 < grid.size(); ++i) {
-        if (g[i] >= g[i - 1] && g[i] > g[i + 1]) brackets.emplace_back(grid[i - 1], grid[i + 1]);
-    }
-    double best = 1.0;  // the limit w -> 0
-    double best_w = 0.0;
-    double highest_peak = -1.0;
-    for (const auto& [lo, hi] : brackets) {
-        const double w = refine_peak(tf, lo > 0.0 ? lo : hi * 1e-9, hi, r.evaluations);
-        const double gw = tf.gain2(w);
+    // 1 - |Gamma|^2 in its cancellation-free form (TransferFunction::attenuation); where its
+    // sign is lost in rounding at small w, the low-frequency series decides (exact there).
+    const double coef = std::max({1.0, tau, a + h + l});
+    const double w_series = 1e-2 / coef;
+    auto loss = [&](double w) {
+        double q = 0.0, noise = 0.0;
+        double att = tf.attenuation(w, &q, &noise);
+        if (std::abs(q) <= noise && w <= w_series && r.lowfreq.decisive_order > 0) {
+            const double w2 = w * w;
+            q = r.lowfreq.c2 + w2 * (r.lowfreq.c4 + w2 * (r.lowfreq.c6 + w2 * r.lowfreq.c8));
+            cplx n, d;
+            tf.evaluate(cplx(0.0, w), n, d);
+            att = w2 * q / std::norm(d);
+        }
         ++r.evaluations;
-        if (!std::isfinite(gw)) continue;
-        r.peaks.push_back({w, std::sqrt(gw)});
-        highest_peak = std::max(highest_peak, gw);
-        if (gw > best) {
-            best = gw;
+        return att;
+    };
+    std::vector<double> g(grid.size());
+    for (std::size_t i = 0; i < grid.size(); ++i) g[i] = loss(grid[i]);
+
+    // local minima of the loss are the peaks of |Gamma|; a minimum at the first sample when low
+    // frequencies amplify: move the bracket towards 0
+    std::vector<std::pair<std::size_t, std::pair<double, double>>> brackets;
+    if (grid.size() >= 2 && g[0] < g[1] && g[0] < 0.0) brackets.push_back({0, {0.0, grid[1]}});
+    for (std::size_t i = 1; i + 1 < grid.size(); ++i) {
+        if (g[i] <= g[i - 1] && g[i] < g[i + 1]) brackets.push_back({i, {grid[i - 1], grid[i + 1]}});
+    }
+    double lowest = 0.0;  // the limit w -> 0
+    double best_w = 0.0;
+    double lowest_peak = 2.0;
+    for (const auto& [i, br] : brackets) {
+        const auto [lo, hi] = br;
+        double w = refine_peak(tf, lo > 0.0 ? lo : hi * 1e-9, hi, r.evaluations);
+        double lw = loss(w);
+        if (!(lw <= g[i])) {  // the refinement may not beat its sample (flat peak, rounding)
+            w = grid[i];
+            lw = g[i];
+        }
+        if (!std::isfinite(lw)) continue;
+        r.peaks.push_back({w, std::sqrt(1.0 - lw)});
+        lowest_peak = std::min(lowest_peak, lw);
+        if (lw < lowest) {
+            lowest = lw;
             best_w = w;
         }
     }
     std::sort(r.peaks.begin(), r.peaks.end(), [](const GainPeak& x, const GainPeak& y) { return x.omega < y.omega; });
-    r.sup_gamma = std::sqrt(best);
+    r.sup_gamma = std::sqrt(1.0 - lowest);
     r.omega_peak = best_w;
-    r.peak_margin = highest_peak < 0.0 ? 1.0 : 1.0 - std::sqrt(highest_peak);
-    r.string_stable = r.plant_stable && r.lowfreq.attenuates && highest_peak <= 1.0;
+    // 1 - sqrt(1 - loss) without cancellation
+    r.peak_margin = lowest_peak > 1.0 ? 1.0 : lowest_peak / (1.0 + std::sqrt(1.0 - lowest_peak));
+    r.string_stable = r.plant_stable && r.lowfreq.attenuates && lowest_peak >= 0.0;
+    if (r.plant_verdict == Verdict::Undecided) {
+        r.string_verdict = Verdict::Undecided;
+    } else if (r.plant_verdict == Verdict::Unstable || lowest_peak < 0.0 || (r.lowfreq.decisive_order > 0 && !r.lowfreq.attenuates)) {
+        r.string_verdict = Verdict::Unstable;
+    } else {
+        r.string_verdict = r.string_stable ? Verdict::Stable : Verdict::Marginal;
+    }
     return r;
 }
 

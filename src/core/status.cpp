@@ -13,4 +13,14 @@ std::string to_string(Status s) {
     return "unknown";
 }
 
+std::string to_string(Verdict v) {
+    switch (v) {
+        case Verdict::Stable: return "stable";
+        case Verdict::Marginal: return "marginal";
+        case Verdict::Unstable: return "unstable";
+        case Verdict::Undecided: return "undecided";
+    }
+    return "unknown";
+}
+
 }  // namespace ddemap

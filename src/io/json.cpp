@@ -104,7 +104,8 @@ std::string ring_roots_json(const RingResult& r) {
     j["abscissa_theta"] = num(r.abscissa_theta);
     j["abscissa_is_limit"] = r.abscissa_is_limit;
     j["ring_stable"] = r.stable;
-    j["ring_margin"] = num(-r.spectral_abscissa);
+    j["ring_verdict"] = to_string(r.verdict);
+    j["ring_margin"] = r.verdict == Verdict::Undecided ? json(nullptr) : num(-r.spectral_abscissa);
     j["unstable_roots"] = r.unstable_roots < 0 ? json(nullptr) : json(r.unstable_roots);
     j["marginal_roots"] = r.marginal_roots;
     j["trivial_root"] = {{"re", 0.0}, {"im", 0.0}, {"mode", 0}, {"excluded", true},
@@ -127,6 +128,7 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& s) {
     j["roots"] = roots;
     j["spectral_abscissa"] = num(s.spectral_abscissa);
     j["stable"] = s.stable;
+    j["verdict"] = to_string(s.verdict);
     j["degree"] = r.degree;
     j["degree_reason"] = r.message;
     j["strip_floor"] = num(r.strip_floor);
@@ -201,7 +203,8 @@ std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
     j["trivial_root_abs"] = num(r.trivial_root);
     j["spectral_abscissa"] = num(r.spectral_abscissa);
     j["ring_stable"] = r.stable;
-    j["ring_margin"] = num(-r.spectral_abscissa);
+    j["ring_verdict"] = to_string(r.verdict);
+    j["ring_margin"] = r.verdict == Verdict::Undecided ? json(nullptr) : num(-r.spectral_abscissa);
     j["unstable_roots"] = r.unstable_roots;
     j["unstable_count_complete"] = r.unstable_count_complete;
     j["product_residual"] = num(r.product_residual);
@@ -219,6 +222,7 @@ std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
 std::string string_json(const StringResult& s, const RingResult* ring) {
     json j;
     j["plant_stable"] = s.plant_stable;
+    j["plant_verdict"] = to_string(s.plant_verdict);
     j["plant_abscissa"] = num(s.plant_abscissa);
     j["plant_margin"] = num(-s.plant_abscissa);
     j["sup_gamma"] = num(s.sup_gamma);
@@ -229,6 +233,7 @@ std::string string_json(const StringResult& s, const RingResult* ring) {
                     {"c8", num(s.lowfreq.c8)}, {"decisive_order", s.lowfreq.decisive_order},
                     {"attenuates", s.lowfreq.attenuates}};
     j["string_stable"] = s.string_stable;
+    j["string_verdict"] = to_string(s.string_verdict);
     json peaks = json::array();
     for (const auto& p : s.peaks) peaks.push_back({{"omega", num(p.omega)}, {"gain", num(p.gain)}});
     j["peaks"] = peaks;
@@ -237,8 +242,9 @@ std::string string_json(const StringResult& s, const RingResult* ring) {
     if (ring) {
         j["ring"] = ring_value(ring->cars);
         j["ring_stable"] = ring->stable;
+        j["ring_verdict"] = to_string(ring->verdict);
         j["spectral_abscissa"] = num(ring->spectral_abscissa);
-        j["ring_margin"] = num(-ring->spectral_abscissa);
+        j["ring_margin"] = ring->verdict == Verdict::Undecided ? json(nullptr) : num(-ring->spectral_abscissa);
     }
     return text(j);
 }
@@ -255,6 +261,9 @@ std::string classification_json(const std::vector<Classification>& rows, int car
         o["plant_stable"] = row.string.plant_stable;
         o["ring_stable"] = row.ring.stable;
         o["string_stable"] = row.string.string_stable;
+        o["plant_verdict"] = to_string(row.string.plant_verdict);
+        o["ring_verdict"] = to_string(row.ring.verdict);
+        o["string_verdict"] = to_string(row.string.string_verdict);
         o["sup_gamma"] = num(row.string.sup_gamma);
         o["omega_peak"] = num(row.string.omega_peak);
         o["lowfreq_margin"] = num(row.string.lowfreq_margin);

@@ -35,6 +35,9 @@ namespace ddemap::detail {
 
 namespace {
 
+/// R(-1/tau) tau below which the roots come from the ODE limit (see dense_roots).
+constexpr double kShortDelay = 1e-3;
+
 /// Newton on det Delta from `guess` (the one Newton loop); true when converged (or stalled
 /// near a multiple root) with a residual below the tolerance.
 bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, Root& out, int& iterations) {
@@ -150,6 +153,49 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
     }
 
     const double tau = dde.max_delay();
+    // A short delay (R tau small, R = R(-1/tau) the bound on |lambda| for every root with
+    // Re >= -1/tau): there |lambda tau_k| <= R tau, so Delta(lambda) differs from the ODE limit
+    // lambda I - (A0 + sum A_k) by at most about R tau sum ||A_k||, and the n roots with
+    // Re >= -1/tau are the ODE eigenvalues moved by O(R tau) (every other root has
+    // Re < -1/tau). They are found by Newton on Delta from those eigenvalues; the collocation on
+    // [-tau, 0] would need entries of size 1/tau (overflow for tau -> 0) for the same roots.
+    const double short_floor = -1.0 / tau;
+    const double short_radius = dde.root_bound(short_floor);
+    if (options.degree == 0 && std::isfinite(short_radius) && short_radius * tau <= kShortDelay) {
+        const MatrixXc limit = dde.ode_limit();
+        std::vector<cplx> ev;
+        bool ok = true;
+        if (dde.is_real()) {
+            Eigen::EigenSolver<Eigen::MatrixXd> es(limit.real(), false);
+            ok = es.info() == Eigen::Success;
+            if (ok) ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        } else {
+            Eigen::ComplexEigenSolver<MatrixXc> es(limit, false);
+            ok = es.info() == Eigen::Success;
+            if (ok) ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+        }
+        int dropped = 0;
+        std::vector<Root> all = ok ? refine_all(dde, ev, options, dropped, result.newton_iterations) : std::vector<Root>{};
+        // every eigenvalue must give its own root (n of them): else the collocation path decides
+        if (ok && static_cast<int>(all.size()) == dde.dimension()) {
+            double worst = 0.0;
+            for (const auto& x : all) worst = std::max(worst, x.collocation_error / scale_of(x.value));
+            result.roots = cut_rightmost(all, options.count);
+            result.degree = 0;
+            result.dropped = dropped;
+            result.collocation_error = worst;
+            result.covered_radius = short_radius;
+            result.strip_floor = static_cast<int>(result.roots.size()) < dde.dimension() ? result.roots.back().value.real() : short_floor;
+            result.status = Status::Converged;
+            std::ostringstream os;
+            os.precision(3);
+            os << "short delay (R tau = " << short_radius * tau << " <= " << kShortDelay << "): the " << dde.dimension()
+               << " roots with Re >= -1/tau = " << short_floor << " refined by Newton from the eigenvalues of the tau -> 0 limit"
+               << " (moved by at most " << worst << " relative)";
+            result.message = os.str();
+            return result;
+        }
+    }
     const int max_degree = std::max(o.max_degree, options.degree);
     int m = options.degree > 0 ? options.degree : std::clamp(degree_for_radius(dde.root_bound(0.0), tau), 8, max_degree);
     std::vector<Root> previous;

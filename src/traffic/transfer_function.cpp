@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace ddemap {
@@ -69,6 +70,56 @@ cplx TransferFunction::derivative(cplx s) const {
 double TransferFunction::gain2_derivative(double w) const {
     const cplx s(0.0, w);
     return 2.0 * (std::conj((*this)(s)) * cplx(0.0, 1.0) * derivative(s)).real();
+}
+
+namespace {
+
+/// sin(w d) / w (d for w = 0), accurate for small w d.
+double sin_over(double w, double d) {
+    const double x = w * d;
+    if (std::abs(x) < 1e-4) return d * (1.0 - x * x / 6.0);
+    return std::sin(x) / w;
+}
+
+}  // namespace
+
+double TransferFunction::attenuation(double w, double* q_out, double* noise_out) const {
+    // Re and Im/w of own, lead, gap at s = i w: e^{-i w d} = cos(w d) - i sin(w d)
+    double re_own = 0.0, re_lead = 0.0, re_gap = 0.0, im_own_w = 0.0, im_lead_w = 0.0, im_gap_w = 0.0;
+    double m_own = 0.0, m_lead = 0.0, m_gap = 0.0, mi_own = 0.0, mi_lead = 0.0, mi_gap = 0.0;  // magnitudes
+    double mi_ol = 0.0;
+    for (const auto& g : m_groups) {
+        const double c = g.delay == 0.0 ? 1.0 : std::cos(w * g.delay);
+        const double so = g.delay == 0.0 ? 0.0 : sin_over(w, g.delay);
+        re_own += g.own * c;
+        re_lead += g.lead * c;
+        re_gap += g.gap * c;
+        im_own_w -= g.own * so;
+        im_lead_w -= g.lead * so;
+        im_gap_w -= g.gap * so;
+        m_own += std::abs(g.own);
+        m_lead += std::abs(g.lead);
+        m_gap += std::abs(g.gap);
+        mi_own += std::abs(g.own * so);
+        mi_lead += std::abs(g.lead * so);
+        mi_gap += std::abs(g.gap * so);
+        mi_ol += std::abs((g.own + g.lead) * so);
+    }
+    // A = i w - own - lead; B = D + N = s^2 - s own + 2 gap + s lead (s = i w, s x = i w x)
+    const double re_a = -re_own - re_lead;
+    const double im_a_w = 1.0 - im_own_w - im_lead_w;
+    const double re_b = -w * w + w * w * im_own_w + 2.0 * re_gap - w * w * im_lead_w;
+    const double im_b_w = re_lead - re_own + 2.0 * im_gap_w;
+    const double q = re_a * im_b_w - re_b * im_a_w;
+    if (q_out) *q_out = q;
+    if (noise_out) {
+        const double ma = m_own + m_lead, mia = 1.0 + mi_ol + mi_own + mi_lead;
+        const double mb = w * w * (1.0 + mi_own + mi_lead) + 2.0 * m_gap, mib = m_lead + m_own + 2.0 * mi_gap;
+        *noise_out = 32.0 * std::numeric_limits<double>::epsilon() * (ma * mib + mb * mia);
+    }
+    cplx n, d;
+    evaluate(cplx(0.0, w), n, d);
+    return w * w * q / std::norm(d);
 }
 
 namespace {

@@ -417,6 +417,60 @@ expect_error "--ring = 'inf'" mix --x E_min --y A_min --ring inf --out "$tmp/mix
 "$bin" mix --x E_min --y A_min --ring 6 --p 0:1:2 --out "$tmp/mixj" --format json >"$tmp/m.json" && json_has "$tmp/m.json" points &&
     python3 -c "import json; d=json.load(open('$tmp/m.json')); assert d['solver']['used'] == 'product' and 'spectral_abscissa' in d['result']['points'][0]" && ok || bad "mix json"
 
+# verdicts (issue 15): the low-frequency boundary, tiny delays, the computable range, MARGINAL,
+# --count on every path, UNDECIDED with its reason on stderr and exit 4
+rows() { awk '/^  #/{t=1; next} t && NF' "$1" | wc -l; }
+"$bin" string --k1 0.2 --k2 0.6423077 --th 1.5 --tau 0.2 --ring inf --format json >"$tmp/v1.json" && python3 - "$tmp/v1.json" <<'PY' && ok || bad "string at c2 = +4e-9: stable, positive margin"
+import json, sys
+r = json.load(open(sys.argv[1]))["result"]
+assert 0 < r["lowfreq_margin"] < 1e-8, r["lowfreq_margin"]
+assert r["string_stable"] is True and r["string_verdict"] == "stable" and r["peak_margin"] > 0, r
+assert r["ring_stable"] is True and r["ring_verdict"] == "stable" and r["spectral_abscissa"] == 0, r
+PY
+"$bin" string --k1 0.2 --k2 0.64230769 --th 1.5 --tau 0.2 --ring inf --format json >"$tmp/v2.json" && python3 - "$tmp/v2.json" <<'PY' && ok || bad "string at c2 = -1.2e-9: unstable, negative margin"
+import json, sys
+r = json.load(open(sys.argv[1]))["result"]
+assert -1e-8 < r["lowfreq_margin"] < 0, r["lowfreq_margin"]
+assert r["string_stable"] is False and r["string_verdict"] == "unstable" and r["peak_margin"] < 0, r
+assert r["ring_verdict"] == "unstable" and r["spectral_abscissa"] > 0, r
+PY
+"$bin" string --k1 0.2 --k2 0.2 --th 1.5 --tau 1e-9 >"$tmp/v3.txt" 2>"$tmp/v3.err" && grep -q '^plant  *stable' "$tmp/v3.txt" && [ ! -s "$tmp/v3.err" ] &&
+    ok || bad "string --tau 1e-9: plant stable, exit 0"
+for t in 1e-300 1e-12 1e-9; do
+    "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau $t --count 3 --format json >"$tmp/v4.json" &&
+        "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0 --count 3 --format json >"$tmp/v5.json" && python3 - "$tmp/v4.json" "$tmp/v5.json" <<'PY' && ok || bad "roots --tau $t continuous with tau = 0"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert a["status"] == "converged", a["status"]
+assert abs(a["result"]["spectral_abscissa"] - b["result"]["spectral_abscissa"]) < 1e-8
+assert a["result"]["ring_verdict"] == b["result"]["ring_verdict"] == "unstable"
+PY
+done
+expect_error "computable range" roots --k1 1e6 --k2 0.2 --th 1.5 --tau 0.2
+expect_error "computable range" roots --k1 0.2 --k2 0.2 --th 1e10 --tau 0.2
+expect_error "computable range" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 1e6
+expect_error "expected <= 1e+08" roots --k1 1e300 --k2 0.2 --th 1.5 --tau 0.2
+expect_error "expected <= 1e+08" string --k1 0.2 --k2 1e20 --th 1.5 --tau 0.2
+expect_error "expected <= 10" string --k1 19.9 --k2 0.2 --th 1.5 --tau 0.2
+"$bin" roots --k1 19.8 --k2 0.2 --th 1.5 --tau 0.2 --count 3 >"$tmp/v6.txt" && grep -q 'verdict    ring STABLE' "$tmp/v6.txt" &&
+    ok || bad "roots just inside the computable range"
+"$bin" roots --k1 0 --k2 0.2 --th 1.5 --tau 0.2 --count 6 >"$tmp/v7.txt" && grep -q 'verdict    ring MARGINAL' "$tmp/v7.txt" &&
+    [ "$(rows "$tmp/v7.txt")" -eq 6 ] && ok || bad "roots --k1 0: MARGINAL and 6 rows"
+"$bin" roots --k1 0 --k2 0.2 --th 1.5 --tau 0.2 --format json | python3 -c "import json,sys; assert json.load(sys.stdin)['result']['ring_verdict'] == 'marginal'" &&
+    ok || bad "roots --k1 0 json ring_verdict"
+"$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.2 --ring inf --count 4 >"$tmp/v8.txt" && n=$(rows "$tmp/v8.txt") && [ "$n" -ge 4 ] && [ "$n" -le 5 ] &&
+    ok || bad "roots --ring inf --count 4 lists 4 rows"
+"$bin" string --k1 0 --k2 0.2 --th 1.5 --tau 0.2 >"$tmp/v9.txt" && grep -q '^plant  *MARGINAL' "$tmp/v9.txt" && grep -q 'string MARGINAL' "$tmp/v9.txt" &&
+    ok || bad "string --k1 0: MARGINAL, not UNSTABLE"
+printf '{"dimension": 1, "delays": [1.0], "A0": [[0.0]], "A": [[[-1.5707963267948966]]]}\n' >"$tmp/marg.json"
+"$bin" roots --system "$tmp/marg.json" --count 3 --format json | python3 -c "import json,sys; r=json.load(sys.stdin)['result']; assert r['verdict']=='marginal' and 3 <= len(r['roots']) <= 4, r" &&
+    ok || bad "roots --system on the axis: marginal, 3 roots (+ a conjugate partner)"
+"$bin" roots --fleet-pattern A_min --ring 3 --solver sparse --degree 2 >"$tmp/v10.txt" 2>"$tmp/v10.err"; rc=$?
+[ $rc -eq 4 ] && grep -q 'verdict    UNDECIDED' "$tmp/v10.txt" && grep -q 'undecided' "$tmp/v10.err" && [ "$(wc -l <"$tmp/v10.err")" -eq 1 ] &&
+    ok || bad "unconverged fleet roots: UNDECIDED, reason on stderr, exit 4 (got $rc)"
+"$bin" roots --fleet-pattern A_min --ring 5 --count 2 --format json | python3 -c "import json,sys; r=json.load(sys.stdin)['result']; assert 2 <= len(r['roots']) <= 3 and r['ring_verdict'] in ('stable','unstable','marginal'), r" &&
+    ok || bad "roots --fleet-pattern --count 2"
+
 # help on every command, with units
 for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi

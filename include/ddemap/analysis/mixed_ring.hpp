@@ -32,6 +32,9 @@ struct MixedRingResult {
     int unstable_roots = 0;          ///< listed roots with Re > marginal band
     bool unstable_count_complete = false;  ///< the list reaches left of the axis, so the count is all of them
     bool stable = false;             ///< converged and the rightmost non-trivial root has Re < -band
+    /// Stable, Marginal (rightmost non-trivial root within the band), Unstable, or Undecided
+    /// (not converged, or no root found).
+    Verdict verdict = Verdict::Undecided;
     double product_residual = std::numeric_limits<double>::quiet_NaN();  ///< max |prod Gamma_i - 1| (predecessor laws)
 };
 

@@ -34,6 +34,9 @@ struct RingResult {
     int unstable_roots = 0;          ///< roots with Re > marginal band, all modes (-1 for N = infinity)
     int marginal_roots = 0;          ///< roots within the marginal band of the axis
     bool stable = false;             ///< every root (trivial one excluded) has Re < -marginal band
+    /// Stable, Marginal (no root right of the band, some within it), Unstable, or Undecided
+    /// when status is not Converged (then `stable` is false and the counts are not a verdict).
+    Verdict verdict = Verdict::Undecided;
     bool trivial_branch_stable = false;  ///< N = infinity: the branch through the trivial root bends left
     int degree = 0;                  ///< the largest collocation degree used over the modes
     int modes_solved = 0;            ///< mode (or wave-number) problems solved

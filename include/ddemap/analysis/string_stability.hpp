@@ -34,6 +34,20 @@ struct LowFrequency {
 
 LowFrequency low_frequency_expansion(const Linearisation& lin);
 
+/// The computable range of the analyses of identical cars (analyse_string, analyse_ring; README
+/// "Computable range"). With c = the sum of the absolute coefficients of gap, own and lead
+/// (for OVRV c = k1 (1 + th) + 2 k2) and tau_max the largest delay:
+///     c <= kMaxCoefficientSum   and   c tau_max <= kMaxScaledDelay.
+/// Every root with Re >= sigma has |lambda| <= R(sigma) ~ c, and the collocation degree that
+/// resolves it grows like R tau_max (rescaling time by tau_max leaves c tau_max unchanged), so
+/// this product, not c or tau alone, bounds the work.
+constexpr double kMaxCoefficientSum = 1e8;
+constexpr double kMaxScaledDelay = 10.0;
+/// c tau_max of the range above (c alone when there is no delay).
+double scaled_delay(const Linearisation& lin);
+/// Throws std::invalid_argument stating the range when `lin` is outside it.
+void require_computable(const Linearisation& lin);
+
 struct StringOptions {
     RootOptions roots;            ///< for the plant roots (its count is replaced by plant_roots)
     int plant_roots = 2;          ///< rightmost roots of D computed (>= 1)
@@ -57,11 +71,19 @@ struct StringResult {
     double omega_peak = 0.0;           ///< where it is reached; 0 when only approached as w -> 0
     std::vector<GainPeak> peaks;       ///< every local maximum found, refined
     double peak_margin = 1.0;          ///< 1 - (highest local maximum at w > 0); 1 when there is none
+                                       ///< (formed as (1 - |Gamma|^2) / (1 + |Gamma|): no cancellation)
     LowFrequency lowfreq;
     double lowfreq_margin = 0.0;       ///< the decisive low-frequency coefficient (c2 unless it vanishes)
     double omega_search_max = 0.0;     ///< beyond it |Gamma(i w)| < sup_gamma is proven by a bound
     int evaluations = 0;               ///< evaluations of Gamma
     bool string_stable = false;
+    /// Stable, Marginal (a root of D on the axis to rounding), Unstable, or Undecided when the
+    /// plant roots did not converge.
+    Verdict plant_verdict = Verdict::Undecided;
+    /// Undecided with the plant; Unstable when the plant is, or |Gamma(i w)| > 1 somewhere
+    /// (a peak, or the low frequencies amplify); Stable when string_stable; Marginal otherwise
+    /// (plant marginal, or |Gamma| = 1 to the order of the series at w -> 0).
+    Verdict string_verdict = Verdict::Undecided;
 };
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options = {});

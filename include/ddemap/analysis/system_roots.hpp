@@ -12,6 +12,9 @@ struct SystemRootResult {
     RootResult roots;               ///< with the method given and used, the status and the certificate
     double spectral_abscissa = 0.0;
     bool stable = false;            ///< converged and every root has Re < -marginal band
+    /// Stable, Marginal (rightmost root within the band), Unstable, or Undecided (not converged
+    /// or no root found).
+    Verdict verdict = Verdict::Undecided;
 };
 
 /// Throws std::invalid_argument for invalid options or a method that does not fit the system

@@ -22,4 +22,19 @@ std::string to_string(Status s);
 /// True for Status::Converged.
 inline bool converged(Status s) { return s == Status::Converged; }
 
+/// The answer of a stability analysis. Stable: every root (trivial ones excluded) has
+/// Re < -marginal band; Marginal: none right of the band but some within it (on the imaginary
+/// axis to rounding); Unstable: some root right of the band; Undecided: the computation did not
+/// converge (its status says why), so no verdict is given.
+enum class Verdict { Stable, Marginal, Unstable, Undecided };
+
+/// "stable", "marginal", "unstable", "undecided"
+std::string to_string(Verdict v);
+
+/// The verdict from the counts of a converged computation (Undecided when not converged).
+inline Verdict verdict_of(Status s, int unstable, int marginal) {
+    if (s != Status::Converged) return Verdict::Undecided;
+    return unstable > 0 ? Verdict::Unstable : marginal > 0 ? Verdict::Marginal : Verdict::Stable;
+}
+
 }  // namespace ddemap

@@ -35,6 +35,13 @@ public:
     double gain2(double w) const { return std::norm((*this)(cplx(0.0, w))); }
     /// d/dw |Gamma(i w)|^2 = 2 Re( conj(Gamma(i w)) i Gamma'(i w) )
     double gain2_derivative(double w) const;
+    /// 1 - |Gamma(i w)|^2 = w^2 q(w) / |D(i w)|^2 without cancellation at small w:
+    /// D - N = s (s - own - lead), so |D|^2 - |N|^2 = Re((D - N) conj(D + N)) = w^2 q(w) with
+    ///     q(w) = Re(A) Im(B)/w - Re(B) Im(A)/w,  A = i w - own(i w) - lead(i w),  B = D + N,
+    /// where Im(A)/w and Im(B)/w are formed from sin(w tau)/w (q(w) -> c2 as w -> 0). The
+    /// rounding error of q is at most `q_noise` (about eps times the sizes of its terms), not
+    /// eps |D|^2 / w^2 as for 1 - |N|^2/|D|^2. q and q_noise are returned when asked.
+    double attenuation(double w, double* q = nullptr, double* q_noise = nullptr) const;
     const Linearisation& linearisation() const { return m_lin; }
 
 private:
