@@ -66,7 +66,9 @@ void annotate_option_types(CLI::App& app, const std::string& command) {
         {"length", "NUMBER"}, {"fleet", "FILE|PATTERN"}, {"fleet-pattern", "FILE|PATTERN"}, {"cars", "N"}, {"lead", "FILE"},
         {"system", "FILE"}, {"svg", "FILE"}, {"lead-profile", "NAME"}, {"on-event", "stop|continue"}, {"out", "PREFIX"},
         {"p", "LO:HI:COUNT"}, {"ring", "N|inf"}, {"solver", "auto|product|dense|sparse"}, {"train", "T0:T1"},
-        {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", "NAME"}, {"y", "CAR"}};
+        {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", "NAME"}, {"y", "CAR"}, {"car", "NAME"}, {"runs", "FILE"},
+        {"data-dir", "FOLDER"}, {"report", "FOLDER"}, {"par", "NAME"}, {"from", "NUMBER"}, {"to", "NUMBER"},
+        {"samples", "INTEGER"}, {"ring-samples", "INTEGER"}};
     for (CLI::Option* o : app.get_options()) {
         if (o->get_lnames().empty()) {  // a positional argument: a file
             if (o->get_type_name() == "TEXT") o->type_name("FILE");
