@@ -17,7 +17,7 @@ namespace ddemap::cli {
 
 namespace {
 struct Args {
-    std::string file, svg;
+    std::string file, svg, samples = "4000", ring_samples = "200", seed = "1";
     RingArg ring;
     FormatArg format;
     OutArg out;
@@ -25,7 +25,13 @@ struct Args {
 }  // namespace
 
 void add_classify_flags(CLI::App& app) {
-    app.add_option("VEHICLES.csv", args.file, "CSV with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m)");
+    app.add_option("VEHICLES.csv", args.file,
+                   "CSV with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m), optionally the covariance "
+                   "columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes (then the verdicts come with probabilities)");
+    app.add_option("--samples", args.samples, "integer: parameter samples per vehicle with a covariance")->capture_default_str();
+    app.add_option("--ring-samples", args.ring_samples, "integer: of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
+        ->capture_default_str();
+    app.add_option("--seed", args.seed, "integer: seed of the parameter samples")->capture_default_str();
     args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
@@ -51,15 +57,30 @@ int run_classify() {
         vehicles = read_vehicles_csv(read_input_file("VEHICLES.csv", args.file), args.file);
         source = args.file;
     }
-    const auto rows = classify(vehicles, cars);
+    UncertaintyOptions uo;
+    uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
+    uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", args.ring_samples, 0, 1000000, "an integer 0..1000000"));
+    uo.seed = static_cast<unsigned long long>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
+    const auto rows = classify(vehicles, cars, uo);
     JsonEnvelope e;
     e.command = "classify";
-    e.inputs = JsonObject().string("vehicles", source).json("ring", json_ring(cars)).str();
+    JsonObject inputs;
+    inputs.string("vehicles", source).json("ring", json_ring(cars));
+    for (const auto& r : rows)
+        if (r.has_uncertainty) {
+            inputs.integer("samples", uo.samples).integer("ring_samples", uo.ring_samples).integer("seed", static_cast<long long>(uo.seed));
+            break;
+        }
+    e.inputs = inputs.str();
     e.result = classification_json(rows, cars, source);
     Status status = Status::Converged;
     for (const auto& r : rows) {
         if (r.ring.status != Status::Converged) status = r.ring.status;
         if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
+        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) {
+            status = r.uncertainty.status;
+            std::cerr << "ddemap: classify: " << r.vehicle.name << ": probabilities undecided: " << r.uncertainty.message << "\n";
+        }
     }
     e.status = to_string(status);
     const std::string csv = classification_csv(rows);
