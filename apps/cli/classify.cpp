@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "tables.hpp"
+#include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/analysis/classify.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/io/csv.hpp"
@@ -27,7 +28,8 @@ struct Args {
 void add_classify_flags(CLI::App& app) {
     app.add_option("VEHICLES.csv", args.file,
                    "CSV with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m), optionally the covariance "
-                   "columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes (then the verdicts come with probabilities)");
+                   "columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes (then the verdicts come with probabilities, from samples "
+                   "of the parameters' normal distribution restricted to calibrate's default bounds of k1, k2, th, tau)");
     app.add_option("--samples", args.samples, "integer: parameter samples per vehicle with a covariance")->capture_default_str();
     app.add_option("--ring-samples", args.ring_samples, "integer: of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
         ->capture_default_str();
@@ -59,6 +61,9 @@ int run_classify() {
     }
     UncertaintyOptions uo;
     uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
+    // the calibration's search space; eta only >= 0 (no verdict depends on it, and fits often sit on its bound)
+    for (const auto& b : paper_calibration_bounds())
+        if (b.name != "eta") uo.domain.push_back(b);
     uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", args.ring_samples, 0, 1000000, "an integer 0..1000000"));
     uo.seed = static_cast<unsigned long long>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
     const auto rows = classify(vehicles, cars, uo);
@@ -86,7 +91,7 @@ int run_classify() {
     const std::string csv = classification_csv(rows);
     if (!prefix.empty() || !svg_file.empty()) {
         const ChartSpec base = parse_chart_spec(builtin_classification_toml, "maps/classification.toml");
-        const std::string svg = render_chart(classification_chart(base, vehicles, cars)).svg;
+        const std::string svg = render_chart(classification_chart(base, vehicles, cars, args.file)).svg;
         if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", svg}});
         else write_files_atomic({{svg_file, svg}});
     }

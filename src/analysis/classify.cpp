@@ -85,6 +85,9 @@ void UncertaintyOptions::validate() const {
     if (ring_samples < 0) throw std::invalid_argument("uncertainty ring_samples = " + std::to_string(ring_samples) + ": expected >= 0");
     if (!(level > 0.0 && level < 1.0))
         throw std::invalid_argument("uncertainty level = " + detail::format_number(level) + ": expected 0 < level < 1");
+    validate_bounds(domain, {"k1", "k2", "th", "tau", "eta"});
+    for (const auto& b : domain)
+        if (b.lower < 0.0) throw std::invalid_argument("uncertainty domain: " + b.name + " >= " + detail::format_number(b.lower) + ": expected a lower bound >= 0");
     if (max_draws_per_sample < 1)
         throw std::invalid_argument("uncertainty max_draws_per_sample = " + std::to_string(max_draws_per_sample) + ": expected >= 1");
 }
@@ -135,6 +138,21 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
     }
     const Eigen::Matrix<double, 5, 5> A = es.eigenvectors() * lam.cwiseSqrt().asDiagonal();
 
+    // unlisted: [0, inf), the model's domain
+    Eigen::Matrix<double, 5, 1> lo = Eigen::Matrix<double, 5, 1>::Zero(), hi;
+    hi.setConstant(std::numeric_limits<double>::infinity());
+    for (const auto& b : options.domain)
+        for (int i = 0; i < 5; ++i)
+            if (b.name == kNames[i]) {
+                lo[i] = b.lower;
+                hi[i] = b.upper;
+            }
+    std::string box;
+    for (int i = 0; i < 5; ++i)
+        if (std::isfinite(lo[i]) || std::isfinite(hi[i]))
+            box += std::string(box.empty() ? "" : ", ") + kNames[i] + " in [" + detail::format_number(lo[i]) + ", " +
+                   (std::isfinite(hi[i]) ? detail::format_number(hi[i]) + "]" : std::string("inf)"));
+
     VerdictUncertainty out;
     // draws on one thread in order, so the samples do not depend on the thread count
     NormalDraws normal(options.seed);
@@ -146,7 +164,7 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
         for (int i = 0; i < 5; ++i) z[i] = normal.next();
         const Eigen::Matrix<double, 5, 1> theta = mean + A * z;
         ++out.draws;
-        if ((theta.array() >= 0.0).all()) thetas.push_back(theta);
+        if ((theta.array() >= lo.array()).all() && (theta.array() <= hi.array()).all()) thetas.push_back(theta);
     }
     out.samples = static_cast<int>(thetas.size());
     out.verdicts.resize(thetas.size());
@@ -198,13 +216,13 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
         out.ring_unstable = probability_estimate(ring_unstable, static_cast<int>(abscissa.size()), options.level);
         out.ring_abscissa = interval(abscissa, options.level);
     }
-    out.message = std::to_string(out.samples) + " samples of N(theta, C) restricted to k1, k2, th, tau, eta >= 0 (" +
+    out.message = std::to_string(out.samples) + " samples of N(theta, C) restricted to " + box + " (" +
                   std::to_string(out.draws) + " draws, seed " + std::to_string(options.seed) + "), each classified exactly; the first " +
                   std::to_string(out.ring_samples) + " also as rings";
     if (out.samples < options.samples) {
         out.status = Status::BudgetExhausted;
         out.message = "only " + std::to_string(out.samples) + " of " + std::to_string(options.samples) + " samples in " +
-                      std::to_string(out.draws) + " draws fell inside k1, k2, th, tau, eta >= 0: the parameter distribution lies mostly outside the model's domain";
+                      std::to_string(out.draws) + " draws fell inside " + box + ": the parameter distribution lies mostly outside it (a parameter the data hardly determine)";
     }
     if (out.undecided > 0) {
         out.status = worse(out.status, Status::NumericalIssue);

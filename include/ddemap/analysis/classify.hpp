@@ -17,10 +17,15 @@ namespace ddemap {
 
 /// How the parameter uncertainty of a calibrated vehicle is propagated to its verdicts.
 struct UncertaintyOptions {
-    /// Parameter samples theta_j drawn from N(theta, C) restricted to the model's domain
-    /// (k1, k2, th, tau, eta >= 0; draws outside are rejected and redrawn). 4000 makes the
-    /// Wilson bound of a sure verdict 1 - 1.92/n ~ 0.9995, so it reads "p > 0.999".
+    /// Parameter samples theta_j drawn from N(theta, C) restricted to `domain` (draws outside
+    /// are rejected and redrawn). 4000 makes the Wilson bound of a sure verdict
+    /// 1 - 1.92/n ~ 0.9995, so it reads "p > 0.999".
     int samples = 4000;
+    /// The box the samples are restricted to, by name (k1, k2, th, tau, eta; a name not listed:
+    /// [0, inf), the model's domain). Set it to the calibration's bounds (e.g.
+    /// paper_calibration_bounds()) to sample the fit's own search space: a parameter the trace
+    /// hardly determines then cannot send samples to delays or gains far outside it.
+    ParameterBounds domain;
     /// The first `ring_samples` samples are classified as rings too (p_ring_unstable and the
     /// ring abscissa's interval); a ring verdict costs 30 (N = 22) to 400 (N = infinity) string
     /// verdicts, and 200 samples place the 2.5 % and 97.5 % quantiles of the abscissa well enough.
@@ -34,7 +39,8 @@ struct UncertaintyOptions {
     /// True when validate() would not throw.
     bool is_valid() const;
     /// Throws std::invalid_argument naming the option (samples >= 1, ring_samples >= 0,
-    /// 0 < level < 1, max_draws_per_sample >= 1).
+    /// 0 < level < 1, max_draws_per_sample >= 1, domain: names k1, k2, th, tau, eta, finite
+    /// bounds, 0 <= lower <= upper).
     void validate() const;
 };
 
@@ -88,7 +94,7 @@ struct VerdictUncertainty {
 
 /// Draws `options.samples` parameter vectors theta_j = theta + V sqrt(Lambda) z_j (C = V Lambda V^T,
 /// z_j standard normal; eigenvalues below 1e-12 max|Lambda| in magnitude are zero: a fixed or
-/// perfectly correlated parameter stays on its subspace), rejecting those outside the domain,
+/// perfectly correlated parameter stays on its subspace), rejecting those outside options.domain,
 /// and classifies each one exactly (OVRV, ring of `cars` cars, 0 = infinity), in parallel over
 /// the samples. std::invalid_argument when the covariance is not finite, not symmetric or
 /// has a negative eigenvalue beyond rounding, or when the options are invalid.
