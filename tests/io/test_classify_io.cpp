@@ -5,6 +5,7 @@
 #include <string>
 
 #include "ddemap/io/csv.hpp"
+#include "ddemap/io/figures.hpp"
 #include "ddemap/io/json.hpp"
 
 TEST_SUITE_BEGIN("fast");
@@ -67,4 +68,50 @@ TEST_CASE("classification outputs: probabilities and intervals only for vehicles
     const auto plain = classify({b}, 22, o);
     CHECK(classification_csv(plain).find("p_string_unstable") == std::string::npos);
     CHECK(classification_json(plain, 22, "x").find("p_string_unstable") == std::string::npos);
+}
+
+TEST_CASE("classification figure: window fitted to the user's vehicles, their ellipses, a legend of what is shown") {
+    const ChartSpec base = parse_chart_spec(
+        "title = \"t\"\nmodel = \"ovrv\"\nring = 22\ncolumns = 2\nvehicles = \"paper\"\n[x]\nname = \"k1\"\nlo = 0.002\nhi = 0.1\ncount = 9\n"
+        "[y]\nname = \"k2\"\nlo = 0.05\nhi = 0.8\ncount = 9\n",
+        "base.toml");
+    CalibratedVehicle a;
+    a.name = "mine";
+    a.parameters = {{"k1", 0.3}, {"k2", 0.6}, {"th", 1.5}, {"tau", 0.3}, {"eta", 8.0}};
+    a.covariance = Eigen::Matrix<double, 5, 5>::Zero();
+    a.covariance(0, 0) = 1e-3;
+    a.covariance(1, 1) = 4e-3;
+    a.covariance(0, 1) = a.covariance(1, 0) = 1e-3;
+    a.has_covariance = true;
+    CalibratedVehicle b = a;
+    b.name = "other";
+    b.parameters["k1"] = 0.5;
+    b.has_covariance = false;
+    const ChartSpec spec = classification_chart(base, {a, b}, 22, "fits.csv");
+    CHECK(spec.title.find("fits.csv") != std::string::npos);
+    // both vehicles and a's ellipse extent sqrt(5.991 C_ii) lie inside the fitted window
+    const double ex = std::sqrt(5.991464547107979 * 1e-3), ey = std::sqrt(5.991464547107979 * 4e-3);
+    CHECK(spec.x.lo <= 0.3 - ex);
+    CHECK(spec.x.hi >= 0.5);
+    CHECK(spec.y.lo <= 0.6 - ey);
+    CHECK(spec.y.hi >= 0.6 + ey);
+    CHECK(spec.x.lo > 0.0);
+    REQUIRE(spec.panels.size() == 2);
+    CHECK(spec.panels[0].markers[0].has_ellipse);
+    CHECK_FALSE(spec.panels[1].markers[0].has_ellipse);
+    const std::string svg = render_chart(spec).svg;
+    CHECK(svg.find("95 % confidence ellipse") != std::string::npos);
+    CHECK(svg.find("(outside)") == std::string::npos);
+    // the legend names only region classes and curves that the panels show: these settings are
+    // plant stable everywhere in the window (th = 1.5 s, tau = 0.3 s, k1, k2 > 0)
+    const RenderedChart r = render_chart(spec);
+    bool plant_unstable = false;
+    for (const auto& sw : r.sweeps)
+        for (const auto& p : sw.points) plant_unstable = plant_unstable || !p.plant_stable;
+    CHECK((svg.find(">plant unstable<") != std::string::npos) == plant_unstable);
+    CHECK(svg.find("k\u2081 [1/s\u00b2]") != std::string::npos);
+    // the paper's table (no source): the base window and title
+    const ChartSpec paper = classification_chart(base, {b}, 22);
+    CHECK(paper.x.lo == base.x.lo);
+    CHECK(paper.title == base.title);
 }
