@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "ddemap/io/svg.hpp"
 
@@ -59,7 +61,18 @@ std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& le
     }
     PlotOptions o;
     o.title = "Disturbance growth behind the '" + lead + "' lead profile (calibrated OVRV platoons)";
-    o.note = "black x: ACC disengages (speed below the minimum ACC speed); red x: gap reaches zero (collision); dashed: max setting";
+    // the note names only the marks the figure shows
+    bool disengage = false, collision = false, dashed = false;
+    for (const auto& r : g) {
+        disengage = disengage || (r.failed_at && r.failure != "collision");
+        collision = collision || (r.failed_at && r.failure == "collision");
+        dashed = dashed || r.name.find("max") != std::string::npos;
+    }
+    std::vector<std::string> notes;
+    if (disengage) notes.push_back("black x: ACC disengages (speed below the minimum ACC speed)");
+    if (collision) notes.push_back("red x: gap reaches zero (collision)");
+    if (dashed) notes.push_back("dashed: max setting");
+    for (std::size_t i = 0; i < notes.size(); ++i) o.note += (i ? "; " : "") + notes[i];
     return render_line_plots_svg({gap, amp}, o);
 }
 

@@ -470,7 +470,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     if (panels.empty()) throw std::invalid_argument("a plot needs at least one panel");
     const int cols = std::max(1, std::min<int>(o.columns, static_cast<int>(panels.size())));
     const int rows = (static_cast<int>(panels.size()) + cols - 1) / cols;
-    const double ml = 62, mr = 16, mt = 34, mb = 48;
+    const double ml = 70, mr = 18, mt = 36, mb = 54;  // type as in the charts: readable at a column width
     const double cw = o.panel_width + ml + mr, ch = o.panel_height + mt + mb;
     const double header = o.title.empty() ? 10 : 34;
     const double width = cols * cw + 10;
@@ -485,10 +485,10 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             ++i;
         }
     }
-    // one slot per entry, wide enough for the longest name (11 px text: about 6.5 px a character)
+    // one slot per entry, wide enough for the longest name (13 px text: about 7.8 px a character)
     std::size_t longest = 0;
     for (const auto& e : entries) longest = std::max(longest, e.first.size());
-    const double slot = std::max(150.0, 29.0 + 6.5 * static_cast<double>(longest) + 14.0);
+    const double slot = std::max(150.0, 29.0 + 7.8 * static_cast<double>(longest) + 14.0);
     const int per_row = std::max(1, static_cast<int>((width - 20) / slot));
     const double legend_h = entries.empty() ? 10 : 20.0 * ((entries.size() + per_row - 1) / per_row) + 12;
     const double note_h = o.note.empty() ? 0 : 20;
@@ -522,24 +522,24 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         auto Y = [&](double y) { return oy + ph - (y - y0) / (y1 - y0) * ph; };
         const std::string id = "plot" + std::to_string(pi + 1);
         s << "<g id=\"" << id << "\">\n";
-        s << "<text id=\"" << id << "-title\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy - 10) << "\" text-anchor=\"middle\" font-size=\"12\">"
+        s << "<text id=\"" << id << "-title\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy - 10) << "\" text-anchor=\"middle\" font-size=\"14\">"
           << esc(p.title) << "</text>\n";
-        s << "<g id=\"" << id << "-axes\" font-size=\"10\">\n";
+        s << "<g id=\"" << id << "-axes\" font-size=\"13\">\n";
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
           << "\" fill=\"none\" stroke=\"#000\"/>\n";
         for (double t = x0; t <= x1 + 1e-9 * sx; t += sx) {
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph)
               << "\" stroke=\"#e5e5e5\"/>\n";
-            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 15) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
+            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 18) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
         for (double t = y0; t <= y1 + 1e-9 * sy; t += sy) {
             s << "<line x1=\"" << num(ox) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox + pw) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#e5e5e5\"/>\n";
-            s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 3.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
+            s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 4.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
         }
-        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 34) << "\" text-anchor=\"middle\" font-size=\"12\">" << esc(p.x_label)
+        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 40) << "\" text-anchor=\"middle\" font-size=\"14\">" << esc(p.x_label)
           << "</text>\n";
-        s << "<text transform=\"translate(" << num(ox - 44) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"12\">"
+        s << "<text transform=\"translate(" << num(ox - 52) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"14\">"
           << esc(p.y_label) << "</text>\n";
         s << "</g>\n";
         s << "<g id=\"" << id << "-series\" fill=\"none\" stroke-width=\"1.4\" stroke-linejoin=\"round\">\n";
@@ -565,7 +565,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     }
     if (!entries.empty()) {
         const double ly = header + rows * ch + 4;
-        s << "<g id=\"legend\" font-size=\"11\">\n";
+        s << "<g id=\"legend\" font-size=\"13\">\n";
         for (std::size_t i = 0; i < entries.size(); ++i) {
             const double x = 10 + (i % per_row) * slot, y = ly + (i / per_row) * 20;
             s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7) << "\" x2=\"" << num(x + 24) << "\" y2=\"" << num(y + 7)
@@ -575,7 +575,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         s << "</g>\n";
     }
     if (!o.note.empty()) {
-        s << "<text id=\"note\" x=\"10\" y=\"" << num(height - 6) << "\" font-size=\"11\">" << esc(o.note) << "</text>\n";
+        s << "<text id=\"note\" x=\"10\" y=\"" << num(height - 6) << "\" font-size=\"13\">" << esc(o.note) << "</text>\n";
     }
     s << "</svg>\n";
     return s.str();
