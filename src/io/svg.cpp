@@ -258,14 +258,17 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         // changes along a cell edge the edge point is where that edge meets a continued boundary
         // curve (exact), else the zero of the failing condition's margin interpolated linearly
         const int nx = ax.count, ny = ay.count;
-        std::vector<std::array<double, 4>> segs;  // boundary curve segments in data coordinates
+        // boundary curve segments in data coordinates, with the lowest level whose set they bound
+        // (plant Hopf: 1, ring Hopf: 2, string: 3)
+        std::vector<std::array<double, 5>> segs;
         if (panel.boundaries)
             for (const auto& c : panel.boundaries->curves) {
+                const double lvl = c.kind == BoundaryKind::PlantHopf ? 1 : c.kind == BoundaryKind::RingHopf ? 2 : 3;
                 const std::size_t n = c.points.size();
                 for (std::size_t k = 0; k + 1 < n + (c.closed ? 1 : 0); ++k) {
                     const auto& a = c.points[k];
                     const auto& b = c.points[(k + 1) % n];
-                    segs.push_back({a.x, a.y, b.x, b.y});
+                    segs.push_back({a.x, a.y, b.x, b.y, lvl});
                 }
             }
         auto crossing = [&](int ia, int ja, int ib, int jb, int level) {
@@ -282,18 +285,19 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
             const double xa = ax.value(ia), ya = ay.value(ja), xb = ax.value(ib), yb = ay.value(jb);
             const double xi = a_in ? xa : xb, yi = a_in ? ya : yb, xo = a_in ? xb : xa, yo = a_in ? yb : ya;
             double px = xi + t * (xo - xi), py = yi + t * (yo - yi);
-            // snap to a continued curve crossing this edge (the nearest to the estimate)
-            double best = 1e300;
+            // snap to the first continued curve crossing this edge from the inside point among
+            // those that bound this level's set (its edge is where the first condition fails)
+            double best = 2.0;
             for (const auto& g : segs) {
+                if (g[4] > level) continue;
                 const double ex = xo - xi, ey = yo - yi, fx = g[2] - g[0], fy = g[3] - g[1];
                 const double den = ex * fy - ey * fx;
                 if (den == 0.0) continue;
                 const double u = ((g[0] - xi) * fy - (g[1] - yi) * fx) / den;
                 const double v = ((g[0] - xi) * ey - (g[1] - yi) * ex) / den;
                 if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) continue;
-                const double d = std::abs(u - t);
-                if (d < best) {
-                    best = d;
+                if (u < best) {
+                    best = u;
                     px = xi + u * ex;
                     py = yi + u * ey;
                 }
