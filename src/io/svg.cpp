@@ -185,7 +185,7 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         if (kind_shown[k]) items.push_back({1, k, curve_style(kinds[k]).name});
     if (any_marker) items.push_back({2, 0, "marked setting (k\u2081, k\u2082)"});
     if (any_ellipse) items.push_back({3, 0, "95 % confidence ellipse of (k\u2081, k\u2082)"});
-    if (any_outside) items.push_back({4, 0, "vehicle outside the window (at the edge)"});
+    if (any_outside) items.push_back({4, 0, "outside the window (at its edge)"});
     std::vector<std::pair<double, double>> item_pos;
     double lx = 10, ly_rel = 0;
     for (const auto& it : items) {

@@ -115,3 +115,15 @@ TEST_CASE("classification figure: window fitted to the user's vehicles, their el
     CHECK(paper.x.lo == base.x.lo);
     CHECK(paper.title == base.title);
 }
+
+TEST_CASE("chart markers outside the window are flagged at its edge, not drawn outside the panel") {
+    const ChartSpec spec = parse_chart_spec(
+        "model = \"ovrv\"\nring = 22\n[x]\nname = \"k1\"\nlo = 0.05\nhi = 0.5\ncount = 7\n"
+        "[y]\nname = \"k2\"\nlo = 0.05\nhi = 0.8\ncount = 7\n[[panel]]\nth = 1.5\ntau = 0.3\n[[panel.marker]]\nk1 = 0.9\nk2 = 0.3\nlabel = \"far\"\n"
+        "[[panel.marker]]\nk1 = 0.2\nk2 = 0.3\nlabel = \"near\"\n",
+        "outside.toml");
+    const std::string svg = render_chart(spec).svg;
+    CHECK(svg.find("far (outside)") != std::string::npos);
+    CHECK(svg.find("near (outside)") == std::string::npos);
+    CHECK(svg.find("outside the window") != std::string::npos);  // and the legend says what the mark means
+}
