@@ -71,4 +71,14 @@ constexpr double special_point = 1e-8;
 /// last printed digit is at most 5e-6 (values < 1) or 5e-5 (values in [1, 10)), relative 5e-5.
 constexpr double published_5_digits_rel = 5e-5;
 
+/// A Monte Carlo estimate against its exact value, in units of the estimate's own standard
+/// error: |estimate - exact| <= 4.5 SE fails by chance with probability 7e-6 (normal tails), so
+/// a pass is not luck, while a bias of a few standard errors (a wrong sampler) fails.
+constexpr double monte_carlo_sigmas = 4.5;
+/// Fraction of independent seeds whose 95 % Wilson interval must cover the exact probability:
+/// nominal 0.95; with 20 seeds the chance of fewer than 16 covering is 2.6e-3 for a correct
+/// interval (binomial), while an interval half as wide as it should be covers ~68 % and then
+/// fails with probability 0.82.
+constexpr double wilson_coverage_min = 0.8;
+
 }  // namespace ddemap::test::tol

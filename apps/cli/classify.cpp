@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "tables.hpp"
+#include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/analysis/classify.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/io/csv.hpp"
@@ -17,7 +18,7 @@ namespace ddemap::cli {
 
 namespace {
 struct Args {
-    std::string file, svg;
+    std::string file, svg, samples = "4000", ring_samples = "200", seed = "1";
     RingArg ring;
     FormatArg format;
     OutArg out;
@@ -27,8 +28,14 @@ struct Args {
 void add_classify_flags(CLI::App& app) {
     app.add_option("VEHICLES", args.file,
                    "the vehicles: a CSV file with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m; other columns ignored, "
-                   "so calibrate's output works), a fleet table of ovrv cars (as roots --fleet), or built-in names \"A_min,E_max\"")
+                   "so calibrate's output works), a fleet table of ovrv cars (as roots --fleet), or built-in names \"A_min,E_max\"; with the "
+                   "covariance columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes the verdicts come with probabilities, from samples "
+                   "of the parameters' normal distribution restricted to calibrate's default bounds of k1, k2, th, tau")
         ->type_name("FILE|PATTERN");
+    app.add_option("--samples", args.samples, "parameter samples per vehicle with a covariance")->capture_default_str();
+    app.add_option("--ring-samples", args.ring_samples, "of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
+        ->capture_default_str();
+    app.add_option("--seed", args.seed, "seed of the parameter samples")->capture_default_str();
     args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
@@ -50,21 +57,39 @@ int run_classify() {
         vehicles = vehicles_argument("VEHICLES", args.file);
         source = args.file;
     }
-    const auto rows = classify(vehicles, cars);
+    UncertaintyOptions uo;
+    uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
+    // the calibration's search space; eta only >= 0 (no verdict depends on it, and fits often sit on its bound)
+    for (const auto& b : paper_calibration_bounds())
+        if (b.name != "eta") uo.domain.push_back(b);
+    uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", args.ring_samples, 0, 1000000, "an integer 0..1000000"));
+    uo.seed = static_cast<unsigned long long>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
+    const auto rows = classify(vehicles, cars, uo);
     JsonEnvelope e;
     e.command = "classify";
-    e.inputs = JsonObject().string("vehicles", source).json("ring", json_ring(cars)).str();
+    JsonObject inputs;
+    inputs.string("vehicles", source).json("ring", json_ring(cars));
+    for (const auto& r : rows)
+        if (r.has_uncertainty) {
+            inputs.integer("samples", uo.samples).integer("ring_samples", uo.ring_samples).integer("seed", static_cast<long long>(uo.seed));
+            break;
+        }
+    e.inputs = inputs.str();
     e.result = classification_json(rows, cars, source);
     Status status = Status::Converged;
     for (const auto& r : rows) {
         if (r.ring.status != Status::Converged) status = r.ring.status;
         if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
+        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) {
+            status = r.uncertainty.status;
+            std::cerr << "ddemap: classify: " << r.vehicle.name << ": probabilities undecided: " << r.uncertainty.message << "\n";
+        }
     }
     e.status = to_string(status);
     const std::string csv = classification_csv(rows);
     if (!prefix.empty() || !svg_file.empty()) {
         const ChartSpec base = parse_chart_spec(builtin_classification_toml, "maps/classification.toml");
-        const std::string svg = render_chart(classification_chart(base, vehicles, cars)).svg;
+        const std::string svg = render_chart(classification_chart(base, vehicles, cars, args.file)).svg;
         if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", svg}});
         else write_files_atomic({{svg_file, svg}});
     }

@@ -1,5 +1,7 @@
 #include "sweep_flags.hpp"
 
+#include "ddemap/io/svg.hpp"
+
 #include <algorithm>
 #include <sstream>
 
@@ -35,8 +37,14 @@ SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::str
 
 std::string fixed_title(const SweepSpec& spec) {
     std::ostringstream t;
+    // figure titles: parameter symbols with their units (k₁ [1/s²] -> "k₁ = 0.2 1/s²")
     t << spec.model;
-    for (const auto& [k, v] : spec.fixed) t << ", " << k << " = " << rounded(v, 4);
+    for (const auto& [k, v] : spec.fixed) {
+        std::string unit;
+        for (const auto& ps : model_parameters(spec.model))
+            if (ps.name == k && ps.unit != "1") unit = " " + unit_text(ps.unit);
+        t << ", " << parameter_symbol(k) << " = " << rounded(v, 4) << unit;
+    }
     t << ", N = " << ring_name(spec.cars);
     return t.str();
 }

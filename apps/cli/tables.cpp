@@ -1,5 +1,6 @@
 #include "tables.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -27,7 +28,45 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
                       row.string.lowfreq_margin);
         out << line;
     }
+    bool any = false;
+    for (const auto& row : rows) any = any || row.has_uncertainty;
+    if (!any) return out.str();
+    out << "\nverdicts under the calibration's parameter uncertainty (p: probability of string instability, "
+        << "Wilson 95 % bounds when every sample agrees, else p -+ its Monte Carlo standard error; margins: 95 % intervals)\n";
+    for (const auto& row : rows) {
+        out << row.vehicle.name << ": ";
+        if (!row.has_uncertainty) {
+            out << "no covariance given\n";
+            continue;
+        }
+        const VerdictUncertainty& u = row.uncertainty;
+        out << "string " << (row.string.string_stable ? "stable" : "UNSTABLE") << " (" << probability_text(u.string_unstable) << ")";
+        if (u.ring_unstable.trials > 0)
+            out << ", ring " << (row.ring.stable ? "stable" : "UNSTABLE") << " (" << probability_text(u.ring_unstable) << ")";
+        if (u.string_unstable.trials > 0) {
+            out << "; 95 % intervals: c2 [" << rounded(u.c2.lower, 3) << ", " << rounded(u.c2.upper, 3) << "] 1/s^2, sup|Gamma|-1 ["
+                << rounded(u.sup_gamma_excess.lower, 3) << ", " << rounded(u.sup_gamma_excess.upper, 3) << "]";
+            if (u.ring_unstable.trials > 0)
+                out << ", ring abscissa [" << rounded(u.ring_abscissa.lower, 3) << ", " << rounded(u.ring_abscissa.upper, 3) << "] 1/s";
+        }
+        out << "; " << u.samples << " samples (" << u.ring_samples << " as rings)";
+        if (u.status != Status::Converged) out << "; UNDECIDED: " << u.message;
+        out << "\n";
+    }
     return out.str();
+}
+
+std::string probability_text(const ProbabilityEstimate& e) {
+    if (e.trials == 0) return "p undecided";
+    char b[64];
+    if (e.successes == e.trials) {
+        std::snprintf(b, sizeof b, "p > %.3f", std::floor(e.lower * 1000.0) / 1000.0);
+    } else if (e.successes == 0) {
+        std::snprintf(b, sizeof b, "p < %.3f", std::ceil(e.upper * 1000.0) / 1000.0);
+    } else {
+        std::snprintf(b, sizeof b, "p = %.3f +- %.3f", e.p, e.standard_error);
+    }
+    return b;
 }
 
 std::string growth_table(const std::vector<GrowthResult>& g) {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -26,9 +27,9 @@ double number(const std::string& source, const toml::node& n, const std::string&
     throw std::invalid_argument(where(source, n) + ": " + key + ": expected a number");
 }
 
-std::string short_number(double v) {
+std::string short_number(double v) {  // 4 significant digits: a title, not data
     std::ostringstream os;
-    os << v;
+    os << std::setprecision(4) << v;
     return os.str();
 }
 
@@ -70,10 +71,21 @@ std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehi
     for (const auto& v : vehicles) {
         PanelSpec p;
         const auto& q = v.parameters;
-        p.title = v.name + ": tau = " + short_number(q.at("tau")) + " s, th = " + short_number(q.at("th")) + " s";
+        p.title = v.name + ": " + parameter_symbol("tau") + " = " + short_number(q.at("tau")) + " s, " + parameter_symbol("th") + " = " +
+                  short_number(q.at("th")) + " s";
         for (const char* k : {"tau", "th", "eta"})
             if (q.count(k)) p.parameters[k] = q.at(k);
-        p.markers.push_back({q.at("k1"), q.at("k2"), v.name});
+        ChartMarker m;
+        m.x = q.at("k1");
+        m.y = q.at("k2");
+        m.label = v.name;
+        if (v.has_covariance) {  // the (k1, k2) block of the calibration's covariance
+            m.has_ellipse = true;
+            m.cov_xx = v.covariance(0, 0);
+            m.cov_xy = v.covariance(0, 1);
+            m.cov_yy = v.covariance(1, 1);
+        }
+        p.markers.push_back(m);
         panels.push_back(p);
     }
     return panels;
@@ -190,8 +202,8 @@ RenderedChart render_chart(const ChartSpec& spec) {
             for (const auto& [k, v] : spec.panels[i].parameters) {
                 std::string unit;
                 for (const auto& ps : model_parameters(spec.model))
-                    if (ps.name == k && ps.unit != "1") unit = " " + ps.unit;
-                title += (title.empty() ? "" : ", ") + k + " = " + short_number(v) + unit;
+                    if (ps.name == k && ps.unit != "1") unit = " " + unit_text(ps.unit);
+                title += (title.empty() ? "" : ", ") + parameter_symbol(k) + " = " + short_number(v) + unit;
             }
         }
         panels[i].title = title;

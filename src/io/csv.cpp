@@ -1,5 +1,7 @@
 #include "ddemap/io/csv.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -112,14 +114,32 @@ std::string string_csv(const StringResult& s, const RingResult* ring) {
 std::string classification_csv(const std::vector<Classification>& rows) {
     std::ostringstream out;
     out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
-           "spectral_abscissa,plant_abscissa\n";
+           "spectral_abscissa,plant_abscissa";
+    // the verdicts under parameter uncertainty, only when a vehicle carries a covariance
+    const bool any = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.has_uncertainty; });
+    if (any)
+        out << ",p_string_unstable,p_string_unstable_se,p_string_unstable_lower,p_string_unstable_upper,c2_lower,c2_upper,"
+               "sup_gamma_minus_1_lower,sup_gamma_minus_1_upper,spectral_abscissa_lower,spectral_abscissa_upper,samples";
+    out << "\n";
     for (const auto& row : rows) {
         out << csv_field(row.vehicle.name);
         for (const char* k : {"k1", "k2", "th", "tau", "eta"}) out << "," << format_exact(row.vehicle.parameters.at(k));
         out << "," << tf(row.string.plant_stable) << "," << tf(row.ring.stable) << "," << tf(row.string.string_stable) << ","
             << format_exact(row.string.sup_gamma) << "," << format_exact(row.string.omega_peak) << ","
             << format_exact(row.string.lowfreq_margin) << "," << format_exact(row.ring.spectral_abscissa) << ","
-            << format_exact(row.string.plant_abscissa) << "\n";
+            << format_exact(row.string.plant_abscissa);
+        if (any && row.has_uncertainty) {
+            const VerdictUncertainty& u = row.uncertainty;
+            for (double v : {u.string_unstable.p, u.string_unstable.standard_error, u.string_unstable.lower, u.string_unstable.upper,
+                             u.c2.lower, u.c2.upper, u.sup_gamma_excess.lower, u.sup_gamma_excess.upper})
+                out << "," << format_exact(v);
+            if (u.ring_unstable.trials > 0) out << "," << format_exact(u.ring_abscissa.lower) << "," << format_exact(u.ring_abscissa.upper);
+            else out << ",,";
+            out << "," << u.samples;
+        } else if (any) {
+            out << ",,,,,,,,,,,";
+        }
+        out << "\n";
     }
     return out.str();
 }
@@ -155,7 +175,11 @@ std::string growth_csv(const std::vector<GrowthResult>& g) {
 std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits) {
     std::ostringstream csv;
     csv << "name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,"
-           "naive_rmse_speed,status\n";
+           "naive_rmse_speed,status";
+    // the covariance (upper triangle, the columns `classify` reads); empty cells when the trace
+    // does not determine a parameter (an infinite standard error: the covariance understates it)
+    for (const auto& c : covariance_column_names()) csv << "," << c;
+    csv << "\n";
     for (std::size_t i = 0; i < fits.size(); ++i) {
         const auto& r = fits[i];
         csv << csv_field(i < names.size() ? names[i] : std::string());
@@ -164,7 +188,12 @@ std::string calibration_csv(const std::vector<std::string>& names, const std::ve
             << "," << format_exact(r.train.rmse_gap) << ",";
         if (r.test.samples > 0) csv << format_exact(r.test.rmse_speed) << "," << format_exact(r.test.rmse_gap);
         else csv << ",";
-        csv << "," << format_exact(r.naive.rmse_speed) << "," << r.status << "\n";
+        csv << "," << format_exact(r.naive.rmse_speed) << "," << r.status;
+        bool determined = r.covariance.allFinite();
+        for (const auto& e : r.estimates) determined = determined && std::isfinite(e.standard_error);
+        for (int a = 0; a < 5; ++a)
+            for (int b = a; b < 5; ++b) csv << "," << (determined ? format_exact(r.covariance(a, b)) : std::string());
+        csv << "\n";
     }
     return csv.str();
 }

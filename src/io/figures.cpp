@@ -1,7 +1,10 @@
 #include "ddemap/io/figures.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "ddemap/io/svg.hpp"
 
@@ -58,7 +61,18 @@ std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& le
     }
     PlotOptions o;
     o.title = "Disturbance growth behind the '" + lead + "' lead profile (calibrated OVRV platoons)";
-    o.note = "black x: ACC disengages (speed below the minimum ACC speed); red x: gap reaches zero (collision); dashed: max setting";
+    // the note names only the marks the figure shows
+    bool disengage = false, collision = false, dashed = false;
+    for (const auto& r : g) {
+        disengage = disengage || (r.failed_at && r.failure != "collision");
+        collision = collision || (r.failed_at && r.failure == "collision");
+        dashed = dashed || r.name.find("max") != std::string::npos;
+    }
+    std::vector<std::string> notes;
+    if (disengage) notes.push_back("black x: ACC disengages (speed below the minimum ACC speed)");
+    if (collision) notes.push_back("red x: gap reaches zero (collision)");
+    if (dashed) notes.push_back("dashed: max setting");
+    for (std::size_t i = 0; i < notes.size(); ++i) o.note += (i ? "; " : "") + notes[i];
     return render_line_plots_svg({gap, amp}, o);
 }
 
@@ -116,12 +130,61 @@ std::string mix_svg(const std::vector<MixPoint>& pts, const MixOptions& o, const
     return render_line_plots_svg({panel}, po);
 }
 
-ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars) {
+ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars, const std::string& source) {
     ChartSpec spec = base;
     spec.panels = vehicle_panels(vehicles);
     spec.cars = cars;
-    if (cars != 22)
-        spec.title = "Calibrated vehicles on their own stability charts, N = " + (cars == 0 ? std::string("inf") : std::to_string(cars));
+    const std::string ring = cars == 0 ? std::string("an infinite ring") : "a ring of " + std::to_string(cars) + " cars";
+    if (!source.empty()) {
+        spec.title = "Vehicles of " + source + " on their own stability charts, " + ring;
+        // the window: every vehicle's (k1, k2), and its 95 % ellipse's extent sqrt(5.991 C_ii)
+        // where that is at most half the vehicles' spread (or half the value, for one vehicle):
+        // a parameter the trace hardly determines would otherwise shrink every vehicle to a dot
+        // (its ellipse is clipped at the window); widened by 12 % of the span on each side and
+        // kept above 2 % of its upper end (k1, k2 > 0)
+        double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+        for (const auto& v : vehicles) {
+            x0 = std::min(x0, v.parameters.at("k1"));
+            x1 = std::max(x1, v.parameters.at("k1"));
+            y0 = std::min(y0, v.parameters.at("k2"));
+            y1 = std::max(y1, v.parameters.at("k2"));
+        }
+        const double sx = x1 - x0, sy = y1 - y0;
+        for (const auto& v : vehicles) {
+            if (!v.has_covariance) continue;
+            const double k1 = v.parameters.at("k1"), k2 = v.parameters.at("k2");
+            const double ex = std::sqrt(5.991464547107979 * std::max(0.0, v.covariance(0, 0)));
+            const double ey = std::sqrt(5.991464547107979 * std::max(0.0, v.covariance(1, 1)));
+            if (ex <= 0.5 * std::max(sx, std::abs(k1))) {
+                x0 = std::min(x0, k1 - ex);
+                x1 = std::max(x1, k1 + ex);
+            }
+            if (ey <= 0.5 * std::max(sy, std::abs(k2))) {
+                y0 = std::min(y0, k2 - ey);
+                y1 = std::max(y1, k2 + ey);
+            }
+        }
+        // (but never above half the smallest vehicle's value, so every vehicle is inside)
+        auto widen = [](double& lo, double& hi, double smallest) {
+            const double span = hi - lo > 0.0 ? hi - lo : std::max(0.5 * std::abs(hi), 0.01);
+            lo -= 0.12 * span;
+            hi += 0.12 * span;
+            lo = std::max(lo, std::min(0.02 * hi, 0.5 * smallest));
+        };
+        double kx = 1e300, ky = 1e300;
+        for (const auto& v : vehicles) {
+            kx = std::min(kx, v.parameters.at("k1"));
+            ky = std::min(ky, v.parameters.at("k2"));
+        }
+        widen(x0, x1, kx);
+        widen(y0, y1, ky);
+        spec.x.lo = x0;
+        spec.x.hi = x1;
+        spec.y.lo = y0;
+        spec.y.hi = y1;
+    } else if (cars != 22) {
+        spec.title = "Calibrated vehicles on their own stability charts, " + ring;
+    }
     return spec;
 }
 

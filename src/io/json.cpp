@@ -269,6 +269,30 @@ std::string classification_json(const std::vector<Classification>& rows, int car
         o["lowfreq_margin"] = num(row.string.lowfreq_margin);
         o["spectral_abscissa"] = num(row.ring.spectral_abscissa);
         o["plant_abscissa"] = num(row.string.plant_abscissa);
+        if (row.has_uncertainty) {
+            // the verdicts under the calibration's parameter uncertainty (classify_with_uncertainty)
+            const VerdictUncertainty& u = row.uncertainty;
+            auto prob = [](const ProbabilityEstimate& e) {
+                return json{{"p", num(e.p)}, {"standard_error", num(e.standard_error)}, {"wilson", {num(e.lower), num(e.upper)}},
+                            {"count", e.successes}, {"samples", e.trials}};
+            };
+            auto range = [](const MarginInterval& m) { return json{num(m.lower), num(m.upper)}; };
+            o["p_string_unstable"] = num(u.string_unstable.p);
+            const bool ring = u.ring_unstable.trials > 0;
+            o["margin_intervals"] = {{"c2", range(u.c2)}, {"sup_gamma_minus_1", range(u.sup_gamma_excess)},
+                                     {"spectral_abscissa", ring ? range(u.ring_abscissa) : json(nullptr)}};
+            o["uncertainty"] = {{"samples", u.samples},
+                                {"draws", u.draws},
+                                {"ring_samples", u.ring_samples},
+                                {"undecided", u.undecided},
+                                {"string_unstable", prob(u.string_unstable)},
+                                {"ring_unstable", ring ? prob(u.ring_unstable) : json(nullptr)},
+                                {"plant_unstable", prob(u.plant_unstable)},
+                                {"medians", {{"c2", num(u.c2.median)}, {"sup_gamma_minus_1", num(u.sup_gamma_excess.median)},
+                                             {"spectral_abscissa", ring ? num(u.ring_abscissa.median) : json(nullptr)}}},
+                                {"status", to_string(u.status)},
+                                {"message", u.message}};
+        }
         arr.push_back(o);
     }
     j["vehicles"] = arr;

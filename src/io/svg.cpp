@@ -1,6 +1,7 @@
 #include "ddemap/io/svg.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -70,8 +71,8 @@ Style curve_style(BoundaryKind k) {
     switch (k) {
         case BoundaryKind::PlantHopf: return {"#67001f", "", 2.2, "plant Hopf boundary"};
         case BoundaryKind::RingHopf: return {"#000000", "", 1.2, "ring Hopf boundary (mode crossing)"};
-        case BoundaryKind::LowFrequency: return {"#08519c", "6,3", 1.8, "string boundary, low frequency (c2 = 0)"};
-        case BoundaryKind::Peak: return {"#6a3d9a", "2,2", 1.8, "string boundary, |Gamma| peak = 1"};
+        case BoundaryKind::LowFrequency: return {"#08519c", "6,3", 1.8, "string boundary, low frequency (c\u2082 = 0)"};
+        case BoundaryKind::Peak: return {"#6a3d9a", "2,2", 1.8, "string boundary, peak of |\u0393(i\u03c9)| = 1"};
     }
     return {"#000", "", 1.0, ""};
 }
@@ -85,11 +86,57 @@ int region_class(const SweepPoint& p) {
     return 3;
 }
 
+std::string parameter_symbol(const std::string& name) {
+    static const std::pair<const char*, const char*> symbols[] = {
+        {"k1", "k\u2081"}, {"k2", "k\u2082"}, {"k3", "k\u2083"}, {"tau", "\u03c4"}, {"tau2", "\u03c4\u2082"},
+        {"th", "t\u2095"}, {"eta", "\u03b7"}, {"alpha", "\u03b1"}, {"beta", "\u03b2"}, {"delta", "\u03b4"}};
+    for (const auto& [n, sym] : symbols)
+        if (name == n) return sym;
+    return name;
+}
+
+std::string unit_text(const std::string& unit) {
+    std::string u = unit;
+    for (const auto& [from, to] : {std::pair<std::string, std::string>{"^2", "\u00b2"}, {"^3", "\u00b3"}, {"^-1", "\u207b\u00b9"}}) {
+        for (std::size_t at = u.find(from); at != std::string::npos; at = u.find(from)) u.replace(at, from.size(), to);
+    }
+    return u;
+}
+
 std::string axis_label(const std::string& model, const std::string& parameter) {
     for (const auto& s : model_parameters(model))
-        if (s.name == parameter) return parameter + " [" + s.unit + "]";
-    return parameter;
+        if (s.name == parameter) return parameter_symbol(parameter) + (s.unit == "1" ? std::string(" [1]") : " [" + unit_text(s.unit) + "]");
+    return parameter_symbol(parameter);
 }
+
+namespace {
+
+/// Approximate advance of `text` in px at `size` px in DejaVu Sans (0.62 em a character;
+/// multi-byte UTF-8 sequences count once).
+double text_width(const std::string& text, double size) {
+    std::size_t chars = 0;
+    for (unsigned char c : text) chars += (c & 0xC0) != 0x80 ? 1 : 0;
+    return 0.62 * size * static_cast<double>(chars);
+}
+
+/// The largest font size <= `size` (and >= `min_size`) at which `text` fits `width`.
+double fitted_size(const std::string& text, double size, double width, double min_size) {
+    const double w = text_width(text, size);
+    return w <= width ? size : std::max(min_size, size * width / w);
+}
+
+/// Margin whose sign decides the region boundary crossed between two grid points, for the
+/// condition that fails at `out` (region_class(out) = 0 plant, 1 ring, 2 string): positive
+/// where the condition holds.
+double condition_margin(const SweepPoint& p, int condition, bool lowfreq) {
+    switch (condition) {
+        case 0: return -p.plant_abscissa;
+        case 1: return -p.spectral_abscissa;
+        default: return lowfreq ? p.lowfreq_margin : 1.0 - p.peak_gain;
+    }
+}
+
+}  // namespace
 
 std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartOptions& o) {
     if (panels.empty()) throw std::invalid_argument("a chart needs at least one panel");
@@ -97,18 +144,69 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         if (p.sweep == nullptr) throw std::invalid_argument("a chart panel needs a sweep");
     const int cols = std::max(1, std::min<int>(o.columns, static_cast<int>(panels.size())));
     const int rows = (static_cast<int>(panels.size()) + cols - 1) / cols;
-    const double ml = 62, mr = 16, mt = 34, mb = 48;  // margins around each plot area
+    // type sizes [px]: readable when the figure is set at a journal's text width (a 1100 px wide
+    // figure at 174 mm puts 13 px at 5.8 pt, 14 px at 6.2 pt)
+    const double f_tick = 13, f_label = 14, f_title = 14, f_legend = 14, f_head = 17;
+    const double ml = 70, mr = 18, mt = 46, mb = 54;  // margins around each plot area (two title lines fit above)
     const double cw = o.panel_width + ml + mr, ch = o.panel_height + mt + mb;
-    const double header = o.title.empty() ? 10 : 34;
     const double width = cols * cw + 10;
-    // legend rows: 4 swatches and 4 line styles, about 150 and 260 px each
-    const int per_row_regions = std::max(1, static_cast<int>((width - 20) / 150));
-    const int per_row_lines = std::max(1, static_cast<int>((width - 20) / 280));
-    const double legend_h = 20.0 * ((4 + per_row_regions - 1) / per_row_regions + (4 + per_row_lines - 1) / per_row_lines) + 22;
+    const double head_size = fitted_size(o.title, f_head, width - 20, 10);
+    const double header = o.title.empty() ? 10 : 40;
+
+    // what the figure shows: region classes (grid points), boundary kinds, markers, ellipses
+    bool class_shown[4] = {false, false, false, false};
+    bool kind_shown[4] = {false, false, false, false};
+    bool any_marker = false, any_ellipse = false, any_outside = false;
+    const BoundaryKind kinds[4] = {BoundaryKind::RingHopf, BoundaryKind::PlantHopf, BoundaryKind::LowFrequency, BoundaryKind::Peak};
+    for (const auto& panel : panels) {
+        for (const auto& pt : panel.sweep->points) class_shown[region_class(pt)] = true;
+        if (panel.boundaries)
+            for (const auto& c : panel.boundaries->curves)
+                for (int k = 0; k < 4; ++k) kind_shown[k] = kind_shown[k] || (c.kind == kinds[k] && c.points.size() >= 2);
+        const Axis& ax = panel.sweep->spec.x;
+        const Axis& ay = panel.sweep->spec.y;
+        for (const auto& m : panel.markers) {
+            any_marker = true;
+            any_ellipse = any_ellipse || m.has_ellipse;
+            any_outside = any_outside || !(m.x >= ax.lo && m.x <= ax.hi && m.y >= ay.lo && m.y <= ay.hi);
+        }
+    }
+    // legend items, wrapped to the figure width
+    struct Item {
+        int type;  // 0 swatch, 1 line, 2 marker, 3 ellipse, 4 outside marker
+        int index;
+        std::string text;
+    };
+    std::vector<Item> items;
+    for (int c = 3; c >= 0; --c)
+        if (class_shown[c]) items.push_back({0, c, region_name[c]});
+    for (int k = 0; k < 4; ++k)
+        if (kind_shown[k]) items.push_back({1, k, curve_style(kinds[k]).name});
+    if (any_marker) items.push_back({2, 0, "marked setting (k\u2081, k\u2082)"});
+    if (any_ellipse) items.push_back({3, 0, "95 % confidence ellipse of (k\u2081, k\u2082)"});
+    if (any_outside) items.push_back({4, 0, "outside the window (at its edge)"});
+    std::vector<std::pair<double, double>> item_pos;
+    double lx = 10, ly_rel = 0;
+    for (const auto& it : items) {
+        const double w = 36 + text_width(it.text, f_legend);
+        if (lx + w > width - 10 && lx > 10) {
+            lx = 10;
+            ly_rel += 24;
+        }
+        item_pos.emplace_back(lx, ly_rel);
+        lx += w + 20;
+    }
+    const double legend_h = items.empty() ? 10 : ly_rel + 24 + 16;
     const double height = header + rows * ch + legend_h;
 
     std::ostringstream s;
-    svg_preamble(s, width, height, o.title);
+    s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" viewBox=\"0 0 "
+      << num(width) << " " << num(height) << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
+    s << "<rect id=\"background\" x=\"0\" y=\"0\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" fill=\"#ffffff\"/>\n";
+    if (!o.title.empty())
+        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"26\" text-anchor=\"middle\" font-size=\"" << num(head_size)
+          << "\" font-weight=\"bold\">" << esc(o.title) << "</text>\n";
     for (std::size_t pi = 0; pi < panels.size(); ++pi) {
         const ChartPanel& panel = panels[pi];
         const SweepResult& sw = *panel.sweep;
@@ -120,25 +218,130 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         auto Y = [&](double y) { return oy + ph - (y - ay.lo) / (ay.hi - ay.lo) * ph; };
         const std::string id = "panel" + std::to_string(pi + 1);
         s << "<g id=\"" << id << "\">\n";
-        s << "<text id=\"" << id << "-title\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy - 10)
-          << "\" text-anchor=\"middle\" font-size=\"12\">" << esc(panel.title) << "</text>\n";
+        // the panel title on one line; too wide, on two (split after "NAME:"), each shortened in
+        // the middle with an ellipsis if it still does not fit
+        {
+            std::vector<std::string> lines{panel.title};
+            const std::size_t colon = panel.title.find(": ");
+            const double room = o.panel_width + 2 * mr;  // centred over the plot area
+            if (text_width(panel.title, f_title) > room && colon != std::string::npos)
+                lines = {panel.title.substr(0, colon + 1), panel.title.substr(colon + 2)};
+            for (std::size_t li = 0; li < lines.size(); ++li) {
+                const double size = fitted_size(lines[li], f_title, room, 11);
+                const auto glyphs = [](const std::string& t) {
+                    std::vector<std::string> g;
+                    for (unsigned char c : t)
+                        if ((c & 0xC0) != 0x80 || g.empty()) g.emplace_back(1, static_cast<char>(c));
+                        else g.back() += static_cast<char>(c);
+                    return g;
+                };
+                std::vector<std::string> g = glyphs(lines[li]);
+                const auto fit = static_cast<std::size_t>(room / (0.62 * size));
+                if (g.size() > fit && fit > 4) {
+                    const std::size_t keep = fit - 1, head = keep / 2;
+                    std::string t;
+                    for (std::size_t k = 0; k < head; ++k) t += g[k];
+                    t += "\u2026";
+                    for (std::size_t k = g.size() - (keep - head); k < g.size(); ++k) t += g[k];
+                    lines[li] = t;
+                }
+                const double y = oy - 12 - (lines.size() - 1 - li) * (size + 3);
+                s << "<text id=\"" << id << "-title" << (li ? "2" : "") << "\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(y)
+                  << "\" text-anchor=\"middle\" font-size=\"" << num(size) << "\">" << esc(lines[li]) << "</text>\n";
+            }
+        }
         s << "<clipPath id=\"" << id << "-clip\"><rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw)
           << "\" height=\"" << num(ph) << "\"/></clipPath>\n";
-        // regions: run-length rectangles per grid row, each cell centred on its grid point
-        s << "<g id=\"" << id << "-regions\" clip-path=\"url(#" << id << "-clip)\" shape-rendering=\"crispEdges\">\n";
+        // regions, filled up to the boundaries: for each level c = 1, 2, 3 the set {class >= c}
+        // (marching squares over the grid cells) painted over the level below; where the class
+        // changes along a cell edge the edge point is where that edge meets a continued boundary
+        // curve (exact), else the zero of the failing condition's margin interpolated linearly
         const int nx = ax.count, ny = ay.count;
-        const double dx = (ax.hi - ax.lo) / (nx - 1), dy = (ay.hi - ay.lo) / (ny - 1);
-        for (int iy = 0; iy < ny; ++iy) {
-            int start = 0;
-            for (int ix = 1; ix <= nx; ++ix) {
-                const int c0 = region_class(sw.at(start, iy));
-                if (ix < nx && region_class(sw.at(ix, iy)) == c0) continue;
-                const double x0 = std::max(ax.lo, ax.value(start) - dx / 2), x1 = std::min(ax.hi, ax.value(ix - 1) + dx / 2);
-                const double y0 = std::max(ay.lo, ay.value(iy) - dy / 2), y1 = std::min(ay.hi, ay.value(iy) + dy / 2);
-                s << "<rect x=\"" << num(X(x0)) << "\" y=\"" << num(Y(y1)) << "\" width=\"" << num(X(x1) - X(x0) + 0.3)
-                  << "\" height=\"" << num(Y(y0) - Y(y1) + 0.3) << "\" fill=\"" << region_fill[c0] << "\"/>\n";
-                start = ix;
+        // boundary curve segments in data coordinates, with the lowest level whose set they bound
+        // (plant Hopf: 1, ring Hopf: 2, string: 3)
+        std::vector<std::array<double, 5>> segs;
+        if (panel.boundaries)
+            for (const auto& c : panel.boundaries->curves) {
+                const double lvl = c.kind == BoundaryKind::PlantHopf ? 1 : c.kind == BoundaryKind::RingHopf ? 2 : 3;
+                const std::size_t n = c.points.size();
+                for (std::size_t k = 0; k + 1 < n + (c.closed ? 1 : 0); ++k) {
+                    const auto& a = c.points[k];
+                    const auto& b = c.points[(k + 1) % n];
+                    segs.push_back({a.x, a.y, b.x, b.y, lvl});
+                }
             }
+        auto crossing = [&](int ia, int ja, int ib, int jb, int level) {
+            // grid points a (inside level) and b (outside), neighbours along x or y
+            const SweepPoint& pa = sw.at(ia, ja);
+            const SweepPoint& pb = sw.at(ib, jb);
+            const bool a_in = region_class(pa) >= level;
+            const SweepPoint& in = a_in ? pa : pb;
+            const SweepPoint& out = a_in ? pb : pa;
+            const int cond = region_class(out);
+            const bool lowfreq = out.lowfreq_margin <= 0.0;
+            const double mi = condition_margin(in, cond, lowfreq), mo = condition_margin(out, cond, lowfreq);
+            double t = (mi > 0.0 && mo <= 0.0 && mi - mo > 0.0) ? mi / (mi - mo) : 0.5;  // from `in` towards `out`
+            const double xa = ax.value(ia), ya = ay.value(ja), xb = ax.value(ib), yb = ay.value(jb);
+            const double xi = a_in ? xa : xb, yi = a_in ? ya : yb, xo = a_in ? xb : xa, yo = a_in ? yb : ya;
+            double px = xi + t * (xo - xi), py = yi + t * (yo - yi);
+            // snap to the first continued curve crossing this edge from the inside point among
+            // those that bound this level's set (its edge is where the first condition fails)
+            double best = 2.0;
+            for (const auto& g : segs) {
+                if (g[4] > level) continue;
+                const double ex = xo - xi, ey = yo - yi, fx = g[2] - g[0], fy = g[3] - g[1];
+                const double den = ex * fy - ey * fx;
+                if (den == 0.0) continue;
+                const double u = ((g[0] - xi) * fy - (g[1] - yi) * fx) / den;
+                const double v = ((g[0] - xi) * ey - (g[1] - yi) * ex) / den;
+                if (u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0) continue;
+                if (u < best) {
+                    best = u;
+                    px = xi + u * ex;
+                    py = yi + u * ey;
+                }
+            }
+            return std::pair<double, double>{px, py};
+        };
+        s << "<g id=\"" << id << "-regions\" clip-path=\"url(#" << id << "-clip)\" stroke-linejoin=\"round\" stroke-width=\"0.6\">\n";
+        s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph) << "\" fill=\""
+          << region_fill[0] << "\"/>\n";
+        for (int level = 1; level <= 3; ++level) {
+            s << "<g class=\"level" << level << "\" fill=\"" << region_fill[level] << "\" stroke=\"" << region_fill[level] << "\">\n";
+            auto inside = [&](int i, int j) { return region_class(sw.at(i, j)) >= level; };
+            for (int j = 0; j + 1 < ny; ++j) {
+                int run = -1;  // start of a run of cells wholly inside
+                for (int i = 0; i + 1 <= nx; ++i) {
+                    const bool full = i + 1 < nx && inside(i, j) && inside(i + 1, j) && inside(i, j + 1) && inside(i + 1, j + 1);
+                    if (full) {
+                        if (run < 0) run = i;
+                        continue;
+                    }
+                    if (run >= 0) {
+                        s << "<rect x=\"" << num(X(ax.value(run))) << "\" y=\"" << num(Y(ay.value(j + 1))) << "\" width=\""
+                          << num(X(ax.value(i)) - X(ax.value(run))) << "\" height=\"" << num(Y(ay.value(j)) - Y(ay.value(j + 1))) << "\"/>\n";
+                        run = -1;
+                    }
+                    if (i + 1 >= nx) break;
+                    // a cell with some corners inside: its inside part as one polygon
+                    const int ci[4] = {i, i + 1, i + 1, i}, cj[4] = {j, j, j + 1, j + 1};
+                    bool in[4];
+                    int count = 0;
+                    for (int k = 0; k < 4; ++k) count += (in[k] = inside(ci[k], cj[k])) ? 1 : 0;
+                    if (count == 0) continue;
+                    s << "<polygon points=\"";
+                    for (int k = 0; k < 4; ++k) {
+                        const int l = (k + 1) % 4;
+                        if (in[k]) s << num(X(ax.value(ci[k]))) << "," << num(Y(ay.value(cj[k]))) << " ";
+                        if (in[k] != in[l]) {
+                            const auto [px, py] = crossing(ci[k], cj[k], ci[l], cj[l], level);
+                            s << num(X(px)) << "," << num(Y(py)) << " ";
+                        }
+                    }
+                    s << "\"/>\n";
+                }
+            }
+            s << "</g>\n";
         }
         s << "</g>\n";
         // boundaries
@@ -157,65 +360,105 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         }
         s << "</g>\n";
         // axes
-        s << "<g id=\"" << id << "-axes\" font-size=\"10\" stroke-linecap=\"square\">\n";
+        s << "<g id=\"" << id << "-axes\" font-size=\"" << num(f_tick) << "\" stroke-linecap=\"square\">\n";
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
           << "\" fill=\"none\" stroke=\"#000\" stroke-width=\"1\"/>\n";
-        const double sx = nice_step(ax.hi - ax.lo), sy = nice_step(ay.hi - ay.lo);
+        // tick labels at least 1.6 label widths apart (no crowded numbers): the next nice step otherwise
+        double sx = nice_step(ax.hi - ax.lo);
+        for (int k = 0; k < 8 && pw / ((ax.hi - ax.lo) / sx) < text_width(tick_text(ax.hi, sx), f_tick) * 1.6; ++k) sx = nice_step(10.0 * sx);
+        const double sy = nice_step(ay.hi - ay.lo);
         for (double t = std::ceil(ax.lo / sx - 1e-9) * sx; t <= ax.hi + 1e-9 * sx; t += sx) {
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy + ph) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph + 5)
               << "\" stroke=\"#000\"/>\n";
-            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 17) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
+            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 19) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
         for (double t = std::ceil(ay.lo / sy - 1e-9) * sy; t <= ay.hi + 1e-9 * sy; t += sy) {
             s << "<line x1=\"" << num(ox - 5) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#000\"/>\n";
-            s << "<text x=\"" << num(ox - 8) << "\" y=\"" << num(Y(t) + 3.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
+            s << "<text x=\"" << num(ox - 8) << "\" y=\"" << num(Y(t) + 4.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
         }
-        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 36) << "\" text-anchor=\"middle\" font-size=\"12\">"
-          << esc(axis_label(sw.spec.model, ax.name)) << "</text>\n";
-        s << "<text transform=\"translate(" << num(ox - 44) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"12\">"
-          << esc(axis_label(sw.spec.model, ay.name)) << "</text>\n";
+        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 40) << "\" text-anchor=\"middle\" font-size=\"" << num(f_label)
+          << "\">" << esc(axis_label(sw.spec.model, ax.name)) << "</text>\n";
+        s << "<text transform=\"translate(" << num(ox - 52) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\""
+          << num(f_label) << "\">" << esc(axis_label(sw.spec.model, ay.name)) << "</text>\n";
         s << "</g>\n";
-        // markers
-        s << "<g id=\"" << id << "-markers\" font-size=\"10\">\n";
+        // confidence ellipses: {d : d^T C^-1 d <= 5.991} (chi-square, 2 degrees of freedom, 95 %),
+        // drawn as C^(1/2) times a circle of radius sqrt(5.991) (a segment when C is singular)
+        s << "<g id=\"" << id << "-ellipses\" clip-path=\"url(#" << id << "-clip)\" fill=\"#000000\" fill-opacity=\"0.08\" stroke=\"#000\" stroke-width=\"1.3\">\n";
         for (const auto& m : panel.markers) {
-            s << "<circle cx=\"" << num(X(m.x)) << "\" cy=\"" << num(Y(m.y)) << "\" r=\"4\" fill=\"#000\" stroke=\"#fff\" stroke-width=\"1.2\"/>\n";
-            const bool right = X(m.x) < ox + pw * 0.6;
-            s << "<text x=\"" << num(X(m.x) + (right ? 7 : -7)) << "\" y=\"" << num(Y(m.y) - 6) << "\" text-anchor=\""
-              << (right ? "start" : "end") << "\" paint-order=\"stroke\" stroke=\"#fff\" stroke-width=\"3\">" << esc(m.label) << "</text>\n";
+            if (!m.has_ellipse) continue;
+            const double a = m.cov_xx, b = m.cov_xy, d = m.cov_yy;
+            const double tr = 0.5 * (a + d), disc = std::sqrt(std::max(0.0, 0.25 * (a - d) * (a - d) + b * b));
+            const double l1 = std::max(0.0, tr + disc), l2 = std::max(0.0, tr - disc);
+            const double phi = 0.5 * std::atan2(2.0 * b, a - d);
+            const double r = std::sqrt(5.991464547107979);
+            s << "<polygon points=\"";
+            for (int k = 0; k < 96; ++k) {
+                const double t = 2.0 * M_PI * k / 96.0;
+                const double u = r * std::sqrt(l1) * std::cos(t), v = r * std::sqrt(l2) * std::sin(t);
+                s << num(X(m.x + u * std::cos(phi) - v * std::sin(phi))) << "," << num(Y(m.y + u * std::sin(phi) + v * std::cos(phi))) << " ";
+            }
+            s << "\"/>\n";
+        }
+        s << "</g>\n";
+        // markers: inside the window as a dot with its label; outside it on the nearest edge as
+        // an open triangle pointing out of the window, the label saying so
+        s << "<g id=\"" << id << "-markers\" font-size=\"" << num(f_tick) << "\">\n";
+        for (const auto& m : panel.markers) {
+            const bool out = !(m.x >= ax.lo && m.x <= ax.hi && m.y >= ay.lo && m.y <= ay.hi);
+            const double cx = std::min(std::max(X(m.x), ox), ox + pw), cy = std::min(std::max(Y(m.y), oy), oy + ph);
+            if (out) {
+                const double dx = X(m.x) - cx, dy = Y(m.y) - cy, n = std::hypot(dx, dy);
+                const double ux = n > 0 ? dx / n : 0.0, uy = n > 0 ? dy / n : -1.0;
+                s << "<polygon points=\"" << num(cx + 7 * ux) << "," << num(cy + 7 * uy) << " " << num(cx - 6 * ux - 5 * uy) << ","
+                  << num(cy - 6 * uy + 5 * ux) << " " << num(cx - 6 * ux + 5 * uy) << "," << num(cy - 6 * uy - 5 * ux)
+                  << "\" fill=\"#fff\" stroke=\"#000\" stroke-width=\"1.5\"/>\n";
+            } else {
+                s << "<circle cx=\"" << num(cx) << "\" cy=\"" << num(cy) << "\" r=\"4.5\" fill=\"#000\" stroke=\"#fff\" stroke-width=\"1.2\"/>\n";
+            }
+            // a label wider than 45 % of the panel is left out (the panel title names the vehicle)
+            const std::string label = out ? m.label + " (outside)" : m.label;
+            const double lw = text_width(label, f_tick);
+            if (label.empty() || lw > 0.45 * pw) continue;
+            const bool right = cx + 8 + lw <= ox + pw;
+            const double ty = cy - 8 < oy + f_tick ? cy + f_tick + 6 : cy - 8;
+            s << "<text x=\"" << num(right ? cx + 8 : std::max(cx - 8, ox + lw)) << "\" y=\"" << num(ty) << "\" text-anchor=\""
+              << (right ? "start" : "end") << "\" paint-order=\"stroke\" stroke=\"#fff\" stroke-width=\"3\">" << esc(label) << "</text>\n";
         }
         s << "</g>\n";
         s << "</g>\n";
     }
-    // legend: region swatches, then line styles, wrapped to the figure width
+    // legend: only what the figure shows
     const double ly = header + rows * ch + 8;
-    s << "<g id=\"legend\" font-size=\"11\">\n";
-    double lx = 10, row_y = ly;
-    auto place = [&](double item_width) {
-        if (lx + item_width > width - 10 && lx > 10) {
-            lx = 10;
-            row_y += 20;
+    s << "<g id=\"legend\" font-size=\"" << num(f_legend) << "\">\n";
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const Item& it = items[i];
+        const double x = item_pos[i].first, y = ly + item_pos[i].second;
+        switch (it.type) {
+            case 0:
+                s << "<rect x=\"" << num(x) << "\" y=\"" << num(y) << "\" width=\"26\" height=\"15\" fill=\"" << region_fill[it.index]
+                  << "\" stroke=\"#555\" stroke-width=\"0.5\"/>\n";
+                break;
+            case 1: {
+                const Style st = curve_style(kinds[it.index]);
+                s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7.5) << "\" x2=\"" << num(x + 26) << "\" y2=\"" << num(y + 7.5)
+                  << "\" stroke=\"" << st.colour << "\" stroke-width=\"" << st.width << "\"";
+                if (*st.dash) s << " stroke-dasharray=\"" << st.dash << "\"";
+                s << "/>\n";
+                break;
+            }
+            case 2:
+                s << "<circle cx=\"" << num(x + 13) << "\" cy=\"" << num(y + 7.5) << "\" r=\"4.5\" fill=\"#000\"/>\n";
+                break;
+            case 3:
+                s << "<ellipse cx=\"" << num(x + 13) << "\" cy=\"" << num(y + 7.5) << "\" rx=\"12\" ry=\"6\" fill=\"#000\" fill-opacity=\"0.08\" "
+                  << "stroke=\"#000\" stroke-width=\"1.3\"/>\n";
+                break;
+            default:
+                s << "<polygon points=\"" << num(x + 20) << "," << num(y + 7.5) << " " << num(x + 7) << "," << num(y + 2.5) << " " << num(x + 7)
+                  << "," << num(y + 12.5) << "\" fill=\"#fff\" stroke=\"#000\" stroke-width=\"1.5\"/>\n";
         }
-        const double x = lx;
-        lx += item_width + 18;
-        return x;
-    };
-    for (int c = 3; c >= 0; --c) {
-        const double x = place(19 + 6.3 * std::string(region_name[c]).size());
-        s << "<rect x=\"" << num(x) << "\" y=\"" << num(row_y) << "\" width=\"14\" height=\"14\" fill=\"" << region_fill[c]
-          << "\" stroke=\"#555\" stroke-width=\"0.5\"/>\n";
-        s << "<text x=\"" << num(x + 19) << "\" y=\"" << num(row_y + 11) << "\">" << region_name[c] << "</text>\n";
-    }
-    lx = 10;
-    row_y += 22;
-    for (BoundaryKind k : {BoundaryKind::RingHopf, BoundaryKind::PlantHopf, BoundaryKind::LowFrequency, BoundaryKind::Peak}) {
-        const Style st = curve_style(k);
-        const double x = place(31 + 6.3 * std::string(st.name).size());
-        const double y = row_y + 7;
-        s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y) << "\" x2=\"" << num(x + 26) << "\" y2=\"" << num(y) << "\" stroke=\""
-          << st.colour << "\" stroke-width=\"" << st.width << "\"";
-        if (*st.dash) s << " stroke-dasharray=\"" << st.dash << "\"";
-        s << "/>\n<text x=\"" << num(x + 31) << "\" y=\"" << num(y + 4) << "\">" << esc(st.name) << "</text>\n";
+        s << "<text x=\"" << num(x + 34) << "\" y=\"" << num(y + 12.5) << "\">" << esc(it.text) << "</text>\n";
     }
     s << "</g>\n</svg>\n";
     return s.str();
@@ -230,7 +473,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     if (panels.empty()) throw std::invalid_argument("a plot needs at least one panel");
     const int cols = std::max(1, std::min<int>(o.columns, static_cast<int>(panels.size())));
     const int rows = (static_cast<int>(panels.size()) + cols - 1) / cols;
-    const double ml = 62, mr = 16, mt = 34, mb = 48;
+    const double ml = 70, mr = 18, mt = 36, mb = 54;  // type as in the charts: readable at a column width
     const double cw = o.panel_width + ml + mr, ch = o.panel_height + mt + mb;
     const double header = o.title.empty() ? 10 : 34;
     const double width = cols * cw + 10;
@@ -245,10 +488,10 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             ++i;
         }
     }
-    // one slot per entry, wide enough for the longest name (11 px text: about 6.5 px a character)
+    // one slot per entry, wide enough for the longest name (13 px text: about 7.8 px a character)
     std::size_t longest = 0;
     for (const auto& e : entries) longest = std::max(longest, e.first.size());
-    const double slot = std::max(150.0, 29.0 + 6.5 * static_cast<double>(longest) + 14.0);
+    const double slot = std::max(150.0, 29.0 + 7.8 * static_cast<double>(longest) + 14.0);
     const int per_row = std::max(1, static_cast<int>((width - 20) / slot));
     const double legend_h = entries.empty() ? 10 : 20.0 * ((entries.size() + per_row - 1) / per_row) + 12;
     const double note_h = o.note.empty() ? 0 : 20;
@@ -282,24 +525,24 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         auto Y = [&](double y) { return oy + ph - (y - y0) / (y1 - y0) * ph; };
         const std::string id = "plot" + std::to_string(pi + 1);
         s << "<g id=\"" << id << "\">\n";
-        s << "<text id=\"" << id << "-title\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy - 10) << "\" text-anchor=\"middle\" font-size=\"12\">"
+        s << "<text id=\"" << id << "-title\" x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy - 10) << "\" text-anchor=\"middle\" font-size=\"14\">"
           << esc(p.title) << "</text>\n";
-        s << "<g id=\"" << id << "-axes\" font-size=\"10\">\n";
+        s << "<g id=\"" << id << "-axes\" font-size=\"13\">\n";
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
           << "\" fill=\"none\" stroke=\"#000\"/>\n";
         for (double t = x0; t <= x1 + 1e-9 * sx; t += sx) {
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph)
               << "\" stroke=\"#e5e5e5\"/>\n";
-            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 15) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
+            s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 18) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
         for (double t = y0; t <= y1 + 1e-9 * sy; t += sy) {
             s << "<line x1=\"" << num(ox) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox + pw) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#e5e5e5\"/>\n";
-            s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 3.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
+            s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 4.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
         }
-        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 34) << "\" text-anchor=\"middle\" font-size=\"12\">" << esc(p.x_label)
+        s << "<text x=\"" << num(ox + pw / 2) << "\" y=\"" << num(oy + ph + 40) << "\" text-anchor=\"middle\" font-size=\"14\">" << esc(p.x_label)
           << "</text>\n";
-        s << "<text transform=\"translate(" << num(ox - 44) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"12\">"
+        s << "<text transform=\"translate(" << num(ox - 52) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"14\">"
           << esc(p.y_label) << "</text>\n";
         s << "</g>\n";
         s << "<g id=\"" << id << "-series\" fill=\"none\" stroke-width=\"1.4\" stroke-linejoin=\"round\">\n";
@@ -325,7 +568,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     }
     if (!entries.empty()) {
         const double ly = header + rows * ch + 4;
-        s << "<g id=\"legend\" font-size=\"11\">\n";
+        s << "<g id=\"legend\" font-size=\"13\">\n";
         for (std::size_t i = 0; i < entries.size(); ++i) {
             const double x = 10 + (i % per_row) * slot, y = ly + (i / per_row) * 20;
             s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7) << "\" x2=\"" << num(x + 24) << "\" y2=\"" << num(y + 7)
@@ -335,7 +578,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         s << "</g>\n";
     }
     if (!o.note.empty()) {
-        s << "<text id=\"note\" x=\"10\" y=\"" << num(height - 6) << "\" font-size=\"11\">" << esc(o.note) << "</text>\n";
+        s << "<text id=\"note\" x=\"10\" y=\"" << num(height - 6) << "\" font-size=\"13\">" << esc(o.note) << "</text>\n";
     }
     s << "</svg>\n";
     return s.str();

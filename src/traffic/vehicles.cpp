@@ -50,6 +50,14 @@ const CalibratedVehicle& builtin_vehicle(const std::string& name) {
     throw std::invalid_argument("vehicle " + detail::quoted(name) + ": expected a name of the calibration table (A_min .. G_max)");
 }
 
+std::vector<std::string> covariance_column_names() {
+    static const char* names[] = {"k1", "k2", "th", "tau", "eta"};
+    std::vector<std::string> out;
+    for (int a = 0; a < 5; ++a)
+        for (int b = a; b < 5; ++b) out.push_back(std::string("cov_") + names[a] + "_" + names[b]);
+    return out;
+}
+
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
     detail::CsvReader csv(text, source, "name,k1,k2,th,tau[,eta]");
     const int c_name = csv.column("name");
@@ -57,6 +65,13 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
     int c_param[5];
     for (int i = 0; i < 5; ++i) c_param[i] = csv.column(params[i], i < 4);
     const int c_min_speed = csv.column("min_acc_speed", false);
+    const std::vector<std::string> cov_names = covariance_column_names();
+    std::vector<int> c_cov;
+    for (const auto& n : cov_names) c_cov.push_back(csv.column(n, false));
+    const auto cov_given = static_cast<int>(std::count_if(c_cov.begin(), c_cov.end(), [](int c) { return c >= 0; }));
+    if (cov_given > 0 && cov_given < 15)
+        throw std::invalid_argument(source + ": the header has " + std::to_string(cov_given) +
+                                    " of the 15 covariance columns cov_k1_k1 .. cov_eta_eta: expected all or none");
     std::vector<CalibratedVehicle> out;
     while (csv.next()) {
         CalibratedVehicle v;
@@ -69,6 +84,22 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
         if (c_min_speed >= 0 && !csv.fields()[c_min_speed].empty()) {
             v.min_acc_speed = csv.number(c_min_speed, "min_acc_speed");
             if (v.min_acc_speed < 0.0) csv.fail("min_acc_speed = " + csv.fields()[c_min_speed] + ": expected >= 0 m/s");
+        }
+        if (cov_given == 15) {
+            int filled = 0;
+            for (int c : c_cov) filled += csv.fields()[static_cast<std::size_t>(c)].empty() ? 0 : 1;
+            if (filled != 0 && filled != 15)
+                csv.fail(std::to_string(filled) + " of the 15 covariance columns are filled: expected all or none");
+            if (filled == 15) {
+                std::size_t k = 0;
+                for (int a = 0; a < 5; ++a)
+                    for (int b = a; b < 5; ++b, ++k) {
+                        const double x = csv.number(c_cov[k], cov_names[k]);
+                        if (a == b && x < 0.0) csv.fail("column '" + cov_names[k] + "' = " + csv.fields()[static_cast<std::size_t>(c_cov[k])] + ": expected a variance >= 0");
+                        v.covariance(a, b) = v.covariance(b, a) = x;
+                    }
+                v.has_covariance = true;
+            }
         }
         try {
             (void)make_model("ovrv", v.parameters);

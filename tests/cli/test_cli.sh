@@ -471,6 +471,28 @@ printf '{"dimension": 1, "delays": [1.0], "A0": [[0.0]], "A": [[[-1.570796326794
 "$bin" roots --fleet-pattern A_min --ring 5 --count 2 --format json | python3 -c "import json,sys; r=json.load(sys.stdin)['result']; assert 2 <= len(r['roots']) <= 3 and r['ring_verdict'] in ('stable','unstable','marginal'), r" &&
     ok || bad "roots --fleet-pattern --count 2"
 
+# classify with the covariance calibrate writes: verdicts with probabilities, margins' intervals
+if [ -s "$tmp/cal.csv" ] || { bad "calibrate wrote no cal.csv"; false; }; then
+    head -1 "$tmp/cal.csv" | grep -q ',cov_k1_k1,cov_k1_k2,' && ok || bad "calibrate csv covariance columns"
+    "$bin" classify "$tmp/cal.csv" --samples 400 --ring-samples 20 >"$tmp/cu.txt" && grep -Eq 'string (UNSTABLE|stable) \(p [<>=] ' "$tmp/cu.txt" && ok || bad "classify with covariance: table verdict with p"
+    "$bin" classify "$tmp/cal.csv" --samples 400 --ring-samples 20 --format json >"$tmp/cu.json" && python3 - "$tmp/cu.json" <<'PY' && ok || bad "classify with covariance: json keys"
+import json, sys
+d = json.load(open(sys.argv[1]))
+v = d['result']['vehicles'][0]
+assert 0.0 <= v['p_string_unstable'] <= 1.0
+m = v['margin_intervals']
+for k in ('c2', 'sup_gamma_minus_1', 'spectral_abscissa'):
+    assert m[k][0] <= m[k][1], k
+u = v['uncertainty']
+assert u['samples'] == 400 and u['ring_samples'] == 20
+lo, hi = u['string_unstable']['wilson']
+assert lo <= v['p_string_unstable'] <= hi
+assert d['inputs']['samples'] == 400 and d['inputs']['seed'] == 1
+PY
+    "$bin" classify "$tmp/cal.csv" --samples 400 --ring-samples 20 --format csv | head -1 | grep -q ',p_string_unstable,' && ok || bad "classify with covariance: csv column"
+fi
+expect_error "--samples = '0'" classify --samples 0
+
 # help on every command, with units
 for c in roots string sweep boundary; do
     if "$bin" $c --help >"$tmp/h.txt" && grep -q '1/s^2' "$tmp/h.txt" && grep -q -- '--tau' "$tmp/h.txt"; then ok; else bad "$c --help"; fi

@@ -25,7 +25,10 @@ std::string calibration_svg(const std::vector<std::string>& names, const std::ve
 std::string mix_svg(const std::vector<MixPoint>& points, const MixOptions& options, const std::string& x_label,
                     const std::string& y_label);
 /// The classification figure's spec: `base` (maps/classification.toml) with one panel per
-/// vehicle and the ring size `cars`.
-ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars);
+/// vehicle (its 95 % (k1, k2) confidence ellipse when it carries a covariance) and the ring size
+/// `cars`. With a `source` (the user's vehicle file) the title names it and the (k1, k2) window
+/// is fitted to the vehicles and their ellipses; without, the base window (the paper's table).
+ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars,
+                               const std::string& source = "");
 
 }  // namespace ddemap

@@ -19,6 +19,9 @@ namespace ddemap {
 struct ChartMarker {
     double x = 0.0, y = 0.0;
     std::string label;
+    /// Covariance of (x, y): drawn as the 95 % confidence ellipse (x, y) + {d : d^T C^-1 d <= 5.991}.
+    bool has_ellipse = false;
+    double cov_xx = 0.0, cov_xy = 0.0, cov_yy = 0.0;
 };
 
 struct ChartPanel {
@@ -39,7 +42,12 @@ struct ChartOptions {
 /// 3 string stable.
 int region_class(const SweepPoint& p);
 
-/// "k1 [1/s^2]" for a model parameter (with the unit from the model's parameter table).
+/// The symbol of a model parameter in figures: k1 -> k₁, k2 -> k₂, tau -> τ, th -> tₕ, eta -> η, ...
+/// (other names unchanged).
+std::string parameter_symbol(const std::string& name);
+/// A unit in figures: 1/s^2 -> 1/s².
+std::string unit_text(const std::string& unit);
+/// "k₁ [1/s²]" for a model parameter (with the unit from the model's parameter table).
 std::string axis_label(const std::string& model, const std::string& parameter);
 
 std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartOptions& options);
