@@ -68,7 +68,8 @@ void annotate_option_types(CLI::App& app, const std::string& command) {
         {"p", "LO:HI:COUNT"}, {"ring", "N|inf"}, {"solver", "auto|product|dense|sparse"}, {"train", "T0:T1"},
         {"bounds", "NAME=LO:HI,..."}, {"speed", "NUMBER"}, {"model", "NAME"}, {"x", "NAME"}, {"y", "CAR"}, {"car", "NAME"}, {"runs", "FILE"},
         {"data-dir", "FOLDER"}, {"report", "FOLDER"}, {"par", "NAME"}, {"from", "NUMBER"}, {"to", "NUMBER"},
-        {"samples", "INTEGER"}, {"ring-samples", "INTEGER"}};
+        {"samples", "INTEGER"}, {"ring-samples", "INTEGER"}, {"max-points", "INTEGER"}, {"alpha", "NUMBER"},
+        {"tau", "NUMBER"}, {"v0", "NUMBER"}, {"h-st", "NUMBER"}, {"headway", "NUMBER"}};
     for (CLI::Option* o : app.get_options()) {
         if (o->get_lnames().empty()) {  // a positional argument: a file
             if (o->get_type_name() == "TEXT") o->type_name("FILE");

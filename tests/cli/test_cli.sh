@@ -615,7 +615,7 @@ printf 'vehicle,model,k1,k2,th,tau,k3,tau2\n,ccc,0.1,0.3,1.2,0.4,0.2,0.1\n' >"$f
 expect_error "has model 'ccc': expected ovrv cars" classify "$fio/ccc.csv"
 
 # ---- one consistent command line: help and errors -----------------------------------------------
-for c in roots string classify sweep boundary chart paper simulate growth calibrate mix; do
+for c in roots string classify sweep boundary chart paper simulate growth calibrate mix equilibria; do
     "$bin" $c --help >"$fio/h.txt" 2>&1
     grep -q ' TEXT' "$fio/h.txt" && bad "$c --help has an option without its kind: $(grep ' TEXT' "$fio/h.txt" | head -1)" || ok
 done
