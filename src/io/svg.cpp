@@ -41,6 +41,17 @@ std::string tick_text(double v, double step) {
     return b;
 }
 
+/// The multiples of `step` in [lo, hi] (to 1e-9 steps), by integer index so that a step below the
+/// spacing of doubles near lo cannot loop forever; empty when there would be more than 1000.
+std::vector<double> tick_values(double lo, double hi, double step) {
+    std::vector<double> ticks;
+    if (!(step > 0) || !std::isfinite(lo) || !std::isfinite(hi)) return ticks;
+    const double first = std::ceil(lo / step - 1e-9), last = std::floor(hi / step + 1e-9);
+    if (!(last - first < 1000)) return ticks;
+    for (double i = first; i <= last; ++i) ticks.push_back(i * step);
+    return ticks;
+}
+
 double nice_step(double range) {
     const double raw = range / 5.0;
     const double p = std::pow(10.0, std::floor(std::log10(raw)));
@@ -367,12 +378,12 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         double sx = nice_step(ax.hi - ax.lo);
         for (int k = 0; k < 8 && pw / ((ax.hi - ax.lo) / sx) < text_width(tick_text(ax.hi, sx), f_tick) * 1.6; ++k) sx = nice_step(10.0 * sx);
         const double sy = nice_step(ay.hi - ay.lo);
-        for (double t = std::ceil(ax.lo / sx - 1e-9) * sx; t <= ax.hi + 1e-9 * sx; t += sx) {
+        for (const double t : tick_values(ax.lo, ax.hi, sx)) {
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy + ph) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph + 5)
               << "\" stroke=\"#000\"/>\n";
             s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 19) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
-        for (double t = std::ceil(ay.lo / sy - 1e-9) * sy; t <= ay.hi + 1e-9 * sy; t += sy) {
+        for (const double t : tick_values(ay.lo, ay.hi, sy)) {
             s << "<line x1=\"" << num(ox - 5) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#000\"/>\n";
             s << "<text x=\"" << num(ox - 8) << "\" y=\"" << num(Y(t) + 4.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
@@ -511,8 +522,18 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             x0 = std::min(x0, m.x); x1 = std::max(x1, m.x);
             y0 = std::min(y0, m.y); y1 = std::max(y1, m.y);
         }
-        if (!(x1 > x0)) { x0 -= 0.5; x1 += 0.5; }
-        if (!(y1 > y0)) { y0 -= 0.5; y1 += 0.5; }
+        // a range below 1e-9 of its values (a constant speed, to rounding) is drawn as +-0.5 around it:
+        // ticks finer than that would be below the spacing of doubles
+        auto widen = [](double& lo, double& hi) {
+            if (lo > hi) { lo = 0; hi = 0; }  // no finite data
+            if (!(hi - lo > 1e-9 * std::max({1.0, std::abs(lo), std::abs(hi)}))) {
+                const double mid = 0.5 * (lo + hi);
+                lo = mid - 0.5;
+                hi = mid + 0.5;
+            }
+        };
+        widen(x0, x1);
+        widen(y0, y1);
         const double pad = 0.04 * (y1 - y0);
         y0 -= pad;
         y1 += pad;
@@ -530,12 +551,12 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         s << "<g id=\"" << id << "-axes\" font-size=\"13\">\n";
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
           << "\" fill=\"none\" stroke=\"#000\"/>\n";
-        for (double t = x0; t <= x1 + 1e-9 * sx; t += sx) {
+        for (const double t : tick_values(x0, x1, sx)) {
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph)
               << "\" stroke=\"#e5e5e5\"/>\n";
             s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 18) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
-        for (double t = y0; t <= y1 + 1e-9 * sy; t += sy) {
+        for (const double t : tick_values(y0, y1, sy)) {
             s << "<line x1=\"" << num(ox) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox + pw) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#e5e5e5\"/>\n";
             s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 4.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";

@@ -714,5 +714,9 @@ EOF2
     python3 -c "import json,sys; h=json.load(sys.stdin)['result']['hopf']; assert len(h) == 1 and abs(h[0]['par']/0.80712-1) < 5e-5 and abs(h[0]['omega']/0.78197-1) < 5e-5, h" &&
     ok || bad "equilibria: DDE-BIFTOOL neuron Hopf point"
 
+# a flat line (speeds constant to rounding) is drawn, not a hang with ever finer ticks
+timeout 30 "$bin" simulate --fleet A_min --t-end 20 --out "$tmp/flat" >/dev/null && [ "$(grep -c '<text' "$tmp/flat.svg")" -lt 200 ] &&
+    ok || bad "simulate --t-end 20: a flat speed plot finishes with a bounded number of ticks"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
