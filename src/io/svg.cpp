@@ -29,6 +29,7 @@ std::string esc(const std::string& s) {
 }
 
 std::string num(double v) {
+    if (!std::isfinite(v)) throw std::logic_error("a non-finite number (" + std::to_string(v) + ") reached an SVG coordinate");
     char b[32];
     std::snprintf(b, sizeof b, "%.2f", v);
     return b;
@@ -162,12 +163,16 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
           << "\" fill=\"none\" stroke=\"#000\" stroke-width=\"1\"/>\n";
         const double sx = nice_step(ax.hi - ax.lo), sy = nice_step(ay.hi - ay.lo);
-        for (double t = std::ceil(ax.lo / sx - 1e-9) * sx; t <= ax.hi + 1e-9 * sx; t += sx) {
+        // ticks by index (at most 1000): a step below the spacing of the values never ends a t += step loop
+        const double tx0 = std::ceil(ax.lo / sx - 1e-9) * sx, ty0 = std::ceil(ay.lo / sy - 1e-9) * sy;
+        for (int i = 0; i <= 1000 && tx0 + i * sx <= ax.hi + 1e-9 * sx; ++i) {
+            const double t = tx0 + i * sx;
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy + ph) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph + 5)
               << "\" stroke=\"#000\"/>\n";
             s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 17) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
-        for (double t = std::ceil(ay.lo / sy - 1e-9) * sy; t <= ay.hi + 1e-9 * sy; t += sy) {
+        for (int i = 0; i <= 1000 && ty0 + i * sy <= ay.hi + 1e-9 * sy; ++i) {
+            const double t = ty0 + i * sy;
             s << "<line x1=\"" << num(ox - 5) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#000\"/>\n";
             s << "<text x=\"" << num(ox - 8) << "\" y=\"" << num(Y(t) + 3.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
@@ -269,8 +274,11 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             x0 = std::min(x0, m.x); x1 = std::max(x1, m.x);
             y0 = std::min(y0, m.y); y1 = std::max(y1, m.y);
         }
-        if (!(x1 > x0)) { x0 -= 0.5; x1 += 0.5; }
-        if (!(y1 > y0)) { y0 -= 0.5; y1 += 0.5; }
+        // a range below rounding noise of its values is flat (else the tick step underflows
+        // the values' spacing and the tick loops never end)
+        auto flat = [](double lo, double hi) { return !(hi - lo > 1e-9 * std::max({1.0, std::abs(lo), std::abs(hi)})); };
+        if (flat(x0, x1)) { x0 -= 0.5; x1 += 0.5; }
+        if (flat(y0, y1)) { y0 -= 0.5; y1 += 0.5; }
         const double pad = 0.04 * (y1 - y0);
         y0 -= pad;
         y1 += pad;
@@ -288,12 +296,14 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         s << "<g id=\"" << id << "-axes\" font-size=\"10\">\n";
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
           << "\" fill=\"none\" stroke=\"#000\"/>\n";
-        for (double t = x0; t <= x1 + 1e-9 * sx; t += sx) {
+        for (int i = 0; i <= 1000 && x0 + i * sx <= x1 + 1e-9 * sx; ++i) {
+            const double t = x0 + i * sx;
             s << "<line x1=\"" << num(X(t)) << "\" y1=\"" << num(oy) << "\" x2=\"" << num(X(t)) << "\" y2=\"" << num(oy + ph)
               << "\" stroke=\"#e5e5e5\"/>\n";
             s << "<text x=\"" << num(X(t)) << "\" y=\"" << num(oy + ph + 15) << "\" text-anchor=\"middle\">" << tick_text(t, sx) << "</text>\n";
         }
-        for (double t = y0; t <= y1 + 1e-9 * sy; t += sy) {
+        for (int i = 0; i <= 1000 && y0 + i * sy <= y1 + 1e-9 * sy; ++i) {
+            const double t = y0 + i * sy;
             s << "<line x1=\"" << num(ox) << "\" y1=\"" << num(Y(t)) << "\" x2=\"" << num(ox + pw) << "\" y2=\"" << num(Y(t))
               << "\" stroke=\"#e5e5e5\"/>\n";
             s << "<text x=\"" << num(ox - 6) << "\" y=\"" << num(Y(t) + 3.5) << "\" text-anchor=\"end\">" << tick_text(t, sy) << "</text>\n";
