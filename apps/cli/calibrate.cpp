@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
@@ -65,6 +66,7 @@ void add_calibrate_flags(CLI::App& app) {
     app.add_option("--gap-weight", args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
     args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
     args.format.add_to(app);
+    run_flags().add_to(app, false);
 }
 
 int run_calibrate() {
@@ -77,7 +79,9 @@ int run_calibrate() {
         traces.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
         names.push_back(base_name(f));
     }
-    const std::vector<CalibrationResult> fits = calibrate_many(traces, o);
+    ExecutionPolicy policy;
+    policy.progress = progress_printer("calibrate", "files");
+    const std::vector<CalibrationResult> fits = calibrate_many(traces, o, policy);
     JsonEnvelope e;
     e.command = "calibrate";
     std::vector<std::string> files;

@@ -6,6 +6,8 @@
 #include "builtin_maps.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
+#include "sweep_flags.hpp"
 #include "tables.hpp"
 #include "ddemap/analysis/classify.hpp"
 #include "ddemap/io/chart_spec.hpp"
@@ -30,6 +32,7 @@ void add_classify_flags(CLI::App& app) {
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
     app.add_option("--svg", args.svg, "old spelling: write only the figure to this file")->group("");
+    run_flags().add_to(app, true);
 }
 
 int run_classify() {
@@ -51,6 +54,12 @@ int run_classify() {
         vehicles = read_vehicles_csv(read_input_file("VEHICLES.csv", args.file), args.file);
         source = args.file;
     }
+    const bool figure = !prefix.empty() || !svg_file.empty();
+    ChartSpec chart;
+    if (figure) {
+        chart = classification_chart(parse_chart_spec(builtin_classification_toml, "maps/classification.toml"), vehicles, cars);
+        if (!chart.panels.empty()) check_sweep_size(panel_sweep(chart, 0), "classify", false, chart.panels.size());
+    }
     const auto rows = classify(vehicles, cars);
     JsonEnvelope e;
     e.command = "classify";
@@ -63,9 +72,10 @@ int run_classify() {
     }
     e.status = to_string(status);
     const std::string csv = classification_csv(rows);
-    if (!prefix.empty() || !svg_file.empty()) {
-        const ChartSpec base = parse_chart_spec(builtin_classification_toml, "maps/classification.toml");
-        const std::string svg = render_chart(classification_chart(base, vehicles, cars)).svg;
+    if (figure) {
+        ExecutionPolicy policy;
+        policy.progress = progress_printer("classify", "panels");
+        const std::string svg = render_chart(chart, policy).svg;
         if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", svg}});
         else write_files_atomic({{svg_file, svg}});
     }

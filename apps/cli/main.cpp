@@ -27,6 +27,7 @@ std::string one_line(std::string s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    std::cout.setf(std::ios::unitbuf);  // stdout flushed as it is written (a pipe sees each line when it is done)
     CLI::App app{"ddemap: stability of delay differential car-following models.\n"
                  "Rightmost characteristic roots of rings of cars, string stability verdicts."};
     app.require_subcommand(1);

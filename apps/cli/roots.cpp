@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "fleet_flags.hpp"
+#include "limits.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
@@ -48,7 +49,17 @@ int run_system(Format format, const std::string& prefix) {
     o.degree = parse_degree();
     o.method = root_method(args.solver);
     if (o.method == "contour") throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
-    const LinearDDE dde = read_linear_dde_json(read_input_file("--system", args.system), args.system);
+    const std::string text = read_input_file("--system", args.system);
+    {
+        // every matrix is held dense (16 n^2 bytes each) and its norm taken by a full SVD
+        // (about 64 n^2 bytes and 2e-9 n^3 s each, measured)
+        const LinearDdeShape shape = peek_linear_dde_json(text, args.system);
+        const double n = static_cast<double>(std::max(shape.dimension, 0L)), terms = static_cast<double>(shape.delays) + 1.0;
+        const std::string what = "a " + std::to_string(shape.dimension) + "-state system with " + std::to_string(shape.delays) + (shape.delays == 1 ? " delay" : " delays");
+        check_size("roots", what, "memory", n * n * (16.0 * terms + 64.0));
+        check_size("roots", what, "time", 2e-9 * n * n * n * terms);
+    }
+    const LinearDDE dde = read_linear_dde_json(text, args.system);
     const SystemRootResult s = analyse_system(dde, o);
     const RootResult& r = s.roots;
     JsonEnvelope e;
@@ -64,7 +75,8 @@ int run_system(Format format, const std::string& prefix) {
     out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delayed().size() << " delays)\n";
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << "trusted    " << r.message << "\n";
-    out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";
+    // no root computed (an empty spectrum or a failed solver): the table says so, never "-inf"
+    out << "abscissa   " << (std::isfinite(s.spectral_abscissa) ? rounded(s.spectral_abscissa, 10) : std::string("none (no root was computed)")) << "\n";
     out << "verdict    " << (r.status != Status::Converged ? "UNDECIDED (" + to_string(r.status) + ")"
                              : s.stable ? std::string("STABLE") : std::string("NOT asymptotically stable")) << "\n\n";
     out << roots_table(r.roots);
@@ -201,6 +213,7 @@ void add_roots_flags(CLI::App& app) {
     app.add_option("--degree", args.degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")
         ->capture_default_str();
     args.format.add_to(app);
+    run_flags().add_to(app, true);
     args.out.add_to(app, "PREFIX.csv (the roots) and PREFIX.json", false);
 }
 

@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "lead_flags.hpp"
+#include "limits.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
@@ -32,6 +33,7 @@ void add_simulate_flags(CLI::App& app) {
     app.add_option("--step", args.step, "largest integration step [s]")->capture_default_str();
     app.add_option("--output-dt", args.output_dt, "output sampling [s]")->capture_default_str();
     args.format.add_to(app);
+    run_flags().add_to(app, true);
 }
 
 int run_simulate() {
@@ -50,6 +52,13 @@ int run_simulate() {
     const bool csv_file = args.fleet.size() > 4 && args.fleet.compare(args.fleet.size() - 4, 4, ".csv") == 0;
     const std::vector<SimCar> cars = platoon_from(csv_file ? read_vehicles_csv(read_input_file("--fleet", args.fleet), args.fleet)
                                                            : vehicles_from_pattern(args.fleet));
+    const SimEstimate size = estimate_simulation(lead, cars, o);
+    const std::string what = std::to_string(cars.size()) + " followers over " + rounded(size.t_end, 6) + " s (" +
+                             rounded(size.steps, 3) + " steps)";
+    check_size("simulate", what, "memory", size.memory_bytes);
+    check_size("simulate", what, "output", size.output_bytes);
+    check_size("simulate", what, "time", size.car_steps * 2e-6);  // about 2 us per car and step (measured)
+    o.progress = progress_printer("simulate", "ms simulated");
     const SimResult r = simulate_platoon(lead, cars, o);
     JsonEnvelope e;
     e.command = "simulate";
@@ -61,6 +70,8 @@ int run_simulate() {
                    .number("step", o.step)
                    .number("output_dt", o.output_dt)
                    .str();
+    e.status = to_string(r.status);
+    e.message = r.message;
     e.result = simulation_json(r, label);
     const std::string csv = simulation_csv(r);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", simulation_svg(r, label)}});
@@ -78,6 +89,10 @@ int run_simulate() {
         s << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << s.str();
     });
+    if (r.status != Status::Converged) {
+        std::cerr << "ddemap: simulate: UNDECIDED: " << r.message << "\n";
+        return exit_not_converged;
+    }
     return exit_ok;
 }
 
