@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "sweep_flags.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/svg.hpp"
@@ -27,14 +28,18 @@ void add_boundary_flags(CLI::App& app) {
     args.out.add_to(app, "PREFIX.csv (one row per curve point) and PREFIX.json", true);
     app.add_option("--seed-grid", args.grid, "grid points per axis used to seed the branches")->capture_default_str();
     args.format.add_to(app);
+    run_flags().add_to(app, true);
 }
 
 int run_boundary() {
     const Format format = args.format.parse();
     const int grid = static_cast<int>(parse_integer("--seed-grid", args.grid, 5, 2001, "an integer between 5 and 2001"));
     const SweepSpec spec = sweep_spec(args.model, args.ring, "", false, grid);
+    check_sweep_size(spec, "boundary", false);
     const std::string prefix = args.out.prepare("boundary", {".csv", ".json"});
-    const SweepResult sw = run_sweep(spec);
+    ExecutionPolicy policy;
+    policy.progress = progress_printer("boundary", "seed-grid rows");
+    const SweepResult sw = run_sweep(spec, policy);
     const BoundarySet b = trace_boundaries(sw);
     JsonEnvelope e;
     e.command = "boundary";

@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/io/calibration_report.hpp"
 #include "ddemap/io/csv.hpp"
@@ -80,6 +81,7 @@ void add_calibrate_flags(CLI::App& app) {
     app.add_option("--gap-weight", args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
     args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
     args.format.add_to(app);
+    run_flags().add_to(app, false);
 }
 
 namespace {
@@ -142,7 +144,7 @@ int run_calibrate() {
     }
     // one progress line per finished fit: ddemap: calibrate: 3/12 fits done (NAME, 0.41 s)
     CarFinished finished;
-    if (cars.size() > 1)
+    if (cars.size() > 1 && !run_flags().quiet)
         finished = [](const CarCalibration& c, long done, long total) {
             std::cerr << "ddemap: calibrate: " << done << "/" << total << " fits done (" << c.car << ", " << rounded(c.fit.seconds, 2) << " s)\n";
         };

@@ -3,6 +3,8 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
+#include "sweep_flags.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/io/svg.hpp"
 
@@ -20,13 +22,17 @@ void add_chart_flags(CLI::App& app) {
     app.add_option("SPEC", args.spec, "chart specification (TOML)")->required();
     args.out.add_to(app, "PREFIX.svg", true);
     args.format.add_to(app, {Format::Table, Format::Json});
+    run_flags().add_to(app, true);
 }
 
 int run_chart() {
     const Format format = args.format.parse();
     const std::string prefix = args.out.prepare("chart", {".svg"});
     const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", args.spec), args.spec);
-    const RenderedChart r = render_chart(spec);
+    if (!spec.panels.empty()) check_sweep_size(panel_sweep(spec, 0), "chart", false, spec.panels.size());  // panels share the window and ring
+    ExecutionPolicy policy;
+    policy.progress = progress_printer("chart", "panels");
+    const RenderedChart r = render_chart(spec, policy);
     write_files_atomic({{prefix + ".svg", r.svg}});
     if (format == Format::Json) {
         JsonEnvelope e;

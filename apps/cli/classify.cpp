@@ -6,6 +6,8 @@
 #include "builtin_maps.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
+#include "sweep_flags.hpp"
 #include "tables.hpp"
 #include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/analysis/classify.hpp"
@@ -40,6 +42,7 @@ void add_classify_flags(CLI::App& app) {
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
     app.add_option("--svg", args.svg, "old spelling: write only the figure to this file")->group("");
+    run_flags().add_to(app, true);
 }
 
 int run_classify() {
@@ -56,6 +59,12 @@ int run_classify() {
     } else {
         vehicles = vehicles_argument("VEHICLES", args.file);
         source = args.file;
+    }
+    const bool figure = !prefix.empty() || !svg_file.empty();
+    ChartSpec chart;
+    if (figure) {
+        chart = classification_chart(parse_chart_spec(builtin_classification_toml, "maps/classification.toml"), vehicles, cars, args.file);
+        if (!chart.panels.empty()) check_sweep_size(panel_sweep(chart, 0), "classify", false, chart.panels.size());
     }
     UncertaintyOptions uo;
     uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
@@ -87,9 +96,10 @@ int run_classify() {
     }
     e.status = to_string(status);
     const std::string csv = classification_csv(rows);
-    if (!prefix.empty() || !svg_file.empty()) {
-        const ChartSpec base = parse_chart_spec(builtin_classification_toml, "maps/classification.toml");
-        const std::string svg = render_chart(classification_chart(base, vehicles, cars, args.file)).svg;
+    if (figure) {
+        ExecutionPolicy policy;
+        policy.progress = progress_printer("classify", "panels");
+        const std::string svg = render_chart(chart, policy).svg;
         if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", svg}});
         else write_files_atomic({{svg_file, svg}});
     }

@@ -6,6 +6,7 @@
 #include "builtin_maps.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "tables.hpp"
 #include "ddemap/io/paper.hpp"
 #include "ddemap/io/svg.hpp"
@@ -25,12 +26,14 @@ void add_paper_flags(CLI::App& app) {
                     "PREFIX-panelK-boundaries.csv, PREFIX-growth.csv/.svg (a folder DIR: DIR/paper...)",
                     true);
     args.format.add_to(app, {Format::Table, Format::Json});
+    run_flags().add_to(app, false);
 }
 
 int run_paper() {
     const Format format = args.format.parse();
     const std::string prefix = args.out.prepare("paper", {".svg", ".json", "-classification.csv", "-classification.json", "-classification.svg", "-growth.csv", "-growth.svg"});
-    const PaperJob job = run_paper_job(builtin_paper_toml, "maps/paper.toml", builtin_classification_toml, "maps/classification.toml");
+    const PaperJob job = run_paper_job(builtin_paper_toml, "maps/paper.toml", builtin_classification_toml, "maps/classification.toml", {},
+                                       progress_printer("paper", "steps"));
     JsonEnvelope e;
     e.command = "paper";
     e.inputs = JsonObject().string("out", prefix).json("ring", json_ring(job.study.options.cars)).string("lead", job.study.options.lead)

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "fleet_flags.hpp"
+#include "limits.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
@@ -54,7 +55,16 @@ int run_system(Format format, const std::string& prefix) {
     std::string equilibrium_json, equilibrium_line;
     Status eq_status = Status::Converged;
     const std::optional<LinearDDE> lin = [&] {
-        if (!is_nonlinear_system_json(text)) return std::optional<LinearDDE>(read_linear_dde_json(text, args.system));
+        if (!is_nonlinear_system_json(text)) {
+            // every matrix is held dense (16 n^2 bytes each) and its norm taken by a full SVD
+            // (about 64 n^2 bytes and 2e-9 n^3 s each, measured)
+            const LinearDdeShape shape = peek_linear_dde_json(text, args.system);
+            const double n = static_cast<double>(std::max(shape.dimension, 0L)), terms = static_cast<double>(shape.delays) + 1.0;
+            const std::string what = "a " + std::to_string(shape.dimension) + "-state system with " + std::to_string(shape.delays) + (shape.delays == 1 ? " delay" : " delays");
+            check_size("roots", what, "memory", n * n * (16.0 * terms + 64.0));
+            check_size("roots", what, "time", 2e-9 * n * n * n * terms);
+            return std::optional<LinearDDE>(read_linear_dde_json(text, args.system));
+        }
         // a nonlinear file: its equilibrium by Newton from the file's guess, then the linearisation there
         const NonlinearSystemFile file = read_nonlinear_system_json(text, args.system);
         const EquilibriumResult eq = find_equilibrium(*file.system, file.equilibrium);
@@ -106,7 +116,8 @@ int run_system(Format format, const std::string& prefix) {
     out << equilibrium_line;
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << "trusted    " << r.message << "\n";
-    out << "abscissa   " << rounded(s.spectral_abscissa, 10) << "\n";
+    // no root computed (an empty spectrum or a failed solver): the table says so, never "-inf"
+    out << "abscissa   " << (std::isfinite(s.spectral_abscissa) ? rounded(s.spectral_abscissa, 10) : std::string("none (no root was computed)")) << "\n";
     out << "verdict    " << verdict_word(s.verdict);
     if (s.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";
     else if (s.verdict == Verdict::Marginal) out << " (roots on the imaginary axis to rounding: not asymptotically stable)";
@@ -242,6 +253,7 @@ void add_roots_flags(CLI::App& app) {
     app.add_option("--degree", args.degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")
         ->capture_default_str();
     args.format.add_to(app);
+    run_flags().add_to(app, true);
     args.out.add_to(app, "PREFIX.csv (the roots) and PREFIX.json", false);
 }
 

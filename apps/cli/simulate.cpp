@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "lead_flags.hpp"
+#include "limits.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
@@ -33,6 +34,7 @@ void add_simulate_flags(CLI::App& app) {
     app.add_option("--step", args.step, "largest integration step [s]")->capture_default_str();
     app.add_option("--output-dt", args.output_dt, "output sampling [s]")->capture_default_str();
     args.format.add_to(app);
+    run_flags().add_to(app, true);
 }
 
 int run_simulate() {
@@ -49,6 +51,13 @@ int run_simulate() {
     std::string label;
     const LeadProfile lead = args.lead.parse(label);
     const std::vector<SimCar> cars = platoon_from(vehicles_argument("--fleet", args.fleet));
+    const SimEstimate size = estimate_simulation(lead, cars, o);
+    const std::string what = std::to_string(cars.size()) + " followers over " + rounded(size.t_end, 6) + " s (" +
+                             rounded(size.steps, 3) + " steps)";
+    check_size("simulate", what, "memory", size.memory_bytes);
+    check_size("simulate", what, "output", size.output_bytes);
+    check_size("simulate", what, "time", size.car_steps * 2e-6);  // about 2 us per car and step (measured)
+    o.progress = progress_printer("simulate", "ms simulated");
     const SimResult r = simulate_platoon(lead, cars, o);
     JsonEnvelope e;
     e.command = "simulate";
@@ -60,6 +69,8 @@ int run_simulate() {
                    .number("step", o.step)
                    .number("output_dt", o.output_dt)
                    .str();
+    e.status = to_string(r.status);
+    e.message = r.message;
     e.result = simulation_json(r, label);
     const std::string csv = simulation_csv(r);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", simulation_svg(r, label)}});
@@ -77,6 +88,10 @@ int run_simulate() {
         s << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << s.str();
     });
+    if (r.status != Status::Converged) {
+        std::cerr << "ddemap: simulate: UNDECIDED: " << r.message << "\n";
+        return exit_not_converged;
+    }
     return exit_ok;
 }
 

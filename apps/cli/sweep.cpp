@@ -1,6 +1,4 @@
 // sweep: a grid over two model parameters (LO:HI:COUNT), the boundaries, the chart.
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -8,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "sweep_flags.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/svg.hpp"
@@ -24,12 +23,6 @@ struct Args {
     FormatArg format;
     OutArg out;
 } args;
-
-void progress_line(int done, int total) {
-    std::fprintf(stderr, "\rsweep: %d/%d rows", done, total);
-    if (done == total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-}
 }  // namespace
 
 void add_sweep_flags(CLI::App& app) {
@@ -39,14 +32,16 @@ void add_sweep_flags(CLI::App& app) {
     app.add_option("--x", args.x, "which swept parameter is the horizontal axis (default: alphabetical)");
     app.add_flag("--no-boundaries", args.no_boundaries, "skip the boundary continuation");
     args.format.add_to(app);
+    run_flags().add_to(app, true);
 }
 
 int run_sweep() {
     const Format format = args.format.parse();
     const SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
+    check_sweep_size(spec, "sweep", true);
     const std::string prefix = args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
-    if (isatty(2)) policy.progress = progress_line;
+    policy.progress = progress_printer("sweep", "rows");
     const SweepResult sw = run_sweep(spec, policy);
     BoundarySet b;
     if (!args.no_boundaries) b = trace_boundaries(sw);

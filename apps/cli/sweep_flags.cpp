@@ -1,8 +1,10 @@
 #include "sweep_flags.hpp"
 
 #include "ddemap/io/svg.hpp"
+#include "limits.hpp"
 
 #include <algorithm>
+#include <string>
 #include <sstream>
 
 namespace ddemap::cli {
@@ -33,6 +35,16 @@ SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::str
     spec.cars = ring.parse();
     spec.validate();
     return spec;
+}
+
+void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels) {
+    const double points = static_cast<double>(spec.x.count) * static_cast<double>(spec.y.count) * static_cast<double>(panels);
+    const double modes = spec.cars == 0 ? 12.0 : spec.cars / 2 + 1.0;  // N = inf: a frequency scan, about 12 modes' work
+    const std::string what = (panels > 1 ? std::to_string(panels) + " panels of " : std::string()) + "a " + std::to_string(spec.x.count) + " x " + std::to_string(spec.y.count) + " grid" +
+                             (spec.cars > 0 ? " of a " + std::to_string(spec.cars) + "-car ring" : std::string());
+    check_size(command, what, "memory", points * (600.0 + 16.0 * modes));
+    if (writes_grid) check_size(command, what, "output", points * 180.0);
+    check_size(command, what, "time", points * modes * 5e-5 / std::max(1, thread_count()));
 }
 
 std::string fixed_title(const SweepSpec& spec) {

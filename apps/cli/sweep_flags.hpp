@@ -10,6 +10,12 @@ namespace ddemap::cli {
 /// `counts`: axes given as LO:HI:COUNT (sweep), else LO:HI with `grid` points (boundary).
 SweepSpec sweep_spec(const ModelArgs& model, const RingArg& ring, const std::string& x_name, bool counts, int grid);
 
+/// Refuses a grid whose estimated memory, CSV or run time is above the limits of limits.hpp
+/// (before any work): per point about 600 bytes + 16 per ring mode in memory, 180 bytes of CSV
+/// (`writes_grid`) and 5e-5 s per mode on one core (measured, BENCHMARKS.md).
+/// `panels`: that many grids of this size (a chart).
+void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels = 1);
+
 /// "ovrv, th = 1.5, tau = 0.5, N = 22"
 std::string fixed_title(const SweepSpec& spec);
 

@@ -107,6 +107,24 @@ void SimOptions::validate() const {
     if (!(std::isfinite(step) && step > 0.0 && step <= 1.0)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 1 s");
     if (!(std::isfinite(t_end) && t_end >= 0.0)) throw std::invalid_argument("t_end = " + detail::format_number(t_end) + ": expected >= 0");
     if (!(std::isfinite(output_dt) && output_dt > 0.0)) throw std::invalid_argument("output_dt = " + detail::format_number(output_dt) + ": expected > 0");
+    if (!(std::isfinite(max_speed) && max_speed > 0.0)) throw std::invalid_argument("max_speed = " + detail::format_number(max_speed) + ": expected > 0");
+}
+
+SimEstimate estimate_simulation(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options) {
+    options.validate();
+    SimEstimate e;
+    const double n = static_cast<double>(cars.size());
+    double h = options.step;
+    for (const auto& c : cars)
+        if (c.model && c.model->delay() > 0.0) h = std::min(h, c.model->delay());
+    e.t_end = options.t_end > 0.0 ? options.t_end : lead.duration() + 30.0;
+    const double marks = static_cast<double>(lead.times().size()) * (1.0 + n);
+    e.steps = std::ceil(e.t_end / h) + marks;
+    e.samples = std::floor(e.t_end / options.output_dt) + 1.0;
+    e.car_steps = e.steps * std::max(n, 1.0);
+    e.output_bytes = e.samples * (n + 1.0) * (75.0 + 16.0);
+    e.memory_bytes = e.steps * (4.0 * n + 1.0) * 8.0 * 1.5 + marks * 16.0 + e.samples * (3.0 * (n + 1.0) + 1.0) * 8.0 + 2.0 * e.output_bytes;
+    return e;
 }
 
 std::vector<SimCar> platoon_from(const std::vector<CalibratedVehicle>& vehicles) {
@@ -190,9 +208,23 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
     std::vector<double> prev(solver.state(), solver.state() + 2 * n);
     double t_prev = 0.0;
     bool stop = false;
+    const long progress_total = static_cast<long>(std::min(t_end * 1e3, 9e15));
     auto after = [&](const DdeSolver& sol) {
         const double t = sol.time();
         const double* y = sol.state();
+        for (int i = 0; i < 2 * n; ++i) {
+            const bool speed = i % 2 == 1;
+            if (!std::isfinite(y[i]) || (speed && std::abs(y[i]) > options.max_speed)) {
+                r.status = Status::NumericalIssue;
+                r.diverged_at = t;
+                r.message = "the solution diverged at t = " + detail::format_number(t) + " s: follower " + std::to_string(i / 2 + 1) + "'s " +
+                            (speed ? "speed" : "gap") + " reached " + detail::format_number(y[i]) + (speed ? " m/s" : " m") +
+                            " (|speed| above " + detail::format_number(options.max_speed) +
+                            " m/s or a non-finite state); the output ends at the last step before, t = " + detail::format_number(t_prev) + " s";
+                return false;
+            }
+        }
+        if (options.progress) options.progress(static_cast<long>(std::min(t * 1e3, 9e15)), progress_total);
         for (int i = 0; i < n; ++i) {
             const double s = y[2 * i], v = y[2 * i + 1];
             auto& c = r.cars[i];
@@ -230,7 +262,7 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
     }
     solver.integrate(t_end, h, marks, after);
     r.stopped = stop;
-    r.t_end = solver.time();
+    r.t_end = r.status == Status::Converged ? solver.time() : t_prev;
     r.steps = solver.steps();
     std::sort(r.events.begin(), r.events.end(), [](const SimEvent& a, const SimEvent& b) { return a.time < b.time; });
     for (auto& c : r.cars) c.speed_drop = v0 - c.min_speed;
@@ -246,10 +278,13 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
         r.time.push_back(t);
         r.position[0][k] = lead.position(t);
         r.speed[0][k] = lead.speed(t);
+        // after a divergence the stored step past t_end is not finite: the last sample takes
+        // the state at t_end itself
+        const bool last_good = r.status != Status::Converged && t >= r.t_end;
         for (int i = 1; i <= n; ++i) {
-            const double s = solver.value(2 * (i - 1), t);
+            const double s = last_good ? prev[2 * (i - 1)] : solver.value(2 * (i - 1), t);
             r.gap[i][k] = s;
-            r.speed[i][k] = solver.value(2 * (i - 1) + 1, t);
+            r.speed[i][k] = last_good ? prev[2 * (i - 1) + 1] : solver.value(2 * (i - 1) + 1, t);
             r.position[i][k] = r.position[i - 1][k] - s;
         }
     }

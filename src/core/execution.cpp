@@ -36,20 +36,21 @@ void parallel_for(long count, const std::function<void(long)>& task, const Execu
     long done = 0;
     long failed_at = std::numeric_limits<long>::max();
     std::exception_ptr failure;
-    auto run = [&](long i) {
+    // Nothing may leave run(): an exception escaping an OpenMP region terminates the program.
+    // The task's and the progress callback's exceptions are kept (the lowest index wins).
+    auto run = [&](long i) noexcept {
         try {
             task(i);
+            if (policy.progress) {
+                std::lock_guard<std::mutex> guard(lock);
+                policy.progress(++done, count);
+            }
         } catch (...) {
             std::lock_guard<std::mutex> guard(lock);
             if (i < failed_at) {
                 failed_at = i;
                 failure = std::current_exception();
             }
-            return;
-        }
-        if (policy.progress) {
-            std::lock_guard<std::mutex> guard(lock);
-            policy.progress(++done, count);
         }
     };
     const int threads = thread_count(policy);

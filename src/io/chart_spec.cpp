@@ -126,9 +126,22 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     }
     spec.x = read_axis(source, root, "x");
     spec.y = read_axis(source, root, "y");
-    if (auto c = root["columns"].value<int64_t>()) spec.columns = static_cast<int>(std::max<int64_t>(1, *c));
-    if (const toml::node* w = root.get("panel_width")) spec.panel_width = number(source, *w, "panel_width");
-    if (const toml::node* h = root.get("panel_height")) spec.panel_height = number(source, *h, "panel_height");
+    if (const toml::node* c = root.get("columns")) {
+        const auto v = c->value<int64_t>();
+        if (!v || *v < 1 || *v > 64) throw std::invalid_argument(where(source, *c) + ": columns: expected an integer from 1 to 64");
+        spec.columns = static_cast<int>(*v);
+    }
+    // panel sizes in px: a finite figure (never width="inf" or a negative width in the SVG)
+    auto size = [&](const char* key, double& out) {
+        if (const toml::node* n = root.get(key)) {
+            out = number(source, *n, key);
+            if (!(out >= 40.0 && out <= 4000.0)) {
+                throw std::invalid_argument(where(source, *n) + ": " + key + " = " + short_number(out) + ": expected 40 to 4000 (px)");
+            }
+        }
+    };
+    size("panel_width", spec.panel_width);
+    size("panel_height", spec.panel_height);
     if (auto b = root["boundaries"].value<bool>()) spec.boundaries = *b;
     if (const toml::node* v = root.get("vehicles")) {
         if (v->value<std::string>() != std::optional<std::string>("paper")) {
@@ -180,7 +193,9 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     return spec;
 }
 
-RenderedChart render_chart(const ChartSpec& spec) {
+RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy) {
+    ExecutionPolicy per_panel = policy;
+    per_panel.progress = nullptr;
     const auto t0 = std::chrono::steady_clock::now();
     RenderedChart out;
     const std::size_t n = spec.panels.size();
@@ -189,8 +204,9 @@ RenderedChart render_chart(const ChartSpec& spec) {
     out.boundaries.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         out.specs[i] = panel_sweep(spec, i);
-        out.sweeps[i] = run_sweep(out.specs[i]);
+        out.sweeps[i] = run_sweep(out.specs[i], per_panel);
         if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i]);
+        if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(n));
     }
     std::vector<ChartPanel> panels(n);
     for (std::size_t i = 0; i < n; ++i) {

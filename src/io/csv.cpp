@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 #include <sstream>
 
 namespace ddemap {
 
 std::string format_exact(double v) {
+    if (!std::isfinite(v)) throw std::logic_error("a non-finite number (" + std::to_string(v) + ") reached a CSV output");
     char b[40];
     std::snprintf(b, sizeof b, "%.17g", v == 0.0 ? 0.0 : v);
     return b;

@@ -348,6 +348,7 @@ std::string simulation_json(const SimResult& r, const std::string& lead) {
     j["initial_speed"] = num(r.initial_speed);
     j["t_end"] = num(r.t_end);
     j["stopped_at_event"] = r.stopped;
+    j["diverged_at"] = r.status == Status::Converged ? json(nullptr) : num(r.diverged_at);
     j["steps"] = r.steps;
     json cs = json::array();
     for (const auto& c : r.cars) {

@@ -11,13 +11,20 @@ const char* table_source = "the paper's calibration table (built in)";
 }
 
 PaperJob run_paper_job(const std::string& paper_toml, const std::string& paper_source, const std::string& classification_toml,
-                       const std::string& classification_source, const PaperStudyOptions& options) {
+                       const std::string& classification_source, const PaperStudyOptions& options, const Progress& progress) {
     PaperJob job;
-    job.study = run_paper_study(options);
-    const ChartSpec base = parse_chart_spec(classification_toml, classification_source);
-    job.classification = render_chart(classification_chart(base, paper_calibration_table(), options.cars));
+    // units of progress: the study, then every panel of the two charts
+    const ChartSpec classes = classification_chart(parse_chart_spec(classification_toml, classification_source), paper_calibration_table(), options.cars);
     job.figure_spec = parse_chart_spec(paper_toml, paper_source);
-    job.figure = render_chart(job.figure_spec);
+    const long total = 1 + static_cast<long>(classes.panels.size() + job.figure_spec.panels.size());
+    long before = 0;
+    ExecutionPolicy charts;
+    if (progress) charts.progress = [&](long done, long) { progress(before + done, total); };
+    job.study = run_paper_study(options);
+    if (progress) progress(++before, total);
+    job.classification = render_chart(classes, charts);
+    before += static_cast<long>(classes.panels.size());
+    job.figure = render_chart(job.figure_spec, charts);
     job.seconds = job.figure.seconds + job.classification.seconds;
     return job;
 }

@@ -29,6 +29,7 @@ std::string esc(const std::string& s) {
 }
 
 std::string num(double v) {
+    if (!std::isfinite(v)) throw std::logic_error("a non-finite number (" + std::to_string(v) + ") reached an SVG coordinate");
     char b[32];
     std::snprintf(b, sizeof b, "%.2f", v);
     return b;

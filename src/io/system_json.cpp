@@ -17,15 +17,26 @@ using json = nlohmann::json;
     throw std::invalid_argument(source + ": " + field + ": " + what);
 }
 
+/// The documented coefficient range (README "--system"): 0 or a magnitude from 1e-100 to 1e100.
+/// Beyond it the eigenvalue solvers lose every digit (1e300 next to 1e-300 made the Schur
+/// decomposition fail), so such a file is bad input.
+void check_range(double x, const std::string& source, const std::string& field) {
+    const double a = std::abs(x);
+    if (!std::isfinite(x) || (a != 0.0 && (a < 1e-100 || a > 1e100))) {
+        fail(source, field, detail::format_number(x) + ": expected 0 or a finite magnitude from 1e-100 to 1e100");
+    }
+}
+
 cplx value_of(const json& v, const std::string& source, const std::string& field) {
     if (v.is_number()) {
         const double x = v.get<double>();
-        if (!std::isfinite(x)) fail(source, field, "expected a finite number");
+        check_range(x, source, field);
         return x;
     }
     if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number()) {
         const double re = v[0].get<double>(), im = v[1].get<double>();
-        if (!std::isfinite(re) || !std::isfinite(im)) fail(source, field, "expected finite [re, im]");
+        check_range(re, source, field + "[0]");
+        check_range(im, source, field + "[1]");
         return {re, im};
     }
     fail(source, field, "expected a number or [re, im]");
@@ -60,6 +71,22 @@ MatrixXc matrix_of(const json& m, int n, const std::string& source, const std::s
 
 }  // namespace
 
+LinearDdeShape peek_linear_dde_json(const std::string& text, const std::string& source) {
+    json j;
+    try {
+        j = json::parse(text, [](int depth, json::parse_event_t, json&) { return depth <= 2; });
+    } catch (const json::parse_error& e) {
+        throw std::invalid_argument(source + ": not valid JSON (" + std::string(e.what()) + ")");
+    } catch (const json::out_of_range& e) {
+        throw std::invalid_argument(source + ": a number outside the range of doubles (" + std::string(e.what()) + ")");
+    }
+    LinearDdeShape s;
+    if (!j.is_object()) return s;
+    if (j.contains("dimension") && j["dimension"].is_number_integer()) s.dimension = j["dimension"].get<long>();
+    if (j.contains("delays") && j["delays"].is_array()) s.delays = j["delays"].size();
+    return s;
+}
+
 LinearDDE read_linear_dde_json(const std::string& text, const std::string& source) {
     json j;
     try {
@@ -90,6 +117,7 @@ LinearDDE read_linear_dde_json(const std::string& text, const std::string& sourc
             if (!d.is_number()) fail(source, f, "expected a number");
             const double x = d.get<double>();
             if (!std::isfinite(x) || x < 0.0) fail(source, f, detail::format_number(x) + ": expected a finite delay >= 0");
+            if (x > 1e100) fail(source, f, detail::format_number(x) + ": expected a delay of at most 1e100");
             delays.push_back(x);
         }
     }

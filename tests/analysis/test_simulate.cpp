@@ -164,3 +164,46 @@ TEST_CASE("one minimum ACC speed rule for built-in and CSV vehicles (platoon_fro
 }
 
 TEST_SUITE_END();
+
+TEST_CASE("a diverging platoon stops with a status and the time, and outputs only finite values") {
+    // k1 = k2 = 1000 with tau = 0.5: the linearised plant is unstable, so the nonlinear solution
+    // grows without bound (the speeds overflow to inf within seconds)
+    const ParameterMap p{{"k1", 1000.0}, {"k2", 1000.0}, {"th", 1.5}, {"tau", 0.5}, {"eta", 10.0}};
+    const auto m = std::shared_ptr<const CarModel>(make_model("ovrv", p));
+    CHECK_FALSE(analyse_string(m->linearise()).plant_stable);
+    const std::vector<SimCar> cars(2, SimCar{m, 0.0, "x"});
+    const SimResult r = simulate_platoon(LeadProfile::builtin("dip"), cars);
+    CHECK(r.status == Status::NumericalIssue);
+    CHECK(r.diverged_at > 0.0);
+    CHECK(r.t_end < r.diverged_at);
+    CHECK(r.message.find("diverged at t = ") != std::string::npos);
+    REQUIRE_FALSE(r.time.empty());
+    CHECK(r.time.back() <= r.t_end);
+    const SimOptions defaults;
+    for (std::size_t c = 0; c < r.speed.size(); ++c)
+        for (std::size_t k = 0; k < r.time.size(); ++k) {
+            CHECK(std::isfinite(r.position[c][k]));
+            CHECK(std::abs(r.speed[c][k]) <= defaults.max_speed);
+            if (c > 0) CHECK(std::isfinite(r.gap[c][k]));
+        }
+    for (const auto& c : r.cars) CHECK((std::isfinite(c.min_speed) && std::isfinite(c.min_gap)));
+}
+
+TEST_CASE("the simulation estimate bounds the steps the run takes and counts its output samples") {
+    const auto& a_min = paper_calibration_table()[0];
+    SimOptions o;
+    o.step = 0.05;
+    const auto cars = platoon_of(a_min, 3);
+    const LeadProfile lead = LeadProfile::builtin("dip");
+    const SimEstimate e = estimate_simulation(lead, cars, o);
+    const SimResult r = simulate_platoon(lead, cars, o);
+    CHECK(r.status == Status::Converged);
+    CHECK(e.t_end == r.t_end);
+    CHECK(static_cast<double>(r.steps) <= e.steps);
+    CHECK(static_cast<double>(r.steps) >= e.t_end / o.step);  // at least t_end / h steps
+    CHECK(e.samples == static_cast<double>(r.time.size()));
+    CHECK(e.car_steps == e.steps * 3);
+    // --t-end 1e9 is sized (and can be refused) before any memory is taken
+    o.t_end = 1e9;
+    CHECK(estimate_simulation(lead, cars, o).memory_bytes > 1e12);
+}

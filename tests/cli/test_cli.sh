@@ -718,5 +718,53 @@ EOF2
 timeout 30 "$bin" simulate --fleet A_min --t-end 20 --out "$tmp/flat" >/dev/null && [ "$(grep -c '<text' "$tmp/flat.svg")" -lt 200 ] &&
     ok || bad "simulate --t-end 20: a flat speed plot finishes with a bounded number of ticks"
 
+# Bounded and visible (README "Limits and progress"): sizes refused before any work, no NaN or inf
+expect_error "estimated" sweep --th 1.5 --tau 0.5 --k1 0:1:5000 --k2 0:1:5000 --out "$tmp/big"
+expect_error "memory" sweep --th 1.5 --tau 0.5 --k1 0:1:100000 --k2 0:1:100000 --out "$tmp/big"   # was std::bad_alloc, exit 3
+[ ! -e "$tmp/big.csv" ] && ok || bad "a refused sweep wrote a file"
+expect_error "1e+09 s" simulate --fleet A_min --t-end 1e9 --out "$tmp/simbig"                      # was exit 3 (vector max_size)
+expect_error "more than this machine has" simulate --fleet A_min --t-end 1e9 --allow-large --out "$tmp/simbig"
+python3 -c "print('time_s,lead_speed_mps'); print('0,20'); print('100000,20')" >"$tmp/longlead.csv"
+expect_error "estimated output files" simulate --fleet A_min --lead "$tmp/longlead.csv" --out "$tmp/simlong"   # was 340 MB written
+printf '{"dimension": 20000, "delays": [1], "A0": {"triplets": []}, "A": [{"triplets": [[0, 0, -1]]}]}\n' >"$tmp/dim20000.json"
+expect_error "20000-state system" roots --system "$tmp/dim20000.json"
+printf '{"dimension": 2, "delays": [1], "A0": [[1e300, 1e-300], [1e-300, -1e300]], "A": [[[1e-300, 1e300], [0, 1]]]}\n' >"$tmp/range.json"
+expect_error "1e-100 to 1e100" roots --system "$tmp/range.json"                # was a Schur decomposition failure
+printf 'title = "t"\nring = 22\nfixed = { th = 1.5, tau = 0.5 }\npanel_width = 1e308\nx = { name = "k1", lo = 0.01, hi = 1, count = 5 }\ny = { name = "k2", lo = 0.01, hi = 1, count = 5 }\n' >"$tmp/wide.toml"
+expect_error "panel_width" chart "$tmp/wide.toml" --out "$tmp/wide"
+sed 's/panel_width = 1e308/panel_width = -300/' "$tmp/wide.toml" >"$tmp/neg.toml"
+expect_error "panel_width" chart "$tmp/neg.toml" --out "$tmp/neg"
+# a constant lead (a flat speed plot): the figure's tick loop once never ended
+python3 -c "print('time_s,lead_speed_mps'); print('0,20'); print('50,20')" >"$tmp/flat.csv"
+timeout 60 "$bin" simulate --fleet A_min --lead "$tmp/flat.csv" --out "$tmp/flat" >/dev/null 2>&1 && xmllint --noout "$tmp/flat.svg" && ok || bad "simulate behind a constant lead"
+# calibrate --train past the end of the file: bad input (once an abort inside a parallel loop)
+python3 -c "
+import math
+print('time_s,lead_speed_mps,follower_speed_mps,gap_m')
+for i in range(2251):
+    t = i * 0.1
+    print(f'{t:.1f},{20 + math.sin(t / 10):.4f},{20 + 0.9 * math.sin(t / 10 - 0.5):.4f},{30 + math.cos(t / 10):.4f}')
+" >"$tmp/t225.csv"
+expect_error "training window 200:300" calibrate "$tmp/t225.csv" "$tmp/t225.csv" --train 200:300
+# a diverging simulation: UNDECIDED with the time, exit 4, no NaN or inf anywhere
+printf 'name,k1,k2,th,tau\nX,1000,1000,1.5,0.5\n' >"$tmp/wild.csv"
+"$bin" simulate --fleet "$tmp/wild.csv" --out "$tmp/wild" --format json >"$tmp/o.txt" 2>"$tmp/e.txt"
+rc=$?
+[ $rc -eq 4 ] && ok || bad "diverging simulate: exit $rc (expected 4)"
+grep -q "UNDECIDED: the solution diverged at t = " "$tmp/e.txt" && ok || bad "diverging simulate: stderr: $(cat "$tmp/e.txt")"
+if grep -qi -E 'nan|inf' "$tmp/o.txt" "$tmp/wild.csv" "$tmp/wild.svg"; then bad "NaN/inf in a diverged simulation's output"; else ok; fi
+python3 -c "
+import json, sys
+d = json.load(open('$tmp/o.txt'))
+assert d['status'] == 'numerical_issue', d['status']
+assert d['result']['diverged_at'] > d['result']['t_end'] > 0
+" && ok || bad "diverging simulate: json status"
+# progress: one line per finished unit on a non-terminal stderr, nothing with --quiet, stdout untouched
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:6 --k2 0.01:1:7 --no-boundaries --out "$tmp/pr" >"$tmp/o.txt" 2>"$tmp/e.txt"
+[ "$(grep -c -E '^ddemap: sweep: rows [0-9]+/7 \(' "$tmp/e.txt")" -eq 7 ] && ok || bad "progress lines: $(cat "$tmp/e.txt")"
+grep -q "ddemap:" "$tmp/o.txt" && bad "progress on stdout" || ok
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:6 --k2 0.01:1:7 --no-boundaries --quiet --out "$tmp/pr" >/dev/null 2>"$tmp/e.txt"
+[ ! -s "$tmp/e.txt" ] && ok || bad "--quiet still printed: $(cat "$tmp/e.txt")"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

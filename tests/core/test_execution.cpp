@@ -47,6 +47,22 @@ TEST_CASE("parallel_for rethrows the exception of the lowest failing task on the
     }
 }
 
+TEST_CASE("a throwing progress callback or a non-standard exception never leaves the parallel region") {
+    for (int threads : {1, 2, 4}) {
+        ExecutionPolicy policy;
+        policy.threads = threads;
+        policy.progress = [](long done, long) {
+            if (done == 5) throw std::runtime_error("progress 5");
+        };
+        CHECK_THROWS_WITH_AS(parallel_for(100, [](long) {}, policy), "progress 5", std::runtime_error);
+        ExecutionPolicy plain;
+        plain.threads = threads;
+        CHECK_THROWS_AS(parallel_for(100, [](long i) {
+            if (i == 60) throw 42;  // not derived from std::exception
+        }, plain), int);
+    }
+}
+
 TEST_CASE("parallel_reduce is bitwise the same for any number of threads") {
     // a sum whose value depends on the order of the additions
     std::mt19937 rng(7);

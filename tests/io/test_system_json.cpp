@@ -59,6 +59,23 @@ TEST_CASE("bad system files name the field") {
                          "s.json: B: unknown field (expected dimension, delays, A0, A, comment)", std::invalid_argument);
 }
 
+
+TEST_CASE("system coefficients outside 1e-100..1e100 in magnitude are bad input (the Schur decomposition once failed on them)") {
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 2, "delays": [1], "A0": [[1e300, 1e-300], [1e-300, -1e300]], "A": [[[0,0],[0,1]]]})", "s.json"),
+                         "s.json: A0[0][0]: 1e+300: expected 0 or a finite magnitude from 1e-100 to 1e100", std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 1, "delays": [1], "A0": [[-1]], "A": [{"triplets": [[0, 0, [1, 1e-300]]]}]})", "s.json"),
+                         doctest::Contains("A[0].triplets[0][1]: 1e-300"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_linear_dde_json(R"({"dimension": 1, "delays": [1e200], "A0": [[-1]], "A": [[[0]]]})", "s.json"),
+                         doctest::Contains("at most 1e100"), std::invalid_argument);
+    // the edges of the range are accepted, and 0 is
+    CHECK(read_linear_dde_json(R"({"dimension": 1, "delays": [1], "A0": [[-1e100]], "A": [[[1e-100]]]})", "s.json").dimension() == 1);
+    // the shape is read without the matrices
+    const LinearDdeShape shape = peek_linear_dde_json(R"({"dimension": 20000, "delays": [1, 2], "A0": {"triplets": []}})", "s.json");
+    CHECK(shape.dimension == 20000);
+    CHECK(shape.delays == 2);
+    CHECK_THROWS_WITH_AS(peek_linear_dde_json(R"({"dimension": 1e400})", "s.json"), doctest::Contains("outside the range of doubles"), std::invalid_argument);
+}
+
 TEST_SUITE_END();
 
 TEST_CASE("a nonlinear system file: expressions, parameter order, equilibrium guess, errors naming the file and field") {

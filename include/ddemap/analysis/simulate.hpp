@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
+#include "ddemap/core/status.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 
@@ -54,6 +56,11 @@ struct SimOptions {
     double t_end = 0.0;        ///< 0: the lead profile's last breakpoint plus 30 s
     double output_dt = 0.1;    ///< output sampling [s]
     OnEvent on_event = OnEvent::Continue;
+    /// A follower whose |speed| exceeds this [m/s], or any non-finite state, has diverged: the
+    /// simulation stops there with Status::NumericalIssue (no non-finite value is output).
+    double max_speed = 1e4;
+    /// (simulated time done, t_end), both in milliseconds, after each step (may be empty).
+    Progress progress;
     void validate() const;
 };
 
@@ -86,7 +93,26 @@ struct SimResult {
     double t_end = 0.0;
     bool stopped = false;                         ///< ended early at an event (OnEvent::Stop)
     std::size_t steps = 0;
+    /// Converged, or NumericalIssue when the solution diverged (see SimOptions::max_speed): the
+    /// output then ends at t_end, the last step before `diverged_at`, and `message` says why.
+    Status status = Status::Converged;
+    std::string message;
+    double diverged_at = 0.0;                     ///< time of the step that diverged (0: none)
 };
+
+/// The size of a simulation, known before it runs: steps ~ t_end / min(step, smallest delay)
+/// plus the breakpoints, output samples = t_end / output_dt + 1; memory = the stored steps
+/// (2 x 2n + 1 doubles each, x 1.5 for vector growth) + the output arrays (3 (n + 1) doubles
+/// per sample) + the files in memory; output = 75 bytes of CSV + 16 of SVG per car and sample.
+struct SimEstimate {
+    double t_end = 0.0;         ///< the end time the run will use [s]
+    double steps = 0.0;
+    double samples = 0.0;
+    double car_steps = 0.0;     ///< steps x followers (the work)
+    double memory_bytes = 0.0;
+    double output_bytes = 0.0;
+};
+SimEstimate estimate_simulation(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options = {});
 
 SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options = {});
 

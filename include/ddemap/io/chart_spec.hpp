@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/study/sweep.hpp"
@@ -52,6 +53,8 @@ struct RenderedChart {
     double seconds = 0.0;
 };
 
-RenderedChart render_chart(const ChartSpec& spec);
+/// Panels run one after the other (each sweep in parallel under `policy`); the policy's
+/// progress counts finished panels.
+RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy = {});
 
 }  // namespace ddemap

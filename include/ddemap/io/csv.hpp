@@ -19,7 +19,7 @@
 
 namespace ddemap {
 
-/// %.17g
+/// %.17g; a non-finite value is an internal error (std::logic_error): no NaN or inf is ever written
 std::string format_exact(double v);
 
 /// One row per grid point: the two axis parameters by name, spectral_abscissa, unstable_roots,

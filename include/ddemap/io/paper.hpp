@@ -22,9 +22,11 @@ struct PaperJob {
 };
 
 /// `paper_toml` and `classification_toml`: the chart specs' text (e.g. maps/paper.toml,
-/// maps/classification.toml); `*_source` names them in errors.
+/// maps/classification.toml); `*_source` names them in errors. `progress` (may be empty) counts
+/// the study, then every panel of the two charts.
 PaperJob run_paper_job(const std::string& paper_toml, const std::string& paper_source, const std::string& classification_toml,
-                       const std::string& classification_source, const PaperStudyOptions& options = {});
+                       const std::string& classification_source, const PaperStudyOptions& options = {},
+                       const Progress& progress = {});
 
 /// The files of the job under PREFIX: PREFIX.svg (the paper's diagrams),
 /// PREFIX-classification.csv/.json/.svg, PREFIX-panelK.csv and PREFIX-panelK-boundaries.csv

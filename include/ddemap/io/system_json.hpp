@@ -20,7 +20,17 @@
 
 namespace ddemap {
 
+/// The size of a system file, read without building the system (so the work can be sized
+/// first): values below the top level's arrays are skipped. 0 for what the text lacks;
+/// std::invalid_argument for text that is not JSON.
+struct LinearDdeShape {
+    long dimension = 0;
+    std::size_t delays = 0;
+};
+LinearDdeShape peek_linear_dde_json(const std::string& text, const std::string& source);
+
 /// Parses the JSON text; std::invalid_argument naming `source` and the field on error.
+/// Coefficients are 0 or of magnitude 1e-100 to 1e100, delays from 0 to 1e100.
 LinearDDE read_linear_dde_json(const std::string& text, const std::string& source);
 
 /// A nonlinear DDE written with expressions (problem/expression.hpp):

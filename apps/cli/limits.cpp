@@ -1,0 +1,100 @@
+#include "limits.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include "common.hpp"
+
+namespace ddemap::cli {
+
+void RunFlags::add_to(CLI::App& app, bool sizes) {
+    if (sizes)
+        app.add_flag("--allow-large", allow_large,
+                     "run even when the estimated memory (2 GB), output (100 MB) or time (10 min) is above its limit "
+                     "(README \"Limits and progress\")")
+            ->group("Run");
+    app.add_flag("--quiet", quiet, "no progress lines on stderr")->group("Run");
+}
+
+RunFlags& run_flags() {
+    static RunFlags flags;
+    return flags;
+}
+
+std::string human_bytes(double bytes) {
+    char b[48];
+    if (bytes >= 1e9) std::snprintf(b, sizeof b, "%.3g GB", bytes / 1e9);
+    else if (bytes >= 1e6) std::snprintf(b, sizeof b, "%.3g MB", bytes / 1e6);
+    else std::snprintf(b, sizeof b, "%.3g kB", bytes / 1e3);
+    return b;
+}
+
+std::string human_seconds(double s) {
+    char b[48];
+    if (s >= 3600) std::snprintf(b, sizeof b, "%.3g h", s / 3600);
+    else if (s >= 60) std::snprintf(b, sizeof b, "%.3g min", s / 60);
+    else std::snprintf(b, sizeof b, "%.2g s", s);
+    return b;
+}
+
+namespace {
+double physical_memory() {
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? static_cast<double>(pages) * static_cast<double>(size) : 0.0;
+}
+}  // namespace
+
+void check_size(const std::string& command, const std::string& what, const std::string& kind, double estimate) {
+    const bool time = kind == "time";
+    const double limit = kind == "memory" ? limit_memory_bytes : kind == "output" ? limit_output_bytes : limit_seconds;
+    auto show = [&](double v) { return time ? human_seconds(v) : human_bytes(v); };
+    const std::string noun = kind == "memory" ? "memory" : kind == "output" ? "output files" : "run time";
+    if (kind == "memory") {
+        const double machine = physical_memory();
+        if (machine > 0 && estimate > machine)
+            throw BadInput(what + ": needs about " + show(estimate) + " of memory, more than this machine has (" + show(machine) + ")");
+    }
+    if (!(estimate > limit)) return;
+    if (!run_flags().allow_large)
+        throw BadInput(what + ": estimated " + noun + " " + show(estimate) + " is above the limit " + show(limit) +
+                       " (--allow-large runs it anyway)");
+    std::fprintf(stderr, "ddemap: %s: note: %s: estimated %s %s (above the limit %s; --allow-large given)\n", command.c_str(),
+                 what.c_str(), noun.c_str(), show(estimate).c_str(), show(limit).c_str());
+}
+
+Progress progress_printer(const std::string& command, const std::string& unit) {
+    if (run_flags().quiet) return nullptr;
+    struct State {
+        std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+        long last_percent = -1;
+        bool shown = false;
+    };
+    auto state = std::make_shared<State>();
+    const bool tty = isatty(2) != 0;
+    // test hook (tests/cli/test_cli.sh): progress from the first unit on
+    const char* hook = std::getenv("DDEMAP_TEST_PROGRESS_AT_ONCE");
+    const double delay = hook && hook[0] == '1' ? 0.0 : 1.0;
+    return [=](long done, long total) {
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - state->start).count();
+        if (elapsed < delay && !state->shown) return;  // short runs print nothing
+        const long percent = total > 0 ? done * 100 / total : 100;
+        if (!tty && percent == state->last_percent && done != total) return;
+        state->last_percent = percent;
+        state->shown = true;
+        char left[64] = "";
+        if (done > 0 && done < total) {
+            const double rest = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
+            std::snprintf(left, sizeof left, ", about %s left", human_seconds(rest).c_str());
+        }
+        std::fprintf(stderr, "%sddemap: %s: %s %ld/%ld (%s%s)%s", tty ? "\r" : "", command.c_str(), unit.c_str(), done, total,
+                     human_seconds(elapsed).c_str(), left, !tty ? "\n" : done == total ? "\033[K\n" : "\033[K");
+        std::fflush(stderr);
+    };
+}
+
+}  // namespace ddemap::cli

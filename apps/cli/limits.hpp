@@ -1,0 +1,45 @@
+#pragma once
+// Bounded and visible work (README "Limits and progress"): the size guard that refuses work
+// whose estimated memory, output or time exceeds a limit before it starts (--allow-large lifts
+// the soft limits, never the machine's memory), and the one progress printer on stderr.
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "ddemap/core/execution.hpp"
+
+namespace ddemap::cli {
+
+/// Soft limits (README "Limits and progress"); --allow-large lifts them.
+constexpr double limit_memory_bytes = 2e9;   ///< estimated memory of one command
+constexpr double limit_output_bytes = 1e8;   ///< estimated size of the files written
+constexpr double limit_seconds = 600.0;      ///< estimated run time (one core)
+
+/// --allow-large and --quiet on a command.
+struct RunFlags {
+    bool allow_large = false;
+    bool quiet = false;
+    /// `sizes`: the command has a size guard (adds --allow-large).
+    void add_to(CLI::App& app, bool sizes);
+};
+
+/// The flags of the command being run (one command runs per process).
+RunFlags& run_flags();
+
+/// Refuses (BadInput, one line naming `what`, the estimate and the limit) when `estimate` is
+/// above `limit` unless --allow-large was given; with it, announces the estimate on stderr.
+/// Memory above the machine's physical memory is refused even with --allow-large.
+/// `kind`: "memory", "output" or "time" (bytes, bytes, seconds).
+void check_size(const std::string& command, const std::string& what, const std::string& kind, double estimate);
+
+/// "1.5 GB", "340 MB", "12 kB"; "2.5 min", "3.1 h".
+std::string human_bytes(double bytes);
+std::string human_seconds(double seconds);
+
+/// The one progress printer: `command: LABEL 12/200 (3.1 s, about 48 s left)` on stderr.
+/// On a terminal one line redrawn in place; otherwise one line per finished unit (at most one
+/// per percent of the work). Silent for the first second (short runs print nothing) and with
+/// --quiet. Returns an empty callback when quiet.
+Progress progress_printer(const std::string& command, const std::string& unit);
+
+}  // namespace ddemap::cli
