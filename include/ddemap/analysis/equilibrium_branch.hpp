@@ -101,7 +101,10 @@ struct EquilibriumBranch {
 };
 
 /// The branch through the equilibrium found from `guess` at p = from. std::invalid_argument for
-/// invalid options, an unknown parameter or a bad guess; non-convergence is a status.
+/// invalid options, an unknown parameter, a bad guess or a system without second derivatives or
+/// delay derivatives (has_higher_derivatives(), has_delay_derivatives(): the exact Jacobians of the
+/// fold and Hopf systems need them); non-convergence is a status. correct_hopf and correct_fold
+/// check the same.
 EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options);
 
 /// The fold system F(z), z = (x, p_j, v) (2n + 1 unknowns):
