@@ -63,9 +63,14 @@ constexpr double expression_vs_hand = 1e-13;
 /// derivative one order lower, step 1e-4: error O(h^2) ~ 1e-8 times the next derivative (<= ~10 here).
 constexpr double higher_derivative_fd = 1e-6;
 /// Fold and Hopf points located by Newton on their defining systems (residual <= 1e-9, the
-/// Jacobian by central differences) against closed forms: the points are regular zeros, so the
+/// exact Jacobian) against closed forms: the points are regular zeros, so the
 /// error is of the order of the residual times the condition (~10 here).
 constexpr double special_point = 1e-8;
+/// Newton on the fold and Hopf systems with their exact Jacobian: r_{k+1} <= C r_k^2 (max-norm
+/// residuals above the rounding floor 1e-12). C is about |F''| |J^{-1}| / 2, measured <= 1.6 for the
+/// scalar test problems (all data O(1)); 10 bounds it, while a Jacobian off by d gives
+/// r_{k+1} ~ d r_k, which breaks the bound once r_k < d / 10.
+constexpr double newton_quadratic = 10.0;
 
 /// A published number printed with 5 significant digits, value in [0.1, 10): half a unit of the
 /// last printed digit is at most 5e-6 (values < 1) or 5e-5 (values in [1, 10)), relative 5e-5.

@@ -61,33 +61,64 @@ private:
     std::vector<double> m_p;
 };
 
-/// Newton on a square system F(z) = 0 with a central-difference Jacobian of F.
-NewtonSummary newton_square(Eigen::VectorXd& z, const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&)>& F,
-                            const NewtonOptions& options) {
+/// Newton on a square system F(z) = 0 with the exact Jacobian J(z) of F; |F|_max at every
+/// iterate where a step was computed is appended to `history`.
+NewtonSummary newton_square(Eigen::VectorXd& z, const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&, Eigen::MatrixXd*)>& F,
+                            const NewtonOptions& options, std::vector<double>& history) {
     return newton(
         z,
         [&](const Eigen::VectorXd& x, Eigen::VectorXd& dx) {
             Eigen::VectorXd f;
-            if (!F(x, f) || !f.allFinite()) return NewtonStep::Singular;
-            if (f.cwiseAbs().maxCoeff() == 0.0) return NewtonStep::Exact;
-            const Eigen::Index m = x.size();
-            Eigen::MatrixXd j(f.size(), m);
-            Eigen::VectorXd xp = x, fp, fm;
-            for (Eigen::Index c = 0; c < m; ++c) {
-                const double h = 1e-6 * std::max(1.0, std::abs(x[c]));
-                xp[c] = x[c] + h;
-                if (!F(xp, fp)) return NewtonStep::Singular;
-                xp[c] = x[c] - h;
-                if (!F(xp, fm)) return NewtonStep::Singular;
-                xp[c] = x[c];
-                j.col(c) = (fp - fm) / (2.0 * h);
-            }
+            Eigen::MatrixXd j;
+            if (!F(x, f, &j) || !f.allFinite()) return NewtonStep::Singular;
+            history.push_back(f.cwiseAbs().maxCoeff());
+            if (history.back() == 0.0) return NewtonStep::Exact;
             const Eigen::FullPivLU<Eigen::MatrixXd> lu(j);
             if (!j.allFinite() || !lu.isInvertible()) return NewtonStep::Singular;
             dx = lu.solve(f);
             return NewtonStep::Ok;
         },
         options);
+}
+
+using Dual1 = Dual<double>;
+using Dual2 = NonlinearDDE::Dual2;
+
+/// f and its derivatives along two directions a = (a_u, a_p), b = (b_u, b_p) of (u, p), from one
+/// evaluation in Dual<Dual<double>> seeded (u + a e1 + b e2, p + a_p e1 + b_p e2):
+/// {f, Df[a], Df[b], D^2 f[a, b]}.
+struct TwoDirections {
+    Eigen::VectorXd f, da, db, dab;
+};
+TwoDirections two_directions(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const Eigen::VectorXd& au,
+                             const Eigen::VectorXd& bu, int bp) {
+    const int n = s.dimension();
+    std::vector<Dual2> U(static_cast<std::size_t>(u.size())), P(p.size()), out(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < u.size(); ++i) U[static_cast<std::size_t>(i)] = Dual2(Dual1(u[i], au[i]), Dual1(bu[i], 0.0));
+    for (std::size_t i = 0; i < p.size(); ++i) P[i] = Dual2(Dual1(p[i], 0.0), Dual1(static_cast<int>(i) == bp ? 1.0 : 0.0, 0.0));
+    s.evaluate(U.data(), P.data(), out.data());
+    TwoDirections r{Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
+    for (int i = 0; i < n; ++i) {
+        const Dual2& o = out[static_cast<std::size_t>(i)];
+        r.f[i] = o.value.value;
+        r.da[i] = o.value.deriv;
+        r.db[i] = o.deriv.value;
+        r.dab[i] = o.deriv.deriv;
+    }
+    return r;
+}
+
+/// Df[w] = sum_k A_k w_k for a stacked direction w.
+Eigen::VectorXd apply_blocks(const std::vector<Eigen::MatrixXd>& a, const Eigen::VectorXd& w) {
+    const Eigen::Index n = a[0].rows();
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(n);
+    for (std::size_t k = 0; k < a.size(); ++k) r += a[k] * w.segment(static_cast<Eigen::Index>(k) * n, n);
+    return r;
+}
+
+void check_derivatives(const NonlinearDDE& s) {
+    if (!s.has_higher_derivatives() || !s.has_delay_derivatives())
+        throw std::invalid_argument("the system gives no second derivatives or no derivatives of its delays: expected an expression system or a built-in model (NonlinearDDEOf)");
 }
 
 std::vector<double> with(const NonlinearDDE& s, int j, double v) {
@@ -118,9 +149,124 @@ bool EquilibriumBranchOptions::is_valid(std::string* why) const {
     return m.empty();
 }
 
+bool fold_system(const NonlinearDDE& system, int j, const Eigen::VectorXd& v0, const Eigen::VectorXd& z, Eigen::VectorXd& out,
+                 Eigen::MatrixXd* jac) {
+    const int n = system.dimension();
+    if (z.size() != 2 * n + 1 || v0.size() != n)
+        throw std::invalid_argument("fold system: z has " + std::to_string(z.size()) + " and v0 " + std::to_string(v0.size()) +
+                                    " entries: expected 2n + 1 and n (n = " + std::to_string(n) + ")");
+    try {
+        const std::vector<double> p = with(system, j, z[n]);
+        const Eigen::VectorXd st = system.stack_constant(z.head(n));
+        const Eigen::VectorXd v = z.segment(n + 1, n);
+        const std::vector<Eigen::MatrixXd> b = system.jacobians(st, p);
+        Eigen::MatrixXd jj = b[0];
+        for (std::size_t k = 1; k < b.size(); ++k) jj += b[k];
+        out.resize(2 * n + 1);
+        out.head(n) = system.f(st, p);
+        out.segment(n, n) = jj * v;
+        out[2 * n] = v0.dot(v) - 1.0;
+        if (jac) {
+            // columns x_i and p_j: (Df[b], D^2 f[(S v, 0), b]) for b = (S e_i, 0) and (0, e_j)
+            Eigen::MatrixXd& J = *jac;
+            J = Eigen::MatrixXd::Zero(2 * n + 1, 2 * n + 1);
+            const Eigen::VectorXd sv = system.stack_constant(v);
+            const Eigen::VectorXd none = Eigen::VectorXd::Zero(st.size());
+            for (int c = 0; c <= n; ++c) {
+                const TwoDirections d = c < n ? two_directions(system, st, p, sv, system.stack_constant(Eigen::VectorXd::Unit(n, c)), -1)
+                                              : two_directions(system, st, p, sv, none, j);
+                J.block(0, c, n, 1) = d.db;
+                J.block(n, c, n, 1) = d.dab;
+            }
+            J.block(n, n + 1, n, n) = jj;
+            J.block(2 * n, n + 1, 1, n) = v0.transpose();
+        }
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+    return out.allFinite() && (!jac || jac->allFinite());
+}
+
+bool hopf_system(const NonlinearDDE& system, int j, const VectorXc& q0, const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac) {
+    const int n = system.dimension();
+    if (z.size() != 3 * n + 2 || q0.size() != n)
+        throw std::invalid_argument("Hopf system: z has " + std::to_string(z.size()) + " and q0 " + std::to_string(q0.size()) +
+                                    " entries: expected 3n + 2 and n (n = " + std::to_string(n) + ")");
+    try {
+        const std::vector<double> p = with(system, j, z[n]);
+        const Eigen::VectorXd x = z.head(n);
+        const Eigen::VectorXd qr = z.segment(n + 1, n), qi = z.segment(2 * n + 1, n);
+        const VectorXc q = qr.cast<cplx>() + cplx(0.0, 1.0) * qi.cast<cplx>();
+        const double w = z[3 * n + 1];
+        const VectorXc dq = linearise(system, x, p).characteristic_matrix(cplx(0.0, w)) * q;
+        const cplx c = q0.dot(q) - 1.0;  // q0^H q - 1
+        out.resize(3 * n + 2);
+        const Eigen::VectorXd st = system.stack_constant(x);
+        out.head(n) = system.f(st, p);
+        out.segment(n, n) = dq.real();
+        out.segment(2 * n, n) = dq.imag();
+        out[3 * n] = c.real();
+        out[3 * n + 1] = c.imag();
+        if (jac) {
+            // Delta(i w) q = i w q - Df[w_q], (w_q)_k = exp(-i w tau_k) q (tau_0 = 0), so with
+            // W = Re w_q, V = Im w_q: rows Re = -w qi - Df[W], Im = w qr - Df[V], and
+            //  d/dx_i: -D^2 f[W, S e_i], -D^2 f[V, S e_i];  d/dp_j: -D^2 f[W, e_pj] - Df[dW/dp] (the same with V),
+            //    dW_k/dp = w tau_k' V_k, dV_k/dp = -w tau_k' W_k;
+            //  d/dq: Delta(i w) (real part [Re, -Im; Im, Re]);  d/dw: i (q + Df[tau w_q]).
+            const std::vector<Eigen::MatrixXd> a = system.jacobians(st, p);
+            std::vector<double> tau = system.delays(p), dtau = system.delay_derivatives(p, j);
+            tau.insert(tau.begin(), 0.0);
+            dtau.insert(dtau.begin(), 0.0);
+            const Eigen::Index s = st.size();
+            Eigen::VectorXd W(s), V(s), dW(s), dV(s), tW(s), tV(s);
+            MatrixXc M = MatrixXc::Identity(n, n) * cplx(0.0, w);
+            for (std::size_t k = 0; k < a.size(); ++k) {
+                const Eigen::Index o = static_cast<Eigen::Index>(k) * n;
+                const double th = w * tau[k];
+                W.segment(o, n) = std::cos(th) * qr + std::sin(th) * qi;
+                V.segment(o, n) = std::cos(th) * qi - std::sin(th) * qr;
+                dW.segment(o, n) = w * dtau[k] * V.segment(o, n);
+                dV.segment(o, n) = -w * dtau[k] * W.segment(o, n);
+                tW.segment(o, n) = tau[k] * W.segment(o, n);
+                tV.segment(o, n) = tau[k] * V.segment(o, n);
+                M -= a[k].cast<cplx>() * std::exp(cplx(0.0, -th));
+            }
+            Eigen::MatrixXd& J = *jac;
+            J = Eigen::MatrixXd::Zero(3 * n + 2, 3 * n + 2);
+            const Eigen::VectorXd none = Eigen::VectorXd::Zero(s);
+            for (int col = 0; col <= n; ++col) {
+                const Eigen::VectorXd e = col < n ? system.stack_constant(Eigen::VectorXd::Unit(n, col)) : none;
+                const int bp = col < n ? -1 : j;
+                const TwoDirections dw = two_directions(system, st, p, W, e, bp);
+                const TwoDirections dv = two_directions(system, st, p, V, e, bp);
+                J.block(0, col, n, 1) = dw.db;
+                J.block(n, col, n, 1) = -dw.dab;
+                J.block(2 * n, col, n, 1) = -dv.dab;
+            }
+            J.block(n, n, n, 1) -= apply_blocks(a, dW);
+            J.block(2 * n, n, n, 1) -= apply_blocks(a, dV);
+            J.block(n, n + 1, n, n) = M.real();
+            J.block(2 * n, n + 1, n, n) = M.imag();
+            J.block(n, 2 * n + 1, n, n) = -M.imag();
+            J.block(2 * n, 2 * n + 1, n, n) = M.real();
+            const Eigen::RowVectorXcd r = q0.adjoint();
+            J.block(3 * n, n + 1, 1, n) = r.real();
+            J.block(3 * n, 2 * n + 1, 1, n) = -r.imag();
+            J.block(3 * n + 1, n + 1, 1, n) = r.imag();
+            J.block(3 * n + 1, 2 * n + 1, 1, n) = r.real();
+            J.block(n, 3 * n + 1, n, 1) = -(qi + apply_blocks(a, tV));
+            J.block(2 * n, 3 * n + 1, n, 1) = qr + apply_blocks(a, tW);
+        }
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+    return out.allFinite() && (!jac || jac->allFinite());
+}
+
 FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, const NewtonOptions& options,
                        double residual_tolerance) {
     check_parameter(system, j);
+    check_derivatives(system);
     const int n = system.dimension();
     FoldPoint r;
     r.x = x0;
@@ -131,28 +277,14 @@ FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd&
     for (std::size_t k = 1; k < a.size(); ++k) jx += a[k];
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jx, Eigen::ComputeFullV);
     const Eigen::VectorXd v0 = svd.matrixV().col(n - 1);
-    auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out) {
-        try {
-            const std::vector<double> p = with(system, j, z[n]);
-            const Eigen::VectorXd st = system.stack_constant(z.head(n));
-            const std::vector<Eigen::MatrixXd> b = system.jacobians(st, p);
-            Eigen::MatrixXd jj = b[0];
-            for (std::size_t k = 1; k < b.size(); ++k) jj += b[k];
-            out.resize(2 * n + 1);
-            out.head(n) = system.f(st, p);
-            out.segment(n, n) = jj * z.segment(n + 1, n);
-            out[2 * n] = v0.dot(z.segment(n + 1, n)) - 1.0;
-        } catch (const std::invalid_argument&) {
-            return false;
-        }
-        return out.allFinite();
-    };
+    auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac) { return fold_system(system, j, v0, z, out, jac); };
     Eigen::VectorXd z(2 * n + 1);
     z << x0, par0, v0;
-    const NewtonSummary s = newton_square(z, F, options);
+    const NewtonSummary s = newton_square(z, F, options, r.residuals);
     Eigen::VectorXd f;
     r.iterations = s.iterations;
-    if (z.allFinite() && F(z, f)) r.residual = f.cwiseAbs().maxCoeff();
+    if (z.allFinite() && F(z, f, nullptr)) r.residual = f.cwiseAbs().maxCoeff();
+    if (static_cast<int>(r.residuals.size()) == s.iterations) r.residuals.push_back(r.residual);
     r.x = z.head(n);
     r.par = z[n];
     r.status = converged(s.status) && !(r.residual <= residual_tolerance) ? Status::NumericalIssue : s.status;
@@ -162,6 +294,7 @@ FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd&
 HopfPoint correct_hopf(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, double omega0, const VectorXc& q0in,
                        const NewtonOptions& options, double residual_tolerance) {
     check_parameter(system, j);
+    check_derivatives(system);
     if (!(std::isfinite(omega0) && omega0 > 0.0)) throw std::invalid_argument("omega0 = " + detail::format_number(omega0) + ": expected a value > 0");
     const int n = system.dimension();
     HopfPoint r;
@@ -176,32 +309,14 @@ HopfPoint correct_hopf(const NonlinearDDE& system, int j, const Eigen::VectorXd&
     }
     if (q0.size() != n) throw std::invalid_argument("q0 has " + std::to_string(q0.size()) + " entries: expected the dimension " + std::to_string(n));
     q0 /= q0.norm();
-    // unknowns z = (x, p, Re q, Im q, omega)
-    auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out) {
-        try {
-            const std::vector<double> p = with(system, j, z[n]);
-            const Eigen::VectorXd x = z.head(n);
-            const VectorXc q = z.segment(n + 1, n).cast<cplx>() + cplx(0.0, 1.0) * z.segment(2 * n + 1, n).cast<cplx>();
-            const double w = z[3 * n + 1];
-            const VectorXc dq = linearise(system, x, p).characteristic_matrix(cplx(0.0, w)) * q;
-            const cplx c = q0.dot(q) - 1.0;  // q0^H q - 1
-            out.resize(3 * n + 2);
-            out.head(n) = system.f(system.stack_constant(x), p);
-            out.segment(n, n) = dq.real();
-            out.segment(2 * n, n) = dq.imag();
-            out[3 * n] = c.real();
-            out[3 * n + 1] = c.imag();
-        } catch (const std::invalid_argument&) {
-            return false;
-        }
-        return out.allFinite();
-    };
+    auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac) { return hopf_system(system, j, q0, z, out, jac); };
     Eigen::VectorXd z(3 * n + 2);
     z << x0, par0, q0.real(), q0.imag(), omega0;
-    const NewtonSummary s = newton_square(z, F, options);
+    const NewtonSummary s = newton_square(z, F, options, r.residuals);
     Eigen::VectorXd f;
     r.iterations = s.iterations;
-    if (z.allFinite() && F(z, f)) r.residual = f.cwiseAbs().maxCoeff();
+    if (z.allFinite() && F(z, f, nullptr)) r.residual = f.cwiseAbs().maxCoeff();
+    if (static_cast<int>(r.residuals.size()) == s.iterations) r.residuals.push_back(r.residual);
     r.x = z.head(n);
     r.par = z[n];
     r.q = z.segment(n + 1, n).cast<cplx>() + cplx(0.0, 1.0) * z.segment(2 * n + 1, n).cast<cplx>();
@@ -214,6 +329,7 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
     std::string why;
     if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);
     const int j = system.parameter_index(options.parameter);
+    check_derivatives(system);
     const int n = system.dimension();
     EquilibriumBranch br;
     br.parameter = options.parameter;

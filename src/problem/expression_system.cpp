@@ -47,4 +47,16 @@ std::vector<double> ExpressionSystem::delays(const std::vector<double>& p) const
     return d;
 }
 
+std::vector<double> ExpressionSystem::delay_derivatives(const std::vector<double>& p, int j) const {
+    if (p.size() != parameter_names().size())
+        throw std::invalid_argument(std::to_string(p.size()) + " parameter values: expected " + std::to_string(parameter_names().size()));
+    if (j < 0 || j >= static_cast<int>(p.size()))
+        throw std::invalid_argument("parameter index " + std::to_string(j) + ": expected 0.." + std::to_string(static_cast<int>(p.size()) - 1));
+    std::vector<Dual<double>> pd(p.begin(), p.end());
+    pd[static_cast<std::size_t>(j)].deriv = 1.0;
+    std::vector<double> d;
+    for (const Expression& e : m_parsed.delays) d.push_back(e.evaluate<Dual<double>>(nullptr, pd.data()).deriv);
+    return d;
+}
+
 }  // namespace ddemap

@@ -155,6 +155,10 @@ Eigen::VectorXd NonlinearDDE::stack_constant(const Eigen::VectorXd& x) const {
     return x.replicate(delay_count() + 1, 1);
 }
 
+std::vector<double> NonlinearDDE::delay_derivatives(const std::vector<double>&, int) const {
+    throw std::logic_error("this system gives no derivatives of its delays: expected a system that implements delay_derivatives");
+}
+
 void NonlinearDDE::evaluate(const Dual2*, const Dual2*, Dual2*) const {
     throw std::logic_error("this system has no second derivatives: expected a system built on NonlinearDDEOf");
 }

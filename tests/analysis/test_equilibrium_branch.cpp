@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 
@@ -258,3 +259,126 @@ TEST_CASE("equilibrium branch inputs and failures") {
 }
 
 TEST_SUITE_END();
+
+namespace {
+
+/// Central differences of F (step 1e-5 max(1, |z_c|)) column by column.
+template <class F>
+Eigen::MatrixXd central_differences(F f, const Eigen::VectorXd& z) {
+    Eigen::VectorXd f0;
+    REQUIRE(f(z, f0));
+    Eigen::MatrixXd j(f0.size(), z.size());
+    for (Eigen::Index c = 0; c < z.size(); ++c) {
+        const double h = 1e-5 * std::max(1.0, std::abs(z[c]));
+        Eigen::VectorXd zp = z, zm = z, fp, fm;
+        zp[c] += h;
+        zm[c] -= h;
+        REQUIRE(f(zp, fp));
+        REQUIRE(f(zm, fm));
+        j.col(c) = (fp - fm) / (2.0 * h);
+    }
+    return j;
+}
+
+/// max over entries of |exact - fd| / max(1, |exact|).
+double jacobian_mismatch(const Eigen::MatrixXd& exact, const Eigen::MatrixXd& fd) {
+    return ((exact - fd).array().abs() / exact.array().abs().max(1.0)).maxCoeff();
+}
+
+/// r_{k+1} <= C r_k^2 for every step that starts below 0.1 and ends above the rounding floor
+/// (1e-14: |F| ~ 1 evaluated in double precision); returns the largest ratio r_{k+1} / r_k^2 and
+/// counts the steps checked.
+double quadratic_constant(const std::vector<double>& r, int& steps) {
+    double c = 0.0;
+    steps = 0;
+    for (std::size_t k = 0; k + 1 < r.size(); ++k)
+        if (r[k] < 1e-1 && r[k + 1] > 1e-14) {
+            c = std::max(c, r[k + 1] / (r[k] * r[k]));
+            ++steps;
+        }
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("fold and Hopf systems: the exact Jacobian agrees with central differences of the residuals") {
+    // two delays tau and 2 tau that move with tau, so the parameter column has the tau_k' terms;
+    // every parameter in turn is the free one; z is an arbitrary point (not a solution)
+    ExpressionSystem sys({"x1", "x2"}, {"a", "b", "c", "tau"}, {0.7, 1.3, 0.4, 0.9},
+                         {"x2 - a*x1*x2(t - 2*tau)", "-c*x2 - a*sin(x1) - x1^3 - b*(x1 - tanh(x1(t - tau)))*exp(0.3*x2(t - 2*tau))"});
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int j = 0; j < 4; ++j) {
+        CAPTURE(j);
+        Eigen::VectorXd zh(3 * 2 + 2);
+        for (Eigen::Index i = 0; i < zh.size(); ++i) zh[i] = u(rng);
+        zh[2] = 0.5 + 0.5 * std::abs(zh[2]);     // the parameter (a delay > 0 when j = 3)
+        zh[7] = 1.0 + std::abs(zh[7]);           // omega
+        VectorXc q0(2);
+        q0 << cplx(u(rng), u(rng)), cplx(u(rng), u(rng));
+        auto fh = [&](const Eigen::VectorXd& z, Eigen::VectorXd& f) { return hopf_system(sys, j, q0, z, f); };
+        Eigen::VectorXd f;
+        Eigen::MatrixXd jh;
+        REQUIRE(hopf_system(sys, j, q0, zh, f, &jh));
+        CHECK(jacobian_mismatch(jh, central_differences(fh, zh)) < tol::finite_difference);
+
+        Eigen::VectorXd zf(2 * 2 + 1);
+        for (Eigen::Index i = 0; i < zf.size(); ++i) zf[i] = u(rng);
+        zf[2] = 0.5 + 0.5 * std::abs(zf[2]);
+        const Eigen::Vector2d v0(u(rng), u(rng));
+        auto ff = [&](const Eigen::VectorXd& z, Eigen::VectorXd& g) { return fold_system(sys, j, v0, z, g); };
+        Eigen::MatrixXd jf;
+        REQUIRE(fold_system(sys, j, v0, zf, f, &jf));
+        CHECK(jacobian_mismatch(jf, central_differences(ff, zf)) < tol::finite_difference);
+    }
+    // the ov ring (its own delay_derivatives): the delay tau and the headway as free parameters
+    const OvRing ring(3, 1.0, 0.8);
+    const int n = ring.dimension();
+    for (int j : {1, 4}) {
+        CAPTURE(j);
+        Eigen::VectorXd z(3 * n + 2);
+        z << ring.uniform_flow() + 0.05 * Eigen::VectorXd::LinSpaced(n, -1.0, 1.0), ring.parameter_values()[static_cast<std::size_t>(j)],
+            Eigen::VectorXd::LinSpaced(n, 0.1, 0.9), Eigen::VectorXd::LinSpaced(n, -0.5, 0.3), 0.8;
+        const VectorXc q0 = VectorXc::Constant(n, cplx(0.3, -0.2));
+        auto fh = [&](const Eigen::VectorXd& zz, Eigen::VectorXd& f) { return hopf_system(ring, j, q0, zz, f); };
+        Eigen::VectorXd f;
+        Eigen::MatrixXd jh;
+        REQUIRE(hopf_system(ring, j, q0, z, f, &jh));
+        CHECK(jacobian_mismatch(jh, central_differences(fh, z)) < tol::finite_difference);
+    }
+}
+
+TEST_CASE("fold and Hopf points: Newton with the exact Jacobian converges quadratically") {
+    // Hopf of x' = -a sin(x(t - tau)) + x^3 in a (a = pi/2, omega = pi/2 at tau = 1), from afar
+    ExpressionSystem s1({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*sin(x(t - tau)) + x^3"});
+    const HopfPoint h1 = correct_hopf(s1, 0, Eigen::VectorXd::Constant(1, 0.05), 1.3, 1.3);
+    // the same in the delay: x' = -x(t - 2 c) + x^3, Hopf at 2 c = pi/2 with omega = 1
+    ExpressionSystem s2({"x"}, {"c"}, {0.5}, {"-x(t - 2*c) + x^3"});
+    const HopfPoint h2 = correct_hopf(s2, 0, Eigen::VectorXd::Constant(1, -0.05), 0.65, 1.2);
+    // fold of x' = p + x - exp(x(t - 1)): equilibria p = exp(x) - x, the fold at (x, p) = (0, 1)
+    ExpressionSystem s3({"x"}, {"p"}, {1.0}, {"p + x - exp(x(t - 1))"});
+    const FoldPoint f3 = correct_fold(s3, 0, Eigen::VectorXd::Constant(1, 0.6), 1.3);
+    REQUIRE(h1.status == Status::Converged);
+    REQUIRE(h2.status == Status::Converged);
+    REQUIRE(f3.status == Status::Converged);
+    CHECK(std::abs(h1.par - pi / 2) < tol::special_point);
+    CHECK(std::abs(h1.omega - pi / 2) < tol::special_point);
+    CHECK(std::abs(h2.par - pi / 4) < tol::special_point);
+    CHECK(std::abs(h2.omega - 1.0) < tol::special_point);
+    CHECK(std::abs(f3.par - 1.0) < tol::special_point);
+    CHECK(std::abs(f3.x[0]) < tol::special_point);
+    for (const std::vector<double>* r : {&h1.residuals, &h2.residuals, &f3.residuals}) {
+        std::string seq;
+        for (double x : *r) {
+            char b[32];
+            std::snprintf(b, sizeof b, "%.3e ", x);
+            seq += b;
+        }
+        CAPTURE(seq);
+        int steps = 0;
+        const double c = quadratic_constant(*r, steps);
+        CHECK(steps >= 2);
+        CHECK(c <= tol::newton_quadratic);
+        CHECK(r->back() <= 1e-13);
+    }
+}

@@ -13,8 +13,9 @@
 ///    pair between two points are not seen); then Newton on
 ///    the Hopf system  g(x, p) = 0,  Delta(i omega; x, p) q = 0,  q0^H q = 1  (x, p, q in C^n,
 ///    omega > 0: 3n + 2 real unknowns), from the root nearest the imaginary axis. The residuals
-///    use the exact characteristic matrix; Newton's Jacobian of these augmented systems is taken
-///    by central differences of those residuals.
+///    use the exact characteristic matrix; Newton's Jacobian of these augmented systems is exact
+///    (fold_system, hopf_system: blocks from second derivatives of f in nested dual numbers), so
+///    Newton converges quadratically.
 
 #include <limits>
 #include <string>
@@ -71,6 +72,7 @@ struct FoldPoint {
     Status status = Status::MaxIterations;
     double residual = std::numeric_limits<double>::infinity();
     int iterations = 0;
+    std::vector<double> residuals;  ///< max |F| of the fold system at every Newton iterate, the start first
     int after = 0;  ///< index of the branch point before it
 };
 
@@ -82,6 +84,7 @@ struct HopfPoint {
     Status status = Status::MaxIterations;
     double residual = std::numeric_limits<double>::infinity();
     int iterations = 0;
+    std::vector<double> residuals;  ///< max |F| of the Hopf system at every Newton iterate, the start first
     int after = 0;
 };
 
@@ -98,8 +101,31 @@ struct EquilibriumBranch {
 };
 
 /// The branch through the equilibrium found from `guess` at p = from. std::invalid_argument for
-/// invalid options, an unknown parameter or a bad guess; non-convergence is a status.
+/// invalid options, an unknown parameter, a bad guess or a system without second derivatives or
+/// delay derivatives (has_higher_derivatives(), has_delay_derivatives(): the exact Jacobians of the
+/// fold and Hopf systems need them); non-convergence is a status. correct_hopf and correct_fold
+/// check the same.
 EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options);
+
+/// The fold system F(z), z = (x, p_j, v) (2n + 1 unknowns):
+///     F = (f(x, ..., x; p),  (A_0 + ... + A_m) v,  v0 . v - 1),
+/// and, when J is given, its exact Jacobian: the x and p_j columns of (sum_k A_k) v are
+/// D^2 f[(S v, 0), (S e_i, 0)] and D^2 f[(S v, 0), (0, e_j)] (S the constant stacking), one
+/// evaluation in Dual<Dual<double>> each. False when F is not defined at z (a bad delay, a
+/// non-finite value); std::invalid_argument for sizes that do not fit.
+bool fold_system(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& v0, const Eigen::VectorXd& z, Eigen::VectorXd& F,
+                 Eigen::MatrixXd* J = nullptr);
+
+/// The Hopf system F(z), z = (x, p_j, Re q, Im q, omega) (3n + 2 unknowns):
+///     F = (f(x, ..., x; p),  Re, Im of Delta(i omega; x, p) q,  Re, Im of q0^H q - 1),
+/// Delta(lambda) = lambda I - sum_k A_k exp(-lambda tau_k) (tau_0 = 0), and, when J is given, its
+/// exact Jacobian: with w_k = exp(-i omega tau_k) q, Delta q = i omega q - Df[w], so
+///     d/dx_i = -D^2 f[w, S e_i],  d/dp_j = -D^2 f[w, e_pj] + i omega sum_k tau_k' A_k w_k,
+///     d/dq = Delta(i omega),  d/domega = i (q + sum_k tau_k A_k w_k)
+/// (second derivatives in Dual<Dual<double>>, tau_k' from delay_derivatives). False when F is not
+/// defined at z; std::invalid_argument for sizes that do not fit.
+bool hopf_system(const NonlinearDDE& system, int parameter, const VectorXc& q0, const Eigen::VectorXd& z, Eigen::VectorXd& F,
+                 Eigen::MatrixXd* J = nullptr);
 
 /// Newton on the Hopf system from (x0, p_j = par0, omega0), the other parameters as held;
 /// q0 is the starting null vector (empty: the right singular vector of Delta(i omega0) for its

@@ -26,6 +26,9 @@ public:
     /// tau_k(p) for k = 1..m (std::invalid_argument when one is negative or not finite).
     std::vector<double> delays(const std::vector<double>& p) const override;
     using NonlinearDDE::delays;
+    /// d tau_k / d p_j: each delay expression evaluated in dual numbers seeded at p_j.
+    std::vector<double> delay_derivatives(const std::vector<double>& p, int j) const override;
+    bool has_delay_derivatives() const override { return true; }
 
     const std::vector<std::string>& variables() const { return m_variables; }
     const std::vector<std::string>& equations() const { return m_texts; }

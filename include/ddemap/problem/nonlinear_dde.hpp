@@ -39,6 +39,12 @@ public:
     virtual std::vector<double> delays(const std::vector<double>& p) const = 0;
     /// The delays at the current parameter values.
     std::vector<double> delays() const { return delays(m_values); }
+    /// d tau_k / d p_j (k = 1..m) at parameter values p, exact (for the Jacobians of defining
+    /// systems in a parameter that moves a delay). The default throws std::logic_error; the
+    /// expression systems and the built-in models implement it (has_delay_derivatives()).
+    virtual std::vector<double> delay_derivatives(const std::vector<double>& p, int j) const;
+    /// True when delay_derivatives() is implemented.
+    virtual bool has_delay_derivatives() const { return false; }
 
     const std::vector<std::string>& parameter_names() const { return m_names; }
     const std::vector<double>& parameter_values() const { return m_values; }

@@ -28,6 +28,9 @@ public:
     int delay_count() const override { return 1; }
     std::vector<double> delays(const std::vector<double>& p) const override { return {p[1]}; }
     using NonlinearDDE::delays;
+    /// d tau / d p_j: 1 for j = 1 (tau), else 0.
+    std::vector<double> delay_derivatives(const std::vector<double>&, int j) const override { return {j == 1 ? 1.0 : 0.0}; }
+    bool has_delay_derivatives() const override { return true; }
 
     /// V(h) and V'(h) at the current v0, h_st.
     double optimal_velocity(double h) const;
