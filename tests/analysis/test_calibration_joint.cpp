@@ -64,7 +64,7 @@ TEST_CASE("joint calibration of two runs recovers the truth with narrower interv
     }
 }
 
-TEST_CASE("joint calibration: the stacked objective is the sample-weighted mean of the runs' objectives; one run is calibrate") {
+TEST_CASE("joint calibration: the stacked objective is the sample-weighted mean of the runs' objectives and one run is calibrate") {
     const std::vector<Trace> runs = two_runs();
     const CalibrationOptions o;
     const ParameterMap p = calib_test::ovrv({0.08, 0.2, 1.0, 0.3, 10});

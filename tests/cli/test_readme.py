@@ -24,7 +24,16 @@ SKIP = re.compile(r"^(scripts/|cmake |ctest )")
 def examples(readme):
     out = []
     block = None  # None outside a code block, else its language
+    pending = None  # (line number, text) of a command continued with a trailing backslash
     for number, line in enumerate(readme.splitlines(), 1):
+        if pending is not None and block is not None and not line.startswith("```"):
+            text = pending[1] + " " + line.strip()
+            if text.endswith("\\"):
+                pending = (pending[0], text[:-1].rstrip())
+            else:
+                out.append((pending[0], text))
+                pending = None
+            continue
         fence = re.match(r"^```\s*(\S*)", line)
         if fence:
             block = None if block is not None else fence.group(1)
@@ -42,6 +51,9 @@ def examples(readme):
         command = re.sub(r"\s+#\s.*$", "", command).strip()
         if not command or command.startswith("#"):
             continue
+        if command.endswith("\\"):
+            pending = (number, command[:-1].rstrip())
+            continue
         out.append((number, command))
     return out
 
@@ -56,6 +68,9 @@ def main():
         work = os.path.join(tmp, "clone")
         shutil.copytree(source, work, symlinks=True,
                         ignore=lambda d, names: [n for n in names if d == source and (n.startswith("build") or n in (".git", "out"))])
+        shared = os.path.join(source, "..", "shared")
+        if os.path.isdir(shared):  # the data beside the clone, as in CI (../shared/data/acc)
+            os.symlink(os.path.abspath(shared), os.path.join(tmp, "shared"))
         os.makedirs(os.path.join(work, "build"))
         os.symlink(binary, os.path.join(work, "build", "ddemap"))
         bindir = os.path.join(tmp, "bin")
