@@ -154,6 +154,7 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
                    (std::isfinite(hi[i]) ? detail::format_number(hi[i]) + "]" : std::string("inf)"));
 
     VerdictUncertainty out;
+    out.domain = options.domain;
     // draws on one thread in order, so the samples do not depend on the thread count
     NormalDraws normal(options.seed);
     const long budget = static_cast<long>(options.samples) * options.max_draws_per_sample;
@@ -251,7 +252,17 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
     inner.progress = nullptr;
     for (std::size_t i = 0; i < vehicles.size(); ++i) {
         if (!vehicles[i].has_covariance) continue;
-        out[i].uncertainty = classify_with_uncertainty(vehicles[i].parameters, vehicles[i].covariance, cars, uncertainty, inner);
+        // the fit's own search space, where the file carries it
+        UncertaintyOptions own = uncertainty;
+        bool from_fit = false;
+        for (auto& b : own.domain)
+            if (const BoundedParameter* f = find_bound(vehicles[i].bounds, b.name)) {
+                b = *f;
+                from_fit = true;
+            }
+        if (from_fit) own.validate();
+        out[i].uncertainty = classify_with_uncertainty(vehicles[i].parameters, vehicles[i].covariance, cars, own, inner);
+        out[i].uncertainty.domain_from_fit = from_fit;
         out[i].has_uncertainty = true;
         if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(vehicles.size()));
     }

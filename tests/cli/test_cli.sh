@@ -718,5 +718,24 @@ EOF2
 timeout 30 "$bin" simulate --fleet A_min --t-end 20 --out "$tmp/flat" >/dev/null && [ "$(grep -c '<text' "$tmp/flat.svg")" -lt 200 ] &&
     ok || bad "simulate --t-end 20: a flat speed plot finishes with a bounded number of ticks"
 
+# calibrate's CSV carries the bounds the fit used; classify samples within them (not calibrate's defaults)
+if "$bin" calibrate "$excerpt" --bounds k1=0:2,tau=0.1:0.9 --out "$tmp/calb" >/dev/null 2>&1 || [ $? -eq 4 ]; then
+    head -1 "$tmp/calb.csv" | grep -q ',cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta$' && ok || bad "calibrate csv bounds columns"
+    sed -n 2p "$tmp/calb.csv" | grep -q ',0,2,0,1,0,3,0.10000000000000001,0.90000000000000002,5,15$' && ok || bad "calibrate csv bounds values"
+    if grep -q ',cov_k1_k1' "$tmp/calb.csv" && [ -n "$(sed -n 2p "$tmp/calb.csv" | cut -d, -f15)" ]; then
+        "$bin" classify "$tmp/calb.csv" --samples 50 --ring-samples 0 --format json 2>/dev/null | python3 -c "
+import json, sys
+u = json.load(sys.stdin)['result']['vehicles'][0]['uncertainty']
+assert u['bounds_source'] == 'file', u
+assert u['bounds']['k1'] == [0, 2] and u['bounds']['tau'] == [0.1, 0.9] and u['bounds']['th'] == [0, 3], u['bounds']
+" && ok || bad "classify samples within the file's bounds"
+    fi
+    "$bin" classify "$tmp/cal.csv" --samples 50 --ring-samples 0 --format json 2>/dev/null |
+        python3 -c "import json,sys; u=json.load(sys.stdin)['result']['vehicles'][0]['uncertainty']; assert u['bounds_source'] == 'file' and u['bounds']['k1'] == [0, 1], u" &&
+        ok || bad "classify: default-bounds fit carries its bounds"
+else
+    bad "calibrate --bounds exit status"
+fi
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
