@@ -737,5 +737,20 @@ else
     bad "calibrate --bounds exit status"
 fi
 
+# the computable range (c <= 1e8, c tau <= 10) on every path, refused before any work and no file written
+crd="$tmp/range"; mkdir -p "$crd"
+printf 'name,k1,k2,th,tau\nok,0.2,0.2,1.5,0.2\nbig,1e6,0.2,1.5,0.2\n' >"$crd/big.csv"
+printf 'vehicle,model,k1,k2,th,tau\n,ovrv,0.2,0.2,1.5,0.2\n,ovrv,0.2,0.2,1.5,1e6\n' >"$crd/fleet.csv"
+printf 'title = "t"\nmodel = "ovrv"\nring = 22\n[x]\nname = "k1"\nlo = 0.1\nhi = 1e6\ncount = 5\n[y]\nname = "k2"\nlo = 0.1\nhi = 0.3\ncount = 5\n[fixed]\nth = 1.5\ntau = 0.2\n' >"$crd/big.toml"
+expect_error "vehicle 'big': gains and delay outside the computable range" classify "$crd/big.csv"
+expect_error "car 2 (big): gains and delay outside the computable range" roots --fleet "$crd/big.csv" --ring 4
+expect_error "computable range" roots --fleet "$crd/fleet.csv" --ring 4
+expect_error "car 1 (big): gains and delay outside the computable range" mix --x "$crd/big.csv:big" --y A_min --ring 6 --p 0:1:2 --out "$crd/mix"
+expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" sweep --k1 0.1:1e6:3 --k2 0.1:0.3:2 --th 1.5 --tau 0.2 --out "$crd/sweep"
+expect_error "computable range" sweep --k1 0.1:0.3:3 --k2 0.1:0.3:2 --th 1.5 --tau 1e6 --out "$crd/sweep"
+expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" boundary --k1 0.1:1e6 --k2 0.1:0.3 --th 1.5 --tau 0.2 --out "$crd/boundary"
+expect_error "panel 1: the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" chart "$crd/big.toml" --out "$crd/chart"
+[ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -73,6 +73,7 @@ struct VerdictSample {
     bool plant_stable = false, string_stable = false, ring_stable = false;
     bool has_ring = false;          ///< among the first ring_samples samples
     bool decided = false;           ///< the plant roots converged (and the ring, when has_ring)
+    bool computable = true;         ///< inside the computable range (require_computable); else not decided, no verdict
 };
 
 /// Verdicts of a vehicle under its parameter uncertainty.
