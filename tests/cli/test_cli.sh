@@ -750,6 +750,10 @@ expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay o
 expect_error "computable range" sweep --k1 0.1:0.3:3 --k2 0.1:0.3:2 --th 1.5 --tau 1e6 --out "$crd/sweep"
 expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" boundary --k1 0.1:1e6 --k2 0.1:0.3 --th 1.5 --tau 0.2 --out "$crd/boundary"
 expect_error "panel 1: the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" chart "$crd/big.toml" --out "$crd/chart"
+# a vehicle just inside the range: its figure's window is pulled back inside, not refused
+printf 'name,k1,k2,th,tau\nedge,19.5,0.2,1.5,0.2\n' >"$crd/edge.csv"
+"$bin" classify "$crd/edge.csv" --out "$crd/edge/c" >/dev/null 2>&1 && xmllint --noout "$crd/edge/c.svg" && ok || bad "classify --out of a vehicle near the edge of the computable range"
+rm -rf "$crd/edge" "$crd/edge.csv"
 [ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
 
 echo "$pass passed, $fail failed"
