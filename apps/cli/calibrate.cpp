@@ -182,7 +182,7 @@ int run_calibrate() {
         for (const auto& w : fits[i].warnings) std::cerr << "ddemap: calibrate: " << names[i] << ": warning: " << w << "\n";
     }
     e.status = to_string(status);
-    const std::string csv = calibration_csv(names, fits);
+    const std::string csv = calibration_csv(names, fits, o);
     std::vector<std::pair<std::string, std::string>> outputs;
     if (!prefix.empty())
         outputs = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}};

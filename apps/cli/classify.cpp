@@ -32,7 +32,8 @@ void add_classify_flags(CLI::App& app) {
                    "the vehicles: a CSV file with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m; other columns ignored, "
                    "so calibrate's output works), a fleet table of ovrv cars (as roots --fleet), or built-in names \"A_min,E_max\"; with the "
                    "covariance columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes the verdicts come with probabilities, from samples "
-                   "of the parameters' normal distribution restricted to calibrate's default bounds of k1, k2, th, tau")
+                   "of the parameters' normal distribution restricted to the fit's bounds of k1, k2, th, tau (columns lo_k1,hi_k1 .. that "
+                   "`calibrate` writes; calibrate's default bounds when the file has none)")
         ->type_name("FILE|PATTERN");
     app.add_option("--samples", args.samples, "parameter samples per vehicle with a covariance")->capture_default_str();
     app.add_option("--ring-samples", args.ring_samples, "of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
@@ -68,7 +69,8 @@ int run_classify() {
     }
     UncertaintyOptions uo;
     uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
-    // the calibration's search space; eta only >= 0 (no verdict depends on it, and fits often sit on its bound)
+    // calibrate's default search space, replaced per vehicle by the bounds its file carries
+    // (lo_NAME, hi_NAME); eta only >= 0 (no verdict depends on it, and fits often sit on its bound)
     for (const auto& b : paper_calibration_bounds())
         if (b.name != "eta") uo.domain.push_back(b);
     uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", args.ring_samples, 0, 1000000, "an integer 0..1000000"));

@@ -154,6 +154,7 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
                    (std::isfinite(hi[i]) ? detail::format_number(hi[i]) + "]" : std::string("inf)"));
 
     VerdictUncertainty out;
+    out.domain = options.domain;
     // draws on one thread in order, so the samples do not depend on the thread count
     NormalDraws normal(options.seed);
     const long budget = static_cast<long>(options.samples) * options.max_draws_per_sample;
@@ -173,6 +174,12 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
         s.parameters = ovrv;
         for (int i = 0; i < 5; ++i) s.parameters[kNames[i]] = thetas[static_cast<std::size_t>(j)][i];
         const Linearisation lin = make_model("ovrv", s.parameters)->linearise();
+        try {
+            require_computable(lin);
+        } catch (const std::invalid_argument&) {
+            s.computable = false;  // undecided: no verdict outside the computable range
+            return;
+        }
         const StringResult st = analyse_string(lin);
         s.c2 = st.lowfreq.c2;
         s.sup_gamma_excess = st.sup_gamma - 1.0;
@@ -224,15 +231,22 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
         out.message = "only " + std::to_string(out.samples) + " of " + std::to_string(options.samples) + " samples in " +
                       std::to_string(out.draws) + " draws fell inside " + box + ": the parameter distribution lies mostly outside it (a parameter the data hardly determine)";
     }
-    if (out.undecided > 0) {
+    const auto outside = std::count_if(out.verdicts.begin(), out.verdicts.end(), [](const VerdictSample& s) { return !s.computable; });
+    if (out.undecided > outside) {
         out.status = worse(out.status, Status::NumericalIssue);
-        out.message += "; " + std::to_string(out.undecided) + " samples undecided (a root computation did not converge), left out of p";
+        out.message += "; " + std::to_string(out.undecided - outside) + " samples undecided (a root computation did not converge), left out of p";
+    }
+    if (outside > 0) {
+        out.status = worse(out.status, Status::NumericalIssue);
+        out.message += "; " + std::to_string(outside) + " samples outside the computable range (README \"Verdicts and the computable range\"), left out of p";
     }
     if (decided == 0) out.status = worse(out.status, Status::NumericalIssue);
     return out;
 }
 
 std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars, const ExecutionPolicy& policy) {
+    for (const auto& v : vehicles)  // every vehicle inside the computable range before any work
+        require_computable(make_model("ovrv", v.parameters)->linearise(), "vehicle " + detail::quoted(v.name));
     std::vector<Classification> out(vehicles.size());
     parallel_for(static_cast<long>(vehicles.size()), [&](long i) {
         const Linearisation lin = make_model("ovrv", vehicles[i].parameters)->linearise();
@@ -251,7 +265,17 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
     inner.progress = nullptr;
     for (std::size_t i = 0; i < vehicles.size(); ++i) {
         if (!vehicles[i].has_covariance) continue;
-        out[i].uncertainty = classify_with_uncertainty(vehicles[i].parameters, vehicles[i].covariance, cars, uncertainty, inner);
+        // the fit's own search space, where the file carries it
+        UncertaintyOptions own = uncertainty;
+        bool from_fit = false;
+        for (auto& b : own.domain)
+            if (const BoundedParameter* f = find_bound(vehicles[i].bounds, b.name)) {
+                b = *f;
+                from_fit = true;
+            }
+        if (from_fit) own.validate();
+        out[i].uncertainty = classify_with_uncertainty(vehicles[i].parameters, vehicles[i].covariance, cars, own, inner);
+        out[i].uncertainty.domain_from_fit = from_fit;
         out[i].has_uncertainty = true;
         if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(vehicles.size()));
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "ddemap/traffic/ring_system.hpp"
 
@@ -15,6 +16,21 @@ void MixedRingOptions::validate() const {
     if (has_speed == has_length) throw std::invalid_argument("a mixed ring needs exactly one of speed or length");
 }
 
+namespace {
+void require_computable_cars(const Fleet& fleet, const std::vector<Linearisation>& lins) {
+    for (std::size_t i = 0; i < lins.size(); ++i)
+        require_computable(lins[i], "car " + std::to_string(i + 1) + (i < fleet.size() ? " (" + fleet[i].label + ")" : std::string()));
+}
+}  // namespace
+
+void require_computable(const Fleet& fleet, const MixedRingOptions& options) {
+    options.validate();
+    const RingEquilibrium eq = std::isnan(options.length) ? ring_equilibrium_at_speed(fleet, options.speed)
+                                                          : ring_equilibrium_at_length(fleet, options.length);
+    const RingSystem ring(fleet, eq.speed);
+    require_computable_cars(fleet, ring.car_linearisations(ring.equilibrium(eq.speed)));
+}
+
 MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& options) {
     options.validate();
     MixedRingResult out;
@@ -23,6 +39,7 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     // the linearisation of the nonlinear ring at its equilibrium, car by car (sparse: O(N))
     const RingSystem ring(fleet, out.equilibrium.speed);
     const std::vector<Linearisation> lins = ring.car_linearisations(ring.equilibrium(out.equilibrium.speed));
+    require_computable_cars(fleet, lins);
     RootOptions ro = options.roots;
     ro.count = options.roots.count + 1;  // room for the trivial root
     const RootProblem problem = ring_root_problem(lins);

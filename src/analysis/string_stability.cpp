@@ -73,11 +73,12 @@ double scaled_delay(const Linearisation& lin) {
     return tau > 0.0 ? c * tau : c;
 }
 
-void require_computable(const Linearisation& lin) {
+void require_computable(const Linearisation& lin, const std::string& what) {
     const double c = coefficient_sum(lin);
     const double tau = lin.max_delay();
     std::ostringstream os;
     os.precision(4);
+    if (!what.empty()) os << what << ": ";
     if (!(c <= kMaxCoefficientSum)) {
         os << "the gains are outside the computable range: the sum of the absolute coefficients (OVRV: k1 (1 + th) + 2 k2) is "
            << c << ": expected <= " << kMaxCoefficientSum;

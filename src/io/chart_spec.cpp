@@ -202,8 +202,11 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
     out.specs.resize(n);
     out.sweeps.resize(n);
     out.boundaries.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < n; ++i) {  // every panel checked (the computable range at its corners) before any work
         out.specs[i] = panel_sweep(spec, i);
+        out.specs[i].validate();
+    }
+    for (std::size_t i = 0; i < n; ++i) {
         out.sweeps[i] = run_sweep(out.specs[i], per_panel);
         if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i]);
         if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(n));

@@ -175,14 +175,22 @@ std::string growth_csv(const std::vector<GrowthResult>& g) {
     return out.str();
 }
 
-std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits) {
+std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
+                            const CalibrationOptions& options) {
     std::ostringstream csv;
     csv << "name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,"
            "naive_rmse_speed,status";
     // the covariance (upper triangle, the columns `classify` reads); empty cells when the trace
     // does not determine a parameter (an infinite standard error: the covariance understates it)
     for (const auto& c : covariance_column_names()) csv << "," << c;
+    // the bounds the fit searched within (classify restricts its parameter samples to them)
+    for (const auto& c : bounds_column_names()) csv << "," << c;
     csv << "\n";
+    std::string bounds;
+    for (const auto& name : calibration_parameter_names()) {
+        const BoundedParameter b = options.bound(name);
+        bounds += "," + format_exact(b.lower) + "," + format_exact(b.upper);
+    }
     for (std::size_t i = 0; i < fits.size(); ++i) {
         const auto& r = fits[i];
         csv << csv_field(i < names.size() ? names[i] : std::string());
@@ -196,7 +204,7 @@ std::string calibration_csv(const std::vector<std::string>& names, const std::ve
         for (const auto& e : r.estimates) determined = determined && std::isfinite(e.standard_error);
         for (int a = 0; a < 5; ++a)
             for (int b = a; b < 5; ++b) csv << "," << (determined ? format_exact(r.covariance(a, b)) : std::string());
-        csv << "\n";
+        csv << bounds << "\n";
     }
     return csv.str();
 }

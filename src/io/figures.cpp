@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -182,6 +183,31 @@ ChartSpec classification_chart(const ChartSpec& base, const std::vector<Calibrat
         spec.x.hi = x1;
         spec.y.lo = y0;
         spec.y.hi = y1;
+        // the widened window may reach past the computable range (a vehicle near its edge): pull
+        // the upper ends back towards the vehicles' largest (k1, k2) until every panel's corners
+        // are inside (c grows with k1, k2); a vehicle outside the range is refused by classify
+        double kx1 = -1e300, ky1 = -1e300;
+        for (const auto& v : vehicles) {
+            kx1 = std::max(kx1, v.parameters.at("k1"));
+            ky1 = std::max(ky1, v.parameters.at("k2"));
+        }
+        auto inside = [&](double t) {
+            ChartSpec trial = spec;
+            trial.x.hi = kx1 + t * (x1 - kx1);
+            trial.y.hi = ky1 + t * (y1 - ky1);
+            try {
+                for (std::size_t i = 0; i < trial.panels.size(); ++i) panel_sweep(trial, i).validate();
+            } catch (const std::invalid_argument&) {
+                return false;
+            }
+            return true;
+        };
+        if (!inside(1.0) && inside(0.0)) {
+            double lo = 0.0, hi = 1.0;
+            for (int it = 0; it < 40; ++it) (inside(0.5 * (lo + hi)) ? lo : hi) = 0.5 * (lo + hi);
+            spec.x.hi = kx1 + lo * (x1 - kx1);
+            spec.y.hi = ky1 + lo * (y1 - ky1);
+        }
     } else if (cars != 22) {
         spec.title = "Calibrated vehicles on their own stability charts, " + ring;
     }

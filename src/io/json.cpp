@@ -292,6 +292,11 @@ std::string classification_json(const std::vector<Classification>& rows, int car
                                              {"spectral_abscissa", ring ? num(u.ring_abscissa.median) : json(nullptr)}}},
                                 {"status", to_string(u.status)},
                                 {"message", u.message}};
+            // the box the samples were restricted to and where it came from
+            json box = json::object();
+            for (const auto& b : u.domain) box[b.name] = {num(b.lower), num(b.upper)};
+            o["uncertainty"]["bounds"] = box;
+            o["uncertainty"]["bounds_source"] = u.domain_from_fit ? "file" : "default";
         }
         arr.push_back(o);
     }

@@ -19,6 +19,9 @@ void MixOptions::validate() const {
 
 std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, const MixOptions& options) {
     options.validate();
+    // every ring of the study inside the computable range, before any root work
+    for (double p : options.fractions)
+        require_computable(mixed_fleet(x, y, options.cars, static_cast<int>(std::lround(p * options.cars)), 0, options.seed), options.ring);
     std::vector<MixPoint> out(options.fractions.size());
     for (std::size_t i = 0; i < options.fractions.size(); ++i) {
         MixPoint& pt = out[i];

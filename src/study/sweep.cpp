@@ -268,8 +268,11 @@ void SweepSpec::validate() const {
             throw std::invalid_argument(a.name + " range " + detail::format_number(a.lo) + ":" + detail::format_number(a.hi) + ": expected finite LO < HI");
         }
     }
+    // the corners of the window inside the computable range (c grows with the gains, th and tau)
     for (double xv : {x.lo, x.hi})
-        for (double yv : {y.lo, y.hi}) (void)model_at(*this, xv, yv);
+        for (double yv : {y.lo, y.hi})
+            require_computable(model_at(*this, xv, yv)->linearise(), "the corner " + x.name + " = " + detail::format_number(xv) + ", " +
+                                                                        y.name + " = " + detail::format_number(yv) + " of the window");
 }
 
 std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y) {

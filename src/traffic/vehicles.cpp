@@ -58,6 +58,15 @@ std::vector<std::string> covariance_column_names() {
     return out;
 }
 
+std::vector<std::string> bounds_column_names() {
+    std::vector<std::string> out;
+    for (const char* n : {"k1", "k2", "th", "tau", "eta"}) {
+        out.push_back(std::string("lo_") + n);
+        out.push_back(std::string("hi_") + n);
+    }
+    return out;
+}
+
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source) {
     detail::CsvReader csv(text, source, "name,k1,k2,th,tau[,eta]");
     const int c_name = csv.column("name");
@@ -72,6 +81,15 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
     if (cov_given > 0 && cov_given < 15)
         throw std::invalid_argument(source + ": the header has " + std::to_string(cov_given) +
                                     " of the 15 covariance columns cov_k1_k1 .. cov_eta_eta: expected all or none");
+    // the calibration's bounds: for each parameter lo_NAME and hi_NAME, both or neither
+    const std::vector<std::string> bound_names = bounds_column_names();
+    std::vector<int> c_bound;
+    for (const auto& n : bound_names) c_bound.push_back(csv.column(n, false));
+    for (std::size_t i = 0; i < 5; ++i)
+        if ((c_bound[2 * i] >= 0) != (c_bound[2 * i + 1] >= 0))
+            throw std::invalid_argument(source + ": the header has " + (c_bound[2 * i] >= 0 ? bound_names[2 * i] : bound_names[2 * i + 1]) +
+                                        " without " + (c_bound[2 * i] >= 0 ? bound_names[2 * i + 1] : bound_names[2 * i]) +
+                                        ": expected both bounds of " + params[i] + " or neither");
     std::vector<CalibratedVehicle> out;
     while (csv.next()) {
         CalibratedVehicle v;
@@ -100,6 +118,19 @@ std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const 
                     }
                 v.has_covariance = true;
             }
+        }
+        for (std::size_t i = 0; i < 5; ++i) {
+            const int cl = c_bound[2 * i], ch = c_bound[2 * i + 1];
+            if (cl < 0) continue;
+            const bool fl = !csv.fields()[static_cast<std::size_t>(cl)].empty(), fh = !csv.fields()[static_cast<std::size_t>(ch)].empty();
+            if (fl != fh) csv.fail(bound_names[2 * i] + " and " + bound_names[2 * i + 1] + ": expected both filled or both empty");
+            if (!fl) continue;
+            const double lo = csv.number(cl, bound_names[2 * i]), hi = csv.number(ch, bound_names[2 * i + 1]);
+            if (lo < 0.0) csv.fail(bound_names[2 * i] + " = " + csv.fields()[static_cast<std::size_t>(cl)] + ": expected >= 0 (the model's domain)");
+            if (!(lo <= hi))
+                csv.fail(bound_names[2 * i] + " = " + detail::format_number(lo) + " above " + bound_names[2 * i + 1] + " = " +
+                         detail::format_number(hi) + ": expected lower <= upper");
+            v.bounds.push_back({params[i], lo, hi});
         }
         try {
             (void)make_model("ovrv", v.parameters);

@@ -766,5 +766,43 @@ grep -q "ddemap:" "$tmp/o.txt" && bad "progress on stdout" || ok
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:6 --k2 0.01:1:7 --no-boundaries --quiet --out "$tmp/pr" >/dev/null 2>"$tmp/e.txt"
 [ ! -s "$tmp/e.txt" ] && ok || bad "--quiet still printed: $(cat "$tmp/e.txt")"
 
+# calibrate's CSV carries the bounds the fit used; classify samples within them (not calibrate's defaults)
+if "$bin" calibrate "$excerpt" --bounds k1=0:2,tau=0.1:0.9 --out "$tmp/calb" >/dev/null 2>&1 || [ $? -eq 4 ]; then
+    head -1 "$tmp/calb.csv" | grep -q ',cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta$' && ok || bad "calibrate csv bounds columns"
+    sed -n 2p "$tmp/calb.csv" | grep -q ',0,2,0,1,0,3,0.10000000000000001,0.90000000000000002,5,15$' && ok || bad "calibrate csv bounds values"
+    if grep -q ',cov_k1_k1' "$tmp/calb.csv" && [ -n "$(sed -n 2p "$tmp/calb.csv" | cut -d, -f15)" ]; then
+        "$bin" classify "$tmp/calb.csv" --samples 50 --ring-samples 0 --format json 2>/dev/null | python3 -c "
+import json, sys
+u = json.load(sys.stdin)['result']['vehicles'][0]['uncertainty']
+assert u['bounds_source'] == 'file', u
+assert u['bounds']['k1'] == [0, 2] and u['bounds']['tau'] == [0.1, 0.9] and u['bounds']['th'] == [0, 3], u['bounds']
+" && ok || bad "classify samples within the file's bounds"
+    fi
+    "$bin" classify "$tmp/cal.csv" --samples 50 --ring-samples 0 --format json 2>/dev/null |
+        python3 -c "import json,sys; u=json.load(sys.stdin)['result']['vehicles'][0]['uncertainty']; assert u['bounds_source'] == 'file' and u['bounds']['k1'] == [0, 1], u" &&
+        ok || bad "classify: default-bounds fit carries its bounds"
+else
+    bad "calibrate --bounds exit status"
+fi
+
+# the computable range (c <= 1e8, c tau <= 10) on every path, refused before any work and no file written
+crd="$tmp/range"; mkdir -p "$crd"
+printf 'name,k1,k2,th,tau\nok,0.2,0.2,1.5,0.2\nbig,1e6,0.2,1.5,0.2\n' >"$crd/big.csv"
+printf 'vehicle,model,k1,k2,th,tau\n,ovrv,0.2,0.2,1.5,0.2\n,ovrv,0.2,0.2,1.5,1e6\n' >"$crd/fleet.csv"
+printf 'title = "t"\nmodel = "ovrv"\nring = 22\n[x]\nname = "k1"\nlo = 0.1\nhi = 1e6\ncount = 5\n[y]\nname = "k2"\nlo = 0.1\nhi = 0.3\ncount = 5\n[fixed]\nth = 1.5\ntau = 0.2\n' >"$crd/big.toml"
+expect_error "vehicle 'big': gains and delay outside the computable range" classify "$crd/big.csv"
+expect_error "car 2 (big): gains and delay outside the computable range" roots --fleet "$crd/big.csv" --ring 4
+expect_error "computable range" roots --fleet "$crd/fleet.csv" --ring 4
+expect_error "car 1 (big): gains and delay outside the computable range" mix --x "$crd/big.csv:big" --y A_min --ring 6 --p 0:1:2 --out "$crd/mix"
+expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" sweep --k1 0.1:1e6:3 --k2 0.1:0.3:2 --th 1.5 --tau 0.2 --out "$crd/sweep"
+expect_error "computable range" sweep --k1 0.1:0.3:3 --k2 0.1:0.3:2 --th 1.5 --tau 1e6 --out "$crd/sweep"
+expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" boundary --k1 0.1:1e6 --k2 0.1:0.3 --th 1.5 --tau 0.2 --out "$crd/boundary"
+expect_error "panel 1: the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" chart "$crd/big.toml" --out "$crd/chart"
+# a vehicle just inside the range: its figure's window is pulled back inside, not refused
+printf 'name,k1,k2,th,tau\nedge,19.5,0.2,1.5,0.2\n' >"$crd/edge.csv"
+"$bin" classify "$crd/edge.csv" --out "$crd/edge/c" >/dev/null 2>&1 && xmllint --noout "$crd/edge/c.svg" && ok || bad "classify --out of a vehicle near the edge of the computable range"
+rm -rf "$crd/edge" "$crd/edge.csv"
+[ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -20,7 +20,7 @@ TEST_CASE("calibration CSV covariance columns read back exactly by the vehicles 
     r.covariance = 0.5 * (c + c.transpose());                           // exactly symmetric
     for (int i = 0; i < 5; ++i) r.estimates[static_cast<std::size_t>(i)].standard_error = std::sqrt(r.covariance(i, i));
     r.status = "converged";
-    const std::string csv = calibration_csv({"car"}, {r});
+    const std::string csv = calibration_csv({"car"}, {r}, CalibrationOptions{});
     const auto v = read_vehicles_csv(csv, "fits.csv");
     REQUIRE(v.size() == 1);
     CHECK(v[0].has_covariance);
@@ -28,7 +28,7 @@ TEST_CASE("calibration CSV covariance columns read back exactly by the vehicles 
     CHECK(v[0].parameters.at("th") == 1.2);
     // a parameter the trace does not determine (infinite standard error): no covariance written
     r.estimates[3].standard_error = std::numeric_limits<double>::infinity();
-    const auto w = read_vehicles_csv(calibration_csv({"car"}, {r}), "fits.csv");
+    const auto w = read_vehicles_csv(calibration_csv({"car"}, {r}, CalibrationOptions{}), "fits.csv");
     CHECK_FALSE(w[0].has_covariance);
     // no covariance columns: a plain vehicle table
     CHECK_FALSE(read_vehicles_csv("name,k1,k2,th,tau\nA,0.1,0.4,1.2,0.5\n", "plain.csv")[0].has_covariance);
@@ -44,6 +44,69 @@ TEST_CASE("calibration CSV covariance columns read back exactly by the vehicles 
     std::string partial = "A,0.1,0.4,1.2,0.5,1";
     for (int i = 1; i < 15; ++i) partial += ",";
     CHECK_THROWS_WITH_AS(read_vehicles_csv(header + "\n" + partial + "\n", "q.csv"), doctest::Contains("1 of the 15"), std::invalid_argument);
+}
+
+TEST_CASE("calibration CSV carries the fit's bounds; classify samples within them, not within the default bounds") {
+    CalibrationResult r;
+    r.parameters = {{"k1", 0.98}, {"k2", 0.4}, {"th", 1.2}, {"tau", 0.5}, {"eta", 7.0}};
+    r.covariance = Eigen::Matrix<double, 5, 5>::Zero();
+    r.covariance(0, 0) = 0.05 * 0.05;  // k1 = 0.98 +- 0.05: half its mass above the default bound 1
+    r.covariance(3, 3) = 0.1 * 0.1;
+    for (int i = 0; i < 5; ++i) r.estimates[static_cast<std::size_t>(i)].standard_error = std::sqrt(r.covariance(i, i));
+    r.status = "converged";
+    CalibrationOptions o;
+    o.set_bounds("k1", 0.9, 1.5);
+    o.set_bounds("tau", 0.45, 0.55);
+    o.set_bounds("eta", 2.0, 12.0);
+    const std::string csv = calibration_csv({"car"}, {r}, o);
+    CHECK(csv.substr(0, csv.find('\n')).find(",cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta") !=
+          std::string::npos);
+    const auto v = read_vehicles_csv(csv, "fits.csv");
+    REQUIRE(v.size() == 1);
+    REQUIRE(v[0].bounds.size() == 5);
+    for (const auto& name : calibration_parameter_names()) {
+        const BoundedParameter* b = find_bound(v[0].bounds, name);
+        REQUIRE(b != nullptr);
+        CHECK(b->lower == o.bound(name).lower);
+        CHECK(b->upper == o.bound(name).upper);
+    }
+    // the CLI's domain: calibrate's default bounds of k1, k2, th, tau
+    UncertaintyOptions uo;
+    for (const auto& b : paper_calibration_bounds())
+        if (b.name != "eta") uo.domain.push_back(b);
+    uo.samples = 200;
+    uo.ring_samples = 0;
+    const auto rows = classify(v, 22, uo);
+    REQUIRE(rows[0].has_uncertainty);
+    const VerdictUncertainty& u = rows[0].uncertainty;
+    CHECK(u.domain_from_fit);
+    CHECK(u.samples == 200);
+    int above_default = 0;
+    for (const auto& s : u.verdicts) {
+        CHECK(s.parameters.at("k1") >= 0.9);
+        CHECK(s.parameters.at("k1") <= 1.5);
+        CHECK(s.parameters.at("tau") >= 0.45);
+        CHECK(s.parameters.at("tau") <= 0.55);
+        above_default += s.parameters.at("k1") > 1.0 ? 1 : 0;
+    }
+    CHECK(above_default > 50);  // not truncated at the default bound k1 <= 1 (about a third of 200 expected)
+    CHECK(classification_json(rows, 22, "x").find("\"bounds_source\":\"file\"") != std::string::npos);
+    // a file without bounds: the default domain, said so
+    std::vector<CalibratedVehicle> w = read_vehicles_csv("name,k1,k2,th,tau\ncar,0.98,0.4,1.2,0.5\n", "plain.csv");
+    CHECK(w[0].bounds.empty());
+    w[0].covariance = v[0].covariance;
+    w[0].has_covariance = true;
+    const auto dflt = classify(w, 22, uo);
+    CHECK_FALSE(dflt[0].uncertainty.domain_from_fit);
+    for (const auto& s : dflt[0].uncertainty.verdicts) CHECK(s.parameters.at("k1") <= 1.0);
+    CHECK(classification_json(dflt, 22, "x").find("\"bounds_source\":\"default\"") != std::string::npos);
+    // one bound of a pair, a reversed pair, a half-filled pair: errors naming the column
+    CHECK_THROWS_WITH_AS(read_vehicles_csv("name,k1,k2,th,tau,lo_k1\nA,0.1,0.4,1.2,0.5,0\n", "b.csv"), doctest::Contains("lo_k1 without hi_k1"),
+                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_vehicles_csv("name,k1,k2,th,tau,lo_k1,hi_k1\nA,0.1,0.4,1.2,0.5,2,1\n", "b.csv"),
+                         doctest::Contains("expected lower <= upper"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_vehicles_csv("name,k1,k2,th,tau,lo_k1,hi_k1\nA,0.1,0.4,1.2,0.5,0,\n", "b.csv"),
+                         doctest::Contains("both filled or both empty"), std::invalid_argument);
 }
 
 TEST_CASE("classification outputs: probabilities and intervals only for vehicles with a covariance") {

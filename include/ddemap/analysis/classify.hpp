@@ -73,6 +73,7 @@ struct VerdictSample {
     bool plant_stable = false, string_stable = false, ring_stable = false;
     bool has_ring = false;          ///< among the first ring_samples samples
     bool decided = false;           ///< the plant roots converged (and the ring, when has_ring)
+    bool computable = true;         ///< inside the computable range (require_computable); else not decided, no verdict
 };
 
 /// Verdicts of a vehicle under its parameter uncertainty.
@@ -88,6 +89,8 @@ struct VerdictUncertainty {
     MarginInterval c2, sup_gamma_excess;  ///< over the decided samples
     MarginInterval ring_abscissa;         ///< over the decided ring samples
     std::vector<VerdictSample> verdicts;  ///< every sample, in draw order
+    ParameterBounds domain;   ///< the box the samples were restricted to (options.domain, or the fit's own bounds)
+    bool domain_from_fit = false;  ///< domain holds the vehicle's calibration bounds (CalibratedVehicle::bounds)
     Status status = Status::Converged;
     std::string message;      ///< what was sampled, or why the status is not converged
 };
@@ -117,7 +120,10 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
                                      const ExecutionPolicy& policy = {});
 
 /// The same, and for every vehicle with a covariance its verdicts under the parameter
-/// uncertainty (classify_with_uncertainty, the samples in parallel under `policy`).
+/// uncertainty (classify_with_uncertainty, the samples in parallel under `policy`). A vehicle
+/// that carries the bounds of its calibration (CalibratedVehicle::bounds, read from the file) is
+/// sampled within them: each parameter `uncertainty.domain` restricts takes the vehicle's bound
+/// instead when it has one (domain_from_fit); a parameter the domain leaves free stays free.
 std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars,
                                      const UncertaintyOptions& uncertainty, const ExecutionPolicy& policy = {});
 

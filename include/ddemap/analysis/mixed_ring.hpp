@@ -38,6 +38,12 @@ struct MixedRingResult {
     double product_residual = std::numeric_limits<double>::quiet_NaN();  ///< max |prod Gamma_i - 1| (predecessor laws)
 };
 
+/// Rightmost roots of the ring; std::invalid_argument naming the car when a car's linearisation
+/// at the equilibrium is outside the computable range (require_computable), before any root work.
 MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& options);
+
+/// require_computable for every car of `fleet` linearised at the ring's equilibrium (options'
+/// speed or length), the message naming the car (1-based position and label).
+void require_computable(const Fleet& fleet, const MixedRingOptions& options);
 
 }  // namespace ddemap

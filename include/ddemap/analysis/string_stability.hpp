@@ -45,8 +45,11 @@ constexpr double kMaxCoefficientSum = 1e8;
 constexpr double kMaxScaledDelay = 10.0;
 /// c tau_max of the range above (c alone when there is no delay).
 double scaled_delay(const Linearisation& lin);
-/// Throws std::invalid_argument stating the range when `lin` is outside it.
-void require_computable(const Linearisation& lin);
+/// Throws std::invalid_argument stating the range when `lin` is outside it; a non-empty `what`
+/// (e.g. "car 3 (A_min)", "the corner k1 = 1, k2 = 2 of the window") starts the message. The one
+/// check of the range: rings of mixed cars (every car), penetration studies, sweep windows (their
+/// corners) and classifications of files call it too, before any work.
+void require_computable(const Linearisation& lin, const std::string& what = std::string());
 
 struct StringOptions {
     RootOptions roots;            ///< for the plant roots (its count is replaced by plant_roots)

@@ -54,8 +54,11 @@ std::string simulation_csv(const SimResult& r);
 /// name,position,speed_drop,amplification,min_gap,failure
 std::string growth_csv(const std::vector<GrowthResult>& g);
 /// name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,
-/// test_rmse_gap,naive_rmse_speed,status (a vehicle table for read_vehicles_csv)
-std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits);
+/// test_rmse_gap,naive_rmse_speed,status, the 15 covariance columns cov_k1_k1 .. cov_eta_eta,
+/// then the bounds of the fit, lo_k1,hi_k1 .. lo_eta,hi_eta (options.bound(NAME)); a vehicle
+/// table for read_vehicles_csv, which reads the covariance and the bounds back.
+std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
+                            const CalibrationOptions& options);
 /// p,x_cars,spectral_abscissa,spectral_abscissa_min,spectral_abscissa_max,speed,ring_stable,
 /// unstable_roots,arrangements,max_residual,status
 std::string mix_csv(const std::vector<MixPoint>& points);

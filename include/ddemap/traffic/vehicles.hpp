@@ -24,11 +24,18 @@ struct CalibratedVehicle {
     /// it); meaningful only when has_covariance.
     Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
     bool has_covariance = false;
+    /// The bounds the calibration searched within (columns lo_NAME, hi_NAME that `calibrate`
+    /// writes); empty when the file carries none.
+    ParameterBounds bounds;
 };
 
 /// CSV column names of the covariance: cov_A_B for the upper triangle (A before or equal to B
 /// in the order k1, k2, th, tau, eta), 15 columns, row by row.
 std::vector<std::string> covariance_column_names();
+
+/// CSV column names of the calibration bounds: lo_NAME, hi_NAME for NAME in k1, k2, th, tau, eta
+/// (10 columns, in that order).
+std::vector<std::string> bounds_column_names();
 
 /// The 14 settings of the paper's calibration table, in the paper's order.
 const std::vector<CalibratedVehicle>& paper_calibration_table();
@@ -41,7 +48,9 @@ const CalibratedVehicle& builtin_vehicle(const std::string& name);
 /// default 10; min_acc_speed [m/s] optional, default 0 = the ACC never disengages; the 15
 /// covariance columns cov_k1_k1 .. cov_eta_eta optional, all or none: a row with all of them
 /// filled carries a covariance (symmetric, finite, non-negative diagonal), a row with all empty
-/// none; other columns are ignored), one vehicle per line. Errors name `source`, the line
+/// none; the bounds columns lo_k1, hi_k1 .. lo_eta, hi_eta optional, for each parameter both or
+/// neither in the header, a row's pair both filled (finite, lower <= upper) or both empty, into
+/// `bounds`; other columns are ignored), one vehicle per line. Errors name `source`, the line
 /// and the column (std::invalid_argument).
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source);
 
