@@ -46,7 +46,7 @@ TEST_CASE("calibration CSV covariance columns read back exactly by the vehicles 
     CHECK_THROWS_WITH_AS(read_vehicles_csv(header + "\n" + partial + "\n", "q.csv"), doctest::Contains("1 of the 15"), std::invalid_argument);
 }
 
-TEST_CASE("calibration CSV carries the fit's bounds; classify samples within them, not within the default bounds") {
+TEST_CASE("calibration CSV carries the fit's bounds and classify samples within them, not within the default bounds") {
     CalibrationResult r;
     r.parameters = {{"k1", 0.98}, {"k2", 0.4}, {"th", 1.2}, {"tau", 0.5}, {"eta", 7.0}};
     r.covariance = Eigen::Matrix<double, 5, 5>::Zero();

@@ -63,7 +63,7 @@ TEST_CASE("computable range: a sweep window is checked at its corners") {
     CHECK_THROWS_WITH_AS(s.validate(), doctest::Contains("tau = 1000000"), std::invalid_argument);
 }
 
-TEST_CASE("computable range: classify refuses a vehicle outside it; samples outside it are undecided, not thrown") {
+TEST_CASE("computable range: classify refuses a vehicle outside it and samples outside it are undecided, not thrown") {
     CalibratedVehicle a;
     a.name = "A";
     a.parameters = {{"k1", 0.2}, {"k2", 0.2}, {"th", 1.5}, {"tau", 0.2}, {"eta", 10.0}};
