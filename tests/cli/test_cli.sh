@@ -701,7 +701,7 @@ if "$bin" equilibria --model ov --ring 5 --par headway --from 1.2 --to 3 --forma
 else
     bad "equilibria --model ov exit status"
 fi
-"$bin" equilibria --model ov --ring 5 --par headway --from 1.2 --to 3 | grep -q '^hopf' && ok || bad "equilibria table"
+"$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 | grep -q "^hopf       p = 0.6168502" && ok || bad "equilibria table"
 
 # a published model as a system file: DDE-BIFTOOL's neuron demo (demo1_hopf: Hopf at a21 = 0.80712, omega = 0.78197)
 cat >"$tmp/neuron.json" <<'EOF2'
