@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -27,6 +28,15 @@ double number(const std::string& source, const toml::node& n, const std::string&
     throw std::invalid_argument(where(source, n) + ": " + key + ": expected a number");
 }
 
+/// An integer field: a TOML integer (not a float such as 1e308, which toml++ would convert with
+/// undefined behaviour) from lo to hi; nullopt otherwise.
+std::optional<int64_t> integer_in(const toml::node& n, int64_t lo, int64_t hi) {
+    if (!n.is_integer()) return std::nullopt;
+    const int64_t v = n.as_integer()->get();
+    if (v < lo || v > hi) return std::nullopt;
+    return v;
+}
+
 std::string short_number(double v) {  // 4 significant digits: a title, not data
     std::ostringstream os;
     os << std::setprecision(4) << v;
@@ -45,9 +55,9 @@ Axis read_axis(const std::string& source, const toml::table& root, const char* k
         if (!t.get(k)) throw std::invalid_argument(where(source, *n) + ": " + key + "." + k + " missing");
     a.lo = number(source, *t.get("lo"), std::string(key) + ".lo");
     a.hi = number(source, *t.get("hi"), std::string(key) + ".hi");
-    const auto c = t.get("count")->value<int64_t>();
-    if (!c || *c < 2 || *c > 100000 || !(a.lo < a.hi)) {
-        throw std::invalid_argument(where(source, *n) + ": " + key + ": expected lo < hi and an integer count >= 2");
+    const auto c = integer_in(*t.get("count"), 2, 100000);
+    if (!c || !(a.lo < a.hi)) {
+        throw std::invalid_argument(where(source, *n) + ": " + key + ": expected lo < hi and an integer count from 2 to 100000");
     }
     a.count = static_cast<int>(*c);
     return a;
@@ -114,10 +124,10 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     if (const toml::node* r = root.get("ring")) {
         if (auto s = r->value<std::string>(); s && *s == "inf") {
             spec.cars = 0;
-        } else if (auto n = r->value<int64_t>(); n && *n >= 2) {
+        } else if (auto n = integer_in(*r, 2, 1000000000)) {
             spec.cars = static_cast<int>(*n);
         } else {
-            throw std::invalid_argument(where(source, *r) + ": ring: expected an integer N >= 2 or \"inf\"");
+            throw std::invalid_argument(where(source, *r) + ": ring: expected an integer N from 2 to 1e9 or \"inf\"");
         }
     }
     if (const toml::node* f = root.get("fixed")) {
@@ -127,8 +137,8 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     spec.x = read_axis(source, root, "x");
     spec.y = read_axis(source, root, "y");
     if (const toml::node* c = root.get("columns")) {
-        const auto v = c->value<int64_t>();
-        if (!v || *v < 1 || *v > 64) throw std::invalid_argument(where(source, *c) + ": columns: expected an integer from 1 to 64");
+        const auto v = integer_in(*c, 1, 64);
+        if (!v) throw std::invalid_argument(where(source, *c) + ": columns: expected an integer from 1 to 64");
         spec.columns = static_cast<int>(*v);
     }
     // panel sizes in px: a finite figure (never width="inf" or a negative width in the SVG)

@@ -13,8 +13,9 @@ namespace {
 
 using json = nlohmann::json;
 
+/// A field name may be a key of the file (any characters): escaped so that the message stays one line.
 [[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& what) {
-    throw std::invalid_argument(source + ": " + field + ": " + what);
+    throw std::invalid_argument(source + ": " + detail::escaped(field, 80) + ": " + what);
 }
 
 /// The documented coefficient range (README "--system"): 0 or a magnitude from 1e-100 to 1e100.
@@ -185,7 +186,7 @@ NonlinearSystemFile read_nonlinear_system_json(const std::string& text, const st
     try {
         out.system = std::make_shared<ExpressionSystem>(variables, names, values, equations);
     } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(source + ": " + e.what());
+        throw std::invalid_argument(source + ": " + detail::escaped(e.what(), 400));
     }
     const std::size_t n = variables.size();
     out.equilibrium = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));

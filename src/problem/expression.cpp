@@ -1,5 +1,7 @@
 #include "ddemap/problem/expression.hpp"
 
+#include "core/internal/text.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
@@ -85,7 +87,7 @@ public:
         if (m_pos >= m_text.size()) fail(m_pos, "the expression is empty", "an expression");
         Code c = expression();
         skip();
-        if (m_pos < m_text.size()) fail(m_pos, "unexpected '" + std::string(1, m_text[m_pos]) + "'", "an operator (+ - * / ^) or the end");
+        if (m_pos < m_text.size()) fail(m_pos, "unexpected " + detail::quoted(std::string(1, m_text[m_pos])), "an operator (+ - * / ^) or the end");
         return c;
     }
 
@@ -108,7 +110,7 @@ private:
     void expect(char c, const std::string& expected) {
         skip();
         if (m_pos >= m_text.size()) fail(m_pos, "the expression ends early", expected);
-        if (m_text[m_pos] != c) fail(m_pos, "unexpected '" + std::string(1, m_text[m_pos]) + "'", expected);
+        if (m_text[m_pos] != c) fail(m_pos, "unexpected " + detail::quoted(std::string(1, m_text[m_pos])), expected);
         ++m_pos;
     }
 
@@ -176,7 +178,7 @@ private:
         }
         if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number();
         if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') return name();
-        fail(m_pos, "unexpected '" + std::string(1, c) + "'", "a number, a name or '('");
+        fail(m_pos, "unexpected " + detail::quoted(std::string(1, c)), "a number, a name or '('");
     }
 
     Code number() {
@@ -317,8 +319,8 @@ bool Expression::is_parameter_only() const {
 void ExpressionNames::check_name(const std::string& name, const std::string& what) {
     bool ok = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
     for (char c : name) ok = ok && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
-    if (!ok) throw std::invalid_argument(what + " '" + name + "' is not a name: expected letters, digits and '_', starting with a letter");
-    if (find_function(name)) throw std::invalid_argument(what + " '" + name + "' is the name of a function: expected another name");
+    if (!ok) throw std::invalid_argument(what + " " + detail::quoted(name) + " is not a name: expected letters, digits and '_', starting with a letter");
+    if (find_function(name)) throw std::invalid_argument(what + " " + detail::quoted(name) + " is the name of a function: expected another name");
     if (name == "t") throw std::invalid_argument(what + " 't' is the time: expected another name");
 }
 

@@ -13,9 +13,9 @@ std::vector<std::string> checked(std::vector<std::string> names, const std::vect
     for (std::size_t i = 0; i < names.size(); ++i) {
         ExpressionNames::check_name(names[i], what);
         for (std::size_t j = 0; j < i; ++j)
-            if (names[j] == names[i]) throw std::invalid_argument(what + " '" + names[i] + "' is named twice: expected distinct names");
+            if (names[j] == names[i]) throw std::invalid_argument(what + " " + detail::quoted(names[i]) + " is named twice: expected distinct names");
         for (const auto& o : others)
-            if (o == names[i]) throw std::invalid_argument(what + " '" + names[i] + "' is also a variable: expected distinct names");
+            if (o == names[i]) throw std::invalid_argument(what + " " + detail::quoted(names[i]) + " is also a variable: expected distinct names");
     }
     return names;
 }
@@ -40,7 +40,7 @@ std::vector<double> ExpressionSystem::delays(const std::vector<double>& p) const
     for (std::size_t k = 0; k < m_parsed.delays.size(); ++k) {
         const double tau = m_parsed.delays[k].evaluate<double>(nullptr, p.data());
         if (!(std::isfinite(tau) && tau >= 0.0))
-            throw std::invalid_argument("the delay " + m_parsed.delay_texts[k] + " is " + (std::isfinite(tau) ? detail::format_number(tau) : std::string("not finite")) +
+            throw std::invalid_argument("the delay " + detail::escaped(m_parsed.delay_texts[k], 80) + " is " + (std::isfinite(tau) ? detail::format_number(tau) : std::string("not finite")) +
                                         ": expected a finite delay >= 0");
         d.push_back(tau);
     }
