@@ -35,7 +35,7 @@ for t in "${targets[@]}"; do
     mkdir -p "$work"
     echo "fuzz_$t: $seconds s"
     if ! build-fuzz/fuzz/fuzz_$t "$work" "fuzz/corpus/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
-            -max_len=65536 -artifact_prefix=build-fuzz/findings/$t- -print_final_stats=1 > "build-fuzz/fuzz_$t.log" 2>&1; then
+            -max_len=65536 -seed="${FUZZ_SEED:-1}" -artifact_prefix=build-fuzz/findings/$t- -print_final_stats=1 > "build-fuzz/fuzz_$t.log" 2>&1; then
         echo "fuzz_$t: FINDING (see build-fuzz/fuzz_$t.log and build-fuzz/findings/)"
         tail -30 "build-fuzz/fuzz_$t.log"
         status=1

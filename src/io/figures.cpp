@@ -38,6 +38,7 @@ std::string simulation_svg(const SimResult& r, const std::string& lead) {
 
 std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& lead) {
     PlotPanel gap{"Minimum gap", "position in the platoon", "minimum gap [m]", {}, {}};
+    gap.y_floor = 0.0;
     PlotPanel amp{"Disturbance amplification", "position in the platoon", "speed drop / lead's drop [1]", {}, {}};
     for (const auto& r : g) {
         PlotSeries a{r.name, {}, {}, "", r.name.find("max") != std::string::npos};

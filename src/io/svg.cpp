@@ -536,11 +536,13 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         widen(x0, x1);
         widen(y0, y1);
         const double pad = 0.04 * (y1 - y0);
+        const bool floored = y0 >= p.y_floor;
         y0 -= pad;
         y1 += pad;
         const double sx = nice_step(x1 - x0), sy = nice_step(y1 - y0);
         x0 = std::floor(x0 / sx) * sx; x1 = std::ceil(x1 / sx) * sx;
         y0 = std::floor(y0 / sy) * sy; y1 = std::ceil(y1 / sy) * sy;
+        if (floored && y0 < p.y_floor) y0 = p.y_floor;
         const double ox = (pi % cols) * cw + ml + 5, oy = header + (pi / cols) * ch + mt;
         const double pw = o.panel_width, ph = o.panel_height;
         auto X = [&](double x) { return ox + (x - x0) / (x1 - x0) * pw; };

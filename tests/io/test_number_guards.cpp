@@ -22,3 +22,14 @@ TEST_CASE("no NaN or inf is ever written: the CSV and SVG number writers make it
     po.panel_width = inf;  // a figure size that is not finite
     CHECK_THROWS_AS(render_line_plots_svg({ok}, po), std::logic_error);
 }
+
+TEST_CASE("a y floor keeps the padding of a gap axis at 0 and is ignored when data lie below it") {
+    PlotOptions po;
+    PlotPanel gap{"gap", "x", "gap [m]", {PlotSeries{"s", {1.0, 2.0, 3.0}, {0.0, 20.0, 55.0}, "", false}}, {}};
+    // without a floor the 4 % padding below 0 rounds the axis to a negative tick
+    CHECK(render_line_plots_svg({gap}, po).find("text-anchor=\"end\">-") != std::string::npos);
+    gap.y_floor = 0.0;
+    CHECK(render_line_plots_svg({gap}, po).find("text-anchor=\"end\">-") == std::string::npos);
+    gap.series[0].y[0] = -5.0;  // data below the floor: the axis shows them
+    CHECK(render_line_plots_svg({gap}, po).find("text-anchor=\"end\">-") != std::string::npos);
+}

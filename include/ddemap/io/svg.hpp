@@ -6,6 +6,7 @@
 /// panels (small multiples). The writer only formats what it is given.
 
 #include <stdexcept>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,6 +71,9 @@ struct PlotPanel {
     std::string title, x_label, y_label;
     std::vector<PlotSeries> series;
     std::vector<PlotMarker> markers;  ///< drawn as crosses
+    /// The y axis does not extend below this when no data lie below it (a gap is never
+    /// negative: the padding around the data stops at 0 instead of showing -10 m).
+    double y_floor = -std::numeric_limits<double>::infinity();
 };
 
 struct PlotOptions {
