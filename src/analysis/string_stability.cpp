@@ -73,6 +73,11 @@ double scaled_delay(const Linearisation& lin) {
     return tau > 0.0 ? c * tau : c;
 }
 
+bool is_computable(const Linearisation& lin) {
+    const double c = coefficient_sum(lin);
+    return c <= kMaxCoefficientSum && c * lin.max_delay() <= kMaxScaledDelay;
+}
+
 void require_computable(const Linearisation& lin, const std::string& what) {
     const double c = coefficient_sum(lin);
     const double tau = lin.max_delay();

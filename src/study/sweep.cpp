@@ -282,6 +282,14 @@ std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y) {
     return make_model(spec.model, p);
 }
 
+namespace {
+/// "the point k1 = 0.5, k2 = 2 of the window" (for the message of a point outside the computable range).
+std::string point_name(const SweepSpec& spec, double x, double y) {
+    return "the point " + spec.x.name + " = " + detail::format_number(x) + ", " + spec.y.name + " = " + detail::format_number(y) +
+           " of the window";
+}
+}  // namespace
+
 SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
     spec.validate();
     SweepResult result;
@@ -302,6 +310,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
         detail::PlantTracker plant;
         for (int iy = 0; iy < ny; ++iy) {
             const Linearisation lin = model_at(spec, spec.x.value(0), spec.y.value(iy))->linearise();
+            if (!is_computable(lin)) require_computable(lin, point_name(spec, spec.x.value(0), spec.y.value(iy)));
             const detail::RingSummary rs = ring.evaluate(lin);
             fallbacks += rs.fallbacks;
             degree = std::max(degree, rs.degree);
@@ -327,6 +336,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
             p.x = spec.x.value(ix);
             p.y = spec.y.value(iy);
             const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
+            if (!is_computable(lin)) require_computable(lin, point_name(spec, p.x, p.y));
             const detail::RingSummary rs = ring.evaluate(lin);
             int fb = rs.fallbacks;
             const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);

@@ -796,6 +796,9 @@ expect_error "computable range" roots --fleet "$crd/fleet.csv" --ring 4
 expect_error "car 1 (big): gains and delay outside the computable range" mix --x "$crd/big.csv:big" --y A_min --ring 6 --p 0:1:2 --out "$crd/mix"
 expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" sweep --k1 0.1:1e6:3 --k2 0.1:0.3:2 --th 1.5 --tau 0.2 --out "$crd/sweep"
 expect_error "computable range" sweep --k1 0.1:0.3:3 --k2 0.1:0.3:2 --th 1.5 --tau 1e6 --out "$crd/sweep"
+# IDM's coefficient sum peaks inside the delta range (corners 9.7 and 9.98, delta = 5.125 gives 10.12):
+# every point is checked, not only the corners
+expect_error "the point a = 100000, delta = 5.125 of the window: gains and delay outside the computable range" sweep --model idm --a 1e5:1.00001e5:2 --delta 3:20:9 --th 1.5 --tau 5.3e-4 --speed 16.65 --out "$crd/sweep" --no-boundaries
 expect_error "the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" boundary --k1 0.1:1e6 --k2 0.1:0.3 --th 1.5 --tau 0.2 --out "$crd/boundary"
 expect_error "panel 1: the corner k1 = 1000000, k2 = 0.1 of the window: gains and delay outside the computable range" chart "$crd/big.toml" --out "$crd/chart"
 # a vehicle just inside the range: its figure's window is pulled back inside, not refused

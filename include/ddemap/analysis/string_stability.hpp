@@ -45,10 +45,13 @@ constexpr double kMaxCoefficientSum = 1e8;
 constexpr double kMaxScaledDelay = 10.0;
 /// c tau_max of the range above (c alone when there is no delay).
 double scaled_delay(const Linearisation& lin);
+/// True when `lin` is inside the range above (the test require_computable makes; cheap).
+bool is_computable(const Linearisation& lin);
 /// Throws std::invalid_argument stating the range when `lin` is outside it; a non-empty `what`
 /// (e.g. "car 3 (A_min)", "the corner k1 = 1, k2 = 2 of the window") starts the message. The one
 /// check of the range: rings of mixed cars (every car), penetration studies, sweep windows (their
-/// corners) and classifications of files call it too, before any work.
+/// corners before any work, and every point, since the range need not be largest at a corner)
+/// and classifications of files call it too.
 void require_computable(const Linearisation& lin, const std::string& what = std::string());
 
 struct StringOptions {
