@@ -47,8 +47,9 @@ struct EquilibriumBranchOptions {
         return c;
     }();
     /// At every point; count: the roots reported. More are computed for the detection of Hopf
-    /// points: at least 8, doubled (up to 256) until 6 of them have Re < 0, so that every
-    /// unstable root and the stable ones nearest the axis are seen.
+    /// points: at least 8, doubled (up to 256) until the result is certified complete in a strip
+    /// Re >= strip_floor with strip_floor < 0, so that every unstable root and the stable ones
+    /// nearest the axis are seen.
     RootOptions roots;
     EquilibriumOptions equilibrium;    ///< the first point
     NewtonOptions special{40, 1e-12};  ///< Newton on the fold and Hopf systems
