@@ -371,7 +371,8 @@ GeneralisedHopfPoint locate_generalised(const NonlinearDDE& s, int j1, const Hop
         best = u;
         g.l1 = c.l1;
         g.residual = c.residual;
-        if (c.criticality == Criticality::Degenerate || shi - slo <= 1e-14) {
+        // to rounding: L1 at the rounding level of its terms, or the chord interval at rounding
+        if (std::abs(c.l1) <= 1e-13 * c.l1_scale || shi - slo <= 1e-14) {
             g.status = Status::Converged;
             break;
         }

@@ -6,6 +6,7 @@
 
 #include "../tolerances.hpp"
 #include "ddemap/analysis/hopf.hpp"
+#include "ddemap/io/hopf_output.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/integrate.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
@@ -95,6 +96,50 @@ TEST_CASE("Wright's equation: L1, the crossing speed and the amplitude law in cl
     CHECK(std::abs(c.amplitude_coefficient[0] - 4 * std::sqrt(10 / (3 * pi - 2))) < tol::normal_form);
     CHECK(std::abs(c.q.norm() - 1) < 1e-14);
     CHECK(c.null_residual < tol::normal_form);
+}
+
+TEST_CASE("the crossing speed through a moving equilibrium and through a delay, in closed form") {
+    // x' = p - x(t - 1)^2: x* = sqrt(p), Delta = lambda + 2 sqrt(p) e^{-lambda}, Hopf at p = pi^2/16,
+    // omega = pi/2; the total dDelta/dp = e^{-lambda} / sqrt(p) (through x*(p)) gives
+    // lambda' = (4 i / pi) / (1 + i pi/2), Re lambda' = 8 / (4 + pi^2).
+    ExpressionSystem fold({"x"}, {"p"}, {0.6}, {"p - x(t - 1)^2"});
+    const HopfPoint h1 = correct_hopf(fold, 0, Eigen::VectorXd::Constant(1, 0.78), 0.6, 1.5);
+    REQUIRE(h1.status == Status::Converged);
+    CHECK(std::abs(h1.par - pi * pi / 16) < tol::special_point);
+    const HopfCoefficients c1 = hopf_coefficients(fold, 0, h1);
+    REQUIRE(c1.status == Status::Converged);
+    CHECK(std::abs(c1.dlambda - cplx(0, 4 / pi) / cplx(1, pi / 2)) < tol::normal_form);
+    CHECK(std::abs(c1.dre_dpar - 8 / (4 + pi * pi)) < tol::normal_form);
+    // x' = -x(t - tau) + x x(t - tau) in tau: Hopf at tau = pi/2, omega = 1; dDelta/dtau = -lambda e^{-lambda tau}
+    // = -1, Delta' = 1 + i pi/2, so lambda' = 1 / (1 + i pi/2), Re lambda' = 4 / (4 + pi^2)
+    ExpressionSystem delay({"x"}, {"tau"}, {1.5}, {"-x(t - tau) + x*x(t - tau)"});
+    const HopfPoint h2 = correct_hopf(delay, 0, Eigen::VectorXd::Zero(1), 1.5, 1.0);
+    REQUIRE(h2.status == Status::Converged);
+    CHECK(std::abs(h2.par - pi / 2) < tol::special_point);
+    const HopfCoefficients c2 = hopf_coefficients(delay, 0, h2);
+    REQUIRE(c2.status == Status::Converged);
+    CHECK(std::abs(c2.dlambda - 1.0 / cplx(1, pi / 2)) < tol::normal_form);
+    CHECK(std::abs(c2.dre_dpar - 4 / (4 + pi * pi)) < tol::normal_form);
+}
+
+TEST_CASE("hopf output: a Hopf point that was not located is undecided, with null coefficients") {
+    ExpressionSystem wright({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)*(1 + y)"});
+    HopfAnalysis a;
+    a.branch.parameter = "alpha";
+    HopfPoint bad;
+    bad.x = Eigen::VectorXd::Zero(1);
+    bad.par = 1.5;
+    bad.omega = 1.5;
+    a.points.push_back(hopf_coefficients(wright, 0, bad));
+    a.points.push_back(hopf_coefficients(wright, 0, correct_hopf(wright, 0, Eigen::VectorXd::Zero(1), 1.5, 1.5)));
+    const std::string j = hopf_points_json(a, {"y"});
+    CHECK(j.find("\"criticality\":\"undecided\"") != std::string::npos);
+    CHECK(j.find("\"l1\":null") != std::string::npos);
+    CHECK(j.find("\"criticality\":\"supercritical\"") != std::string::npos);
+    const std::string csv = hopf_points_csv(a, {"y"});
+    CHECK(csv.find(",undecided,") != std::string::npos);
+    CHECK(csv.find("nan") == std::string::npos);
+    CHECK(csv.find("inf") == std::string::npos);
 }
 
 TEST_CASE("Wright's equation: the predicted amplitude against a long simulation, error O(mu)") {
@@ -301,7 +346,7 @@ TEST_CASE("DDE-BIFTOOL demo 1 (neuron): the Hopf curve in (a21, taus) is supercr
         CHECK(p.coefficients.criticality == Criticality::Supercritical);
     }
     CHECK(c.generalised.empty());
-    MESSAGE("neuron Hopf curve: " << c.points.size() << " points, " << c.message << "; L1 at the start " << hc.start.points[0].l1);
+    MESSAGE("neuron Hopf curve: " << c.message << "; L1 at the start " << hc.start.points[0].l1);
 }
 
 TEST_CASE("Hopf coefficients: inputs and failures") {

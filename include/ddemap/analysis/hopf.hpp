@@ -139,7 +139,7 @@ struct GeneralisedHopfPoint {
     double par = 0.0, par2 = 0.0, omega = 0.0;
     Eigen::VectorXd x;
     Status status = Status::MaxIterations;
-    double l1 = 0.0;       ///< at the located point (|l1| <= degenerate tolerance * scale when converged)
+    double l1 = 0.0;       ///< at the located point (|l1| <= 1e-13 of its scale, or the chord bracket at rounding, when converged)
     double residual = std::numeric_limits<double>::infinity();  ///< of the Hopf system
     int after = 0;         ///< index of the curve point before it
 };
