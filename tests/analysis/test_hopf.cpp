@@ -349,6 +349,44 @@ TEST_CASE("DDE-BIFTOOL demo 1 (neuron): the Hopf curve in (a21, taus) is supercr
     MESSAGE("neuron Hopf curve: " << c.message << "; L1 at the start " << hc.start.points[0].l1);
 }
 
+TEST_CASE("DDE-BIFTOOL minimal demo (delayed Duffing oscillator): published L1 values and the generalised Hopf point" *
+          doctest::test_suite("reference")) {
+    // DDE-Biftool, demos/minimal_demo/html/minimal_demo.html (published output of minimal_demo.m,
+    // DDE-BIFTOOL's current normal form code): x'' + d x' + a x + x^3 + b (x - x(t - tau)) = 0 with
+    // a = 0.5, b = 0.6, d = 0.05, continued in tau from 0: LocateSpecialPoints prints the Hopf points
+    // with "L1: 0.12631", "L1: 0.13109", "L1: -0.48039"; along the Hopf curve in (b, tau) from the
+    // second one (b <= 0.6, tau <= 20) BranchFromCodimension2 prints "from genh at par(3)=0.036906,
+    // par(1)=14.8348" (par(3) = b, par(1) = tau).
+    ExpressionSystem duffing({"x1", "x2"}, {"a", "b", "d", "tau"}, {0.5, 0.6, 0.05, 0.0},
+                             {"x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"});
+    EquilibriumBranchOptions o;
+    o.parameter = "tau";
+    o.from = 0.0;
+    o.to = 10.0;
+    const HopfAnalysis ha = hopf_points(duffing, Eigen::VectorXd::Zero(2), o);
+    CHECK(ha.status == Status::Converged);
+    REQUIRE(ha.points.size() == 3);
+    const double published[3] = {0.12631, 0.13109, -0.48039};
+    for (int i = 0; i < 3; ++i) {
+        REQUIRE(ha.points[static_cast<std::size_t>(i)].status == Status::Converged);
+        CHECK(std::abs(ha.points[static_cast<std::size_t>(i)].l1 / published[i] - 1) < tol::published_5_digits_rel);
+    }
+    HopfCurveOptions co;
+    co.branch = o;
+    co.branch.to = 20.0;
+    co.parameter2 = "b";
+    co.from2 = 0.0;
+    co.to2 = 0.6;
+    const HopfCurve c = hopf_curve(duffing, ha.branch.hopf[1], co);
+    CHECK(c.status == Status::Converged);
+    REQUIRE(c.generalised.size() == 1);
+    const GeneralisedHopfPoint& g = c.generalised[0];
+    CHECK(g.status == Status::Converged);
+    CHECK(std::abs(g.par / 14.8348 - 1) < tol::published_5_digits_rel);
+    CHECK(std::abs(g.par2 / 0.036906 - 1) < tol::published_5_digits_rel);
+    MESSAGE("generalised Hopf point at tau = " << g.par << ", b = " << g.par2 << ", omega = " << g.omega << "; curve: " << c.message);
+}
+
 TEST_CASE("Hopf coefficients: inputs and failures") {
     ExpressionSystem wright({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)*(1 + y)"});
     HopfPoint bad;  // not located

@@ -865,5 +865,14 @@ expect_error "--from2/--to2 without --par2" hopf --system "$tmp/wright.json" --p
 rc=$?
 [ $rc -eq 4 ] && grep -q "undecided" "$tmp/hund.err" && python3 -c "import json,sys; json.load(open(sys.argv[1]))" "$tmp/hund.out" && ok || bad "hopf undecided: exit $rc"
 
+# DDE-BIFTOOL's minimal demo (published L1 = 0.12631, 0.13109, -0.48039 at its three Hopf points in tau)
+"$bin" hopf --system "$(dirname "$0")/../../examples/duffing.json" --par tau --from 0 --to 10 --format json |
+    python3 -c "
+import json, sys
+h = json.load(sys.stdin)['result']['hopf']
+assert [abs(x['l1'] / p - 1) < 5e-5 for x, p in zip(h, (0.12631, 0.13109, -0.48039))] == [True] * 3 and len(h) == 3, h
+assert [x['criticality'] for x in h] == ['subcritical', 'subcritical', 'supercritical'], h
+" && ok || bad "hopf: DDE-BIFTOOL minimal demo L1 values"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
