@@ -166,6 +166,67 @@ TEST_CASE("Wright's equation: the predicted amplitude against a long simulation,
     CHECK(std::abs(err[0] / err[1] - 2.0) < tol::order_ratio_band);
 }
 
+TEST_CASE("neuron demo: the predicted range of each variable against a long simulation, error O(mu)") {
+    // a vector system: the range of x_j is predicted as amplitude_coefficient_j sqrt(mu), through
+    // |q_j| (the direction of the eigenvector matters, its normalisation does not)
+    ExpressionSystem neuron = neuron_system();
+    const int j = neuron.parameter_index("a21");
+    const HopfPoint h = correct_hopf(neuron, j, Eigen::VectorXd::Zero(2), 0.8, 0.78);
+    const HopfCoefficients c = hopf_coefficients(neuron, j, h);
+    REQUIRE(c.status == Status::Converged);
+    REQUIRE(c.criticality == Criticality::Supercritical);
+    REQUIRE(c.side == 1);
+    double err[2][2];
+    const double mus[2] = {0.02, 0.01};
+    for (int i = 0; i < 2; ++i) {
+        const double mu = mus[i];
+        neuron.set_parameter("a21", h.par + mu);
+        const std::vector<double> tau = neuron.delays();
+        const double r = std::sqrt(-mu * c.dre_dpar / c.c1.real());
+        // from the predicted orbit x ~ 2 r Re(q e^{i omega t})
+        DdeSolver solver(
+            2, 0.0,
+            [&](double t, double* y) {
+                for (int k = 0; k < 2; ++k) y[k] = 2 * r * std::real(c.q[k] * std::exp(cplx(0, c.omega * t)));
+            },
+            [&](double t, const double* y, const DdeSolver& s, double* dy) {
+                Eigen::VectorXd u(2 * (tau.size() + 1));
+                u << y[0], y[1], Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(tau.size()));
+                for (std::size_t k = 0; k < tau.size(); ++k)
+                    for (int m = 0; m < 2; ++m) u[2 * static_cast<Eigen::Index>(k + 1) + m] = s.value(m, t - tau[k]);
+                const Eigen::VectorXd f = neuron.f(u);
+                dy[0] = f[0];
+                dy[1] = f[1];
+            });
+        const double t_end = 5.0 / (mu * c.dre_dpar) + 100.0;
+        double hi[2] = {-1e300, -1e300}, lo[2] = {1e300, 1e300};
+        std::vector<double> prev[2];
+        solver.integrate(t_end, 1.0 / 32, {}, [&](const DdeSolver& s) {
+            if (s.time() < t_end - 60.0) return true;
+            for (int m = 0; m < 2; ++m) {
+                prev[m].push_back(s.state()[m]);
+                const std::size_t n = prev[m].size();
+                if (n < 3) continue;
+                const double a = prev[m][n - 3], b = prev[m][n - 2], cc = prev[m][n - 1], den = a - 2 * b + cc;
+                if ((b >= a && b >= cc) || (b <= a && b <= cc)) {
+                    const double ext = den != 0.0 ? b - (cc - a) * (cc - a) / (8.0 * den) : b;
+                    hi[m] = std::max(hi[m], ext);
+                    lo[m] = std::min(lo[m], ext);
+                }
+            }
+            return true;
+        });
+        for (int m = 0; m < 2; ++m) {
+            const double predicted = c.amplitude_coefficient[m] * std::sqrt(mu);
+            err[i][m] = std::abs((hi[m] - lo[m]) / predicted - 1);
+            MESSAGE("neuron, mu = " << mu << ", x" << m + 1 << ": simulated range " << hi[m] - lo[m] << ", predicted " << predicted
+                                    << ", relative error " << err[i][m]);
+            CHECK(err[i][m] < tol::amplitude_law_per_mu * mu);
+        }
+    }
+    for (int m = 0; m < 2; ++m) CHECK(std::abs(err[0][m] / err[1][m] - 2.0) < tol::order_ratio_band);
+}
+
 TEST_CASE("a cubic term flips the criticality: x' = -a x(t - 1) + b x x(t - 1) + c x^3") {
     // At x = 0 the linearisation is Wright's (alpha = a): Hopf at a = omega = pi/2 for every b, c.
     // The quadratic term contributes b^2 times Wright's Re c1 / alpha^2 (Wright: b = -alpha), the
