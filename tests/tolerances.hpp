@@ -86,4 +86,20 @@ constexpr double monte_carlo_sigmas = 4.5;
 /// fails with probability 0.82.
 constexpr double wilson_coverage_min = 0.8;
 
+/// Normal form coefficients (c1, L1, lambda', amplitude coefficients) against closed forms or
+/// against the same quantity computed another way: exact derivatives combined in double
+/// precision at a Hopf point located to a residual ~1e-13, with O(1) condition numbers here;
+/// 1e-9 leaves a wide margin over the ~1e-12 differences measured.
+constexpr double normal_form = 1e-9;
+/// The relative error of the leading-order amplitude law near a Hopf point, per unit distance mu
+/// to it: the next term of the expansion is O(mu) relative, with a coefficient fixed by the
+/// system (against long simulations at mu = 0.01 and 0.02: measured 0.32 mu for Wright's equation,
+/// 0.41 mu and 0.18 mu for the two variables of the neuron demo; deterministic computations); 0.5
+/// is above those while a wrong factor in L1 or lambda' (an error of O(1), not O(mu)) fails.
+constexpr double amplitude_law_per_mu = 0.5;
+/// An observed error ratio e(2 mu) / e(mu) against 2^p for an error O(mu^p): the higher-order
+/// terms move it by O(mu) relative (measured 1.97 to 1.99 for p = 1 at mu = 0.01); +-0.4 still tells
+/// p = 1 from p = 0.5 (1.41) and p = 1.5 (2.83).
+constexpr double order_ratio_band = 0.4;
+
 }  // namespace ddemap::test::tol

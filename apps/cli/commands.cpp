@@ -31,6 +31,9 @@ const std::vector<Command>& command_table() {
         {"equilibria", "a branch of equilibria of a nonlinear DDE (--system FILE with expressions, or --model ov --ring N) in one parameter: "
          "stability at every point, folds and Hopf points",
          add_equilibria_flags, run_equilibria},
+        {"hopf", "Hopf points of a nonlinear DDE on its equilibrium branch with their criticality (first Lyapunov coefficient), "
+         "crossing speed and predicted orbit amplitude; with --par2 the Hopf curves in two parameters",
+         add_hopf_flags, run_hopf},
     };
     return table;
 }

@@ -187,13 +187,18 @@ bool fold_system(const NonlinearDDE& system, int j, const Eigen::VectorXd& v0, c
     return out.allFinite() && (!jac || jac->allFinite());
 }
 
-bool hopf_system(const NonlinearDDE& system, int j, const VectorXc& q0, const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac) {
+bool hopf_system(const NonlinearDDE& system, int j, const VectorXc& q0, const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac,
+                 const std::vector<double>& values) {
     const int n = system.dimension();
     if (z.size() != 3 * n + 2 || q0.size() != n)
         throw std::invalid_argument("Hopf system: z has " + std::to_string(z.size()) + " and q0 " + std::to_string(q0.size()) +
                                     " entries: expected 3n + 2 and n (n = " + std::to_string(n) + ")");
+    if (!values.empty() && values.size() != system.parameter_values().size())
+        throw std::invalid_argument("Hopf system: " + std::to_string(values.size()) + " parameter values: expected " +
+                                    std::to_string(system.parameter_values().size()));
     try {
-        const std::vector<double> p = with(system, j, z[n]);
+        std::vector<double> p = values.empty() ? system.parameter_values() : values;
+        p[static_cast<std::size_t>(j)] = z[n];
         const Eigen::VectorXd x = z.head(n);
         const Eigen::VectorXd qr = z.segment(n + 1, n), qi = z.segment(2 * n + 1, n);
         const VectorXc q = qr.cast<cplx>() + cplx(0.0, 1.0) * qi.cast<cplx>();

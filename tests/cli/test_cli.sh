@@ -807,5 +807,75 @@ printf 'name,k1,k2,th,tau\nedge,19.5,0.2,1.5,0.2\n' >"$crd/edge.csv"
 rm -rf "$crd/edge" "$crd/edge.csv"
 [ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
 
+# ---- hopf: Hopf points with their criticality, and Hopf curves in two parameters ----------------
+"$bin" hopf --help >"$tmp/hh.txt" 2>&1
+grep -q ' TEXT' "$tmp/hh.txt" && bad "hopf --help has an option without its kind: $(grep ' TEXT' "$tmp/hh.txt" | head -1)" || ok
+# Wright's equation y' = -alpha y(t - 1) (1 + y): Hopf at alpha = omega = pi/2, supercritical,
+# L1 = -2 (3 pi - 2) / (5 (4 + pi^2)), max - min ~ 4 sqrt(10 (alpha - pi/2) / (3 pi - 2)) (Chow and Mallet-Paret)
+echo '{"variables": ["y"], "parameters": {"alpha": 1, "b": 1}, "equations": ["-alpha*y(t - 1)*(1 + b*y)"]}' >"$tmp/wright.json"
+if "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --format json --out "$tmp/hw" >"$tmp/hw.out"; then
+    json_has "$tmp/hw.out" parameter hopf && ok || bad "hopf json keys"
+    python3 - "$tmp/hw.out" "$tmp/hw.csv" <<'PY' && ok || bad "hopf: Wright's equation against the closed forms"
+import json, sys, math, csv
+e = json.load(open(sys.argv[1]))
+assert e["command"] == "hopf" and e["status"] == "converged"
+d = e["result"]
+assert d["parameter"] == "alpha" and len(d["hopf"]) == 1
+h = d["hopf"][0]
+pi = math.pi
+assert abs(h["par"] - pi / 2) < 1e-8 and abs(h["omega"] - pi / 2) < 1e-8
+assert abs(h["l1"] + 2 * (3 * pi - 2) / (5 * (4 + pi * pi))) < 1e-9 and h["criticality"] == "supercritical"
+assert abs(h["dre_dpar"] - 2 * pi / (4 + pi * pi)) < 1e-9 and h["side"] == "above"
+assert abs(h["amplitude_coefficient"][0] - 4 * math.sqrt(10 / (3 * pi - 2))) < 1e-9
+assert abs(h["equilibrium"][0]) < 1e-12 and h["residual"] < 1e-9
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert len(rows) == 1 and float(rows[0]["l1"]) == h["l1"] and rows[0]["criticality"] == "supercritical"  # round trip exact
+PY
+else
+    bad "hopf --system exit status"
+fi
+"$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 | grep -q "supercritical" && ok || bad "hopf table"
+# the Hopf curve in (alpha, b): the line alpha = pi/2 (the linearisation does not see b); L1 ~ b^2 < 0, b = 0 degenerate
+if "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b --from2 0.5 --to2 2 --format json >"$tmp/hc.out"; then
+    python3 - "$tmp/hc.out" <<'PY' && ok || bad "hopf --par2: the curve alpha = pi/2"
+import json, sys, math
+d = json.load(open(sys.argv[1]))["result"]
+assert d["parameter2"] == "b" and len(d["curves"]) == 1
+pts = d["curves"][0]["points"]
+assert len(pts) > 5 and all(abs(p["par"] - math.pi / 2) < 1e-8 and p["criticality"] == "supercritical" for p in pts)
+assert abs(min(p["par2"] for p in pts) - 0.5) < 1e-12 and abs(max(p["par2"] for p in pts) - 2) < 1e-12
+PY
+else
+    bad "hopf --par2 exit status"
+fi
+"$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b --from2 0.5 --to2 2 --format csv | head -1 |
+    grep -q '^curve,kind,par,par2,omega,l1,criticality,status$' && ok || bad "hopf --par2 csv header"
+expect_error "parameter 'q' is not a parameter of this system" hopf --system "$tmp/wright.json" --par q --from 1 --to 2
+expect_error "expected --from < --to" hopf --system "$tmp/wright.json" --par alpha --from 2 --to 1
+expect_error "expected a value other than --from" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 1
+expect_error "parameter 'c' is not a parameter of this system" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 c --from2 0 --to2 1
+expect_error "expected a parameter other than --par" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 alpha --from2 0 --to2 1
+expect_error "--par2 needs --from2 and --to2" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b
+expect_error "expected --from2 < --to2" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b --from2 2 --to2 0.5
+expect_error "expected it in \[--from2, --to2\]" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b --from2 2 --to2 3 --out "$tmp/hbad"
+[ ! -e "$tmp/hbad.csv" ] && [ ! -e "$tmp/hbad.json" ] && ok || bad "hopf bad input wrote files"
+expect_error "--from2/--to2 without --par2" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --from2 0
+# the ov ring (3 cars): two Hopf points of the ring mode, both subcritical (Orosz and Stepan 2006)
+"$bin" hopf --model ov --ring 3 --par headway --from 1.2 --to 3 --format csv >"$tmp/hov.csv" &&
+    [ "$(grep -c ',subcritical,' "$tmp/hov.csv")" -eq 2 ] && ! grep -qi 'nan\|inf' "$tmp/hov.csv" && ok || bad "hopf ov ring: two subcritical Hopf points"
+# a branch cut short by --max-points: undecided, exit 4, the output still printed as JSON
+"$bin" hopf --model ov --ring 3 --par headway --from 1.2 --to 3 --max-points 3 --format json >"$tmp/hund.out" 2>"$tmp/hund.err"
+rc=$?
+[ $rc -eq 4 ] && grep -q "undecided" "$tmp/hund.err" && python3 -c "import json,sys; json.load(open(sys.argv[1]))" "$tmp/hund.out" && ok || bad "hopf undecided: exit $rc"
+
+# DDE-BIFTOOL's minimal demo (published L1 = 0.12631, 0.13109, -0.48039 at its three Hopf points in tau)
+"$bin" hopf --system "$(dirname "$0")/../../examples/duffing.json" --par tau --from 0 --to 10 --format json |
+    python3 -c "
+import json, sys
+h = json.load(sys.stdin)['result']['hopf']
+assert [abs(x['l1'] / p - 1) < 5e-5 for x, p in zip(h, (0.12631, 0.13109, -0.48039))] == [True] * 3 and len(h) == 3, h
+assert [x['criticality'] for x in h] == ['subcritical', 'subcritical', 'supercritical'], h
+" && ok || bad "hopf: DDE-BIFTOOL minimal demo L1 values"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

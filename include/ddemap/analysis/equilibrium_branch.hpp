@@ -124,9 +124,11 @@ bool fold_system(const NonlinearDDE& system, int parameter, const Eigen::VectorX
 ///     d/dx_i = -D^2 f[w, S e_i],  d/dp_j = -D^2 f[w, e_pj] + i omega sum_k tau_k' A_k w_k,
 ///     d/dq = Delta(i omega),  d/domega = i (q + sum_k tau_k A_k w_k)
 /// (second derivatives in Dual<Dual<double>>, tau_k' from delay_derivatives). False when F is not
-/// defined at z; std::invalid_argument for sizes that do not fit.
+/// defined at z; std::invalid_argument for sizes that do not fit. `values` (optional, all the
+/// parameter values) replaces the held values of the parameters other than p_j (two-parameter
+/// continuation of Hopf curves, analysis/hopf.hpp).
 bool hopf_system(const NonlinearDDE& system, int parameter, const VectorXc& q0, const Eigen::VectorXd& z, Eigen::VectorXd& F,
-                 Eigen::MatrixXd* J = nullptr);
+                 Eigen::MatrixXd* J = nullptr, const std::vector<double>& values = {});
 
 /// Newton on the Hopf system from (x0, p_j = par0, omega0), the other parameters as held;
 /// q0 is the starting null vector (empty: the right singular vector of Delta(i omega0) for its

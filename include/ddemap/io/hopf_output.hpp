@@ -1,0 +1,33 @@
+#pragma once
+/// \file hopf_output.hpp
+/// JSON and CSV of the hopf command (analysis/hopf.hpp): Hopf points with their criticality, and
+/// Hopf curves in two parameters. Doubles round-trip exact; a quantity that is not defined (a
+/// point that did not converge) is null in JSON and empty in CSV.
+
+#include <string>
+#include <vector>
+
+#include "ddemap/analysis/hopf.hpp"
+
+namespace ddemap {
+
+/// {"parameter", "variables", "hopf": [{"par", "omega", "l1", "criticality", "status",
+/// "equilibrium", "dre_dpar", "side", "amplitude_coefficient", "c1", "residual", "message"}],
+/// "branch": {"points", "stop", "status"}}. criticality is "undecided" for a point without
+/// coefficients (its status says why).
+std::string hopf_points_json(const HopfAnalysis& a, const std::vector<std::string>& variables);
+/// kind,par,omega,l1,criticality,dre_dpar,side,VAR...(equilibrium),amp_VAR...,residual,status
+std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables);
+
+/// {"parameter", "parameter2", "hopf": [the starting points as above], "curves": [{"start",
+/// "status", "message", "stop": [backward, forward], "points": [{"par", "par2", "omega", "l1",
+/// "criticality", "dre_dpar"}], "generalised_hopf": [{"par", "par2", "omega", "l1", "status"}]}]}
+std::string hopf_curves_json(const HopfCurves& c, const std::string& parameter2, const std::vector<std::string>& variables);
+/// curve,kind,par,par2,omega,l1,criticality,status (kind: point or generalised_hopf)
+std::string hopf_curves_csv(const HopfCurves& c);
+
+/// The criticality word of a point: to_string(criticality), or "undecided" when its
+/// coefficients did not converge.
+std::string criticality_word(const HopfCoefficients& c);
+
+}  // namespace ddemap

@@ -1,0 +1,148 @@
+#include "ddemap/io/hopf_output.hpp"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "ddemap/io/csv.hpp"
+
+namespace ddemap {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json vec(const Eigen::VectorXd& x) {
+    json a = json::array();
+    for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(num(x[i]));
+    return a;
+}
+std::string exact(double v) { return std::isfinite(v) ? format_exact(v) : std::string(); }
+std::string field(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"') out += '"';
+        out += c;
+    }
+    return out + "\"";
+}
+
+json point_json(const HopfCoefficients& c) {
+    const bool ok = converged(c.status);
+    json o;
+    o["par"] = num(c.par);
+    o["omega"] = num(c.omega);
+    o["l1"] = ok ? num(c.l1) : json(nullptr);
+    o["criticality"] = criticality_word(c);
+    o["status"] = to_string(c.status);
+    o["equilibrium"] = vec(c.x);
+    o["dre_dpar"] = ok ? num(c.dre_dpar) : json(nullptr);
+    o["side"] = c.side > 0 ? json("above") : c.side < 0 ? json("below") : json(nullptr);
+    o["amplitude_coefficient"] = c.amplitude_coefficient.size() > 0 ? vec(c.amplitude_coefficient) : json(nullptr);
+    o["c1"] = ok ? json::array({num(c.c1.real()), num(c.c1.imag())}) : json(nullptr);
+    o["residual"] = num(c.residual);
+    o["message"] = c.message;
+    return o;
+}
+
+}  // namespace
+
+std::string criticality_word(const HopfCoefficients& c) { return converged(c.status) ? to_string(c.criticality) : "undecided"; }
+
+std::string hopf_points_json(const HopfAnalysis& a, const std::vector<std::string>& variables) {
+    json j;
+    j["parameter"] = a.branch.parameter;
+    j["variables"] = variables;
+    json hopf = json::array();
+    for (const HopfCoefficients& c : a.points) hopf.push_back(point_json(c));
+    j["hopf"] = hopf;
+    json branch;
+    branch["points"] = a.branch.points.size();
+    branch["stop"] = to_string(a.branch.stop);
+    branch["status"] = to_string(a.branch.status);
+    branch["message"] = a.branch.message;
+    j["branch"] = branch;
+    return j.dump();
+}
+
+std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables) {
+    std::string out = "par,omega,l1,criticality,dre_dpar,side";
+    for (const auto& v : variables) out += "," + field(v);
+    for (const auto& v : variables) out += "," + field("amp_" + v);
+    out += ",residual,status\n";
+    for (const HopfCoefficients& c : a.points) {
+        const bool ok = converged(c.status);
+        out += exact(c.par) + "," + exact(c.omega) + "," + (ok ? exact(c.l1) : "") + "," + criticality_word(c) + "," + (ok ? exact(c.dre_dpar) : "") +
+               "," + (c.side > 0 ? "above" : c.side < 0 ? "below" : "");
+        for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(variables.size()); ++i) out += "," + (i < c.x.size() ? exact(c.x[i]) : "");
+        for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(variables.size()); ++i)
+            out += "," + (i < c.amplitude_coefficient.size() ? exact(c.amplitude_coefficient[i]) : "");
+        out += "," + exact(c.residual) + "," + to_string(c.status) + "\n";
+    }
+    return out;
+}
+
+std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2, const std::vector<std::string>& variables) {
+    json j;
+    j["parameter"] = hc.start.branch.parameter;
+    j["parameter2"] = parameter2;
+    j["variables"] = variables;
+    json hopf = json::array();
+    for (const HopfCoefficients& c : hc.start.points) hopf.push_back(point_json(c));
+    j["hopf"] = hopf;
+    json curves = json::array();
+    for (const HopfCurve& c : hc.curves) {
+        json o;
+        o["start"] = c.start;
+        o["status"] = to_string(c.status);
+        o["message"] = c.message;
+        o["stop"] = json::array({to_string(c.stop_backward), to_string(c.stop_forward)});
+        json pts = json::array();
+        for (const HopfCurvePoint& p : c.points) {
+            const bool ok = converged(p.coefficients.status);
+            json q;
+            q["par"] = num(p.par);
+            q["par2"] = num(p.par2);
+            q["omega"] = num(p.omega);
+            q["l1"] = ok ? num(p.coefficients.l1) : json(nullptr);
+            q["criticality"] = criticality_word(p.coefficients);
+            q["dre_dpar"] = ok ? num(p.coefficients.dre_dpar) : json(nullptr);
+            pts.push_back(q);
+        }
+        o["points"] = pts;
+        json gh = json::array();
+        for (const GeneralisedHopfPoint& g : c.generalised) {
+            json q;
+            q["par"] = num(g.par);
+            q["par2"] = num(g.par2);
+            q["omega"] = num(g.omega);
+            q["l1"] = num(g.l1);
+            q["status"] = to_string(g.status);
+            gh.push_back(q);
+        }
+        o["generalised_hopf"] = gh;
+        curves.push_back(o);
+    }
+    j["curves"] = curves;
+    return j.dump();
+}
+
+std::string hopf_curves_csv(const HopfCurves& hc) {
+    std::string out = "curve,kind,par,par2,omega,l1,criticality,status\n";
+    for (std::size_t k = 0; k < hc.curves.size(); ++k) {
+        const HopfCurve& c = hc.curves[k];
+        for (const HopfCurvePoint& p : c.points) {
+            const bool ok = converged(p.coefficients.status);
+            out += std::to_string(k) + ",point," + exact(p.par) + "," + exact(p.par2) + "," + exact(p.omega) + "," + (ok ? exact(p.coefficients.l1) : "") +
+                   "," + criticality_word(p.coefficients) + "," + to_string(p.coefficients.status) + "\n";
+        }
+        for (const GeneralisedHopfPoint& g : c.generalised)
+            out += std::to_string(k) + ",generalised_hopf," + exact(g.par) + "," + exact(g.par2) + "," + exact(g.omega) + "," + exact(g.l1) +
+                   ",degenerate," + to_string(g.status) + "\n";
+    }
+    return out;
+}
+
+}  // namespace ddemap
