@@ -22,8 +22,9 @@ command line, a computation that did not converge is a status, not an exception.
 
 Bad input raises ValueError with the library's message. Every computation runs with the GIL
 released. Ctrl-C (KeyboardInterrupt) stops ``sweep`` and ``boundary`` between grid rows,
-``simulate`` between steps and ``calibrate`` between fits; the other functions (each well
-under a second to a few seconds) finish their call first.
+``classify`` between vehicles (and parameter samples), ``simulate`` between steps and
+``calibrate`` between fits; the other functions (each well under a second to a few seconds)
+finish their call first.
 
 Quick start (the paper's stability chart)::
 

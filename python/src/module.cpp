@@ -6,14 +6,15 @@
 //
 // Errors: std::invalid_argument (the library's bad-input errors) -> ValueError (pybind11's
 // default translation, kept explicit here). Every computation runs with the GIL released; where
-// the library reports progress (sweep rows, boundary seed rows, simulated time, calibration
-// fits) the callback checks for Ctrl-C on the main thread and stops the computation
+// the library reports progress (sweep rows, boundary seed rows, vehicles and samples of
+// classify, simulated time, calibration fits) the callback checks for Ctrl-C on the main thread and stops the computation
 // (KeyboardInterrupt).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -60,14 +61,24 @@ std::thread::id g_main_thread;
 /// A progress callback that runs the Python signal handlers between units of work (on the
 /// main thread only: Python runs them nowhere else) and stops the computation if one raised.
 Progress interruptible() {
-    auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
-    return [last](long, long) {
+    struct State {
+        std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+        std::atomic<bool> interrupted{false};
+    };
+    auto state = std::make_shared<State>();
+    return [state](long, long) {
+        // once interrupted, every later call throws, on any thread: nested loops (a loop whose
+        // tasks run loops of their own) all stop
+        if (state->interrupted.load()) throw Interrupted();
         if (std::this_thread::get_id() != g_main_thread) return;
         const auto now = std::chrono::steady_clock::now();
-        if (now - *last < std::chrono::milliseconds(50)) return;  // at most 20 checks a second
-        *last = now;
+        if (now - state->last < std::chrono::milliseconds(50)) return;  // at most 20 checks a second
+        state->last = now;
         py::gil_scoped_acquire gil;
-        if (PyErr_CheckSignals() != 0) throw Interrupted();
+        if (PyErr_CheckSignals() != 0) {
+            state->interrupted.store(true);
+            throw Interrupted();
+        }
     };
 }
 
@@ -279,7 +290,9 @@ std::string py_classify(const std::string& spec, int cars, int samples, int ring
         if (b.name != "eta") uo.domain.push_back(b);
     uo.ring_samples = ring_samples;
     uo.seed = seed;
-    const auto rows = released([&] { return classify(vehicles, cars, uo); });
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    const auto rows = released([&] { return classify(vehicles, cars, uo, policy); });
     JsonEnvelope e;
     e.command = "classify";
     JsonObject inputs;
