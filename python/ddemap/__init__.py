@@ -185,8 +185,11 @@ def _axis_text(axis, grid):
 # ------------------------------------------------------------------ commands
 
 
-def roots(model="ovrv", ring=22, count=6, **parameters):
-    """Rightmost characteristic roots of a ring of ``ring`` identical cars (``ddemap roots``).
+def roots(model="ovrv", ring=22, count=6, system=None, solver="auto", degree=0, **parameters):
+    """Rightmost characteristic roots of a ring of ``ring`` identical cars (``ddemap roots``),
+    or of any linear DDE ``x' = A0 x + sum_k A_k x(t - tau_k)`` from a JSON file
+    (``system=FILE``, ``roots --system``; a nonlinear system file is linearised at its
+    equilibrium, found by Newton from the file's guess).
 
     The linearisation of the car-following law about the equilibrium gives, per ring mode m
     (zeta = exp(-2 pi i m / N)), the quasi-polynomial
@@ -197,12 +200,26 @@ def roots(model="ovrv", ring=22, count=6, **parameters):
     Keyword arguments: ``model`` ("ovrv", "idm", "ccc"), its parameters (k1 [1/s^2], k2 [1/s],
     th [s], tau [s], eta [m], ...), ``ring`` (N >= 2 or "inf"), ``count`` (how many roots).
 
+    With ``system``: ``solver`` "auto" (dense up to 16 states), "dense" or "sparse"
+    (shift-invert Arnoldi) and ``degree`` M (sparse path; 0 automatic); no model parameters.
+
     Returns: ``roots`` (columns ``re``, ``im`` [1/s], ``mode``, ``theta`` [rad], ``residual``,
     ``newton_step``), ``spectral_abscissa`` [1/s] (max Re, trivial zero excluded),
     ``abscissa_mode``, ``ring_stable``, ``ring_margin`` (= -abscissa), ``unstable_roots``,
-    ``marginal_roots``, ``trivial_root``, ``degree`` (collocation degree M), ``degree_reason``.
+    ``marginal_roots``, ``trivial_root``, ``degree`` (collocation degree M), ``degree_reason``;
+    with ``system`` the keys of ``roots --system`` (``equilibrium`` and ``linearisation`` for
+    a nonlinear file).
     """
     count = _integer("count", count, 1, 10000)
+    if system is not None:
+        if parameters or model != "ovrv" or ring != 22:
+            raise ValueError("system takes the whole problem from the file: expected no model parameters, model or ring")
+        degree = _integer("degree", degree, 0, 200)
+        if degree == 1:
+            raise ValueError("degree = 1: expected 0 (automatic) or an integer 2..200")
+        return _result(_ddemap.roots_system(str(system), count, degree, solver))
+    if solver != "auto" or degree != 0:
+        raise ValueError("solver and degree go with system (and mixed_ring); a ring of identical cars has one method")
     return _result(_ddemap.roots(model, _parameters(parameters), _ring(ring), count))
 
 

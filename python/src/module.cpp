@@ -32,12 +32,14 @@
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/system_roots.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
 #include "ddemap/io/vehicle_files.hpp"
 #include "ddemap/problem/expression_system.hpp"
+#include "ddemap/solve/equilibrium.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/traffic/fleet.hpp"
@@ -129,6 +131,54 @@ std::string py_roots(const std::string& model_name, const ParameterMap& values, 
     e.status = to_string(r.status);
     e.message = r.reason;
     e.result = ring_roots_json(r);
+    return envelope_json(e);
+}
+
+/// roots --system FILE: any linear DDE, or a nonlinear one linearised at its equilibrium
+/// (Newton from the file's guess), as the command.
+std::string py_roots_system(const std::string& path, int count, int degree, const std::string& solver) {
+    RootOptions o;
+    o.count = count;
+    o.degree = degree;
+    o.method = root_method(solver);
+    if (o.method == "contour") throw std::invalid_argument("solver = 'product' goes with fleet rings: expected auto, dense or sparse for a system");
+    const std::string text = read_text_file(path);
+    JsonEnvelope e;
+    e.command = "roots";
+    e.inputs = JsonObject().string("system", path).integer("count", o.count).integer("degree", o.degree).str();
+    std::string equilibrium_json;
+    std::optional<LinearDDE> lin;
+    if (!is_nonlinear_system_json(text)) {
+        lin.emplace(read_linear_dde_json(text, path));
+    } else {
+        const NonlinearSystemFile file = read_nonlinear_system_json(text, path);
+        const EquilibriumResult eq = released([&] { return find_equilibrium(*file.system, file.equilibrium); });
+        std::vector<std::string> xs;
+        for (Eigen::Index i = 0; i < eq.x.size(); ++i) xs.push_back(json_number(eq.x[i]));
+        equilibrium_json = JsonObject()
+                               .json("x", json_array(xs))
+                               .number("residual", eq.residual)
+                               .integer("iterations", eq.iterations)
+                               .string("status", to_string(eq.status))
+                               .string("message", eq.message)
+                               .str();
+        if (!converged(eq.status)) {  // no equilibrium: undecided, the Newton result returned
+            e.status = to_string(eq.status);
+            e.message = "no equilibrium found from the guess";
+            e.result = JsonObject().json("equilibrium", equilibrium_json).str();
+            return envelope_json(e);
+        }
+        lin.emplace(linearise(*file.system, eq.x));
+    }
+    const SystemRootResult sr = released([&] { return analyse_system(*lin, o); });
+    const RootResult& r = sr.roots;
+    e.has_solver = true;
+    e.solver_given = solver_name(r.method_given);
+    e.solver_used = solver_name(r.method_used);
+    e.status = to_string(r.status);
+    e.message = r.message;
+    e.result = system_roots_json(*lin, sr);
+    if (!equilibrium_json.empty()) e.result = JsonObject().json("equilibrium", equilibrium_json).json("linearisation", e.result).str();
     return envelope_json(e);
 }
 
@@ -518,6 +568,7 @@ PYBIND11_MODULE(_ddemap, m) {
         }
     });
     m.def("roots", &py_roots, py::arg("model"), py::arg("parameters"), py::arg("ring"), py::arg("count"));
+    m.def("roots_system", &py_roots_system, py::arg("system"), py::arg("count"), py::arg("degree"), py::arg("solver"));
     m.def("string", &py_string, py::arg("model"), py::arg("parameters"), py::arg("ring"));
     m.def("sweep", &py_sweep, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"), py::arg("y_axis"),
           py::arg("ring"), py::arg("boundaries"));

@@ -98,6 +98,25 @@ def test_roots_idm():
     same_envelope(r, cli_json("roots", *flags(p)))
 
 
+def test_roots_system(tmp_path):
+    linear = os.path.join(SOURCE, "examples", "system.json")
+    same_envelope(ddemap.roots(system=linear, count=4), cli_json("roots", "--system", linear, "--count", 4))
+    same_envelope(ddemap.roots(system=linear, solver="dense"), cli_json("roots", "--system", linear, "--solver", "dense"))
+    nonlinear = tmp_path / "nl.json"
+    nonlinear.write_text(json.dumps({"variables": ["x1", "x2"], "parameters": {"a": 0.5, "b": 0.6, "d": 0.05, "tau": 2.0},
+                                     "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"],
+                                     "equilibrium": [0.1, 0.0]}))
+    r = ddemap.roots(system=nonlinear)
+    same_envelope(r, cli_json("roots", "--system", nonlinear))
+    assert set(r) == {"equilibrium", "linearisation"}
+    # x' = x^2 + 1 has no equilibrium: undecided (exit 4 in the command line), not an exception
+    none = tmp_path / "none.json"
+    none.write_text('{"variables": ["x"], "equations": ["x^2 + 1"], "equilibrium": [0.5]}')
+    r = ddemap.roots(system=none)
+    same_envelope(r, cli_json("roots", "--system", none, expect=4))
+    assert not r.converged
+
+
 def test_string():
     same_envelope(ddemap.string(**OVRV), cli_json("string", *flags(OVRV)))
     r = ddemap.string(ring="inf", **OVRV)
