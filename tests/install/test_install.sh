@@ -2,11 +2,13 @@
 # The installable package: `cmake --install` into a temporary prefix, then a project outside
 # the source tree (tests/install/consumer: find_package(ddemap), ddemap::ddemap) configured,
 # built and run against that prefix alone.
-# Usage: test_install.sh BUILD_DIR SOURCE_DIR [CXX_COMPILER]
+# With the Python module built (PYTHON given): also the installed package imported and used.
+# Usage: test_install.sh BUILD_DIR SOURCE_DIR [CXX_COMPILER [PYTHON]]
 set -euo pipefail
 build=$1
 source=$2
 compiler=${3:-}
+python=${4:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
@@ -21,6 +23,15 @@ for f in ddemapConfig.cmake ddemapConfigVersion.cmake ddemapTargets.cmake; do
 done
 [ "$("$tmp/prefix/bin/ddemap" --version)" = "$("$build/ddemap" --version)" ] || fail "the installed ddemap program does not run"
 echo "installed: headers, libraries, bin/ddemap, the CMake package"
+if [ -n "$python" ]; then
+    (cd "$tmp" && PYTHONPATH="$tmp/prefix/lib/python3/dist-packages" "$python" -c '
+import ddemap, os, sys
+assert ddemap.__file__.startswith(sys.argv[1]), ddemap.__file__
+r = ddemap.string(k1=0.2, k2=0.2, th=1.5, tau=0.1)
+assert r.converged and r["string_stable"] is False
+print("python: the installed package imports and runs (ddemap %s)" % ddemap.version)' "$tmp/prefix") ||
+        fail "the installed Python package does not import"
+fi
 
 args=(-DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_BUILD_TYPE=Release -DDDEMAP_TESTS_DIR="$source/tests")
 [ -n "$compiler" ] && args+=(-DCMAKE_CXX_COMPILER="$compiler")
