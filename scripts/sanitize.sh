@@ -15,7 +15,7 @@ if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=cc
 if [ "$what" = all ] || [ "$what" = asan ]; then
     start=$SECONDS
     flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -O1 -g1"
-    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DDDEMAP_BUILD_BENCH=OFF "${launcher[@]}" \
+    cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=None -DDDEMAP_BUILD_BENCH=OFF -DDDEMAP_BUILD_PYTHON=OFF "${launcher[@]}" \
         -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
     cmake --build build-asan -j"$(nproc)" >/dev/null
     echo "sanitizer build: $((SECONDS - start)) s"

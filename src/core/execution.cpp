@@ -1,5 +1,6 @@
 #include "ddemap/core/execution.hpp"
 
+#include <atomic>
 #include <exception>
 #include <limits>
 #include <mutex>
@@ -37,13 +38,22 @@ void parallel_for(long count, const std::function<void(long)>& task, const Execu
     long failed_at = std::numeric_limits<long>::max();
     std::exception_ptr failure;
     // Nothing may leave run(): an exception escaping an OpenMP region terminates the program.
-    // The task's and the progress callback's exceptions are kept (the lowest index wins).
+    // The task's and the progress callback's exceptions are kept (the lowest index wins). A
+    // progress callback that throws cancels the loop: tasks not yet started are skipped (how a
+    // front end stops a long loop, e.g. on Ctrl-C).
+    std::atomic<bool> cancelled{false};
     auto run = [&](long i) noexcept {
+        if (cancelled.load()) return;
         try {
             task(i);
             if (policy.progress) {
                 std::lock_guard<std::mutex> guard(lock);
-                policy.progress(++done, count);
+                try {
+                    policy.progress(++done, count);
+                } catch (...) {
+                    cancelled.store(true);
+                    throw;
+                }
             }
         } catch (...) {
             std::lock_guard<std::mutex> guard(lock);

@@ -63,6 +63,20 @@ TEST_CASE("a throwing progress callback or a non-standard exception never leaves
     }
 }
 
+TEST_CASE("a throwing progress callback cancels the tasks not yet started") {
+    for (int threads : {1, 2, 4}) {
+        ExecutionPolicy policy;
+        policy.threads = threads;
+        policy.progress = [](long done, long) {
+            if (done == 3) throw std::runtime_error("stop");
+        };
+        std::atomic<long> started{0};
+        CHECK_THROWS_WITH_AS(parallel_for(10000, [&](long) { ++started; }, policy), "stop", std::runtime_error);
+        // the tasks already running when the callback threw finish (at most one per thread)
+        CHECK(started.load() <= 3 + threads);
+    }
+}
+
 TEST_CASE("parallel_reduce is bitwise the same for any number of threads") {
     // a sum whose value depends on the order of the additions
     std::mt19937 rng(7);

@@ -32,8 +32,9 @@ int thread_count(const ExecutionPolicy& policy = {});
 
 /// Runs task(i) for every i in [0, count), dynamically scheduled over the policy's threads.
 /// Tasks must be independent (each writes only its own outputs). If tasks throw, the exception
-/// of the lowest index is rethrown after every task has ended. Throws std::invalid_argument for
-/// an invalid policy or count < 0.
+/// of the lowest index is rethrown after every task has ended. A progress callback that throws
+/// cancels the loop: tasks not yet started are skipped and its exception is rethrown likewise.
+/// Throws std::invalid_argument for an invalid policy or count < 0.
 void parallel_for(long count, const std::function<void(long)>& task, const ExecutionPolicy& policy = {});
 
 /// Deterministic reduction: partial(begin, end) -> T for every block [begin, end) of at most

@@ -1,0 +1,585 @@
+// The compiled part of the Python module `ddemap` (ddemap._ddemap): one function per command,
+// calling the same library functions as apps/cli and returning the command's JSON envelope
+// (io/json.hpp: the same keys as `ddemap COMMAND --format json`); the grids of sweeps and the
+// curves of boundaries also as NumPy arrays. python/ddemap/__init__.py turns the keyword
+// arguments into these calls and the JSON into Python objects.
+//
+// Errors: std::invalid_argument (the library's bad-input errors) -> ValueError (pybind11's
+// default translation, kept explicit here). Every computation runs with the GIL released; where
+// the library reports progress (sweep rows, boundary seed rows, vehicles and samples of
+// classify, simulated time, calibration fits) the callback checks for Ctrl-C on the main thread and stops the computation
+// (KeyboardInterrupt).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/system_roots.hpp"
+#include "ddemap/io/files.hpp"
+#include "ddemap/io/json.hpp"
+#include "ddemap/io/svg.hpp"
+#include "ddemap/io/system_json.hpp"
+#include "ddemap/io/vehicle_files.hpp"
+#include "ddemap/problem/expression_system.hpp"
+#include "ddemap/solve/equilibrium.hpp"
+#include "ddemap/study/boundary.hpp"
+#include "ddemap/study/sweep.hpp"
+#include "ddemap/traffic/fleet.hpp"
+#include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/ov_ring.hpp"
+#include "ddemap/traffic/vehicles.hpp"
+
+namespace py = pybind11;
+using namespace ddemap;
+
+namespace {
+
+/// Thrown by the progress callback when a signal handler raised (Ctrl-C: KeyboardInterrupt);
+/// the Python error stays set and is what the caller sees.
+struct Interrupted : std::exception {
+    const char* what() const noexcept override { return "interrupted"; }
+};
+
+std::thread::id g_main_thread;
+
+/// A progress callback that runs the Python signal handlers between units of work (on the
+/// main thread only: Python runs them nowhere else) and stops the computation if one raised.
+Progress interruptible() {
+    struct State {
+        std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+        std::atomic<bool> interrupted{false};
+    };
+    auto state = std::make_shared<State>();
+    return [state](long, long) {
+        // once interrupted, every later call throws, on any thread: nested loops (a loop whose
+        // tasks run loops of their own) all stop
+        if (state->interrupted.load()) throw Interrupted();
+        if (std::this_thread::get_id() != g_main_thread) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (now - state->last < std::chrono::milliseconds(50)) return;  // at most 20 checks a second
+        state->last = now;
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+            state->interrupted.store(true);
+            throw Interrupted();
+        }
+    };
+}
+
+/// Runs `f` with the GIL released.
+template <class F>
+auto released(F&& f) {
+    py::gil_scoped_release nogil;
+    return f();
+}
+
+JsonObject model_inputs(const CarModel& m) {
+    JsonObject o;
+    o.string("model", m.name()).json("parameters", json_parameters(m.parameters()));
+    return o;
+}
+
+std::string solver_name(const std::string& method) {
+    if (method == "shift_invert") return "sparse";
+    if (method == "contour") return "product";
+    return method;
+}
+
+std::string root_method(const std::string& solver) {
+    if (solver == "sparse") return "shift_invert";
+    if (solver == "product") return "contour";
+    if (solver == "auto" || solver == "dense" || solver == "shift_invert" || solver == "contour") return solver;
+    throw std::invalid_argument("solver = '" + solver + "': expected auto, dense, sparse or product");
+}
+
+/// A fleet or vehicles argument: an existing file (io names_a_file) or a pattern of built-in names.
+Fleet fleet_spec(const std::string& spec) {
+    return names_a_file(spec) ? read_fleet_table(read_text_file(spec), spec) : fleet_from_pattern(spec, 0);
+}
+std::vector<CalibratedVehicle> vehicles_spec(const std::string& spec) {
+    return names_a_file(spec) ? read_vehicle_table(read_text_file(spec), spec) : vehicles_from_pattern(spec);
+}
+
+// ------------------------------------------------------------------ commands
+
+std::string py_roots(const std::string& model_name, const ParameterMap& values, int cars, int count) {
+    const auto model = make_model(model_name, values);
+    RingOptions opt;
+    opt.roots.count = count;
+    const RingResult r = released([&] { return analyse_ring(model->linearise(), cars, opt); });
+    JsonEnvelope e;
+    e.command = "roots";
+    e.inputs = model_inputs(*model).json("ring", json_ring(cars)).integer("count", count).str();
+    e.status = to_string(r.status);
+    e.message = r.reason;
+    e.result = ring_roots_json(r);
+    return envelope_json(e);
+}
+
+/// roots --system FILE: any linear DDE, or a nonlinear one linearised at its equilibrium
+/// (Newton from the file's guess), as the command.
+std::string py_roots_system(const std::string& path, int count, int degree, const std::string& solver) {
+    RootOptions o;
+    o.count = count;
+    o.degree = degree;
+    o.method = root_method(solver);
+    if (o.method == "contour") throw std::invalid_argument("solver = 'product' goes with fleet rings: expected auto, dense or sparse for a system");
+    const std::string text = read_text_file(path);
+    JsonEnvelope e;
+    e.command = "roots";
+    e.inputs = JsonObject().string("system", path).integer("count", o.count).integer("degree", o.degree).str();
+    std::string equilibrium_json;
+    std::optional<LinearDDE> lin;
+    if (!is_nonlinear_system_json(text)) {
+        lin.emplace(read_linear_dde_json(text, path));
+    } else {
+        const NonlinearSystemFile file = read_nonlinear_system_json(text, path);
+        const EquilibriumResult eq = released([&] { return find_equilibrium(*file.system, file.equilibrium); });
+        std::vector<std::string> xs;
+        for (Eigen::Index i = 0; i < eq.x.size(); ++i) xs.push_back(json_number(eq.x[i]));
+        equilibrium_json = JsonObject()
+                               .json("x", json_array(xs))
+                               .number("residual", eq.residual)
+                               .integer("iterations", eq.iterations)
+                               .string("status", to_string(eq.status))
+                               .string("message", eq.message)
+                               .str();
+        if (!converged(eq.status)) {  // no equilibrium: undecided, the Newton result returned
+            e.status = to_string(eq.status);
+            e.message = "no equilibrium found from the guess";
+            e.result = JsonObject().json("equilibrium", equilibrium_json).str();
+            return envelope_json(e);
+        }
+        lin.emplace(linearise(*file.system, eq.x));
+    }
+    const SystemRootResult sr = released([&] { return analyse_system(*lin, o); });
+    const RootResult& r = sr.roots;
+    e.has_solver = true;
+    e.solver_given = solver_name(r.method_given);
+    e.solver_used = solver_name(r.method_used);
+    e.status = to_string(r.status);
+    e.message = r.message;
+    e.result = system_roots_json(*lin, sr);
+    if (!equilibrium_json.empty()) e.result = JsonObject().json("equilibrium", equilibrium_json).json("linearisation", e.result).str();
+    return envelope_json(e);
+}
+
+std::string py_string(const std::string& model_name, const ParameterMap& values, std::optional<int> cars) {
+    const auto model = make_model(model_name, values);
+    const Linearisation lin = model->linearise();
+    std::optional<RingResult> ring;
+    const StringResult s = released([&] {
+        StringResult r = analyse_string(lin);
+        if (cars) ring = analyse_ring(lin, *cars);
+        return r;
+    });
+    Status status = s.plant_roots.status;
+    if (ring && ring->status != Status::Converged) status = ring->status;
+    JsonEnvelope e;
+    e.command = "string";
+    JsonObject in = model_inputs(*model);
+    if (cars) in.json("ring", json_ring(*cars));
+    e.inputs = in.str();
+    e.status = to_string(status);
+    e.message = ring && ring->status != Status::Converged ? ring->reason : s.plant_roots.message;
+    e.result = string_json(s, ring ? &*ring : nullptr);
+    return envelope_json(e);
+}
+
+SweepSpec sweep_spec(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
+                     const std::string& y_name, const std::string& y_text, int cars) {
+    SweepSpec spec;
+    spec.model = model;
+    spec.fixed = fixed;
+    spec.x = parse_axis(x_name, x_text);
+    spec.y = parse_axis(y_name, y_text);
+    spec.cars = cars;
+    spec.validate();
+    return spec;
+}
+
+std::string sweep_inputs(const SweepSpec& spec, JsonObject& o) {
+    auto axis = [](const Axis& a) {
+        return JsonObject().string("name", a.name).number("lo", a.lo).number("hi", a.hi).integer("count", a.count).str();
+    };
+    o.string("model", spec.model).json("fixed", json_parameters(spec.fixed)).json("x", axis(spec.x)).json("y", axis(spec.y))
+        .json("ring", json_ring(spec.cars));
+    return o.str();
+}
+
+/// The curves of a boundary set: per curve its kind, mode and the points as arrays.
+py::list curves_arrays(const BoundarySet& b) {
+    py::list curves;
+    for (std::size_t i = 0; i < b.curves.size(); ++i) {
+        const BoundaryCurve& c = b.curves[i];
+        const auto n = static_cast<py::ssize_t>(c.points.size());
+        py::array_t<double> x(n), y(n), omega(n);
+        auto xm = x.mutable_unchecked<1>();
+        auto ym = y.mutable_unchecked<1>();
+        auto om = omega.mutable_unchecked<1>();
+        for (py::ssize_t k = 0; k < n; ++k) {
+            const BoundaryPoint& p = c.points[static_cast<std::size_t>(k)];
+            xm(k) = p.x;
+            ym(k) = p.y;
+            om(k) = p.omega;
+        }
+        py::dict d;
+        d["branch"] = i + 1;
+        d["kind"] = kind_name(c.kind);
+        d["subkind"] = subkind_name(c.kind);
+        d["mode"] = c.kind == BoundaryKind::RingHopf ? py::object(py::int_(c.mode)) : py::object(py::none());
+        d["x"] = x;
+        d["y"] = y;
+        d["omega"] = omega;
+        d["closed"] = c.closed;
+        d["max_residual"] = c.max_residual;
+        curves.append(d);
+    }
+    return curves;
+}
+
+py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
+                const std::string& y_name, const std::string& y_text, int cars, bool boundaries) {
+    const SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    BoundarySet b;
+    const SweepResult sw = released([&] {
+        SweepResult r = run_sweep(spec, policy);
+        if (boundaries) b = trace_boundaries(r);
+        return r;
+    });
+    const BoundarySet* bp = boundaries ? &b : nullptr;
+    JsonEnvelope e;
+    e.command = "sweep";
+    JsonObject in;
+    sweep_inputs(spec, in);
+    e.inputs = in.boolean("boundaries", boundaries).str();
+    e.status = sw.uncertified > 0 ? "uncertified" : "converged";
+    e.message = sw.uncertified > 0 ? std::to_string(sw.uncertified) + " points have no certificate even after collocation (see their 'certified' column)" : "";
+    e.result = sweep_json(sw, bp);
+
+    // the grid: one (ny, nx) array per quantity (rows: y, columns: x), as the CSV's columns
+    const py::ssize_t nx = spec.x.count, ny = spec.y.count;
+    auto grid = [&](auto get, auto zero) {
+        py::array_t<decltype(zero)> a({ny, nx});
+        auto m = a.template mutable_unchecked<2>();
+        for (py::ssize_t iy = 0; iy < ny; ++iy)
+            for (py::ssize_t ix = 0; ix < nx; ++ix) m(iy, ix) = get(sw.at(static_cast<int>(ix), static_cast<int>(iy)));
+        return a;
+    };
+    py::dict g;
+    g["spectral_abscissa"] = grid([](const SweepPoint& p) { return p.spectral_abscissa; }, 0.0);
+    g["unstable_roots"] = grid([](const SweepPoint& p) { return p.unstable_roots; }, 0);
+    g["sup_gamma"] = grid([](const SweepPoint& p) { return p.sup_gamma; }, 0.0);
+    g["omega_peak"] = grid([](const SweepPoint& p) { return p.omega_peak; }, 0.0);
+    g["plant_stable"] = grid([](const SweepPoint& p) { return p.plant_stable; }, false);
+    g["ring_stable"] = grid([](const SweepPoint& p) { return p.ring_stable; }, false);
+    g["string_stable"] = grid([](const SweepPoint& p) { return p.string_stable; }, false);
+    g["abscissa_mode"] = grid([](const SweepPoint& p) { return p.abscissa_mode; }, 0);
+    g["plant_abscissa"] = grid([](const SweepPoint& p) { return p.plant_abscissa; }, 0.0);
+    g["lowfreq_margin"] = grid([](const SweepPoint& p) { return p.lowfreq_margin; }, 0.0);
+    g["peak_gain"] = grid([](const SweepPoint& p) { return p.peak_gain; }, 0.0);
+    g["certified"] = grid([](const SweepPoint& p) { return p.certified; }, false);
+    // the chart's region: 0 plant unstable, 1 ring unstable, 2 string unstable, 3 string stable
+    g["region"] = grid([](const SweepPoint& p) { return region_class(p); }, 0);
+    py::array_t<double> xs(nx), ys(ny);
+    for (py::ssize_t i = 0; i < nx; ++i) xs.mutable_at(i) = sw.at(static_cast<int>(i), 0).x;
+    for (py::ssize_t i = 0; i < ny; ++i) ys.mutable_at(i) = sw.at(0, static_cast<int>(i)).y;
+    g["x"] = xs;
+    g["y"] = ys;
+    return py::make_tuple(envelope_json(e), g, bp ? py::object(curves_arrays(b)) : py::object(py::none()));
+}
+
+py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
+                   const std::string& y_name, const std::string& y_text, int cars, int seed_grid) {
+    const SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    const BoundarySet b = released([&] { return trace_boundaries(run_sweep(spec, policy)); });
+    JsonEnvelope e;
+    e.command = "boundary";
+    JsonObject in;
+    sweep_inputs(spec, in);
+    e.inputs = in.integer("seed_grid", seed_grid).str();
+    e.message = b.rejected > 0 ? std::to_string(b.rejected) + " seeds failed their Newton correction (the branches through the others were traced)" : "";
+    e.result = boundary_json(b);
+    return py::make_tuple(envelope_json(e), curves_arrays(b));
+}
+
+std::string py_classify(const std::string& spec, int cars, int samples, int ring_samples, unsigned long long seed) {
+    std::vector<CalibratedVehicle> vehicles;
+    std::string source = "the paper's calibration table (built in)";
+    if (spec.empty()) {
+        vehicles = paper_calibration_table();
+    } else {
+        vehicles = vehicles_spec(spec);
+        source = spec;
+    }
+    UncertaintyOptions uo;
+    uo.samples = samples;
+    for (const auto& b : paper_calibration_bounds())  // as the CLI: calibrate's bounds but eta
+        if (b.name != "eta") uo.domain.push_back(b);
+    uo.ring_samples = ring_samples;
+    uo.seed = seed;
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    const auto rows = released([&] { return classify(vehicles, cars, uo, policy); });
+    JsonEnvelope e;
+    e.command = "classify";
+    JsonObject inputs;
+    inputs.string("vehicles", source).json("ring", json_ring(cars));
+    for (const auto& r : rows)
+        if (r.has_uncertainty) {
+            inputs.integer("samples", uo.samples).integer("ring_samples", uo.ring_samples).integer("seed", static_cast<long long>(uo.seed));
+            break;
+        }
+    e.inputs = inputs.str();
+    e.result = classification_json(rows, cars, source);
+    Status status = Status::Converged;
+    for (const auto& r : rows) {
+        if (r.ring.status != Status::Converged) status = r.ring.status;
+        if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
+        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) status = r.uncertainty.status;
+    }
+    e.status = to_string(status);
+    return envelope_json(e);
+}
+
+py::tuple py_simulate(const std::string& fleet, const std::string& lead_profile, const std::string& lead_file, const std::string& on_event,
+                   double t_end, double step, double output_dt) {
+    SimOptions o;
+    o.step = step;
+    o.t_end = t_end;
+    o.output_dt = output_dt;
+    if (on_event == "stop") o.on_event = OnEvent::Stop;
+    else if (on_event != "continue") throw std::invalid_argument("on_event = '" + on_event + "': expected stop or continue");
+    o.validate();
+    if (!lead_profile.empty() && !lead_file.empty()) throw std::invalid_argument("give either lead (a CSV file) or lead_profile (a name), not both");
+    const std::string label = !lead_file.empty() ? lead_file : lead_profile.empty() ? std::string("dip") : lead_profile;
+    const LeadProfile lead = [&] {
+        if (!lead_file.empty()) return LeadProfile::from_csv(read_text_file(lead_file), lead_file);
+        const auto names = LeadProfile::builtin_names();
+        if (std::find(names.begin(), names.end(), label) == names.end())
+            throw std::invalid_argument("lead_profile = '" + label + "': expected one of dip, oscillatory, step-low, step-high");
+        return LeadProfile::builtin(label);
+    }();
+    const std::vector<SimCar> cars = platoon_from(vehicles_spec(fleet));
+    o.progress = interruptible();
+    const SimResult r = released([&] { return simulate_platoon(lead, cars, o); });
+    JsonEnvelope e;
+    e.command = "simulate";
+    e.inputs = JsonObject()
+                   .string("fleet", fleet)
+                   .string("lead", label)
+                   .string("on_event", on_event)
+                   .number("t_end", o.t_end)
+                   .number("step", o.step)
+                   .number("output_dt", o.output_dt)
+                   .str();
+    e.status = to_string(r.status);
+    e.message = r.message;
+    e.result = simulation_json(r, label);
+    // the time series: (cars + 1, samples) arrays, row 0 the lead (its gap row NaN)
+    const auto n = static_cast<py::ssize_t>(r.time.size()), rows = static_cast<py::ssize_t>(r.speed.size());
+    py::array_t<double> time(n), position({rows, n}), speed({rows, n}), gap({rows, n});
+    for (py::ssize_t k = 0; k < n; ++k) time.mutable_at(k) = r.time[static_cast<std::size_t>(k)];
+    for (py::ssize_t c = 0; c < rows; ++c)
+        for (py::ssize_t k = 0; k < n; ++k) {
+            const auto ci = static_cast<std::size_t>(c), ki = static_cast<std::size_t>(k);
+            position.mutable_at(c, k) = ki < r.position[ci].size() ? r.position[ci][ki] : std::nan("");
+            speed.mutable_at(c, k) = ki < r.speed[ci].size() ? r.speed[ci][ki] : std::nan("");
+            gap.mutable_at(c, k) = ci < r.gap.size() && ki < r.gap[ci].size() ? r.gap[ci][ki] : std::nan("");
+        }
+    py::dict series;
+    series["time"] = time;
+    series["position"] = position;
+    series["speed"] = speed;
+    series["gap"] = gap;
+    return py::make_tuple(envelope_json(e), series);
+}
+
+std::string py_calibrate(const std::vector<std::string>& files, bool joint, const std::string& car, std::optional<std::pair<double, double>> train,
+                      const std::vector<std::tuple<std::string, double, double>>& bounds, double gap_weight) {
+    CalibrationOptions o;
+    o.gap_weight = gap_weight;
+    if (train) {
+        o.train_start = train->first;
+        o.train_end = train->second;
+        if (!(o.train_start >= 0 && o.train_end > o.train_start))
+            throw std::invalid_argument("train = (" + json_number(o.train_start) + ", " + json_number(o.train_end) + "): expected 0 <= T0 < T1 [s]");
+    }
+    for (const auto& [name, lo, hi] : bounds) o.set_bounds(name, lo, hi);
+    o.validate();
+    if (files.empty()) throw std::invalid_argument("files: expected at least one trace");
+    std::vector<CarRuns> cars;
+    auto base_name = [](const std::string& path) {
+        std::string b = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+        if (b.size() > 4 && b.substr(b.size() - 4) == ".csv") b.resize(b.size() - 4);
+        return b;
+    };
+    if (joint) {
+        cars.push_back(CarRuns{car, {}, {}, {}});
+        for (const auto& f : files) cars[0].train.push_back(read_trace_csv(read_text_file(f), f));
+    } else {
+        for (const auto& f : files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_text_file(f), f)}, {}, {}});
+    }
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    const std::vector<CarCalibration> results = released([&] { return calibrate_cars(cars, o, policy); });
+    std::vector<CalibrationResult> fits;
+    std::vector<std::string> names;
+    for (const auto& r : results) {
+        fits.push_back(r.fit);
+        names.push_back(r.car);
+    }
+    JsonEnvelope e;
+    e.command = "calibrate";
+    std::vector<std::string> traces;
+    for (const auto& c : cars)
+        for (const auto& t : c.train) traces.push_back(json_string(t.source));
+    JsonObject in;
+    in.json("traces", json_array(traces)).string("model", "ovrv").number("gap_weight", o.gap_weight);
+    if (joint) in.string("joint", car);
+    if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
+    e.inputs = in.str();
+    e.result = calibration_json(names, fits, o, &results);
+    Status status = Status::Converged;
+    for (std::size_t i = 0; i < fits.size(); ++i)
+        if (fits[i].status_code != Status::Converged) {
+            status = fits[i].status_code;
+            e.message = names[i] + ": " + fits[i].message;
+        }
+    e.status = to_string(status);
+    return envelope_json(e);
+}
+
+std::string py_mixed_ring(const std::string& spec, bool is_pattern, int cars, std::optional<double> speed, std::optional<double> length,
+                       const std::string& solver, int count, int degree) {
+    Fleet unit = fleet_spec(spec);
+    Fleet fleet;
+    if (cars <= 0) fleet = unit;
+    else
+        for (int i = 0; i < cars; ++i) fleet.push_back(unit[static_cast<std::size_t>(i) % unit.size()]);
+    MixedRingOptions o;
+    if (speed && length) throw std::invalid_argument("speed and length: expected only one of them");
+    if (length) o.length = *length;
+    else o.speed = speed ? *speed : 20.0;
+    o.roots.method = root_method(solver);
+    o.roots.count = count;
+    o.roots.degree = degree;
+    const MixedRingResult r = released([&] { return analyse_mixed_ring(fleet, o); });
+    const RootResult& rr = r.roots;
+    JsonEnvelope e;
+    e.command = "roots";
+    JsonObject in;
+    in.string(is_pattern ? "fleet_pattern" : "fleet", spec).integer("ring", static_cast<long long>(fleet.size()));
+    if (std::isnan(o.length)) in.number("speed", o.speed);
+    else in.number("length", o.length);
+    in.integer("count", o.roots.count).integer("degree", o.roots.degree);
+    e.inputs = in.str();
+    e.has_solver = true;
+    e.solver_given = solver_name(rr.method_given);
+    e.solver_used = solver_name(rr.method_used);
+    e.status = to_string(rr.status);
+    e.message = rr.message;
+    e.result = mixed_ring_json(r, fleet.size());
+    return envelope_json(e);
+}
+
+std::string py_equilibria(const std::string& system_file, const std::string& model, int ring, double alpha, double tau, double v0, double h_st,
+                       double headway, const std::string& par, double from, double to, int count, int max_points) {
+    EquilibriumBranchOptions o;
+    o.parameter = par;
+    o.from = from;
+    o.to = to;
+    if (o.from == o.to) throw std::invalid_argument("to = " + json_number(to) + ": expected a value other than from");
+    o.roots.count = count;
+    o.continuation.max_points = max_points;
+    std::unique_ptr<NonlinearDDE> system;
+    std::vector<std::string> variables;
+    Eigen::VectorXd guess;
+    JsonObject inputs;
+    if (!system_file.empty()) {
+        NonlinearSystemFile file = read_nonlinear_system_json(read_text_file(system_file), system_file);
+        variables = file.system->variables();
+        guess = file.equilibrium;
+        system = std::make_unique<ExpressionSystem>(*file.system);
+        inputs.string("system", system_file);
+    } else {
+        if (model != "ov") throw std::invalid_argument("model = '" + model + "': expected ov (other models: write a system file)");
+        auto r = std::make_unique<OvRing>(ring, alpha, tau, v0, h_st, headway);
+        r->set_parameter(r->parameter_names()[static_cast<std::size_t>(r->parameter_index(par))], o.from);
+        guess = r->uniform_flow();
+        for (int i = 0; i + 1 < ring; ++i) variables.push_back("h" + std::to_string(i));
+        for (int i = 0; i < ring; ++i) variables.push_back("v" + std::to_string(i));
+        inputs.string("model", "ov").integer("ring", ring);
+        system = std::move(r);
+    }
+    (void)system->parameter_index(par);  // an unknown name is bad input naming the known ones
+    for (std::size_t i = 0; i < system->parameter_names().size(); ++i) {
+        const std::string& name = system->parameter_names()[i];
+        if (name != par) inputs.number(name, system->parameter_values()[i]);
+    }
+    inputs.string("par", par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
+    const EquilibriumBranch b = released([&] { return equilibrium_branch(*system, guess, o); });
+    JsonEnvelope e;
+    e.command = "equilibria";
+    e.inputs = inputs.str();
+    e.status = to_string(b.status);
+    e.message = b.message;
+    e.result = equilibrium_branch_json(b, variables);
+    return envelope_json(e);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_ddemap, m) {
+    g_main_thread = std::this_thread::get_id();
+    m.doc() = "ddemap's compiled core: each function returns the JSON envelope of the matching command (use the "
+              "wrappers of the ddemap package, which take keyword arguments and return Python objects).";
+    m.attr("version") = DDEMAP_VERSION;
+    // std::invalid_argument is ValueError (pybind11 does this by default; kept explicit, first)
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const Interrupted&) {
+            if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
+        } catch (const std::invalid_argument& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        }
+    });
+    m.def("roots", &py_roots, py::arg("model"), py::arg("parameters"), py::arg("ring"), py::arg("count"));
+    m.def("roots_system", &py_roots_system, py::arg("system"), py::arg("count"), py::arg("degree"), py::arg("solver"));
+    m.def("string", &py_string, py::arg("model"), py::arg("parameters"), py::arg("ring"));
+    m.def("sweep", &py_sweep, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"), py::arg("y_axis"),
+          py::arg("ring"), py::arg("boundaries"));
+    m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
+          py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"));
+    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"));
+    m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("lead_profile"), py::arg("lead"), py::arg("on_event"), py::arg("t_end"),
+          py::arg("step"), py::arg("output_dt"));
+    m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"));
+    m.def("mixed_ring", &py_mixed_ring, py::arg("fleet"), py::arg("is_pattern"), py::arg("ring"), py::arg("speed"), py::arg("length"),
+          py::arg("solver"), py::arg("count"), py::arg("degree"));
+    m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("alpha"), py::arg("tau"), py::arg("v0"),
+          py::arg("h_st"), py::arg("headway"), py::arg("par"), py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
+}

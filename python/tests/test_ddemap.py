@@ -1,0 +1,314 @@
+"""The Python module against the command line: every function on the same input as
+``ddemap COMMAND --format json`` (the program given by $DDEMAP, run as a subprocess), the
+results compared key by key and number by number (the same library on the same input: equal
+to the last bit). Also: bad input is ValueError with the message the program prints, the GIL is
+released during a computation, Ctrl-C stops a long sweep, and examples/stability_chart.py runs.
+
+Run: PYTHONPATH=build/python DDEMAP=build/ddemap python3 -m pytest python/tests -q
+"""
+import csv
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import ddemap
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.path.abspath(os.path.join(HERE, "..", ".."))
+CLI = os.environ.get("DDEMAP", os.path.join(SOURCE, "build", "ddemap"))
+OVRV = dict(k1=0.2, k2=0.2, th=1.5, tau=0.1)
+TIMING = {"seconds", "points_per_second"}  # wall-clock times differ between two runs
+
+
+def cli(*args, expect=0):
+    r = subprocess.run([CLI, *map(str, args)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == expect, (args, r.returncode, r.stderr)
+    return r
+
+
+def cli_json(*args, expect=0):
+    return json.loads(cli(*args, "--format", "json", expect=expect).stdout)
+
+
+def same(py, ref, path="result"):
+    """py (the module's value) equals ref (the CLI's JSON value): a list of records is a dict of
+    columns in Python, a list of numbers an array, null a NaN in a numeric column."""
+    if isinstance(ref, dict):
+        assert isinstance(py, dict), path
+        missing = set(ref) - set(py)
+        assert not missing, (path, missing)
+        for k, v in ref.items():
+            if k not in TIMING:
+                same(py[k], v, path + "." + k)
+    elif isinstance(ref, list):
+        if ref and all(isinstance(v, dict) for v in ref) and all(v.keys() == ref[0].keys() for v in ref):
+            assert isinstance(py, dict) and set(py) == set(ref[0]), path
+            for k in ref[0]:
+                if k not in TIMING:
+                    same(py[k], [v[k] for v in ref], path + "." + k)
+        else:
+            assert len(py) == len(ref), (path, len(py), len(ref))
+            for i, v in enumerate(ref):
+                same(py[i], v, "%s[%d]" % (path, i))
+    elif ref is None:
+        assert py is None or (isinstance(py, float) and math.isnan(py)), (path, py)
+    elif isinstance(ref, bool):
+        assert bool(py) == ref and isinstance(py, (bool, np.bool_)), (path, py, ref)
+    elif isinstance(ref, (int, float)):
+        assert not isinstance(py, (bool, np.bool_)) and py == ref, (path, py, ref)  # exact
+    else:
+        assert py == ref, (path, py, ref)
+
+
+def same_envelope(r, e, compare_inputs=True):
+    assert r.command == e["command"] and r.version == e["version"]
+    assert r.status == e["status"] and r.message == e["message"] and r.solver == e["solver"]
+    if compare_inputs:
+        assert r.inputs == e["inputs"]
+    same(r, e["result"])
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+# ------------------------------------------------------------------ every function against the CLI
+
+
+@pytest.mark.parametrize("ring", [22, "inf"])
+def test_roots(ring):
+    r = ddemap.roots(ring=ring, count=5, **OVRV)
+    same_envelope(r, cli_json("roots", "--ring", ring, "--count", 5, *flags(OVRV)))
+    assert isinstance(r["roots"]["re"], np.ndarray) and r["roots"]["re"].dtype == float and len(r["roots"]["re"]) >= 5
+
+
+def test_roots_idm():
+    p = dict(model="idm", th=1.5, tau=0.3, speed=15)
+    r = ddemap.roots(**p)
+    same_envelope(r, cli_json("roots", *flags(p)))
+
+
+def test_roots_system(tmp_path):
+    linear = os.path.join(SOURCE, "examples", "system.json")
+    same_envelope(ddemap.roots(system=linear, count=4), cli_json("roots", "--system", linear, "--count", 4))
+    same_envelope(ddemap.roots(system=linear, solver="dense"), cli_json("roots", "--system", linear, "--solver", "dense"))
+    nonlinear = tmp_path / "nl.json"
+    nonlinear.write_text(json.dumps({"variables": ["x1", "x2"], "parameters": {"a": 0.5, "b": 0.6, "d": 0.05, "tau": 2.0},
+                                     "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"],
+                                     "equilibrium": [0.1, 0.0]}))
+    r = ddemap.roots(system=nonlinear)
+    same_envelope(r, cli_json("roots", "--system", nonlinear))
+    assert set(r) == {"equilibrium", "linearisation"}
+    # x' = x^2 + 1 has no equilibrium: undecided (exit 4 in the command line), not an exception
+    none = tmp_path / "none.json"
+    none.write_text('{"variables": ["x"], "equations": ["x^2 + 1"], "equilibrium": [0.5]}')
+    r = ddemap.roots(system=none)
+    same_envelope(r, cli_json("roots", "--system", none, expect=4))
+    assert not r.converged
+
+
+def test_string():
+    same_envelope(ddemap.string(**OVRV), cli_json("string", *flags(OVRV)))
+    r = ddemap.string(ring="inf", **OVRV)
+    same_envelope(r, cli_json("string", "--ring", "inf", *flags(OVRV)))
+    assert r["string_stable"] is False and r["sup_gamma"] > 1
+
+
+def test_sweep(tmp_path):
+    r = ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 17), k2=(0.05, 0.9, 13), ring=10)
+    e = cli_json("sweep", "--th", 1.5, "--tau", 0.1, "--k1", "0.01:1:17", "--k2", "0.05:0.9:13", "--ring", 10,
+                 "--out", tmp_path / "s")
+    same_envelope(r, e)
+    # the grid against the CSV: row-major, y outer, x inner
+    rows = read_csv(tmp_path / "s.csv")
+    g = r["grid"]
+    assert g["region"].shape == (13, 17) and len(rows) == 13 * 17
+    for i, row in enumerate(rows):
+        iy, ix = divmod(i, 17)
+        assert float(row["k1"]) == g["x"][ix] == r["x"]["values"][ix]
+        assert float(row["k2"]) == g["y"][iy] == r["y"]["values"][iy]
+        for k in ("spectral_abscissa", "sup_gamma", "omega_peak", "plant_abscissa", "lowfreq_margin", "peak_gain"):
+            assert float(row[k]) == g[k][iy, ix], (k, i)
+        for k in ("plant_stable", "ring_stable", "string_stable", "certified"):
+            assert (row[k] == "true") == g[k][iy, ix], (k, i)
+        for k in ("unstable_roots", "abscissa_mode"):
+            assert (int(row[k]) if row[k] else -1) == g[k][iy, ix], (k, i)
+        region = 0 if not row["plant_stable"] == "true" else 1 if not row["ring_stable"] == "true" else \
+            2 if not row["string_stable"] == "true" else 3
+        assert g["region"][iy, ix] == region
+    same_curves(r["curves"], read_csv(tmp_path / "s-boundaries.csv"), "k1", "k2")
+    assert r["boundaries"]["curves"] == len(r["curves"]) > 0
+
+
+def same_curves(curves, rows, x, y):
+    for c in curves:
+        pts = [row for row in rows if int(row["branch"]) == c["branch"]]
+        assert len(pts) == len(c["x"]) > 1
+        assert all(row["kind"] == c["kind"] and row["subkind"] == c["subkind"] for row in pts)
+        assert (int(pts[0]["mode"]) if pts[0]["mode"] else None) == c["mode"]
+        assert [float(row[x]) for row in pts] == list(c["x"])
+        assert [float(row[y]) for row in pts] == list(c["y"])
+        assert [float(row["omega"]) for row in pts] == list(c["omega"])
+
+
+def test_boundary(tmp_path):
+    r = ddemap.boundary(th=1.5, tau=0.1, k1=(0.01, 1), k2=(0.01, 1), seed_grid=15, ring="inf")
+    e = cli_json("boundary", "--th", 1.5, "--tau", 0.1, "--k1", "0.01:1", "--k2", "0.01:1", "--seed-grid", 15, "--ring", "inf",
+                 "--out", tmp_path / "b")
+    assert r.status == e["status"] and r.message == e["message"] and r.inputs == e["inputs"]
+    summary = e["result"]["curves"]
+    assert len(r["curves"]) == len(summary) > 0
+    for c, s in zip(r["curves"], summary):
+        for k in ("branch", "kind", "subkind", "mode", "points", "max_residual", "closed"):
+            assert c[k] == s[k], k
+    assert r["seeds"] == e["result"]["seeds"] and r["rejected_seeds"] == e["result"]["rejected_seeds"]
+    same_curves(r["curves"], read_csv(tmp_path / "b.csv"), "k1", "k2")
+
+
+def test_classify():
+    r = ddemap.classify()
+    same_envelope(r, cli_json("classify"))
+    assert not r["vehicles"]["string_stable"].any()  # the paper: all 14 settings string unstable
+    r = ddemap.classify(os.path.join(SOURCE, "examples", "vehicles.csv"), ring="inf")
+    same_envelope(r, cli_json("classify", os.path.join(SOURCE, "examples", "vehicles.csv"), "--ring", "inf"))
+
+
+def test_simulate(tmp_path):
+    r = ddemap.simulate("A_min*2,E_max", lead_profile="oscillatory", t_end=20, step=0.05, output_dt=0.5)
+    e = cli_json("simulate", "--fleet", "A_min*2,E_max", "--lead-profile", "oscillatory", "--t-end", 20, "--step", 0.05,
+                 "--output-dt", 0.5, "--out", tmp_path / "sim")
+    same_envelope(r, e)
+    s = r["series"]
+    rows = read_csv(tmp_path / "sim.csv")
+    assert s["speed"].shape == (4, len(s["time"])) and s["time"][-1] == 20
+    header = list(rows[0].keys())
+    times = sorted({float(row[header[0]]) for row in rows})
+    assert times == list(s["time"])
+
+
+def test_calibrate():
+    trace = os.path.join(SOURCE, "tests", "data", "openacc_excerpt_rav4_to_etron.csv")
+    r = ddemap.calibrate(trace, bounds={"eta": (5, 20)}, train=(0, 45))
+    same_envelope(r, cli_json("calibrate", trace, "--bounds", "eta=5:20", "--train", "0:45"))
+    assert len(r["fits"]["status"]) == 1
+
+
+def test_mixed_ring():
+    r = ddemap.mixed_ring("A_min,C_max*3", count=4)
+    same_envelope(r, cli_json("roots", "--fleet", "A_min,C_max*3", "--count", 4))
+    r = ddemap.mixed_ring("A_min,E_max", ring=6, length=200, solver="dense")
+    same_envelope(r, cli_json("roots", "--fleet", "A_min,E_max", "--ring", 6, "--length", 200, "--solver", "dense"))
+
+
+def test_equilibria(tmp_path):
+    # x' = p - x(t - 1)^2: a fold at p = 0 and a Hopf point at p = (pi/4)^2
+    system = tmp_path / "fold.json"
+    system.write_text(json.dumps({"variables": ["x"], "parameters": {"p": 1}, "equations": ["p - x(t - 1)^2"],
+                                  "equilibrium": [1]}))
+    r = ddemap.equilibria("p", 0.9, -1, system=system)
+    same_envelope(r, cli_json("equilibria", "--system", system, "--par", "p", "--from", 0.9, "--to", -1))
+    assert len(r["hopf"]["par"]) == 1 and len(r["folds"]["par"]) == 1  # the closed forms: tests/cli/test_cli.sh
+    r = ddemap.equilibria("alpha", 0.5, 2, model="ov", ring=3, count=2, max_points=60)
+    same_envelope(r, cli_json("equilibria", "--model", "ov", "--ring", 3, "--par", "alpha", "--from", 0.5, "--to", 2,
+                              "--count", 2, "--max-points", 60))
+
+
+def flags(params):
+    out = []
+    for k, v in params.items():
+        out += ["--" + k.replace("_", "-"), v]
+    return out
+
+
+# ------------------------------------------------------------------ errors, GIL, Ctrl-C
+
+
+@pytest.mark.parametrize("call, args", [
+    (lambda: ddemap.roots(k1=-1, k2=0.2, th=1.5, tau=0.1), ["roots", "--k1", -1, "--k2", 0.2, "--th", 1.5, "--tau", 0.1]),
+    (lambda: ddemap.string(k1=0.2, k2=0.2, th=1.5), ["string", "--k1", 0.2, "--k2", 0.2, "--th", 1.5]),
+    (lambda: ddemap.roots(model="idm", k1=0.2), ["roots", "--model", "idm", "--k1", 0.2]),
+    (lambda: ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 1), k2=(0.01, 1, 5)),
+     ["sweep", "--th", 1.5, "--tau", 0.1, "--k1", "0.01:1:1", "--k2", "0.01:1:5", "--out", "/dev/null/x"]),
+    (lambda: ddemap.mixed_ring("A_min,NOPE"), ["roots", "--fleet", "A_min,NOPE"]),
+    (lambda: ddemap.classify("A_min,NOPE"), ["classify", "A_min,NOPE"]),
+])
+def test_bad_input_is_value_error_with_the_library_message(call, args):
+    with pytest.raises(ValueError) as info:
+        call()
+    message = str(info.value)
+    err = cli(*args, expect=2).stderr
+    assert message and message in err, (message, err)
+
+
+def test_bad_python_arguments():
+    with pytest.raises(ValueError, match="ring = 1: expected an integer N >= 2"):
+        ddemap.roots(ring=1, **OVRV)
+    with pytest.raises(ValueError, match="expected exactly two swept parameters"):
+        ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 10), k2=0.2)
+    with pytest.raises(ValueError, match="k2 = nan: expected a finite number"):
+        ddemap.string(k1=0.2, k2=float("nan"), th=1.5, tau=0.1)
+    with pytest.raises(ValueError, match="speed and length"):
+        ddemap.mixed_ring("A_min", speed=20, length=100)
+
+
+def test_the_gil_is_released_during_a_computation():
+    ticks = []
+    done = threading.Event()
+
+    def work():
+        ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 80), k2=(0.01, 1, 80), ring=22, boundaries=False)
+        done.set()
+
+    t = threading.Thread(target=work)
+    start = time.perf_counter()
+    t.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+        time.sleep(0.005)
+    t.join()
+    took = time.perf_counter() - start
+    # Python ran on the main thread all along: with the GIL held the loop could not tick
+    assert len(ticks) >= 10 and len(ticks) > took / 0.005 / 4, (took, len(ticks))
+
+
+def test_ctrl_c_stops_a_long_sweep():
+    code = textwrap.dedent("""
+        import sys, ddemap
+        in_call = False
+        try:
+            print("start", flush=True)
+            in_call = True  # the KeyboardInterrupt must come from inside the call
+            ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 60), k2=(0.01, 1, 3000), ring=22)  # short rows; 8 s on 2 idle cores
+            in_call = False
+        except KeyboardInterrupt:
+            print("interrupted" if in_call else "outside the call", flush=True)
+            sys.exit(7)
+        sys.exit(0)
+    """)
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, env=dict(os.environ))
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(0.5)
+    sent = time.perf_counter()
+    p.send_signal(signal.SIGINT)
+    rc = p.wait(timeout=30)
+    stopped = time.perf_counter() - sent
+    assert rc == 7 and p.stdout.read().strip() == "interrupted"
+    assert stopped < 5, stopped  # the full sweep takes minutes
+
+
+def test_stability_chart_example(tmp_path):
+    png = tmp_path / "chart.png"
+    subprocess.run([sys.executable, os.path.join(SOURCE, "examples", "stability_chart.py"), str(png), "--count", "15"],
+                   check=True, timeout=120)
+    with open(png, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
