@@ -31,6 +31,9 @@ const std::vector<Command>& command_table() {
         {"equilibria", "a branch of equilibria of a nonlinear DDE (--system FILE with expressions, or --model ov --ring N) in one parameter: "
          "stability at every point, folds and Hopf points",
          add_equilibria_flags, run_equilibria},
+        {"atlas", "the sweep's quantities and verdicts over a grid of up to five parameters and ring sizes (a TOML spec): "
+         "OpenMP threads and MPI ranks (mpirun), resumable (--resume); writes DIR/atlas.h5 (HDF5) and DIR/atlas.svg",
+         add_atlas_flags, run_atlas},
     };
     return table;
 }
