@@ -5,7 +5,8 @@ set -euo pipefail
 packages=(g++ make cmake python3 pkg-config
           libeigen3-dev libspectra-dev libsuitesparse-dev doctest-dev
           libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
-          libxml2-utils librsvg2-bin)
+          libxml2-utils librsvg2-bin
+          libhdf5-dev libopenmpi-dev openmpi-bin python3-h5py hdf5-tools)  # ddemap atlas (HDF5, MPI)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

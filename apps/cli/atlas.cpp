@@ -205,6 +205,8 @@ void serve(const AtlasSpec& spec, int threads) {
     }
 }
 
+#endif
+
 /// True when started by mpirun (OpenMPI or a PMI launcher): only then is MPI initialised, so the
 /// program runs as before without mpirun.
 bool under_mpirun() {
@@ -212,7 +214,6 @@ bool under_mpirun() {
         if (std::getenv(v)) return true;
     return false;
 }
-#endif
 
 }  // namespace
 
@@ -241,6 +242,11 @@ int run_atlas() {
             if (on) MPI_Finalize();
         }
     } finalize{mpi};
+#else
+    // without MPI, every process under mpirun would compute and write the whole atlas alone
+    const char* world = std::getenv("OMPI_COMM_WORLD_SIZE");
+    if (under_mpirun() && world && std::atoi(world) > 1)
+        throw BadInput("this ddemap was built without MPI (DDEMAP_WITH_MPI=OFF): run `ddemap atlas` without mpirun, or build with MPI");
 #endif
     const auto t0 = std::chrono::steady_clock::now();
     // rank 0 reads the spec and sends its text to the others (which need no copy of the file)
