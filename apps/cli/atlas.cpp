@@ -11,6 +11,8 @@
 #include <sstream>
 #include <thread>
 
+#include <sys/stat.h>
+
 #include "commands.hpp"
 #include "common.hpp"
 #include "limits.hpp"
@@ -103,7 +105,7 @@ void compute_locally(const AtlasSpec& spec, Ledger& ledger, int threads) {
 }
 
 /// Refuses an atlas above the limits before any work: per point 16 values of 8 bytes in memory
-/// (twice: the values and the HDF5 image), about 60 bytes of HDF5 (11 float64, 3 int32, 4 flags),
+/// (twice: the values and the HDF5 image), 88 bytes of HDF5 (9 float64, 3 int32, 4 flags),
 /// and 5e-5 s per ring mode on one core (the sweep's measured cost; N = inf about 12 modes).
 void check_atlas_size(const AtlasSpec& spec, int workers) {
     double modes = 0.0;
@@ -112,7 +114,7 @@ void check_atlas_size(const AtlasSpec& spec, int workers) {
     std::ostringstream what;
     what << "an atlas of " << spec.points() << " points";
     check_size("atlas", what.str(), "memory", static_cast<double>(spec.points()) * 2.0 * 16.0 * 8.0);
-    check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * 60.0);
+    check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * 88.0);
     check_size("atlas", what.str(), "time", per_ring * modes * 5e-5 / std::max(1, workers));
 }
 
@@ -298,6 +300,9 @@ int run_atlas() {
             OutArg dir;
             dir.text = args.out.text.empty() || args.out.text.back() == '/' ? args.out.text : args.out.text + "/";
             prefix = dir.prepare("atlas", {".h5", ".svg", ".chunks"});
+            struct stat st {};
+            if (!args.resume && ::stat((prefix + ".chunks").c_str(), &st) == 0 && !run_flags().quiet)
+                std::cerr << "ddemap: atlas: note: the chunks of an earlier run in " << prefix << ".chunks are discarded (--resume continues that run)\n";
             store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, values, done);
         } catch (...) {
             setup_error = std::current_exception();

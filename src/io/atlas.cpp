@@ -4,6 +4,7 @@
 #include "io/internal/toml_fields.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cerrno>
 #include <cstring>
 #include <iomanip>
@@ -84,6 +85,8 @@ AtlasAxis read_axis(const std::string& source, const toml::node& n, std::size_t 
     ax.count = static_cast<int>(*c);
     for (int i = 0; i < ax.count; ++i) a.values.push_back(ax.value(i));
     a.uniform = true;
+    a.lo = ax.lo;
+    a.hi = ax.hi;
     return a;
 }
 
@@ -257,15 +260,20 @@ AtlasStore::AtlasStore(const std::string& path, const AtlasSpec& spec, unsigned 
         m_dropped = static_cast<long>(end - good);
         if (m_dropped > 0 && ::ftruncate(m_fd, good) != 0) fail("cannot cut the torn last record of", path, errno);
         if (::lseek(m_fd, good, SEEK_SET) < 0) fail("cannot seek in", path, errno);
+        m_synced = std::chrono::steady_clock::now();
         return;
     }
     m_fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (m_fd < 0) fail("cannot create the chunk store", path, errno);
     if (!write_all(m_fd, &want, sizeof want) || ::fsync(m_fd) != 0) fail("cannot write", path, errno);
+    m_synced = std::chrono::steady_clock::now();
 }
 
 AtlasStore::~AtlasStore() {
-    if (m_fd >= 0) ::close(m_fd);
+    if (m_fd >= 0) {
+        ::fdatasync(m_fd);
+        ::close(m_fd);
+    }
 }
 
 void AtlasStore::append(long c, const double* values, std::size_t count) {
@@ -276,7 +284,15 @@ void AtlasStore::append(long c, const double* values, std::size_t count) {
     std::memcpy(&record[sizeof h], values, count * sizeof(double));
     std::memcpy(&record[sizeof h + count * sizeof(double)], &sum, sizeof sum);
     if (!write_all(m_fd, record.data(), record.size())) fail("cannot append a chunk to", m_path, errno ? errno : EIO);
+    // written: the record survives the process (Ctrl-C, kill -9); synced at most once per
+    // `sync_interval` so that the disk's latency (often 10 ms per fdatasync) never paces the work
+    const auto now = std::chrono::steady_clock::now();
+    if (now - m_synced >= std::chrono::duration<double>(m_sync_interval)) sync();
+}
+
+void AtlasStore::sync() {
     if (::fdatasync(m_fd) != 0) fail("cannot sync", m_path, errno);
+    m_synced = std::chrono::steady_clock::now();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -18,8 +18,8 @@ Axis AtlasAxis::sweep_axis() const {
     if (!uniform || values.size() < 2) throw std::invalid_argument("axis '" + name + "': expected an axis given as lo, hi, count");
     Axis a;
     a.name = name;
-    a.lo = values.front();
-    a.hi = values.back();
+    a.lo = lo;
+    a.hi = hi;
     a.count = static_cast<int>(values.size());
     return a;
 }

@@ -57,6 +57,7 @@ def sweep(path, ddemap, sweep_dir):
     fixed = spec.get("fixed", {})
     xname, yname = dims[-2], dims[-1]
     xs, ys = coords[xname], coords[yname]
+    window = {a["name"]: a for a in spec["axis"]}  # the figure's axes are given as lo, hi, count
     outer = dims[:-2]  # ring, then the outer parameter axes
     compared = 0
     worst = 0.0
@@ -68,7 +69,9 @@ def sweep(path, ddemap, sweep_dir):
             args += [f"--{k}", repr(float(v))]
         for d, i in zip(outer[1:], index[1:]):
             args += [f"--{d}", repr(float(coords[d][i]))]
-        args += [f"--{xname}", f"{xs[0]!r}:{xs[-1]!r}:{len(xs)}", f"--{yname}", f"{ys[0]!r}:{ys[-1]!r}:{len(ys)}"]
+        for name in (xname, yname):
+            a = window[name]
+            args += [f"--{name}", f"{float(a['lo'])!r}:{float(a['hi'])!r}:{a['count']}"]
         run = subprocess.run(args, capture_output=True, text=True)
         assert run.returncode in (0, 4), f"{' '.join(args)}: exit {run.returncode}: {run.stderr}"
         rows = list(csv.DictReader(io.StringIO(run.stdout)))

@@ -3,6 +3,7 @@
 /// Atlas files: the spec (TOML, see maps/atlas-example.toml), the chunk store that lets an
 /// interrupted atlas resume, the HDF5 result and the small-multiples figure.
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -37,9 +38,12 @@ unsigned long long atlas_fingerprint(const std::string& spec_text);
 
 /// The chunk store of an atlas run (DIR/atlas.chunks): a header (format, fingerprint, points,
 /// chunk size) and one record per finished chunk (chunk index, value count, the values as
-/// native doubles, FNV-1a checksum), each appended with write() and fsync()ed before the chunk
-/// counts as finished. A run killed at any moment leaves a store whose complete records are
-/// valid; a torn last record fails its length or checksum test and is dropped on resume.
+/// native doubles, FNV-1a checksum), each appended with one write() as the chunk finishes (it
+/// then survives the process: Ctrl-C, kill -9, a lost MPI rank) and fdatasync()ed at most once
+/// per `sync_interval` seconds and on close (so that a crash of the machine loses at most that
+/// last interval, and the disk's latency never paces the work). A run killed at any moment
+/// leaves a store whose complete records are valid; a torn last record fails its length or
+/// checksum test and is dropped on resume.
 class AtlasStore {
 public:
     /// Opens `path`. Without `resume` (or with no store at `path`) the store starts empty (an
@@ -59,11 +63,17 @@ public:
     /// Appends chunk `c` (its values: count doubles) and fsyncs; WriteError on failure.
     /// Not thread-safe (callers serialise).
     void append(long c, const double* values, std::size_t count);
+    /// fdatasync now (WriteError on failure).
+    void sync();
+    /// Seconds between fdatasyncs of append (default 1; 0: after every chunk).
+    void set_sync_interval(double seconds) { m_sync_interval = seconds; }
 
 private:
     std::string m_path;
     int m_fd = -1;
     long m_loaded = 0, m_dropped = 0;
+    double m_sync_interval = 1.0;
+    std::chrono::steady_clock::time_point m_synced;
 };
 
 /// The HDF5 file (its bytes): one dataset per atlas field shaped like the grid (ring, axes...;

@@ -24,6 +24,7 @@ struct AtlasAxis {
     std::string name;
     std::vector<double> values;
     bool uniform = false;  ///< given as lo, hi, count
+    double lo = 0.0, hi = 0.0;  ///< uniform axes: the range as given (values.back() may differ from hi by rounding)
     /// The axis as a sweep axis (uniform axes only).
     Axis sweep_axis() const;
 };
