@@ -155,7 +155,7 @@ TEST_CASE("atlas spec: bad inputs are refused in one line naming the key and the
     CHECK(error_of("[fixed]\neta = 10.0\n").find("[[axis]] tables missing") != std::string::npos);
 }
 
-TEST_CASE("atlas chunks: every point in exactly one chunk; a chunk's values do not depend on when it is computed") {
+TEST_CASE("atlas chunks: every point in exactly one chunk, and a chunk's values do not depend on when it is computed") {
     const AtlasSpec s = parse_atlas_spec(edited("chunk = 5", "chunk = 7"), "a.toml").spec;
     std::set<long> seen;
     for (long c = 0; c < s.chunks(); ++c)
