@@ -240,7 +240,9 @@ bool under_mpirun() {
 
 void add_atlas_flags(CLI::App& app) {
     app.add_option("spec", args.spec, "the atlas spec (TOML, see maps/atlas-example.toml)")->required();
-    app.add_option("--out", args.out.text, "the folder of DIR/atlas.h5, DIR/atlas.svg (and DIR/atlas.chunks while it runs)")->required();
+    app.add_option("--out", args.out.text, "the folder of DIR/atlas.h5, DIR/atlas.svg (and DIR/atlas.chunks while it runs)")
+        ->required()
+        ->type_name("DIR");
     app.add_flag("--resume", args.resume, "continue an interrupted run from the chunks finished in DIR/atlas.chunks");
     run_flags().add_to(app, true);
 }
