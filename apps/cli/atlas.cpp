@@ -315,28 +315,41 @@ int run_atlas() {
     std::vector<char> done;
     std::unique_ptr<AtlasStore> store;
     std::exception_ptr setup_error;
+    bool complete = false;
     if (rank == 0) {
         try {
             check_atlas_size(spec, threads * ranks);
             OutArg dir;
             dir.text = args.out.text.empty() || args.out.text.back() == '/' ? args.out.text : args.out.text + "/";
             prefix = dir.prepare("atlas", {".h5", ".svg", ".chunks"});
+            // --resume of a run that had finished: nothing to do (the store went with the result)
             struct stat st {};
-            if (!args.resume && ::stat((prefix + ".chunks").c_str(), &st) == 0 && !run_flags().quiet)
-                std::cerr << "ddemap: atlas: note: the chunks of an earlier run in " << prefix << ".chunks are discarded (--resume continues that run)\n";
-            store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, values, done);
+            const bool store_exists = ::stat((prefix + ".chunks").c_str(), &st) == 0;
+            if (args.resume && !store_exists && atlas_hdf5_matches(prefix + ".h5", text)) {
+                complete = true;
+            } else {
+                if (!args.resume && store_exists && !run_flags().quiet)
+                    std::cerr << "ddemap: atlas: note: the chunks of an earlier run in " << prefix
+                              << ".chunks are discarded (--resume continues that run)\n";
+                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, values, done);
+            }
         } catch (...) {
             setup_error = std::current_exception();
         }
     }
 #if DDEMAP_WITH_MPI
     if (ranks > 1) {
-        int good = setup_error ? 0 : 1;
-        MPI_Bcast(&good, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        if (!good && rank > 0) return exit_bad_input;
+        int state = setup_error ? 0 : complete ? 2 : 1;  // 0: refused, 1: run, 2: nothing to do
+        MPI_Bcast(&state, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        if (state == 0 && rank > 0) return exit_bad_input;
+        if (state == 2 && rank > 0) return exit_ok;
     }
 #endif
     if (setup_error) std::rethrow_exception(setup_error);
+    if (complete) {
+        std::cout << "atlas      " << prefix << ".h5 is complete for this spec: nothing to compute\n";
+        return exit_ok;
+    }
 
 #if DDEMAP_WITH_MPI
     if (rank > 0) {

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -407,6 +408,39 @@ std::string atlas_hdf5(const AtlasSpec& spec, const std::vector<double>& values,
     std::string image(static_cast<std::size_t>(size), '\0');
     if (H5Fget_file_image(file, &image[0], image.size()) != size) throw std::runtime_error("HDF5: cannot take the file image");
     return image;
+}
+
+namespace {
+
+/// A string attribute of the root group, or nullopt.
+std::optional<std::string> read_string_attribute(hid_t file, const char* name) {
+    if (H5Aexists_by_name(file, "/", name, H5P_DEFAULT) <= 0) return std::nullopt;
+    const hid_t attr = H5Aopen_by_name(file, "/", name, H5P_DEFAULT, H5P_DEFAULT);
+    if (attr < 0) return std::nullopt;
+    H5Id a(attr, H5Aclose);
+    H5Id type(H5Aget_type(a), H5Tclose);
+    if (H5Tget_class(type) != H5T_STRING || H5Tis_variable_str(type) != 0) return std::nullopt;
+    const std::size_t size = H5Tget_size(type);
+    std::string value(size, '\0');
+    if (H5Aread(a, type, &value[0]) < 0) return std::nullopt;
+    while (!value.empty() && value.back() == '\0') value.pop_back();
+    return value;
+}
+
+}  // namespace
+
+bool atlas_hdf5_matches(const std::string& path, const std::string& spec_text) {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return false;
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) return false;
+    try {
+        H5Id file(f, H5Fclose);
+        return read_string_attribute(file, "spec") == spec_text && read_string_attribute(file, "version") == std::string(DDEMAP_VERSION);
+    } catch (const std::exception&) {
+        return false;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

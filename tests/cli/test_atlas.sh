@@ -82,6 +82,11 @@ if [ -f "$tmp/killed/atlas.chunks" ] && [ ! -e "$tmp/killed/atlas.h5" ]; then
     grep -q "resumed $finished of 128 chunks" "$tmp/resume.err" && ok || bad "atlas --resume did not take the $finished finished chunks: $(cat "$tmp/resume.err")"
     grep -q "($((128 - finished)) computed, $finished resumed)" "$tmp/resume.out" && ok || bad "atlas --resume recomputed finished chunks: $(cat "$tmp/resume.out")"
     "$py" "$check" same "$tmp/serial/atlas.h5" "$tmp/killed/atlas.h5" && ok || bad "atlas: killed and resumed differs from serial"
+    # --resume once more: the finished atlas is recognised, nothing is computed or rewritten
+    cp "$tmp/killed/atlas.h5" "$tmp/finished.h5"
+    "$bin" atlas "$spec" --out "$tmp/killed" --resume 2>&1 | grep -q "is complete for this spec: nothing to compute" && ok ||
+        bad "atlas --resume of a finished atlas recomputed it"
+    cmp -s "$tmp/finished.h5" "$tmp/killed/atlas.h5" && ok || bad "atlas --resume of a finished atlas changed it"
 else
     bad "atlas: the run ended before it could be killed after its first chunk"
 fi

@@ -83,6 +83,11 @@ private:
 /// timestamps are stored: the same values give the same bytes.
 std::string atlas_hdf5(const AtlasSpec& spec, const std::vector<double>& values, const std::string& spec_text);
 
+/// True when `path` is an atlas HDF5 file written by this ddemap version for exactly
+/// `spec_text` (its "spec" and "version" attributes); false for anything else, a missing or
+/// unreadable file included.
+bool atlas_hdf5_matches(const std::string& path, const std::string& spec_text);
+
 /// Small multiples: the verdict map in the plane of the last two axes for every ring size and
 /// combination of the outer axes (render_chart_svg).
 std::string atlas_svg(const AtlasFile& file, const std::vector<double>& values);
