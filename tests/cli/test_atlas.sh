@@ -90,14 +90,18 @@ if [ -f "$tmp/killed/atlas.chunks" ] && [ ! -e "$tmp/killed/atlas.h5" ]; then
 else
     bad "atlas: the run ended before it could be killed after its first chunk"
 fi
-# a store of another spec is not resumed
+# interrupted (SIGINT, as Ctrl-C): the store stays, no result and no temporary file; a store of
+# another spec is not resumed
 mkdir -p "$tmp/other"
 sed 's/^chunk = 16 /chunk = 8 /' "$spec" >"$tmp/other.toml"
+set -m  # job control: the background job does not ignore SIGINT (as a non-interactive shell's would)
 OMP_NUM_THREADS=1 "$bin" atlas "$tmp/other.toml" --out "$tmp/other" --quiet >/dev/null 2>&1 &
 pid=$!
-for _ in $(seq 1 3000); do [ -s "$tmp/other/atlas.chunks" ] && break; sleep 0.005; done
-kill -9 $pid 2>/dev/null
+set +m
+for _ in $(seq 1 3000); do [ "$(stat -c %s "$tmp/other/atlas.chunks" 2>/dev/null || echo 0)" -gt $header ] && break; sleep 0.005; done
+kill -INT $pid 2>/dev/null
 wait $pid 2>/dev/null
+[ "$(ls -A "$tmp/other")" = "atlas.chunks" ] && ok || bad "atlas after SIGINT: expected only the chunk store: $(ls -A "$tmp/other")"
 if [ -f "$tmp/other/atlas.chunks" ]; then
     "$bin" atlas "$spec" --out "$tmp/other" --resume >"$tmp/o.out" 2>"$tmp/o.err"
     rc=$?

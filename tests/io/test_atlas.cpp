@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "ddemap/io/atlas.hpp"
+#include "ddemap/io/files.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "tolerances.hpp"
 
@@ -299,4 +300,18 @@ TEST_CASE("atlas HDF5: the same values give the same bytes (no timestamps)") {
     values[7] = 0.25;
     CHECK(atlas_hdf5(s, values, good_spec) != a);
     CHECK_THROWS_AS(atlas_hdf5(s, std::vector<double>(3), good_spec), std::invalid_argument);
+}
+
+TEST_CASE("atlas HDF5: a written file is recognised as the atlas of its spec, and only of it") {
+    TempDir dir;
+    const AtlasSpec s = parse_atlas_spec(good_spec, "a.toml").spec;
+    std::vector<double> values(static_cast<std::size_t>(s.points()) * atlas_fields().size(), 1.0);
+    const std::string path = dir.path + "/atlas.h5";
+    write_file_atomic(path, atlas_hdf5(s, values, good_spec));
+    CHECK(atlas_hdf5_matches(path, good_spec));
+    CHECK_FALSE(atlas_hdf5_matches(path, std::string(good_spec) + "# edited\n"));
+    CHECK_FALSE(atlas_hdf5_matches(dir.path + "/missing.h5", good_spec));
+    CHECK_FALSE(atlas_hdf5_matches(dir.path, good_spec));  // a folder
+    write_file_atomic(path, "not HDF5");
+    CHECK_FALSE(atlas_hdf5_matches(path, good_spec));
 }
