@@ -2,9 +2,7 @@
 // in chunks over OpenMP threads and, under mpirun, MPI ranks; HDF5 and a figure in DIR; resumable.
 #include <atomic>
 #include <chrono>
-#include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <deque>
 #include <iostream>
 #include <mutex>
