@@ -28,7 +28,7 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz "${launcher[@]}" -DCMAKE_BUILD_TYP
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(system_json fleet_csv fleet_pattern vehicles_csv trace_csv lead_csv chart_spec axis expression)
+    targets=(system_json fleet_csv fleet_pattern vehicles_csv trace_csv lead_csv chart_spec axis expression atlas_spec)
 fi
 cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}" >/dev/null
 mkdir -p build-fuzz/findings

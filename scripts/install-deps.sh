@@ -6,7 +6,8 @@ packages=(g++ make cmake python3 pkg-config
           libeigen3-dev libspectra-dev libsuitesparse-dev doctest-dev
           libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
           libxml2-utils librsvg2-bin
-          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib)
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+          libhdf5-dev libopenmpi-dev openmpi-bin python3-h5py hdf5-tools)  # ddemap atlas (HDF5, MPI)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

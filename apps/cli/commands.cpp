@@ -34,6 +34,10 @@ const std::vector<Command>& command_table() {
         {"hopf", "Hopf points of a nonlinear DDE on its equilibrium branch with their criticality (first Lyapunov coefficient), "
          "crossing speed and predicted orbit amplitude; with --par2 the Hopf curves in two parameters",
          add_hopf_flags, run_hopf},
+
+        {"atlas", "the sweep's quantities and verdicts over a grid of up to five parameters and ring sizes (a TOML spec): "
+         "OpenMP threads and MPI ranks (mpirun), resumable (--resume); writes DIR/atlas.h5 (HDF5) and DIR/atlas.svg",
+         add_atlas_flags, run_atlas},
     };
     return table;
 }

@@ -32,6 +32,8 @@ DDEMAP_COMMAND(calibrate)
 DDEMAP_COMMAND(mix)
 DDEMAP_COMMAND(equilibria)
 DDEMAP_COMMAND(hopf)
+
+DDEMAP_COMMAND(atlas)
 #undef DDEMAP_COMMAND
 
 }  // namespace ddemap::cli

@@ -1,6 +1,7 @@
 #include "ddemap/io/chart_spec.hpp"
 
 #include "core/internal/text.hpp"
+#include "io/internal/toml_fields.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -15,27 +16,11 @@ namespace ddemap {
 
 namespace {
 
-std::string where(const std::string& source, const toml::node& n) {
-    const auto& src = n.source();
-    return source + ":" + std::to_string(src.begin.line);
-}
+std::string where(const std::string& source, const toml::node& n) { return detail::toml_where(source, n); }
 
-double number(const std::string& source, const toml::node& n, const std::string& key) {
-    if (auto v = n.value<double>()) {
-        if (!std::isfinite(*v)) throw std::invalid_argument(where(source, n) + ": " + key + ": expected a finite number");
-        return *v;
-    }
-    throw std::invalid_argument(where(source, n) + ": " + key + ": expected a number");
-}
+double number(const std::string& source, const toml::node& n, const std::string& key) { return detail::toml_number(source, n, key); }
 
-/// An integer field: a TOML integer (not a float such as 1e308, which toml++ would convert with
-/// undefined behaviour) from lo to hi; nullopt otherwise.
-std::optional<int64_t> integer_in(const toml::node& n, int64_t lo, int64_t hi) {
-    if (!n.is_integer()) return std::nullopt;
-    const int64_t v = n.as_integer()->get();
-    if (v < lo || v > hi) return std::nullopt;
-    return v;
-}
+std::optional<int64_t> integer_in(const toml::node& n, int64_t lo, int64_t hi) { return detail::toml_integer_in(n, lo, hi); }
 
 std::string short_number(double v) {  // 4 significant digits: a title, not data
     std::ostringstream os;

@@ -256,6 +256,37 @@ RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
     return rr;
 }
 
+
+RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks) {
+    StringOptions so;
+    so.grid_points = 120;
+    const RingSummary rs = ring.evaluate(lin);
+    int fb = rs.fallbacks;
+    const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
+    p.spectral_abscissa = rs.spectral_abscissa;
+    p.unstable_roots = rs.unstable_roots;
+    p.abscissa_mode = rs.abscissa_mode;
+    p.ring_stable = rs.stable;
+    p.certified = rs.certified;
+    p.sup_gamma = sr.sup_gamma;
+    p.omega_peak = sr.omega_peak;
+    p.lowfreq_margin = sr.lowfreq_margin;
+    p.peak_gain = 0.0;
+    p.peak_omega = 0.0;
+    for (const auto& pk : sr.peaks) {
+        if (pk.gain > p.peak_gain) {
+            p.peak_gain = pk.gain;
+            p.peak_omega = pk.omega;
+        }
+    }
+    p.plant_root = sr.plant_roots.roots.empty() ? cplx(0.0) : sr.plant_roots.roots.front().value;
+    p.plant_abscissa = sr.plant_abscissa;
+    p.plant_stable = sr.plant_stable;
+    p.string_stable = sr.string_stable;
+    fallbacks += fb;
+    return rs;
+}
+
 }  // namespace detail
 
 void SweepSpec::validate() const {
@@ -329,38 +360,17 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
         int& degree = row_degree[iy];
         detail::RingTracker ring = ring_seed[iy];
         detail::PlantTracker plant = plant_seed[iy];
-        StringOptions so;
-        so.grid_points = 120;
         for (int ix = 0; ix < nx; ++ix) {
             SweepPoint& p = result.points[static_cast<std::size_t>(iy) * nx + ix];
             p.x = spec.x.value(ix);
             p.y = spec.y.value(iy);
             const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
             if (!is_computable(lin)) require_computable(lin, point_name(spec, p.x, p.y));
-            const detail::RingSummary rs = ring.evaluate(lin);
-            int fb = rs.fallbacks;
-            const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
-            p.spectral_abscissa = rs.spectral_abscissa;
-            p.unstable_roots = rs.unstable_roots;
-            p.abscissa_mode = rs.abscissa_mode;
-            p.ring_stable = rs.stable;
-            p.certified = rs.certified;
-            p.sup_gamma = sr.sup_gamma;
-            p.omega_peak = sr.omega_peak;
-            p.lowfreq_margin = sr.lowfreq_margin;
-            for (const auto& pk : sr.peaks) {
-                if (pk.gain > p.peak_gain) {
-                    p.peak_gain = pk.gain;
-                    p.peak_omega = pk.omega;
-                }
-            }
-            if (!sr.plant_roots.roots.empty()) p.plant_root = sr.plant_roots.roots.front().value;
+            int fb = 0;
+            const detail::RingSummary rs = detail::evaluate_sweep_point(lin, ring, plant, p, fb);
             for (int m = 0; m < result.modes; ++m) {
                 result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
             }
-            p.plant_abscissa = sr.plant_abscissa;
-            p.plant_stable = sr.plant_stable;
-            p.string_stable = sr.string_stable;
             fallbacks += fb;
             degree = std::max(degree, rs.degree);
             uncertified += !rs.certified;

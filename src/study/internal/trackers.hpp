@@ -12,6 +12,7 @@
 #include "ddemap/problem/quasi_polynomial.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/model.hpp"
+#include "ddemap/study/sweep.hpp"
 
 namespace ddemap::detail {
 
@@ -62,5 +63,10 @@ public:
 private:
     std::optional<cplx> m_guess;
 };
+
+/// One point of a sweep (and of an atlas): the ring's and the plant's rightmost roots continued
+/// from the trackers' previous point, then string stability (|Gamma(iw)| on 120 frequencies and
+/// refined). Fills every field of `p` but x and y; adds the collocation fallbacks to `fallbacks`.
+RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks);
 
 }  // namespace ddemap::detail
