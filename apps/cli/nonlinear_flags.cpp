@@ -1,55 +1,97 @@
 #include "nonlinear_flags.hpp"
 
+#include <algorithm>
+
 #include "common.hpp"
 #include "ddemap/io/system_json.hpp"
 #include "ddemap/problem/expression_system.hpp"
+#include "ddemap/traffic/idm_ring.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
 
 namespace ddemap::cli {
 
 void NonlinearProblemArgs::add_to(CLI::App& app) {
     app.add_option("--system", system, "a nonlinear DDE from a JSON file (variables, parameters, equations, equilibrium; see README)");
-    app.add_option("--model", model, "a built-in nonlinear ring instead of --system: ov (optimal velocity with reaction delay)");
-    app.add_option("--ring", ring, "--model ov: the number of cars N >= 2 (one headway is eliminated: 2N - 1 states)");
-    ov_flags = {
-        app.add_option("--alpha", alpha, "--model ov: sensitivity alpha [1/s]")->capture_default_str(),
-        app.add_option("--tau", tau, "--model ov: reaction delay tau [s]")->capture_default_str(),
-        app.add_option("--v0", v0, "--model ov: the speed scale v0 of V(h) [m/s]")->capture_default_str(),
-        app.add_option("--h-st", h_st, "--model ov: the standstill headway h_st of V(h) [m] (V = 0 below)")->capture_default_str(),
-        app.add_option("--headway", headway, "--model ov: mean headway = ring length / N [m]")->capture_default_str(),
+    app.add_option("--model", model, "a built-in nonlinear ring instead of --system: ov (optimal velocity with reaction delay) or "
+                                      "idm (intelligent driver model with sensing delay)");
+    app.add_option("--ring", ring, "--model ov|idm: the number of cars N >= 2 (one headway or gap is eliminated: 2N - 1 states)");
+    model_flags = {
+        app.add_option("--alpha", alpha, "--model ov: sensitivity alpha [1/s] (default 1)"),
+        app.add_option("--tau", tau, "--model ov: reaction delay tau [s] (default 1); idm: sensing delay [s] (required)"),
+        app.add_option("--v0", v0, "--model ov: the speed scale v0 of V(h) [m/s] (default 1); idm: desired speed [m/s] (default 33.3)"),
+        app.add_option("--h-st", h_st, "--model ov: the standstill headway h_st of V(h) [m] (V = 0 below; default 1)"),
+        app.add_option("--headway", headway, "--model ov: mean headway = ring length / N [m] (default 2)"),
+        app.add_option("--a", a, "--model idm: maximum acceleration [m/s^2] (default 1)"),
+        app.add_option("--b", b, "--model idm: comfortable deceleration [m/s^2] (default 1.5)"),
+        app.add_option("--delta", delta, "--model idm: acceleration exponent [1] (default 4)"),
+        app.add_option("--th", th, "--model idm: time headway [s] (required)"),
+        app.add_option("--eta", eta, "--model idm: jam (standstill) gap s0 [m] (default 2)"),
+        app.add_option("--gap", gap, "--model idm: mean gap = ring length / N - car length [m] (default 20; the uniform flow needs gap > eta)"),
     };
-    app.add_option("--par", par, "the free parameter (a name of the system; ov: alpha, tau, v0, h_st, headway)")->required();
+    app.add_option("--par", par, "the free parameter (a name of the system; ov: alpha, tau, v0, h_st, headway; idm: a, b, v0, delta, th, eta, tau, gap)")->required();
     app.add_option("--from", from, "the branch starts at this value of the parameter")->required();
     app.add_option("--to", to, "and is followed (through folds) until the parameter leaves [from, to]")->required();
 }
 
+namespace {
+/// The flag's value, or the model's default when it was not given.
+double value_or(const std::string& flag, const std::string& text, double fallback) { return text.empty() ? fallback : parse_number(flag, text); }
+/// A flag the model needs: BadInput naming it when missing.
+double required(const std::string& flag, const std::string& text, const std::string& model) {
+    if (text.empty()) throw BadInput("--model " + model + " needs " + flag + ": expected a number");
+    return parse_number(flag, text);
+}
+}  // namespace
+
 NonlinearProblemArgs::Problem NonlinearProblemArgs::load() const {
     Problem r;
-    if (system.empty() == model.empty()) throw BadInput("expected one of --system FILE or --model ov (with --ring N)");
+    if (system.empty() == model.empty()) throw BadInput("expected one of --system FILE or --model ov|idm (with --ring N)");
     r.from = parse_number("--from", from);
     r.to = parse_number("--to", to);
     if (r.from == r.to) throw BadInput("--to = '" + to + "': expected a value other than --from");
-    bool ov_given = false;
-    for (const auto* f : ov_flags) ov_given = ov_given || f->count() > 0;
+    std::vector<std::string> given;
+    for (const auto* f : model_flags)
+        if (f->count() > 0) given.push_back(f->get_name());
+    auto refuse_flags = [&](const std::vector<std::string>& allowed, const std::string& what) {
+        for (const std::string& g : given)
+            if (std::find(allowed.begin(), allowed.end(), g) == allowed.end()) throw BadInput(g + " is not a parameter of " + what);
+    };
     if (!system.empty()) {
-        if (!ring.empty() || ov_given) throw BadInput("--system takes the whole problem from the file: expected no --ring or ov parameters");
+        if (!ring.empty() || !given.empty()) throw BadInput("--system takes the whole problem from the file: expected no --ring or model parameters");
         NonlinearSystemFile file = read_nonlinear_system_json(read_input_file("--system", system), system);
         r.variables = file.system->variables();
         r.guess = file.equilibrium;
         r.system = std::make_unique<ExpressionSystem>(*file.system);
         r.inputs.string("system", system);
     } else {
-        if (model != "ov") throw BadInput("--model = '" + model + "': expected ov (other models: write a --system file)");
-        if (ring.empty()) throw BadInput("--model ov needs --ring N: expected the number of cars");
+        if (model != "ov" && model != "idm") throw BadInput("--model = '" + model + "': expected ov or idm (other models: write a --system file)");
+        if (ring.empty()) throw BadInput("--model " + model + " needs --ring N: expected the number of cars");
         const int n = static_cast<int>(parse_integer("--ring", ring, 2, 2000, "an integer between 2 and 2000"));
-        auto ov = std::make_unique<OvRing>(n, parse_number("--alpha", alpha), parse_number("--tau", tau), parse_number("--v0", v0),
-                                           parse_number("--h-st", h_st), parse_number("--headway", headway));
-        ov->set_parameter(ov->parameter_names()[static_cast<std::size_t>(ov->parameter_index(par))], r.from);
-        r.guess = ov->uniform_flow();
-        for (int i = 0; i + 1 < n; ++i) r.variables.push_back("h" + std::to_string(i));
+        std::unique_ptr<NonlinearDDE> sys;
+        std::string state;
+        if (model == "ov") {
+            refuse_flags({"--alpha", "--tau", "--v0", "--h-st", "--headway"}, "--model ov (alpha, tau, v0, h_st, headway)");
+            auto ov = std::make_unique<OvRing>(n, value_or("--alpha", alpha, 1.0), value_or("--tau", tau, 1.0), value_or("--v0", v0, 1.0),
+                                               value_or("--h-st", h_st, 1.0), value_or("--headway", headway, 2.0));
+            ov->set_parameter(ov->parameter_names()[static_cast<std::size_t>(ov->parameter_index(par))], r.from);
+            r.guess = ov->uniform_flow();
+            sys = std::move(ov);
+            state = "h";
+        } else {
+            refuse_flags({"--a", "--b", "--v0", "--delta", "--th", "--eta", "--tau", "--gap"}, "--model idm (a, b, v0, delta, th, eta, tau, gap)");
+            auto idm = std::make_unique<IdmRing>(n, value_or("--a", a, 1.0), value_or("--b", b, 1.5), value_or("--v0", v0, 33.3),
+                                                 value_or("--delta", delta, 4.0), required("--th", th, "idm"), value_or("--eta", eta, 2.0),
+                                                 required("--tau", tau, "idm"), value_or("--gap", gap, 20.0));
+            idm->set_parameter(idm->parameter_names()[static_cast<std::size_t>(idm->parameter_index(par))], r.from);
+            // a gap <= eta at --from: uniform_flow() refuses it (std::invalid_argument naming gap and eta)
+            r.guess = idm->uniform_flow();
+            sys = std::move(idm);
+            state = "s";
+        }
+        for (int i = 0; i + 1 < n; ++i) r.variables.push_back(state + std::to_string(i));
         for (int i = 0; i < n; ++i) r.variables.push_back("v" + std::to_string(i));
-        r.inputs.string("model", "ov").integer("ring", n);
-        r.system = std::move(ov);
+        r.inputs.string("model", model).integer("ring", n);
+        r.system = std::move(sys);
     }
     (void)r.system->parameter_index(par);  // an unknown name is bad input naming the known ones
     for (std::size_t i = 0; i < r.system->parameter_names().size(); ++i) {

@@ -1,7 +1,7 @@
 #pragma once
 // The flag group of the commands on nonlinear DDEs (equilibria, hopf): the problem (--system FILE
-// with expressions, or --model ov --ring N with the ov parameters) and the free parameter
-// (--par NAME --from A --to B).
+// with expressions, or --model ov|idm --ring N with the model's parameters) and the free
+// parameter (--par NAME --from A --to B).
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,10 +16,12 @@ namespace ddemap::cli {
 
 struct NonlinearProblemArgs {
     std::string system, model, ring, par, from, to;
-    std::string alpha = "1", tau = "1", v0 = "1", h_st = "1", headway = "2";
-    std::vector<CLI::Option*> ov_flags;
+    // empty: the model's default (ov: alpha 1, tau 1, v0 1, h_st 1, headway 2; idm: a 1, b 1.5,
+    // v0 33.3, delta 4, eta 2, gap 20; th and tau required)
+    std::string alpha, tau, v0, h_st, headway, a, b, delta, th, eta, gap;
+    std::vector<CLI::Option*> model_flags;
 
-    /// --system, --model, --ring, the ov flags, --par, --from, --to (required).
+    /// --system, --model, --ring, the model flags, --par, --from, --to (required).
     void add_to(CLI::App& app);
 
     struct Problem {
@@ -31,7 +33,7 @@ struct NonlinearProblemArgs {
         JsonObject inputs;
     };
     /// The problem, with --par checked (BadInput naming the known names) and --from != --to
-    /// (BadInput); the ov ring is set to --par = --from for its guess (the uniform flow).
+    /// (BadInput); a built-in ring is set to --par = --from for its guess (the uniform flow).
     Problem load() const;
 };
 

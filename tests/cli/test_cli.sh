@@ -675,7 +675,7 @@ expect_error "character 10: the expression ends early: expected ')'" equilibria 
 echo '{"variables": ["x"], "parameters": {"p": 1}, "equations": ["p - x(t - 1)^2"], "equilibrium": [1]}' >"$tmp/fold.json"
 expect_error "parameter 'q' is not a parameter of this system: expected one of p" equilibria --system "$tmp/fold.json" --par q --from 0 --to 1
 expect_error "expected one of --system FILE or --model ov" equilibria --system "$tmp/fold.json" --model ov --par p --from 0 --to 1
-expect_error "--model = 'idm'" equilibria --model idm --ring 5 --par v0 --from 0 --to 1
+expect_error "--model = 'ccc'" equilibria --model ccc --ring 5 --par v0 --from 0 --to 1
 expect_error "--ring" equilibria --model ov --par headway --from 1.2 --to 3
 # equilibria: a fold at p = 0 and a Hopf point at p = (pi/4)^2, omega = pi/2 (closed forms of x' = p - x(t-1)^2)
 if "$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 --format json --out "$tmp/eqf" >"$tmp/eqf.out"; then
@@ -876,6 +876,30 @@ h = json.load(sys.stdin)['result']['hopf']
 assert [abs(x['l1'] / p - 1) < 5e-5 for x, p in zip(h, (0.12631, 0.13109, -0.48039))] == [True] * 3 and len(h) == 3, h
 assert [x['criticality'] for x in h] == ['subcritical', 'subcritical', 'supercritical'], h
 " && ok || bad "hopf: DDE-BIFTOOL minimal demo L1 values"
+
+# the IDM ring (--model idm): the branch in the mean gap; its Hopf point is where the linear ring analysis
+# (roots --model idm --ring 5 at the uniform-flow speed of that gap) puts a root on the axis
+"$bin" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --a 1.1 --b 1.6 --v0 32 --par gap --from 6 --to 40 --format json >"$tmp/hidm.json" &&
+    python3 - "$tmp/hidm.json" "$bin" <<'PY' && ok || bad "hopf --model idm: the Hopf point against the linear ring analysis"
+import json, math, subprocess, sys
+h = json.load(open(sys.argv[1]))['result']['hopf']
+assert len(h) == 1 and h[0]['status'] == 'converged', h
+gap = h[0]['par']
+# the uniform-flow speed of this gap: s*(v) = (eta + th v) / sqrt(1 - (v/v0)^4) = gap, by bisection
+lo, hi = 0.0, 32.0
+for _ in range(200):
+    mid = 0.5 * (lo + hi)
+    lo, hi = (mid, hi) if (2 + 1.2 * mid) / math.sqrt(1 - (mid / 32) ** 4) < gap else (lo, mid)
+r = json.loads(subprocess.run([sys.argv[2], 'roots', '--model', 'idm', '--ring', '5', '--th', '1.2', '--tau', '0.6', '--a', '1.1', '--b', '1.6',
+                               '--v0', '32', '--speed', repr(lo), '--format', 'json'], capture_output=True, text=True, check=True).stdout)['result']
+assert abs(r['spectral_abscissa']) < 1e-8, r['spectral_abscissa']
+assert any(abs(abs(x['im']) - h[0]['omega']) < 1e-8 for x in r['roots'] if abs(x['re']) < 1e-8), r['roots']
+PY
+expect_error "--model idm needs --tau" equilibria --model idm --ring 5 --th 1.2 --par gap --from 6 --to 40
+expect_error "--alpha is not a parameter of --model idm" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --alpha 2 --par gap --from 6 --to 40
+expect_error "gap = 1: expected a mean gap > eta = 2 m" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --par gap --from 1 --to 40
+expect_error "--h-st is not a parameter of --model idm" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --h-st 2 --par gap --from 6 --to 40
+expect_error "--th is not a parameter of --model ov" equilibria --model ov --ring 5 --th 2 --par headway --from 1.2 --to 3
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
