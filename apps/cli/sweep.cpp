@@ -37,7 +37,8 @@ void add_sweep_flags(CLI::App& app) {
 
 int run_sweep() {
     const Format format = args.format.parse();
-    const SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
+    SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
+    if (!args.no_boundaries) spec.ring_method = "modes";  // the boundary seeds need every mode's root
     check_sweep_size(spec, "sweep", true);
     const std::string prefix = args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
