@@ -1,6 +1,7 @@
 #include "ddemap/analysis/ring_winding.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -125,6 +126,20 @@ private:
     Sizes m_sizes;
 };
 
+double mag(cplx z) { return std::sqrt(std::norm(z)); }
+
+/// Signed crossings of the ray {p + t u : t > 0} by the segment from x to y: +1 when the
+/// segment passes it counter-clockwise about p. Summed over a closed polygon that keeps away
+/// from p, this is its winding number about p (no arctangents).
+int ray_crossing(cplx x, cplx y, cplx p, cplx u) {
+    const cplx a = (x - p) * std::conj(u), b = (y - p) * std::conj(u);
+    if ((a.imag() < 0.0) == (b.imag() < 0.0)) return 0;
+    // where the segment meets the line of the ray: Re there, by interpolation in Im
+    const double t = a.imag() / (a.imag() - b.imag());
+    if (a.real() + t * (b.real() - a.real()) <= 0.0) return 0;
+    return a.imag() < 0.0 ? 1 : -1;
+}
+
 /// d log|Gamma| / ds
 double ell_rate(const Sample& x) { return (x.dg / x.g).real(); }
 int sign_of(double v) { return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0); }
@@ -137,14 +152,16 @@ struct Pass {
     std::vector<Sample> path;            // accepted samples in order of s
     std::vector<double> reach;           // excursion bound between path[j] and path[j + 1]
     std::vector<WindingCrossing> crossings;
-    double p_arg = 0.0;                  // change of arg P along [0, r]
+    int p_turns = 0;                     // signed crossings of the negative real axis by P along [0, r]
 
     void accept(const Sample& a, const Sample& m, const Sample& b, double e) {
         path.push_back(m);
         path.push_back(b);
         reach.push_back(e);
         reach.push_back(e);
-        p_arg += std::arg(m.p.f * std::conj(a.p.f)) + std::arg(b.p.f * std::conj(m.p.f));
+        // each half turns arg P by less than pi/4: its continuous change is the change of the
+        // principal args plus 2 pi per crossing of the negative real axis
+        p_turns += ray_crossing(a.p.f, m.p.f, 0.0, -1.0) + ray_crossing(m.p.f, b.p.f, 0.0, -1.0);
     }
 
     void locate(Sample lo, Sample hi, int direction) {
@@ -194,27 +211,32 @@ struct Pass {
         const Sample m = f(0.5 * (a.s + b.s));
         if (f.failed) return;
         const double h = 0.5 * (b.s - a.s);
-        const double e = std::max({std::abs(a.dg), std::abs(m.dg), std::abs(b.dg)}) * h;
+        const double e = std::sqrt(std::max({std::norm(a.dg), std::norm(m.dg), std::norm(b.dg)})) * h;
         // Gamma resolved as the tracker resolves a phase (where |Gamma| >= 1/2, near the circle)
         constexpr double kEighth = 0.39269908169872414;  // pi / 8
         const double limit = kEighth * kEighth / (h * h);
         auto speed2 = [](const Sample& x) {
-            const double g = std::max(std::abs(x.g), 0.5);
-            return std::norm(x.dg) / (g * g);
+            return std::norm(x.dg) / std::max(std::norm(x.g), 0.25);
         };
         auto within_quarter = [](cplx y, cplx x) {
             const cplx w = y * std::conj(x);
             return w.real() > std::abs(w.imag());
         };
         bool resolved = speed2(a) < limit && speed2(m) < limit && speed2(b) < limit && phase_piece_resolved(a.p, m.p, b.p);
-        if (resolved && std::min({std::abs(a.g), std::abs(m.g), std::abs(b.g)}) >= 0.5)
+        if (resolved && std::min({std::norm(a.g), std::norm(m.g), std::norm(b.g)}) >= 0.25)
             resolved = within_quarter(m.g, a.g) && within_quarter(b.g, m.g);
         if (resolved) {
-            // change of log|Gamma| within a half piece: at most h |l'| + h^2 |l''| (l'' from the
-            // differences of the sampled l'), doubled
+            // l = log|Gamma| on a half piece stays on its side of 0 when the Taylor bounds
+            // l(x + t) >= l(x) + t l'(x) - D t^2 from both ends over the two quarters stay there,
+            // with D twice the second derivative seen in the differences of the sampled l'
             const double la = ell_rate(a), lm = ell_rate(m), lb = ell_rate(b);
             const double d2 = std::max(std::abs(lm - la), std::abs(lb - lm)) / h;
-            const double reach = h * std::max({std::abs(la), std::abs(lm), std::abs(lb)}) + h * h * d2;
+            const double big_d = 2.0 * d2 + 1e-3 * std::max({std::abs(la), std::abs(lm), std::abs(lb)}) / h;
+            auto clear_half = [&](const Sample& x, const Sample& y, double lx, double ly) {
+                const double side = x.side, q = 0.5 * h;
+                const double fx = side * x.ell, fy = side * y.ell, dx = side * lx, dy = side * ly;
+                return std::min(fx, fx + q * dx - big_d * q * q) > 0.0 && std::min(fy, fy - q * dy - big_d * q * q) > 0.0;
+            };
             if (on_axis && a.s == 0.0) {
                 // the tangency at Gamma(0) = 1: the series' side on the whole first piece
                 if (m.side != 0 && m.side == b.side && (touch_side == 0 || m.side == touch_side)) {
@@ -222,7 +244,7 @@ struct Pass {
                     return;
                 }
             } else if (a.side != 0 && a.side == m.side && m.side == b.side) {
-                if (std::min({std::abs(a.ell), std::abs(m.ell), std::abs(b.ell)}) > 2.0 * reach) {
+                if (clear_half(a, m, la, lm) && clear_half(m, b, lm, lb)) {
                     accept(a, m, b, e);
                     return;
                 }
@@ -269,7 +291,7 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
         const LowFrequency lf = low_frequency_expansion(lin);
         if (lf.decisive_order > 0) touch = lf.attenuates ? -1 : 1;
     }
-    Pass pass{f, sigma == 0.0, touch, {}, {}, {}, 0.0};
+    Pass pass{f, sigma == 0.0, touch, {}, {}, {}, 0};
     const double tau = lin.max_delay();
     int pieces = 8;
     if (tau > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(r * tau * 4.0 / M_PI)));
@@ -283,6 +305,8 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
         }
     }
     if (!f.failed) {
+        pass.path.reserve(256);
+        pass.reach.reserve(256);
         pass.path.push_back(a);
         for (int i = 1; i <= pieces && !f.failed; ++i) {
             const Sample b = f(r * i / pieces);
@@ -300,8 +324,11 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
     // (lambda - sigma)^2: 2 pi + arg h(top) - arg h(bottom), h = P / (lambda - sigma)^2, and
     // h(bottom) = conj h(top); the line's change is twice the change along [0, r]
     const cplx p_top = pass.path.back().p.f;
+    // principal args with the negative real axis on the side ray_crossing gives it (Im <= 0)
+    auto ray_arg = [](cplx x) { return x.imag() == 0.0 && x.real() < 0.0 ? -M_PI : std::arg(x); };
+    const double p_arg = ray_arg(p_top) - ray_arg(pass.path.front().p.f) + kTwoPi * pass.p_turns;
     const double arc = kTwoPi + 2.0 * std::arg(-p_top);
-    const double zp = (arc - 2.0 * pass.p_arg) / kTwoPi;
+    const double zp = (arc - 2.0 * p_arg) / kTwoPi;
     const double zpr = std::round(zp);
     if (std::abs(zp - zpr) > 0.05 || zpr < 0) {
         t.message = "winding table: the plant's zero count is not an integer";
@@ -325,30 +352,53 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
     for (std::size_t i = 0; i + 1 < cuts.size(); ++i)
         if (cuts[i + 1] > cuts[i]) gaps.push_back({cuts[i + 1] - cuts[i], 0.5 * (cuts[i] + cuts[i + 1])});
     std::sort(gaps.begin(), gaps.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
-    const cplx top = pass.path.back().g;
     bool anchored = false;
     double phi0 = M_PI, w0r = 0.0;
-    for (std::size_t k = 0; k < std::min<std::size_t>(gaps.size(), 4) && !anchored; ++k) {
+    for (std::size_t k = 0; k < std::min<std::size_t>(gaps.size(), 8) && !anchored; ++k) {
         phi0 = gaps[k].second;
         const cplx p = std::polar(1.0, phi0), pc = std::conj(p);
-        double total = 0.0;
+        // W about p of the closed curve C (s from -r to r, then the chord): the path [0, r] about
+        // p and about its mirror pc (Gamma(-s) = conj Gamma(s)), counted by crossings of the rays
+        // from p and pc away from the origin. A step counts as its chord when the curve between
+        // its samples stays within its reach e of them and e is smaller than their distance to p
+        // and pc (then curve and chord wind alike); a step too close is sampled finer.
+        int crossings = 0;
         bool clear = true;
+        auto far = [&](cplx g, double e) { return mag(g - p) > e && mag(g - pc) > e; };
+        auto count = [&](cplx g0, cplx g1) {
+            // the mirror half (s from -r to 0) runs through the conjugate samples in reverse order
+            crossings += ray_crossing(g0, g1, p, p) - ray_crossing(std::conj(g0), std::conj(g1), p, p);
+        };
+        std::function<void(const Sample&, const Sample&, int)> finer = [&](const Sample& x, const Sample& y, int depth) {
+            if (!clear) return;
+            if (--f.budget < 0 || depth > 40) {
+                clear = false;
+                return;
+            }
+            const Sample z = f(0.5 * (x.s + y.s));
+            if (f.failed) {
+                clear = false;
+                return;
+            }
+            const double e = 0.5 * (y.s - x.s) * std::sqrt(std::max({std::norm(x.dg), std::norm(z.dg), std::norm(y.dg)}));
+            if (far(x.g, e) && far(z.g, e) && far(y.g, e)) {
+                count(x.g, z.g);
+                count(z.g, y.g);
+                return;
+            }
+            finer(x, z, depth + 1);
+            finer(z, y, depth + 1);
+        };
         for (std::size_t j = 0; j + 1 < pass.path.size() && clear; ++j) {
-            const cplx g0 = pass.path[j].g, g1 = pass.path[j + 1].g;
-            const double e = pass.reach[j];
-            clear = std::abs(g0 - p) > e && std::abs(g1 - p) > e && std::abs(g0 - pc) > e && std::abs(g1 - pc) > e;
-            total += std::arg((g1 - p) * std::conj(g0 - p)) + std::arg((g1 - pc) * std::conj(g0 - pc));
+            const Sample &x = pass.path[j], &y = pass.path[j + 1];
+            if (far(x.g, pass.reach[j]) && far(y.g, pass.reach[j])) count(x.g, y.g);
+            else finer(x, y, 0);
         }
         if (!clear) continue;
-        total += std::arg((std::conj(top) - p) * std::conj(top - p));  // the chord back to Gamma(sigma - i r)
-        const double w0 = total / kTwoPi;
-        w0r = std::round(w0);
-        if (std::abs(w0 - w0r) > 0.05) {
-            t.message = "winding table: the anchor's winding number is not an integer";
-            return t;
-        }
+        w0r = crossings;  // the closing chord lies in the unit disc and meets no ray
         anchored = true;
     }
+    t.evaluations = f.evaluations;
     if (!anchored) {
         t.message = "winding table: no anchor angle away from the image curve";
         return t;
