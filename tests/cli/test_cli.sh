@@ -804,5 +804,15 @@ printf 'name,k1,k2,th,tau\nedge,19.5,0.2,1.5,0.2\n' >"$crd/edge.csv"
 rm -rf "$crd/edge" "$crd/edge.csv"
 [ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
 
+# the ring method of a sweep: winding tables without boundaries (any N), per mode with them
+wnd="$tmp/winding"; mkdir -p "$wnd"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000 --no-boundaries --out "$wnd/a" --format json >"$wnd/a.out" 2>/dev/null &&
+    python3 -c "import json; d = json.load(open('$wnd/a.out')); assert d['solver'] == {'given': 'auto', 'used': 'winding'}, d['solver']" &&
+    ok || bad "sweep --ring 1000000 --no-boundaries: winding tables"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 6 --out "$wnd/b" --format json >"$wnd/b.out" 2>/dev/null &&
+    python3 -c "import json; d = json.load(open('$wnd/b.out')); assert d['solver']['used'] == 'modes', d['solver']" &&
+    ok || bad "sweep with boundaries: per-mode roots"
+rm -rf "$wnd"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
