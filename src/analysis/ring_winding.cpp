@@ -238,8 +238,9 @@ struct Pass {
                 return std::min(fx, fx + q * dx - big_d * q * q) > 0.0 && std::min(fy, fy - q * dy - big_d * q * q) > 0.0;
             };
             if (on_axis && a.s == 0.0) {
-                // the tangency at Gamma(0) = 1: the series' side on the whole first piece
-                if (m.side != 0 && m.side == b.side && (touch_side == 0 || m.side == touch_side)) {
+                // the tangency at Gamma(0) = 1: the series' side on the whole first piece; the
+                // Taylor bounds on its second half (the first ends at the tangency itself)
+                if (m.side != 0 && m.side == b.side && (touch_side == 0 || m.side == touch_side) && clear_half(m, b, lm, lb)) {
                     accept(a, m, b, e);
                     return;
                 }

@@ -91,6 +91,22 @@ TEST_CASE("the winding verdict, unstable count and abscissa equal the per-mode r
     }
 }
 
+TEST_CASE("the winding path agrees with the per-mode path for the IDM law too") {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int i = 0; i < 4; ++i) {
+        const ParameterMap p{{"a", 0.5 + 1.5 * u(rng)}, {"b", 1.0 + 2.0 * u(rng)}, {"v0", 30.0},
+                             {"th", 0.8 + 1.5 * u(rng)}, {"tau", 0.05 + 0.6 * u(rng)}, {"speed", 5.0 + 20.0 * u(rng)}};
+        const Linearisation lin = make_model("idm", p)->linearise();
+        for (int cars : {5, 22}) {
+            CAPTURE(i);
+            CAPTURE(cars);
+            check_counts(lin, cars, 0.0);
+            check_against_modes(lin, cars);
+        }
+    }
+}
+
 TEST_CASE("next to the ring and low-frequency boundaries the winding counts and verdicts stay exact") {
     SweepSpec spec = test::ovrv_chart(11, 22, 1.5, 0.5);
     spec.ring_method = "modes";
