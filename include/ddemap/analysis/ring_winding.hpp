@@ -30,15 +30,19 @@
 /// is counted on its own, without that root (ring_mode0_characteristic).
 ///
 /// Sampling: [0, r] is bisected (the recursion of bisect_phase, core/phase_tracking.hpp) until on
-/// every piece the plant's phase passes the tracker's test (phase_piece_resolved) and the image
-/// of Gamma is resolved: with E = h max |dGamma/ds| over the piece's three samples (h its half
-/// length), a piece is accepted when its samples lie on one side of the unit circle farther from
-/// it than 2 E, or when it holds exactly one sign change of |Gamma| - 1 with E <= 1/16 and
-/// d|Gamma|/ds of one sign at the three samples (the crossing, then located by Illinois
-/// iterations to rounding). On the imaginary axis |Gamma(i s)| - 1 is formed from the
-/// attenuation series w^2 q(w) / |D|^2 (TransferFunction::attenuation) near |Gamma| = 1, so the
-/// tangency of C to the circle at s = 0 (Gamma(0) = 1) is decided by the sign of q, the same series
-/// that decides the low frequencies of |Gamma|. A budget of samples or a zero of P on the line
+/// every piece the plant's phase passes the tracker's test (phase_piece_resolved), Gamma passes
+/// the same test where |Gamma| >= 1/2 (|Gamma'/Gamma| h < pi/8, quarter turns), and l = log|Gamma|
+/// is resolved: either its three samples lie on one side of 0 and the Taylor bounds
+/// l(x + t) >= l(x) + t l'(x) - D t^2 from both ends of each half (D twice the second derivative
+/// seen in the sampled l') keep that side, or it changes sign exactly once with l' of that sign
+/// at the three samples and |l'| > 2 h |l''| (a single crossing, then located by Illinois steps
+/// to rounding). On the imaginary axis 1 - |Gamma(i s)|^2 is formed from the cancellation-free
+/// series w^2 q(w) / |D|^2 (TransferFunction::attenuation) near |Gamma| = 1, so the tangency of
+/// C to the circle at s = 0 (Gamma(0) = 1, the trivial root) is decided by the sign of q, the
+/// series that decides the low frequencies of |Gamma|. The plant's phase and W(phi_0) are
+/// counted by crossings of rays by the sampled polygon, which winds like the curve because each
+/// step stays within its reach h max|dGamma/ds| of its samples (steps passing closer to the
+/// anchor are sampled finer). A budget of samples or a zero of P on the line
 /// makes the table fail (ok = false): the result is then Undecided, never a guess.
 
 #include <string>
@@ -132,7 +136,24 @@ struct RingWindingResult {
 bool ring_winding_applies(const Linearisation& lin);
 
 /// The ring's counts, verdict and spectral abscissa from winding tables (cost independent of N).
-/// `guess` (a previous point's result.next) makes the abscissa a Newton step plus one table.
+///
+/// Verdict (sigma = 0, the axis table): finite N, unstable = sum over m = 1..N-1 of Z(2 pi m / N)
+/// (one sum over the intervals between crossing angles) plus mode 0's count, which is
+/// Z(0+) less the trivial branch when it bends right; roots within marginal_band of the axis are
+/// marginal and not unstable, as on the per-mode path: a mode within band / |re_rate| of a
+/// crossing angle, and the smallest wave numbers theta on the branch through the trivial root,
+/// whose real part is c_k w^k / (2 D(0)^2 Gamma'(0)), w = theta / |Gamma'(0)| (the series of
+/// string_stability.hpp). N = inf: unstable when an interval of angles wider than the marginal
+/// windows at its ends has Z > 0, or the trivial branch bends right (c_k / Gamma'(0) > 0);
+/// then the abscissa is the sup over theta, else 0 (approached as theta -> 0).
+/// Abscissa: Newton from `guess` (a previous point's result.next) on the last mode and its
+/// neighbours (N <= 64), or on the maximum of Re lambda on the level curve |Gamma(lambda)| = 1
+/// (log|Gamma| = 0, Im Gamma'/Gamma = 0) and the two modes nearest its angle; certified by one
+/// table on Re lambda = Re z + 1e-10 max(1, |z|) counting no root in any mode. Without a guess,
+/// or when that count is not 0, the abscissa is bracketed by bisection on the counts (Newton
+/// from the crossings once the bracket is narrow; the bracket itself, 1e-10 wide, otherwise).
+/// When the certified line lies left of -1e-12 max(1, r(0)) the ring is stable without the axis
+/// table.
 /// std::invalid_argument when cars is not >= 2 or 0, or the law has more than one leader.
 RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const RingWindingOptions& options = {},
                                        const RingWindingGuess& guess = {});
