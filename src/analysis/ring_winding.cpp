@@ -294,7 +294,7 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
     }
     Pass pass{f, sigma == 0.0, touch, {}, {}, {}, 0};
     const double tau = lin.max_delay();
-    int pieces = 8;
+    int pieces = 4;
     if (tau > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(r * tau * 4.0 / M_PI)));
     pieces = std::min(pieces, 4096);
     Sample a = f(0.0);
