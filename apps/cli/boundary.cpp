@@ -34,7 +34,8 @@ void add_boundary_flags(CLI::App& app) {
 int run_boundary() {
     const Format format = args.format.parse();
     const int grid = static_cast<int>(parse_integer("--seed-grid", args.grid, 5, 2001, "an integer between 5 and 2001"));
-    const SweepSpec spec = sweep_spec(args.model, args.ring, "", false, grid);
+    SweepSpec spec = sweep_spec(args.model, args.ring, "", false, grid);
+    spec.ring_method = "modes";  // the boundary seeds need every mode's root
     check_sweep_size(spec, "boundary", false);
     const std::string prefix = args.out.prepare("boundary", {".csv", ".json"});
     ExecutionPolicy policy;

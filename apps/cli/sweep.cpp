@@ -37,7 +37,8 @@ void add_sweep_flags(CLI::App& app) {
 
 int run_sweep() {
     const Format format = args.format.parse();
-    const SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
+    SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
+    if (!args.no_boundaries) spec.ring_method = "modes";  // the boundary seeds need every mode's root
     check_sweep_size(spec, "sweep", true);
     const std::string prefix = args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
@@ -58,6 +59,9 @@ int run_sweep() {
     JsonEnvelope e;
     e.command = "sweep";
     e.inputs = sweep_inputs(spec).boolean("boundaries", !args.no_boundaries).str();
+    e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
+    e.solver_given = spec.ring_method;
+    e.solver_used = sw.ring_method;
     e.status = sw.uncertified > 0 ? "uncertified" : "converged";
     e.message = sw.uncertified > 0 ? std::to_string(sw.uncertified) + " points have no certificate even after collocation (see their 'certified' column)" : "";
     e.result = sweep_json(sw, bp);

@@ -39,7 +39,8 @@ SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::str
 
 void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels) {
     const double points = static_cast<double>(spec.x.count) * static_cast<double>(spec.y.count) * static_cast<double>(panels);
-    const double modes = spec.cars == 0 ? 12.0 : spec.cars / 2 + 1.0;  // N = inf: a frequency scan, about 12 modes' work
+    // N = inf: a frequency scan, about 12 modes' work; the winding path: about that at any N
+    const double modes = spec.cars == 0 || sweep_ring_method(spec) == "winding" ? 12.0 : spec.cars / 2 + 1.0;
     const std::string what = (panels > 1 ? std::to_string(panels) + " panels of " : std::string()) + "a " + std::to_string(spec.x.count) + " x " + std::to_string(spec.y.count) + " grid" +
                              (spec.cars > 0 ? " of a " + std::to_string(spec.cars) + "-car ring" : std::string());
     check_size(command, what, "memory", points * (600.0 + 16.0 * modes));

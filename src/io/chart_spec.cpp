@@ -199,6 +199,7 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
     out.boundaries.resize(n);
     for (std::size_t i = 0; i < n; ++i) {  // every panel checked (the computable range at its corners) before any work
         out.specs[i] = panel_sweep(spec, i);
+        if (spec.boundaries) out.specs[i].ring_method = "modes";  // the boundary seeds need every mode's root
         out.specs[i].validate();
     }
     for (std::size_t i = 0; i < n; ++i) {

@@ -150,6 +150,12 @@ double boundary_residual(const SweepSpec& spec, BoundaryKind kind, int mode, con
 
 BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& options) {
     options.validate();
+    if (sweep.spec.cars > 0 && sweep.modes == 0) {
+        // a winding sweep holds no per-mode roots; the ring Hopf seeds need them
+        SweepSpec spec = sweep.spec;
+        spec.ring_method = "modes";
+        return trace_boundaries(run_sweep(spec), options);
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const SweepSpec& spec = sweep.spec;
     const int nx = spec.x.count, ny = spec.y.count;

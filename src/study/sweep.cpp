@@ -8,11 +8,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/ring_winding.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "core/internal/text.hpp"
 
@@ -258,9 +260,14 @@ RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
 
 
 RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks) {
+    const RingSummary rs = ring.evaluate(lin);
+    fill_sweep_point(lin, rs, plant, p, fallbacks);
+    return rs;
+}
+
+void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks) {
     StringOptions so;
     so.grid_points = 120;
-    const RingSummary rs = ring.evaluate(lin);
     int fb = rs.fallbacks;
     const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
     p.spectral_abscissa = rs.spectral_abscissa;
@@ -284,7 +291,6 @@ RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, Pl
     p.plant_stable = sr.plant_stable;
     p.string_stable = sr.string_stable;
     fallbacks += fb;
-    return rs;
 }
 
 }  // namespace detail
@@ -304,6 +310,19 @@ void SweepSpec::validate() const {
         for (double yv : {y.lo, y.hi})
             require_computable(model_at(*this, xv, yv)->linearise(), "the corner " + x.name + " = " + detail::format_number(xv) + ", " +
                                                                         y.name + " = " + detail::format_number(yv) + " of the window");
+    sweep_ring_method(*this);  // a known method that applies to the model
+}
+
+std::string sweep_ring_method(const SweepSpec& spec) {
+    const std::string& m = spec.ring_method;
+    if (m != "auto" && m != "winding" && m != "modes")
+        throw std::invalid_argument("ring method " + detail::quoted(m) + ": expected auto, winding or modes");
+    if (m == "modes") return m;
+    const bool applies = ring_winding_applies(model_at(spec, spec.x.lo, spec.y.lo)->linearise());
+    if (m == "winding" && !applies)
+        throw std::invalid_argument("ring method winding: the model '" + spec.model +
+                                    "' uses more than the car ahead; expected ring method modes or auto");
+    return applies ? "winding" : "modes";
 }
 
 std::unique_ptr<CarModel> model_at(const SweepSpec& spec, double x, double y) {
@@ -326,8 +345,10 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
     SweepResult result;
     result.spec = spec;
     const int nx = spec.x.count, ny = spec.y.count;
+    result.ring_method = sweep_ring_method(spec);
+    const bool winding = result.ring_method == "winding";
     result.points.resize(static_cast<std::size_t>(nx) * ny);
-    result.modes = spec.cars > 0 ? spec.cars / 2 + 1 : 0;
+    result.modes = spec.cars > 0 && !winding ? spec.cars / 2 + 1 : 0;
     result.mode_roots.resize(result.points.size() * result.modes);
     const auto t0 = std::chrono::steady_clock::now();
     int fallbacks = 0, uncertified = 0, degree = 0;
@@ -336,28 +357,41 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
     // fixed, whatever the number of threads.
     std::vector<detail::RingTracker> ring_seed;
     std::vector<detail::PlantTracker> plant_seed;
+    std::vector<RingWindingGuess> winding_seed;
+    long tables = 0;
     {
-        detail::RingTracker ring(spec.cars);
+        detail::RingTracker ring(winding ? 2 : spec.cars);  // unused on the winding path
         detail::PlantTracker plant;
+        RingWindingGuess guess;
         for (int iy = 0; iy < ny; ++iy) {
             const Linearisation lin = model_at(spec, spec.x.value(0), spec.y.value(iy))->linearise();
             if (!is_computable(lin)) require_computable(lin, point_name(spec, spec.x.value(0), spec.y.value(iy)));
-            const detail::RingSummary rs = ring.evaluate(lin);
-            fallbacks += rs.fallbacks;
-            degree = std::max(degree, rs.degree);
+            if (winding) {
+                const RingWindingResult w = analyse_ring_winding(lin, spec.cars, {}, guess);
+                tables += w.tables;
+                guess = w.next;
+            } else {
+                const detail::RingSummary rs = ring.evaluate(lin);
+                fallbacks += rs.fallbacks;
+                degree = std::max(degree, rs.degree);
+            }
             plant.evaluate(lin, fallbacks);
             ring_seed.push_back(ring);
             plant_seed.push_back(plant);
+            winding_seed.push_back(guess);
         }
     }
     result.threads = thread_count(policy);
     // per-row counters, summed in row order after the loop
-    std::vector<int> row_fallbacks(ny, 0), row_uncertified(ny, 0), row_degree(ny, 0);
+    std::vector<int> row_fallbacks(ny, 0), row_uncertified(ny, 0), row_degree(ny, 0), row_winding_fallbacks(ny, 0);
+    std::vector<long> row_tables(ny, 0);
     parallel_for(ny, [&](long row) {
         const int iy = static_cast<int>(row);
         int& fallbacks = row_fallbacks[iy];
         int& uncertified = row_uncertified[iy];
         int& degree = row_degree[iy];
+        RingWindingGuess guess = winding_seed[iy];
+        std::optional<detail::RingTracker> reference;  // the per-mode path where a winding point is undecided
         detail::RingTracker ring = ring_seed[iy];
         detail::PlantTracker plant = plant_seed[iy];
         for (int ix = 0; ix < nx; ++ix) {
@@ -366,9 +400,35 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
             p.y = spec.y.value(iy);
             const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
             if (!is_computable(lin)) require_computable(lin, point_name(spec, p.x, p.y));
+            detail::RingSummary rs;
+            if (winding) {
+                const RingWindingResult w = analyse_ring_winding(lin, spec.cars, {}, guess);
+                row_tables[iy] += w.tables;
+                if (w.status == Status::Converged && w.certified) {
+                    guess = w.next;
+                    rs.spectral_abscissa = w.spectral_abscissa;
+                    rs.abscissa_mode = w.abscissa_mode;
+                    rs.abscissa_theta = w.abscissa_theta;
+                    rs.unstable_roots = w.unstable_roots;
+                    rs.stable = w.verdict == Verdict::Stable;
+                    rs.certified = true;
+                } else if (spec.cars <= kWindingFallbackCars) {
+                    guess = RingWindingGuess{};
+                    if (!reference) reference.emplace(spec.cars);
+                    rs = reference->evaluate(lin);
+                    ++row_winding_fallbacks[iy];
+                } else {
+                    guess = RingWindingGuess{};
+                    rs.certified = false;
+                    rs.stable = false;
+                    rs.spectral_abscissa = w.spectral_abscissa;
+                }
+            } else {
+                rs = ring.evaluate(lin);
+            }
             int fb = 0;
-            const detail::RingSummary rs = detail::evaluate_sweep_point(lin, ring, plant, p, fb);
-            for (int m = 0; m < result.modes; ++m) {
+            detail::fill_sweep_point(lin, rs, plant, p, fb);
+            for (int m = 0; m < result.modes && !winding; ++m) {
                 result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
             }
             fallbacks += fb;
@@ -380,7 +440,10 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
         fallbacks += row_fallbacks[iy];
         uncertified += row_uncertified[iy];
         degree = std::max(degree, row_degree[iy]);
+        result.winding_fallbacks += row_winding_fallbacks[iy];
+        tables += row_tables[iy];
     }
+    result.winding_tables = tables;
     result.fallbacks = fallbacks;
     result.uncertified = uncertified;
     result.degree_max = degree;

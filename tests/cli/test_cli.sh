@@ -901,5 +901,15 @@ expect_error "gap = 1: expected a mean gap > eta = 2 m" equilibria --model idm -
 expect_error "--h-st is not a parameter of --model idm" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --h-st 2 --par gap --from 6 --to 40
 expect_error "--th is not a parameter of --model ov" equilibria --model ov --ring 5 --th 2 --par headway --from 1.2 --to 3
 
+# the ring method of a sweep: winding tables without boundaries (any N), per mode with them
+wnd="$tmp/winding"; mkdir -p "$wnd"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000 --no-boundaries --out "$wnd/a" --format json >"$wnd/a.out" 2>/dev/null &&
+    python3 -c "import json; d = json.load(open('$wnd/a.out')); assert d['solver'] == {'given': 'auto', 'used': 'winding'}, d['solver']" &&
+    ok || bad "sweep --ring 1000000 --no-boundaries: winding tables"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 6 --out "$wnd/b" --format json >"$wnd/b.out" 2>/dev/null &&
+    python3 -c "import json; d = json.load(open('$wnd/b.out')); assert d['solver']['used'] == 'modes', d['solver']" &&
+    ok || bad "sweep with boundaries: per-mode roots"
+rm -rf "$wnd"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

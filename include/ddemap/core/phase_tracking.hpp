@@ -58,6 +58,22 @@ struct PhaseSample {
     double speed2 = 0.0;
 };
 
+/// The acceptance test of bisect_phase for the piece from a to b with midpoint m: on each half
+/// the phase turns by less than pi/4 between the samples and |f'/f| at the three samples times
+/// the half length is below pi/8.
+inline bool phase_piece_resolved(const PhaseSample& a, const PhaseSample& m, const PhaseSample& b) {
+    const double h = 0.5 * (b.t - a.t);
+    constexpr double kEighth = 0.39269908169872414;  // pi / 8
+    const double limit = kEighth * kEighth / (h * h);
+    // |arg(b / a)| < pi/4 without atan2: Re(b conj a) > |Im(b conj a)|
+    auto within_quarter = [](std::complex<double> y, std::complex<double> x) {
+        const std::complex<double> w = y * std::conj(x);
+        return w.real() > std::abs(w.imag());
+    };
+    const bool slow = a.speed2 < limit && m.speed2 < limit && b.speed2 < limit;
+    return slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f);
+}
+
 /// The continuous change of arg f from sample a to sample b by bisection: a piece is accepted
 /// when, on each of its halves, the phase turns by less than pi/4 between the samples and
 /// |f'/f| at the three samples times the half length is below pi/8; otherwise it is split. A
@@ -74,16 +90,7 @@ double bisect_phase(Sampler& sample, const PhaseSample& a, const PhaseSample& b,
     }
     const PhaseSample m = sample(0.5 * (a.t + b.t));
     if (sample.failed) return 0.0;
-    const double h = 0.5 * (b.t - a.t);
-    constexpr double kEighth = 0.39269908169872414;  // pi / 8
-    const double limit = kEighth * kEighth / (h * h);
-    // |arg(b / a)| < pi/4 without atan2: Re(b conj a) > |Im(b conj a)|
-    auto within_quarter = [](std::complex<double> y, std::complex<double> x) {
-        const std::complex<double> w = y * std::conj(x);
-        return w.real() > std::abs(w.imag());
-    };
-    const bool slow = a.speed2 < limit && m.speed2 < limit && b.speed2 < limit;
-    if (slow && within_quarter(m.f, a.f) && within_quarter(b.f, m.f)) return std::arg(b.f * std::conj(a.f));
+    if (phase_piece_resolved(a, m, b)) return std::arg(b.f * std::conj(a.f));
     return bisect_phase(sample, a, m, depth + 1) + bisect_phase(sample, m, b, depth + 1);
 }
 

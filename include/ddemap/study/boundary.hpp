@@ -56,7 +56,8 @@ struct BoundarySet {
 };
 
 /// Traces every boundary branch that crosses the grid of `sweep` (whose spec gives the model,
-/// the window and the ring size).
+/// the window and the ring size). The ring Hopf seeds need every mode's root: a sweep made with
+/// ring method "winding" (no mode_roots) is run again with "modes" first.
 BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& options = {});
 
 /// Residual of a boundary equation at a point (for checks): |F(x, y, omega)|.

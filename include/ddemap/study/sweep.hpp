@@ -33,13 +33,26 @@ struct SweepSpec {
     ParameterMap fixed;  ///< the other parameters
     Axis x, y;           ///< the two swept parameters (count >= 2 each)
     int cars = 22;       ///< ring size, 0 = infinity
+    /// The ring certificate: "winding" (every mode at once from winding tables along vertical
+    /// lines, analysis/ring_winding.hpp: cost independent of N; one-leader models), "modes"
+    /// (each mode's rightmost root continued and certified on its own: cost ~ N, fills
+    /// SweepResult::mode_roots, which the boundary continuation needs), or "auto" (winding
+    /// when it applies).
+    std::string ring_method = "auto";
     void validate() const;  ///< builds the model at the four corners
 };
+
+/// The largest ring whose undecided winding points fall back to the per-mode path.
+constexpr int kWindingFallbackCars = 2000;
+
+/// "winding" or "modes": the ring method spec.ring_method resolves to (std::invalid_argument for
+/// an unknown name, or "winding" for a law that uses more than one car ahead).
+std::string sweep_ring_method(const SweepSpec& spec);
 
 struct SweepPoint {
     double x = 0.0, y = 0.0;
     double spectral_abscissa = 0.0;
-    int unstable_roots = 0;
+    long long unstable_roots = 0;  ///< over all modes (-1 for N = infinity)
     int abscissa_mode = 0;
     double sup_gamma = 1.0, omega_peak = 0.0;
     double lowfreq_margin = 0.0;
@@ -54,8 +67,13 @@ struct SweepPoint {
 struct SweepResult {
     SweepSpec spec;
     std::vector<SweepPoint> points;  ///< row-major: y outer, x inner
-    int modes = 0;                   ///< finite N: N/2 + 1 modes per point
-    std::vector<cplx> mode_roots;    ///< finite N: rightmost root of each mode, point-major
+    int modes = 0;                   ///< finite N and method "modes": N/2 + 1 modes per point (else 0)
+    std::vector<cplx> mode_roots;    ///< finite N and method "modes": rightmost root of each mode, point-major
+    std::string ring_method;         ///< the method used: "winding" or "modes"
+    /// Method "winding": points whose tables could not be certified and that the per-mode path
+    /// decided instead (N <= kWindingFallbackCars; larger rings count them as uncertified).
+    int winding_fallbacks = 0;
+    long winding_tables = 0;         ///< winding passes made in all
     int fallbacks = 0;               ///< points x modes that needed collocation
     int uncertified = 0;             ///< points whose certificate failed even after collocation
     int degree_max = 0;              ///< largest collocation degree any fallback used

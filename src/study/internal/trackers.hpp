@@ -68,5 +68,8 @@ private:
 /// from the trackers' previous point, then string stability (|Gamma(iw)| on 120 frequencies and
 /// refined). Fills every field of `p` but x and y; adds the collocation fallbacks to `fallbacks`.
 RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks);
+/// The same with the ring's summary already computed (by the tracker or the winding path): the
+/// plant and string stability, every field of `p` but x and y.
+void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks);
 
 }  // namespace ddemap::detail
