@@ -258,7 +258,8 @@ py::list curves_arrays(const BoundarySet& b) {
 
 py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
                 const std::string& y_name, const std::string& y_text, int cars, bool boundaries) {
-    const SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    if (boundaries) spec.ring_method = "modes";  // as the CLI: the boundary seeds need every mode's root
     ExecutionPolicy policy;
     policy.progress = interruptible();
     BoundarySet b;
@@ -273,6 +274,9 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     JsonObject in;
     sweep_inputs(spec, in);
     e.inputs = in.boolean("boundaries", boundaries).str();
+    e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
+    e.solver_given = spec.ring_method;
+    e.solver_used = sw.ring_method;
     e.status = sw.uncertified > 0 ? "uncertified" : "converged";
     e.message = sw.uncertified > 0 ? std::to_string(sw.uncertified) + " points have no certificate even after collocation (see their 'certified' column)" : "";
     e.result = sweep_json(sw, bp);
@@ -311,7 +315,8 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
 
 py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
                    const std::string& y_name, const std::string& y_text, int cars, int seed_grid) {
-    const SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    spec.ring_method = "modes";  // as the CLI: the boundary seeds need every mode's root
     ExecutionPolicy policy;
     policy.progress = interruptible();
     const BoundarySet b = released([&] { return trace_boundaries(run_sweep(spec, policy)); });
