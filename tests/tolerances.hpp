@@ -86,4 +86,22 @@ constexpr double monte_carlo_sigmas = 4.5;
 /// fails with probability 0.82.
 constexpr double wilson_coverage_min = 0.8;
 
+/// Periodic orbits by collocation (degree 4, 40 intervals) of y' = -(pi/2) y(t - 1), whose orbits
+/// A sin(pi t / 2) are not polynomials: the collocation error at the mesh points is O(h^{2d}) ~
+/// 1e-13 relative (h = 1/40), the Newton tolerance 1e-10 relative to max |u| <= ~10; 1e-9 bounds both.
+constexpr double orbit_closed_form = 1e-9;
+/// The first-order Hopf amplitude law (half amplitude K sqrt(p - p_H)) against collocation at
+/// p - p_H ~ 1.5e-4: the next term of the expansion is O(p - p_H) relative (~1e-4 with O(1)
+/// coefficients); 1e-3 leaves room for the coefficient, while a wrong K (or an amplitude off by a
+/// factor) fails.
+constexpr double hopf_amplitude_law = 1e-3;
+/// |mu_trivial - 1| of a smooth orbit on the default mesh (degree 4, 40 intervals): the
+/// collocation error of the monodromy operator, O(h^d) ~ 1e-6 for O(1) derivatives; 1e-5.
+constexpr double orbit_trivial_multiplier = 1e-5;
+/// Period and amplitude of a stable orbit (collocation, degree 4, 40 intervals) against a long
+/// RK4 simulation (step 0.01-0.02, Hermite extension, crossings by bisection): both errors are
+/// below 1e-6 relative for smooth orbits, the sampled amplitude O(dt^2 |y''|) ~ 1e-6; the ov ring's
+/// V is only C^2 at h_st (order of both methods reduced there): 2e-4 relative.
+constexpr double orbit_vs_simulation = 2e-4;
+
 }  // namespace ddemap::test::tol
