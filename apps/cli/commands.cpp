@@ -31,6 +31,9 @@ const std::vector<Command>& command_table() {
         {"equilibria", "a branch of equilibria of a nonlinear DDE (--system FILE with expressions, or --model ov --ring N) in one parameter: "
          "stability at every point, folds and Hopf points",
          add_equilibria_flags, run_equilibria},
+        {"orbits", "the branch of periodic orbits from a Hopf point of a nonlinear DDE (--system FILE or --model ov --ring N) in one parameter: "
+         "period, amplitude, Floquet stability, folds, period doublings, tori; --svg the bifurcation diagram",
+         add_orbits_flags, run_orbits},
     };
     return table;
 }

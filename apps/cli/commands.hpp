@@ -31,6 +31,7 @@ DDEMAP_COMMAND(growth)
 DDEMAP_COMMAND(calibrate)
 DDEMAP_COMMAND(mix)
 DDEMAP_COMMAND(equilibria)
+DDEMAP_COMMAND(orbits)
 #undef DDEMAP_COMMAND
 
 }  // namespace ddemap::cli
