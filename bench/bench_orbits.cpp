@@ -5,6 +5,7 @@
 // orbits, the largest |mu_trivial - 1|. The Hopf point comes from the ring modes' closed form
 // (see test_equilibrium_branch.cpp), corrected by Newton, so the equilibrium branch is not timed.
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -41,7 +42,7 @@ int main(int argc, char** argv) {
     }
     if (sizes.empty()) sizes = {5, 10};
     const double pi = 3.14159265358979323846, alpha = 1.0, tau = 1.0;
-    std::printf("| N cars | states | orbits | time [s] | fold headway | max trivial dist | Newton its |\n|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("| N cars | states | orbits | wall [s] | CPU [s] | fold headway | max trivial dist | Newton its |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (int n : sizes) {
         const double theta = 2 * pi / n;
         const double omega = bisect([&](double w) { return w * tau - theta / 2 + pi / 2 - std::atan(alpha / w); }, 1e-6, 10.0);
@@ -66,9 +67,11 @@ int main(int argc, char** argv) {
         o.intervals = intervals;
         o.degree = degree;
         const auto t0 = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
         const OrbitBranch b = orbit_branch_from_hopf(ring, hopf, o);
         const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::printf("| %d | %d | %zu | %.2f | %s | %.1e | %d |\n", n, ring.dimension(), b.points.size(), t,
+        const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+        std::printf("| %d | %d | %zu | %.2f | %.2f | %s | %.1e | %d |\n", n, ring.dimension(), b.points.size(), t, cpu,
                     b.folds.empty() ? "-" : std::to_string(b.folds[0].par).c_str(), b.max_trivial_distance, b.newton_iterations);
         std::fflush(stdout);
     }

@@ -21,6 +21,7 @@ namespace {
 struct Args {
     NonlinearSystemArgs system;
     std::string par, from, to, hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
+    bool adapt = false;
     FormatArg format;
     OutArg out;
 } args;
@@ -43,6 +44,8 @@ void add_orbits_flags(CLI::App& app) {
     app.add_option("--degree", args.degree, "degree d of the piecewise polynomials (1..20)")->capture_default_str()->type_name("INTEGER");
     app.add_option("--intervals", args.intervals, "number L of mesh intervals over one period (2..10000)")->capture_default_str()->type_name("INTEGER");
     app.add_option("--points", args.points, "the most orbits on the branch")->capture_default_str()->type_name("INTEGER");
+    app.add_flag("--adapt", args.adapt,
+                 "move the mesh after every orbit to equidistribute |x^(d+1)|^(1/(d+1)) (more accurate orbits, less accurate multipliers; see README)");
     app.add_option("--variable", args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
     app.add_option("--svg", args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
     args.format.add_to(app);
@@ -62,6 +65,7 @@ int run_orbits() {
     o.degree = static_cast<int>(parse_integer("--degree", args.degree, 1, 20, "an integer between 1 and 20"));
     o.intervals = static_cast<int>(parse_integer("--intervals", args.intervals, 2, 10000, "an integer between 2 and 10000"));
     o.max_points = static_cast<int>(parse_integer("--points", args.points, 2, 100000, "an integer between 2 and 100000"));
+    o.adapt = args.adapt;
 
     NonlinearSystemArgs::Built built = args.system.build(args.par, o.from);
     const std::vector<std::string>& variables = built.variables;
@@ -77,7 +81,7 @@ int run_orbits() {
     }
     JsonObject& inputs = built.inputs;
     inputs.string("par", args.par).number("from", o.from).number("to", o.to).integer("hopf", hopf_index).integer("degree", o.degree)
-        .integer("intervals", o.intervals).integer("points", o.max_points);
+        .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
 
     EquilibriumBranchOptions eo;
     eo.parameter = args.par;

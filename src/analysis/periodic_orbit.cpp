@@ -1,14 +1,15 @@
 #include "ddemap/analysis/periodic_orbit.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 
-#include "ddemap/solve/sparse_lu.hpp"
 
 namespace ddemap {
 
@@ -200,13 +201,19 @@ Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& re
     Correction r;
     Eigen::VectorXd F;
     SpD J;
-    SparseLU lu;
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    auto factorize = [&lu](SpD& m) {
+        m.makeCompressed();
+        lu.compute(m);
+        return lu.info() == Eigen::Success;
+    };
     double last_step = std::numeric_limits<double>::infinity();
     for (int it = 0; it <= o.max_iterations; ++it) {
-        if (!assemble(c, u, ref, &a, b, F, &J)) return r;
-        if (!lu.factorize(J)) return r;
-        r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
         if (it > 0 && last_step <= o.tolerance * std::max(1.0, u.lpNorm<Eigen::Infinity>())) {
+            // converged: the residual at u, the tangent from the last factorisation (one step
+            // earlier, an O(|du|) difference in a direction that is normalised anyway)
+            if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+            r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
             r.ok = r.residual <= o.residual_tolerance;
             Eigen::VectorXd e = Eigen::VectorXd::Zero(c.N() + 2);
             e(c.N() + 1) = 1.0;
@@ -215,6 +222,9 @@ Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& re
             return r;
         }
         if (it == o.max_iterations) break;
+        if (!assemble(c, u, ref, &a, b, F, &J)) return r;
+        if (!factorize(J)) return r;
+        r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
         const Eigen::VectorXd du = lu.solve(F);
         if (!du.allFinite()) return r;
         u -= du;
@@ -270,8 +280,11 @@ bool multipliers(const Setup& c, const Eigen::VectorXd& u, std::vector<cplx>& ou
     SpD m1(N, N), m0(N, static_cast<int>(nh * n));
     m1.setFromTriplets(t1.begin(), t1.end());
     m0.setFromTriplets(t0.begin(), t0.end());
-    SparseLU lu;
-    if (!lu.factorize(m1)) return false;
+    // many right-hand sides: the supernodal LU solves them as a block
+    m1.makeCompressed();
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(m1);
+    if (lu.info() != Eigen::Success) return false;
     const Eigen::MatrixXd y = -lu.solve(Eigen::MatrixXd(m0));
     if (!y.allFinite()) return false;
     const auto H = static_cast<Eigen::Index>(nh * n);
@@ -303,6 +316,7 @@ PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correct
             o.min = o.min.cwiseMin(x);
             o.max = o.max.cwiseMax(x);
         }
+    o.breakpoints = c.mesh.breakpoints();
     o.residual = r.residual;
     o.iterations = r.iterations;
     if (floquet && multipliers(c, u, o.multipliers) && !o.multipliers.empty()) {
@@ -384,18 +398,109 @@ Setup make_setup(const NonlinearDDE& system, const PeriodicMesh& mesh, const Per
     return c;
 }
 
+/// The mesh that equidistributes |x^(d+1)|^(1/(d+1)) of the orbit u (as in COLSYS and DDE-BIFTOOL):
+/// on interval i the d-th derivative D_i of the polynomial is constant (the d-th difference of its
+/// d + 1 equispaced values over (h_i / d)^d); |x^(d+1)| is estimated from the jumps of D_i to
+/// both neighbours. The density is that estimate to the power 1/(d+1) plus 10 % of its mean (so
+/// that no interval grows without bound where x is nearly polynomial).
+std::vector<double> adapted_breakpoints(const Setup& c, const Eigen::VectorXd& u) {
+    const int L = c.L, d = c.d;
+    std::vector<double> binom(static_cast<std::size_t>(d) + 1, 1.0);
+    for (int j = 1; j <= d; ++j) binom[static_cast<std::size_t>(j)] = binom[static_cast<std::size_t>(j - 1)] * (d - j + 1) / j;
+    std::vector<Eigen::VectorXd> D(static_cast<std::size_t>(L));
+    for (int i = 0; i < L; ++i) {
+        Eigen::VectorXd v = Eigen::VectorXd::Zero(c.n);
+        for (int j = 0; j <= d; ++j) {
+            const int pt = (i * d + j) % c.P;
+            v += (((d - j) % 2) ? -1.0 : 1.0) * binom[static_cast<std::size_t>(j)] * u.segment(static_cast<Eigen::Index>(pt) * c.n, c.n);
+        }
+        D[static_cast<std::size_t>(i)] = v / std::pow(c.mesh.width(i) / d, d);
+    }
+    std::vector<double> m(static_cast<std::size_t>(L));
+    double mean = 0.0;
+    for (int i = 0; i < L; ++i) {
+        const int ip = (i + 1) % L, im = (i + L - 1) % L;
+        const auto ui = static_cast<std::size_t>(i);
+        const double wl = (D[ui] - D[static_cast<std::size_t>(im)]).lpNorm<Eigen::Infinity>() / (0.5 * (c.mesh.width(i) + c.mesh.width(im)));
+        const double wr = (D[static_cast<std::size_t>(ip)] - D[ui]).lpNorm<Eigen::Infinity>() / (0.5 * (c.mesh.width(i) + c.mesh.width(ip)));
+        m[ui] = std::pow(0.5 * (wl + wr), 1.0 / (d + 1));
+        mean += m[ui] * c.mesh.width(i);
+    }
+    if (!(mean > 0.0) || !std::isfinite(mean)) return c.mesh.breakpoints();
+    std::vector<double> F(static_cast<std::size_t>(L) + 1, 0.0);
+    for (int i = 0; i < L; ++i) {
+        m[static_cast<std::size_t>(i)] += 0.1 * mean;
+        F[static_cast<std::size_t>(i) + 1] = F[static_cast<std::size_t>(i)] + m[static_cast<std::size_t>(i)] * c.mesh.width(i);
+    }
+    std::vector<double> t(static_cast<std::size_t>(L) + 1);
+    t.front() = 0.0;
+    t.back() = 1.0;
+    int i = 0;
+    for (int k = 1; k < L; ++k) {
+        const double target = F.back() * k / L;
+        while (i + 1 < L && F[static_cast<std::size_t>(i) + 1] <= target) ++i;
+        t[static_cast<std::size_t>(k)] = c.mesh.breakpoints()[static_cast<std::size_t>(i)] + (target - F[static_cast<std::size_t>(i)]) / m[static_cast<std::size_t>(i)];
+    }
+    for (int k = 1; k <= L; ++k)
+        if (!(t[static_cast<std::size_t>(k)] > t[static_cast<std::size_t>(k) - 1])) return c.mesh.breakpoints();
+    return t;
+}
+
+/// The same problem on another mesh of the same degree and number of intervals.
+Setup with_mesh(const Setup& c, const PeriodicMesh& mesh) {
+    Setup s(c.sys, mesh);
+    s.n = c.n;
+    s.m = c.m;
+    s.j = c.j;
+    s.d = c.d;
+    s.L = c.L;
+    s.P = c.P;
+    s.base = c.base;
+    s.w = c.w;
+    return s;
+}
+
+/// u (or a tangent) on the mesh of `from` re-represented on the mesh of `to`: the X part
+/// interpolated at the new points, T and p kept.
+Eigen::VectorXd resample(const Setup& from, const Setup& to, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd profile(from.P, from.n);
+    for (int i = 0; i < from.P; ++i) profile.row(i) = u.segment(static_cast<Eigen::Index>(i) * from.n, from.n).transpose();
+    Eigen::VectorXd v(to.N() + 2);
+    for (int i = 0; i < to.P; ++i) v.segment(static_cast<Eigen::Index>(i) * to.n, to.n) = orbit_value(from.mesh, profile, to.mesh.point(i));
+    v(to.N()) = u(from.N());
+    v(to.N() + 1) = u(from.N() + 1);
+    return v;
+}
+
 /// Follows the branch from the corrected first orbit u with unit tangent t.
-void follow(const Setup& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const PeriodicOrbitOptions& o,
+void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const PeriodicOrbitOptions& o,
             OrbitBranch& b) {
-    const int N = c.N();
+    // the mesh of the next orbit (adapted to the last one when o.adapt); Setup refers to it
+    std::unique_ptr<PeriodicMesh> mesh;
+    std::unique_ptr<Setup> cp = std::make_unique<Setup>(c0);
+    const int N = c0.N();
     const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
     const double T0 = u(N);
-    b.points.push_back(make_orbit(c, u, first, o.floquet));
+    const Setup* cur = cp.get();
+    auto adapt = [&]() {
+        if (!o.adapt) return;
+        auto next_mesh = std::make_unique<PeriodicMesh>(c0.mesh.degree(), adapted_breakpoints(*cur, u));
+        auto next = std::make_unique<Setup>(with_mesh(*cur, *next_mesh));
+        u = resample(*cur, *next, u);
+        t = resample(*cur, *next, t);
+        t /= next->norm(t);
+        mesh = std::move(next_mesh);
+        cp = std::move(next);
+        cur = cp.get();
+    };
+    b.points.push_back(make_orbit(*cur, u, first, o.floquet));
     const double amp0 = amplitude(b.points.front());
     b.newton_iterations += first.iterations;
     double h = o.initial_step;
     b.stop = "max_points";
+    adapt();
     while (static_cast<int>(b.points.size()) < o.max_points) {
+        const Setup& c = *cur;
         const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
         Eigen::VectorXd v = u + h * t;
         const Eigen::VectorXd a = c.w.cwiseProduct(t);
@@ -511,6 +616,7 @@ void follow(const Setup& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correcti
             b.stop = "period";
             return;
         }
+        adapt();
     }
 }
 
@@ -529,7 +635,7 @@ void finish(OrbitBranch& b) {
 std::string method_text(const PeriodicMesh& mesh) {
     std::ostringstream s;
     s << "piecewise polynomial collocation, degree " << mesh.degree() << " on " << mesh.intervals()
-      << " intervals at Gauss-Legendre points; Newton with sparse LU (UMFPACK); pseudo-arclength; Floquet multipliers of the collocated monodromy matrix";
+      << " intervals at Gauss-Legendre points; Newton with a sparse LU (Eigen SparseLU, COLAMD); pseudo-arclength; Floquet multipliers of the collocated monodromy matrix";
     return s.str();
 }
 

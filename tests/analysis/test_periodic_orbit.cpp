@@ -198,9 +198,13 @@ TEST_CASE("ov ring (N = 5): subcritical Hopf, fold of orbits and bistability, ch
     REQUIRE(iu > 0);
     REQUIRE(is > after);
     ring.set_parameter("headway", hm);
-    const PeriodicMesh mesh(4, 40);
     // the stable large orbit, corrected at h = hm, against a long simulation
-    OrbitGuess g{hm, b.points[is].period, b.points[is].profile};
+    OrbitGuess g{hm, b.points[is].period, Eigen::MatrixXd()};
+    {
+        const PeriodicMesh from(b.degree, b.points[is].breakpoints), to(4, 40);
+        g.profile.resize(to.points(), ring.dimension());
+        for (int i = 0; i < to.points(); ++i) g.profile.row(i) = orbit_value(from, b.points[is].profile, to.point(i)).transpose();
+    }
     const OrbitBranch stable = orbit_branch_from_guess(ring, g, options("headway", hm, hm + 0.1, 2, 40));
     REQUIRE(!stable.points.empty());
     const PeriodicOrbit& ps = stable.points.front();
@@ -208,6 +212,7 @@ TEST_CASE("ov ring (N = 5): subcritical Hopf, fold of orbits and bistability, ch
     CHECK(ps.stable);
     // start the simulation on a profile that is the unstable orbit grown by 20 % around the uniform flow
     const PeriodicOrbit& pu = b.points[iu];
+    const PeriodicMesh mesh(b.degree, pu.breakpoints);
     const Eigen::VectorXd xs = ring.uniform_flow();
     auto from_orbit = [&](double factor) {
         return [&, factor](double t, double* y) {
@@ -265,4 +270,23 @@ TEST_CASE("orbit options and starts: bad input is std::invalid_argument, a faile
     const OrbitBranch far = orbit_branch_from_guess(sys, g, options("alpha", 1.5, 2.0, 5));
     CHECK(far.status != Status::Converged);
     CHECK(far.stop == "first_orbit_failed");
+}
+
+TEST_CASE("Wright's equation at alpha = 2.9: the adapted mesh gives a more accurate period than the uniform one") {
+    // the orbit has a fast pulse and a slow phase near y = -1; the reference is a uniform mesh of 200 intervals
+    std::vector<double> period;
+    for (int k = 0; k < 3; ++k) {
+        PeriodicOrbitOptions o = options("alpha", 1.5, 2.9, 200, k == 2 ? 200 : 40);
+        o.adapt = k == 1;
+        const OrbitBranch b = orbit_branch_from_hopf(wright(), scalar_hopf(), o);
+        REQUIRE(b.stop == "bound");
+        period.push_back(b.points.back().period);
+        if (k == 1) {  // the mesh moved: its intervals differ by more than a factor 2
+            const std::vector<double>& t = b.points.back().breakpoints;
+            double hmin = 1.0, hmax = 0.0;
+            for (std::size_t i = 1; i < t.size(); ++i) hmin = std::min(hmin, t[i] - t[i - 1]), hmax = std::max(hmax, t[i] - t[i - 1]);
+            CHECK(hmax > 2.0 * hmin);
+        }
+    }
+    CHECK(std::abs(period[1] - period[2]) < 0.5 * std::abs(period[0] - period[2]));
 }
