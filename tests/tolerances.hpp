@@ -95,6 +95,10 @@ constexpr double orbit_closed_form = 1e-9;
 /// coefficients); 1e-3 leaves room for the coefficient, while a wrong K (or an amplitude off by a
 /// factor) fails.
 constexpr double hopf_amplitude_law = 1e-3;
+/// The slope (T - T_H) / (p - p_H) of the period at two orbits near a Hopf point (p - p_H = 1.5e-4
+/// and 6e-4): it changes by the next term of the expansion, O(p - p_H) relative with an O(1)
+/// coefficient (~1e-3 here); 1e-2 relative, while a period not tending to T_H linearly fails.
+constexpr double hopf_period_slope = 1e-2;
 /// |mu_trivial - 1| of a smooth orbit on the default mesh (degree 4, 40 intervals): the
 /// collocation error of the monodromy operator, O(h^d) ~ 1e-6 for O(1) derivatives; 1e-5.
 constexpr double orbit_trivial_multiplier = 1e-5;
