@@ -143,7 +143,8 @@ int run_orbits() {
             out << "doubling   " << args.par << " ~ " << rounded(x.par, 6) << ", period " << rounded(x.period, 6) << " (interpolated)\n";
         for (const OrbitCrossing& x : b.tori)
             out << "torus      " << args.par << " ~ " << rounded(x.par, 6) << ", period " << rounded(x.period, 6) << " (interpolated)\n";
-        out << "accuracy   max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", max residual = " << rounded(b.max_residual, 2) << "\n";
+        if (!b.points.empty())
+            out << "accuracy   max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", max residual = " << rounded(b.max_residual, 2) << "\n";
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
         if (!files.empty()) {
             out << "wrote     ";
