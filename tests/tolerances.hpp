@@ -99,6 +99,11 @@ constexpr double hopf_amplitude_law = 1e-3;
 /// and 6e-4): it changes by the next term of the expansion, O(p - p_H) relative with an O(1)
 /// coefficient (~1e-3 here); 1e-2 relative, while a period not tending to T_H linearly fails.
 constexpr double hopf_period_slope = 1e-2;
+/// The min and max of an orbit sampled at 8 d points per mesh interval (PeriodicOrbit::min/max)
+/// compared between two phases of one orbit: each misses the extreme by at most
+/// (T / (8 d L))^2 |x''| / 8 ~ 3e-5 for Wright's orbit at alpha = 2 (T = 4.4, |y''| <= 20, L = 40);
+/// 1e-4 (a phase-dependent sampling error, not a collocation error).
+constexpr double orbit_extremes = 1e-4;
 /// |mu_trivial - 1| of a smooth orbit on the default mesh (degree 4, 40 intervals): the
 /// collocation error of the monodromy operator, O(h^d) ~ 1e-6 for O(1) derivatives; 1e-5.
 constexpr double orbit_trivial_multiplier = 1e-5;

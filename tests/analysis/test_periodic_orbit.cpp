@@ -159,6 +159,32 @@ TEST_CASE("Wright's equation at alpha = 2: the stable orbit's period and amplitu
     CHECK(std::abs(amp - (p.max[0] - p.min[0])) < tol::orbit_vs_simulation * amp);
 }
 
+TEST_CASE("Wright's equation at alpha = 2: a branch started from an orbit sampled from a simulation") {
+    const ExpressionSystem sys = wright(2.0);
+    const DdeSolver s = simulate(sys, [](double, double* y) { y[0] = 0.5; }, 300.0, 0.01);
+    const std::vector<double> up = crossings(s, 0, 0.0, 250.0, 300.0, 0.05);
+    REQUIRE(up.size() >= 2);
+    // one period of samples every 0.05 from an upward crossing, the period from two crossings
+    std::vector<double> times;
+    for (double t = up[0]; t <= up[1] + 1e-9; t += 0.05) times.push_back(t);
+    times.push_back(up[1]);
+    Eigen::MatrixXd states(static_cast<Eigen::Index>(times.size()), 1);
+    for (std::size_t i = 0; i < times.size(); ++i) states(static_cast<Eigen::Index>(i), 0) = s.value(0, times[i]);
+    const PeriodicMesh mesh(4, 40);
+    const OrbitGuess g = orbit_guess_from_samples(mesh, times, states, up[1] - up[0], 2.0);
+    const OrbitBranch b = orbit_branch_from_guess(sys, g, options("alpha", 2.0, 2.2, 4));
+    REQUIRE(b.points.size() == 4);
+    CHECK(b.status == Status::Converged);
+    CHECK(std::abs(b.points[0].par - 2.0) < 1e-12);
+    CHECK(b.points[1].par > 2.0);  // followed towards --to
+    // the same orbit as the branch from the Hopf point reaches at alpha = 2
+    const OrbitBranch h = orbit_branch_from_hopf(wright(), scalar_hopf(), options("alpha", 1.5, 2.0, 60));
+    REQUIRE(h.stop == "bound");
+    CHECK(std::abs(b.points[0].period - h.points.back().period) < tol::orbit_closed_form * h.points.back().period);
+    CHECK(std::abs(b.points[0].max[0] - h.points.back().max[0]) < tol::orbit_extremes);
+    CHECK(std::abs(b.points[0].min[0] - h.points.back().min[0]) < tol::orbit_extremes);
+}
+
 TEST_CASE("Wright's equation: the trivial multiplier tends to 1 and the period converges as the mesh is refined") {
     std::vector<double> trivial, period;
     for (int L : {8, 16, 32, 64}) {

@@ -91,7 +91,7 @@ struct PeriodicOrbit {
     double period = 0.0;
     Eigen::MatrixXd profile;  ///< L d x n: row i is x at mesh point i (x(1) = row 0)
     std::vector<double> breakpoints;  ///< the mesh t_0 = 0 < ... < t_L = 1 of the profile
-    Eigen::VectorXd min, max;  ///< of every variable over the orbit (mesh values and collocation points)
+    Eigen::VectorXd min, max;  ///< of every variable over the orbit (sampled at 8 d points per interval)
     std::vector<cplx> multipliers;  ///< by decreasing modulus, the trivial one included
     double trivial_distance = std::numeric_limits<double>::quiet_NaN();  ///< |mu_trivial - 1|
     double max_nontrivial = std::numeric_limits<double>::quiet_NaN();   ///< max |mu| over the others
