@@ -102,4 +102,31 @@ constexpr double amplitude_law_per_mu = 0.5;
 /// p = 1 from p = 0.5 (1.41) and p = 1.5 (2.83).
 constexpr double order_ratio_band = 0.4;
 
+/// Periodic orbits by collocation (degree 4, 40 intervals) of y' = -(pi/2) y(t - 1), whose orbits
+/// A sin(pi t / 2) are not polynomials: the collocation error at the mesh points is O(h^{2d}) ~
+/// 1e-13 relative (h = 1/40), the Newton tolerance 1e-10 relative to max |u| <= ~10; 1e-9 bounds both.
+constexpr double orbit_closed_form = 1e-9;
+/// The first-order Hopf amplitude law (half amplitude K sqrt(p - p_H)) against collocation at
+/// p - p_H ~ 1.5e-4: the next term of the expansion is O(p - p_H) relative (~1e-4 with O(1)
+/// coefficients); 1e-3 leaves room for the coefficient, while a wrong K (or an amplitude off by a
+/// factor) fails.
+constexpr double hopf_amplitude_law = 1e-3;
+/// The slope (T - T_H) / (p - p_H) of the period at two orbits near a Hopf point (p - p_H = 1.5e-4
+/// and 6e-4): it changes by the next term of the expansion, O(p - p_H) relative with an O(1)
+/// coefficient (~1e-3 here); 1e-2 relative, while a period not tending to T_H linearly fails.
+constexpr double hopf_period_slope = 1e-2;
+/// The min and max of an orbit sampled at 8 d points per mesh interval (PeriodicOrbit::min/max)
+/// compared between two phases of one orbit: each misses the extreme by at most
+/// (T / (8 d L))^2 |x''| / 8 ~ 3e-5 for Wright's orbit at alpha = 2 (T = 4.4, |y''| <= 20, L = 40);
+/// 1e-4 (a phase-dependent sampling error, not a collocation error).
+constexpr double orbit_extremes = 1e-4;
+/// |mu_trivial - 1| of a smooth orbit on the default mesh (degree 4, 40 intervals): the
+/// collocation error of the monodromy operator, O(h^d) ~ 1e-6 for O(1) derivatives; 1e-5.
+constexpr double orbit_trivial_multiplier = 1e-5;
+/// Period and amplitude of a stable orbit (collocation, degree 4, 40 intervals) against a long
+/// RK4 simulation (step 0.01-0.02, Hermite extension, crossings by bisection): both errors are
+/// below 1e-6 relative for smooth orbits, the sampled amplitude O(dt^2 |y''|) ~ 1e-6; the ov ring's
+/// V is only C^2 at h_st (order of both methods reduced there): 2e-4 relative.
+constexpr double orbit_vs_simulation = 2e-4;
+
 }  // namespace ddemap::test::tol

@@ -28,7 +28,7 @@ const std::vector<Command>& command_table() {
          add_calibrate_flags, run_calibrate},
         {"mix", "penetration-rate study: spectral abscissa of a ring with a fraction p of type X among type Y",
          add_mix_flags, run_mix},
-        {"equilibria", "a branch of equilibria of a nonlinear DDE (--system FILE with expressions, or --model ov --ring N) in one parameter: "
+        {"equilibria", "a branch of equilibria of a nonlinear DDE (--system FILE with expressions, or --model ov|idm --ring N) in one parameter: "
          "stability at every point, folds and Hopf points",
          add_equilibria_flags, run_equilibria},
         {"hopf", "Hopf points of a nonlinear DDE on its equilibrium branch with their criticality (first Lyapunov coefficient), "
@@ -38,6 +38,10 @@ const std::vector<Command>& command_table() {
         {"atlas", "the sweep's quantities and verdicts over a grid of up to five parameters and ring sizes (a TOML spec): "
          "OpenMP threads and MPI ranks (mpirun), resumable (--resume); writes DIR/atlas.h5 (HDF5) and DIR/atlas.svg",
          add_atlas_flags, run_atlas},
+
+        {"orbits", "the branch of periodic orbits from a Hopf point of a nonlinear DDE (--system FILE or --model ov|idm --ring N) in one parameter: "
+         "period, amplitude, Floquet stability, folds, period doublings, tori; --svg the bifurcation diagram",
+         add_orbits_flags, run_orbits},
     };
     return table;
 }

@@ -34,6 +34,8 @@ DDEMAP_COMMAND(equilibria)
 DDEMAP_COMMAND(hopf)
 
 DDEMAP_COMMAND(atlas)
+
+DDEMAP_COMMAND(orbits)
 #undef DDEMAP_COMMAND
 
 }  // namespace ddemap::cli

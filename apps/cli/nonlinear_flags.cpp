@@ -88,8 +88,16 @@ NonlinearProblemArgs::Problem NonlinearProblemArgs::load() const {
             sys = std::move(idm);
             state = "s";
         }
-        for (int i = 0; i + 1 < n; ++i) r.variables.push_back(state + std::to_string(i));
-        for (int i = 0; i < n; ++i) r.variables.push_back("v" + std::to_string(i));
+        for (int i = 0; i + 1 < n; ++i) {
+            r.variables.push_back(state + std::to_string(i));
+            r.units[r.variables.back()] = "m";
+        }
+        for (int i = 0; i < n; ++i) {
+            r.variables.push_back("v" + std::to_string(i));
+            r.units[r.variables.back()] = "m/s";
+        }
+        if (model == "ov") r.units.insert({{"alpha", "1/s"}, {"tau", "s"}, {"v0", "m/s"}, {"h_st", "m"}, {"headway", "m"}});
+        else r.units.insert({{"a", "m/s^2"}, {"b", "m/s^2"}, {"v0", "m/s"}, {"delta", "1"}, {"th", "s"}, {"eta", "m"}, {"tau", "s"}, {"gap", "m"}});
         r.inputs.string("model", model).integer("ring", n);
         r.system = std::move(sys);
     }

@@ -1,7 +1,8 @@
 #pragma once
-// The flag group of the commands on nonlinear DDEs (equilibria, hopf): the problem (--system FILE
+// The flag group of the commands on nonlinear DDEs (equilibria, hopf, orbits): the problem (--system FILE
 // with expressions, or --model ov|idm --ring N with the model's parameters) and the free
 // parameter (--par NAME --from A --to B).
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@ struct NonlinearProblemArgs {
         double from = 0.0, to = 0.0;
         /// system or model (and ring), then every parameter other than --par with its value
         JsonObject inputs;
+        std::map<std::string, std::string> units;  ///< of variables and parameters, where known (built-in rings)
     };
     /// The problem, with --par checked (BadInput naming the known names) and --from != --to
     /// (BadInput); a built-in ring is set to --par = --from for its guess (the uniform flow).

@@ -80,6 +80,27 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
     return out;
 }
 
+std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables) {
+    std::string out = "kind," + csv_field(b.parameter) + ",period,stable,trivial_distance,max_nontrivial";
+    for (const auto& v : variables) out += "," + csv_field("min_" + v);
+    for (const auto& v : variables) out += "," + csv_field("max_" + v);
+    out += "\n";
+    const std::string empty_extremes(2 * variables.size(), ',');
+    auto finite = [](double v) { return std::isfinite(v) ? format_exact(v) : std::string(); };
+    auto row = [&](const std::string& kind, const PeriodicOrbit& p) {
+        std::string r = kind + "," + format_exact(p.par) + "," + format_exact(p.period) + "," + (p.multipliers.empty() ? "" : p.stable ? "true" : "false") +
+                        "," + finite(p.trivial_distance) + "," + finite(p.max_nontrivial);
+        for (Eigen::Index i = 0; i < p.min.size(); ++i) r += "," + format_exact(p.min[i]);
+        for (Eigen::Index i = 0; i < p.max.size(); ++i) r += "," + format_exact(p.max[i]);
+        return r + "\n";
+    };
+    for (const PeriodicOrbit& p : b.points) out += row("orbit", p);
+    for (const OrbitFold& f : b.folds) out += row("fold", f.orbit);
+    for (const OrbitCrossing& x : b.period_doublings) out += "period_doubling," + format_exact(x.par) + "," + format_exact(x.period) + ",,," + empty_extremes + "\n";
+    for (const OrbitCrossing& x : b.tori) out += "torus," + format_exact(x.par) + "," + format_exact(x.period) + ",,," + empty_extremes + "\n";
+    return out;
+}
+
 std::string roots_csv(const std::vector<Root>& roots) {
     std::string out = "re,im,residual,newton_step\n";
     for (const auto& x : roots)

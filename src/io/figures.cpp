@@ -215,4 +215,111 @@ ChartSpec classification_chart(const ChartSpec& base, const std::vector<Calibrat
     return spec;
 }
 
+std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbits, int variable, const std::string& variable_name,
+                            const std::string& variable_unit, const std::string& parameter_unit, const std::string& title) {
+    const std::string orbit_colour = "#1f77b4", eq_colour = "#000000";
+    std::vector<PlotSeries> series;
+    // consecutive points of one stability form a piece; neighbouring pieces share their end point
+    auto pieces = [&series](const std::vector<double>& x, const std::vector<double>& y, const std::vector<bool>& stable, const std::string& what,
+                            const std::string& colour) {
+        std::size_t start = 0;
+        for (std::size_t i = 1; i <= x.size(); ++i) {
+            if (i < x.size() && stable[i] == stable[start]) continue;
+            PlotSeries s{(stable[start] ? "stable " : "unstable ") + what, {}, {}, colour, !stable[start]};
+            const std::size_t end = std::min(i + 1, x.size());
+            s.x.assign(x.begin() + static_cast<std::ptrdiff_t>(start), x.begin() + static_cast<std::ptrdiff_t>(end));
+            s.y.assign(y.begin() + static_cast<std::ptrdiff_t>(start), y.begin() + static_cast<std::ptrdiff_t>(end));
+            series.push_back(std::move(s));
+            start = i;
+        }
+    };
+    std::vector<double> x, y;
+    std::vector<bool> st;
+    for (const PeriodicOrbit& p : orbits.points) {
+        x.push_back(p.par);
+        y.push_back(p.max[variable] - p.min[variable]);
+        st.push_back(p.stable);
+    }
+    if (!x.empty()) pieces(x, y, st, "periodic orbits", orbit_colour);
+    std::vector<PlotMarker> markers;
+    if (eq) {
+        std::vector<double> ex, ey;
+        std::vector<bool> es;
+        for (const EquilibriumPoint& p : eq->points) {
+            ex.push_back(p.par);
+            ey.push_back(0.0);
+            es.push_back(p.stable);
+        }
+        if (!ex.empty()) pieces(ex, ey, es, "equilibria", eq_colour);
+        for (const HopfPoint& h : eq->hopf) markers.push_back({h.par, 0.0, "#d62728", "Hopf"});
+    }
+    for (const OrbitFold& f : orbits.folds) markers.push_back({f.par, f.orbit.max[variable] - f.orbit.min[variable], "#2ca02c", "fold"});
+    for (const OrbitCrossing& c : orbits.period_doublings) markers.push_back({c.par, 0.0, "#9467bd", "PD"});
+    for (const OrbitCrossing& c : orbits.tori) markers.push_back({c.par, 0.0, "#8c564b", "torus"});
+    // the markers of PD and tori are put on the branch by interpolation between its orbits
+    for (PlotMarker& m : markers) {
+        if (m.label != "PD" && m.label != "torus") continue;
+        for (std::size_t i = 0; i + 1 < x.size(); ++i)
+            if ((x[i] - m.x) * (x[i + 1] - m.x) <= 0.0 && x[i] != x[i + 1]) {
+                m.y = y[i] + (m.x - x[i]) / (x[i + 1] - x[i]) * (y[i + 1] - y[i]);
+                break;
+            }
+    }
+    auto label = [](const std::string& name, const std::string& unit) { return unit.empty() ? name : name + " [" + unit_text(unit) + "]"; };
+    PlotPanel panel{title, label(parameter_symbol(orbits.parameter), parameter_unit), "amplitude max - min of " + label(variable_name, variable_unit),
+                    std::move(series), std::move(markers)};
+    PlotOptions po;
+    po.columns = 1;
+    po.panel_width = 640.0;
+    po.panel_height = 360.0;
+    po.note = "crosses: Hopf points (red), folds of periodic orbits (green); solid: stable, dashed: unstable";
+    // bistability: between consecutive special points (where stability can change) a stable orbit
+    // and a stable equilibrium both exist at the interval's midpoint
+    if (eq && !eq->points.empty() && x.size() > 1) {
+        std::vector<double> cuts;
+        // the extent of the orbits (their folds included) and of the equilibria
+        double olo = *std::min_element(x.begin(), x.end()), ohi = *std::max_element(x.begin(), x.end());
+        for (const OrbitFold& f : orbits.folds) {
+            olo = std::min(olo, f.par);
+            ohi = std::max(ohi, f.par);
+        }
+        for (const EquilibriumPoint& p : eq->points) cuts.push_back(p.par);
+        std::sort(cuts.begin(), cuts.end());
+        cuts = {cuts.front(), cuts.back()};
+        for (const HopfPoint& h : eq->hopf) cuts.push_back(h.par);
+        for (const FoldPoint& f : eq->folds) cuts.push_back(f.par);
+        for (const OrbitFold& f : orbits.folds) cuts.push_back(f.par);
+        for (const OrbitCrossing& c : orbits.period_doublings) cuts.push_back(c.par);
+        for (const OrbitCrossing& c : orbits.tori) cuts.push_back(c.par);
+        std::sort(cuts.begin(), cuts.end());
+        auto stable_at = [](const std::vector<double>& px, const std::vector<bool>& ps, double m) {
+            for (std::size_t i = 0; i + 1 < px.size(); ++i)
+                if ((px[i] - m) * (px[i + 1] - m) <= 0.0 && ps[i] && ps[i + 1]) return true;
+            return false;
+        };
+        std::vector<double> ex;
+        std::vector<bool> es;
+        for (const EquilibriumPoint& p : eq->points) {
+            ex.push_back(p.par);
+            es.push_back(p.stable);
+        }
+        double lo = 0.0, hi = 0.0;
+        bool any = false;
+        for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+            if (!(cuts[i + 1] > cuts[i])) continue;
+            const double m = 0.5 * (cuts[i] + cuts[i + 1]);
+            if (!stable_at(x, st, m) || !stable_at(ex, es, m)) continue;
+            if (!any) lo = cuts[i];
+            hi = cuts[i + 1];
+            any = true;
+        }
+        lo = std::max(lo, olo);
+        hi = std::min(hi, ohi);
+        if (any && hi > lo)
+            po.note = "bistable (stable orbit and stable equilibrium) for " + parameter_symbol(orbits.parameter) + " in [" + rounded(lo, 4) + ", " +
+                      rounded(hi, 4) + "]; crosses: Hopf red, fold green";
+    }
+    return render_line_plots_svg({panel}, po);
+}
+
 }  // namespace ddemap

@@ -461,4 +461,47 @@ std::string mix_json(const std::vector<MixPoint>& points, int cars) {
     return text(json{{"ring", cars}, {"points", arr}});
 }
 
+std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers) {
+    auto vec = [](const Eigen::VectorXd& x) {
+        json a = json::array();
+        for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(num(x[i]));
+        return a;
+    };
+    auto pair = [](cplx z) { return json::array({num(z.real()), num(z.imag())}); };
+    json j;
+    j["parameter"] = b.parameter;
+    j["variables"] = variables;
+    j["degree"] = b.degree;
+    j["intervals"] = b.intervals;
+    json points = json::array();
+    for (const PeriodicOrbit& p : b.points) {
+        json o;
+        o["par"] = num(p.par);
+        o["period"] = num(p.period);
+        o["min"] = vec(p.min);
+        o["max"] = vec(p.max);
+        o["stable"] = p.stable;
+        json m = json::array();
+        for (std::size_t k = 0; k < p.multipliers.size() && static_cast<int>(k) < multipliers; ++k) m.push_back(pair(p.multipliers[k]));
+        o["multipliers"] = m;
+        o["trivial_distance"] = num(p.trivial_distance);
+        o["residual"] = num(p.residual);
+        points.push_back(o);
+    }
+    j["points"] = points;
+    json folds = json::array();
+    for (const OrbitFold& f : b.folds) folds.push_back({{"par", num(f.par)}, {"period", num(f.period)}, {"located", f.located}});
+    j["folds"] = folds;
+    for (const char* key : {"period_doublings", "tori"}) {
+        json a = json::array();
+        for (const OrbitCrossing& x : std::string(key) == "tori" ? b.tori : b.period_doublings)
+            a.push_back({{"par", num(x.par)}, {"period", num(x.period)}, {"multiplier", pair(x.multiplier)}});
+        j[key] = a;
+    }
+    j["stop"] = b.stop;
+    j["method"] = b.method;
+    j["certificate"] = {{"max_residual", num(b.max_residual)}, {"max_trivial_distance", num(b.max_trivial_distance)}};
+    return text(j);
+}
+
 }  // namespace ddemap

@@ -495,9 +495,15 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     if (o.legend) {
         std::size_t i = 0;
         for (const auto& sr : panels.front().series) {
-            entries.emplace_back(sr.name, sr.colour.empty() ? palette[i % 14] : sr.colour);
-            dashed_entries.push_back(sr.dashed);
+            const std::string colour = sr.colour.empty() ? palette[i % 14] : sr.colour;
             ++i;
+            // a series drawn in pieces (same name, colour and dash) has one legend entry
+            bool seen = false;
+            for (std::size_t k = 0; k < entries.size(); ++k)
+                seen = seen || (entries[k].first == sr.name && entries[k].second == colour && dashed_entries[k] == sr.dashed);
+            if (seen) continue;
+            entries.emplace_back(sr.name, colour);
+            dashed_entries.push_back(sr.dashed);
         }
     }
     // one slot per entry, wide enough for the longest name (13 px text: about 7.8 px a character)

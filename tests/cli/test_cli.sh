@@ -911,5 +911,37 @@ wnd="$tmp/winding"; mkdir -p "$wnd"
     ok || bad "sweep with boundaries: per-mode roots"
 rm -rf "$wnd"
 
+# ---- orbits: periodic orbits from a Hopf point (Wright's equation y' = -alpha y(t-1)(1 + y): Hopf at
+# alpha = pi/2 with period 4; the orbits exist for alpha > pi/2 and are stable)
+orb="$tmp/orbits"; mkdir -p "$orb"
+echo '{"variables": ["y"], "parameters": {"alpha": 1}, "equations": ["-alpha*y(t - 1)*(1 + y)"], "equilibrium": [0]}' >"$orb/wright.json"
+if "$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --points 8 --format json --out "$orb/w" --svg "$orb/w.svg" >"$orb/w.out"; then
+    json_has "$orb/w.out" points folds period_doublings tori && ok || bad "orbits json keys"
+    python3 - "$orb/w.out" "$orb/w.csv" <<'PY' && ok || bad "orbits: Wright's branch (period -> 4, stable, alpha > pi/2)"
+import json, sys, math, csv
+d = json.load(open(sys.argv[1]))["result"]
+assert abs(d["hopf"]["par"] - math.pi / 2) < 1e-8 and abs(d["hopf"]["omega"] - math.pi / 2) < 1e-8
+p = d["points"]
+assert len(p) == 8 and all(set(q) >= {"par", "period", "min", "max", "stable", "multipliers"} for q in p)
+assert abs(p[0]["period"] - 4) < 1e-3 and all(q["par"] > math.pi / 2 and q["stable"] for q in p)
+assert all(abs(complex(*q["multipliers"][0]) - 1) < 1e-8 for q in p)  # the trivial multiplier, the largest here
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert [r["kind"] for r in rows].count("orbit") == 8 and float(rows[0]["period"]) == p[0]["period"]  # round trip exact
+PY
+    xmllint --noout "$orb/w.svg" && grep -q 'stable periodic orbits' "$orb/w.svg" && ok || bad "orbits --svg"
+else
+    bad "orbits --system exit status"
+fi
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --points 3 | grep -q "^hopf       alpha = 1.570796327" && ok || bad "orbits table"
+# bad input: nothing on stdout, one line on stderr, exit 2, no file written
+expect_error "parameter 'beta' is not a parameter of this system" orbits --system "$orb/wright.json" --par beta --from 1 --to 2 --out "$orb/bad1"
+expect_error "--hopf = '1': expected an index from 0 to 0 (the branch has 1 Hopf point)" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --hopf 1 --out "$orb/bad2" --svg "$orb/bad2.svg"
+expect_error "no Hopf point on the equilibrium branch in alpha from 0.5 to 1.5" orbits --system "$orb/wright.json" --par alpha --from 0.5 --to 1.5 --out "$orb/bad3"
+expect_error "--variable = 'x': expected one of y" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --variable x
+expect_error "--degree" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --degree 0
+expect_error "--intervals" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --intervals 1
+[ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits bad input wrote files: $(ls "$orb")"
+"$bin" orbits --help >"$orb/h.txt" 2>&1 && ! grep -q ' TEXT' "$orb/h.txt" && ok || bad "orbits --help has an option without its kind"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -9,6 +9,7 @@
 #include "ddemap/analysis/calibrate.hpp"
 #include "ddemap/analysis/classify.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/analysis/periodic_orbit.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
@@ -38,6 +39,10 @@ std::string csv_field(const std::string& s);
 /// kind (point|fold|hopf),PARAMETER,<variables>,abscissa,unstable,stable,omega,status
 /// (abscissa, unstable, stable empty on special rows; omega only on hopf rows).
 std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables);
+
+/// kind,PAR,period,stable,trivial_distance,max_nontrivial,min_VAR..,max_VAR..: one row per orbit
+/// (kind "orbit"), fold ("fold"), period doubling ("period_doubling") and torus ("torus").
+std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables);
 
 /// re,im,residual,newton_step
 std::string roots_csv(const std::vector<Root>& roots);

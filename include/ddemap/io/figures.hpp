@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/analysis/periodic_orbit.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/study/growth.hpp"
@@ -30,5 +32,12 @@ std::string mix_svg(const std::vector<MixPoint>& points, const MixOptions& optio
 /// is fitted to the vehicles and their ellipses; without, the base window (the paper's table).
 ChartSpec classification_chart(const ChartSpec& base, const std::vector<CalibratedVehicle>& vehicles, int cars,
                                const std::string& source = "");
+
+/// The bifurcation diagram of one parameter: the amplitude max - min of variable `variable` of
+/// every orbit against the parameter (stable solid, unstable dashed), the equilibria at
+/// amplitude 0 (stable solid, unstable dashed; `equilibria` may be null), Hopf points and folds
+/// of orbits marked. Labels: "NAME [UNIT]" when a unit is given.
+std::string bifurcation_svg(const EquilibriumBranch* equilibria, const OrbitBranch& orbits, int variable, const std::string& variable_name,
+                            const std::string& variable_unit, const std::string& parameter_unit, const std::string& title);
 
 }  // namespace ddemap

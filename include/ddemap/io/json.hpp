@@ -15,6 +15,7 @@
 #include "ddemap/analysis/classify.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/periodic_orbit.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
@@ -100,5 +101,12 @@ std::string calibration_json(const std::vector<std::string>& names, const std::v
                              const CalibrationOptions& options, const std::vector<CarCalibration>* cars = nullptr);
 /// the penetration-rate study: one object per p
 std::string mix_json(const std::vector<MixPoint>& points, int cars);
+
+/// A branch of periodic orbits: {"parameter", "variables", "degree", "intervals", "points": [{"par",
+/// "period", "min": [..], "max": [..], "stable", "multipliers": [[re, im], ..] (the largest
+/// `multipliers` by modulus, the trivial one included), "trivial_distance", "residual"}],
+/// "folds": [{"par", "period", "located"}], "period_doublings" and "tori": [{"par", "period",
+/// "multiplier": [re, im]}], "stop", "method", "certificate": {"max_residual", "max_trivial_distance"}}.
+std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers = 10);
 
 }  // namespace ddemap

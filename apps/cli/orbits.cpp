@@ -1,0 +1,156 @@
+// orbits: the branch of periodic orbits born at a Hopf point of a nonlinear DDE's equilibrium
+// branch (a system file with expressions, or the built-in ov ring), with Floquet stability,
+// folds of orbits, period doublings and tori; the bifurcation diagram as SVG.
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "format.hpp"
+#include "nonlinear_flags.hpp"
+#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/io/csv.hpp"
+#include "ddemap/io/figures.hpp"
+#include "ddemap/io/json.hpp"
+
+namespace ddemap::cli {
+
+namespace {
+
+struct Args {
+    NonlinearProblemArgs problem;
+    std::string hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
+    bool adapt = false;
+    FormatArg format;
+    OutArg out;
+} args;
+
+std::string pad(std::string s, std::size_t w) {
+    if (s.size() < w) s.resize(w, ' ');
+    else s += ' ';
+    return s;
+}
+
+}  // namespace
+
+void add_orbits_flags(CLI::App& app) {
+    args.problem.add_to(app);  // --system | --model ov|idm ..., --par, --from (the equilibrium branch, whose Hopf points start the orbits), --to
+    app.add_option("--hopf", args.hopf, "the index (from 0, in the order met along the equilibrium branch) of the Hopf point to start from")
+        ->capture_default_str()->type_name("INTEGER");
+    app.add_option("--degree", args.degree, "degree d of the piecewise polynomials (1..20)")->capture_default_str()->type_name("INTEGER");
+    app.add_option("--intervals", args.intervals, "number L of mesh intervals over one period (2..10000)")->capture_default_str()->type_name("INTEGER");
+    app.add_option("--points", args.points, "the most orbits on the branch")->capture_default_str()->type_name("INTEGER");
+    app.add_flag("--adapt", args.adapt,
+                 "move the mesh after every orbit to equidistribute |x^(d+1)|^(1/(d+1)) (more accurate orbits, less accurate multipliers; see README)");
+    app.add_option("--variable", args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
+    app.add_option("--svg", args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
+    args.format.add_to(app);
+    args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json", false);
+}
+
+int run_orbits() {
+    const Format format = args.format.parse();
+    const std::string prefix = args.out.given() ? args.out.prepare("orbits", {".csv", ".json"}) : std::string();
+    const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);
+    PeriodicOrbitOptions o;
+    const std::string& par = args.problem.par;
+    o.parameter = par;
+    const int hopf_index = static_cast<int>(parse_integer("--hopf", args.hopf, 0, 1000000, "an integer >= 0"));
+    o.degree = static_cast<int>(parse_integer("--degree", args.degree, 1, 20, "an integer between 1 and 20"));
+    o.intervals = static_cast<int>(parse_integer("--intervals", args.intervals, 2, 10000, "an integer between 2 and 10000"));
+    o.max_points = static_cast<int>(parse_integer("--points", args.points, 2, 100000, "an integer between 2 and 100000"));
+    o.adapt = args.adapt;
+
+    NonlinearProblemArgs::Problem built = args.problem.load();  // --from != --to checked there
+    o.from = built.from;
+    o.to = built.to;
+    const std::vector<std::string>& variables = built.variables;
+    int variable = 0;
+    if (!args.variable.empty()) {
+        const auto it = std::find(variables.begin(), variables.end(), args.variable);
+        if (it == variables.end()) {
+            std::string known;
+            for (const auto& v : variables) known += (known.empty() ? "" : ", ") + v;
+            throw BadInput("--variable = '" + args.variable + "': expected one of " + known);
+        }
+        variable = static_cast<int>(it - variables.begin());
+    }
+    JsonObject& inputs = built.inputs;
+    inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf_index).integer("degree", o.degree)
+        .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
+
+    EquilibriumBranchOptions eo;
+    eo.parameter = par;
+    eo.from = o.from;
+    eo.to = o.to;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = equilibrium_branch(*built.system, built.guess, eo);
+    if (eq.hopf.empty())
+        throw BadInput("no Hopf point on the equilibrium branch in " + par + " from " + args.problem.from + " to " + args.problem.to +
+                       " (ended: " + to_string(eq.stop) + "): expected at least one to start the periodic orbits from");
+    if (hopf_index >= static_cast<int>(eq.hopf.size()))
+        throw BadInput("--hopf = '" + args.hopf + "': expected an index from 0 to " + std::to_string(eq.hopf.size() - 1) + " (the branch has " +
+                       std::to_string(eq.hopf.size()) + " Hopf point" + (eq.hopf.size() == 1 ? "" : "s") + ")");
+    const HopfPoint& h = eq.hopf[static_cast<std::size_t>(hopf_index)];
+    OrbitBranch b = orbit_branch_from_hopf(*built.system, h, o);
+    if (h.status != Status::Converged && b.status == Status::Converged) {
+        b.status = h.status;
+        b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
+    }
+
+    JsonEnvelope e;
+    e.command = "orbits";
+    e.inputs = inputs.str();
+    e.status = to_string(b.status);
+    e.message = b.message;
+    JsonObject hj;
+    hj.integer("index", hopf_index).number("par", h.par).number("omega", h.omega).string("status", to_string(h.status));
+    std::string result = orbit_branch_json(b, variables);
+    result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    e.result = result;
+    const std::string csv = orbit_branch_csv(b, variables);
+    std::vector<std::pair<std::string, std::string>> files;
+    if (!prefix.empty()) {
+        files.push_back({prefix + ".csv", csv});
+        files.push_back({prefix + ".json", envelope_json(e)});
+    }
+    if (!svg_file.empty()) {
+        const std::string punit = built.units.count(par) ? built.units.at(par) : std::string();
+        const std::string vunit = built.units.count(variables[static_cast<std::size_t>(variable)]) ? built.units.at(variables[static_cast<std::size_t>(variable)]) : std::string();
+        std::ostringstream title;
+        title << "Periodic orbits from the Hopf point at " << par << " = " << rounded(h.par, 6);
+        if (!args.problem.model.empty()) title << ", " << args.problem.model << " ring of " << args.problem.ring << " cars";
+        files.push_back({svg_file, bifurcation_svg(&eq, b, variable, variables[static_cast<std::size_t>(variable)], vunit, punit, title.str())});
+    }
+    if (!files.empty()) write_files_atomic(files);
+    print_output(format, e, csv, [&] {
+        std::ostringstream out;
+        out << "hopf       " << par << " = " << rounded(h.par, 10) << ", omega = " << rounded(h.omega, 10) << ", period 2 pi / omega = "
+            << rounded(6.283185307179586 / h.omega, 8) << " (Hopf point " << hopf_index << " of " << eq.hopf.size() << ")\n";
+        out << "branch     " << b.points.size() << " orbits, degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
+        const std::string& v = variables[static_cast<std::size_t>(variable)];
+        out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
+        for (const PeriodicOrbit& p : b.points)
+            out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[variable] - p.min[variable], 6), 14)
+                << pad(rounded(p.max_nontrivial, 4), 12) << pad(rounded(p.trivial_distance, 2), 12) << (p.stable ? "yes" : "no") << "\n";
+        for (const OrbitFold& f : b.folds)
+            out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
+        for (const OrbitCrossing& x : b.period_doublings)
+            out << "doubling   " << par << " ~ " << rounded(x.par, 6) << ", period " << rounded(x.period, 6) << " (interpolated)\n";
+        for (const OrbitCrossing& x : b.tori)
+            out << "torus      " << par << " ~ " << rounded(x.par, 6) << ", period " << rounded(x.period, 6) << " (interpolated)\n";
+        if (!b.points.empty())
+            out << "accuracy   max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", max residual = " << rounded(b.max_residual, 2) << "\n";
+        if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
+        if (!files.empty()) {
+            out << "wrote     ";
+            for (const auto& f : files) out << " " << f.first;
+            out << "\n";
+        }
+        std::cout << out.str();
+    });
+    return report_undecided(b.status, "orbits", b.message);
+}
+
+}  // namespace ddemap::cli

@@ -1,0 +1,163 @@
+#pragma once
+/// \file periodic_orbit.hpp
+/// Periodic orbits of a nonlinear DDE x'(t) = f(x(t), x(t - tau_1), ..., x(t - tau_m); p)
+/// (problem/nonlinear_dde.hpp) and their branches in one parameter p.
+///
+/// Discretisation (discretize/periodic_mesh.hpp): time scaled by the period T, s = t / T in
+/// [0, 1], x is a continuous piecewise polynomial of degree d on L intervals, given by its
+/// values at the L d mesh points (x(1) = x(0)). The equations are
+///     x'(c) = T f(x(c), x((c - tau_1 / T) mod 1), ..., x((c - tau_m / T) mod 1); p)
+/// at the L d Gauss-Legendre collocation points c (delayed values by the piecewise polynomial's
+/// Lagrange interpolation), and the integral phase condition against a reference orbit x_ref
+/// (the previous orbit of the branch),  int_0^1 x(s) . x_ref'(s) ds = 0  (Gauss quadrature,
+/// exact for these polynomials): L d n + 1 equations in the L d n + 2 unknowns (x, T, p).
+/// Newton's Jacobian is exact: the blocks A_k = D_{u_k} f and df/dp from dual numbers, and
+///     dF/dT = -f - sum_k A_k x'(c_k) tau_k / T,
+///     dF/dp = -T df/dp + sum_k A_k x'(c_k) d tau_k / dp        (c_k = c - tau_k / T);
+/// it is sparse (the delayed terms couple distant intervals) and solved by a sparse LU,
+/// bordered by the phase row and the pseudo-arclength row: Eigen's supernodal SparseLU with
+/// COLAMD ordering (UMFPACK, through Debian's reference BLAS, took 1.2 to 3.7 times as long on
+/// the ov rings of BENCHMARKS.md: its frontal matrices go through dgemm).
+///
+/// Mesh adaptation (options.adapt, off by default): after every orbit the breakpoints are moved so that they
+/// equidistribute |x^(d+1)|^(1/(d+1)) (estimated from the jumps of the piecewise constant d-th
+/// derivative between intervals), as in COLSYS and DDE-BIFTOOL, and the orbit and the tangent
+/// are interpolated onto the new mesh before the next step.
+///
+/// Continuation: pseudo-arclength in the weighted norm
+///     |u|^2 = (1 / (L d)) sum_i |x_i|^2 / sx^2 + (T / sT)^2 + (p / sp)^2
+/// (sx = 1, sT = the first period, sp = |to - from|), tangent predictor, step halved on a
+/// failed corrector and grown by 1.5 after an easy one. From a Hopf point (x*, p_H, omega, q):
+/// the first orbit is corrected from x* + eps Re(q e^{2 pi i s}), T = 2 pi / omega, p = p_H
+/// with the step condition along that direction (the equilibrium is excluded by it).
+///
+/// Floquet multipliers (DDE-BIFTOOL's approach, Engelborghs et al. 2000): the collocation
+/// equations of the variational equation y' = T (A_0(s) y(s) + sum_k A_k(s) y(s - tau_k / T))
+/// on [0, 1], M1 y_new + M0 y_hist = 0, with y_hist the mesh values (the mesh repeated
+/// periodically) on the intervals that meet [-max tau_k / T, 0]; the monodromy matrix maps
+/// y_hist to the values on the same points shifted by one period (rows of -M1^{-1} M0 or of the
+/// identity), and its eigenvalues (dense) are the multipliers (the zero multipliers of the
+/// points that no delay reaches are left out). The trivial multiplier (the one nearest 1, of
+/// the eigenvector x') must be 1: |mu_trivial - 1| is the accuracy check.
+///
+/// Special points along a branch: a fold (the parameter component of the unit tangent changes
+/// sign) is located by Illinois regula falsi in the arclength on that component (each trial
+/// orbit corrected); a period doubling (the number of real multipliers < -1 changes) and a
+/// torus bifurcation (the number of complex multipliers with |mu| > 1 changes) are located by
+/// linear interpolation in p of |mu| - 1 of the multiplier that crosses (between the two orbits).
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/core/status.hpp"
+#include "ddemap/core/types.hpp"
+#include "ddemap/discretize/periodic_mesh.hpp"
+#include "ddemap/problem/nonlinear_dde.hpp"
+
+namespace ddemap {
+
+struct PeriodicOrbitOptions {
+    std::string parameter;   ///< the free parameter (a name of the system)
+    double from = 0.0;       ///< the parameter range [min(from, to), max(from, to)]: the branch
+    double to = 1.0;         ///< ends on its faces (located exactly)
+    int degree = 4;          ///< d, the degree of the piecewise polynomials (1..20)
+    int intervals = 40;      ///< L, the number of mesh intervals (>= 2)
+    int max_points = 100;    ///< orbits on the branch, the first included (>= 2)
+    double initial_step = 0.02;  ///< h in the weighted norm (also the first orbit's amplitude measure)
+    double max_step = 0.1;
+    double min_step = 1e-6;  ///< the branch ends when the step falls below it
+    int max_iterations = 10;      ///< Newton iterations per corrector
+    double tolerance = 1e-10;     ///< Newton stops when max |du| <= tolerance * max(1, max |u|)
+    double residual_tolerance = 1e-8;  ///< an orbit is accepted when max |F| <= this
+    /// the branch ends when the period exceeds this multiple of the first period (a homoclinic orbit)
+    double max_period_factor = 50.0;
+    bool floquet = true;     ///< compute the multipliers (stability, period doublings, tori)
+    /// move the mesh after every orbit so that it equidistributes |x^(d+1)|^(1/(d+1)) of that
+    /// orbit (L and d kept; false: the uniform mesh throughout). Off by default: on Wright's
+    /// equation at alpha = 2.9 (L = 40) it makes the period 3 times more accurate but the trivial
+    /// multiplier 100 times less (6.8e-4 against 5.4e-6), and the history segment of the
+    /// monodromy matrix (so its size) can grow where the mesh is fine near s = 1.
+    bool adapt = false;
+    bool is_valid(std::string* why = nullptr) const;
+};
+
+/// One orbit: mesh values, period, parameter and what is derived from them.
+struct PeriodicOrbit {
+    double par = 0.0;
+    double period = 0.0;
+    Eigen::MatrixXd profile;  ///< L d x n: row i is x at mesh point i (x(1) = row 0)
+    std::vector<double> breakpoints;  ///< the mesh t_0 = 0 < ... < t_L = 1 of the profile
+    Eigen::VectorXd min, max;  ///< of every variable over the orbit (sampled at 8 d points per interval)
+    std::vector<cplx> multipliers;  ///< by decreasing modulus, the trivial one included
+    double trivial_distance = std::numeric_limits<double>::quiet_NaN();  ///< |mu_trivial - 1|
+    double max_nontrivial = std::numeric_limits<double>::quiet_NaN();   ///< max |mu| over the others
+    bool stable = false;      ///< every nontrivial |mu| < 1 (false without multipliers)
+    double residual = std::numeric_limits<double>::infinity();  ///< max |F| (collocation and phase)
+    int iterations = 0;       ///< Newton iterations of its corrector
+};
+
+struct OrbitFold {
+    double par = 0.0, period = 0.0;
+    PeriodicOrbit orbit;
+    bool located = false;  ///< the regula falsi reached its tolerance
+    int after = 0;         ///< index of the branch orbit before it
+};
+
+/// A period doubling or a torus bifurcation between orbits after and after + 1.
+struct OrbitCrossing {
+    double par = 0.0, period = 0.0;  ///< linear interpolation in p of |mu| - 1 (and of T)
+    cplx multiplier;                  ///< the crossing multiplier at the orbit after + 1
+    int after = 0;
+};
+
+struct OrbitBranch {
+    std::string parameter;
+    int degree = 0, intervals = 0;
+    std::vector<PeriodicOrbit> points;
+    std::vector<OrbitFold> folds;
+    std::vector<OrbitCrossing> period_doublings, tori;
+    /// Converged when the branch ended regularly (a face of the range, max_points, a period
+    /// above max_period_factor, an equilibrium) with every orbit and fold located; MaxIterations /
+    /// NumericalIssue when the first orbit failed or the step fell below min_step.
+    Status status = Status::Converged;
+    std::string message;
+    /// why it ended: "bound" (a face of the range), "max_points", "period" (above
+    /// max_period_factor), "hopf" (the amplitude fell below half the first orbit's: an
+    /// equilibrium, usually another Hopf point), "step_below_minimum", "first_orbit_failed"
+    std::string stop;
+    std::string method;   ///< the discretisation and solver used
+    double max_residual = 0.0;          ///< certificate: max over orbits of max |F|
+    double max_trivial_distance = 0.0;  ///< certificate: max over orbits of |mu_trivial - 1|
+    int newton_iterations = 0;
+};
+
+/// A starting orbit (e.g. sampled from a simulation): values on the mesh of `mesh`, period, parameter.
+struct OrbitGuess {
+    double par = 0.0, period = 0.0;
+    Eigen::MatrixXd profile;  ///< points() x n
+};
+
+/// The guess from samples of one period: times t_0 < ... (covering [t_0, t_0 + period]) and
+/// states (one row per time), linearly interpolated at the mesh points t_0 + s period.
+/// std::invalid_argument when the samples do not cover a period or sizes do not fit.
+OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<double>& times, const Eigen::MatrixXd& states,
+                                    double period, double par);
+
+/// The branch from a Hopf point of an equilibrium branch (hopf.x, hopf.par, hopf.omega, hopf.q).
+/// std::invalid_argument for invalid options, an unknown parameter, a system without delay
+/// derivatives, or a Hopf point with omega <= 0 or q of the wrong size; non-convergence is a status.
+OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options);
+
+/// The branch through the orbit corrected from `guess` (the parameter fixed at guess.par for
+/// that correction), followed in the direction of increasing p when to > from, else decreasing.
+OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options);
+
+/// x(s) of an orbit on `mesh` at s (any real: taken mod 1), all n components (for an orbit of a
+/// branch: PeriodicMesh(branch.degree, orbit.breakpoints)).
+Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s);
+
+}  // namespace ddemap

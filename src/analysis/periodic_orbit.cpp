@@ -1,0 +1,781 @@
+#include "ddemap/analysis/periodic_orbit.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+
+namespace ddemap {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+using Triplet = Eigen::Triplet<double>;
+using SpD = Eigen::SparseMatrix<double>;
+
+/// The problem on a mesh: system, parameter index, weights of the continuation norm.
+struct Setup {
+    Setup(const NonlinearDDE& s, const PeriodicMesh& me) : sys(s), mesh(me) {}
+    const NonlinearDDE& sys;
+    const PeriodicMesh& mesh;
+    int n = 0, m = 0, j = 0, d = 0, L = 0, P = 0;  // dimension, delays, parameter, degree, intervals, points
+    std::vector<double> base;                       // parameter values (p_j replaced)
+    Eigen::VectorXd w;                              // weights of the norm (size N + 2)
+    int N() const { return P * n; }
+    std::vector<double> params(double p) const {
+        std::vector<double> v = base;
+        v[static_cast<std::size_t>(j)] = p;
+        return v;
+    }
+    double norm(const Eigen::VectorXd& v) const { return std::sqrt((w.array() * v.array().square()).sum()); }
+};
+
+/// What is evaluated at one collocation point.
+struct PointData {
+    double s = 0.0;
+    int interval = 0;
+    std::vector<double> l, dl;        // basis at s
+    std::vector<double> sk;           // unwrapped delayed positions s - tau_k / T
+    std::vector<int> lk;              // their intervals (of the wrapped position)
+    std::vector<std::vector<double>> lkv, lkd;  // basis at the wrapped positions
+    Eigen::VectorXd x, dx, stacked, f, fp;
+    std::vector<Eigen::VectorXd> dxk;  // x'(s_k)
+    std::vector<Eigen::MatrixXd> A;
+};
+
+Eigen::VectorXd combine(const Setup& c, const Eigen::VectorXd& u, int interval, const std::vector<double>& coef) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(c.n);
+    for (int jj = 0; jj <= c.d; ++jj) {
+        const int pt = (interval * c.d + jj) % c.P;
+        v += coef[static_cast<std::size_t>(jj)] * u.segment(static_cast<Eigen::Index>(pt) * c.n, c.n);
+    }
+    return v;
+}
+
+/// Evaluates the collocation point (interval, g) of the orbit u = (X, T, p); false when f is not
+/// finite there. With `derivatives` the Jacobian blocks and df/dp too.
+bool evaluate_point(const Setup& c, const Eigen::VectorXd& u, const std::vector<double>& tau, int interval, int g, bool derivatives,
+                    PointData& pd) {
+    const double T = u(c.N()), p = u(c.N() + 1);
+    const std::vector<double> pv = c.params(p);
+    pd.interval = interval;
+    pd.s = c.mesh.collocation_point(interval, g);
+    pd.l.assign(static_cast<std::size_t>(c.d) + 1, 0.0);
+    pd.dl.assign(static_cast<std::size_t>(c.d) + 1, 0.0);
+    c.mesh.basis(interval, pd.s, pd.l.data(), pd.dl.data());
+    pd.x = combine(c, u, interval, pd.l);
+    pd.dx = combine(c, u, interval, pd.dl);
+    pd.stacked.resize(static_cast<Eigen::Index>(c.n) * (c.m + 1));
+    pd.stacked.head(c.n) = pd.x;
+    pd.sk.resize(static_cast<std::size_t>(c.m));
+    pd.lk.resize(static_cast<std::size_t>(c.m));
+    pd.lkv.assign(static_cast<std::size_t>(c.m), std::vector<double>(static_cast<std::size_t>(c.d) + 1));
+    pd.lkd.assign(static_cast<std::size_t>(c.m), std::vector<double>(static_cast<std::size_t>(c.d) + 1));
+    pd.dxk.resize(static_cast<std::size_t>(c.m));
+    for (int k = 0; k < c.m; ++k) {
+        const auto uk = static_cast<std::size_t>(k);
+        const double sk = pd.s - tau[uk] / T;
+        double wrapped = sk - std::floor(sk);
+        if (wrapped >= 1.0) wrapped = 0.0;
+        pd.sk[uk] = sk;
+        pd.lk[uk] = c.mesh.interval_of(wrapped);
+        c.mesh.basis(pd.lk[uk], wrapped, pd.lkv[uk].data(), pd.lkd[uk].data());
+        pd.stacked.segment(static_cast<Eigen::Index>(k + 1) * c.n, c.n) = combine(c, u, pd.lk[uk], pd.lkv[uk]);
+        pd.dxk[uk] = combine(c, u, pd.lk[uk], pd.lkd[uk]);
+    }
+    pd.f = c.sys.f(pd.stacked, pv);
+    if (!pd.f.allFinite()) return false;
+    if (derivatives) {
+        pd.A = c.sys.jacobians(pd.stacked, pv);
+        pd.fp = c.sys.parameter_derivative(pd.stacked, c.j, pv);
+        for (const auto& a : pd.A)
+            if (!a.allFinite()) return false;
+        if (!pd.fp.allFinite()) return false;
+    }
+    return true;
+}
+
+void add_block(std::vector<Triplet>& t, int row, int col, const Eigen::MatrixXd& b, double factor) {
+    for (Eigen::Index cc = 0; cc < b.cols(); ++cc)
+        for (Eigen::Index r = 0; r < b.rows(); ++r)
+            if (b(r, cc) != 0.0) t.emplace_back(row + static_cast<int>(r), col + static_cast<int>(cc), factor * b(r, cc));
+}
+
+/// x' of the orbit u at every collocation point (row l d + g), for the phase condition.
+Eigen::MatrixXd derivative_at_collocation(const Setup& c, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd r(c.P, c.n);
+    std::vector<double> l(static_cast<std::size_t>(c.d) + 1), dl(static_cast<std::size_t>(c.d) + 1);
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < c.d; ++g) {
+            c.mesh.basis(i, c.mesh.collocation_point(i, g), l.data(), dl.data());
+            r.row(i * c.d + g) = combine(c, u, i, dl).transpose();
+        }
+    return r;
+}
+
+/// F(u) (N + 1: collocation and phase) and, with J, the bordered Jacobian [dF/du; a^T] and its
+/// last residual a . u - b appended (N + 2 rows).
+bool assemble(const Setup& c, const Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd* a, double b,
+              Eigen::VectorXd& F, SpD* J) {
+    const int N = c.N();
+    const double T = u(N), p = u(N + 1);
+    if (!(T > 0.0) || !std::isfinite(p)) return false;
+    const std::vector<double> pv = c.params(p);
+    std::vector<double> tau, dtau;
+    try {
+        tau = c.sys.delays(pv);
+        dtau = c.sys.delay_derivatives(pv, c.j);
+    } catch (const std::exception&) {
+        return false;
+    }
+    for (double t : tau)
+        if (!(t >= 0.0) || !std::isfinite(t)) return false;
+    F.setZero(N + (a ? 2 : 1));
+    std::vector<Triplet> trip;
+    if (J) trip.reserve(static_cast<std::size_t>(N) * static_cast<std::size_t>((c.d + 1) * (c.m + 1) * 4 + 4));
+    PointData pd;
+    for (int i = 0; i < c.L; ++i) {
+        const double h = c.mesh.width(i);
+        for (int g = 0; g < c.d; ++g) {
+            if (!evaluate_point(c, u, tau, i, g, J != nullptr, pd)) return false;
+            const int row = (i * c.d + g) * c.n;
+            F.segment(row, c.n) = pd.dx - T * pd.f;
+            const double wg = c.mesh.gauss_weights()[static_cast<std::size_t>(g)] * h;
+            const Eigen::VectorXd r = ref.row(i * c.d + g).transpose();
+            F(N) += wg * pd.x.dot(r);
+            if (!J) continue;
+            for (int jj = 0; jj <= c.d; ++jj) {
+                const int col = ((i * c.d + jj) % c.P) * c.n;
+                const double lj = pd.l[static_cast<std::size_t>(jj)], dlj = pd.dl[static_cast<std::size_t>(jj)];
+                for (int q = 0; q < c.n; ++q) trip.emplace_back(row + q, col + q, dlj);
+                add_block(trip, row, col, pd.A[0], -T * lj);
+                for (int q = 0; q < c.n; ++q)
+                    if (r(q) != 0.0) trip.emplace_back(N, col + q, wg * lj * r(q));
+            }
+            Eigen::VectorXd dT = -pd.f, dp = -T * pd.fp;
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                for (int jj = 0; jj <= c.d; ++jj) {
+                    const int col = ((pd.lk[uk] * c.d + jj) % c.P) * c.n;
+                    add_block(trip, row, col, pd.A[uk + 1], -T * pd.lkv[uk][static_cast<std::size_t>(jj)]);
+                }
+                const Eigen::VectorXd ad = pd.A[uk + 1] * pd.dxk[uk];
+                dT -= ad * (tau[uk] / T);
+                dp += ad * dtau[uk];
+            }
+            for (int q = 0; q < c.n; ++q) {
+                trip.emplace_back(row + q, N, dT(q));
+                trip.emplace_back(row + q, N + 1, dp(q));
+            }
+        }
+    }
+    if (a) {
+        F(N + 1) = a->dot(u) - b;
+        if (J)
+            for (int q = 0; q < N + 2; ++q)
+                if ((*a)(q) != 0.0) trip.emplace_back(N + 1, q, (*a)(q));
+    }
+    if (J) {
+        J->resize(N + 2, N + 2);
+        J->setFromTriplets(trip.begin(), trip.end());
+    }
+    return F.allFinite();
+}
+
+struct Correction {
+    bool ok = false;
+    int iterations = 0;
+    double residual = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd tangent;  // [J; a^T]^{-1} e_last at the result (not normalised)
+};
+
+/// Newton on [F(u); a . u - b] = 0 with the phase reference `ref` (x' of the previous orbit).
+Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b,
+                   const PeriodicOrbitOptions& o) {
+    Correction r;
+    Eigen::VectorXd F;
+    SpD J;
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    auto factorize = [&lu](SpD& m) {
+        m.makeCompressed();
+        lu.compute(m);
+        return lu.info() == Eigen::Success;
+    };
+    double last_step = std::numeric_limits<double>::infinity();
+    for (int it = 0; it <= o.max_iterations; ++it) {
+        if (it > 0 && last_step <= o.tolerance * std::max(1.0, u.lpNorm<Eigen::Infinity>())) {
+            // converged: the residual at u, the tangent from the last factorisation (one step
+            // earlier, an O(|du|) difference in a direction that is normalised anyway)
+            if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+            r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
+            r.ok = r.residual <= o.residual_tolerance;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(c.N() + 2);
+            e(c.N() + 1) = 1.0;
+            r.tangent = lu.solve(e);
+            if (!r.tangent.allFinite()) r.ok = false;
+            return r;
+        }
+        if (it == o.max_iterations) break;
+        if (!assemble(c, u, ref, &a, b, F, &J)) return r;
+        if (!factorize(J)) return r;
+        r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
+        const Eigen::VectorXd du = lu.solve(F);
+        if (!du.allFinite()) return r;
+        u -= du;
+        ++r.iterations;
+        last_step = du.lpNorm<Eigen::Infinity>();
+    }
+    return r;
+}
+
+/// Floquet multipliers of the orbit u (see the header), sorted by decreasing modulus.
+bool multipliers(const Setup& c, const Eigen::VectorXd& u, std::vector<cplx>& out) {
+    const int N = c.N(), n = c.n, d = c.d, P = c.P;
+    const double T = u(N);
+    const std::vector<double> pv = c.params(u(N + 1));
+    const std::vector<double> tau = c.sys.delays(pv);
+    double rmax = 0.0;
+    for (double t : tau) rmax = std::max(rmax, t / T);
+    long gmin = 0;
+    if (rmax > 0.0) {
+        const double smin = -rmax;
+        const double fl = std::floor(smin);
+        double w = smin - fl;
+        if (w >= 1.0) w = 0.0;
+        gmin = static_cast<long>(fl) * P + static_cast<long>(c.mesh.interval_of(w)) * d;
+    }
+    const long nh = 1 - gmin;  // history points gmin..0
+    if (nh * n > 4000) return false;  // the dense eigenvalue problem would be too large
+    std::vector<Triplet> t1, t0;
+    auto put = [&](long g, int row, const Eigen::MatrixXd& blk, double factor) {
+        if (g >= 1) add_block(t1, row, static_cast<int>((g - 1) * n), blk, factor);
+        else add_block(t0, row, static_cast<int>((g - gmin) * n), blk, factor);
+    };
+    const Eigen::MatrixXd eye = Eigen::MatrixXd::Identity(n, n);
+    PointData pd;
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < d; ++g) {
+            if (!evaluate_point(c, u, tau, i, g, true, pd)) return false;
+            const int row = (i * d + g) * n;
+            for (int jj = 0; jj <= d; ++jj) {
+                const long gl = i * d + jj;  // 0..P, not wrapped
+                put(gl, row, eye, pd.dl[static_cast<std::size_t>(jj)]);
+                put(gl, row, pd.A[0], -T * pd.l[static_cast<std::size_t>(jj)]);
+            }
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                const long per = static_cast<long>(std::floor(pd.sk[uk]));
+                for (int jj = 0; jj <= d; ++jj) {
+                    const long gl = per * P + static_cast<long>(pd.lk[uk]) * d + jj;
+                    put(gl, row, pd.A[uk + 1], -T * pd.lkv[uk][static_cast<std::size_t>(jj)]);
+                }
+            }
+        }
+    SpD m1(N, N), m0(N, static_cast<int>(nh * n));
+    m1.setFromTriplets(t1.begin(), t1.end());
+    m0.setFromTriplets(t0.begin(), t0.end());
+    // many right-hand sides: the supernodal LU solves them as a block
+    m1.makeCompressed();
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(m1);
+    if (lu.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd y = -lu.solve(Eigen::MatrixXd(m0));
+    if (!y.allFinite()) return false;
+    const auto H = static_cast<Eigen::Index>(nh * n);
+    Eigen::MatrixXd mono = Eigen::MatrixXd::Zero(H, H);
+    for (long h = 0; h < nh; ++h) {
+        const long g = gmin + h + P;
+        if (g <= 0) mono.block(h * n, (g - gmin) * n, n, n) = eye;
+        else mono.block(h * n, 0, n, H) = y.block((g - 1) * n, 0, n, H);
+    }
+    Eigen::EigenSolver<Eigen::MatrixXd> es(mono, false);
+    if (es.info() != Eigen::Success) return false;
+    out.clear();
+    for (Eigen::Index k = 0; k < H; ++k) out.push_back(es.eigenvalues()(k));
+    std::sort(out.begin(), out.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
+    return true;
+}
+
+PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correction& r, bool floquet) {
+    PeriodicOrbit o;
+    o.period = u(c.N());
+    o.par = u(c.N() + 1);
+    o.profile.resize(c.P, c.n);
+    for (int i = 0; i < c.P; ++i) o.profile.row(i) = u.segment(static_cast<Eigen::Index>(i) * c.n, c.n).transpose();
+    o.min = o.profile.colwise().minCoeff().transpose();
+    o.max = o.profile.colwise().maxCoeff().transpose();
+    // the extremes sampled at 8 d points per interval (besides the mesh points): the sampling
+    // error is at most (h T / (8 d))^2 |x''| / 8
+    const int per = 8 * c.d;
+    for (int i = 0; i < c.L; ++i)
+        for (int k = 1; k < per; ++k) {
+            const Eigen::VectorXd x = orbit_value(c.mesh, o.profile, c.mesh.breakpoints()[static_cast<std::size_t>(i)] + c.mesh.width(i) * k / per);
+            o.min = o.min.cwiseMin(x);
+            o.max = o.max.cwiseMax(x);
+        }
+    o.breakpoints = c.mesh.breakpoints();
+    o.residual = r.residual;
+    o.iterations = r.iterations;
+    if (floquet && multipliers(c, u, o.multipliers) && !o.multipliers.empty()) {
+        std::size_t k1 = 0;
+        for (std::size_t k = 1; k < o.multipliers.size(); ++k)
+            if (std::abs(o.multipliers[k] - 1.0) < std::abs(o.multipliers[k1] - 1.0)) k1 = k;
+        o.trivial_distance = std::abs(o.multipliers[k1] - 1.0);
+        o.max_nontrivial = 0.0;
+        for (std::size_t k = 0; k < o.multipliers.size(); ++k)
+            if (k != k1) o.max_nontrivial = std::max(o.max_nontrivial, std::abs(o.multipliers[k]));
+        o.stable = o.max_nontrivial < 1.0;
+    }
+    return o;
+}
+
+/// max over the variables of max - min: 0 for an equilibrium.
+double amplitude(const PeriodicOrbit& o) { return (o.max - o.min).maxCoeff(); }
+
+/// The nontrivial multipliers (the one nearest 1 removed).
+std::vector<cplx> nontrivial(const PeriodicOrbit& o) {
+    std::vector<cplx> v = o.multipliers;
+    if (v.empty()) return v;
+    std::size_t k1 = 0;
+    for (std::size_t k = 1; k < v.size(); ++k)
+        if (std::abs(v[k] - 1.0) < std::abs(v[k1] - 1.0)) k1 = k;
+    v.erase(v.begin() + static_cast<std::ptrdiff_t>(k1));
+    return v;
+}
+
+constexpr double kRealTolerance = 1e-6;  // |Im mu| below this: a real multiplier
+
+int count_pd(const PeriodicOrbit& o) {
+    int c = 0;
+    for (cplx z : nontrivial(o))
+        if (std::abs(z.imag()) <= kRealTolerance && z.real() < -1.0) ++c;
+    return c;
+}
+int count_torus(const PeriodicOrbit& o) {
+    int c = 0;
+    for (cplx z : nontrivial(o))
+        if (std::abs(z.imag()) > kRealTolerance && std::abs(z) > 1.0) ++c;
+    return c;
+}
+
+/// |mu| - 1 of the multiplier of the kind (period doubling: nearest -1; torus: complex, nearest
+/// the unit circle) and that multiplier.
+double crossing_value(const PeriodicOrbit& o, bool pd, cplx& mu) {
+    double best = std::numeric_limits<double>::infinity(), value = 0.0;
+    for (cplx z : nontrivial(o)) {
+        const double dist = pd ? std::abs(z + 1.0) : (std::abs(z.imag()) > kRealTolerance ? std::abs(std::abs(z) - 1.0) : best);
+        if (dist < best) {
+            best = dist;
+            value = std::abs(z) - 1.0;
+            mu = z;
+        }
+    }
+    return value;
+}
+
+Setup make_setup(const NonlinearDDE& system, const PeriodicMesh& mesh, const PeriodicOrbitOptions& o, double period_scale) {
+    std::string why;
+    if (!o.is_valid(&why)) throw std::invalid_argument("periodic orbit options: " + why);
+    if (!system.has_delay_derivatives())
+        throw std::invalid_argument("periodic orbits: the system must give exact delay derivatives (has_delay_derivatives())");
+    Setup c(system, mesh);
+    c.n = system.dimension();
+    c.m = system.delay_count();
+    c.j = system.parameter_index(o.parameter);
+    c.d = mesh.degree();
+    c.L = mesh.intervals();
+    c.P = mesh.points();
+    c.base = system.parameter_values();
+    const int N = c.N();
+    c.w.resize(N + 2);
+    c.w.head(N).setConstant(1.0 / c.P);
+    c.w(N) = 1.0 / (period_scale * period_scale);
+    const double sp = std::abs(o.to - o.from);
+    c.w(N + 1) = 1.0 / (sp * sp);
+    return c;
+}
+
+/// The mesh that equidistributes |x^(d+1)|^(1/(d+1)) of the orbit u (as in COLSYS and DDE-BIFTOOL):
+/// on interval i the d-th derivative D_i of the polynomial is constant (the d-th difference of its
+/// d + 1 equispaced values over (h_i / d)^d); |x^(d+1)| is estimated from the jumps of D_i to
+/// both neighbours. The density is that estimate to the power 1/(d+1) plus 10 % of its mean (so
+/// that no interval grows without bound where x is nearly polynomial).
+std::vector<double> adapted_breakpoints(const Setup& c, const Eigen::VectorXd& u) {
+    const int L = c.L, d = c.d;
+    std::vector<double> binom(static_cast<std::size_t>(d) + 1, 1.0);
+    for (int j = 1; j <= d; ++j) binom[static_cast<std::size_t>(j)] = binom[static_cast<std::size_t>(j - 1)] * (d - j + 1) / j;
+    std::vector<Eigen::VectorXd> D(static_cast<std::size_t>(L));
+    for (int i = 0; i < L; ++i) {
+        Eigen::VectorXd v = Eigen::VectorXd::Zero(c.n);
+        for (int j = 0; j <= d; ++j) {
+            const int pt = (i * d + j) % c.P;
+            v += (((d - j) % 2) ? -1.0 : 1.0) * binom[static_cast<std::size_t>(j)] * u.segment(static_cast<Eigen::Index>(pt) * c.n, c.n);
+        }
+        D[static_cast<std::size_t>(i)] = v / std::pow(c.mesh.width(i) / d, d);
+    }
+    std::vector<double> m(static_cast<std::size_t>(L));
+    double mean = 0.0;
+    for (int i = 0; i < L; ++i) {
+        const int ip = (i + 1) % L, im = (i + L - 1) % L;
+        const auto ui = static_cast<std::size_t>(i);
+        const double wl = (D[ui] - D[static_cast<std::size_t>(im)]).lpNorm<Eigen::Infinity>() / (0.5 * (c.mesh.width(i) + c.mesh.width(im)));
+        const double wr = (D[static_cast<std::size_t>(ip)] - D[ui]).lpNorm<Eigen::Infinity>() / (0.5 * (c.mesh.width(i) + c.mesh.width(ip)));
+        m[ui] = std::pow(0.5 * (wl + wr), 1.0 / (d + 1));
+        mean += m[ui] * c.mesh.width(i);
+    }
+    if (!(mean > 0.0) || !std::isfinite(mean)) return c.mesh.breakpoints();
+    std::vector<double> F(static_cast<std::size_t>(L) + 1, 0.0);
+    for (int i = 0; i < L; ++i) {
+        m[static_cast<std::size_t>(i)] += 0.1 * mean;
+        F[static_cast<std::size_t>(i) + 1] = F[static_cast<std::size_t>(i)] + m[static_cast<std::size_t>(i)] * c.mesh.width(i);
+    }
+    std::vector<double> t(static_cast<std::size_t>(L) + 1);
+    t.front() = 0.0;
+    t.back() = 1.0;
+    int i = 0;
+    for (int k = 1; k < L; ++k) {
+        const double target = F.back() * k / L;
+        while (i + 1 < L && F[static_cast<std::size_t>(i) + 1] <= target) ++i;
+        t[static_cast<std::size_t>(k)] = c.mesh.breakpoints()[static_cast<std::size_t>(i)] + (target - F[static_cast<std::size_t>(i)]) / m[static_cast<std::size_t>(i)];
+    }
+    for (int k = 1; k <= L; ++k)
+        if (!(t[static_cast<std::size_t>(k)] > t[static_cast<std::size_t>(k) - 1])) return c.mesh.breakpoints();
+    return t;
+}
+
+/// The same problem on another mesh of the same degree and number of intervals.
+Setup with_mesh(const Setup& c, const PeriodicMesh& mesh) {
+    Setup s(c.sys, mesh);
+    s.n = c.n;
+    s.m = c.m;
+    s.j = c.j;
+    s.d = c.d;
+    s.L = c.L;
+    s.P = c.P;
+    s.base = c.base;
+    s.w = c.w;
+    return s;
+}
+
+/// u (or a tangent) on the mesh of `from` re-represented on the mesh of `to`: the X part
+/// interpolated at the new points, T and p kept.
+Eigen::VectorXd resample(const Setup& from, const Setup& to, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd profile(from.P, from.n);
+    for (int i = 0; i < from.P; ++i) profile.row(i) = u.segment(static_cast<Eigen::Index>(i) * from.n, from.n).transpose();
+    Eigen::VectorXd v(to.N() + 2);
+    for (int i = 0; i < to.P; ++i) v.segment(static_cast<Eigen::Index>(i) * to.n, to.n) = orbit_value(from.mesh, profile, to.mesh.point(i));
+    v(to.N()) = u(from.N());
+    v(to.N() + 1) = u(from.N() + 1);
+    return v;
+}
+
+/// Follows the branch from the corrected first orbit u with unit tangent t.
+void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const PeriodicOrbitOptions& o,
+            OrbitBranch& b) {
+    // the mesh of the next orbit (adapted to the last one when o.adapt); Setup refers to it
+    std::unique_ptr<PeriodicMesh> mesh;
+    std::unique_ptr<Setup> cp = std::make_unique<Setup>(c0);
+    const int N = c0.N();
+    const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
+    const double T0 = u(N);
+    const Setup* cur = cp.get();
+    auto adapt = [&]() {
+        if (!o.adapt) return;
+        auto next_mesh = std::make_unique<PeriodicMesh>(c0.mesh.degree(), adapted_breakpoints(*cur, u));
+        auto next = std::make_unique<Setup>(with_mesh(*cur, *next_mesh));
+        u = resample(*cur, *next, u);
+        t = resample(*cur, *next, t);
+        t /= next->norm(t);
+        mesh = std::move(next_mesh);
+        cp = std::move(next);
+        cur = cp.get();
+    };
+    b.points.push_back(make_orbit(*cur, u, first, o.floquet));
+    const double amp0 = amplitude(b.points.front());
+    b.newton_iterations += first.iterations;
+    double h = o.initial_step;
+    b.stop = "max_points";
+    adapt();
+    while (static_cast<int>(b.points.size()) < o.max_points) {
+        const Setup& c = *cur;
+        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        Eigen::VectorXd v = u + h * t;
+        const Eigen::VectorXd a = c.w.cwiseProduct(t);
+        Correction r = correct(c, v, ref, a, a.dot(u + h * t), o);
+        b.newton_iterations += r.iterations;
+        const bool jump = r.ok && c.norm(v - u) > 3.0 * h;
+        if (!r.ok || jump) {
+            h *= 0.5;
+            if (h < o.min_step) {
+                b.stop = "step_below_minimum";
+                b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
+                std::ostringstream s;
+                s << "the corrector failed at " << b.parameter << " = " << v(N + 1) << " with the step below " << o.min_step;
+                b.message = s.str();
+                return;
+            }
+            continue;
+        }
+        Eigen::VectorXd tn = r.tangent / c.norm(r.tangent);
+        if (tn.dot(c.w.cwiseProduct(t)) < 0.0) tn = -tn;
+        // the end of the parameter range: the orbit on the face
+        const double p = v(N + 1);
+        if (p < lo || p > hi) {
+            const double bound = p < lo ? lo : hi;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
+            e(N + 1) = 1.0;
+            Eigen::VectorXd w = v;
+            const Correction rb = correct(c, w, ref, e, bound, o);
+            b.newton_iterations += rb.iterations;
+            if (rb.ok) b.points.push_back(make_orbit(c, w, rb, o.floquet));
+            else {
+                b.status = Status::MaxIterations;
+                b.message = "the orbit on the end of the parameter range did not converge";
+            }
+            b.stop = "bound";
+            return;
+        }
+        PeriodicOrbit orbit = make_orbit(c, v, r, o.floquet);
+        const int after = static_cast<int>(b.points.size()) - 1;
+        // fold: the parameter component of the tangent changes sign
+        if (t(N + 1) * tn(N + 1) < 0.0) {
+            OrbitFold f;
+            f.after = after;
+            const Eigen::VectorXd tk = t, uk = u;
+            const Eigen::VectorXd ak = c.w.cwiseProduct(tk);
+            double slo = 0.0, shi = ak.dot(v - uk), glo = tk(N + 1), ghi = tn(N + 1);
+            int side = 0;
+            Eigen::VectorXd best = v;
+            Correction bestc = r;
+            const double sp = std::abs(o.to - o.from);
+            for (int it = 0; it < 40; ++it) {
+                const double s = slo - glo * (shi - slo) / (ghi - glo);
+                Eigen::VectorXd w = uk + s * tk;
+                const Correction rc = correct(c, w, ref, ak, ak.dot(uk + s * tk), o);
+                b.newton_iterations += rc.iterations;
+                if (!rc.ok) break;
+                const double gv = (rc.tangent / c.norm(rc.tangent))(N + 1) * (rc.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
+                best = w;
+                bestc = rc;
+                if (std::abs(gv) <= 1e-11 * sp || std::abs(shi - slo) <= 1e-12 * h) {
+                    f.located = true;
+                    break;
+                }
+                if ((gv < 0.0) == (glo < 0.0)) {
+                    slo = s;
+                    glo = gv;
+                    if (side == -1) ghi *= 0.5;
+                    side = -1;
+                } else {
+                    shi = s;
+                    ghi = gv;
+                    if (side == 1) glo *= 0.5;
+                    side = 1;
+                }
+            }
+            f.orbit = make_orbit(c, best, bestc, o.floquet);
+            f.par = f.orbit.par;
+            f.period = f.orbit.period;
+            if (!f.located && b.status == Status::Converged) {
+                b.status = Status::MaxIterations;
+                b.message = "a fold of periodic orbits was detected but not located";
+            }
+            b.folds.push_back(f);
+        }
+        // period doubling and torus: counts of multipliers outside the unit circle
+        const PeriodicOrbit& prev = b.points.back();
+        if (o.floquet && !prev.multipliers.empty() && !orbit.multipliers.empty()) {
+            for (int kind = 0; kind < 2; ++kind) {
+                const bool pd = kind == 0;
+                const int c0 = pd ? count_pd(prev) : count_torus(prev), c1 = pd ? count_pd(orbit) : count_torus(orbit);
+                if (c0 == c1) continue;
+                cplx m0, m1;
+                const double g0 = crossing_value(prev, pd, m0), g1 = crossing_value(orbit, pd, m1);
+                const double frac = g0 != g1 ? std::clamp(g0 / (g0 - g1), 0.0, 1.0) : 0.5;
+                OrbitCrossing x;
+                x.after = after;
+                x.par = prev.par + frac * (orbit.par - prev.par);
+                x.period = prev.period + frac * (orbit.period - prev.period);
+                x.multiplier = m1;
+                (pd ? b.period_doublings : b.tori).push_back(x);
+            }
+        }
+        const bool collapsed = amplitude(orbit) < 0.5 * amp0;
+        b.points.push_back(std::move(orbit));
+        if (collapsed) {  // the amplitude fell back towards 0: the branch ends at an equilibrium (a Hopf point)
+            b.stop = "hopf";
+            return;
+        }
+        u = v;
+        t = tn;
+        if (r.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
+        if (u(N) > o.max_period_factor * T0) {
+            b.stop = "period";
+            return;
+        }
+        adapt();
+    }
+}
+
+void finish(OrbitBranch& b) {
+    for (const PeriodicOrbit& p : b.points) {
+        b.max_residual = std::max(b.max_residual, p.residual);
+        if (std::isfinite(p.trivial_distance)) b.max_trivial_distance = std::max(b.max_trivial_distance, p.trivial_distance);
+    }
+    if (b.message.empty()) {
+        std::ostringstream s;
+        s << b.points.size() << " orbits, ended: " << b.stop;
+        b.message = s.str();
+    }
+}
+
+std::string method_text(const PeriodicMesh& mesh) {
+    std::ostringstream s;
+    s << "piecewise polynomial collocation, degree " << mesh.degree() << " on " << mesh.intervals()
+      << " intervals at Gauss-Legendre points; Newton with a sparse LU (Eigen SparseLU, COLAMD); pseudo-arclength; Floquet multipliers of the collocated monodromy matrix";
+    return s.str();
+}
+
+}  // namespace
+
+bool PeriodicOrbitOptions::is_valid(std::string* why) const {
+    const char* w = nullptr;
+    if (parameter.empty()) w = "parameter: expected a name";
+    else if (!std::isfinite(from) || !std::isfinite(to) || from == to) w = "from, to: expected two different finite values";
+    else if (degree < 1 || degree > 20) w = "degree: expected an integer between 1 and 20";
+    else if (intervals < 2 || intervals > 100000) w = "intervals: expected an integer between 2 and 100000";
+    else if (max_points < 2) w = "max_points: expected an integer >= 2";
+    else if (!(min_step > 0.0 && initial_step >= min_step && max_step >= initial_step && std::isfinite(max_step)))
+        w = "steps: expected 0 < min_step <= initial_step <= max_step";
+    else if (max_iterations < 1) w = "max_iterations: expected an integer >= 1";
+    else if (!(tolerance > 0.0) || !(residual_tolerance > 0.0)) w = "tolerance, residual_tolerance: expected values > 0";
+    else if (!(max_period_factor > 1.0)) w = "max_period_factor: expected a value > 1";
+    if (w && why) *why = w;
+    return w == nullptr;
+}
+
+Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s) {
+    double w = s - std::floor(s);
+    if (w >= 1.0) w = 0.0;
+    const int l = mesh.interval_of(w), d = mesh.degree();
+    std::vector<double> v(static_cast<std::size_t>(d) + 1), dv(static_cast<std::size_t>(d) + 1);
+    mesh.basis(l, w, v.data(), dv.data());
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(profile.cols());
+    for (int j = 0; j <= d; ++j) x += v[static_cast<std::size_t>(j)] * profile.row((l * d + j) % mesh.points()).transpose();
+    return x;
+}
+
+OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<double>& times, const Eigen::MatrixXd& states,
+                                    double period, double par) {
+    if (times.size() < 2 || static_cast<Eigen::Index>(times.size()) != states.rows())
+        throw std::invalid_argument("orbit guess: expected at least two samples, one state row per time");
+    if (!(period > 0.0) || times.back() - times.front() < period * (1.0 - 1e-12))
+        throw std::invalid_argument("orbit guess: the samples must cover one period");
+    for (std::size_t i = 1; i < times.size(); ++i)
+        if (!(times[i] > times[i - 1])) throw std::invalid_argument("orbit guess: expected increasing times");
+    OrbitGuess g;
+    g.par = par;
+    g.period = period;
+    g.profile.resize(mesh.points(), states.cols());
+    std::size_t k = 0;
+    for (int i = 0; i < mesh.points(); ++i) {
+        const double t = times.front() + mesh.point(i) * period;
+        while (k + 2 < times.size() && times[k + 1] < t) ++k;
+        const double th = std::clamp((t - times[k]) / (times[k + 1] - times[k]), 0.0, 1.0);
+        g.profile.row(i) = (1.0 - th) * states.row(static_cast<Eigen::Index>(k)) + th * states.row(static_cast<Eigen::Index>(k + 1));
+    }
+    return g;
+}
+
+OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options) {
+    if (!(hopf.omega > 0.0) || !std::isfinite(hopf.omega)) throw std::invalid_argument("orbits from a Hopf point: expected omega > 0");
+    if (hopf.q.size() != system.dimension() || hopf.x.size() != system.dimension())
+        throw std::invalid_argument("orbits from a Hopf point: x and q must have the system's dimension");
+    const PeriodicMesh mesh(options.degree, options.intervals);
+    const double T0 = 2.0 * kPi / hopf.omega;
+    const Setup c = make_setup(system, mesh, options, T0);
+    const int N = c.N();
+    OrbitBranch b;
+    b.parameter = options.parameter;
+    b.degree = options.degree;
+    b.intervals = options.intervals;
+    b.method = method_text(mesh);
+    const VectorXc q = hopf.q / hopf.q.norm();
+    Eigen::VectorXd uh(N + 2), t0(N + 2);
+    for (int i = 0; i < c.P; ++i) {
+        const cplx e = std::exp(cplx(0.0, 2.0 * kPi * mesh.point(i)));
+        uh.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = hopf.x;
+        t0.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = (q * e).real();
+    }
+    uh(N) = T0;
+    uh(N + 1) = hopf.par;
+    t0(N) = t0(N + 1) = 0.0;
+    t0 /= c.norm(t0);
+    Eigen::VectorXd u = uh + options.initial_step * t0;
+    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+    const Eigen::VectorXd a = c.w.cwiseProduct(t0);
+    const Correction r = correct(c, u, ref, a, a.dot(u), options);
+    if (!r.ok) {
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = "the first orbit from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
+        b.newton_iterations = r.iterations;
+        return b;
+    }
+    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
+    follow(c, u, t, r, options, b);
+    finish(b);
+    return b;
+}
+
+OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options) {
+    const PeriodicMesh mesh(options.degree, options.intervals);
+    if (guess.profile.rows() != mesh.points() || guess.profile.cols() != system.dimension())
+        throw std::invalid_argument("orbit guess: expected a profile of (degree x intervals) rows and one column per variable");
+    if (!(guess.period > 0.0)) throw std::invalid_argument("orbit guess: expected a period > 0");
+    const Setup c = make_setup(system, mesh, options, guess.period);
+    const int N = c.N();
+    OrbitBranch b;
+    b.parameter = options.parameter;
+    b.degree = options.degree;
+    b.intervals = options.intervals;
+    b.method = method_text(mesh);
+    Eigen::VectorXd u(N + 2);
+    for (int i = 0; i < c.P; ++i) u.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = guess.profile.row(i).transpose();
+    u(N) = guess.period;
+    u(N + 1) = guess.par;
+    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
+    e(N + 1) = 1.0;
+    const Correction r = correct(c, u, ref, e, guess.par, options);
+    if (!r.ok) {
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = "the orbit did not converge from the guess";
+        b.newton_iterations = r.iterations;
+        return b;
+    }
+    {
+        const PeriodicOrbit first = make_orbit(c, u, r, false);
+        if (!(amplitude(first) > 1e-6 * std::max(1.0, first.max.cwiseAbs().maxCoeff()))) {
+            b.status = Status::NumericalIssue;
+            b.stop = "first_orbit_failed";
+            b.message = "the guess converged to an equilibrium, not a periodic orbit";
+            b.newton_iterations = r.iterations;
+            return b;
+        }
+    }
+    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
+    if ((t(N + 1) < 0.0) != (options.to < options.from)) t = -t;
+    follow(c, u, t, r, options, b);
+    finish(b);
+    return b;
+}
+
+}  // namespace ddemap
