@@ -268,6 +268,7 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
     auto label = [](const std::string& name, const std::string& unit) { return unit.empty() ? name : name + " [" + unit_text(unit) + "]"; };
     PlotPanel panel{title, label(parameter_symbol(orbits.parameter), parameter_unit), "amplitude max - min of " + label(variable_name, variable_unit),
                     std::move(series), std::move(markers)};
+    panel.y_floor = 0.0;  // an amplitude max - min is never negative
     PlotOptions po;
     po.columns = 1;
     po.panel_width = 640.0;
