@@ -5,8 +5,7 @@
 #include "common.hpp"
 #include "ddemap/io/system_json.hpp"
 #include "ddemap/problem/expression_system.hpp"
-#include "ddemap/traffic/idm_ring.hpp"
-#include "ddemap/traffic/ov_ring.hpp"
+#include "ddemap/traffic/nonlinear_ring.hpp"
 
 namespace ddemap::cli {
 
@@ -33,15 +32,6 @@ void NonlinearProblemArgs::add_to(CLI::App& app) {
     app.add_option("--to", to, "and is followed (through folds) until the parameter leaves [from, to]")->required();
 }
 
-namespace {
-/// The flag's value, or the model's default when it was not given.
-double value_or(const std::string& flag, const std::string& text, double fallback) { return text.empty() ? fallback : parse_number(flag, text); }
-/// A flag the model needs: BadInput naming it when missing.
-double required(const std::string& flag, const std::string& text, const std::string& model) {
-    if (text.empty()) throw BadInput("--model " + model + " needs " + flag + ": expected a number");
-    return parse_number(flag, text);
-}
-}  // namespace
 
 NonlinearProblemArgs::Problem NonlinearProblemArgs::load() const {
     Problem r;
@@ -67,39 +57,30 @@ NonlinearProblemArgs::Problem NonlinearProblemArgs::load() const {
         if (model != "ov" && model != "idm") throw BadInput("--model = '" + model + "': expected ov or idm (other models: write a --system file)");
         if (ring.empty()) throw BadInput("--model " + model + " needs --ring N: expected the number of cars");
         const int n = static_cast<int>(parse_integer("--ring", ring, 2, 2000, "an integer between 2 and 2000"));
-        std::unique_ptr<NonlinearDDE> sys;
-        std::string state;
         if (model == "ov") {
             refuse_flags({"--alpha", "--tau", "--v0", "--h-st", "--headway"}, "--model ov (alpha, tau, v0, h_st, headway)");
-            auto ov = std::make_unique<OvRing>(n, value_or("--alpha", alpha, 1.0), value_or("--tau", tau, 1.0), value_or("--v0", v0, 1.0),
-                                               value_or("--h-st", h_st, 1.0), value_or("--headway", headway, 2.0));
-            ov->set_parameter(ov->parameter_names()[static_cast<std::size_t>(ov->parameter_index(par))], r.from);
-            r.guess = ov->uniform_flow();
-            sys = std::move(ov);
-            state = "h";
         } else {
             refuse_flags({"--a", "--b", "--v0", "--delta", "--th", "--eta", "--tau", "--gap"}, "--model idm (a, b, v0, delta, th, eta, tau, gap)");
-            auto idm = std::make_unique<IdmRing>(n, value_or("--a", a, 1.0), value_or("--b", b, 1.5), value_or("--v0", v0, 33.3),
-                                                 value_or("--delta", delta, 4.0), required("--th", th, "idm"), value_or("--eta", eta, 2.0),
-                                                 required("--tau", tau, "idm"), value_or("--gap", gap, 20.0));
-            idm->set_parameter(idm->parameter_names()[static_cast<std::size_t>(idm->parameter_index(par))], r.from);
-            // a gap <= eta at --from: uniform_flow() refuses it (std::invalid_argument naming gap and eta)
-            r.guess = idm->uniform_flow();
-            sys = std::move(idm);
-            state = "s";
+            if (th.empty()) throw BadInput("--model idm needs --th: expected a number");
+            if (tau.empty()) throw BadInput("--model idm needs --tau: expected a number");
         }
-        for (int i = 0; i + 1 < n; ++i) {
-            r.variables.push_back(state + std::to_string(i));
-            r.units[r.variables.back()] = "m";
-        }
-        for (int i = 0; i < n; ++i) {
-            r.variables.push_back("v" + std::to_string(i));
-            r.units[r.variables.back()] = "m/s";
-        }
-        if (model == "ov") r.units.insert({{"alpha", "1/s"}, {"tau", "s"}, {"v0", "m/s"}, {"h_st", "m"}, {"headway", "m"}});
-        else r.units.insert({{"a", "m/s^2"}, {"b", "m/s^2"}, {"v0", "m/s"}, {"delta", "1"}, {"th", "s"}, {"eta", "m"}, {"tau", "s"}, {"gap", "m"}});
+        // the flags given, by parameter name (--h-st: h_st); --par starts at --from (the uniform flow
+        // there is the guess; for idm a gap <= eta is refused naming gap and eta)
+        ParameterMap values;
+        for (const auto* f : model_flags)
+            if (f->count() > 0) {
+                std::string name = f->get_name().substr(2);
+                for (char& c : name) c = c == '-' ? '_' : c;
+                values[name] = parse_number(f->get_name(), f->as<std::string>());
+            }
+        const std::vector<std::string> known = nonlinear_ring_parameters(model);
+        if (std::find(known.begin(), known.end(), par) != known.end()) values[par] = r.from;
+        NonlinearRing built = make_nonlinear_ring(model, n, values);
+        r.guess = built.uniform_flow;
+        r.variables = built.variables;
+        r.units = built.units;
+        r.system = std::move(built.system);
         r.inputs.string("model", model).integer("ring", n);
-        r.system = std::move(sys);
     }
     (void)r.system->parameter_index(par);  // an unknown name is bad input naming the known ones
     for (std::size_t i = 0; i < r.system->parameter_names().size(); ++i) {

@@ -897,7 +897,7 @@ assert any(abs(abs(x['im']) - h[0]['omega']) < 1e-8 for x in r['roots'] if abs(x
 PY
 expect_error "--model idm needs --tau" equilibria --model idm --ring 5 --th 1.2 --par gap --from 6 --to 40
 expect_error "--alpha is not a parameter of --model idm" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --alpha 2 --par gap --from 6 --to 40
-expect_error "gap = 1: expected a mean gap > eta = 2 m" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --par gap --from 1 --to 40
+expect_error "gap = 1: expected a finite mean gap > eta" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --par gap --from 1 --to 40
 expect_error "--h-st is not a parameter of --model idm" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --h-st 2 --par gap --from 6 --to 40
 expect_error "--th is not a parameter of --model ov" equilibria --model ov --ring 5 --th 2 --par headway --from 1.2 --to 3
 

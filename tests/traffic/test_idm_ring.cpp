@@ -9,6 +9,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/idm_ring.hpp"
 #include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/nonlinear_ring.hpp"
 #include "ddemap/traffic/ring_system.hpp"
 #include "../tolerances.hpp"
 
@@ -133,4 +134,21 @@ TEST_CASE("idm ring: the Hopf points of the branch in the mean gap are where the
             on_axis = on_axis || (std::abs(r.root.value.real()) < tol::special_point && std::abs(std::abs(r.root.value.imag()) - hp.omega) < tol::special_point);
         CHECK(on_axis);
     }
+}
+
+TEST_CASE("nonlinear rings by name: defaults, required parameters and refusals") {
+    const NonlinearRing r = make_nonlinear_ring("idm", 4, {{"th", 1.2}, {"tau", 0.6}, {"gap", 25.0}});
+    const IdmRing direct(4, 1.0, 1.5, 33.3, 4.0, 1.2, 2.0, 0.6, 25.0);
+    CHECK(r.system->parameter_values() == direct.parameter_values());
+    CHECK((r.uniform_flow - direct.uniform_flow()).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(r.variables.size() == 7);
+    CHECK(r.variables.front() == "s0");
+    CHECK(r.units.at("gap") == "m");
+    const NonlinearRing ov = make_nonlinear_ring("ov", 3, {{"headway", 1.7}});
+    CHECK(ov.variables.front() == "h0");
+    CHECK(ov.system->parameter("headway") == 1.7);
+    CHECK_THROWS_WITH_AS(make_nonlinear_ring("idm", 4, {{"th", 1.2}}), doctest::Contains("the idm ring needs tau"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(make_nonlinear_ring("ov", 4, {{"th", 1.2}}), doctest::Contains("th is not a parameter of the ov ring"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(make_nonlinear_ring("ccc", 4, {}), doctest::Contains("expected ov or idm"), std::invalid_argument);
+    CHECK_THROWS_AS(make_nonlinear_ring("ov", 1, {}), std::invalid_argument);
 }
