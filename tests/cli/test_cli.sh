@@ -961,6 +961,21 @@ assert rw["winding"]["unstable_roots"] == rm["unstable_roots"] and rw["winding"]
 assert abs(rw["winding"]["spectral_abscissa"] - rm["spectral_abscissa"]) < 1e-8, (rw["winding"]["spectral_abscissa"], rm["spectral_abscissa"])
 PY
 done
+# N = 2001 (past the per-mode listing): the roots listed by Newton from the abscissa mode are the per-mode path's
+for p in "0.6 0.9" "0.2 0.2"; do
+    set -- $p
+    "$bin" roots --k1 "$1" --k2 "$2" --th 1.5 --tau 0.1 --ring 2001 --count 4 --format json >"$rwd/w.json" 2>/dev/null
+    "$bin" roots --k1 "$1" --k2 "$2" --th 1.5 --tau 0.1 --ring 2001 --count 4 --ring-method modes --format json >"$rwd/m.json" 2>/dev/null
+    python3 - "$rwd" <<'PY' && ok || bad "roots --ring 2001 k1=$1 k2=$2: Newton-listed roots differ from the per-mode ones"
+import json, sys
+w, m = (json.load(open(sys.argv[1] + f))["result"] for f in ("/w.json", "/m.json"))
+assert w["listed_by"] == "newton" and m["listed_by"] == "modes", (w["listed_by"], m["listed_by"])
+assert len(w["roots"]) == len(m["roots"]) == 4
+for a, b in zip(w["roots"], m["roots"]):
+    assert abs(complex(a["re"], a["im"]) - complex(b["re"], b["im"])) < 1e-10 and a["residual"] < 1e-12, (a, b)
+assert w["ring_verdict"] == m["ring_verdict"] and w["unstable_roots"] == m["unstable_roots"]
+PY
+done
 expect_error "at most 1000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000 --ring-method modes
 expect_error "at most 1000000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000000
 expect_error "--ring-method = 'fast': expected auto, winding or modes" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring-method fast
