@@ -115,7 +115,8 @@ FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string
         f.ring.verdict = Verdict::Undecided;
         f.ring.status = w.status == Status::Converged ? Status::NumericalIssue : w.status;
         f.ring.reason = "the winding pass did not certify the ring (" + w.message + ") and the ring is too long (N > " +
-                        std::to_string(kWindingFallbackCars) + ") for the per-mode path to decide it";
+                        std::to_string(kWindingFallbackCars) + ") for the per-mode path to decide it here (--ring-method modes decides rings of at most " +
+                        std::to_string(kModesMaxCars) + " cars mode by mode, about 0.3 ms per mode)";
         f.ring.unstable_roots = -1;
         return f;
     }

@@ -224,9 +224,13 @@ int run_ring(Format format, const std::string& prefix) {
     if (fast.listed_by == "modes") out << ", M = " << r.degree;
     out << " (" << to_string(r.status) << ")\n";
     out << "trivial    lambda = 0 in mode 0 (ring-length invariance), excluded from the verdict\n";
-    out << "abscissa   " << rounded(r.spectral_abscissa, 10);
-    if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
-    else out << " (mode " << r.abscissa_mode << ")";
+    if (fast.method_used == "winding" && r.verdict == Verdict::Undecided) {
+        out << "abscissa   none (the winding pass is undecided)";
+    } else {
+        out << "abscissa   " << rounded(r.spectral_abscissa, 10);
+        if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
+        else out << " (mode " << r.abscissa_mode << ")";
+    }
     out << "\n";
     out << "verdict    ring " << verdict_word(r.verdict);
     if (r.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";

@@ -91,7 +91,7 @@ int run_string() {
             << (s.lowfreq.attenuates ? "  (attenuates as w -> 0)" : "  (AMPLIFIES as w -> 0)") << "\n";
         if (ring) {
             char label[32];
-            std::snprintf(label, sizeof label, "%-17s", ("ring N=" + ring_name(*cars)).c_str());
+            std::snprintf(label, sizeof label, "%-16s ", ("ring N=" + ring_name(*cars)).c_str());
             out << label << (ring->stable ? std::string("stable") : verdict_word(ring->verdict)) << "   (spectral abscissa "
                 << rounded(ring->spectral_abscissa, 6) << ")\n";
         }

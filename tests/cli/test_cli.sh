@@ -976,6 +976,12 @@ for a, b in zip(w["roots"], m["roots"]):
 assert w["ring_verdict"] == m["ring_verdict"] and w["unstable_roots"] == m["unstable_roots"]
 PY
 done
+# k1 = 0 (every gap free): the low-frequency series cannot decide the trivial branch; past 2,000 cars: UNDECIDED, exit 4
+"$bin" roots --k1 0 --k2 0.5 --th 1.5 --tau 0.1 --ring 100000 >"$rwd/u.txt" 2>"$rwd/u.err"
+[ $? -eq 4 ] && grep -q "verdict    ring UNDECIDED" "$rwd/u.txt" && grep -q "ring-method modes" "$rwd/u.err" && ok || bad "roots --ring 100000 at k1 = 0: not UNDECIDED with exit 4"
+"$bin" roots --k1 0 --k2 0.5 --th 1.5 --tau 0.1 --ring 22 --format json >"$rwd/u.json" 2>/dev/null &&
+    python3 -c "import json; r = json.load(open('$rwd/u.json'))['result']; assert r['ring_verdict'] == 'marginal' and r['winding']['fell_back_to_modes'], r['winding']" &&
+    ok || bad "roots --ring 22 at k1 = 0: the per-mode path does not decide where the winding pass cannot"
 expect_error "at most 1000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000 --ring-method modes
 expect_error "at most 1000000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000000
 expect_error "--ring-method = 'fast': expected auto, winding or modes" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring-method fast
