@@ -164,11 +164,12 @@ void RingArg::add_to(CLI::App& app, const std::string& fallback, const std::stri
     if (!fallback.empty()) option->capture_default_str();
 }
 
-int RingArg::parse(bool allow_inf) const {
+int RingArg::parse(bool allow_inf, int max_cars) const {
     if (allow_inf && (text == "inf" || text == "infinity")) return 0;
-    return static_cast<int>(parse_integer("--ring", text, 2, 1000000,
-                                          allow_inf ? "an integer N >= 2 (at most 1000000) or 'inf'"
-                                                    : "an integer N >= 2 (at most 1000000); this ring is finite"));
+    const std::string most = "(at most " + std::to_string(max_cars) + ")";
+    return static_cast<int>(parse_integer("--ring", text, 2, max_cars,
+                                          allow_inf ? "an integer N >= 2 " + most + " or 'inf'"
+                                                    : "an integer N >= 2 " + most + "; this ring is finite"));
 }
 
 namespace {

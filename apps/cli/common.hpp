@@ -104,8 +104,8 @@ struct RingArg {
     void add_to(CLI::App& app, const std::string& fallback, const std::string& help);
     bool given() const { return option && option->count() > 0; }
     bool empty() const { return text.empty(); }
-    /// N, or 0 for inf (when `allow_inf`).
-    int parse(bool allow_inf = true) const;
+    /// N, or 0 for inf (when `allow_inf`); N at most `max_cars`.
+    int parse(bool allow_inf = true, int max_cars = 1000000) const;
 };
 
 enum class Format { Table, Json, Csv };

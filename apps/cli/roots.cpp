@@ -9,6 +9,7 @@
 #include "common.hpp"
 #include "fleet_flags.hpp"
 #include "limits.hpp"
+#include "ring_fast.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
@@ -24,7 +25,7 @@ namespace {
 struct Args {
     ModelArgs model;
     RingArg ring;
-    std::string count = "6", system, fleet, pattern, cars, length, solver = "auto", degree = "0";
+    std::string count = "6", system, fleet, pattern, cars, length, solver = "auto", degree = "0", ring_method = "auto";
     FormatArg format;
     OutArg out;
 } args;
@@ -192,31 +193,49 @@ int run_fleet(Format format, const std::string& prefix) {
 
 int run_ring(Format format, const std::string& prefix) {
     if (args.solver != "auto" || args.degree != "0" || !args.length.empty() || !args.cars.empty())
-        throw BadInput("--solver, --degree, --length and --cars go with --fleet, --fleet-pattern or --system; a ring of identical cars has one method");
+        throw BadInput("--solver, --degree, --length and --cars go with --fleet, --fleet-pattern or --system; a ring of identical cars "
+                       "takes --ring-method");
     const auto model = args.model.build();
-    const int cars = args.ring.parse();
-    RingOptions opt;
-    opt.roots.count = parse_count();
-    const RingResult r = analyse_ring(model->linearise(), cars, opt);
+    const std::string given = parse_ring_method(args.ring_method);
+    const Linearisation lin = model->linearise();
+    const std::string method = resolve_ring_method(given, lin);
+    const int cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
+    const int count = parse_count();
+    const FastRing fast = analyse_ring_fast(lin, cars, method, count);
+    const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
-    e.inputs = model_inputs(*model).json("ring", json_ring(cars)).integer("count", opt.roots.count).str();
+    e.inputs = model_inputs(*model).json("ring", json_ring(cars)).integer("count", count).string("ring_method", given).str();
+    e.has_solver = true;
+    e.solver_given = given;
+    e.solver_used = fast.method_used;
     e.status = to_string(r.status);
     e.message = r.reason;
-    e.result = ring_roots_json(r);
+    e.result = append_ring_method_json(ring_roots_json(r), fast);
     std::ostringstream out;
     out << "model      " << model->name();
     for (const auto& [k, v] : model->parameters()) out << " " << k << "=" << rounded(v, 6);
     out << "\n";
     out << "ring       N = " << ring_name(cars) << "\n";
-    out << "degree     M = " << r.degree << " (" << to_string(r.status) << ")\n";
+    out << "method     " << fast.method_used;
+    if (fast.winding_ran)
+        out << " (" << fast.winding.tables << " winding passes" << (fast.fell_back ? ", undecided: per-mode path" : "") << ")";
+    out << ", listed roots: " << fast.listed_by;
+    if (fast.listed_by == "modes") out << ", M = " << r.degree;
+    out << " (" << to_string(r.status) << ")\n";
     out << "trivial    lambda = 0 in mode 0 (ring-length invariance), excluded from the verdict\n";
-    out << "abscissa   " << rounded(r.spectral_abscissa, 10);
-    if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
-    else out << " (mode " << r.abscissa_mode << ")";
+    if (fast.method_used == "winding" && r.verdict == Verdict::Undecided) {
+        out << "abscissa   none (the winding pass is undecided)";
+    } else {
+        out << "abscissa   " << rounded(r.spectral_abscissa, 10);
+        if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
+        else out << " (mode " << r.abscissa_mode << ")";
+    }
     out << "\n";
     out << "verdict    ring " << verdict_word(r.verdict);
     if (r.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";
+    else if (cars > 0 && fast.method_used == "winding")
+        out << " (" << fast.winding.unstable_roots << " unstable roots, " << fast.winding.marginal_roots << " marginal)";
     else if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
     out << "\n\n";
     out << "  #   mode        theta                re                 im    residual\n";
@@ -236,7 +255,8 @@ int run_ring(Format format, const std::string& prefix) {
 void add_roots_flags(CLI::App& app) {
     args.model.add_to(app);
     args.ring.add_to(app, "22",
-                     "ring size N >= 2 (time grows linearly: about 0.3 ms per mode, N/2+1 modes), or inf for all wave numbers; "
+                     "ring size N >= 2 (at most 10^9 when the car reacts only to the car ahead: one winding pass, milliseconds; "
+                     "the per-mode path, at most 10^6, takes about 0.3 ms per mode), or inf for all wave numbers; "
                      "with --fleet: the number of cars, the fleet repeated (default: the fleet once)");
     app.add_option("--count", args.count, "how many rightmost roots to list")->capture_default_str();
     app.add_option("--system", args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
@@ -250,6 +270,11 @@ void add_roots_flags(CLI::App& app) {
                    "--fleet: auto (product for cars that react only to the car ahead, else dense up to 8 cars and sparse beyond), "
                    "product, dense or sparse; --system: auto (dense up to 16 states), dense or sparse")
         ->capture_default_str();
+    app.add_option("--ring-method", args.ring_method,
+                   "a ring of identical cars: auto (winding when the car reacts only to the car ahead, else modes), winding "
+                   "(verdict, counts and abscissa from one certified winding pass whatever N) or modes (every mode on its own)")
+        ->capture_default_str()
+        ->type_name("auto|winding|modes");
     app.add_option("--degree", args.degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")
         ->capture_default_str();
     args.format.add_to(app);
@@ -260,6 +285,8 @@ void add_roots_flags(CLI::App& app) {
 int run_roots() {
     const Format format = args.format.parse();
     const std::string prefix = args.out.given() ? args.out.prepare("roots", {".csv", ".json"}) : std::string();
+    if ((!args.fleet.empty() || !args.pattern.empty() || !args.system.empty()) && args.ring_method != "auto")
+        throw BadInput("--ring-method = '" + args.ring_method + "' goes with a ring of identical cars; --fleet and --system take --solver");
     if (!args.fleet.empty() || !args.pattern.empty()) return run_fleet(format, prefix);
     if (!args.system.empty()) return run_system(format, prefix);
     return run_ring(format, prefix);

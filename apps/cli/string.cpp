@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "ring_fast.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/io/csv.hpp"
@@ -18,6 +19,7 @@ namespace {
 struct Args {
     ModelArgs model;
     RingArg ring;
+    std::string ring_method = "auto";
     FormatArg format;
     OutArg out;
 } args;
@@ -25,7 +27,11 @@ struct Args {
 
 void add_string_flags(CLI::App& app) {
     args.model.add_to(app);
-    args.ring.add_to(app, "", "also decide ring stability for N cars (N >= 2 or inf)");
+    args.ring.add_to(app, "", "also decide ring stability for N cars (N >= 2 or inf; at most 10^9 on the winding path, 10^6 on the per-mode path)");
+    app.add_option("--ring-method", args.ring_method,
+                   "with --ring: auto (winding when the car reacts only to the car ahead, else modes), winding or modes")
+        ->capture_default_str()
+        ->type_name("auto|winding|modes");
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv and PREFIX.json", false);
 }
@@ -33,13 +39,23 @@ void add_string_flags(CLI::App& app) {
 int run_string() {
     const auto model = args.model.build();
     const Format format = args.format.parse();
-    std::optional<int> cars;
-    if (!args.ring.empty()) cars = args.ring.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("string", {".csv", ".json"}) : std::string();
     const Linearisation lin = model->linearise();
+    const std::string given = parse_ring_method(args.ring_method);
+    if (args.ring.empty() && given != "auto") throw BadInput("--ring-method = '" + given + "' goes with --ring: expected --ring N|inf too");
+    std::optional<int> cars;
+    std::string method;
+    if (!args.ring.empty()) {
+        method = resolve_ring_method(given, lin);
+        cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
+    }
+    const std::string prefix = args.out.given() ? args.out.prepare("string", {".csv", ".json"}) : std::string();
     const StringResult s = analyse_string(lin);
     std::optional<RingResult> ring;
-    if (cars) ring = analyse_ring(lin, *cars);
+    std::optional<FastRing> fast;
+    if (cars) {
+        fast = analyse_ring_fast(lin, *cars, method, 0);
+        ring = fast->ring;
+    }
     const RingResult* rp = ring ? &*ring : nullptr;
     Status status = s.plant_roots.status;
     if (ring && ring->status != Status::Converged) status = ring->status;
@@ -48,10 +64,16 @@ int run_string() {
     e.command = "string";
     JsonObject in = model_inputs(*model);
     if (cars) in.json("ring", json_ring(*cars));
+    if (cars) in.string("ring_method", given);
     e.inputs = in.str();
+    if (fast) {
+        e.has_solver = true;
+        e.solver_given = given;
+        e.solver_used = fast->method_used;
+    }
     e.status = to_string(status);
     e.message = ring && ring->status != Status::Converged ? ring->reason : s.plant_roots.message;
-    e.result = string_json(s, rp);
+    e.result = fast ? append_ring_method_json(string_json(s, rp), *fast) : string_json(s, rp);
     const std::string csv = string_csv(s, rp);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
     print_output(format, e, csv, [&] {
@@ -69,7 +91,7 @@ int run_string() {
             << (s.lowfreq.attenuates ? "  (attenuates as w -> 0)" : "  (AMPLIFIES as w -> 0)") << "\n";
         if (ring) {
             char label[32];
-            std::snprintf(label, sizeof label, "%-17s", ("ring N=" + ring_name(*cars)).c_str());
+            std::snprintf(label, sizeof label, "%-16s ", ("ring N=" + ring_name(*cars)).c_str());
             out << label << (ring->stable ? std::string("stable") : verdict_word(ring->verdict)) << "   (spectral abscissa "
                 << rounded(ring->spectral_abscissa, 6) << ")\n";
         }

@@ -943,5 +943,81 @@ expect_error "--intervals" orbits --system "$orb/wright.json" --par alpha --from
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits bad input wrote files: $(ls "$orb")"
 "$bin" orbits --help >"$orb/h.txt" 2>&1 && ! grep -q ' TEXT' "$orb/h.txt" && ok || bad "orbits --help has an option without its kind"
 
+# roots/string --ring: verdict, counts and abscissa from the winding pass (cost independent of N)
+rwd="$tmp/ringwind"; mkdir -p "$rwd"
+ms_now() { echo $(( $(date +%s%N) / 1000000 )); }
+for n in 1000000 1000000000; do
+    t0=$(ms_now)
+    "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring "$n" --format json >"$rwd/r$n.json" 2>/dev/null &&
+        [ $(( $(ms_now) - t0 )) -lt 3000 ] && ok || bad "roots --ring $n: not done in 3 s or failed"
+done
+"$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring inf --format json >"$rwd/rinf.json" 2>/dev/null
+python3 - "$rwd" <<'PY' && ok || bad "roots --ring 1e6 / 1e9: winding verdict equals the N = inf verdict, listed roots are roots"
+import json, sys
+d = sys.argv[1]
+inf = json.load(open(d + "/rinf.json"))
+for n in (1000000, 1000000000):
+    e = json.load(open(d + "/r%d.json" % n))
+    assert e["solver"] == {"given": "auto", "used": "winding"}, e["solver"]
+    r = e["result"]
+    assert r["listed_by"] == "newton" and r["winding"]["certified"], r["winding"]
+    assert r["ring_verdict"] == inf["result"]["ring_verdict"] == "unstable", (n, r["ring_verdict"])
+    assert r["winding"]["unstable_roots"] > 0
+    # far from the boundary the long ring's abscissa is near the sup over theta
+    assert abs(r["spectral_abscissa"] - inf["result"]["spectral_abscissa"]) < 1e-6, r["spectral_abscissa"]
+    assert len(r["roots"]) == 6 and r["roots"][0]["re"] == r["spectral_abscissa"], r["roots"][0]
+    for x in r["roots"]:
+        assert x["residual"] < 1e-12 and 0 <= x["mode"] < n, x
+PY
+# a string-stable point: the long ring is stable as N = inf is
+for n in inf 1000000; do "$bin" string --k1 0.6 --k2 0.9 --th 1.5 --tau 0.1 --ring "$n" --format json >"$rwd/s$n.json" 2>/dev/null; done
+python3 - "$rwd" <<'PY' && ok || bad "string --ring 1e6: winding verdict equals the N = inf verdict"
+import json, sys
+a, b = (json.load(open(sys.argv[1] + "/s%s.json" % n)) for n in ("inf", "1000000"))
+assert b["solver"]["used"] == "winding", b["solver"]
+assert a["result"]["ring_verdict"] == b["result"]["ring_verdict"] == "stable", (a["result"]["ring_verdict"], b["result"]["ring_verdict"])
+PY
+# N = 22: the winding pass and the per-mode path agree (verdict, counts, abscissa to 1e-8)
+for p in "0.2 0.2" "0.6 0.9" "0.4 0.3"; do
+    set -- $p
+    "$bin" roots --k1 "$1" --k2 "$2" --th 1.5 --tau 0.1 --ring 22 --ring-method winding --format json >"$rwd/w.json" 2>/dev/null
+    "$bin" roots --k1 "$1" --k2 "$2" --th 1.5 --tau 0.1 --ring 22 --ring-method modes --format json >"$rwd/m.json" 2>/dev/null
+    python3 - "$rwd" <<'PY' && ok || bad "roots --ring 22 k1=$1 k2=$2: winding and per-mode path differ"
+import json, sys
+w, m = (json.load(open(sys.argv[1] + f)) for f in ("/w.json", "/m.json"))
+assert w["solver"] == {"given": "winding", "used": "winding"} and m["solver"] == {"given": "modes", "used": "modes"}, (w["solver"], m["solver"])
+rw, rm = w["result"], m["result"]
+assert rm["winding"] is None and rw["winding"]["certified"]
+assert rw["winding"]["verdict"] == rm["ring_verdict"], (rw["winding"]["verdict"], rm["ring_verdict"])
+assert rw["winding"]["unstable_roots"] == rm["unstable_roots"] and rw["winding"]["marginal_roots"] == rm["marginal_roots"]
+assert abs(rw["winding"]["spectral_abscissa"] - rm["spectral_abscissa"]) < 1e-8, (rw["winding"]["spectral_abscissa"], rm["spectral_abscissa"])
+PY
+done
+# N = 2001 (past the per-mode listing): the roots listed by Newton from the abscissa mode are the per-mode path's
+for p in "0.6 0.9" "0.2 0.2"; do
+    set -- $p
+    "$bin" roots --k1 "$1" --k2 "$2" --th 1.5 --tau 0.1 --ring 2001 --count 4 --format json >"$rwd/w.json" 2>/dev/null
+    "$bin" roots --k1 "$1" --k2 "$2" --th 1.5 --tau 0.1 --ring 2001 --count 4 --ring-method modes --format json >"$rwd/m.json" 2>/dev/null
+    python3 - "$rwd" <<'PY' && ok || bad "roots --ring 2001 k1=$1 k2=$2: Newton-listed roots differ from the per-mode ones"
+import json, sys
+w, m = (json.load(open(sys.argv[1] + f))["result"] for f in ("/w.json", "/m.json"))
+assert w["listed_by"] == "newton" and m["listed_by"] == "modes", (w["listed_by"], m["listed_by"])
+assert len(w["roots"]) == len(m["roots"]) == 4
+for a, b in zip(w["roots"], m["roots"]):
+    assert abs(complex(a["re"], a["im"]) - complex(b["re"], b["im"])) < 1e-10 and a["residual"] < 1e-12, (a, b)
+assert w["ring_verdict"] == m["ring_verdict"] and w["unstable_roots"] == m["unstable_roots"]
+PY
+done
+# k1 = 0 (every gap free): the low-frequency series cannot decide the trivial branch; past 2,000 cars: UNDECIDED, exit 4
+"$bin" roots --k1 0 --k2 0.5 --th 1.5 --tau 0.1 --ring 100000 >"$rwd/u.txt" 2>"$rwd/u.err"
+[ $? -eq 4 ] && grep -q "verdict    ring UNDECIDED" "$rwd/u.txt" && grep -q "ring-method modes" "$rwd/u.err" && ok || bad "roots --ring 100000 at k1 = 0: not UNDECIDED with exit 4"
+"$bin" roots --k1 0 --k2 0.5 --th 1.5 --tau 0.1 --ring 22 --format json >"$rwd/u.json" 2>/dev/null &&
+    python3 -c "import json; r = json.load(open('$rwd/u.json'))['result']; assert r['ring_verdict'] == 'marginal' and r['winding']['fell_back_to_modes'], r['winding']" &&
+    ok || bad "roots --ring 22 at k1 = 0: the per-mode path does not decide where the winding pass cannot"
+expect_error "at most 1000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000 --ring-method modes
+expect_error "at most 1000000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000000
+expect_error "--ring-method = 'fast': expected auto, winding or modes" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring-method fast
+rm -rf "$rwd"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
