@@ -10,6 +10,7 @@
 #include "fleet_flags.hpp"
 #include "limits.hpp"
 #include "ring_fast.hpp"
+#include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"

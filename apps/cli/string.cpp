@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "ring_fast.hpp"
+#include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/io/csv.hpp"

@@ -34,6 +34,7 @@
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
 #include "ddemap/io/files.hpp"
+#include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
@@ -122,15 +123,20 @@ std::vector<CalibratedVehicle> vehicles_spec(const std::string& spec) {
 
 std::string py_roots(const std::string& model_name, const ParameterMap& values, int cars, int count) {
     const auto model = make_model(model_name, values);
-    RingOptions opt;
-    opt.roots.count = count;
-    const RingResult r = released([&] { return analyse_ring(model->linearise(), cars, opt); });
+    const Linearisation lin = model->linearise();
+    // as the command: the verdict from one winding pass where it applies (analysis/ring_fast.hpp)
+    const std::string method = resolve_ring_method("auto", lin);
+    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count); });
+    const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
-    e.inputs = model_inputs(*model).json("ring", json_ring(cars)).integer("count", count).str();
+    e.inputs = model_inputs(*model).json("ring", json_ring(cars)).integer("count", count).string("ring_method", "auto").str();
+    e.has_solver = true;
+    e.solver_given = "auto";
+    e.solver_used = fast.method_used;
     e.status = to_string(r.status);
     e.message = r.reason;
-    e.result = ring_roots_json(r);
+    e.result = append_ring_method_json(ring_roots_json(r), fast);
     return envelope_json(e);
 }
 
@@ -186,9 +192,14 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
     const auto model = make_model(model_name, values);
     const Linearisation lin = model->linearise();
     std::optional<RingResult> ring;
+    std::optional<FastRing> fast;
+    const std::string method = cars ? resolve_ring_method("auto", lin) : std::string();
     const StringResult s = released([&] {
         StringResult r = analyse_string(lin);
-        if (cars) ring = analyse_ring(lin, *cars);
+        if (cars) {
+            fast = analyse_ring_fast(lin, *cars, method, 0);
+            ring = fast->ring;
+        }
         return r;
     });
     Status status = s.plant_roots.status;
@@ -196,11 +207,16 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
     JsonEnvelope e;
     e.command = "string";
     JsonObject in = model_inputs(*model);
-    if (cars) in.json("ring", json_ring(*cars));
+    if (cars) in.json("ring", json_ring(*cars)).string("ring_method", "auto");
     e.inputs = in.str();
+    if (fast) {
+        e.has_solver = true;
+        e.solver_given = "auto";
+        e.solver_used = fast->method_used;
+    }
     e.status = to_string(status);
     e.message = ring && ring->status != Status::Converged ? ring->reason : s.plant_roots.message;
-    e.result = string_json(s, ring ? &*ring : nullptr);
+    e.result = fast ? append_ring_method_json(string_json(s, ring ? &*ring : nullptr), *fast) : string_json(s, nullptr);
     return envelope_json(e);
 }
 

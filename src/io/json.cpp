@@ -504,4 +504,32 @@ std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::strin
     return text(j);
 }
 
+std::string append_ring_method_json(const std::string& object_text, const FastRing& f) {
+    JsonObject o;
+    o.string("ring_method", f.method_used).string("listed_by", f.listed_by);
+    if (f.winding_ran) {
+        const RingWindingResult& w = f.winding;
+        JsonObject wj;
+        wj.string("status", to_string(w.status))
+            .boolean("certified", w.certified)
+            .string("verdict", to_string(w.verdict))
+            .integer("unstable_roots", w.unstable_roots)
+            .integer("marginal_roots", w.marginal_roots)
+            .number("spectral_abscissa", w.spectral_abscissa)
+            .integer("tables", w.tables)
+            .integer("evaluations", w.evaluations)
+            .boolean("fell_back_to_modes", f.fell_back)
+            .string("message", w.message);
+        o.json("winding", wj.str());
+    } else {
+        o.null("winding");
+    }
+    std::string text = object_text;
+    const std::string extra = o.str();
+    while (!text.empty() && text.back() != '}') text.pop_back();
+    if (text.empty()) return extra;
+    text.pop_back();
+    return text + (text.size() > 1 ? "," : "") + extra.substr(1);
+}
+
 }  // namespace ddemap

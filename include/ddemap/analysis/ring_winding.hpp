@@ -55,6 +55,10 @@
 
 namespace ddemap {
 
+/// The largest ring whose undecided winding result falls back to the per-mode path (sweeps,
+/// analyse_ring_fast).
+constexpr int kWindingFallbackCars = 2000;
+
 /// One crossing of the unit circle by Gamma(sigma + i s), s > 0 (its mirror at -s is implied).
 struct WindingCrossing {
     double s = 0.0;        ///< Im lambda of the crossing

@@ -16,6 +16,7 @@
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/mixed_ring.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
@@ -83,6 +84,9 @@ std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vecto
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars);
 /// string stability, with the ring verdict when `ring` is given
 std::string string_json(const StringResult& s, const RingResult* ring);
+/// {"ring_method", "listed_by", "winding": {...} or null} of analyse_ring_fast appended to a JSON
+/// object's text (the result of roots or string for a ring of identical cars).
+std::string append_ring_method_json(const std::string& object_text, const FastRing& f);
 /// one object per vehicle: parameters, the three verdicts, sup_gamma, ...
 std::string classification_json(const std::vector<Classification>& rows, int cars, const std::string& source);
 /// the summary of a sweep (and its boundaries): inputs, method, degree, timings, region counts

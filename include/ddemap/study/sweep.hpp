@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/analysis/ring_winding.hpp"  // kWindingFallbackCars
 #include "ddemap/core/execution.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/solve/roots.hpp"
@@ -42,8 +43,6 @@ struct SweepSpec {
     void validate() const;  ///< builds the model at the four corners
 };
 
-/// The largest ring whose undecided winding points fall back to the per-mode path.
-constexpr int kWindingFallbackCars = 2000;
 
 /// "winding" or "modes": the ring method spec.ring_method resolves to (std::invalid_argument for
 /// an unknown name, or "winding" for a law that uses more than one car ahead).
