@@ -41,7 +41,7 @@ import numpy as _np
 from . import _ddemap
 
 __all__ = ["Result", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
-           "mixed_ring", "equilibria", "version"]
+           "mixed_ring", "equilibria", "hopf", "orbits", "version"]
 
 version = _ddemap.version
 
@@ -419,14 +419,28 @@ def mixed_ring(fleet, ring=None, speed=None, length=None, solver="auto", count=6
                                       None if length is None else _number("length", length), solver, count, degree))
 
 
-def equilibria(par, from_, to, system=None, model=None, ring=None, alpha=1.0, tau=1.0, v0=1.0, h_st=1.0, headway=2.0,
-               count=4, max_points=400):
+def _nonlinear_problem(system, model, ring, parameters):
+    """The problem arguments of equilibria, hopf and orbits, checked as the commands check them."""
+    if (system is None) == (model is None):
+        raise ValueError("expected one of system=FILE or model='ov'|'idm' (with ring=N)")
+    if system is not None:
+        if ring is not None or parameters:
+            raise ValueError("system takes the whole problem from the file: expected no ring or model parameters")
+        return str(system), "", 0, {}
+    if ring is None:
+        raise ValueError("model=" + repr(model) + " needs ring=N: expected the number of cars")
+    return "", str(model), _integer("ring", ring, 2, 2000), _parameters(parameters)
+
+
+def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_points=400, **parameters):
     """A branch of equilibria of a nonlinear DDE in one parameter (``ddemap equilibria``).
 
-    ``system``: a JSON file (variables, parameters, equations, equilibrium guess), or
-    ``model="ov"`` with ``ring`` N: the optimal-velocity ring with reaction delay
-    (``alpha`` [1/s], ``tau`` [s], ``v0`` [m/s], ``h_st`` [m], ``headway`` [m]). The branch in
-    the parameter ``par`` starts at ``from_`` (``--from``) and is followed by pseudo-arclength
+    ``system``: a JSON file (variables, parameters, equations, equilibrium guess), or ``model``
+    with ``ring`` N: ``"ov"``, the optimal-velocity ring with reaction delay (``alpha`` [1/s],
+    ``tau`` [s], ``v0`` [m/s], ``h_st`` [m], ``headway`` [m]), or ``"idm"``, the intelligent
+    driver model ring with sensing delay (``a``, ``b`` [m/s^2], ``v0`` [m/s], ``delta``, ``th``
+    [s], ``eta`` [m], ``tau`` [s], ``gap`` [m]; ``th`` and ``tau`` required). The branch in the
+    parameter ``par`` starts at ``from_`` (``--from``) and is followed by pseudo-arclength
     continuation (through folds) until the parameter leaves [from_, to] or ``max_points``;
     at every point the ``count`` rightmost roots of the linearisation decide stability; folds
     and Hopf points (a pair crossing the imaginary axis) are located by Newton.
@@ -434,18 +448,41 @@ def equilibria(par, from_, to, system=None, model=None, ring=None, alpha=1.0, ta
     Returns ``points`` (columns ``par``, ``x``, ``abscissa``, ``unstable``, ``stable``, ...),
     ``folds``, ``hopf`` (``par``, ``omega`` [rad/s], ...), ``stop``: the command's JSON.
     """
-    if (system is None) == (model is None):
-        raise ValueError("expected one of system=FILE or model='ov' (with ring=N)")
+    sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     count = _integer("count", count, 1, 100)
     max_points = _integer("max_points", max_points, 2, 100000)
-    n = 0
-    if system is None:
-        if ring is None:
-            raise ValueError("model='ov' needs ring=N: expected the number of cars")
-        n = _integer("ring", ring, 2, 2000)
-    elif ring is not None:
-        raise ValueError("system takes the whole problem from the file: expected no ring or ov parameters")
-    return _result(_ddemap.equilibria(str(system) if system is not None else "", model or "", n,
-                                      _number("alpha", alpha), _number("tau", tau), _number("v0", v0),
-                                      _number("h_st", h_st), _number("headway", headway), par,
-                                      _number("from_", from_), _number("to", to), count, max_points))
+    return _result(_ddemap.equilibria(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), count, max_points))
+
+
+def hopf(par, from_, to, system=None, model=None, ring=None, par2=None, from2=None, to2=None, max_points=400, **parameters):
+    """Hopf points on the equilibrium branch with their criticality (``ddemap hopf``).
+
+    The problem as in :func:`equilibria`; ``from_ < to``. Every Hopf point gets the first
+    Lyapunov coefficient ``l1`` (DDE-BIFTOOL's normalisation: ||q|| = 1, p Delta'(i omega) q = 1,
+    L1 = Re c1 / omega), its ``criticality`` (subcritical L1 > 0, supercritical L1 < 0),
+    ``dre_dpar`` (d Re lambda / d par) and ``amplitude_coefficient`` (max - min of each variable
+    of the bifurcating orbit per sqrt|par - par_H|). With ``par2``, ``from2``, ``to2``: the Hopf
+    curves in (par, par2) through those points and the generalised Hopf points (L1 = 0) on them.
+    Returns the command's JSON as Python objects.
+    """
+    sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
+    max_points = _integer("max_points", max_points, 2, 100000)
+    return _result(_ddemap.hopf(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), par2 or "",
+                                None if from2 is None else _number("from2", from2), None if to2 is None else _number("to2", to2),
+                                max_points))
+
+
+def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False, **parameters):
+    """The branch of periodic orbits born at a Hopf point (``ddemap orbits``).
+
+    The problem as in :func:`equilibria`; the equilibrium branch from ``from_`` to ``to`` gives
+    the Hopf points, number ``hopf`` (from 0) starts the orbits: piecewise polynomials of degree
+    ``degree`` on ``intervals`` mesh intervals, the period an unknown, at most ``points`` orbits.
+    Returns ``points`` (``par``, ``period`` [time units of the system], ``min``, ``max`` per
+    variable, ``stable``, ``multipliers``: Floquet multipliers as [re, im]), ``folds``,
+    ``period_doublings``, ``tori``: the command's JSON.
+    """
+    sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
+    return _result(_ddemap.orbits(sys_, model_, n, p, par, _number("from_", from_), _number("to", to),
+                                  _integer("hopf", hopf, 0, 1000000), _integer("degree", degree, 1, 20),
+                                  _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000), bool(adapt)))

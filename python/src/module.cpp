@@ -35,6 +35,11 @@
 #include "ddemap/analysis/system_roots.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/analysis/ring_fast.hpp"
+#include "ddemap/traffic/nonlinear_ring.hpp"
+#include "ddemap/analysis/hopf.hpp"
+#include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/io/hopf_output.hpp"
+#include <map>
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
@@ -45,7 +50,6 @@
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/traffic/fleet.hpp"
 #include "ddemap/traffic/model.hpp"
-#include "ddemap/traffic/ov_ring.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 
 namespace py = pybind11;
@@ -526,48 +530,149 @@ std::string py_mixed_ring(const std::string& spec, bool is_pattern, int cars, st
     return envelope_json(e);
 }
 
-std::string py_equilibria(const std::string& system_file, const std::string& model, int ring, double alpha, double tau, double v0, double h_st,
-                       double headway, const std::string& par, double from, double to, int count, int max_points) {
+/// The problem of the nonlinear commands (equilibria, hopf, orbits), as their flag group builds it:
+/// a system file, or a built-in ring by name (traffic/nonlinear_ring.hpp) with `par` set to `from`.
+struct NonlinearProblem {
+    std::unique_ptr<NonlinearDDE> system;
+    std::vector<std::string> variables;
+    std::map<std::string, std::string> units;
+    Eigen::VectorXd guess;
+    JsonObject inputs;
+};
+
+NonlinearProblem nonlinear_problem(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters,
+                                   const std::string& par, double from, double to) {
+    if (from == to) throw std::invalid_argument("to = " + json_number(to) + ": expected a value other than from");
+    NonlinearProblem r;
+    if (!system_file.empty()) {
+        NonlinearSystemFile file = read_nonlinear_system_json(read_text_file(system_file), system_file);
+        r.variables = file.system->variables();
+        r.guess = file.equilibrium;
+        r.system = std::make_unique<ExpressionSystem>(*file.system);
+        r.inputs.string("system", system_file);
+    } else {
+        ParameterMap values = parameters;
+        const std::vector<std::string> known = nonlinear_ring_parameters(model);
+        if (std::find(known.begin(), known.end(), par) != known.end()) values[par] = from;
+        NonlinearRing built = make_nonlinear_ring(model, ring, values);
+        r.variables = built.variables;
+        r.units = built.units;
+        r.guess = built.uniform_flow;
+        r.system = std::move(built.system);
+        r.inputs.string("model", model).integer("ring", ring);
+    }
+    (void)r.system->parameter_index(par);  // an unknown name is bad input naming the known ones
+    for (std::size_t i = 0; i < r.system->parameter_names().size(); ++i) {
+        const std::string& name = r.system->parameter_names()[i];
+        if (name != par) r.inputs.number(name, r.system->parameter_values()[i]);
+    }
+    return r;
+}
+
+std::string py_equilibria(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters,
+                          const std::string& par, double from, double to, int count, int max_points) {
+    NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
     EquilibriumBranchOptions o;
     o.parameter = par;
     o.from = from;
     o.to = to;
-    if (o.from == o.to) throw std::invalid_argument("to = " + json_number(to) + ": expected a value other than from");
     o.roots.count = count;
     o.continuation.max_points = max_points;
-    std::unique_ptr<NonlinearDDE> system;
-    std::vector<std::string> variables;
-    Eigen::VectorXd guess;
-    JsonObject inputs;
-    if (!system_file.empty()) {
-        NonlinearSystemFile file = read_nonlinear_system_json(read_text_file(system_file), system_file);
-        variables = file.system->variables();
-        guess = file.equilibrium;
-        system = std::make_unique<ExpressionSystem>(*file.system);
-        inputs.string("system", system_file);
-    } else {
-        if (model != "ov") throw std::invalid_argument("model = '" + model + "': expected ov (other models: write a system file)");
-        auto r = std::make_unique<OvRing>(ring, alpha, tau, v0, h_st, headway);
-        r->set_parameter(r->parameter_names()[static_cast<std::size_t>(r->parameter_index(par))], o.from);
-        guess = r->uniform_flow();
-        for (int i = 0; i + 1 < ring; ++i) variables.push_back("h" + std::to_string(i));
-        for (int i = 0; i < ring; ++i) variables.push_back("v" + std::to_string(i));
-        inputs.string("model", "ov").integer("ring", ring);
-        system = std::move(r);
-    }
-    (void)system->parameter_index(par);  // an unknown name is bad input naming the known ones
-    for (std::size_t i = 0; i < system->parameter_names().size(); ++i) {
-        const std::string& name = system->parameter_names()[i];
-        if (name != par) inputs.number(name, system->parameter_values()[i]);
-    }
-    inputs.string("par", par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
-    const EquilibriumBranch b = released([&] { return equilibrium_branch(*system, guess, o); });
+    pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
+    const EquilibriumBranch b = released([&] { return equilibrium_branch(*pb.system, pb.guess, o); });
     JsonEnvelope e;
     e.command = "equilibria";
-    e.inputs = inputs.str();
+    e.inputs = pb.inputs.str();
     e.status = to_string(b.status);
     e.message = b.message;
-    e.result = equilibrium_branch_json(b, variables);
+    e.result = equilibrium_branch_json(b, pb.variables);
+    return envelope_json(e);
+}
+
+std::string py_hopf(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
+                    double from, double to, const std::string& par2, std::optional<double> from2, std::optional<double> to2, int max_points) {
+    NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
+    if (!(from < to)) throw std::invalid_argument("from = " + json_number(from) + ", to = " + json_number(to) + ": expected from < to");
+    const bool two = !par2.empty();
+    if (!two && (from2 || to2)) throw std::invalid_argument("from2/to2 without par2: expected par2=NAME with them");
+    EquilibriumBranchOptions o;
+    o.parameter = par;
+    o.from = from;
+    o.to = to;
+    o.continuation.max_points = max_points;
+    pb.inputs.string("par", par).number("from", o.from).number("to", o.to);
+    HopfCurveOptions co;
+    if (two) {
+        if (!from2 || !to2) throw std::invalid_argument("par2 needs from2 and to2: expected the box of " + par2);
+        if (par2 == par) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
+        const int j2 = pb.system->parameter_index(par2);
+        co.branch = o;
+        co.parameter2 = par2;
+        co.from2 = *from2;
+        co.to2 = *to2;
+        if (!(co.from2 < co.to2)) throw std::invalid_argument("from2 = " + json_number(co.from2) + ", to2 = " + json_number(co.to2) + ": expected from2 < to2");
+        const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
+        if (!(held >= co.from2 && held <= co.to2))
+            throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
+        co.continuation.max_points = max_points;
+        pb.inputs.string("par2", par2).number("from2", co.from2).number("to2", co.to2);
+    }
+    JsonEnvelope e;
+    e.command = "hopf";
+    e.inputs = pb.inputs.str();
+    if (two) {
+        const HopfCurves c = released([&] { return hopf_curves(*pb.system, pb.guess, co); });
+        e.status = to_string(c.status);
+        e.message = c.message;
+        e.result = hopf_curves_json(c, par2, pb.variables);
+    } else {
+        const HopfAnalysis h = released([&] { return hopf_points(*pb.system, pb.guess, o); });
+        e.status = to_string(h.status);
+        e.message = h.message;
+        e.result = hopf_points_json(h, pb.variables);
+    }
+    return envelope_json(e);
+}
+
+std::string py_orbits(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
+                      double from, double to, int hopf, int degree, int intervals, int points, bool adapt) {
+    NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
+    PeriodicOrbitOptions o;
+    o.parameter = par;
+    o.from = from;
+    o.to = to;
+    o.degree = degree;
+    o.intervals = intervals;
+    o.max_points = points;
+    o.adapt = adapt;
+    pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf).integer("degree", o.degree)
+        .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
+    EquilibriumBranchOptions eo;
+    eo.parameter = par;
+    eo.from = o.from;
+    eo.to = o.to;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = released([&] { return equilibrium_branch(*pb.system, pb.guess, eo); });
+    if (eq.hopf.empty())
+        throw std::invalid_argument("no Hopf point on the equilibrium branch in " + par + " from " + json_number(from) + " to " + json_number(to) +
+                                    " (ended: " + to_string(eq.stop) + "): expected at least one to start the periodic orbits from");
+    if (hopf >= static_cast<int>(eq.hopf.size()))
+        throw std::invalid_argument("hopf = " + std::to_string(hopf) + ": expected an index from 0 to " + std::to_string(eq.hopf.size() - 1));
+    const HopfPoint& h = eq.hopf[static_cast<std::size_t>(hopf)];
+    OrbitBranch b = released([&] { return orbit_branch_from_hopf(*pb.system, h, o); });
+    if (h.status != Status::Converged && b.status == Status::Converged) {
+        b.status = h.status;
+        b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
+    }
+    JsonEnvelope e;
+    e.command = "orbits";
+    e.inputs = pb.inputs.str();
+    e.status = to_string(b.status);
+    e.message = b.message;
+    JsonObject hj;
+    hj.integer("index", hopf).number("par", h.par).number("omega", h.omega).string("status", to_string(h.status));
+    const std::string result = orbit_branch_json(b, pb.variables);
+    e.result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
     return envelope_json(e);
 }
 
@@ -601,6 +706,10 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"));
     m.def("mixed_ring", &py_mixed_ring, py::arg("fleet"), py::arg("is_pattern"), py::arg("ring"), py::arg("speed"), py::arg("length"),
           py::arg("solver"), py::arg("count"), py::arg("degree"));
-    m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("alpha"), py::arg("tau"), py::arg("v0"),
-          py::arg("h_st"), py::arg("headway"), py::arg("par"), py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
+    m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
+          py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
+    m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
+          py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("max_points"));
+    m.def("orbits", &py_orbits, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
+          py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"));
 }

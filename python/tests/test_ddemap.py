@@ -222,6 +222,34 @@ def test_equilibria(tmp_path):
     same_envelope(r, cli_json("equilibria", "--model", "ov", "--ring", 3, "--par", "alpha", "--from", 0.5, "--to", 2,
                               "--count", 2, "--max-points", 60))
 
+    # the idm ring by name, as --model idm
+    r = ddemap.equilibria("gap", 6, 40, model="idm", ring=5, th=1.2, tau=0.6)
+    same_envelope(r, cli_json("equilibria", "--model", "idm", "--ring", 5, "--th", 1.2, "--tau", 0.6, "--par", "gap", "--from", 6, "--to", 40))
+
+
+def test_hopf(tmp_path):
+    # Wright's equation: one supercritical Hopf point at alpha = pi/2 (closed forms: tests/cli/test_cli.sh)
+    system = tmp_path / "wright.json"
+    system.write_text(json.dumps({"variables": ["y"], "parameters": {"alpha": 1, "b": 1}, "equations": ["-alpha*y(t - 1)*(1 + b*y)"]}))
+    r = ddemap.hopf("alpha", 1, 2, system=system)
+    same_envelope(r, cli_json("hopf", "--system", system, "--par", "alpha", "--from", 1, "--to", 2))
+    assert r["hopf"]["criticality"] == ["supercritical"] and abs(r["hopf"]["par"][0] - math.pi / 2) < 1e-8
+    r = ddemap.hopf("alpha", 1, 2, system=system, par2="b", from2=0.5, to2=2, max_points=40)
+    same_envelope(r, cli_json("hopf", "--system", system, "--par", "alpha", "--from", 1, "--to", 2, "--par2", "b", "--from2", 0.5,
+                              "--to2", 2, "--max-points", 40))
+    r = ddemap.hopf("gap", 6, 40, model="idm", ring=5, th=1.2, tau=0.6)
+    same_envelope(r, cli_json("hopf", "--model", "idm", "--ring", 5, "--th", 1.2, "--tau", 0.6, "--par", "gap", "--from", 6, "--to", 40))
+    with pytest.raises(ValueError, match="expected from < to"):
+        ddemap.hopf("alpha", 2, 1, system=system)
+
+
+def test_orbits():
+    r = ddemap.orbits("headway", 2, 3.5, model="ov", ring=3, points=12)
+    same_envelope(r, cli_json("orbits", "--model", "ov", "--ring", 3, "--par", "headway", "--from", 2, "--to", 3.5, "--points", 12))
+    assert len(r["points"]["period"]) == 12
+    with pytest.raises(ValueError, match="hopf = 7: expected an index from 0"):
+        ddemap.orbits("headway", 2, 3.5, model="ov", ring=3, hopf=7, points=12)
+
 
 def flags(params):
     out = []
