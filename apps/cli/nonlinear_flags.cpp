@@ -73,20 +73,14 @@ NonlinearProblemArgs::Problem NonlinearProblemArgs::load() const {
                 for (char& c : name) c = c == '-' ? '_' : c;
                 values[name] = parse_number(f->get_name(), f->as<std::string>());
             }
-        const std::vector<std::string> known = nonlinear_ring_parameters(model);
-        if (std::find(known.begin(), known.end(), par) != known.end()) values[par] = r.from;
-        NonlinearRing built = make_nonlinear_ring(model, n, values);
+        NonlinearRing built = make_nonlinear_ring(model, n, values, par, r.from);
         r.guess = built.uniform_flow;
         r.variables = built.variables;
         r.units = built.units;
         r.system = std::move(built.system);
         r.inputs.string("model", model).integer("ring", n);
     }
-    (void)r.system->parameter_index(par);  // an unknown name is bad input naming the known ones
-    for (std::size_t i = 0; i < r.system->parameter_names().size(); ++i) {
-        const std::string& name = r.system->parameter_names()[i];
-        if (name != par) r.inputs.number(name, r.system->parameter_values()[i]);
-    }
+    add_held_parameters(r.inputs, *r.system, par);  // an unknown --par is bad input naming the known ones
     return r;
 }
 

@@ -551,21 +551,14 @@ NonlinearProblem nonlinear_problem(const std::string& system_file, const std::st
         r.system = std::make_unique<ExpressionSystem>(*file.system);
         r.inputs.string("system", system_file);
     } else {
-        ParameterMap values = parameters;
-        const std::vector<std::string> known = nonlinear_ring_parameters(model);
-        if (std::find(known.begin(), known.end(), par) != known.end()) values[par] = from;
-        NonlinearRing built = make_nonlinear_ring(model, ring, values);
+        NonlinearRing built = make_nonlinear_ring(model, ring, parameters, par, from);
         r.variables = built.variables;
         r.units = built.units;
         r.guess = built.uniform_flow;
         r.system = std::move(built.system);
         r.inputs.string("model", model).integer("ring", ring);
     }
-    (void)r.system->parameter_index(par);  // an unknown name is bad input naming the known ones
-    for (std::size_t i = 0; i < r.system->parameter_names().size(); ++i) {
-        const std::string& name = r.system->parameter_names()[i];
-        if (name != par) r.inputs.number(name, r.system->parameter_values()[i]);
-    }
+    add_held_parameters(r.inputs, *r.system, par);  // an unknown par: ValueError naming the known ones
     return r;
 }
 

@@ -532,4 +532,13 @@ std::string append_ring_method_json(const std::string& object_text, const FastRi
     return text + (text.size() > 1 ? "," : "") + extra.substr(1);
 }
 
+JsonObject& add_held_parameters(JsonObject& o, const NonlinearDDE& system, const std::string& free_parameter) {
+    (void)system.parameter_index(free_parameter);  // an unknown name: std::invalid_argument naming the known ones
+    for (std::size_t i = 0; i < system.parameter_names().size(); ++i) {
+        const std::string& name = system.parameter_names()[i];
+        if (name != free_parameter) o.number(name, system.parameter_values()[i]);
+    }
+    return o;
+}
+
 }  // namespace ddemap

@@ -1,5 +1,6 @@
 #include "ddemap/traffic/nonlinear_ring.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "ddemap/traffic/idm_ring.hpp"
@@ -62,6 +63,12 @@ NonlinearRing make_nonlinear_ring(const std::string& model, int cars, const Para
         r.units[r.variables.back()] = "m/s";
     }
     return r;
+}
+
+NonlinearRing make_nonlinear_ring(const std::string& model, int cars, ParameterMap parameters, const std::string& free_parameter, double start) {
+    const std::vector<std::string> names = nonlinear_ring_parameters(model);
+    if (std::find(names.begin(), names.end(), free_parameter) != names.end()) parameters[free_parameter] = start;
+    return make_nonlinear_ring(model, cars, parameters);
 }
 
 }  // namespace ddemap

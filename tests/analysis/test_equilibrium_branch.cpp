@@ -5,6 +5,7 @@
 #include <random>
 #include <string>
 
+#include "../numeric_helpers.hpp"
 #include "../tolerances.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/problem/expression_system.hpp"
@@ -18,19 +19,8 @@ namespace tol = ddemap::test::tol;
 
 namespace {
 
-const double pi = 3.14159265358979323846;
-
-/// The root of a continuous g on [lo, hi] with g(lo) g(hi) < 0, by bisection to rounding.
-template <class G>
-double bisect(G g, double lo, double hi) {
-    double glo = g(lo);
-    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(lo)); ++i) {
-        const double mid = 0.5 * (lo + hi), gm = g(mid);
-        if ((gm < 0) == (glo < 0)) lo = mid, glo = gm;
-        else hi = mid;
-    }
-    return 0.5 * (lo + hi);
-}
+using test::bisect;
+using test::pi;
 
 }  // namespace
 

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "../numeric_helpers.hpp"
 #include "../tolerances.hpp"
 #include "ddemap/analysis/hopf.hpp"
 #include "ddemap/io/hopf_output.hpp"
@@ -18,19 +19,8 @@ namespace tol = ddemap::test::tol;
 
 namespace {
 
-const double pi = 3.14159265358979323846;
-
-/// The root of a continuous g on [lo, hi] with g(lo) g(hi) < 0, by bisection to rounding.
-template <class G>
-double bisect(G g, double lo, double hi) {
-    double glo = g(lo);
-    for (int i = 0; i < 200 && hi - lo > 1e-15 * std::max(1.0, std::abs(lo)); ++i) {
-        const double mid = 0.5 * (lo + hi), gm = g(mid);
-        if ((gm < 0) == (glo < 0)) lo = mid, glo = gm;
-        else hi = mid;
-    }
-    return 0.5 * (lo + hi);
-}
+using test::bisect;
+using test::pi;
 
 /// max - min of y' = -alpha y(t - 1) (1 + y) on its attracting orbit: RK4 with Hermite history
 /// (solve/integrate.hpp, order 4) from y = a0 cos(pi t / 2) on [-1, 0], until t_end; the extrema

@@ -21,6 +21,7 @@
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
+#include "ddemap/problem/nonlinear_dde.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/study/penetration.hpp"
@@ -43,6 +44,11 @@ public:
 private:
     std::vector<std::pair<std::string, std::string>> m_items;  // key, JSON text
 };
+
+/// The parameters of a nonlinear system other than the free one of a branch, by name with their
+/// values, added to `o` (the inputs of equilibria, hopf, orbits). std::invalid_argument naming the
+/// known parameters when `free_parameter` is not one of them.
+JsonObject& add_held_parameters(JsonObject& o, const NonlinearDDE& system, const std::string& free_parameter);
 
 /// A JSON array of JSON texts.
 std::string json_array(const std::vector<std::string>& items);

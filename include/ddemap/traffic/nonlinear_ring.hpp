@@ -35,5 +35,9 @@ std::vector<std::string> nonlinear_ring_parameters(const std::string& model);
 /// value for an unknown model, a parameter the model does not have, a missing required one, or
 /// values without a uniform flow (idm: gap <= eta).
 NonlinearRing make_nonlinear_ring(const std::string& model, int cars, const ParameterMap& parameters);
+/// The same with the free parameter of a branch set to its start value first (when it is a
+/// parameter of the ring; otherwise the name is left to the caller's check), so that the uniform
+/// flow is the equilibrium at the start of the branch.
+NonlinearRing make_nonlinear_ring(const std::string& model, int cars, ParameterMap parameters, const std::string& free_parameter, double start);
 
 }  // namespace ddemap
