@@ -69,10 +69,8 @@ int run_classify() {
     }
     UncertaintyOptions uo;
     uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
-    // calibrate's default search space, replaced per vehicle by the bounds its file carries
-    // (lo_NAME, hi_NAME); eta only >= 0 (no verdict depends on it, and fits often sit on its bound)
-    for (const auto& b : paper_calibration_bounds())
-        if (b.name != "eta") uo.domain.push_back(b);
+    // calibrate's default search space, replaced per vehicle by the bounds its file carries (lo_NAME, hi_NAME)
+    uo.domain = classification_domain();
     uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", args.ring_samples, 0, 1000000, "an integer 0..1000000"));
     uo.seed = static_cast<unsigned long long>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
     const auto rows = classify(vehicles, cars, uo);
@@ -87,15 +85,10 @@ int run_classify() {
         }
     e.inputs = inputs.str();
     e.result = classification_json(rows, cars, source);
-    Status status = Status::Converged;
-    for (const auto& r : rows) {
-        if (r.ring.status != Status::Converged) status = r.ring.status;
-        if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
-        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) {
-            status = r.uncertainty.status;
+    const Status status = classification_status(rows);
+    for (const auto& r : rows)
+        if (r.has_uncertainty && r.uncertainty.status != Status::Converged)
             std::cerr << "ddemap: classify: " << r.vehicle.name << ": probabilities undecided: " << r.uncertainty.message << "\n";
-        }
-    }
     e.status = to_string(status);
     const std::string csv = classification_csv(rows);
     if (figure) {

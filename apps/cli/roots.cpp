@@ -71,15 +71,7 @@ int run_system(Format format, const std::string& prefix) {
         const NonlinearSystemFile file = read_nonlinear_system_json(text, args.system);
         const EquilibriumResult eq = find_equilibrium(*file.system, file.equilibrium);
         eq_status = eq.status;
-        std::vector<std::string> xs;
-        for (Eigen::Index i = 0; i < eq.x.size(); ++i) xs.push_back(json_number(eq.x[i]));
-        equilibrium_json = JsonObject()
-                               .json("x", json_array(xs))
-                               .number("residual", eq.residual)
-                               .integer("iterations", eq.iterations)
-                               .string("status", to_string(eq.status))
-                               .string("message", eq.message)
-                               .str();
+        equilibrium_json = equilibrium_result_json(eq);
         equilibrium_line = "equilibrium";
         for (Eigen::Index i = 0; i < eq.x.size(); ++i)
             equilibrium_line += (i ? ", " : " ") + file.system->variables()[static_cast<std::size_t>(i)] + " = " + rounded(eq.x[i], 10);

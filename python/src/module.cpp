@@ -163,15 +163,7 @@ std::string py_roots_system(const std::string& path, int count, int degree, cons
     } else {
         const NonlinearSystemFile file = read_nonlinear_system_json(text, path);
         const EquilibriumResult eq = released([&] { return find_equilibrium(*file.system, file.equilibrium); });
-        std::vector<std::string> xs;
-        for (Eigen::Index i = 0; i < eq.x.size(); ++i) xs.push_back(json_number(eq.x[i]));
-        equilibrium_json = JsonObject()
-                               .json("x", json_array(xs))
-                               .number("residual", eq.residual)
-                               .integer("iterations", eq.iterations)
-                               .string("status", to_string(eq.status))
-                               .string("message", eq.message)
-                               .str();
+        equilibrium_json = equilibrium_result_json(eq);
         if (!converged(eq.status)) {  // no equilibrium: undecided, the Newton result returned
             e.status = to_string(eq.status);
             e.message = "no equilibrium found from the guess";
@@ -361,8 +353,7 @@ std::string py_classify(const std::string& spec, int cars, int samples, int ring
     }
     UncertaintyOptions uo;
     uo.samples = samples;
-    for (const auto& b : paper_calibration_bounds())  // as the CLI: calibrate's bounds but eta
-        if (b.name != "eta") uo.domain.push_back(b);
+    uo.domain = classification_domain();  // as the CLI
     uo.ring_samples = ring_samples;
     uo.seed = seed;
     ExecutionPolicy policy;
@@ -379,13 +370,7 @@ std::string py_classify(const std::string& spec, int cars, int samples, int ring
         }
     e.inputs = inputs.str();
     e.result = classification_json(rows, cars, source);
-    Status status = Status::Converged;
-    for (const auto& r : rows) {
-        if (r.ring.status != Status::Converged) status = r.ring.status;
-        if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
-        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) status = r.uncertainty.status;
-    }
-    e.status = to_string(status);
+    e.status = to_string(classification_status(rows));
     return envelope_json(e);
 }
 

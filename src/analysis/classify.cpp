@@ -1,5 +1,7 @@
 #include "ddemap/analysis/classify.hpp"
 
+#include "ddemap/analysis/calibrate.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -280,6 +282,23 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
         if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(vehicles.size()));
     }
     return out;
+}
+
+Status classification_status(const std::vector<Classification>& rows) {
+    Status status = Status::Converged;
+    for (const auto& r : rows) {
+        if (r.ring.status != Status::Converged) status = r.ring.status;
+        if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
+        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) status = r.uncertainty.status;
+    }
+    return status;
+}
+
+ParameterBounds classification_domain() {
+    ParameterBounds d;
+    for (const auto& b : paper_calibration_bounds())
+        if (b.name != "eta") d.push_back(b);
+    return d;
 }
 
 }  // namespace ddemap

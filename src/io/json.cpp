@@ -541,4 +541,16 @@ JsonObject& add_held_parameters(JsonObject& o, const NonlinearDDE& system, const
     return o;
 }
 
+std::string equilibrium_result_json(const EquilibriumResult& eq) {
+    std::vector<std::string> xs;
+    for (Eigen::Index i = 0; i < eq.x.size(); ++i) xs.push_back(json_number(eq.x[i]));
+    return JsonObject()
+        .json("x", json_array(xs))
+        .number("residual", eq.residual)
+        .integer("iterations", eq.iterations)
+        .string("status", to_string(eq.status))
+        .string("message", eq.message)
+        .str();
+}
+
 }  // namespace ddemap

@@ -127,4 +127,13 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
 std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars,
                                      const UncertaintyOptions& uncertainty, const ExecutionPolicy& policy = {});
 
+/// The status of a classification as a whole: converged, or the last status of a vehicle's ring,
+/// plant roots or uncertainty that is not (then its verdicts are undecided).
+Status classification_status(const std::vector<Classification>& rows);
+
+/// The sampling domain of classify's uncertainty when the vehicles carry no bounds: calibrate's
+/// search space (paper_calibration_bounds()) without eta (no verdict depends on it, and fits often
+/// sit on its lower bound).
+ParameterBounds classification_domain();
+
 }  // namespace ddemap

@@ -22,6 +22,7 @@
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
 #include "ddemap/problem/nonlinear_dde.hpp"
+#include "ddemap/solve/equilibrium.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/study/penetration.hpp"
@@ -49,6 +50,9 @@ private:
 /// values, added to `o` (the inputs of equilibria, hopf, orbits). std::invalid_argument naming the
 /// known parameters when `free_parameter` is not one of them.
 JsonObject& add_held_parameters(JsonObject& o, const NonlinearDDE& system, const std::string& free_parameter);
+/// {"x", "residual", "iterations", "status", "message"}: Newton's equilibrium of a nonlinear
+/// system file (roots --system on a file with expressions).
+std::string equilibrium_result_json(const EquilibriumResult& eq);
 
 /// A JSON array of JSON texts.
 std::string json_array(const std::vector<std::string>& items);
