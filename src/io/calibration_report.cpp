@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/internal/json_values.hpp"
+
 #include "core/internal/text.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/svg.hpp"
@@ -16,7 +18,7 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+const auto num = detail::json_value;
 
 std::string round3(double v) {
     char buf[64];

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ddemap/io/csv.hpp"
+#include "io/internal/json_values.hpp"
 
 namespace ddemap {
 
@@ -12,22 +13,9 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-json vec(const Eigen::VectorXd& x) {
-    json a = json::array();
-    for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(num(x[i]));
-    return a;
-}
+const auto num = detail::json_value;
+const auto vec = detail::json_values;
 std::string exact(double v) { return std::isfinite(v) ? format_exact(v) : std::string(); }
-std::string field(const std::string& s) {
-    if (s.find_first_of(",\"\n") == std::string::npos) return s;
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"') out += '"';
-        out += c;
-    }
-    return out + "\"";
-}
 
 json point_json(const HopfCoefficients& c) {
     const bool ok = converged(c.status);
@@ -69,8 +57,8 @@ std::string hopf_points_json(const HopfAnalysis& a, const std::vector<std::strin
 
 std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables) {
     std::string out = "par,omega,l1,criticality,dre_dpar,side";
-    for (const auto& v : variables) out += "," + field(v);
-    for (const auto& v : variables) out += "," + field("amp_" + v);
+    for (const auto& v : variables) out += "," + csv_field(v);
+    for (const auto& v : variables) out += "," + csv_field("amp_" + v);
     out += ",residual,status\n";
     for (const HopfCoefficients& c : a.points) {
         const bool ok = converged(c.status);

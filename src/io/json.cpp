@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/internal/json_values.hpp"
+
 #include "ddemap/io/svg.hpp"  // region_class
 
 namespace ddemap {
@@ -12,7 +14,7 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+const auto num = detail::json_value;
 json ring_value(int cars) { return cars == 0 ? json("inf") : json(cars); }
 json params(const ParameterMap& p) {
     json o = json::object();
@@ -136,11 +138,7 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& s) {
 }
 
 std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vector<std::string>& variables) {
-    auto vec = [](const Eigen::VectorXd& x) {
-        json a = json::array();
-        for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(num(x[i]));
-        return a;
-    };
+    const auto vec = detail::json_values;
     json j;
     j["parameter"] = b.parameter;
     j["variables"] = variables;
@@ -462,11 +460,7 @@ std::string mix_json(const std::vector<MixPoint>& points, int cars) {
 }
 
 std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers) {
-    auto vec = [](const Eigen::VectorXd& x) {
-        json a = json::array();
-        for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(num(x[i]));
-        return a;
-    };
+    const auto vec = detail::json_values;
     auto pair = [](cplx z) { return json::array({num(z.real()), num(z.imag())}); };
     json j;
     j["parameter"] = b.parameter;
