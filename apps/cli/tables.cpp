@@ -1,5 +1,6 @@
 #include "tables.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -17,12 +18,19 @@ std::string word(Verdict v) { return v == Verdict::Stable ? std::string("stable"
 std::string classification_table(const std::vector<Classification>& rows, int cars, const std::string& source) {
     std::ostringstream out;
     out << "vehicle settings of " << source << "; ring N = " << ring_name(cars) << "\n\n";
-    out << "name      k1     k2     th     tau    eta     plant     ring      string    sup|Gamma|  w_peak   c2\n";
+    // the name column as wide as the longest name (names from files can be long), so the columns stay aligned
+    int width = 7;
+    for (const auto& row : rows) width = std::max(width, static_cast<int>(row.vehicle.name.size()));
+    char header[256];
+    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s\n", "k1", "k2", "th", "tau", "eta",
+                  "plant", "ring", "string", "sup|Gamma|", "w_peak", "c2");
+    out << "name" << std::string(static_cast<std::size_t>(width) - 4, ' ') << header;
     for (const auto& row : rows) {
         char line[256];
         const auto& p = row.vehicle.parameters;
-        std::snprintf(line, sizeof line, "%-7s %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %9.6f %7.4f %9.2e\n",
-                      row.vehicle.name.c_str(), p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
+        out << row.vehicle.name << std::string(static_cast<std::size_t>(width) - row.vehicle.name.size(), ' ');
+        std::snprintf(line, sizeof line, " %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %10.6f %7.4f %9.2e\n",
+                      p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
                       word(row.string.plant_verdict).c_str(), word(row.ring.verdict).c_str(),
                       word(row.string.string_verdict).c_str(), row.string.sup_gamma, row.string.omega_peak,
                       row.string.lowfreq_margin);
