@@ -1,0 +1,214 @@
+// Rings with connected cruise control (cars that react to the car two ahead) through
+// D = prod P_i det(I - T_{N-1} ... T_0): the determinant against a dense determinant of the 2N
+// system (random cars, random order, random complex lambda), the overflow-free evaluation of
+// long rings against the closed form of a homogeneous ring, argument-principle counts against
+// dense roots, and the rightmost roots and their certificate against the sparse path.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <Eigen/Dense>
+
+#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/traffic/ring_determinant.hpp"
+#include "fleet_helpers.hpp"
+#include "tolerances.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+using ddemap::test::linearised;
+using ddemap::test::random_car;
+
+namespace {
+
+double nearest(const std::vector<Root>& set, cplx z) {
+    double d = 1e300;
+    for (const auto& w : set) d = std::min(d, std::abs(w.value - z));
+    return d;
+}
+
+/// N cars in random order: a fraction `ccc` of connected cruise control cars; `kinds` random
+/// cars of each law are drawn first and the ring repeats them (so types are grouped).
+std::vector<Linearisation> random_ccc_ring(std::mt19937& rng, int n, double ccc, int kinds = 2) {
+    std::vector<Linearisation> c, o;
+    for (int k = 0; k < kinds; ++k) {
+        c.push_back(linearised(random_car(rng, true)));
+        o.push_back(linearised(random_car(rng, false)));
+    }
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::uniform_int_distribution<int> pick(0, kinds - 1);
+    std::vector<Linearisation> out;
+    for (int i = 0; i < n; ++i) out.push_back(u(rng) < ccc ? c[pick(rng)] : o[pick(rng)]);
+    if (std::none_of(out.begin(), out.end(), [](const Linearisation& l) { return l.leaders() == 2; })) out[0] = c[0];
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("transfer ring determinant: prod P_i det(I - prod T_i) is det Delta of the 2N system, and D'/D its trace formula") {
+    std::mt19937 rng(1313);
+    std::uniform_real_distribution<double> re(-1.5, 1.0), im(-3.0, 3.0);
+    int reordered_differs = 0, checked = 0;
+    for (int n : {2, 3, 4, 7, 12}) {
+        for (double share : {0.5, 1.0}) {
+            std::vector<Linearisation> cars = random_ccc_ring(rng, n, share, 3);
+            std::vector<Linearisation> shuffled = cars;
+            std::shuffle(shuffled.begin(), shuffled.end(), rng);
+            const TransferRingDeterminant det(cars), det2(shuffled);
+            const LinearDDE dde = mixed_ring_dde(cars), dde2 = mixed_ring_dde(shuffled);
+            for (int k = 0; k < 20; ++k) {
+                const cplx z(re(rng), im(rng));
+                CAPTURE(n);
+                CAPTURE(share);
+                CAPTURE(z);
+                const Eigen::MatrixXcd d = Eigen::MatrixXcd(dde.characteristic_matrix(z));
+                Eigen::PartialPivLU<Eigen::MatrixXcd> lu(d);
+                const cplx dense_det = lu.determinant();
+                CHECK(std::abs(std::exp(det.log_value(z)) / dense_det - 1.0) < 1e-11);
+                const cplx trace = lu.solve(Eigen::MatrixXcd(dde.characteristic_derivative(z))).trace();
+                CHECK(std::abs(det.log_derivative(z) - trace) < 1e-10 * std::max(1.0, std::abs(trace)));
+                // the other order: its own dense determinant, and (for N >= 4) a different value
+                const cplx dense2 = Eigen::MatrixXcd(dde2.characteristic_matrix(z)).determinant();
+                CHECK(std::abs(std::exp(det2.log_value(z)) / dense2 - 1.0) < 1e-11);
+                if (std::abs(dense2 / dense_det - 1.0) > 1e-6) ++reordered_differs;
+                ++checked;
+            }
+        }
+    }
+    CHECK(checked == 200);
+    CHECK(reordered_differs >= 60);
+    // lambda = 0 is a root of every ring: M(0) has the eigenvalue 1
+    const TransferRingDeterminant det(random_ccc_ring(rng, 9, 0.5));
+    CHECK(std::exp(det.log_value(cplx(0.0, 0.0))) == 0.0);
+}
+
+TEST_CASE("transfer ring determinant: long rings without overflow, against the closed form of a homogeneous ring") {
+    // N identical cars: det(I - T^N) = (1 - mu_1^N)(1 - mu_2^N) with mu the eigenvalues of T
+    std::mt19937 rng(77);
+    const Linearisation car = linearised(random_car(rng, true));
+    std::uniform_real_distribution<double> re(-1.0, 0.5), im(-2.0, 2.0);
+    int huge = 0;
+    for (int n : {5, 1000, 100000}) {
+        const TransferRingDeterminant det(std::vector<Linearisation>(static_cast<std::size_t>(n), car));
+        CHECK(det.products() <= 60);  // repeated squaring, not N products
+        for (int k = 0; k < 10; ++k) {
+            const cplx z(re(rng), im(rng));
+            const cplx p = z * z - z * car.own(z) + car.gap(z), q = car.gap(z) + z * car.lead(z), r = z * car.further[0](z);
+            // T = [[q/p, r/p], [1, 0]]: mu^2 - (q/p) mu - r/p = 0
+            const cplx a = q / p, b = r / p, root = std::sqrt(a * a + 4.0 * b);
+            const cplx mu1 = 0.5 * (a + root), mu2 = 0.5 * (a - root);
+            auto log1m = [n](cplx mu) {  // log(1 - mu^N) without overflow
+                const cplx l = static_cast<double>(n) * std::log(mu);
+                return l.real() <= 0.0 ? std::log(1.0 - std::exp(l)) : l + std::log(std::exp(-l) - 1.0);
+            };
+            const cplx expected = log1m(mu1) + log1m(mu2);
+            const cplx got = det.log_closure(z);
+            CAPTURE(n);
+            CAPTURE(z);
+            CHECK(std::abs(got.real() - expected.real()) < 1e-9 * std::max(1.0, std::abs(expected.real())));
+            CHECK(std::abs(std::remainder(got.imag() - expected.imag(), 2.0 * M_PI)) < 1e-6);
+            // mu^N beyond the range of a double
+            if (static_cast<double>(n) * std::max(std::abs(std::log(std::abs(mu1))), std::abs(std::log(std::abs(mu2)))) > 800.0) ++huge;
+        }
+    }
+    CHECK(huge >= 5);
+}
+
+TEST_CASE("transfer ring determinant: argument-principle counts equal the dense roots inside random rectangles") {
+    std::mt19937 rng(2026);
+    int nonzero = 0, rectangles = 0;
+    for (int n : {3, 5}) {
+        const std::vector<Linearisation> cars = random_ccc_ring(rng, n, 0.6, 3);
+        const TransferRingDeterminant det(cars);
+        RootOptions ro;
+        ro.count = 14;
+        const RootResult dense = rightmost_roots(mixed_ring_dde(cars).to_dense(), ro);
+        REQUIRE(dense.status == Status::Converged);
+        std::uniform_real_distribution<double> x(dense.strip_floor, 0.5), y(-2.0, 2.0);
+        for (int k = 0; k < 40; ++k) {
+            double x0 = x(rng), x1 = x(rng), y0 = y(rng), y1 = y(rng);
+            if (x0 > x1) std::swap(x0, x1);
+            if (y0 > y1) std::swap(y0, y1);
+            int expected = 0;
+            double closest = 1e300;
+            for (const auto& r : dense.roots) {
+                const cplx z = r.value;
+                if (z.real() > x0 && z.real() < x1 && z.imag() > y0 && z.imag() < y1) ++expected;
+                closest = std::min({closest, std::abs(z.real() - x0), std::abs(z.real() - x1), std::abs(z.imag() - y0),
+                                    std::abs(z.imag() - y1)});
+            }
+            if (closest < 1e-6) continue;  // a root on the boundary: the count is not defined
+            const auto c = det.count(x0, x1, y0, y1);
+            CAPTURE(n);
+            CAPTURE(x0);
+            CAPTURE(x1);
+            CAPTURE(y0);
+            CAPTURE(y1);
+            REQUIRE(c.ok);
+            CHECK(c.zeros == expected);
+            nonzero += expected > 0 ? 1 : 0;
+            ++rectangles;
+        }
+    }
+    CHECK(rectangles >= 60);
+    CHECK(nonzero >= 10);
+}
+
+namespace {
+
+/// The transfer-matrix path against the sparse path on one ring: the same rightmost roots
+/// (both ways) and the same number of roots right of the certified floor.
+void check_against_sparse(const std::vector<Linearisation>& cars, int count) {
+    RootOptions po;
+    po.method = "contour";
+    po.count = count;
+    const RootProblem problem = ring_root_problem(cars);
+    REQUIRE(dynamic_cast<const TransferRingDeterminant*>(problem.characteristic.get()) != nullptr);
+    const RootResult p = rightmost_roots(problem, po);
+    RootOptions so;
+    so.method = "shift_invert";
+    so.count = count + 6;  // reaches left of the contour path's floor
+    const RootResult s = rightmost_roots(problem.dde, so);
+    CAPTURE(p.message);
+    CAPTURE(s.message);
+    REQUIRE(p.status == Status::Converged);
+    REQUIRE(s.status == Status::Converged);
+    REQUIRE(p.roots.size() >= static_cast<std::size_t>(count));
+    for (const auto& r : p.roots) {
+        CAPTURE(r.value);
+        CHECK(nearest(s.roots, r.value) < tol::same_root * std::max(1.0, std::abs(r.value)));
+        CHECK(r.residual < 1e-12);
+    }
+    // the certificate: the contour count right of the floor is the sparse path's number there
+    REQUIRE(s.strip_floor < p.strip_floor);
+    int right = 0;
+    for (const auto& r : s.roots)
+        if (r.value.real() >= p.strip_floor) {
+            ++right;
+            CHECK(nearest(p.roots, r.value) < tol::same_root * std::max(1.0, std::abs(r.value)));
+        }
+    CHECK(right == static_cast<int>(p.roots.size()));
+    CHECK(p.eigenvalues_found >= right);
+}
+
+}  // namespace
+
+TEST_CASE("transfer ring path: the same rightmost roots and certified count as the sparse path (N = 10, 50, random orders)") {
+    std::mt19937 rng(4242);
+    for (int n : {6, 10, 50}) {
+        for (double share : {0.3, 0.7}) {
+            CAPTURE(n);
+            CAPTURE(share);
+            check_against_sparse(random_ccc_ring(rng, n, share), 10);
+        }
+    }
+}
+
+TEST_CASE("transfer ring path: N = 200 against the sparse path" * doctest::test_suite("slow")) {
+    std::mt19937 rng(200);
+    check_against_sparse(random_ccc_ring(rng, 200, 0.5), 10);
+}
