@@ -7,10 +7,11 @@
 // For each N: the product path (argument principle on prod P_i - prod Q_i), then for
 // N <= sparse-max the sparse collocation path and for N <= dense-max the dense path on the same
 // ring: wall time, peak resident memory so far, collocation degree, shifts, residuals, and the
-// largest distance of the listed roots from those of the first path.
+// largest distance of the listed roots from those of the first path, and the CPU time (all threads).
 #include <sys/resource.h>
 
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
         std::printf("round(%g N) cars %s among %s cars in random order (seed %u), %d rightmost roots, speed 20 m/s\n", ccc_share,
                     ccc.c_str(), pattern.c_str(), seed, count);
     std::printf("%7s %7s %9s %9s %4s %6s %6s %10s %10s %22s %s\n", "N", "path", "time_s", "peak_MiB", "M", "shifts", "LUs", "residual",
-                "vs_first", "abscissa", "status");
+                "vs_first", "abscissa", "status cpu_s");
     // the paths by their old names: product = contour, sparse = shift_invert
     const std::pair<const char*, const char*> paths[] = {{"product", "contour"}, {"sparse", "shift_invert"}, {"dense", "dense"}};
     for (int n : sizes) {
@@ -72,8 +73,10 @@ int main(int argc, char** argv) {
             o.roots.count = count;
             o.roots.method = method;
             const auto t0 = std::chrono::steady_clock::now();
+            const std::clock_t c0 = std::clock();
             const MixedRingResult r = analyse_mixed_ring(fleet, o);
             const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
             double diff = 0.0;
             if (first.empty()) {
                 first = r.roots.roots;
@@ -82,9 +85,9 @@ int main(int argc, char** argv) {
                     diff = std::max(diff, std::abs(first[i].value - r.roots.roots[i].value));
                 if (first.size() != r.roots.roots.size()) diff = std::numeric_limits<double>::infinity();
             }
-            std::printf("%7d %7s %9.3f %9.1f %4d %6d %6d %10.2e %10.2e %22.17g %s\n", n, label, dt, peak_mib(),
+            std::printf("%7d %7s %9.3f %9.1f %4d %6d %6d %10.2e %10.2e %22.17g %s %.3f\n", n, label, dt, peak_mib(),
                         r.roots.degree, r.roots.shifts, r.roots.factorizations, r.roots.max_residual, diff, r.spectral_abscissa,
-                        to_string(r.roots.status).c_str());
+                        to_string(r.roots.status).c_str(), cpu);
             std::fflush(stdout);
         }
     }
