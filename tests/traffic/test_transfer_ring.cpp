@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 
 #include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
@@ -211,4 +212,33 @@ TEST_CASE("transfer ring path: the same rightmost roots and certified count as t
 TEST_CASE("transfer ring path: N = 200 against the sparse path" * doctest::test_suite("slow")) {
     std::mt19937 rng(200);
     check_against_sparse(random_ccc_ring(rng, 200, 0.5), 10);
+}
+
+TEST_CASE("transfer ring path: a homogeneous CCC ring equals the Fourier-mode roots (N up to 2000)") {
+    // identical cars: the roots of mode m solve P zeta^2 - Q zeta - R = 0, zeta = e^{2 pi i m / N}
+    // (analyse_ring, one mode at a time); long rings put N roots next to the floor's edge
+    const Linearisation lin = linearised({"ccc", "ccc", {{"k1", 0.1}, {"k2", 0.3}, {"k3", 0.2}, {"th", 1.2}, {"tau", 0.4}, {"tau2", 0.1}}});
+    for (int n : {3, 40, 2000}) {
+        CAPTURE(n);
+        RootOptions po;
+        po.method = "contour";
+        po.count = 8;
+        const RootResult p = rightmost_roots(ring_root_problem(std::vector<Linearisation>(static_cast<std::size_t>(n), lin)), po);
+        CAPTURE(p.message);
+        REQUIRE(p.status == Status::Converged);
+        RingOptions ro;
+        ro.roots.count = 8;
+        const RingResult modes = analyse_ring(lin, n, ro);
+        REQUIRE(modes.status == Status::Converged);
+        // every mode root right of the certified floor is listed (the trivial root only by the product path)
+        int matched = 0;
+        for (const auto& r : modes.roots) {
+            if (r.root.value.real() < p.strip_floor) continue;
+            CAPTURE(r.root.value);
+            CHECK(nearest(p.roots, r.root.value) < tol::same_root);
+            ++matched;
+        }
+        CHECK(matched >= 6);
+        for (const auto& r : p.roots) CHECK(r.residual < 1e-12);
+    }
 }
