@@ -1052,6 +1052,9 @@ assert len(zp) == len(zs) >= 8 and all(abs(a - b) < 1e-10 * max(1, abs(a)) for a
 assert all(r["residual"] < 1e-12 for r in p["roots"]), p["roots"]
 assert abs(p["spectral_abscissa"] - o["spectral_abscissa"]) > 1e-4, (p["spectral_abscissa"], o["spectral_abscissa"])
 PY
+OMP_NUM_THREADS=1 "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >"$ccwd/p1.json" &&
+    OMP_NUM_THREADS=2 "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >"$ccwd/p2.json" &&
+    cmp -s "$ccwd/p1.json" "$ccwd/p2.json" && ok || bad "roots --fleet with ccc cars: output depends on the number of threads"
 rm -rf "$ccwd"
 
 echo "$pass passed, $fail failed"
