@@ -209,6 +209,27 @@ TEST_CASE("transfer ring path: the same rightmost roots and certified count as t
     }
 }
 
+TEST_CASE("transfer ring path: a string-stable CCC ring, rightmost roots next to the imaginary axis, against the sparse path") {
+    // two kinds of CCC car in a random order: every non-trivial root has Re < 0, the first pair
+    // (the lowest mode) at Re ~ -0.024, the trivial root 0 listed as well
+    const FleetCar a{"a", "ccc", {{"k1", 0.2}, {"k2", 0.6}, {"k3", 0.4}, {"th", 2.0}, {"tau", 0.2}, {"tau2", 0.1}}};
+    const FleetCar b{"b", "ccc", {{"k1", 0.3}, {"k2", 0.5}, {"k3", 0.3}, {"th", 1.8}, {"tau", 0.3}, {"tau2", 0.2}}};
+    const Fleet fleet = mixed_fleet(a, b, 40, 20, 1, 7);
+    const std::vector<Linearisation> cars = linearise_fleet(fleet, 20.0);
+    check_against_sparse(cars, 10);
+    RootOptions po;
+    po.count = 10;
+    const RootResult p = rightmost_roots(ring_root_problem(cars), po);
+    REQUIRE(p.method_used == "contour");
+    int near_axis = 0;
+    for (const auto& r : p.roots) {
+        CHECK(r.value.real() <= 1e-12);
+        if (r.value.real() > -3e-2 && std::abs(r.value) > 1e-8) ++near_axis;
+    }
+    CHECK(near_axis == 2);
+    CHECK(std::abs(p.roots.front().value) < 1e-12);
+}
+
 TEST_CASE("transfer ring path: N = 200 against the sparse path" * doctest::test_suite("slow")) {
     std::mt19937 rng(200);
     check_against_sparse(random_ccc_ring(rng, 200, 0.5), 10);
