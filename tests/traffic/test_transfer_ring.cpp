@@ -263,3 +263,81 @@ TEST_CASE("transfer ring path: a homogeneous CCC ring equals the Fourier-mode ro
         for (const auto& r : p.roots) CHECK(r.residual < 1e-12);
     }
 }
+
+namespace {
+
+/// Change of arg D along a -> b by uniform steps of the principal log, the number of steps
+/// doubled until no step turns by more than 0.5 rad (a reference that shares nothing with the
+/// adaptive tracking but the evaluation of D).
+double brute_arg(const TransferRingDeterminant& d, cplx a, cplx b) {
+    for (int n = 4096;; n *= 2) {
+        double total = 0.0, worst = 0.0;
+        cplx prev = d.log_value(a);
+        for (int i = 1; i <= n; ++i) {
+            const cplx v = d.log_value(a + (b - a) * (static_cast<double>(i) / n));
+            const double step = std::remainder(v.imag() - prev.imag(), 2.0 * M_PI);
+            worst = std::max(worst, std::abs(step));
+            total += step;
+            prev = v;
+        }
+        if (worst <= 0.5 || n >= (1 << 22)) return total;
+    }
+}
+
+}  // namespace
+
+TEST_CASE("transfer ring determinant: counts on a long ring next to its band of roots equal a fine uniform sampling of arg D") {
+    // 300 cars in a random order: the unstable band holds many roots close together; rectangles
+    // whose left edge runs just below the top of the band, where a step could jump over it
+    std::mt19937 rng(300);
+    const std::vector<Linearisation> cars = linearise_fleet(
+        mixed_fleet(parse_fleet_car("ccc:k1=0.1,k2=0.3,k3=0.2,th=1.2,tau=0.4,tau2=0.1"), fleet_from_pattern("A_min", 1)[0], 300, 150, 1, 3),
+        20.0);
+    const TransferRingDeterminant det(cars);
+    // (its roots with Re > 0.02 lie at Im 0.07 to 0.22, about 0.007 apart)
+    std::uniform_real_distribution<double> x(0.02, 0.034), y(0.0, 0.15), h(0.02, 0.12);
+    int nonzero = 0;
+    for (int k = 0; k < 8; ++k) {
+        double x0 = x(rng), x1 = 0.06, y0 = y(rng), y1 = y0 + h(rng);
+        if (k == 0) {  // a long strip as the floor search uses: long edges, large first steps
+            x0 = 0.0328;
+            x1 = 1.4;
+            y0 = -2.85;
+            y1 = 2.85;
+        }
+        const cplx a(x0, y0), b(x1, y0), c(x1, y1), d(x0, y1);
+        const double total = brute_arg(det, a, b) + brute_arg(det, b, c) + brute_arg(det, c, d) + brute_arg(det, d, a);
+        const long reference = std::lround(total / (2.0 * M_PI));
+        CAPTURE(x0);
+        CAPTURE(y0);
+        CAPTURE(y1);
+        CHECK(std::abs(total - 2.0 * M_PI * static_cast<double>(reference)) < 1e-6);
+        const auto count = det.count(x0, x1, y0, y1);
+        REQUIRE(count.ok);
+        CHECK(count.zeros == reference);
+        nonzero += reference > 0 ? 1 : 0;
+    }
+    CHECK(nonzero >= 5);
+}
+
+TEST_CASE("transfer ring determinant: the floor search's strip on a 2,000-car ring counts what a fine uniform sampling counts" *
+          doctest::test_suite("slow")) {
+    // the benchmark's ring: 92 roots in the strip, all within 0.0015 of its left edge; a step
+    // control that looked only at the rates of arg D at its end points jumped over them (count 0)
+    const std::vector<Linearisation> cars = linearise_fleet(
+        mixed_fleet(parse_fleet_car("ccc:k1=0.1,k2=0.3,k3=0.2,th=1.2,tau=0.4,tau2=0.1"), fleet_from_pattern("A_min", 1)[0], 2000, 1000, 1, 1),
+        20.0);
+    const TransferRingDeterminant det(cars);
+    const double x0 = 0.0328, x1 = 1.38, y = 2.85;
+    const cplx a(x0, -y), b(x1, -y), c(x1, y), d(x0, y);
+    const double total = brute_arg(det, a, b) + brute_arg(det, b, c) + brute_arg(det, c, d) + brute_arg(det, d, a);
+    const long reference = std::lround(total / (2.0 * M_PI));
+    CHECK(std::abs(total - 2.0 * M_PI * static_cast<double>(reference)) < 1e-6);
+    CHECK(reference > 20);
+    const auto count = det.count(x0, x1, -y, y);
+    REQUIRE(count.ok);
+    CHECK(count.zeros == reference);
+    const auto sym = det.count_symmetric(x0, x1, y);
+    REQUIRE(sym.ok);
+    CHECK(sym.zeros == reference);
+}
