@@ -260,8 +260,9 @@ void add_roots_flags(CLI::App& app) {
     app.add_option("--cars", args.cars, "old spelling of --ring for --fleet-pattern")->group("");
     app.add_option("--length", args.length, "fleet: ring length [m] (sum of the gaps); the speed follows");
     app.add_option("--solver", args.solver,
-                   "--fleet: auto (product for cars that react only to the car ahead, else dense up to 8 cars and sparse beyond), "
-                   "product, dense or sparse; --system: auto (dense up to 16 states), dense or sparse")
+                   "--fleet: auto (product: the argument principle on det Delta, for cars that react to the car ahead and "
+                   "connected cruise control cars that react to the car two ahead too), product, dense or sparse; "
+                   "--system: auto (dense up to 16 states), dense or sparse")
         ->capture_default_str();
     app.add_option("--ring-method", args.ring_method,
                    "a ring of identical cars: auto (winding when the car reacts only to the car ahead, else modes), winding "

@@ -397,10 +397,12 @@ def mixed_ring(fleet, ring=None, speed=None, length=None, solver="auto", count=6
     ``fleet``: a CSV file (a fleet table, or a vehicle table as ``calibrate`` writes) or
     built-in names ``"A_min,C_max*3,E_min"``; ``ring``: the number of cars (the fleet repeated;
     default the fleet once). The equilibrium: a common ``speed`` [m/s] (default 20) or the
-    ring ``length`` [m]. For cars that react only to the car ahead the roots of
-    ``det Delta = prod P_i - prod Q_i`` are located and certified complete by the argument
-    principle (``solver="product"``); otherwise collocation, ``"dense"`` or ``"sparse"``
-    (shift-invert Arnoldi), with ``degree`` M (0: automatic).
+    ring ``length`` [m]. The roots of ``det Delta = prod P_i - prod Q_i`` (cars that react
+    only to the car ahead), or of ``prod P_i det(I - prod T_i)`` with 2 x 2 transfer matrices
+    (connected cruise control cars, which also react to the car two ahead), are located and
+    certified complete by the argument principle (``solver="product"``, the default through
+    ``"auto"``); or collocation, ``"dense"`` or ``"sparse"`` (shift-invert Arnoldi), with
+    ``degree`` M (0: automatic).
 
     Returns ``roots`` (columns ``re``, ``im``, ``residual``, ...), ``spectral_abscissa``,
     ``ring_stable``, ``unstable_roots``, the equilibrium and the other keys of the command's

@@ -43,7 +43,7 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     RootOptions ro = options.roots;
     ro.count = options.roots.count + 1;  // room for the trivial root
     const RootProblem problem = ring_root_problem(lins);
-    const bool one_leader = problem.characteristic != nullptr;
+    const bool one_leader = std::all_of(lins.begin(), lins.end(), [](const Linearisation& l) { return l.leaders() == 1; });
     // the facade chooses (auto: contour for one-leader rings unless a degree is asked) or checks the forced method
     RootResult r = rightmost_roots(problem, ro);
     // the trivial root: lambda = 0 to rounding

@@ -203,7 +203,7 @@ private:
 
 std::string contour_why_not(const RootProblem& problem, const RootOptions& options) {
     if (!problem.characteristic)
-        return "method 'contour' needs a scalar characteristic function det Delta (e.g. a ring whose cars react only to the car "
+        return "method 'contour' needs a scalar characteristic function det Delta (e.g. a ring whose cars react to one or two cars "
                "ahead); this problem has none: expected auto, dense or shift_invert";
     if (!problem.characteristic->is_real())
         return "method 'contour' counts zeros of a real characteristic function; this one is complex: expected auto or dense";

@@ -274,8 +274,12 @@ VectorXc RingDeterminant::null_vector(cplx z) const {
 
 RootProblem ring_root_problem(const std::vector<Linearisation>& cars) {
     const bool one_leader = std::all_of(cars.begin(), cars.end(), [](const Linearisation& l) { return l.leaders() == 1; });
+    const bool two_leaders = std::all_of(cars.begin(), cars.end(), [](const Linearisation& l) { return l.leaders() <= 2; });
     RootProblem p{mixed_ring_dde(cars), nullptr};
-    if (one_leader) p.characteristic = std::make_shared<RingDeterminant>(cars);
+    if (one_leader)
+        p.characteristic = std::make_shared<RingDeterminant>(cars);
+    else if (two_leaders)
+        p.characteristic = std::make_shared<TransferRingDeterminant>(cars);
     return p;
 }
 

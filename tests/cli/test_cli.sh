@@ -354,7 +354,7 @@ zp = [complex(r["re"], r["im"]) for r in p["roots"]]
 zs = [complex(r["re"], r["im"]) for r in s["roots"]]
 assert len(zp) == len(zs) >= 6 and all(abs(a - b) < 1e-10 for a, b in zip(zp, zs)), (zp, zs)
 PY
-expect_error "react only to the car ahead" roots --fleet "$tmp/fleet.csv" --solver product
+"$bin" roots --fleet "$tmp/fleet.csv" --solver product --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['solver']['used'] == 'product' else 1)" && ok || bad "--solver product with ccc cars"
 expect_error "the product path has no collocation degree" roots --fleet-pattern "A_min,E_min" --ring 6 --solver product --degree 20
 "$bin" roots --fleet-pattern "A_min,E_min" --ring 6 --degree 20 --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['result']['degree'] == 20 else 1)" && ok || bad "--degree selects a collocation path"
 expect_error "expected at least" roots --fleet-pattern "A_min" --ring 4 --length 5
@@ -1018,6 +1018,44 @@ expect_error "at most 1000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --rin
 expect_error "at most 1000000000)" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 2000000000
 expect_error "--ring-method = 'fast': expected auto, winding or modes" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring-method fast
 rm -rf "$rwd"
+
+# connected cruise control rings (cars of two leaders, in a random order): the product path
+# (transfer matrices, taken by auto) against the sparse path, and the order of the cars matters
+ccwd=$(mktemp -d)
+printf 'vehicle,model,k1,k2,k3,th,tau,tau2
+,ccc,0.1,0.3,0.2,1.2,0.4,0.1
+A_min,,,,,,,
+A_min,,,,,,,
+,ccc,0.1,0.3,0.2,1.2,0.4,0.1
+,ccc,0.1,0.3,0.2,1.2,0.4,0.1
+A_min,,,,,,,
+,ccc,0.1,0.3,0.2,1.2,0.4,0.1
+A_min,,,,,,,
+A_min,,,,,,,
+,ccc,0.1,0.3,0.2,1.2,0.4,0.1
+,ccc,0.1,0.3,0.2,1.2,0.4,0.1
+A_min,,,,,,,
+' >"$ccwd/ccc.csv"
+{ head -1 "$ccwd/ccc.csv"; tail -n +2 "$ccwd/ccc.csv" | sort; } >"$ccwd/sorted.csv"
+"$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >"$ccwd/p.json" &&
+    "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --solver sparse --format json >"$ccwd/s.json" &&
+    "$bin" roots --fleet "$ccwd/sorted.csv" --count 8 --format json >"$ccwd/o.json" &&
+    python3 - "$ccwd" <<'PY' && ok || bad "roots --fleet with ccc cars: product path against sparse, order"
+import json, sys
+p, s, o = (json.load(open(sys.argv[1] + f)) for f in ("/p.json", "/s.json", "/o.json"))
+assert p["status"] == s["status"] == o["status"] == "converged"
+assert p["solver"]["used"] == "product" and s["solver"]["used"] == "sparse", (p["solver"], s["solver"])
+p, s, o = p["result"], s["result"], o["result"]
+zp = [complex(r["re"], r["im"]) for r in p["roots"]]
+zs = [complex(r["re"], r["im"]) for r in s["roots"]]
+assert len(zp) == len(zs) >= 8 and all(abs(a - b) < 1e-10 * max(1, abs(a)) for a, b in zip(zp, zs)), (zp, zs)
+assert all(r["residual"] < 1e-12 for r in p["roots"]), p["roots"]
+assert abs(p["spectral_abscissa"] - o["spectral_abscissa"]) > 1e-4, (p["spectral_abscissa"], o["spectral_abscissa"])
+PY
+OMP_NUM_THREADS=1 "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >"$ccwd/p1.json" &&
+    OMP_NUM_THREADS=2 "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >"$ccwd/p2.json" &&
+    cmp -s "$ccwd/p1.json" "$ccwd/p2.json" && ok || bad "roots --fleet with ccc cars: output depends on the number of threads"
+rm -rf "$ccwd"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -81,12 +81,15 @@ TEST_CASE("facade dispatch: auto takes contour with a characteristic function, d
 }
 
 TEST_CASE("facade dispatch: a forced method that does not apply throws std::invalid_argument saying why") {
-    // contour without a characteristic function (e.g. a ring with a CCC car)
+    // contour without a characteristic function (a ring written out as a plain LinearDDE); a
+    // ring with a CCC car has one (the transfer-matrix determinant), so auto takes contour
     std::mt19937 rng(5);
     std::vector<Linearisation> ccc{linearised(random_car(rng, false)), linearised(random_car(rng, true)),
                                    linearised(random_car(rng, false))};
-    const RootProblem p = ring_root_problem(ccc);
-    CHECK(p.characteristic == nullptr);
+    const RootProblem with_ccc = ring_root_problem(ccc);
+    CHECK(with_ccc.characteristic != nullptr);
+    CHECK(choose_root_method(with_ccc, RootOptions{}) == "contour");
+    const RootProblem p{with_ccc.dde, nullptr};
     CHECK_THROWS_WITH_AS(rightmost_roots(p, with("contour", 4)), doctest::Contains("needs a scalar characteristic function"),
                          std::invalid_argument);
     CHECK_THROWS_WITH_AS(rightmost_roots(scalar_delayed(-1.0, 1.0), with("contour", 2)),
