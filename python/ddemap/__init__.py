@@ -22,9 +22,11 @@ command line, a computation that did not converge is a status, not an exception.
 
 Bad input raises ValueError with the library's message. Every computation runs with the GIL
 released. Ctrl-C (KeyboardInterrupt) stops ``sweep`` and ``boundary`` between grid rows,
-``classify`` between vehicles (and parameter samples), ``simulate`` between steps and
-``calibrate`` between fits; the other functions (each well under a second to a few seconds)
-finish their call first.
+``classify`` between vehicles (and parameter samples), ``simulate`` between steps,
+``calibrate`` between fits, ``equilibria`` and ``hopf`` between the points of a branch or a
+Hopf curve, ``orbits`` between orbits, and ``roots``/``string`` with a ring between the modes
+of the per-mode path; ``roots`` of a ``system``, ``mixed_ring`` and the winding pass (each well
+under a second to a few seconds) finish their call first.
 
 Quick start (the paper's stability chart)::
 

@@ -139,7 +139,8 @@ std::string py_roots(const std::string& model_name, const ParameterMap& values, 
     const Linearisation lin = model->linearise();
     // as the command: the verdict from one winding pass where it applies (analysis/ring_fast.hpp)
     const std::string method = resolve_ring_method("auto", lin);
-    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count); });
+    const Progress progress = interruptible();
+    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count, progress); });
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
@@ -199,10 +200,11 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;
     const std::string method = cars ? resolve_ring_method("auto", lin) : std::string();
+    const Progress progress = interruptible();
     const StringResult s = released([&] {
         StringResult r = analyse_string(lin);
         if (cars) {
-            fast = analyse_ring_fast(lin, *cars, method, 0);
+            fast = analyse_ring_fast(lin, *cars, method, 0, progress);
             ring = fast->ring;
         }
         return r;

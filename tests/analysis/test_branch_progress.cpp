@@ -9,7 +9,10 @@
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/hopf.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/analysis/ring_fast.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/problem/expression_system.hpp"
+#include "fleet_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -127,4 +130,26 @@ TEST_CASE("periodic orbits: one progress call per orbit; a throwing callback sto
     o.progress = recorder(stopped, 3);
     CHECK_THROWS_AS(orbit_branch_from_hopf(sys, h, o), Stop);
     CHECK(stopped.done == std::vector<long>{1, 2, 3});
+}
+
+TEST_CASE("ring of N cars, per-mode path: one progress call per mode of the first pass; a throwing callback stops it") {
+    const Linearisation lin = test::ovrv(0.2, 0.2, 1.5, 0.1);  // the paper's example
+    std::vector<long> done;
+    RingOptions o;
+    o.progress = [&](long d, long total) {
+        CHECK(total == 12);  // N / 2 + 1 modes
+        done.push_back(d);
+    };
+    const RingResult r = analyse_ring(lin, 22, o);
+    CHECK(r.modes_solved >= 12);
+    REQUIRE(done.size() == 12);
+    for (std::size_t k = 0; k < done.size(); ++k) CHECK(done[k] == static_cast<long>(k + 1));
+    // the same through analyse_ring_fast on the per-mode path, stopped after 5 modes
+    long calls = 0;
+    const Progress stop = [&](long d, long) {
+        ++calls;
+        if (d == 5) throw std::runtime_error("stopped by the caller");
+    };
+    CHECK_THROWS_AS(analyse_ring_fast(lin, 22, "modes", 6, stop), std::runtime_error);
+    CHECK(calls == 5);
 }
