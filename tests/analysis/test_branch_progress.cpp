@@ -43,7 +43,7 @@ BranchProgress recorder(Seen& seen, long stop_at = 0) {
 
 }  // namespace
 
-TEST_CASE("equilibrium branch: one progress call per point after its roots; a throwing callback stops it") {
+TEST_CASE("equilibrium branch: one progress call per point after its roots, and a throwing callback stops it") {
     // x' = p - x(t - 1)^2: the branch x = sqrt(p) with a fold at p = 0 (tests/cli/test_cli.sh)
     const ExpressionSystem sys({"x"}, {"p"}, {0.9}, {"p - x(t - 1)^2"});
     EquilibriumBranchOptions o;
@@ -67,7 +67,7 @@ TEST_CASE("equilibrium branch: one progress call per point after its roots; a th
     CHECK(stopped.done == std::vector<long>{1, 2, 3});  // nothing after the throwing call
 }
 
-TEST_CASE("Hopf curve: one progress call per traced point; a throwing callback stops the continuation") {
+TEST_CASE("Hopf curve: one progress call per traced point, and a throwing callback stops the continuation") {
     // the curve a tau = pi/2 of x' = -a x(t - tau) + x x(t - tau) - x^3 (test_hopf.cpp)
     const ExpressionSystem sys({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*x(t - tau) + x*x(t - tau) - x^3"});
     HopfCurveOptions o;
@@ -100,7 +100,7 @@ TEST_CASE("Hopf curve: one progress call per traced point; a throwing callback s
     CHECK(stopped.done == std::vector<long>{2, 3, 4, 5});
 }
 
-TEST_CASE("periodic orbits: one progress call per orbit; a throwing callback stops the branch") {
+TEST_CASE("periodic orbits: one progress call per orbit, and a throwing callback stops the branch") {
     // Wright's equation from its Hopf point alpha = omega = pi/2 (test_periodic_orbit.cpp)
     const ExpressionSystem sys({"y"}, {"alpha"}, {1.6}, {"-alpha*y(t - 1)*(1 + y)"});
     HopfPoint h;
@@ -132,7 +132,7 @@ TEST_CASE("periodic orbits: one progress call per orbit; a throwing callback sto
     CHECK(stopped.done == std::vector<long>{1, 2, 3});
 }
 
-TEST_CASE("ring of N cars, per-mode path: one progress call per mode of the first pass; a throwing callback stops it") {
+TEST_CASE("ring of N cars, per-mode path: one progress call per mode of the first pass, and a throwing callback stops it") {
     const Linearisation lin = test::ovrv(0.2, 0.2, 1.5, 0.1);  // the paper's example
     std::vector<long> done;
     RingOptions o;
