@@ -3,7 +3,6 @@
 // list with test runs (--runs); --report DIR writes the Tables 1/2 report and fit figures.
 #include <unistd.h>
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
