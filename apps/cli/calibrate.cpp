@@ -3,7 +3,6 @@
 // list with test runs (--runs); --report DIR writes the Tables 1/2 report and fit figures.
 #include <unistd.h>
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -88,25 +87,11 @@ namespace {
 
 /// the cars of --runs RUNS.csv (car,file,role[,type]), in order of first appearance
 std::vector<CarRuns> read_runs(const std::string& path) {
-    std::vector<CarRuns> cars;
-    for (const RunListEntry& e : read_run_list_csv(read_input_file("--runs", path), path)) {
-        auto it = std::find_if(cars.begin(), cars.end(), [&](const CarRuns& c) { return c.car == e.car; });
-        if (it == cars.end()) {
-            cars.push_back(CarRuns{e.car, {}, {}, {}});
-            it = cars.end() - 1;
-        }
-        const std::string file = args.data_dir.empty() || e.file.front() == '/' ? e.file : (std::filesystem::path(args.data_dir) / e.file).string();
-        Trace tr = read_trace_csv(read_input_file("--runs " + path + ": file", file), file);
-        if (e.role == "train") {
-            it->train.push_back(std::move(tr));
-        } else {
-            it->test.push_back(std::move(tr));
-            it->test_types.push_back(e.type);
-        }
-    }
-    for (const CarRuns& c : cars)
-        if (c.train.empty()) throw BadInput("--runs " + path + ": car '" + c.car + "' has no run with role train");
-    return cars;
+    auto read = [&](const std::string& name) {
+        const std::string file = args.data_dir.empty() || name.front() == '/' ? name : (std::filesystem::path(args.data_dir) / name).string();
+        return read_trace_csv(read_input_file("--runs " + path + ": file", file), file);
+    };
+    return cars_from_run_list(read_run_list_csv(read_input_file("--runs", path), path), read, "--runs " + path);
 }
 
 /// the --report folder, created as needed and writable (bad input otherwise, before any work)
@@ -186,27 +171,9 @@ int run_calibrate() {
     std::vector<std::pair<std::string, std::string>> outputs;
     if (!prefix.empty())
         outputs = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}};
-    if (!report_dir.empty()) {
-        const CalibrationReport rep = calibration_report(results);
-        outputs.push_back({report_dir + "table.csv", calibration_report_csv(rep)});
-        outputs.push_back({report_dir + "table.json", calibration_report_json(rep)});
-        outputs.push_back({report_dir + "table.md", calibration_report_markdown(rep, o)});
-        // one figure per run and car: fit_CAR_FILE.svg (CAR with every character but letters,
-        // digits, '-' and '.' replaced by '_'; CAR_ left out when each car is one file)
-        auto figure = [&](const std::string& car, const std::string& title, const Trace& tr, const FitEvaluation& ev) {
-            std::string slug;
-            for (char ch : car) slug += std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '.' ? ch : '_';
-            const bool plain = args.runs.empty() && !args.joint;
-            outputs.push_back({report_dir + "fit_" + (plain ? std::string() : slug + "_") + base_name(tr.source) + ".svg", calibration_fit_svg(title, tr, ev, "run: " + tr.source)});
-        };
-        for (std::size_t i = 0; i < results.size(); ++i) {
-            const auto& r = results[i];
-            for (std::size_t k = 0; k < cars[i].train.size() && k < r.fit.runs.size(); ++k)
-                figure(r.car, r.car + ": training run " + std::to_string(k + 1) + " of " + std::to_string(cars[i].train.size()), cars[i].train[k], r.fit.runs[k]);
-            for (std::size_t k = 0; k < r.tests.size(); ++k)
-                figure(r.car, r.car + ": test run (" + r.tests[k].type + ")", cars[i].test[k], r.tests[k].evaluation);
-        }
-    }
+    if (!report_dir.empty())
+        for (auto& [name, text] : calibration_report_files(results, cars, o, args.runs.empty() && !args.joint))
+            outputs.push_back({report_dir + name, std::move(text)});
     if (!outputs.empty()) write_files_atomic(outputs);
     print_output(format, e, csv, [&] {
         std::ostringstream out;

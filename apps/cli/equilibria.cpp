@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "format.hpp"
+#include "limits.hpp"
 #include "nonlinear_flags.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/io/csv.hpp"
@@ -39,6 +40,7 @@ void add_equilibria_flags(CLI::App& app) {
     app.add_option("--max-points", args.points, "the most points of the branch")->capture_default_str();
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv (one row per point and special point) and PREFIX.json", false);
+    run_flags().add_to(app, false);
 }
 
 int run_equilibria() {
@@ -57,7 +59,9 @@ int run_equilibria() {
     JsonObject& inputs = pb.inputs;
     inputs.string("par", args.problem.par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
 
+    o.progress = branch_progress_printer("equilibria", "points", args.problem.par, true);
     const EquilibriumBranch b = equilibrium_branch(*system, guess, o);
+    o.progress = nullptr;  // ends an open progress line before the output
     JsonEnvelope e;
     e.command = "equilibria";
     e.inputs = inputs.str();

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "format.hpp"
+#include "limits.hpp"
 #include "nonlinear_flags.hpp"
 #include "ddemap/analysis/hopf.hpp"
 #include "ddemap/io/files.hpp"
@@ -43,6 +44,7 @@ void add_hopf_flags(CLI::App& app) {
     app.add_option("--max-points", args.points, "the most points of the branch, and of a Hopf curve in each direction")->capture_default_str();
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv (one row per Hopf point, or per curve point with --par2) and PREFIX.json", false);
+    run_flags().add_to(app, false);
 }
 
 int run_hopf() {
@@ -88,13 +90,19 @@ int run_hopf() {
     HopfCurves curves;
     HopfAnalysis points;
     if (two) {
+        co.branch.progress = branch_progress_printer("hopf", "equilibria", args.problem.par, true);
+        co.progress = branch_progress_printer("hopf", "curve points", args.problem.par, false);
         curves = hopf_curves(system, pb.guess, co);
+        co.branch.progress = nullptr;  // ends an open progress line before the output
+        co.progress = nullptr;
         status = curves.status;
         message = curves.message;
         e.result = hopf_curves_json(curves, args.par2, pb.variables);
         csv = hopf_curves_csv(curves);
     } else {
+        o.progress = branch_progress_printer("hopf", "equilibria", args.problem.par, true);
         points = hopf_points(system, pb.guess, o);
+        o.progress = nullptr;
         status = points.status;
         message = points.message;
         e.result = hopf_points_json(points, pb.variables);

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
+#include <utility>
 
 #include "common.hpp"
 
@@ -67,33 +69,73 @@ void check_size(const std::string& command, const std::string& what, const std::
                  what.c_str(), noun.c_str(), show(estimate).c_str(), show(limit).c_str());
 }
 
-Progress progress_printer(const std::string& command, const std::string& unit) {
-    if (run_flags().quiet) return nullptr;
-    struct State {
-        std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
-        long last_percent = -1;
-        bool shown = false;
-    };
-    auto state = std::make_shared<State>();
-    const bool tty = isatty(2) != 0;
-    // test hook (tests/cli/test_cli.sh): progress from the first unit on
-    const char* hook = std::getenv("DDEMAP_TEST_PROGRESS_AT_ONCE");
-    const double delay = hook && hook[0] == '1' ? 0.0 : 1.0;
-    return [=](long done, long total) {
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - state->start).count();
-        if (elapsed < delay && !state->shown) return;  // short runs print nothing
+namespace {
+
+/// What the printers share: quiet for the first second (short runs print nothing), on a
+/// terminal one line redrawn in place, otherwise one line per finished unit (at most one per
+/// percent of `total`), the elapsed time and, when `estimate`, the time left.
+class Printer {
+public:
+    explicit Printer(std::string command) : m_command(std::move(command)) {
+        // test hook (tests/cli/test_cli.sh): progress from the first unit on
+        const char* hook = std::getenv("DDEMAP_TEST_PROGRESS_AT_ONCE");
+        m_delay = hook && hook[0] == '1' ? 0.0 : 1.0;
+    }
+    Printer(const Printer&) = delete;
+    Printer& operator=(const Printer&) = delete;
+    /// A line left open on a terminal (a branch ends before its budget) is ended.
+    ~Printer() {
+        if (m_tty && m_open) {
+            std::fputc('\n', stderr);
+            std::fflush(stderr);
+        }
+    }
+    /// `what`: the line between the command and the times ("rows 3/200", "37 orbits (at most 100), par = 2.8").
+    void operator()(long done, long total, const std::string& what, bool estimate) {
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+        if (elapsed < m_delay && !m_shown) return;
         const long percent = total > 0 ? done * 100 / total : 100;
-        if (!tty && percent == state->last_percent && done != total) return;
-        state->last_percent = percent;
-        state->shown = true;
+        if (!m_tty && percent == m_last_percent && done != total) return;
+        m_last_percent = percent;
+        m_shown = true;
         char left[64] = "";
-        if (done > 0 && done < total) {
+        if (estimate && done > 0 && done < total) {
             const double rest = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
             std::snprintf(left, sizeof left, ", about %s left", human_seconds(rest).c_str());
         }
-        std::fprintf(stderr, "%sddemap: %s: %s %ld/%ld (%s%s)%s", tty ? "\r" : "", command.c_str(), unit.c_str(), done, total,
-                     human_seconds(elapsed).c_str(), left, !tty ? "\n" : done == total ? "\033[K\n" : "\033[K");
+        std::fprintf(stderr, "%sddemap: %s: %s (%s%s)%s", m_tty ? "\r" : "", m_command.c_str(), what.c_str(), human_seconds(elapsed).c_str(), left,
+                     !m_tty ? "\n" : done == total ? "\033[K\n" : "\033[K");
         std::fflush(stderr);
+        m_open = m_tty && done != total;
+    }
+
+private:
+    std::string m_command;
+    std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now();
+    bool m_tty = isatty(2) != 0;
+    double m_delay = 1.0;
+    long m_last_percent = -1;
+    bool m_shown = false;
+    bool m_open = false;  ///< a terminal line without its newline
+};
+
+}  // namespace
+
+Progress progress_printer(const std::string& command, const std::string& unit) {
+    if (run_flags().quiet) return nullptr;
+    auto printer = std::make_shared<Printer>(command);
+    return [=](long done, long total) { (*printer)(done, total, unit + " " + std::to_string(done) + "/" + std::to_string(total), true); };
+}
+
+BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total) {
+    if (run_flags().quiet) return nullptr;
+    auto printer = std::make_shared<Printer>(command);
+    return [=](long done, long total, double value) {
+        char v[32];
+        std::snprintf(v, sizeof v, "%.6g", value);
+        const std::string count = exact_total ? unit + " " + std::to_string(done) + "/" + std::to_string(total)
+                                              : std::to_string(done) + " " + unit + " (at most " + std::to_string(total) + ")";
+        (*printer)(done, total, count + ", " + par + " = " + v, exact_total);
     };
 }
 

@@ -42,4 +42,9 @@ std::string human_seconds(double seconds);
 /// --quiet. Returns an empty callback when quiet.
 Progress progress_printer(const std::string& command, const std::string& unit);
 
+/// The same printer for a branch (a continuation), one line per finished point:
+/// `command: 37 orbits (at most 100), headway = 2.81 (4.2 s)`, or with `exact_total` (the
+/// number of points is known) `command: points 37/80, gap = 12.5 (4.2 s, about 3 s left)`.
+BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total);
+
 }  // namespace ddemap::cli

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "format.hpp"
+#include "limits.hpp"
 #include "nonlinear_flags.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
@@ -47,6 +48,7 @@ void add_orbits_flags(CLI::App& app) {
     app.add_option("--svg", args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json", false);
+    run_flags().add_to(app, false);
 }
 
 int run_orbits() {
@@ -85,7 +87,9 @@ int run_orbits() {
     eo.from = o.from;
     eo.to = o.to;
     eo.roots.count = 2;
+    eo.progress = branch_progress_printer("orbits", "equilibria", par, true);
     const EquilibriumBranch eq = equilibrium_branch(*built.system, built.guess, eo);
+    eo.progress = nullptr;  // ends an open progress line
     if (eq.hopf.empty())
         throw BadInput("no Hopf point on the equilibrium branch in " + par + " from " + args.problem.from + " to " + args.problem.to +
                        " (ended: " + to_string(eq.stop) + "): expected at least one to start the periodic orbits from");
@@ -93,7 +97,9 @@ int run_orbits() {
         throw BadInput("--hopf = '" + args.hopf + "': expected an index from 0 to " + std::to_string(eq.hopf.size() - 1) + " (the branch has " +
                        std::to_string(eq.hopf.size()) + " Hopf point" + (eq.hopf.size() == 1 ? "" : "s") + ")");
     const HopfPoint& h = eq.hopf[static_cast<std::size_t>(hopf_index)];
+    o.progress = branch_progress_printer("orbits", "orbits", par, false);
     OrbitBranch b = orbit_branch_from_hopf(*built.system, h, o);
+    o.progress = nullptr;
     if (h.status != Status::Converged && b.status == Status::Converged) {
         b.status = h.status;
         b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";

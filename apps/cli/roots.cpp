@@ -194,7 +194,7 @@ int run_ring(Format format, const std::string& prefix) {
     const std::string method = resolve_ring_method(given, lin);
     const int cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
     const int count = parse_count();
-    const FastRing fast = analyse_ring_fast(lin, cars, method, count);
+    const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", "modes"));
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";

@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "ring_fast.hpp"
 #include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
@@ -35,6 +36,7 @@ void add_string_flags(CLI::App& app) {
         ->type_name("auto|winding|modes");
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv and PREFIX.json", false);
+    run_flags().add_to(app, false);
 }
 
 int run_string() {
@@ -54,7 +56,7 @@ int run_string() {
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;
     if (cars) {
-        fast = analyse_ring_fast(lin, *cars, method, 0);
+        fast = analyse_ring_fast(lin, *cars, method, 0, progress_printer("string", "modes"));
         ring = fast->ring;
     }
     const RingResult* rp = ring ? &*ring : nullptr;

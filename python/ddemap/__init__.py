@@ -22,9 +22,11 @@ command line, a computation that did not converge is a status, not an exception.
 
 Bad input raises ValueError with the library's message. Every computation runs with the GIL
 released. Ctrl-C (KeyboardInterrupt) stops ``sweep`` and ``boundary`` between grid rows,
-``classify`` between vehicles (and parameter samples), ``simulate`` between steps and
-``calibrate`` between fits; the other functions (each well under a second to a few seconds)
-finish their call first.
+``classify`` between vehicles (and parameter samples), ``simulate`` between steps,
+``calibrate`` between fits, ``equilibria`` and ``hopf`` between the points of a branch or a
+Hopf curve, ``orbits`` between orbits, and ``roots``/``string`` with a ring between the modes
+of the per-mode path; ``roots`` of a ``system``, ``mixed_ring`` and the winding pass (each well
+under a second to a few seconds) finish their call first.
 
 Quick start (the paper's stability chart)::
 
@@ -35,6 +37,7 @@ Quick start (the paper's stability chart)::
 
 import json as _json
 import math as _math
+import os as _os
 
 import numpy as _np
 
@@ -356,7 +359,8 @@ def simulate(fleet, lead_profile=None, lead=None, on_event="continue", t_end=0.0
     return r
 
 
-def calibrate(*files, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, model="ovrv"):
+def calibrate(*files, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, model="ovrv", runs=None, data_dir=None,
+              report=None):
     """Fits OVRV to measured car-following traces (``ddemap calibrate``).
 
     ``files``: CSV traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one
@@ -366,17 +370,23 @@ def calibrate(*files, joint=False, car="joint", train=None, bounds=None, gap_wei
     The fit minimises ``MSE(speed) + gap_weight * MSE(gap)`` [gap_weight in 1/s^2] over the
     simulated follower (RK4 with the delay).
 
-    Returns ``fits`` (per fit the parameters, errors, estimates with 95 % intervals, status),
-    ``gap_weight`` and ``bounds``, as the command's JSON. (The command's ``--runs`` run lists
-    and ``--report`` folders are not offered here.)
+    ``runs`` (instead of ``files``): a run list, CSV with columns car, file, role[, type]: each
+    car fitted jointly on its ``role=train`` files and tested on its ``role=test`` files (errors
+    per type); its file names are relative to ``data_dir`` (default the current folder).
+    ``report``: a folder (created as needed) that receives table.csv, table.json, table.md and
+    one fit figure per run, fit_CAR_FILE.svg, as ``--report`` writes them.
+
+    Returns ``fits`` (per fit the parameters, errors, estimates with 95 % intervals, status,
+    and with ``runs`` the test runs), ``gap_weight`` and ``bounds``, as the command's JSON.
+    Ctrl-C stops it between fits.
     """
     if model != "ovrv":
         raise ValueError("model = %r: calibration supports ovrv" % (model,))
     if len(files) == 1 and isinstance(files[0], (list, tuple)):
         files = tuple(files[0])
     files = [str(f) for f in files]
-    if not files:
-        raise ValueError("files: expected at least one trace")
+    if not files and runs is None:
+        raise ValueError("files: expected at least one trace (or runs=RUNS.csv)")
     if train is not None:
         if len(train) != 2:
             raise ValueError("train = %r: expected (T0, T1) in seconds" % (train,))
@@ -388,7 +398,14 @@ def calibrate(*files, joint=False, car="joint", train=None, bounds=None, gap_wei
         if name not in ("k1", "k2", "th", "tau", "eta"):
             raise ValueError("bounds item %r: expected one of k1, k2, th, tau, eta" % (name,))
         items.append((name, _number("bounds " + name, b[0]), _number("bounds " + name, b[1])))
-    return _result(_ddemap.calibrate(files, bool(joint), car, train, items, _number("gap_weight", gap_weight)))
+    if report is not None:
+        report = str(report)
+        if _os.path.exists(report) and not _os.path.isdir(report):
+            raise ValueError("report = %r: expected a folder" % (report,))
+        _os.makedirs(report, exist_ok=True)
+    return _result(_ddemap.calibrate(files, bool(joint), car, train, items, _number("gap_weight", gap_weight),
+                                     "" if runs is None else str(runs), "" if data_dir is None else str(data_dir),
+                                     "" if report is None else report))
 
 
 def mixed_ring(fleet, ring=None, speed=None, length=None, solver="auto", count=6, degree=0):

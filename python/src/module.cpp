@@ -7,7 +7,8 @@
 // Errors: std::invalid_argument (the library's bad-input errors) -> ValueError (pybind11's
 // default translation, kept explicit here). Every computation runs with the GIL released; where
 // the library reports progress (sweep rows, boundary seed rows, vehicles and samples of
-// classify, simulated time, calibration fits) the callback checks for Ctrl-C on the main thread and stops the computation
+// classify, simulated time, calibration fits, the points of equilibrium branches, Hopf curves and
+// orbit branches) the callback checks for Ctrl-C on the main thread and stops the computation
 // (KeyboardInterrupt).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -17,6 +18,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -33,6 +35,7 @@
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
+#include "ddemap/io/calibration_report.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/traffic/nonlinear_ring.hpp"
@@ -89,6 +92,12 @@ Progress interruptible() {
     };
 }
 
+/// The same for a branch (a continuation: equilibria, Hopf curves, periodic orbits), checked
+/// after every point.
+BranchProgress branch_interruptible() {
+    return [check = interruptible()](long done, long total, double) { check(done, total); };
+}
+
 /// Runs `f` with the GIL released.
 template <class F>
 auto released(F&& f) {
@@ -130,7 +139,8 @@ std::string py_roots(const std::string& model_name, const ParameterMap& values, 
     const Linearisation lin = model->linearise();
     // as the command: the verdict from one winding pass where it applies (analysis/ring_fast.hpp)
     const std::string method = resolve_ring_method("auto", lin);
-    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count); });
+    const Progress progress = interruptible();
+    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count, progress); });
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
@@ -190,10 +200,11 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;
     const std::string method = cars ? resolve_ring_method("auto", lin) : std::string();
+    const Progress progress = interruptible();
     const StringResult s = released([&] {
         StringResult r = analyse_string(lin);
         if (cars) {
-            fast = analyse_ring_fast(lin, *cars, method, 0);
+            fast = analyse_ring_fast(lin, *cars, method, 0, progress);
             ring = fast->ring;
         }
         return r;
@@ -428,7 +439,8 @@ py::tuple py_simulate(const std::string& fleet, const std::string& lead_profile,
 }
 
 std::string py_calibrate(const std::vector<std::string>& files, bool joint, const std::string& car, std::optional<std::pair<double, double>> train,
-                      const std::vector<std::tuple<std::string, double, double>>& bounds, double gap_weight) {
+                      const std::vector<std::tuple<std::string, double, double>>& bounds, double gap_weight, const std::string& runs,
+                      const std::string& data_dir, const std::string& report) {
     CalibrationOptions o;
     o.gap_weight = gap_weight;
     if (train) {
@@ -439,14 +451,23 @@ std::string py_calibrate(const std::vector<std::string>& files, bool joint, cons
     }
     for (const auto& [name, lo, hi] : bounds) o.set_bounds(name, lo, hi);
     o.validate();
-    if (files.empty()) throw std::invalid_argument("files: expected at least one trace");
+    if (!runs.empty() && !files.empty()) throw std::invalid_argument("runs = '" + runs + "': give the files in the run list, not also as files");
+    if (runs.empty() && files.empty()) throw std::invalid_argument("files: expected at least one trace (or runs=RUNS.csv)");
+    if (!data_dir.empty() && runs.empty()) throw std::invalid_argument("data_dir = '" + data_dir + "': only with runs=RUNS.csv");
+    if (joint && !runs.empty()) throw std::invalid_argument("joint: not with runs (the run list groups the runs into cars)");
     std::vector<CarRuns> cars;
     auto base_name = [](const std::string& path) {
         std::string b = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
         if (b.size() > 4 && b.substr(b.size() - 4) == ".csv") b.resize(b.size() - 4);
         return b;
     };
-    if (joint) {
+    if (!runs.empty()) {
+        auto read = [&](const std::string& name) {
+            const std::string file = data_dir.empty() || name.front() == '/' ? name : (std::filesystem::path(data_dir) / name).string();
+            return read_trace_csv(read_text_file(file), file);
+        };
+        cars = cars_from_run_list(read_run_list_csv(read_text_file(runs), runs), read, "runs " + runs);
+    } else if (joint) {
         cars.push_back(CarRuns{car, {}, {}, {}});
         for (const auto& f : files) cars[0].train.push_back(read_trace_csv(read_text_file(f), f));
     } else {
@@ -468,6 +489,7 @@ std::string py_calibrate(const std::vector<std::string>& files, bool joint, cons
         for (const auto& t : c.train) traces.push_back(json_string(t.source));
     JsonObject in;
     in.json("traces", json_array(traces)).string("model", "ovrv").number("gap_weight", o.gap_weight);
+    if (!runs.empty()) in.string("runs", runs);
     if (joint) in.string("joint", car);
     if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
     e.inputs = in.str();
@@ -479,6 +501,11 @@ std::string py_calibrate(const std::vector<std::string>& files, bool joint, cons
             e.message = names[i] + ": " + fits[i].message;
         }
     e.status = to_string(status);
+    if (!report.empty()) {  // the folder exists (the Python wrapper creates it)
+        std::vector<std::pair<std::string, std::string>> out = calibration_report_files(results, cars, o, runs.empty() && !joint);
+        for (auto& f : out) f.first = report + "/" + f.first;
+        write_files_atomic(out);
+    }
     return envelope_json(e);
 }
 
@@ -557,6 +584,7 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
     o.roots.count = count;
     o.continuation.max_points = max_points;
     pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
+    o.progress = branch_interruptible();
     const EquilibriumBranch b = released([&] { return equilibrium_branch(*pb.system, pb.guess, o); });
     JsonEnvelope e;
     e.command = "equilibria";
@@ -599,11 +627,14 @@ std::string py_hopf(const std::string& system_file, const std::string& model, in
     e.command = "hopf";
     e.inputs = pb.inputs.str();
     if (two) {
+        co.branch.progress = branch_interruptible();
+        co.progress = branch_interruptible();
         const HopfCurves c = released([&] { return hopf_curves(*pb.system, pb.guess, co); });
         e.status = to_string(c.status);
         e.message = c.message;
         e.result = hopf_curves_json(c, par2, pb.variables);
     } else {
+        o.progress = branch_interruptible();
         const HopfAnalysis h = released([&] { return hopf_points(*pb.system, pb.guess, o); });
         e.status = to_string(h.status);
         e.message = h.message;
@@ -630,6 +661,8 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     eo.from = o.from;
     eo.to = o.to;
     eo.roots.count = 2;
+    eo.progress = branch_interruptible();
+    o.progress = branch_interruptible();
     const EquilibriumBranch eq = released([&] { return equilibrium_branch(*pb.system, pb.guess, eo); });
     if (eq.hopf.empty())
         throw std::invalid_argument("no Hopf point on the equilibrium branch in " + par + " from " + json_number(from) + " to " + json_number(to) +
@@ -681,7 +714,8 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("classify", &py_classify, py::arg("vehicles"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"));
     m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("lead_profile"), py::arg("lead"), py::arg("on_event"), py::arg("t_end"),
           py::arg("step"), py::arg("output_dt"));
-    m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"));
+    m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"),
+          py::arg("runs"), py::arg("data_dir"), py::arg("report"));
     m.def("mixed_ring", &py_mixed_ring, py::arg("fleet"), py::arg("is_pattern"), py::arg("ring"), py::arg("speed"), py::arg("length"),
           py::arg("solver"), py::arg("count"), py::arg("degree"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),

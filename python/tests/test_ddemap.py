@@ -203,6 +203,30 @@ def test_calibrate():
     assert len(r["fits"]["status"]) == 1
 
 
+def test_calibrate_runs_joint_report(tmp_path):
+    # what the command offers for several runs: --joint, --runs (with --data-dir) and --report
+    trace = os.path.join(SOURCE, "tests", "data", "openacc_excerpt_rav4_to_etron.csv")
+    data = tmp_path / "data"
+    data.mkdir()
+    for name in ("a.csv", "b.csv"):
+        (data / name).write_text(open(trace).read())
+    r = ddemap.calibrate(str(data / "a.csv"), str(data / "b.csv"), joint=True, car="rav4", train=(0, 45))
+    same_envelope(r, cli_json("calibrate", "--joint", "--car", "rav4", data / "a.csv", data / "b.csv", "--train", "0:45", "--quiet"))
+    runs = tmp_path / "runs.csv"
+    runs.write_text("car,file,role,type\nrav4,a.csv,train,\nrav4,b.csv,test,same\n")
+    r = ddemap.calibrate(runs=runs, data_dir=data, report=tmp_path / "py")
+    same_envelope(r, cli_json("calibrate", "--runs", runs, "--data-dir", data, "--report", tmp_path / "cli", "--quiet"))
+    assert r["fits"]["tests"][0]["type"] == ["same"]
+    files = sorted(os.listdir(tmp_path / "cli"))
+    assert files == sorted(os.listdir(tmp_path / "py")) and len(files) == 5, files  # 3 tables, 2 figures
+    for f in files:
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+    with pytest.raises(ValueError, match="data_dir = .*: only with runs"):
+        ddemap.calibrate(trace, data_dir=data)
+    with pytest.raises(ValueError, match="joint: not with runs"):
+        ddemap.calibrate(runs=runs, data_dir=data, joint=True)
+
+
 def test_mixed_ring():
     r = ddemap.mixed_ring("A_min,C_max*3", count=4)
     same_envelope(r, cli_json("roots", "--fleet", "A_min,C_max*3", "--count", 4))
@@ -332,6 +356,33 @@ def test_ctrl_c_stops_a_long_sweep():
     stopped = time.perf_counter() - sent
     assert rc == 7 and p.stdout.read().strip() == "interrupted"
     assert stopped < 5, stopped  # the full sweep takes minutes
+
+
+def test_ctrl_c_stops_orbits_and_a_later_call_works():
+    # SIGINT from a timer thread while the orbits are computed: the 10-car IDM ring's branch of 100
+    # orbits (about a minute: BENCHMARKS.md), interrupted a few orbits in (the branch timed first)
+    ring = dict(model="idm", ring=10, th=1.2, tau=0.6)
+    start = time.perf_counter()
+    branch = ddemap.equilibria("gap", 6, 40, count=2, **ring)
+    t_branch = time.perf_counter() - start
+    start = time.perf_counter()
+    short = ddemap.orbits("gap", 6, 40, points=3, **ring)
+    per_orbit = (time.perf_counter() - start - t_branch) / 3
+    assert len(short["points"]["par"]) == 3
+    at = t_branch + max(0.5, 3 * per_orbit)  # a few orbits into the branch of 100
+    timer = threading.Timer(at, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        ddemap.orbits("gap", 6, 40, points=100, **ring)
+    took = time.perf_counter() - start
+    timer.join()
+    # stopped within about one orbit of the signal, long before the 100 orbits would end
+    assert took - at < max(1.5, 3 * per_orbit), (took, at, per_orbit)
+    assert took < t_branch + 30 * per_orbit, (took, t_branch, per_orbit)
+    # the module still works, and gives what it gave before
+    again = ddemap.equilibria("gap", 6, 40, count=2, **ring)
+    assert list(again["points"]["par"]) == list(branch["points"]["par"])
 
 
 def test_stability_chart_example(tmp_path):

@@ -394,6 +394,7 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         }
         pt.stable = converged(rr.status) && !rr.roots.empty() && pt.abscissa < -marginal_band(rr.roots.front().value);
         br.points.push_back(std::move(pt));
+        if (options.progress) options.progress(static_cast<long>(br.points.size()), static_cast<long>(c.points.size()), u[n]);
     }
 
     bool special_ok = true;

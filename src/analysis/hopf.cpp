@@ -432,6 +432,9 @@ HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCu
     Eigen::VectorXd u0(N);
     u0 << start.x, start.par, q.real(), q.imag(), start.omega, held2;
 
+    long traced = 1;  // the start
+    if (o.progress)
+        co.on_point = [&](const Eigen::VectorXd& u) { o.progress(++traced, 2L * budget - 1, u[n]); };
     std::vector<CurveSample> samples[2];
     ContinuationStop stops[2] = {ContinuationStop::MaxPoints, ContinuationStop::MaxPoints};
     Status dir_status[2] = {Status::Converged, Status::Converged};

@@ -496,7 +496,11 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         cp = std::move(next);
         cur = cp.get();
     };
+    auto report = [&] {
+        if (o.progress) o.progress(static_cast<long>(b.points.size()), o.max_points, b.points.back().par);
+    };
     b.points.push_back(make_orbit(*cur, u, first, o.floquet));
+    report();
     const double amp0 = amplitude(b.points.front());
     b.newton_iterations += first.iterations;
     double h = o.initial_step;
@@ -533,8 +537,10 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
             Eigen::VectorXd w = v;
             const Correction rb = correct(c, w, ref, e, bound, o);
             b.newton_iterations += rb.iterations;
-            if (rb.ok) b.points.push_back(make_orbit(c, w, rb, o.floquet));
-            else {
+            if (rb.ok) {
+                b.points.push_back(make_orbit(c, w, rb, o.floquet));
+                report();
+            } else {
                 b.status = Status::MaxIterations;
                 b.message = "the orbit on the end of the parameter range did not converge";
             }
@@ -608,6 +614,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         }
         const bool collapsed = amplitude(orbit) < 0.5 * amp0;
         b.points.push_back(std::move(orbit));
+        report();
         if (collapsed) {  // the amplitude fell back towards 0: the branch ends at an equilibrium (a Hopf point)
             b.stop = "hopf";
             return;

@@ -82,9 +82,10 @@ std::vector<RingRoot> neighbour_roots(const Linearisation& lin, int cars, const 
 
 }  // namespace
 
-FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count) {
+FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress) {
     FastRing f;
     RingOptions opt;
+    opt.progress = progress;
     if (count > 0) opt.roots.count = count;
     if (method == "modes") {
         f.ring = analyse_ring(lin, cars, opt);

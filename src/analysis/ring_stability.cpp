@@ -72,7 +72,10 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             per_mode[m] = solve_mode(dde, o, true);
             asked[m] = std::max(asked[m], static_cast<int>(per_mode[m].roots.size()));
         };
-        for (int m = 0; m < modes; ++m) solve(m);
+        for (int m = 0; m < modes; ++m) {
+            solve(m);
+            if (options.progress) options.progress(m + 1, modes);
+        }
         auto weight = [&](int m) { return (m > 0 && 2 * m != cars) ? 2 : 1; };
         for (int round = 0; round < 16; ++round) {
             std::vector<double> re;

@@ -1,6 +1,9 @@
 #include "ddemap/io/calibration_report.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <stdexcept>
 #include <cstdio>
 #include <sstream>
 
@@ -232,6 +235,57 @@ std::string calibration_fit_svg(const std::string& title, const Trace& t, const 
     po.panel_width = 760.0;
     po.panel_height = 260.0;
     return render_line_plots_svg({sp, gp}, po);
+}
+
+std::vector<CarRuns> cars_from_run_list(const std::vector<RunListEntry>& entries, const std::function<Trace(const std::string& file)>& read,
+                                        const std::string& source) {
+    std::vector<CarRuns> cars;
+    for (const RunListEntry& e : entries) {
+        auto it = std::find_if(cars.begin(), cars.end(), [&](const CarRuns& c) { return c.car == e.car; });
+        if (it == cars.end()) {
+            cars.push_back(CarRuns{e.car, {}, {}, {}});
+            it = cars.end() - 1;
+        }
+        Trace tr = read(e.file);
+        if (e.role == "train") {
+            it->train.push_back(std::move(tr));
+        } else {
+            it->test.push_back(std::move(tr));
+            it->test_types.push_back(e.type);
+        }
+    }
+    for (const CarRuns& c : cars)
+        if (c.train.empty()) throw std::invalid_argument(source + ": car '" + c.car + "' has no run with role train");
+    return cars;
+}
+
+std::vector<std::pair<std::string, std::string>> calibration_report_files(const std::vector<CarCalibration>& results, const std::vector<CarRuns>& cars,
+                                                                          const CalibrationOptions& options, bool per_file) {
+    if (results.size() != cars.size()) throw std::invalid_argument("calibration report: expected one result per car");
+    std::vector<std::pair<std::string, std::string>> files;
+    const CalibrationReport rep = calibration_report(results);
+    files.push_back({"table.csv", calibration_report_csv(rep)});
+    files.push_back({"table.json", calibration_report_json(rep)});
+    files.push_back({"table.md", calibration_report_markdown(rep, options)});
+    auto base_name = [](const std::string& path) {
+        const auto slash = path.find_last_of('/');
+        std::string b = path.substr(slash == std::string::npos ? 0 : slash + 1);
+        if (b.size() > 4 && b.substr(b.size() - 4) == ".csv") b.resize(b.size() - 4);
+        return b;
+    };
+    auto figure = [&](const std::string& car, const std::string& title, const Trace& tr, const FitEvaluation& ev) {
+        std::string slug;
+        for (char ch : car) slug += std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '.' ? ch : '_';
+        files.push_back({"fit_" + (per_file ? std::string() : slug + "_") + base_name(tr.source) + ".svg", calibration_fit_svg(title, tr, ev, "run: " + tr.source)});
+    };
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        const CarCalibration& r = results[i];
+        for (std::size_t k = 0; k < cars[i].train.size() && k < r.fit.runs.size(); ++k)
+            figure(r.car, r.car + ": training run " + std::to_string(k + 1) + " of " + std::to_string(cars[i].train.size()), cars[i].train[k], r.fit.runs[k]);
+        for (std::size_t k = 0; k < r.tests.size() && k < cars[i].test.size(); ++k)
+            figure(r.car, r.car + ": test run (" + r.tests[k].type + ")", cars[i].test[k], r.tests[k].evaluation);
+    }
+    return files;
 }
 
 }  // namespace ddemap

@@ -184,6 +184,7 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
         r.points.push_back(sp.u(v));
         r.tangents.push_back(sp.u_tangent(tv));
         r.max_residual = std::max(r.max_residual, residual);
+        if (options.on_point && r.points.size() > 1) options.on_point(r.points.back());
     };
     auto test_values = [&](const Eigen::VectorXd& v, const Eigen::VectorXd& tv) {
         std::vector<double> g(tests.size());
@@ -328,6 +329,7 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
             r.points.push_back(e.u);
             r.tangents.push_back(e.t);
             r.max_residual = std::max(r.max_residual, e.residual);
+            if (options.on_point) options.on_point(r.points.back());
             return finish(ContinuationStop::TerminalEvent, Status::Converged, "test function '" + tests[static_cast<std::size_t>(e.index)].name + "' vanished");
         }
 

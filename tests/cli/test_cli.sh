@@ -1057,5 +1057,52 @@ OMP_NUM_THREADS=1 "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >
     cmp -s "$ccwd/p1.json" "$ccwd/p2.json" && ok || bad "roots --fleet with ccc cars: output depends on the number of threads"
 rm -rf "$ccwd"
 
+# ---- progress of equilibria, hopf and orbits on stderr (one line per finished point when stderr
+# is a file, none with --quiet), and SIGINT during orbits --out leaves the old set, nothing else
+pgd="$tmp/progress"; mkdir -p "$pgd"
+pgcount() {  # pgcount FILE REGEX: the number of lines of FILE matching REGEX
+    grep -c -E "$2" "$1"
+}
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 --format json >"$pgd/eq.json" 2>"$pgd/eq.err"
+n=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['result']['points']))" "$pgd/eq.json" 2>/dev/null || echo none)
+[ "$(pgcount "$pgd/eq.err" "^ddemap: equilibria: points [0-9]+/$n, p = [-0-9.e]+ \(")" = "$n" ] && ! grep -q "ddemap:" "$pgd/eq.json" && ok ||
+    bad "equilibria: not one progress line per point ($n): $(head -3 "$pgd/eq.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 --quiet >/dev/null 2>"$pgd/eq.err"
+[ ! -s "$pgd/eq.err" ] && ok || bad "equilibria --quiet still printed: $(head -3 "$pgd/eq.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b --from2 0.5 --to2 2 >/dev/null 2>"$pgd/hc.err"
+pgcount "$pgd/hc.err" '^ddemap: hopf: equilibria [0-9]+/[0-9]+, alpha = ' >/dev/null &&
+    pgcount "$pgd/hc.err" '^ddemap: hopf: [0-9]+ curve points \(at most 799\), alpha = [-0-9.e]+ \(' >/dev/null && ok ||
+    bad "hopf --par2: progress lines of the branch and the curve: $(head -3 "$pgd/hc.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --quiet >/dev/null 2>"$pgd/hc.err"
+[ ! -s "$pgd/hc.err" ] && ok || bad "hopf --quiet still printed: $(head -3 "$pgd/hc.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 12 --format json >"$pgd/or.json" 2>"$pgd/or.err"
+n=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['result']['points']))" "$pgd/or.json" 2>/dev/null || echo none)
+[ "$(pgcount "$pgd/or.err" '^ddemap: orbits: [0-9]+ orbits \(at most 12\), headway = [-0-9.e]+ \(')" = "$n" ] && ok ||
+    bad "orbits: not one progress line per orbit ($n): $(grep -v equilibria "$pgd/or.err" | head -3)"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 12 --quiet >/dev/null 2>"$pgd/or.err"
+[ ! -s "$pgd/or.err" ] && ok || bad "orbits --quiet still printed: $(head -3 "$pgd/or.err")"
+# SIGINT while the orbits are computed (after the second one): the old output set stays as it was
+mkdir -p "$pgd/int"
+for f in o.csv o.json o.svg; do echo old >"$pgd/int/$f"; done
+python3 - "$bin" "$pgd/int" <<'PY' && ok || bad "orbits interrupted by SIGINT"
+import os, signal, subprocess, sys, time
+bin, d = sys.argv[1], sys.argv[2]
+env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
+p = subprocess.Popen([bin, "orbits", "--model", "ov", "--ring", "10", "--par", "headway", "--from", "1.2", "--to", "3",
+                      "--out", d + "/o", "--svg", d + "/o.svg"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+for line in p.stderr:  # wait for the second orbit: the work is under way
+    if ": 2 orbits (at most" in line:
+        break
+else:
+    sys.exit("the orbits ended before the second orbit was reported")
+p.send_signal(signal.SIGINT)
+p.stderr.close()
+rc = p.wait(timeout=60)
+assert rc == -signal.SIGINT, rc
+left = sorted(os.listdir(d))
+assert left == ["o.csv", "o.json", "o.svg"], left
+assert all(open(os.path.join(d, f)).read() == "old\n" for f in left)
+PY
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

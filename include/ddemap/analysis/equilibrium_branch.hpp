@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/core/status.hpp"
 #include "ddemap/core/types.hpp"
 #include "ddemap/problem/nonlinear_dde.hpp"
@@ -54,6 +55,10 @@ struct EquilibriumBranchOptions {
     EquilibriumOptions equilibrium;    ///< the first point
     NewtonOptions special{40, 1e-12};  ///< Newton on the fold and Hopf systems
     double special_residual = 1e-9;    ///< accept a fold/Hopf point with residual at most this
+    /// After the roots of every point of the branch: (points done, points of the branch, p).
+    /// The continuation (Newton only) runs first, then the roots point by point (most of the
+    /// time); the callback may throw to stop, and that exception reaches the caller.
+    BranchProgress progress;
     bool is_valid(std::string* why = nullptr) const;
 };
 

@@ -126,6 +126,10 @@ struct HopfCurveOptions {
     }();
     int segment = 25;
     HopfCoefficientOptions coefficients;
+    /// After every point traced on a curve (both directions; the equilibrium branch in p1
+    /// reports through branch.progress): (points of this curve so far, at most
+    /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
+    BranchProgress progress;
     bool is_valid(std::string* why = nullptr) const;
 };
 

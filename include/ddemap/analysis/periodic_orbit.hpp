@@ -53,6 +53,7 @@
 #include <Eigen/Core>
 
 #include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/core/execution.hpp"
 #include "ddemap/core/status.hpp"
 #include "ddemap/core/types.hpp"
 #include "ddemap/discretize/periodic_mesh.hpp"
@@ -82,6 +83,9 @@ struct PeriodicOrbitOptions {
     /// multiplier 100 times less (6.8e-4 against 5.4e-6), and the history segment of the
     /// monodromy matrix (so its size) can grow where the mesh is fine near s = 1.
     bool adapt = false;
+    /// After every orbit added to the branch, the first included: (orbits so far, max_points, p).
+    /// It may throw to stop the branch; the exception reaches the caller (no partial branch).
+    BranchProgress progress;
     bool is_valid(std::string* why = nullptr) const;
 };
 

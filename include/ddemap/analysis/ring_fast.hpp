@@ -29,7 +29,8 @@ struct FastRing {
 };
 
 /// The ring's verdict and, when `count` > 0, its listed roots. `method` is "winding" or "modes";
-/// the per-mode path needs cars <= kModesMaxCars (checked by the caller).
-FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count);
+/// the per-mode path needs cars <= kModesMaxCars (checked by the caller). `progress`: the per-mode
+/// path's (RingOptions::progress; it may throw to stop); the winding pass does not report.
+FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress = {});
 
 }  // namespace ddemap

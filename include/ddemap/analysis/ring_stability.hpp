@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/traffic/ring.hpp"
@@ -15,6 +16,9 @@ namespace ddemap {
 struct RingOptions {
     RootOptions roots;      ///< per-mode options; roots.count is the number of roots reported
     int theta_grid = 64;    ///< N = infinity: uniform wave numbers in (0, pi] before refinement
+    /// N finite: after every mode of the first pass over the N/2 + 1 modes (modes done, modes);
+    /// it may throw to stop, and the exception reaches the caller. Not called for N = infinity.
+    Progress progress;
     void validate() const;
 };
 

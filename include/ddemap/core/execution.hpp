@@ -20,6 +20,12 @@ namespace ddemap {
 /// Progress callback: (tasks done, tasks in all); called from one thread at a time.
 using Progress = std::function<void(long done, long total)>;
 
+/// Progress of a branch (a continuation): after every finished point, (points done, total,
+/// the free parameter at that point). `total` is the number of points when it is known, else
+/// the most the branch may have (its max_points budget). Called on the caller's thread; it may
+/// throw to stop the work, and the exception then reaches the caller (no partial result).
+using BranchProgress = std::function<void(long done, long total, double par)>;
+
 struct ExecutionPolicy {
     int threads = 0;    ///< 0: the default (OMP_NUM_THREADS, else every core); 1: serial
     Progress progress;  ///< after each finished task of a parallel_for (may be empty)

@@ -5,7 +5,9 @@
 /// and the test error per test type (speed and spacing RMSE of the simulated follower), as
 /// CSV, JSON and Markdown; and per run a figure of the measured against the simulated speed
 /// and gap over time.
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ddemap/analysis/calibrate.hpp"
@@ -21,6 +23,12 @@ struct RunListEntry {
 /// Reads a run list; std::invalid_argument "SOURCE:LINE: ..." for an empty car or file, a role
 /// other than train or test, a missing column; "SOURCE: ..." when no line is listed.
 std::vector<RunListEntry> read_run_list_csv(const std::string& text, const std::string& source);
+
+/// The cars of a run list, in order of first appearance, each with its train runs and its test
+/// runs (and their types); `read(file)` reads the trace a line names. std::invalid_argument
+/// "SOURCE: car 'X' has no run with role train" when a car has no train run.
+std::vector<CarRuns> cars_from_run_list(const std::vector<RunListEntry>& entries, const std::function<Trace(const std::string& file)>& read,
+                                        const std::string& source);
 
 /// One row of the report: a car, its fit and its errors pooled per test type.
 struct CalibrationReportRow {
@@ -63,5 +71,13 @@ std::string calibration_report_markdown(const CalibrationReport& report, const C
 /// line under the legend (e.g. the run's file).
 std::string calibration_fit_svg(const std::string& title, const Trace& trace, const FitEvaluation& evaluation,
                                 const std::string& note = {});
+
+/// The files of a report folder (names relative to it, and contents): table.csv, table.json,
+/// table.md, and one figure per training and test run, fit_CAR_FILE.svg (CAR with every
+/// character but letters, digits, '-' and '.' replaced by '_'; FILE the run's file name
+/// without folder and ".csv"; "CAR_" left out when `per_file`: one fit per file, named after
+/// it). `results[i]` is the calibration of `cars[i]`.
+std::vector<std::pair<std::string, std::string>> calibration_report_files(const std::vector<CarCalibration>& results, const std::vector<CarRuns>& cars,
+                                                                          const CalibrationOptions& options, bool per_file);
 
 }  // namespace ddemap

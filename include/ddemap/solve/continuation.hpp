@@ -81,6 +81,10 @@ struct ContinuationOptions {
     Eigen::VectorXd lower, upper;
     /// Characteristic size c_i > 0 of each unknown (empty: all 1).
     Eigen::VectorXd scale;
+    /// Called with the unknowns u of every point added to the branch after the start (in u, not
+    /// scaled); may throw to stop the continuation (the exception reaches the caller of
+    /// continue_branch). Empty: nothing is called.
+    std::function<void(const Eigen::VectorXd& u)> on_point;
     /// True when the options are usable; otherwise `why` (if given) names the field.
     bool is_valid(std::string* why = nullptr) const;
 };
