@@ -463,7 +463,8 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
         std::ostringstream s;
         s << "no Hopf point of ring mode " << options.wave << " with omega > 0 on the uniform flow for " << o.parameter << " in [" << o.from << ", "
           << o.to << "]" << (res.hopf.status == Status::MaxIterations ? " was located" : "")
-          << " (a Hopf point of modes k and N - k is a wave of one of the two wave numbers: try " << options.cars - options.wave << ")";
+          << " (a Hopf point of modes k and N - k is a wave of only one of the two wave numbers: if the ring has one in this range, try "
+          << options.cars - options.wave << ")";
         b.message = s.str();
         return res;
     }

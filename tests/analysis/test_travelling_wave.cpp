@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "../tolerances.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
@@ -55,7 +56,7 @@ FullRing full_ring(int cars, int points) {
 
 /// |a - b| <= the mesh change |a - a20| + floor (see tol::wave_vs_full_ring_floor)
 void check_agrees(double reduced, double reduced20, double full, double floor, const char* what) {
-    INFO(what << ": reduced " << reduced << " (20 intervals: " << reduced20 << "), full ring " << full);
+    INFO(std::string(what) << ": reduced " << reduced << " (20 intervals: " << reduced20 << "), full ring " << full);
     CHECK(std::abs(reduced - full) <= std::abs(reduced - reduced20) + floor);
 }
 
@@ -157,6 +158,61 @@ TEST_CASE("travelling waves: 1000 cars, 100 per wave, the ring length held by ev
         for (long car = 0; car < 1000; ++car) sum += wave_car_state(mesh, last, 1000, 10, car, s)(0);
         CHECK(std::abs(sum / (1000 * last.par) - 1.0) <= tol::wave_ring_length);
     }
+}
+
+TEST_CASE("travelling waves: the 6-car IDM ring, reduced against full (supercritical Hopf point, the end orbit and its stability)") {
+    // th = 1.2 s, tau = 0.6 s: the uniform flow loses stability below gap ~10.917 m (ring modes
+    // 1 and 5); the waves born there are stable and exist for smaller gaps
+    const int cars = 6;
+    const ParameterMap parameters{{"th", 1.2}, {"tau", 0.6}};
+    auto options = [&](int intervals, bool floquet) {
+        TravellingWaveOptions o;
+        o.model = "idm";
+        o.cars = cars;
+        o.wave = 1;
+        o.orbit.parameter = "gap";
+        o.orbit.from = 10.92;
+        o.orbit.to = 10.85;
+        o.orbit.intervals = intervals;
+        o.orbit.max_points = 60;
+        o.orbit.floquet = floquet;
+        return o;
+    };
+    ParameterMap start = parameters;
+    start["gap"] = 10.92;
+    NonlinearRing ring = make_nonlinear_ring("idm", cars, start);
+    EquilibriumBranchOptions eo;
+    eo.parameter = "gap";
+    eo.from = 10.92;
+    eo.to = 10.85;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = equilibrium_branch(*ring.system, ring.uniform_flow, eo);
+    REQUIRE(eq.hopf.size() == 1);
+    const OrbitBranch full = orbit_branch_from_hopf(*ring.system, eq.hopf[0], options(40, false).orbit);
+    REQUIRE(full.stop == "bound");
+    const TravellingWaveBranch w = travelling_wave_branch(parameters, options(40, true));
+    const TravellingWaveBranch w20 = travelling_wave_branch(parameters, options(20, false));
+    REQUIRE(w.hopf.status == Status::Converged);
+    CHECK(std::abs(w.hopf.par - eq.hopf[0].par) <= tol::wave_vs_full_ring_floor);
+    CHECK(std::abs(w.hopf.omega - eq.hopf[0].omega) <= tol::wave_vs_full_ring_floor);
+    REQUIRE(w.branch.stop == "bound");
+    REQUIRE(w20.branch.stop == "bound");
+    const PeriodicOrbit& er = w.branch.points.back();
+    const PeriodicOrbit& er20 = w20.branch.points.back();
+    const PeriodicOrbit& ef = full.points.back();
+    REQUIRE(er.par == 10.85);
+    REQUIRE(ef.par == 10.85);
+    check_agrees(er.period, er20.period, ef.period, tol::wave_vs_full_ring_floor, "period at gap 10.85");
+    for (int q = 0; q < 2; ++q) {
+        const int col = q == 0 ? 0 : cars - 1;  // s_0, v_0 of the full ring's state
+        check_agrees(er.min(q), er20.min(q), ef.min(col), tol::orbit_extremes, "min at gap 10.85");
+        check_agrees(er.max(q), er20.max(q), ef.max(col), tol::orbit_extremes, "max at gap 10.85");
+    }
+    // supercritical: stable waves in the full ring (its multipliers along the reduced wave)
+    REQUIRE(w.full_ring_stability);
+    REQUIRE(!er.multipliers.empty());
+    CHECK(er.stable);
+    CHECK(er.trivial_distance <= tol::wave_full_ring_multipliers);
 }
 
 TEST_CASE("travelling waves: bad input") {
