@@ -30,9 +30,10 @@
 /// Start: the Hopf point of ring mode k on the uniform flow, i.e. of the 2 x 2 characteristic
 /// matrix  Delta_k(lambda) = lambda I - A_0 - A_1 e^{-lambda tau} - z (A_2 + A_3 e^{-lambda tau}),
 /// z = exp(2 pi i k / N) (the leader of a wave x e^{i omega t} is z times the car at omega T = 2 pi):
-/// the rightmost roots of this complex DDE (solve/roots.hpp) on a grid of 41 values of p, the
-/// first sign change of max Re(lambda) over the roots with Im(lambda) > 0 bracketed and located by
-/// Illinois regula falsi with Newton on det Delta_k. A Hopf point of modes k and N - k is one pair
+/// the 8 rightmost roots of this complex DDE at p = from (solve/roots.hpp, certified), those with
+/// Im(lambda) > 0 followed by Newton on det Delta_k over 200 equal steps of p towards `to`; the
+/// first sign change of Re(lambda) of one of them is located by Illinois regula falsi (a root
+/// that enters from left of these 8 is not followed). A Hopf point of modes k and N - k is one pair
 /// of roots: one of the two wave numbers has it at +i omega, the other at -i omega (no wave with
 /// omega > 0), so one of k and N - k is the wave born there.
 ///
