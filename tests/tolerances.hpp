@@ -129,4 +129,34 @@ constexpr double orbit_trivial_multiplier = 1e-5;
 /// V is only C^2 at h_st (order of both methods reduced there): 2e-4 relative.
 constexpr double orbit_vs_simulation = 2e-4;
 
+/// The reduced travelling-wave form against the full ring on the same mesh (degree 4, 40
+/// intervals): the two discretise the same wave differently (the full ring's cars are each a
+/// piecewise polynomial, the reduced form's cars are one polynomial shifted), so they differ by
+/// their discretisation errors, each at most the change of the reduced form from 20 to 40
+/// intervals (an error O(h^d) falls by 2^d = 16 under halving, so that change is ~15 times the
+/// error at 40). The test asserts |reduced - full| <= that change + this floor, which covers what
+/// the mesh change does not: the Newton and fold-location tolerances (1e-10 relative, regula
+/// falsi to 1e-11) for periods and parameters; a wrong shift or wave number is off by O(1).
+constexpr double wave_vs_full_ring_floor = 1e-8;
+/// The full ring's Floquet multipliers along the reduced wave spread to the N cars (not a
+/// collocation solution of the full ring: each car's shifted polynomial differs from it by the
+/// discretisation error) against those of the full ring's own orbit at the same parameter: the
+/// trivial multiplier of the spread wave is off by up to 6e-4 (N = 5, 40 intervals, steep
+/// fronts), the others by the same order; 1e-3 absolute, while a different orbit or ring is off by
+/// O(1).
+constexpr double wave_full_ring_multipliers = 1e-3;
+/// The ring length sum_i h_i(t) = N headway of a travelling wave spread to the N cars from car
+/// 0's piecewise polynomial: exact for the continuous wave (d/dt sum_i h_i = sum_i (v_{i+1} -
+/// v_i) = 0 around the ring); the collocation imposes the mean of h exactly (Gauss quadrature of
+/// a polynomial) and the sum at other times to the discretisation error of h, O(h^(d+1)) ~ 1e-6
+/// relative per car on 40 intervals of degree 4 for these smooth waves; 1e-5 relative.
+constexpr double wave_ring_length = 1e-5;
+
+/// The unfolding term mu of the reduced travelling-wave form, 0 for the continuous wave
+/// (mu = mean(v_lead - v) over a period): the collocation leaves the Gauss quadrature error of
+/// the leader's shifted polynomial (breakpoints inside the intervals unless k / N is a multiple of
+/// the mesh width), measured 6e-8 on 20 and below 1e-8 on 40 intervals of degree 4 (ov ring,
+/// N = 3); 1e-6.
+constexpr double wave_drift = 1e-6;
+
 }  // namespace ddemap::test::tol

@@ -9,6 +9,7 @@
 #include "format.hpp"
 #include "limits.hpp"
 #include "nonlinear_flags.hpp"
+#include "orbits_wave.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
 #include "ddemap/io/csv.hpp"
@@ -22,6 +23,8 @@ namespace {
 struct Args {
     NonlinearProblemArgs problem;
     std::string hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
+    std::string wave, initial_step;
+    CLI::Option* hopf_option = nullptr;
     bool adapt = false;
     FormatArg format;
     OutArg out;
@@ -37,7 +40,7 @@ std::string pad(std::string s, std::size_t w) {
 
 void add_orbits_flags(CLI::App& app) {
     args.problem.add_to(app);  // --system | --model ov|idm ..., --par, --from (the equilibrium branch, whose Hopf points start the orbits), --to
-    app.add_option("--hopf", args.hopf, "the index (from 0, in the order met along the equilibrium branch) of the Hopf point to start from")
+    args.hopf_option = app.add_option("--hopf", args.hopf, "the index (from 0, in the order met along the equilibrium branch) of the Hopf point to start from")
         ->capture_default_str()->type_name("INTEGER");
     app.add_option("--degree", args.degree, "degree d of the piecewise polynomials (1..20)")->capture_default_str()->type_name("INTEGER");
     app.add_option("--intervals", args.intervals, "number L of mesh intervals over one period (2..10000)")->capture_default_str()->type_name("INTEGER");
@@ -49,9 +52,20 @@ void add_orbits_flags(CLI::App& app) {
     args.format.add_to(app);
     args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json", false);
     run_flags().add_to(app, false);
+
+    app.add_option("--wave", args.wave,
+                   "--model ov|idm --ring N: the travelling waves of wave number K (1..N-1; car i + 1 repeats car i shifted by K T / N) in "
+                   "the reduced form, one car whatever N (see README)")
+        ->type_name("K");
+    app.add_option("--initial-step", args.initial_step, "--wave: the first step along the branch in its weighted norm (default 0.02; long waves need smaller)")
+        ->type_name("H");
 }
 
 int run_orbits() {
+    if (!args.wave.empty())
+        return run_orbits_wave({args.problem, args.wave, args.degree, args.intervals, args.points, args.initial_step, args.svg, args.variable, args.adapt,
+                                args.hopf_option && args.hopf_option->count() > 0, args.format, args.out});
+    if (!args.initial_step.empty()) throw BadInput("--initial-step: only with --wave (expected --wave K)");
     const Format format = args.format.parse();
     const std::string prefix = args.out.given() ? args.out.prepare("orbits", {".csv", ".json"}) : std::string();
     const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);

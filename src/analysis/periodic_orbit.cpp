@@ -700,6 +700,28 @@ OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<
     return g;
 }
 
+std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
+                                    const Eigen::MatrixXd& profile, double period, double par) {
+    if (profile.rows() != mesh.points() || profile.cols() != system.dimension())
+        throw std::invalid_argument("orbit multipliers: expected a profile of (degree x intervals) rows and one column per variable");
+    if (!(period > 0.0) || !std::isfinite(period)) throw std::invalid_argument("orbit multipliers: expected a period > 0");
+    Setup c(system, mesh);
+    c.n = system.dimension();
+    c.m = system.delay_count();
+    c.j = system.parameter_index(parameter);
+    c.d = mesh.degree();
+    c.L = mesh.intervals();
+    c.P = mesh.points();
+    c.base = system.parameter_values();
+    Eigen::VectorXd u(c.N() + 2);
+    for (int i = 0; i < c.P; ++i) u.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = profile.row(i).transpose();
+    u(c.N()) = period;
+    u(c.N() + 1) = par;
+    std::vector<cplx> out;
+    if (!multipliers(c, u, out)) out.clear();
+    return out;
+}
+
 OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options) {
     if (!(hopf.omega > 0.0) || !std::isfinite(hopf.omega)) throw std::invalid_argument("orbits from a Hopf point: expected omega > 0");
     if (hopf.q.size() != system.dimension() || hopf.x.size() != system.dimension())

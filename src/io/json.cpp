@@ -547,4 +547,19 @@ std::string equilibrium_result_json(const EquilibriumResult& eq) {
         .str();
 }
 
+std::string travelling_wave_json(const TravellingWaveBranch& w, const std::vector<std::string>& variables, int multipliers) {
+    json j = json::parse(orbit_branch_json(w.branch, variables, multipliers));
+    for (std::size_t i = 0; i < w.branch.points.size(); ++i)
+        if (w.branch.points[i].multipliers.empty()) j["points"][i]["stable"] = nullptr;
+    json wave;
+    wave["cars"] = w.cars;
+    wave["wave"] = w.wave;
+    wave["shift"] = num(static_cast<double>(w.wave) / w.cars);
+    wave["hopf"] = {{"par", num(w.hopf.par)}, {"omega", num(w.hopf.omega)}, {"status", to_string(w.hopf.status)}};
+    wave["stability"] = w.full_ring_stability ? "full_ring" : "not_computed";
+    wave["max_drift"] = num(w.max_drift);
+    j["wave"] = wave;
+    return text(j);
+}
+
 }  // namespace ddemap

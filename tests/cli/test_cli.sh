@@ -1104,5 +1104,40 @@ assert left == ["o.csv", "o.json", "o.svg"], left
 assert all(open(os.path.join(d, f)).read() == "old\n" for f in left)
 PY
 
+# ---- orbits --wave: travelling waves of a ring in the reduced form (one car; the leader is the car
+# shifted by K T / N). The 3-car ov ring: the wave agrees with the full ring's branch from the same
+# Hopf point (fold headway, period), and the stability is the full ring's (N <= 10)
+wav="$tmp/waves"; mkdir -p "$wav"
+"$bin" orbits --model ov --ring 3 --wave 1 --par headway --from 3.5 --to 2 --points 40 --format json --out "$wav/w" >"$wav/w.out" &&
+    "$bin" orbits --model ov --ring 3 --par headway --from 3.5 --to 2 --points 40 --format json >"$wav/f.out" &&
+    json_has "$wav/w.out" points folds period_doublings tori wave && [ -s "$wav/w.csv" ] && [ -s "$wav/w.json" ] &&
+    python3 - "$wav/w.out" "$wav/f.out" <<'PY' && ok || bad "orbits --wave 1 --ring 3: the reduced branch differs from the full ring's"
+import json, sys
+w, f = (json.load(open(a))["result"] for a in sys.argv[1:3])
+assert w["wave"]["cars"] == 3 and w["wave"]["wave"] == 1 and w["wave"]["stability"] == "full_ring", w["wave"]
+assert abs(w["wave"]["hopf"]["par"] - f["hopf"]["par"]) < 1e-8
+assert len(w["folds"]) == len(f["folds"]) == 1
+assert abs(w["folds"][0]["par"] - f["folds"][0]["par"]) < 1e-6 and abs(w["folds"][0]["period"] - f["folds"][0]["period"]) < 1e-6
+assert w["points"][-1]["par"] == f["points"][-1]["par"] == 2 and abs(w["points"][-1]["period"] - f["points"][-1]["period"]) < 1e-6
+assert w["points"][-1]["stable"] is True and w["points"][0]["stable"] is False
+assert w["variables"] == ["h0", "v0"]
+PY
+# 1000 cars, 10 per wave: one car's cost; no stability claimed (stable null, the table says not computed)
+"$bin" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --points 5 --format json >"$wav/l.out" &&
+    python3 -c "
+import json; r = json.load(open('$wav/l.out'))['result']
+assert r['wave']['stability'] == 'not_computed' and all(p['stable'] is None and p['multipliers'] == [] for p in r['points']), r['points'][0]
+assert len(r['points']) == 5 and r['certificate']['max_residual'] < 1e-8" && ok || bad "orbits --wave at 1000 cars"
+"$bin" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --points 3 | grep -q "not computed" && ok || bad "orbits --wave table: stability not computed"
+# the other wave number of the same Hopf pair has no wave with omega > 0: UNDECIDED, exit 4, naming the other one
+"$bin" orbits --model ov --ring 5 --wave 4 --par headway --from 3.5 --to 2 >"$wav/u.txt" 2>"$wav/u.err"
+[ $? -eq 4 ] && grep -q "try 1" "$wav/u.err" && ok || bad "orbits --wave 4 --ring 5: not UNDECIDED naming wave number 1"
+expect_error "--wave = '5': expected a wave number from 1 to N - 1 = 4" orbits --model ov --ring 5 --wave 5 --par headway --from 3.5 --to 2 --out "$wav/bad1"
+expect_error "--wave = '0': expected a wave number from 1 to N - 1 = 4" orbits --model ov --ring 5 --wave 0 --par headway --from 3.5 --to 2
+expect_error "--wave = '1' needs a built-in ring" orbits --system "$orb/wright.json" --wave 1 --par alpha --from 1 --to 2 --out "$wav/bad2"
+expect_error "--svg: not available with --wave" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --svg "$wav/bad3.svg"
+expect_error "--initial-step: only with --wave" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --initial-step 0.01
+[ -z "$(ls "$wav" | grep bad)" ] && ok || bad "orbits --wave bad input wrote files: $(ls "$wav")"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

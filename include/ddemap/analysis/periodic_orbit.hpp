@@ -160,6 +160,14 @@ OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& 
 /// that correction), followed in the direction of increasing p when to > from, else decreasing.
 OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options);
 
+/// The Floquet multipliers (as in the branch, by decreasing modulus, the trivial one included)
+/// of a given orbit of `system`: its values on `mesh` (points() x n), period and the value `par`
+/// of `parameter` (the other parameters as held). Empty when they could not be computed (a
+/// singular collocation matrix, a non-finite value, or a history segment above 4000 values).
+/// std::invalid_argument for sizes that do not fit, a period <= 0 or an unknown parameter.
+std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
+                                    const Eigen::MatrixXd& profile, double period, double par);
+
 /// x(s) of an orbit on `mesh` at s (any real: taken mod 1), all n components (for an orbit of a
 /// branch: PeriodicMesh(branch.degree, orbit.breakpoints)).
 Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s);

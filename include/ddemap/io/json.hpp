@@ -21,6 +21,7 @@
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/analysis/system_roots.hpp"
+#include "ddemap/analysis/travelling_wave.hpp"
 #include "ddemap/problem/nonlinear_dde.hpp"
 #include "ddemap/solve/equilibrium.hpp"
 #include "ddemap/study/boundary.hpp"
@@ -122,5 +123,11 @@ std::string mix_json(const std::vector<MixPoint>& points, int cars);
 /// "folds": [{"par", "period", "located"}], "period_doublings" and "tori": [{"par", "period",
 /// "multiplier": [re, im]}], "stop", "method", "certificate": {"max_residual", "max_trivial_distance"}}.
 std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers = 10);
+
+/// A branch of travelling waves (analysis/travelling_wave.hpp): the keys of orbit_branch_json
+/// (the variables are car 0's; "stable" is null where no multiplier was computed, i.e. N above
+/// the full-ring limit: not decided) and "wave": {"cars", "wave", "shift" (k / N of the period),
+/// "hopf": {"par", "omega", "status"}, "stability": "full_ring" | "not_computed", "max_drift"}.
+std::string travelling_wave_json(const TravellingWaveBranch& w, const std::vector<std::string>& variables, int multipliers = 10);
 
 }  // namespace ddemap

@@ -1,0 +1,639 @@
+#include "ddemap/analysis/travelling_wave.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+#include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/nonlinear_ring.hpp"
+#include "ddemap/traffic/ring_car.hpp"
+
+namespace ddemap {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+using Triplet = Eigen::Triplet<double>;
+using SpD = Eigen::SparseMatrix<double>;
+
+/// The reduced problem on a mesh. Unknowns u = (X (P x 2), T, p, mu): N + 3 values, N = 2 P.
+struct Wave {
+    Wave(const RingCar& c, const PeriodicMesh& me) : car(c), mesh(me) {}
+    const RingCar& car;
+    const PeriodicMesh& mesh;
+    double kappa = 0.0;  // k / N
+    int j = 0, d = 0, L = 0, P = 0;
+    std::vector<double> base;
+    Eigen::VectorXd w;  // weights of the continuation norm (size N + 3; mu not weighted)
+    static constexpr int n = 2;
+    static constexpr int m = 3;
+    int N() const { return P * n; }
+    std::vector<double> params(double p) const {
+        std::vector<double> v = base;
+        v[static_cast<std::size_t>(j)] = p;
+        return v;
+    }
+    double norm(const Eigen::VectorXd& v) const { return std::sqrt((w.array() * v.array().square()).sum()); }
+};
+
+Eigen::Vector2d combine(const Wave& c, const Eigen::VectorXd& u, int interval, const double* coef) {
+    Eigen::Vector2d v = Eigen::Vector2d::Zero();
+    for (int jj = 0; jj <= c.d; ++jj) v += coef[jj] * u.segment<2>(static_cast<Eigen::Index>(((interval * c.d + jj) % c.P) * 2));
+    return v;
+}
+
+/// The residual (N + 3: collocation, phase, length, arclength a . u - b) and with J its Jacobian.
+bool assemble(const Wave& c, const Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b, Eigen::VectorXd& F,
+              SpD* J) {
+    const int N = c.N();
+    const double T = u(N), p = u(N + 1), mu = u(N + 2);
+    if (!(T > 0.0) || !std::isfinite(p) || !std::isfinite(mu)) return false;
+    const std::vector<double> pv = c.params(p);
+    const std::vector<double> tau = c.car.delays(pv), dtau = c.car.delay_derivatives(pv, c.j);
+    for (double t : tau)
+        if (!(t >= 0.0) || !std::isfinite(t)) return false;
+    F.setZero(N + 3);
+    std::vector<Triplet> trip;
+    if (J) trip.reserve(static_cast<std::size_t>(N) * static_cast<std::size_t>(4 * (c.d + 1) * 4 + 8));
+    const int d = c.d;
+    std::vector<double> l(static_cast<std::size_t>(d) + 1), dl(l), lk(l), dlk(l);
+    Eigen::VectorXd stacked(2 * (c.m + 1));
+    std::vector<int> intervals(static_cast<std::size_t>(c.m));
+    std::vector<std::vector<double>> bases(static_cast<std::size_t>(c.m), l);
+    std::vector<Eigen::Vector2d> dxk(static_cast<std::size_t>(c.m));
+    const double length_target = c.j == c.car.length_parameter() ? p : c.base[static_cast<std::size_t>(c.car.length_parameter())];
+    for (int i = 0; i < c.L; ++i) {
+        const double h = c.mesh.width(i);
+        for (int g = 0; g < d; ++g) {
+            const double s = c.mesh.collocation_point(i, g);
+            c.mesh.basis(i, s, l.data(), dl.data());
+            const Eigen::Vector2d x = combine(c, u, i, l.data()), dx = combine(c, u, i, dl.data());
+            stacked.head<2>() = x;
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                const double sk = s - tau[uk] / T + (RingCar::is_lead(k + 1) ? c.kappa : 0.0);
+                double wrapped = sk - std::floor(sk);
+                if (wrapped >= 1.0) wrapped = 0.0;
+                intervals[uk] = c.mesh.interval_of(wrapped);
+                c.mesh.basis(intervals[uk], wrapped, bases[uk].data(), dlk.data());
+                stacked.segment<2>(2 * (k + 1)) = combine(c, u, intervals[uk], bases[uk].data());
+                dxk[uk] = combine(c, u, intervals[uk], dlk.data());
+            }
+            Eigen::VectorXd f = c.car.f(stacked, pv);
+            if (!f.allFinite()) return false;
+            f(0) += mu;
+            const int row = (i * d + g) * 2;
+            F.segment<2>(row) = dx - T * f;
+            const double wg = c.mesh.gauss_weights()[static_cast<std::size_t>(g)] * h;
+            const Eigen::Vector2d r = ref.row(i * d + g).transpose();
+            F(N) += wg * x.dot(r);
+            F(N + 1) += wg * x(0);
+            if (!J) continue;
+            const std::vector<Eigen::MatrixXd> A = c.car.jacobians(stacked, pv);
+            const Eigen::VectorXd fp = c.car.parameter_derivative(stacked, c.j, pv);
+            for (const auto& blk : A)
+                if (!blk.allFinite()) return false;
+            if (!fp.allFinite()) return false;
+            for (int jj = 0; jj <= d; ++jj) {
+                const int col = ((i * d + jj) % c.P) * 2;
+                const double lj = l[static_cast<std::size_t>(jj)], dlj = dl[static_cast<std::size_t>(jj)];
+                for (int q = 0; q < 2; ++q) {
+                    trip.emplace_back(row + q, col + q, dlj);
+                    for (int rr = 0; rr < 2; ++rr)
+                        if (A[0](rr, q) != 0.0) trip.emplace_back(row + rr, col + q, -T * lj * A[0](rr, q));
+                    if (r(q) != 0.0) trip.emplace_back(N, col + q, wg * lj * r(q));
+                }
+                trip.emplace_back(N + 1, col, wg * lj);
+            }
+            Eigen::Vector2d dT = -f, dp = -T * fp;
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                const Eigen::MatrixXd& Ak = A[uk + 1];
+                for (int jj = 0; jj <= d; ++jj) {
+                    const int col = ((intervals[uk] * d + jj) % c.P) * 2;
+                    const double lj = bases[uk][static_cast<std::size_t>(jj)];
+                    for (int q = 0; q < 2; ++q)
+                        for (int rr = 0; rr < 2; ++rr)
+                            if (Ak(rr, q) != 0.0) trip.emplace_back(row + rr, col + q, -T * lj * Ak(rr, q));
+                }
+                const Eigen::Vector2d ad = Ak * dxk[uk];
+                dT -= ad * (tau[uk] / T);  // the leader's shift kappa is constant in s: no T term
+                dp += ad * dtau[uk];
+            }
+            for (int q = 0; q < 2; ++q) {
+                trip.emplace_back(row + q, N, dT(q));
+                trip.emplace_back(row + q, N + 1, dp(q));
+            }
+            trip.emplace_back(row, N + 2, -T);
+        }
+    }
+    F(N + 1) -= length_target;
+    F(N + 2) = a.dot(u) - b;
+    if (J) {
+        if (c.j == c.car.length_parameter()) trip.emplace_back(N + 1, N + 1, -1.0);
+        for (int q = 0; q < N + 3; ++q)
+            if (a(q) != 0.0) trip.emplace_back(N + 2, q, a(q));
+        J->resize(N + 3, N + 3);
+        J->setFromTriplets(trip.begin(), trip.end());
+    }
+    return F.allFinite();
+}
+
+/// x' at the collocation points (row l d + g): the phase reference.
+Eigen::MatrixXd derivative_at_collocation(const Wave& c, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd r(c.P, 2);
+    std::vector<double> l(static_cast<std::size_t>(c.d) + 1), dl(l);
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < c.d; ++g) {
+            c.mesh.basis(i, c.mesh.collocation_point(i, g), l.data(), dl.data());
+            r.row(i * c.d + g) = combine(c, u, i, dl.data()).transpose();
+        }
+    return r;
+}
+
+struct Correction {
+    bool ok = false;
+    int iterations = 0;
+    double residual = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd tangent;
+};
+
+/// Newton on the bordered system (the last row a . u = b), as periodic_orbit's corrector.
+Correction correct(const Wave& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b, const PeriodicOrbitOptions& o) {
+    Correction r;
+    Eigen::VectorXd F;
+    SpD J;
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    const int N = c.N();
+    double last_step = std::numeric_limits<double>::infinity();
+    for (int it = 0; it <= o.max_iterations; ++it) {
+        if (it > 0 && last_step <= o.tolerance * std::max(1.0, u.head(N + 2).lpNorm<Eigen::Infinity>())) {
+            if (!assemble(c, u, ref, a, b, F, nullptr)) return r;
+            r.residual = F.head(N + 2).lpNorm<Eigen::Infinity>();
+            r.ok = r.residual <= o.residual_tolerance;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+            e(N + 2) = 1.0;
+            r.tangent = lu.solve(e);
+            if (!r.tangent.allFinite()) r.ok = false;
+            return r;
+        }
+        if (it == o.max_iterations) break;
+        if (!assemble(c, u, ref, a, b, F, &J)) return r;
+        J.makeCompressed();
+        lu.compute(J);
+        if (lu.info() != Eigen::Success) return r;
+        r.residual = F.head(N + 2).lpNorm<Eigen::Infinity>();
+        const Eigen::VectorXd du = lu.solve(F);
+        if (!du.allFinite()) return r;
+        u -= du;
+        ++r.iterations;
+        last_step = du.head(N + 2).lpNorm<Eigen::Infinity>();
+    }
+    return r;
+}
+
+/// The full ring (one headway eliminated) for the multipliers, or null when N is above the limit.
+struct FullRing {
+    std::unique_ptr<NonlinearDDE> system;
+    int cars = 0, wave = 0;
+};
+
+PeriodicOrbit make_orbit(const Wave& c, const Eigen::VectorXd& u, const Correction& r, const FullRing& full, const std::string& parameter,
+                         bool floquet) {
+    const int N = c.N();
+    PeriodicOrbit o;
+    o.period = u(N);
+    o.par = u(N + 1);
+    o.profile.resize(c.P, 2);
+    for (int i = 0; i < c.P; ++i) o.profile.row(i) = u.segment<2>(2 * i).transpose();
+    o.breakpoints = c.mesh.breakpoints();
+    o.min = o.profile.colwise().minCoeff().transpose();
+    o.max = o.profile.colwise().maxCoeff().transpose();
+    const int per = 8 * c.d;  // as periodic_orbit: 8 d samples per interval
+    for (int i = 0; i < c.L; ++i)
+        for (int k = 1; k < per; ++k) {
+            const Eigen::VectorXd x = orbit_value(c.mesh, o.profile, c.mesh.breakpoints()[static_cast<std::size_t>(i)] + c.mesh.width(i) * k / per);
+            o.min = o.min.cwiseMin(x);
+            o.max = o.max.cwiseMax(x);
+        }
+    o.residual = r.residual;
+    o.iterations = r.iterations;
+    if (floquet && full.system) {
+        // the wave spread to the N cars: (h_0..h_{N-2}, v_0..v_{N-1}) at every mesh point
+        const int cars = full.cars;
+        Eigen::MatrixXd profile(c.P, 2 * cars - 1);
+        for (int i = 0; i < c.P; ++i)
+            for (int car = 0; car < cars; ++car) {
+                const Eigen::VectorXd x = wave_car_state(c.mesh, o, cars, full.wave, car, c.mesh.point(i));
+                if (car + 1 < cars) profile(i, car) = x(0);
+                profile(i, cars - 1 + car) = x(1);
+            }
+        o.multipliers = orbit_multipliers(*full.system, parameter, c.mesh, profile, o.period, o.par);
+        if (!o.multipliers.empty()) {
+            std::size_t k1 = 0;
+            for (std::size_t k = 1; k < o.multipliers.size(); ++k)
+                if (std::abs(o.multipliers[k] - 1.0) < std::abs(o.multipliers[k1] - 1.0)) k1 = k;
+            o.trivial_distance = std::abs(o.multipliers[k1] - 1.0);
+            o.max_nontrivial = 0.0;
+            for (std::size_t k = 0; k < o.multipliers.size(); ++k)
+                if (k != k1) o.max_nontrivial = std::max(o.max_nontrivial, std::abs(o.multipliers[k]));
+            o.stable = o.max_nontrivial < 1.0;
+        }
+    }
+    return o;
+}
+
+double amplitude(const PeriodicOrbit& o) { return (o.max - o.min).maxCoeff(); }
+
+/// The mode-k characteristic matrix Delta_k(lambda) and Delta_k'(lambda) at the uniform flow of p.
+struct Mode {
+    Eigen::Matrix2cd M0, M1;
+    double tau = 0.0;
+    Eigen::Matrix2cd delta(cplx l) const { return l * Eigen::Matrix2cd::Identity() - M0 - M1 * std::exp(-l * tau); }
+    Eigen::Matrix2cd ddelta(cplx l) const { return Eigen::Matrix2cd::Identity() + tau * M1 * std::exp(-l * tau); }
+};
+
+Mode mode_at(const RingCar& car, const std::vector<double>& pv, cplx z, Eigen::VectorXd& x) {
+    x = car.uniform_flow(pv);
+    const std::vector<Eigen::MatrixXd> A = car.jacobians(car.stack_constant(x), pv);
+    Mode md;
+    md.tau = car.delays(pv)[0];
+    md.M0 = A[0].cast<cplx>() + z * A[2].cast<cplx>();
+    md.M1 = A[1].cast<cplx>() + z * A[3].cast<cplx>();
+    return md;
+}
+
+/// Newton on det Delta_k from lambda (lambda <- lambda - 1 / trace(Delta^{-1} Delta')); false when
+/// it does not converge.
+bool newton_root(const Mode& md, cplx& lambda) {
+    for (int it = 0; it < 60; ++it) {
+        const Eigen::Matrix2cd D = md.delta(lambda);
+        const cplx det = D.determinant();
+        if (det == 0.0) return true;
+        const cplx tr = (D.inverse() * md.ddelta(lambda)).trace();
+        if (!std::isfinite(std::abs(tr)) || tr == 0.0) return false;
+        const cplx step = 1.0 / tr;
+        lambda -= step;
+        if (std::abs(step) <= 1e-14 * std::max(1.0, std::abs(lambda))) return std::isfinite(std::abs(lambda));
+    }
+    return false;
+}
+
+/// The rightmost roots with Im > 0 of mode k at p (rightmost_roots of the complex 2 x 2 DDE).
+std::vector<cplx> upper_roots(const RingCar& car, const std::vector<double>& pv, cplx z) {
+    Eigen::VectorXd x;
+    const Mode md = mode_at(car, pv, z, x);
+    std::vector<DelayTerm> delayed;
+    MatrixXc a0 = md.M0;
+    if (md.tau > 0.0) delayed.push_back({md.M1, md.tau});
+    else a0 += md.M1;
+    RootOptions ro;
+    ro.count = 8;
+    const RootResult rr = rightmost_roots(LinearDDE(a0, delayed), ro);
+    std::vector<cplx> out;
+    for (const Root& r : rr.roots)
+        if (r.value.imag() > 1e-9 * std::max(1.0, std::abs(r.value))) out.push_back(r.value);
+    return out;
+}
+
+/// The first Hopf point of mode k from `from` towards `to` (see the header).
+HopfPoint wave_hopf(const RingCar& car, int j, double from, double to, cplx z) {
+    HopfPoint h;
+    h.status = Status::NumericalIssue;
+    std::vector<double> pv = car.parameter_values();
+    auto at = [&](double p) {
+        pv[static_cast<std::size_t>(j)] = p;
+        return pv;
+    };
+    // the rightmost roots with Im > 0 at `from` (rightmost_roots), each followed by Newton on
+    // det Delta_k over a grid of 200 steps in p; the first sign change of Re of one of them is
+    // located (a root that would enter from the left of these 8 is not seen)
+    const int grid = 200;
+    std::vector<cplx> tracked;
+    try {
+        tracked = upper_roots(car, at(from), z);
+    } catch (const std::invalid_argument&) {
+        return h;  // no uniform flow at from
+    }
+    if (tracked.empty()) return h;
+    double p0 = from, g0 = 0.0;
+    cplx l0;
+    std::vector<double> previous(tracked.size());
+    for (std::size_t r = 0; r < tracked.size(); ++r) previous[r] = tracked[r].real();
+    for (int i = 1; i <= grid; ++i) {
+        const double p = from + (to - from) * i / grid;
+        Eigen::VectorXd xs;
+        Mode md;
+        try {
+            md = mode_at(car, at(p), z, xs);
+        } catch (const std::invalid_argument&) {
+            return h;  // the uniform flow ends (idm: gap <= eta)
+        }
+        int crossing = -1;
+        cplx l;
+        for (std::size_t r = 0; r < tracked.size(); ++r) {
+            cplx lr = tracked[r];
+            if (!newton_root(md, lr) || !(lr.imag() > 0.0)) continue;
+            if (crossing < 0 && (previous[r] < 0.0) != (lr.real() < 0.0)) {
+                crossing = static_cast<int>(r);
+                l0 = tracked[r];
+                g0 = previous[r];
+                l = lr;
+            }
+            tracked[r] = lr;
+            previous[r] = lr.real();
+        }
+        if (crossing < 0) {
+            p0 = p;
+            continue;
+        }
+        {
+            const double g = l.real();
+            // Illinois regula falsi in p on Re lambda, lambda followed by Newton
+            double a = p0, ga = g0, b = p, gb = g;
+            cplx la = l0, lb = l;
+            int side = 0;
+            for (int it = 0; it < 100; ++it) {
+                const double pm = a - ga * (b - a) / (gb - ga);
+                cplx lm = la + (lb - la) * ((pm - a) / (b - a));
+                Eigen::VectorXd x;
+                const Mode md = mode_at(car, at(pm), z, x);
+                if (!newton_root(md, lm)) break;
+                const double gm = lm.real();
+                h.par = pm;
+                h.x = x;
+                h.omega = lm.imag();
+                h.iterations = it + 1;
+                if (std::abs(gm) <= 1e-12 * std::max(1.0, std::abs(lm)) || std::abs(b - a) <= 1e-14 * std::max(1.0, std::abs(pm))) {
+                    const Eigen::Matrix2cd D = md.delta(cplx(0.0, h.omega));
+                    // the null vector from the row of larger norm
+                    const int r = D.row(0).norm() >= D.row(1).norm() ? 0 : 1;
+                    h.q.resize(2);
+                    h.q << D(r, 1), -D(r, 0);
+                    h.q /= h.q.norm();
+                    h.residual = std::abs(gm);
+                    h.status = h.omega > 0.0 ? Status::Converged : Status::NumericalIssue;
+                    return h;
+                }
+                if ((gm < 0.0) == (ga < 0.0)) {
+                    a = pm;
+                    ga = gm;
+                    la = lm;
+                    if (side == -1) gb *= 0.5;
+                    side = -1;
+                } else {
+                    b = pm;
+                    gb = gm;
+                    lb = lm;
+                    if (side == 1) ga *= 0.5;
+                    side = 1;
+                }
+            }
+            h.status = Status::MaxIterations;
+            return h;
+        }
+    }
+    return h;
+}
+
+}  // namespace
+
+bool TravellingWaveOptions::is_valid(std::string* why) const {
+    std::string w;
+    if (model != "ov" && model != "idm") w = "model " + model + ": expected ov or idm";
+    else if (cars < 2) w = "cars = " + std::to_string(cars) + ": expected a ring of at least 2 cars";
+    else if (wave < 1 || wave > cars - 1) w = "wave = " + std::to_string(wave) + ": expected a wave number from 1 to N - 1 = " + std::to_string(cars - 1);
+    else if (full_ring_floquet_limit < 0) w = "full_ring_floquet_limit: expected an integer >= 0";
+    else if (!orbit.is_valid(&w)) w = "orbit options: " + w;
+    if (!w.empty() && why) *why = w;
+    return w.empty();
+}
+
+Eigen::VectorXd wave_car_state(const PeriodicMesh& mesh, const PeriodicOrbit& orbit, int cars, int wave, long car, double s) {
+    // s + car k / N mod 1, the integer part of car k taken first (exact for large N)
+    const long shift = static_cast<long>((static_cast<long long>(car) * wave) % cars);
+    return orbit_value(mesh, orbit.profile, s + static_cast<double>(shift) / cars);
+}
+
+TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, const TravellingWaveOptions& options) {
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("travelling waves: " + why);
+    const PeriodicOrbitOptions& o = options.orbit;
+    ParameterMap start = parameters;
+    const RingCar probe(options.model, parameters);
+    const int j = probe.parameter_index(o.parameter);  // throws for an unknown parameter
+    start[o.parameter] = o.from;
+    TravellingWaveBranch res;
+    res.cars = options.cars;
+    res.wave = options.wave;
+    OrbitBranch& b = res.branch;
+    b.parameter = o.parameter;
+    b.degree = o.degree;
+    b.intervals = o.intervals;
+    const PeriodicMesh mesh(o.degree, o.intervals);
+    {
+        std::ostringstream s;
+        s << "travelling wave of wave number " << options.wave << " on a ring of " << options.cars
+          << " cars in the reduced form (one car, the leader shifted by k T / N): piecewise polynomial collocation, degree " << o.degree << " on "
+          << o.intervals << " intervals at Gauss-Legendre points; Newton with a sparse LU (Eigen SparseLU, COLAMD); pseudo-arclength; "
+          << (options.cars <= options.full_ring_floquet_limit && o.floquet ? "Floquet multipliers of the full ring along the wave"
+                                                                             : "no Floquet multipliers (the ring's stability is not computed)");
+        b.method = s.str();
+    }
+    ParameterMap at_from = parameters;
+    at_from[o.parameter] = o.from;
+    std::unique_ptr<RingCar> car;
+    try {
+        car = std::make_unique<RingCar>(options.model, at_from);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("travelling waves at ") + o.parameter + " = from: " + e.what());
+    }
+    const double phase = 2.0 * kPi * (static_cast<double>(options.wave) / options.cars);
+    const cplx z(std::cos(phase), std::sin(phase));
+    res.hopf = wave_hopf(*car, j, o.from, o.to, z);
+    if (res.hopf.status != Status::Converged) {
+        b.status = Status::NumericalIssue;
+        b.stop = "first_orbit_failed";
+        std::ostringstream s;
+        s << "no Hopf point of ring mode " << options.wave << " with omega > 0 on the uniform flow for " << o.parameter << " in [" << o.from << ", "
+          << o.to << "]" << (res.hopf.status == Status::MaxIterations ? " was located" : "")
+          << " (a Hopf point of modes k and N - k is a wave of only one of the two wave numbers: if the ring has one in this range, try "
+          << options.cars - options.wave << ")";
+        b.message = s.str();
+        return res;
+    }
+    FullRing full;
+    if (o.floquet && options.cars <= options.full_ring_floquet_limit) {
+        full.system = make_nonlinear_ring(options.model, options.cars, at_from).system;
+        full.cars = options.cars;
+        full.wave = options.wave;
+    }
+    Wave c(*car, mesh);
+    c.kappa = static_cast<double>(options.wave) / options.cars;
+    c.j = j;
+    c.d = mesh.degree();
+    c.L = mesh.intervals();
+    c.P = mesh.points();
+    c.base = car->parameter_values();
+    const int N = c.N();
+    const double T0 = 2.0 * kPi / res.hopf.omega;
+    c.w = Eigen::VectorXd::Zero(N + 3);
+    c.w.head(N).setConstant(1.0 / c.P);
+    c.w(N) = 1.0 / (T0 * T0);
+    c.w(N + 1) = 1.0 / ((o.to - o.from) * (o.to - o.from));
+
+    // the first orbit from the Hopf point along Re(q e^{2 pi i s})
+    Eigen::VectorXd uh(N + 3), t0 = Eigen::VectorXd::Zero(N + 3);
+    for (int i = 0; i < c.P; ++i) {
+        const cplx e = std::exp(cplx(0.0, 2.0 * kPi * mesh.point(i)));
+        uh.segment<2>(2 * i) = res.hopf.x;
+        t0.segment<2>(2 * i) = (res.hopf.q * e).real();
+    }
+    uh(N) = T0;
+    uh(N + 1) = res.hopf.par;
+    uh(N + 2) = 0.0;
+    t0 /= c.norm(t0);
+    Eigen::VectorXd u = uh + o.initial_step * t0;
+    Correction r;
+    {
+        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        const Eigen::VectorXd a = c.w.cwiseProduct(t0);
+        r = correct(c, u, ref, a, a.dot(u), o);
+    }
+    b.newton_iterations += r.iterations;
+    if (!r.ok) {
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = "the first travelling wave from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
+        return res;
+    }
+    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
+    if (t.dot(c.w.cwiseProduct(t0)) < 0.0) t = -t;
+
+    // the branch (the continuation of periodic_orbit's follow, uniform mesh)
+    const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
+    b.points.push_back(make_orbit(c, u, r, full, o.parameter, o.floquet));
+    res.max_drift = std::abs(u(N + 2));
+    const double amp0 = amplitude(b.points.front());
+    double h = o.initial_step;
+    b.stop = "max_points";
+    while (static_cast<int>(b.points.size()) < o.max_points) {
+        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        Eigen::VectorXd v = u + h * t;
+        const Eigen::VectorXd a = c.w.cwiseProduct(t);
+        Correction rc = correct(c, v, ref, a, a.dot(u + h * t), o);
+        b.newton_iterations += rc.iterations;
+        const bool jump = rc.ok && c.norm(v - u) > 3.0 * h;
+        if (!rc.ok || jump) {
+            h *= 0.5;
+            if (h < o.min_step) {
+                b.stop = "step_below_minimum";
+                b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
+                std::ostringstream s;
+                s << "the corrector failed at " << b.parameter << " = " << v(N + 1) << " with the step below " << o.min_step;
+                b.message = s.str();
+                break;
+            }
+            continue;
+        }
+        Eigen::VectorXd tn = rc.tangent / c.norm(rc.tangent);
+        if (tn.dot(c.w.cwiseProduct(t)) < 0.0) tn = -tn;
+        const double p = v(N + 1);
+        if (p < lo || p > hi) {  // the orbit on the face of the range
+            const double bound = p < lo ? lo : hi;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+            e(N + 1) = 1.0;
+            Eigen::VectorXd wv = v;
+            const Correction rb = correct(c, wv, ref, e, bound, o);
+            b.newton_iterations += rb.iterations;
+            if (rb.ok) {
+                b.points.push_back(make_orbit(c, wv, rb, full, o.parameter, o.floquet));
+                res.max_drift = std::max(res.max_drift, std::abs(wv(N + 2)));
+            } else {
+                b.status = Status::MaxIterations;
+                b.message = "the wave on the end of the parameter range did not converge";
+            }
+            b.stop = "bound";
+            break;
+        }
+        // fold: the parameter component of the tangent changes sign; Illinois regula falsi in the
+        // arclength on that component, every trial orbit corrected
+        if (t(N + 1) * tn(N + 1) < 0.0) {
+            OrbitFold f;
+            f.after = static_cast<int>(b.points.size()) - 1;
+            const Eigen::VectorXd ak = c.w.cwiseProduct(t);
+            double slo = 0.0, shi = ak.dot(v - u), glo = t(N + 1), ghi = tn(N + 1);
+            int side = 0;
+            Eigen::VectorXd best = v;
+            Correction bestc = rc;
+            const double sp = std::abs(o.to - o.from);
+            for (int it = 0; it < 40; ++it) {
+                const double s = slo - glo * (shi - slo) / (ghi - glo);
+                Eigen::VectorXd wv = u + s * t;
+                const Correction rf = correct(c, wv, ref, ak, ak.dot(u + s * t), o);
+                b.newton_iterations += rf.iterations;
+                if (!rf.ok) break;
+                const double gv = (rf.tangent / c.norm(rf.tangent))(N + 1) * (rf.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
+                best = wv;
+                bestc = rf;
+                if (std::abs(gv) <= 1e-11 * sp || std::abs(shi - slo) <= 1e-12 * h) {
+                    f.located = true;
+                    break;
+                }
+                if ((gv < 0.0) == (glo < 0.0)) {
+                    slo = s;
+                    glo = gv;
+                    if (side == -1) ghi *= 0.5;
+                    side = -1;
+                } else {
+                    shi = s;
+                    ghi = gv;
+                    if (side == 1) glo *= 0.5;
+                    side = 1;
+                }
+            }
+            f.orbit = make_orbit(c, best, bestc, full, o.parameter, false);
+            f.par = f.orbit.par;
+            f.period = f.orbit.period;
+            if (!f.located && b.status == Status::Converged) {
+                b.status = Status::MaxIterations;
+                b.message = "a fold of travelling waves was detected but not located";
+            }
+            b.folds.push_back(f);
+        }
+        PeriodicOrbit orbit = make_orbit(c, v, rc, full, o.parameter, o.floquet);
+        res.max_drift = std::max(res.max_drift, std::abs(v(N + 2)));
+        const bool collapsed = amplitude(orbit) < 0.5 * amp0;
+        b.points.push_back(std::move(orbit));
+        if (collapsed) {
+            b.stop = "hopf";
+            break;
+        }
+        u = v;
+        t = tn;
+        if (rc.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
+        if (u(N) > o.max_period_factor * T0) {
+            b.stop = "period";
+            break;
+        }
+    }
+    for (const PeriodicOrbit& pt : b.points) {
+        b.max_residual = std::max(b.max_residual, pt.residual);
+        if (std::isfinite(pt.trivial_distance)) b.max_trivial_distance = std::max(b.max_trivial_distance, pt.trivial_distance);
+    }
+    res.full_ring_stability = full.system != nullptr;
+    if (b.message.empty()) {
+        std::ostringstream s;
+        s << b.points.size() << " travelling waves, ended: " << b.stop;
+        b.message = s.str();
+    }
+    return res;
+}
+
+}  // namespace ddemap
