@@ -28,7 +28,9 @@ TransferFunction::TransferFunction(Linearisation lin) : m_lin(std::move(lin)) {
 void TransferFunction::evaluate(cplx s, cplx& n, cplx& d) const {
     cplx gap = 0.0, own = 0.0, lead = 0.0;
     for (const auto& g : m_groups) {
-        const cplx e = g.delay == 0.0 ? cplx(1.0) : std::exp(-s * g.delay);
+        // e^{-s d} = e^{-d Re s} (cos(d Im s) - i sin(d Im s)): no exponential on the imaginary axis
+        const cplx e = g.delay == 0.0 ? cplx(1.0)
+                                      : std::polar(s.real() == 0.0 ? 1.0 : std::exp(-s.real() * g.delay), -s.imag() * g.delay);
         gap += g.gap * e;
         own += g.own * e;
         lead += g.lead * e;
@@ -40,7 +42,9 @@ void TransferFunction::evaluate(cplx s, cplx& n, cplx& d) const {
 void TransferFunction::evaluate(cplx s, cplx& n, cplx& d, cplx& dn, cplx& dd) const {
     cplx gap = 0.0, own = 0.0, lead = 0.0, dgap = 0.0, down = 0.0, dlead = 0.0;
     for (const auto& g : m_groups) {
-        const cplx e = g.delay == 0.0 ? cplx(1.0) : std::exp(-s * g.delay);
+        // e^{-s d} = e^{-d Re s} (cos(d Im s) - i sin(d Im s)): no exponential on the imaginary axis
+        const cplx e = g.delay == 0.0 ? cplx(1.0)
+                                      : std::polar(s.real() == 0.0 ? 1.0 : std::exp(-s.real() * g.delay), -s.imag() * g.delay);
         gap += g.gap * e;
         own += g.own * e;
         lead += g.lead * e;
