@@ -254,8 +254,10 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     const double w_series = 1e-2 / coef;
     auto loss = [&](double w) {
         double q = 0.0, noise = 0.0;
-        double att = tf.attenuation(w, &q, &noise);
-        if (std::abs(q) <= noise && w <= w_series && r.lowfreq.decisive_order > 0) {
+        // the rounding bound of q matters only where the series may take over
+        const bool series = w <= w_series && r.lowfreq.decisive_order > 0;
+        double att = tf.attenuation(w, &q, series ? &noise : nullptr);
+        if (series && std::abs(q) <= noise) {
             const double w2 = w * w;
             q = r.lowfreq.c2 + w2 * (r.lowfreq.c4 + w2 * (r.lowfreq.c6 + w2 * r.lowfreq.c8));
             cplx n, d;

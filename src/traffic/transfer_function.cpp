@@ -92,6 +92,7 @@ double TransferFunction::attenuation(double w, double* q_out, double* noise_out)
     double re_own = 0.0, re_lead = 0.0, re_gap = 0.0, im_own_w = 0.0, im_lead_w = 0.0, im_gap_w = 0.0;
     double im_own = 0.0, im_gap = 0.0;  // Im of own and gap (for D)
     double mi_own = 0.0, mi_lead = 0.0, mi_gap = 0.0, mi_ol = 0.0;  // magnitudes of the Im/w terms
+    const bool noise = noise_out != nullptr;  // the magnitudes only when the rounding bound is asked for
     for (const auto& g : m_groups) {
         double c = 1.0, sn = 0.0, so = 0.0;
         if (g.delay != 0.0) {
@@ -108,10 +109,12 @@ double TransferFunction::attenuation(double w, double* q_out, double* noise_out)
         im_own_w -= g.own * so;
         im_lead_w -= g.lead * so;
         im_gap_w -= g.gap * so;
-        mi_own += std::abs(g.own * so);
-        mi_lead += std::abs(g.lead * so);
-        mi_gap += std::abs(g.gap * so);
-        mi_ol += std::abs((g.own + g.lead) * so);
+        if (noise) {
+            mi_own += std::abs(g.own * so);
+            mi_lead += std::abs(g.lead * so);
+            mi_gap += std::abs(g.gap * so);
+            mi_ol += std::abs((g.own + g.lead) * so);
+        }
     }
     // A = i w - own - lead; B = D + N = s^2 - s own + 2 gap + s lead (s = i w, s x = i w x)
     const double re_a = -re_own - re_lead;
