@@ -24,7 +24,7 @@ struct Args {
 
 void add_boundary_flags(CLI::App& app) {
     args.model.add_to(app);
-    args.ring.add_to(app, "22", "ring size N >= 2, or inf");
+    args.ring.add_to(app, "22", "ring size N >= 2 (at most 10^6: the seeds need every mode's root), or inf");
     args.out.add_to(app, "PREFIX.csv (one row per curve point) and PREFIX.json", true);
     app.add_option("--seed-grid", args.grid, "grid points per axis used to seed the branches")->capture_default_str();
     args.format.add_to(app);

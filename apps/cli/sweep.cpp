@@ -27,7 +27,7 @@ struct Args {
 
 void add_sweep_flags(CLI::App& app) {
     args.model.add_to(app);
-    args.ring.add_to(app, "22", "ring size N >= 2, or inf");
+    args.ring.add_to(app, "22", "ring size N >= 2 (at most 10^9 with --no-boundaries, 10^6 with boundaries), or inf");
     args.out.add_to(app, "PREFIX.csv, PREFIX.json, PREFIX.svg, PREFIX-boundaries.csv", true);
     app.add_option("--x", args.x, "which swept parameter is the horizontal axis (default: alphabetical)");
     app.add_flag("--no-boundaries", args.no_boundaries, "skip the boundary continuation");

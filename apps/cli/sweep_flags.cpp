@@ -1,5 +1,6 @@
 #include "sweep_flags.hpp"
 
+#include "ddemap/analysis/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars
 #include "ddemap/io/svg.hpp"
 #include "limits.hpp"
 
@@ -32,12 +33,19 @@ SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::str
             throw BadInput("--" + std::string(e.what()));  // the library names the parameter; the flag is --NAME
         }
     }
-    spec.cars = ring.parse();
+    // up to 10^9 cars: the winding tables cost the same at any N; the per-mode path (boundaries)
+    // is held to kModesMaxCars by check_sweep_size once the caller has chosen the ring method
+    spec.cars = ring.parse(true, kWindingMaxCars);
     spec.validate();
     return spec;
 }
 
 void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels) {
+    if (spec.cars > kModesMaxCars && sweep_ring_method(spec) == "modes")
+        throw BadInput("--ring = " + std::to_string(spec.cars) + ": expected at most " + std::to_string(kModesMaxCars) + " cars for " +
+                       (command == "boundary" ? std::string("boundary (its seeds need every mode's root, one by one)")
+                                              : command + " with boundaries (their seeds need every mode's root, one by one; without boundaries the winding tables take up to " +
+                                                    std::to_string(kWindingMaxCars) + ")"));
     const double points = static_cast<double>(spec.x.count) * static_cast<double>(spec.y.count) * static_cast<double>(panels);
     // N = inf: a frequency scan, about 12 modes' work; the winding path: about that at any N
     const double modes = spec.cars == 0 || sweep_ring_method(spec) == "winding" ? 12.0 : spec.cars / 2 + 1.0;

@@ -276,7 +276,19 @@ int RingWindingTable::winding(double phi) const {
     return w;
 }
 
+namespace {
+RingWindingTable winding_table(const TransferFunction& gamma, double sigma, int budget, const LowFrequency* series);
+}  // namespace
+
 RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma, int budget) {
+    return winding_table(gamma, sigma, budget, nullptr);
+}
+
+namespace {
+
+/// The table, with the low-frequency series of gamma when the caller has it (else formed here
+/// for the axis, where it decides the tangency at s = 0).
+RingWindingTable winding_table(const TransferFunction& gamma, double sigma, int budget, const LowFrequency* series) {
     RingWindingTable t;
     t.sigma = sigma;
     const Linearisation& lin = gamma.linearisation();
@@ -289,7 +301,7 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
     LineSampler f(gamma, lin, sigma, budget);
     int touch = 0;
     if (sigma == 0.0) {
-        const LowFrequency lf = low_frequency_expansion(lin);
+        const LowFrequency lf = series ? *series : low_frequency_expansion(lin);
         if (lf.decisive_order > 0) touch = lf.attenuates ? -1 : 1;
     }
     Pass pass{f, sigma == 0.0, touch, {}, {}, {}, 0};
@@ -412,6 +424,8 @@ RingWindingTable ring_winding_table(const TransferFunction& gamma, double sigma,
     return t;
 }
 
+}  // namespace
+
 void RingWindingOptions::validate() const {
     if (budget < 100) throw std::invalid_argument("budget = " + std::to_string(budget) + ": expected >= 100");
 }
@@ -531,9 +545,10 @@ struct Engine {
     TransferFunction tf;
     RingWindingResult& r;
     const QuasiPolynomial& f0;  // mode 0 without its trivial root
+    const LowFrequency& series; // the low-frequency series of tf
 
     RingWindingTable table(double sigma) {
-        RingWindingTable t = ring_winding_table(tf, sigma, options.budget);
+        RingWindingTable t = winding_table(tf, sigma, options.budget, &series);
         ++r.tables;
         r.evaluations += t.evaluations;
         return t;
@@ -613,8 +628,8 @@ RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const
     RingWindingResult r;
     r.cars = cars;
     const QuasiPolynomial f0 = ring_mode0_characteristic(lin);
-    Engine en{lin, cars, options, TransferFunction(lin), r, f0};
     const LowFrequency lf = low_frequency_expansion(lin);
+    Engine en{lin, cars, options, TransferFunction(lin), r, f0, lf};
     double margin = 0.0;
     switch (lf.decisive_order) {
         case 2: margin = lf.c2; break;

@@ -202,7 +202,14 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     std::vector<double> grid;
     const int np = options.grid_points;
     const double w_lo = w_hi * 1e-6;
-    for (int i = 0; i < np; ++i) grid.push_back(w_lo * std::pow(w_hi / w_lo, double(i) / (np - 1)));
+    grid.reserve(static_cast<std::size_t>(np) + 256);
+    {
+        // geometric: w_lo rho^i, rho = (w_hi / w_lo)^(1 / (np - 1)), by products (one pow)
+        const double rho = std::pow(w_hi / w_lo, 1.0 / (np - 1));
+        double w = w_lo;
+        for (int i = 0; i < np; ++i, w *= rho) grid.push_back(w);
+    }
+    const std::size_t geometric = grid.size();
     double step = w_hi / np;
     if (tau > 0.0) step = std::min(step, M_PI / (8.0 * tau));
     // roots of D left of those computed have Re <= the last computed one: their peaks are at
@@ -213,23 +220,32 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     }
     step = std::max(step, w_hi / 50000.0);
     for (double w = step; w < w_hi; w += step) grid.push_back(w);
+    // each piece of the grid is sorted: merged in, not sorted
+    std::inplace_merge(grid.begin(), grid.begin() + static_cast<std::ptrdiff_t>(geometric), grid.end());
+    auto merge_from = [&](std::size_t start) {
+        std::inplace_merge(grid.begin(), grid.begin() + static_cast<std::ptrdiff_t>(start), grid.end());
+    };
     for (const auto& root : r.plant_roots.roots) {
         const double wp = root.value.imag();
         if (wp <= 0.0 || wp >= w_hi) continue;
         const double width = std::max(std::abs(root.value.real()), 1e-12 * wp);
+        const std::size_t start = grid.size();
         for (int j = -6; j <= 6; ++j) {
             const double w = wp + j * 0.5 * width;
             if (w > 0.0 && w < w_hi) grid.push_back(w);
         }
+        merge_from(start);
     }
     if (!r.lowfreq.attenuates && r.lowfreq.decisive_order == 2 && r.lowfreq.c4 > 0.0) {
         const double wc = std::sqrt(-r.lowfreq.c2 / (2.0 * r.lowfreq.c4));
-        for (int i = 0; i <= 60; ++i) {
-            const double w = wc * std::pow(10.0, -2.0 + 3.0 * i / 60.0);
+        const std::size_t start = grid.size();
+        // wc 10^(-2 + 3 i / 60), i = 0..60, by products (one pow)
+        const double rho = std::pow(10.0, 3.0 / 60.0);
+        double w = wc * 1e-2;
+        for (int i = 0; i <= 60; ++i, w *= rho)
             if (w < w_hi) grid.push_back(w);
-        }
+        merge_from(start);
     }
-    std::sort(grid.begin(), grid.end());
     grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
 
     // 1 - |Gamma|^2 in its cancellation-free form (TransferFunction::attenuation); where its
@@ -238,8 +254,10 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     const double w_series = 1e-2 / coef;
     auto loss = [&](double w) {
         double q = 0.0, noise = 0.0;
-        double att = tf.attenuation(w, &q, &noise);
-        if (std::abs(q) <= noise && w <= w_series && r.lowfreq.decisive_order > 0) {
+        // the rounding bound of q matters only where the series may take over
+        const bool series = w <= w_series && r.lowfreq.decisive_order > 0;
+        double att = tf.attenuation(w, &q, series ? &noise : nullptr);
+        if (series && std::abs(q) <= noise) {
             const double w2 = w * w;
             q = r.lowfreq.c2 + w2 * (r.lowfreq.c4 + w2 * (r.lowfreq.c6 + w2 * r.lowfreq.c8));
             cplx n, d;

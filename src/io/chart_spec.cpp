@@ -58,6 +58,7 @@ SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel) {
     s.x = spec.x;
     s.y = spec.y;
     s.cars = spec.cars;
+    if (spec.boundaries) s.ring_method = "modes";  // the boundary seeds need every mode's root
     return s;
 }
 

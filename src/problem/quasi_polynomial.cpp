@@ -151,20 +151,24 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     for (int i = 0; i < 400 && !enough(r); ++i) r *= 1.25;
     if (!enough(r)) return -1;
 
-    // the line from sigma - i r to sigma + i r, sampled at least every pi / (4 tau_max)
-    int pieces = 8;
-    if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(2.0 * r * m_max_delay * 4.0 / M_PI)));
-    pieces = std::min(pieces, 4096);
+    // the line from sigma - i r to sigma + i r, sampled at least every pi / (4 tau_max); for real
+    // coefficients f(conj lambda) = conj f(lambda), so the change of arg f along the lower half
+    // equals the change along the upper half: only [0, r] is sampled (half the work)
+    const bool real = is_real();
+    int pieces = real ? 4 : 8;
+    if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil((real ? 1.0 : 2.0) * r * m_max_delay * 4.0 / M_PI)));
+    pieces = std::min(pieces, real ? 2048 : 4096);
     // e^{-sigma d_j} is the same at every sample of the line: computed once per term
     const Magnitudes mags(m_terms, sigma);
     auto eval = [&](double w, cplx& v, cplx& d) { evaluate(cplx(sigma, w), mags.data(), v, d); };
     LineSampler<decltype(eval)> line{eval};
     double total = 0.0;
-    PhaseSample a = line(-r);
+    const double start = real ? 0.0 : -r, length = real ? r : 2.0 * r;
+    PhaseSample a = line(start);
     if (line.failed) return -1;
     const cplx first = a.f;
     for (int i = 1; i <= pieces; ++i) {
-        const PhaseSample b = line(-r + 2.0 * r * i / pieces);
+        const PhaseSample b = line(start + length * i / pieces);
         if (line.failed) return -1;
         total += bisect_phase(line, a, b);
         if (line.failed) return -1;
@@ -173,9 +177,16 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     const cplx fa = a.f;
     const cplx last = fa;
     // along the half circle (counter-clockwise, bottom to top) arg f changes by
-    // n pi + arg h(top) - arg h(bottom), h = f / (lambda - sigma)^n (principal args: |h - 1| < 1/2)
+    // n pi + arg h(top) - arg h(bottom), h = f / (lambda - sigma)^n (principal args: |h - 1| < 1/2);
+    // for real coefficients h(bottom) = conj h(top) and the line's change is twice the upper half's
     const cplx top = cplx(0.0, r), bottom = cplx(0.0, -r);
-    const double arc = m_degree * M_PI + arg_ratio(last, std::pow(top, m_degree)) - arg_ratio(first, std::pow(bottom, m_degree));
+    double arc = 0.0;
+    if (real) {
+        arc = m_degree * M_PI + 2.0 * arg_ratio(last, std::pow(top, m_degree));
+        total *= 2.0;
+    } else {
+        arc = m_degree * M_PI + arg_ratio(last, std::pow(top, m_degree)) - arg_ratio(first, std::pow(bottom, m_degree));
+    }
     const double z = (arc - total) / (2.0 * M_PI);
     const double zr = std::round(z);
     if (std::abs(z - zr) > 0.05 || zr < 0) return -1;

@@ -14,6 +14,7 @@
 
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars
 #include "ddemap/analysis/ring_winding.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "core/internal/text.hpp"
@@ -310,7 +311,11 @@ void SweepSpec::validate() const {
         for (double yv : {y.lo, y.hi})
             require_computable(model_at(*this, xv, yv)->linearise(), "the corner " + x.name + " = " + detail::format_number(xv) + ", " +
                                                                         y.name + " = " + detail::format_number(yv) + " of the window");
-    sweep_ring_method(*this);  // a known method that applies to the model
+    // a known method that applies to the model; the per-mode path solves N/2 + 1 modes per point
+    if (sweep_ring_method(*this) == "modes" && cars > kModesMaxCars)
+        throw std::invalid_argument("ring of " + std::to_string(cars) + " cars: expected at most " + std::to_string(kModesMaxCars) +
+                                    " cars on the per-mode ring path (boundaries need every mode's root); the winding tables take up to " +
+                                    std::to_string(kWindingMaxCars));
 }
 
 std::string sweep_ring_method(const SweepSpec& spec) {

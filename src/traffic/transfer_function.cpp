@@ -18,12 +18,19 @@ TransferFunction::TransferFunction(Linearisation lin) : m_lin(std::move(lin)) {
     for (const auto& t : m_lin.gap.terms()) group(t.delay).gap += t.coef;
     for (const auto& t : m_lin.own.terms()) group(t.delay).own += t.coef;
     for (const auto& t : m_lin.lead.terms()) group(t.delay).lead += t.coef;
+    for (const auto& g : m_groups) {
+        m_abs_own += std::abs(g.own);
+        m_abs_lead += std::abs(g.lead);
+        m_abs_gap += std::abs(g.gap);
+    }
 }
 
 void TransferFunction::evaluate(cplx s, cplx& n, cplx& d) const {
     cplx gap = 0.0, own = 0.0, lead = 0.0;
     for (const auto& g : m_groups) {
-        const cplx e = g.delay == 0.0 ? cplx(1.0) : std::exp(-s * g.delay);
+        // e^{-s d} = e^{-d Re s} (cos(d Im s) - i sin(d Im s)): no exponential on the imaginary axis
+        const cplx e = g.delay == 0.0 ? cplx(1.0)
+                                      : std::polar(s.real() == 0.0 ? 1.0 : std::exp(-s.real() * g.delay), -s.imag() * g.delay);
         gap += g.gap * e;
         own += g.own * e;
         lead += g.lead * e;
@@ -35,7 +42,9 @@ void TransferFunction::evaluate(cplx s, cplx& n, cplx& d) const {
 void TransferFunction::evaluate(cplx s, cplx& n, cplx& d, cplx& dn, cplx& dd) const {
     cplx gap = 0.0, own = 0.0, lead = 0.0, dgap = 0.0, down = 0.0, dlead = 0.0;
     for (const auto& g : m_groups) {
-        const cplx e = g.delay == 0.0 ? cplx(1.0) : std::exp(-s * g.delay);
+        // e^{-s d} = e^{-d Re s} (cos(d Im s) - i sin(d Im s)): no exponential on the imaginary axis
+        const cplx e = g.delay == 0.0 ? cplx(1.0)
+                                      : std::polar(s.real() == 0.0 ? 1.0 : std::exp(-s.real() * g.delay), -s.imag() * g.delay);
         gap += g.gap * e;
         own += g.own * e;
         lead += g.lead * e;
@@ -68,42 +77,44 @@ cplx TransferFunction::derivative(cplx s) const {
 }
 
 double TransferFunction::gain2_derivative(double w) const {
+    // one evaluation of N, D and their derivatives (the same exponentials)
     const cplx s(0.0, w);
-    return 2.0 * (std::conj((*this)(s)) * cplx(0.0, 1.0) * derivative(s)).real();
+    cplx n, d, np, dp;
+    evaluate(s, n, d, np, dp);
+    const cplx gamma = n / d, derivative = (np * d - n * dp) / (d * d);
+    return 2.0 * (std::conj(gamma) * cplx(0.0, 1.0) * derivative).real();
 }
 
-namespace {
-
-/// sin(w d) / w (d for w = 0), accurate for small w d.
-double sin_over(double w, double d) {
-    const double x = w * d;
-    if (std::abs(x) < 1e-4) return d * (1.0 - x * x / 6.0);
-    return std::sin(x) / w;
-}
-
-}  // namespace
 
 double TransferFunction::attenuation(double w, double* q_out, double* noise_out) const {
-    // Re and Im/w of own, lead, gap at s = i w: e^{-i w d} = cos(w d) - i sin(w d)
+    // Re and Im/w of own, lead, gap at s = i w: e^{-i w d} = cos(w d) - i sin(w d); one sincos per
+    // delay also gives N(i w) and D(i w) for |D|^2
     double re_own = 0.0, re_lead = 0.0, re_gap = 0.0, im_own_w = 0.0, im_lead_w = 0.0, im_gap_w = 0.0;
-    double m_own = 0.0, m_lead = 0.0, m_gap = 0.0, mi_own = 0.0, mi_lead = 0.0, mi_gap = 0.0;  // magnitudes
-    double mi_ol = 0.0;
+    double im_own = 0.0, im_gap = 0.0;  // Im of own and gap (for D)
+    double mi_own = 0.0, mi_lead = 0.0, mi_gap = 0.0, mi_ol = 0.0;  // magnitudes of the Im/w terms
+    const bool noise = noise_out != nullptr;  // the magnitudes only when the rounding bound is asked for
     for (const auto& g : m_groups) {
-        const double c = g.delay == 0.0 ? 1.0 : std::cos(w * g.delay);
-        const double so = g.delay == 0.0 ? 0.0 : sin_over(w, g.delay);
+        double c = 1.0, sn = 0.0, so = 0.0;
+        if (g.delay != 0.0) {
+            const double x = w * g.delay;
+            sn = std::sin(x);
+            c = std::cos(x);
+            so = std::abs(x) < 1e-4 ? g.delay * (1.0 - x * x / 6.0) : sn / w;  // sin(w d) / w, accurate for small w d
+        }
         re_own += g.own * c;
         re_lead += g.lead * c;
         re_gap += g.gap * c;
+        im_own -= g.own * sn;
+        im_gap -= g.gap * sn;
         im_own_w -= g.own * so;
         im_lead_w -= g.lead * so;
         im_gap_w -= g.gap * so;
-        m_own += std::abs(g.own);
-        m_lead += std::abs(g.lead);
-        m_gap += std::abs(g.gap);
-        mi_own += std::abs(g.own * so);
-        mi_lead += std::abs(g.lead * so);
-        mi_gap += std::abs(g.gap * so);
-        mi_ol += std::abs((g.own + g.lead) * so);
+        if (noise) {
+            mi_own += std::abs(g.own * so);
+            mi_lead += std::abs(g.lead * so);
+            mi_gap += std::abs(g.gap * so);
+            mi_ol += std::abs((g.own + g.lead) * so);
+        }
     }
     // A = i w - own - lead; B = D + N = s^2 - s own + 2 gap + s lead (s = i w, s x = i w x)
     const double re_a = -re_own - re_lead;
@@ -113,13 +124,13 @@ double TransferFunction::attenuation(double w, double* q_out, double* noise_out)
     const double q = re_a * im_b_w - re_b * im_a_w;
     if (q_out) *q_out = q;
     if (noise_out) {
-        const double ma = m_own + m_lead, mia = 1.0 + mi_ol + mi_own + mi_lead;
-        const double mb = w * w * (1.0 + mi_own + mi_lead) + 2.0 * m_gap, mib = m_lead + m_own + 2.0 * mi_gap;
+        const double ma = m_abs_own + m_abs_lead, mia = 1.0 + mi_ol + mi_own + mi_lead;
+        const double mb = w * w * (1.0 + mi_own + mi_lead) + 2.0 * m_abs_gap, mib = m_abs_lead + m_abs_own + 2.0 * mi_gap;
         *noise_out = 32.0 * std::numeric_limits<double>::epsilon() * (ma * mib + mb * mia);
     }
-    cplx n, d;
-    evaluate(cplx(0.0, w), n, d);
-    return w * w * q / std::norm(d);
+    // D(i w) = -w^2 - i w own + gap
+    const double d_re = -w * w + w * im_own + re_gap, d_im = -w * re_own + im_gap;
+    return w * w * q / (d_re * d_re + d_im * d_im);
 }
 
 namespace {

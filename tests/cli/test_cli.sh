@@ -1139,5 +1139,31 @@ expect_error "--svg: not available with --wave" orbits --model ov --ring 5 --wav
 expect_error "--initial-step: only with --wave" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --initial-step 0.01
 [ -z "$(ls "$wav" | grep bad)" ] && ok || bad "orbits --wave bad input wrote files: $(ls "$wav")"
 
+# sweep and chart rings up to 10^9 cars on the winding tables; the per-mode path (boundaries) stays at 10^6
+big="$tmp/bigring"; mkdir -p "$big"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000000 --no-boundaries --out "$big/n" --format json >"$big/n.out" 2>/dev/null &&
+    "$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring inf --no-boundaries --out "$big/i" --format json >/dev/null 2>&1 &&
+    python3 - "$big" <<'PY' && ok || bad "sweep --ring 1000000000 --no-boundaries: winding tables, the abscissa and counts of N = inf"
+import csv, json, sys
+d = json.load(open(sys.argv[1] + "/n.out"))
+assert d["solver"]["used"] == "winding" and d["inputs"]["ring"] == 1000000000, (d["solver"], d["inputs"]["ring"])
+n = list(csv.DictReader(open(sys.argv[1] + "/n.csv")))
+i = list(csv.DictReader(open(sys.argv[1] + "/i.csv")))
+assert len(n) == len(i) == 16
+for a, b in zip(n, i):
+    # N = inf unstable: the same sup of the abscissa; N = inf stable: 10^9 cars have no unstable root, only
+    # the smallest wave numbers within the marginal band of the axis (so not "stable" either)
+    if b["ring_stable"] == "false":
+        assert a["ring_stable"] == "false" and int(a["unstable_roots"]) > 0, (a, b)
+        assert abs(float(a["spectral_abscissa"]) - float(b["spectral_abscissa"])) < 1e-10, (a, b)
+    else:
+        assert int(a["unstable_roots"]) == 0 and abs(float(a["spectral_abscissa"])) < 1e-12, (a, b)
+PY
+expect_error "expected at most 1000000 cars for sweep with boundaries" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000001 --out "$big/b"
+expect_error "expected at most 1000000 cars for boundary" boundary --th 1.5 --tau 0.5 --k1 0.1:1 --k2 0.1:1 --ring 2000000 --out "$big/c"
+expect_error "at most 1000000000)" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000001 --no-boundaries --out "$big/d"
+[ ! -e "$big/b.csv" ] && [ ! -e "$big/c.csv" ] && ok || bad "a refused ring size wrote files"
+rm -rf "$big"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

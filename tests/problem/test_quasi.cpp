@@ -58,4 +58,38 @@ TEST_CASE("argument-principle counts equal the number of collocation roots right
     CHECK(checked > 400);
 }
 
+TEST_CASE("real quasi-polynomials (counted along the upper half line) equal the collocation roots right of the line") {
+    // the plant D and ring mode N/2 (zeta = -1) have real coefficients: zeros_right_of samples
+    // only Im >= 0 and doubles the change of arg (conjugate symmetry); the collocation roots are
+    // the independent count
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int checked = 0, converged = 0;
+    for (int i = 0; i < 30; ++i) {
+        const Linearisation lin = ovrv(0.01 + u(rng), 0.01 + u(rng), 0.2 + 2.8 * u(rng), 0.05 + 0.95 * u(rng));
+        const bool plant = i % 2 == 0;
+        const QuasiPolynomial f = plant ? plant_characteristic(lin) : ring_mode_characteristic(lin, cplx(-1.0, 0.0));
+        REQUIRE(f.is_real());
+        RootOptions o;
+        o.count = 8;
+        const RootResult r = rightmost_roots(plant ? plant_dde(lin) : ring_mode_dde(lin, cplx(-1.0, 0.0)), o);
+        if (r.status != Status::Converged || r.roots.empty()) continue;  // the list does not decide the counts
+        ++converged;
+        for (double sigma : {-0.7, -0.2, 0.0, 0.1}) {
+            int expected = 0;
+            for (const auto& x : r.roots) expected += x.value.real() > sigma;
+            if (expected >= static_cast<int>(r.roots.size())) continue;  // count not certain from the list
+            CAPTURE(i);
+            CAPTURE(sigma);
+            CHECK(f.zeros_right_of(sigma) == expected);
+            ++checked;
+        }
+        const double a = r.roots.front().value.real();
+        CHECK(f.zeros_right_of(a + 1e-9 * std::max(1.0, std::abs(a))) == 0);
+        CHECK(f.zeros_right_of(a - 1e-6) >= 1);
+    }
+    CHECK(converged >= 20);
+    CHECK(checked > 60);
+}
+
 TEST_SUITE_END();

@@ -51,6 +51,7 @@ private:
         double gap, own, lead;  // coefficients of e^{-s delay}
     };
     std::vector<DelayGroup> m_groups;
+    double m_abs_own = 0.0, m_abs_lead = 0.0, m_abs_gap = 0.0;  // sums of |coefficient| over the delays
 };
 
 /// The plant: one car behind a lead car held at its equilibrium speed,
