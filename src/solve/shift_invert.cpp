@@ -1,8 +1,6 @@
 #include "ddemap/solve/shift_invert.hpp"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -516,7 +514,6 @@ public:
             const int kmax = static_cast<int>(std::min<Eigen::Index>(size - 1, std::max<Eigen::Index>(ncv, m_o.compact_max_steps)));
             const CompactRitz rz = compact_arnoldi(m_op, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax, m_o.arnoldi_tolerance);
             m_steps += rz.steps;
-            if (std::getenv("DDEMAP_DEBUG_SI")) std::fprintf(stderr, "shift %g%+gi M=%d steps %d conv %d rank %d thmin %g\n", sigma.real(), sigma.imag(), m_op.degree(), rz.steps, rz.converged, rz.rank, rz.converged ? std::abs(rz.theta[rz.converged-1]) : 0.0);
             double thmin = std::numeric_limits<double>::infinity();
             for (int i = 0; i < rz.converged; ++i) {
                 const cplx th = rz.theta[static_cast<std::size_t>(i)];
@@ -596,7 +593,6 @@ public:
                 // a root-free disc of the DDE around the cell's centre (valid right of the floor)
                 const double h = 0.5 * std::hypot(cw, ch);
                 const double r = m_res->free_radius(cplx(mx, my), m_floor);
-                if (std::getenv("DDEMAP_DEBUG_SI")) std::fprintf(stderr, "cell [%g %g]x[%g %g] h %g r %g floor %g\n", c.x0, c.x1, c.y0, c.y1, h, r, m_floor);
                 if (r >= h) {
                     ++m_excluded;
                     continue;
