@@ -195,7 +195,6 @@ CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_
     for (;;) {
         // one step: v_{k+1} from T v_k
         {
-            const Eigen::Index len = rows * r;
             Eigen::Map<const Eigen::MatrixXcd> a(v.col(k).data(), rows, r);
             Eigen::VectorXcd u0 = op.solve_compact(q.leftCols(r), a, w);
             Eigen::VectorXcd p = q.leftCols(r).adjoint() * u0;
@@ -216,7 +215,6 @@ CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_
             }
             r = r1;
             const Eigen::Index len1 = rows * r;
-            (void)len;
             Eigen::Map<Eigen::VectorXcd> x(c.data(), len1);
             // classical Gram-Schmidt twice on the coefficients
             Eigen::VectorXcd hk = v.topLeftCorner(len1, k + 1).adjoint() * x;
