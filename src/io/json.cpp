@@ -123,7 +123,7 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& s) {
     json j;
     j["dimension"] = dde.dimension();
     json delays = json::array();
-    for (const auto& t : dde.delayed()) delays.push_back(t.delay);
+    for (double t : dde.delays()) delays.push_back(t);
     j["delays"] = delays;
     json roots = json::array();
     for (const auto& x : r.roots) roots.push_back(root_json(x));

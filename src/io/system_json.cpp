@@ -43,22 +43,30 @@ cplx value_of(const json& v, const std::string& source, const std::string& field
     fail(source, field, "expected a number or [re, im]");
 }
 
+/// The entries of a {"triplets": ...} matrix, checked (indices 0-based, values in range).
+std::vector<Eigen::Triplet<cplx>> triplets_of(const json& m, int n, const std::string& source, const std::string& field) {
+    if (!m.contains("triplets") || !m["triplets"].is_array()) fail(source, field, "expected {\"triplets\": [[row, col, value], ...]}");
+    const json& t = m["triplets"];
+    std::vector<Eigen::Triplet<cplx>> out;
+    out.reserve(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) {
+        const std::string f = field + ".triplets[" + std::to_string(i) + "]";
+        if (!t[i].is_array() || t[i].size() != 3 || !t[i][0].is_number_integer() || !t[i][1].is_number_integer()) {
+            fail(source, f, "expected [row, col, value] with integer row and col");
+        }
+        const long r = t[i][0].get<long>(), c = t[i][1].get<long>();
+        if (r < 0 || r >= n || c < 0 || c >= n) {
+            fail(source, f, "index (" + std::to_string(r) + ", " + std::to_string(c) + ") outside 0.." + std::to_string(n - 1));
+        }
+        out.emplace_back(static_cast<int>(r), static_cast<int>(c), value_of(t[i][2], source, f));
+    }
+    return out;
+}
+
 MatrixXc matrix_of(const json& m, int n, const std::string& source, const std::string& field) {
     MatrixXc a = MatrixXc::Zero(n, n);
     if (m.is_object()) {
-        if (!m.contains("triplets") || !m["triplets"].is_array()) fail(source, field, "expected {\"triplets\": [[row, col, value], ...]}");
-        const json& t = m["triplets"];
-        for (std::size_t i = 0; i < t.size(); ++i) {
-            const std::string f = field + ".triplets[" + std::to_string(i) + "]";
-            if (!t[i].is_array() || t[i].size() != 3 || !t[i][0].is_number_integer() || !t[i][1].is_number_integer()) {
-                fail(source, f, "expected [row, col, value] with integer row and col");
-            }
-            const long r = t[i][0].get<long>(), c = t[i][1].get<long>();
-            if (r < 0 || r >= n || c < 0 || c >= n) {
-                fail(source, f, "index (" + std::to_string(r) + ", " + std::to_string(c) + ") outside 0.." + std::to_string(n - 1));
-            }
-            a(r, c) += value_of(t[i][2], source, f);
-        }
+        for (const auto& t : triplets_of(m, n, source, field)) a(t.row(), t.col()) += t.value();
         return a;
     }
     if (!m.is_array() || static_cast<int>(m.size()) != n) fail(source, field, "expected " + std::to_string(n) + " rows or {\"triplets\": ...}");
@@ -68,6 +76,28 @@ MatrixXc matrix_of(const json& m, int n, const std::string& source, const std::s
         for (int c = 0; c < n; ++c) a(r, c) = value_of(m[r][c], source, fr + "[" + std::to_string(c) + "]");
     }
     return a;
+}
+
+/// Every matrix of the file given as triplets (A0 may be absent): such a file can be held sparse.
+bool all_triplets(const json& j) {
+    if (j.contains("A0") && !j["A0"].is_object()) return false;
+    if (!j.contains("A") || !j["A"].is_array()) return false;
+    for (const auto& m : j["A"])
+        if (!m.is_object()) return false;
+    return true;
+}
+
+/// A triplet matrix as sparse real storage; false (nothing written) when a value is complex.
+bool real_sparse_of(const std::vector<Eigen::Triplet<cplx>>& t, int n, SparseMatrixXd& out) {
+    std::vector<Eigen::Triplet<double>> real;
+    real.reserve(t.size());
+    for (const auto& e : t) {
+        if (e.value().imag() != 0.0) return false;
+        real.emplace_back(e.row(), e.col(), e.value().real());
+    }
+    out.resize(n, n);
+    out.setFromTriplets(real.begin(), real.end());  // repeated entries add up
+    return true;
 }
 
 }  // namespace
@@ -85,6 +115,24 @@ LinearDdeShape peek_linear_dde_json(const std::string& text, const std::string& 
     if (!j.is_object()) return s;
     if (j.contains("dimension") && j["dimension"].is_number_integer()) s.dimension = j["dimension"].get<long>();
     if (j.contains("delays") && j["delays"].is_array()) s.delays = j["delays"].size();
+    if (all_triplets(j)) {
+        // triplet matrices: the text is as long as the nonzeros, so reading it all is cheap
+        const json full = json::parse(text, nullptr, false);
+        if (full.is_discarded()) return s;
+        bool real = true;
+        long nonzeros = 0;
+        auto scan = [&](const json& m) {
+            if (!m.contains("triplets") || !m["triplets"].is_array()) return;
+            for (const auto& t : m["triplets"]) {
+                ++nonzeros;
+                if (t.is_array() && t.size() == 3 && !t[2].is_number()) real = false;
+            }
+        };
+        if (full.contains("A0")) scan(full["A0"]);
+        for (const auto& m : full["A"]) scan(m);
+        s.sparse = real;
+        s.nonzeros = nonzeros;
+    }
     return s;
 }
 
@@ -122,12 +170,24 @@ LinearDDE read_linear_dde_json(const std::string& text, const std::string& sourc
             delays.push_back(x);
         }
     }
-    const MatrixXc a0 = j.contains("A0") ? matrix_of(j["A0"], n, source, "A0") : MatrixXc::Zero(n, n);
-    std::vector<DelayTerm> terms;
     const std::size_t given = j.contains("A") ? (j["A"].is_array() ? j["A"].size() : std::size_t(-1)) : 0;
     if (given != delays.size()) {
         fail(source, "A", "expected an array of " + std::to_string(delays.size()) + " matrices, one per delay");
     }
+    if (all_triplets(j)) {
+        // real triplets are held sparse (large systems); a complex value makes the file dense
+        SparseMatrixXd sa0(n, n);
+        bool real = !j.contains("A0") || real_sparse_of(triplets_of(j["A0"], n, source, "A0"), n, sa0);
+        std::vector<SparseDelayTerm> sterms;
+        for (std::size_t k = 0; real && k < delays.size(); ++k) {
+            SparseMatrixXd a;
+            real = real_sparse_of(triplets_of(j["A"][k], n, source, "A[" + std::to_string(k) + "]"), n, a);
+            sterms.push_back({a, delays[k]});
+        }
+        if (real) return LinearDDE(sa0, sterms);
+    }
+    const MatrixXc a0 = j.contains("A0") ? matrix_of(j["A0"], n, source, "A0") : MatrixXc::Zero(n, n);
+    std::vector<DelayTerm> terms;
     for (std::size_t k = 0; k < delays.size(); ++k) {
         terms.push_back({matrix_of(j["A"][k], n, source, "A[" + std::to_string(k) + "]"), delays[k]});
     }

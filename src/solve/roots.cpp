@@ -112,6 +112,12 @@ bool RootOptions::is_valid(std::string* why) const {
     } else if (shift_invert.max_shifts < 1) {
         os << "shift_invert.max_shifts = " << shift_invert.max_shifts << ": expected an integer >= 1";
         ok = false;
+    } else if (shift_invert.arnoldi != "compact" && shift_invert.arnoldi != "spectra") {
+        os << "shift_invert.arnoldi = '" << shift_invert.arnoldi << "': expected compact or spectra";
+        ok = false;
+    } else if (shift_invert.compact_max_steps < 2) {
+        os << "shift_invert.compact_max_steps = " << shift_invert.compact_max_steps << ": expected an integer >= 2";
+        ok = false;
     } else if (shift_invert.arnoldi_max_restarts < 1) {
         os << "shift_invert.arnoldi_max_restarts = " << shift_invert.arnoldi_max_restarts << ": expected an integer >= 1";
         ok = false;

@@ -100,6 +100,28 @@ public:
         return u;
     }
 
+    /// The same solve for b in compact form, blocks b_j = Q a_j^T (a: (M+1) x r coefficients, Q:
+    /// n x r): with W = B^{-1} a[1:] (written to w, M x r) the history blocks of u are
+    /// u_j = Q w_{j-1}^T - g_j u0, and u0 = S^{-1} (Q a_0^T - sum_k A_k Q (W^T l_k[1:])) is returned.
+    /// Cost: one sparse solve and O((M + delays) n r + M^2 r) (the (M+1) n vector is never formed).
+    Eigen::VectorXcd solve_compact(const Eigen::Ref<const Eigen::MatrixXcd>& q, const Eigen::Ref<const Eigen::MatrixXcd>& a,
+                                   Eigen::MatrixXcd& w) const {
+        const int m = m_m;
+        w = m_blu.solve(a.bottomRows(m));
+        Eigen::VectorXcd x = a.row(0).transpose();
+        Eigen::VectorXcd r = q * x;
+        for (std::size_t k = 0; k < m_ak.size(); ++k) {
+            x.noalias() = w.transpose() * m_l[k].tail(m).cast<cplx>();
+            r -= m_ak[k] * (q * x);
+        }
+        return m_lu.solve(r);
+    }
+    int degree() const { return m_m; }
+    int dimension() const { return m_n; }
+    /// g = B^{-1} (2/tau) D[1:, 0] of the current shift
+    const Eigen::VectorXcd& g() const { return m_g; }
+    bool factored() const { return m_ok; }
+
     void perform_op(const double* x_in, double* y_out) const {
         const Eigen::Index len = rows();
         if (!m_ok) {
@@ -128,6 +150,114 @@ private:
     bool m_ok = false;
     int m_factorizations = 0;
 };
+
+/// Ritz values of a compact Arnoldi run: theta ~ 1/(lambda - sigma), largest |theta| first, and
+/// how many of them, from the largest on, are converged without a gap.
+struct CompactRitz {
+    std::vector<cplx> theta;
+    int converged = 0;   ///< length of the converged prefix of `theta`
+    int steps = 0;       ///< Arnoldi steps taken (sparse solves)
+    int rank = 0;        ///< columns of Q
+};
+
+/// Shift-invert Arnoldi on T = (A_M - sigma I)^{-1} in compact form (TOAR-like): every Krylov
+/// vector of C^{(M+1) n} is stored as V_i = Q a_i, block j of it Q a_i[j, :]^T, with one
+/// orthonormal n x r matrix Q for the whole basis and small (M+1) x r coefficients a_i. T maps
+/// span(Q) blocks into span(Q, u0) blocks (StructuredShiftInvert::solve_compact), so each step
+/// adds at most one column to Q, orthogonalised against Q (twice), and the Arnoldi
+/// orthogonalisation runs on the coefficients ((M+1) r numbers instead of (M+1) n): with Q
+/// orthonormal, <V_i, V_l> = <a_i, a_l>_F. The basis grows (no restart) until `nev` Ritz values,
+/// largest |theta| first, have |h_{k+1,k}| |y_k| <= tol |theta| (the Arnoldi residual), or
+/// until `max_steps`. Cost per step: one sparse solve, O(n r) for Q, O((M+1) r k) for the rest.
+CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_check, int max_steps, double tol) {
+    const int m = op.degree(), n = op.dimension();
+    const Eigen::Index rows = static_cast<Eigen::Index>(m + 1);
+    const int kmax = std::max(2, max_steps);
+    const int rcap = kmax + 2;
+    Eigen::MatrixXcd q(n, rcap);
+    Eigen::MatrixXcd v = Eigen::MatrixXcd::Zero(rows * rcap, kmax + 1);  // column i: vec(a_i), (M+1) x rcap
+    Eigen::MatrixXcd h = Eigen::MatrixXcd::Zero(kmax + 1, kmax);
+    std::mt19937 rng(20261123);
+    std::uniform_real_distribution<double> unif(-1.0, 1.0);
+    Eigen::VectorXcd q0(n);
+    for (int i = 0; i < n; ++i) q0(i) = unif(rng);
+    q.col(0) = q0 / q0.norm();
+    int r = 1;
+    Eigen::VectorXcd a0(rows);
+    for (Eigen::Index j = 0; j < rows; ++j) a0(j) = unif(rng);
+    v.col(0).head(rows) = a0 / a0.norm();
+    CompactRitz out;
+    const Eigen::VectorXcd& g = op.g();
+    Eigen::MatrixXcd w;
+    int k = 0;
+    int check = std::min(first_check, kmax);
+    bool invariant = false;
+    for (;;) {
+        // one step: v_{k+1} from T v_k
+        {
+            Eigen::Map<const Eigen::MatrixXcd> a(v.col(k).data(), rows, r);
+            Eigen::VectorXcd u0 = op.solve_compact(q.leftCols(r), a, w);
+            Eigen::VectorXcd p = q.leftCols(r).adjoint() * u0;
+            u0.noalias() -= q.leftCols(r) * p;
+            const Eigen::VectorXcd p2 = q.leftCols(r).adjoint() * u0;
+            u0.noalias() -= q.leftCols(r) * p2;
+            p += p2;
+            const double rho = u0.norm();
+            const bool grow = rho > 1e-14 * std::max(p.norm(), 1e-300) && r < rcap;
+            const int r1 = grow ? r + 1 : r;
+            if (grow) q.col(r) = u0 / rho;
+            Eigen::MatrixXcd c(rows, r1);
+            c.row(0).head(r) = p.transpose();
+            c.bottomRows(m).leftCols(r) = w - g * p.transpose();
+            if (grow) {
+                c(0, r) = rho;
+                c.bottomRows(m).col(r) = -rho * g;
+            }
+            r = r1;
+            const Eigen::Index len1 = rows * r;
+            Eigen::Map<Eigen::VectorXcd> x(c.data(), len1);
+            // classical Gram-Schmidt twice on the coefficients
+            Eigen::VectorXcd hk = v.topLeftCorner(len1, k + 1).adjoint() * x;
+            x.noalias() -= v.topLeftCorner(len1, k + 1) * hk;
+            const Eigen::VectorXcd hk2 = v.topLeftCorner(len1, k + 1).adjoint() * x;
+            x.noalias() -= v.topLeftCorner(len1, k + 1) * hk2;
+            hk += hk2;
+            const double beta = x.norm();
+            h.col(k).head(k + 1) = hk;
+            h(k + 1, k) = beta;
+            ++k;
+            if (beta <= 1e-14 * hk.norm() || !std::isfinite(beta)) {
+                invariant = std::isfinite(beta);
+                h(k, k - 1) = 0.0;
+            } else {
+                v.col(k).head(len1) = x / beta;
+            }
+        }
+        if (k < check && !invariant && k < kmax) continue;
+        Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(h.topLeftCorner(k, k));
+        out.theta.clear();
+        out.converged = 0;
+        out.steps = k;
+        out.rank = r;
+        if (es.info() != Eigen::Success) return out;
+        const Eigen::VectorXcd ev = es.eigenvalues();
+        std::vector<int> order(static_cast<std::size_t>(k));
+        for (int i = 0; i < k; ++i) order[static_cast<std::size_t>(i)] = i;
+        std::sort(order.begin(), order.end(), [&](int x, int y) { return std::abs(ev(x)) > std::abs(ev(y)); });
+        const double hk1 = std::abs(h(k, k - 1));
+        bool prefix = true;
+        for (int i : order) {
+            const cplx th = ev(i);
+            out.theta.push_back(th);
+            const Eigen::VectorXcd y = es.eigenvectors().col(i);
+            const double res = hk1 * std::abs(y(k - 1)) / y.norm();
+            prefix = prefix && std::isfinite(th.real()) && std::isfinite(th.imag()) && res <= tol * std::abs(th);
+            if (prefix) ++out.converged;
+        }
+        if (out.converged >= nev || invariant || k >= kmax) return out;
+        check = std::min(kmax, k + std::max(10, k / 2));
+    }
+}
 
 }  // namespace
 
@@ -171,11 +301,14 @@ namespace {
 struct Disc {
     cplx centre;
     double radius = 0.0;
+    bool root_free = false;  ///< no root of the DDE inside (resolvent), rather than "every collocation eigenvalue inside found"
+    double valid_from = -std::numeric_limits<double>::infinity();  ///< root_free: the claim holds right of this line
 };
 
 struct Cell {
     double x0, x1, y0, y1;
     bool shifted = false;
+    int splits = 0;  ///< splits since a shift was last tried (a root on a corner stops the halving)
 };
 
 bool inside(const Cell& c, const Disc& d) {
@@ -270,11 +403,95 @@ private:
     std::vector<double> m_tau;
 };
 
+/// UMFPACK's LU with the solve of the adjoint system too (UMFPACK_At: A^H x = b), which
+/// Eigen's wrapper does not offer.
+class AdjointUmfPackLU : public Eigen::UmfPackLU<SpC> {
+public:
+    bool adjoint_solve(const Eigen::VectorXcd& b, Eigen::VectorXcd& x) const {
+        x.resize(b.size());
+        const int code = umfpack_zi_solve(UMFPACK_At, mp_matrix.outerIndexPtr(), mp_matrix.innerIndexPtr(),
+                                          &Eigen::numext::real_ref(mp_matrix.valuePtr()[0]), nullptr, &Eigen::numext::real_ref(x.data()[0]),
+                                          nullptr, &Eigen::numext::real_ref(b.data()[0]), nullptr, m_numeric, m_control.data(),
+                                          m_umfpackInfo.data());
+        return code == 0;
+    }
+};
+
+/// Root-free discs of the DDE itself from the resolvent norm: for |z - z_c| <= r,
+///     sigma_min(Delta(z)) >= sigma_min(Delta(z_c)) - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}
+/// (L bounds ||Delta'|| right of x0), so Delta(z) is nonsingular in the disc of radius
+/// sigma_min(Delta(z_c)) / L. sigma_min = 1 / ||Delta(z_c)^{-1}||: the norm is estimated by
+/// Lanczos on Delta^{-H} Delta^{-1} (one sparse LU of Delta(z_c), two solves per step, full
+/// reorthogonalisation) until the estimate changes by less than 1e-4 over a step, and taken
+/// 25% larger (Lanczos approaches it from below). Independent of the collocation degree.
+class ResolventExclusion {
+public:
+    explicit ResolventExclusion(const LinearDDE& dde) : m_dde(dde), m_n(dde.dimension()) {
+        m_pattern = union_pattern(dde).cast<cplx>();
+        m_pattern.makeCompressed();
+        m_lu.analyzePattern(m_pattern);
+        for (const auto& t : dde.bounds().terms) m_terms.push_back({t.norm, t.delay});
+    }
+
+    /// The radius of a root-free disc around z_c (right of x0), 0 when Delta(z_c) is singular.
+    double free_radius(cplx zc, double x0) {
+        ++m_tests;
+        m_d = m_dde.sparse_characteristic_matrix(zc) + cplx(0.0) * m_pattern;
+        m_d.makeCompressed();
+        m_lu.factorize(m_d);
+        if (m_lu.info() != Eigen::Success) return 0.0;
+        const int kmax = std::min(m_n, 40);
+        std::mt19937 rng(977);
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        Eigen::MatrixXcd basis(m_n, kmax + 1);
+        Eigen::VectorXcd x(m_n);
+        for (int i = 0; i < m_n; ++i) x(i) = cplx(u(rng), u(rng));
+        basis.col(0) = x / x.norm();
+        Eigen::MatrixXd t = Eigen::MatrixXd::Zero(kmax + 1, kmax + 1);
+        double estimate = 0.0;
+        for (int k = 0; k < kmax; ++k) {
+            const Eigen::VectorXcd y = m_lu.solve(basis.col(k));
+            Eigen::VectorXcd w;
+            if (!m_lu.adjoint_solve(y, w) || !w.allFinite()) return 0.0;  // w = Delta^{-H} Delta^{-1} q_k
+            for (int pass = 0; pass < 2; ++pass) {
+                const Eigen::VectorXcd hcoef = basis.leftCols(k + 1).adjoint() * w;
+                w.noalias() -= basis.leftCols(k + 1) * hcoef;
+                if (pass == 0) t(k, k) = hcoef(k).real();
+            }
+            const double beta = w.norm();
+            t(k + 1, k) = t(k, k + 1) = beta;
+            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(k + 1, k + 1), Eigen::EigenvaluesOnly);
+            const double next = es.eigenvalues().maxCoeff();
+            const bool settled = k > 2 && std::abs(next - estimate) <= 1e-4 * next;
+            estimate = next;
+            if (settled || beta <= 1e-13 * next) break;
+            if (k + 1 == kmax) return 0.0;  // not settled: no claim
+            basis.col(k + 1) = w / beta;
+        }
+        if (!(estimate > 0.0) || !std::isfinite(estimate)) return 0.0;
+        const double inverse_norm = 1.25 * std::sqrt(estimate);
+        double lipschitz = 1.0;
+        for (const auto& [norm, delay] : m_terms) lipschitz += delay * norm * std::exp(-x0 * delay);
+        return 1.0 / (inverse_norm * lipschitz);
+    }
+    int tests() const { return m_tests; }
+
+private:
+    const LinearDDE& m_dde;
+    int m_n;
+    SpC m_pattern, m_d;
+    AdjointUmfPackLU m_lu;
+    std::vector<std::pair<double, double>> m_terms;
+    int m_tests = 0;
+};
+
 /// The covering: discs of completeness around the shifts, root-free Gershgorin cells, and
 /// the distinct eigenvalues met.
 class Covering {
 public:
-    Covering(StructuredShiftInvert& op, const Gershgorin& gersh, const ShiftInvertRootOptions& o) : m_op(op), m_gersh(gersh), m_o(o) {}
+    /// `resolvent` (may be null: the reference covering) adds root-free discs of the DDE itself.
+    Covering(StructuredShiftInvert& op, const Gershgorin& gersh, const ShiftInvertRootOptions& o, ResolventExclusion* resolvent)
+        : m_op(op), m_gersh(gersh), m_o(o), m_res(resolvent) {}
 
     /// Runs one shift (nudged off a singular point); false after max_shifts.
     bool shift_at(cplx sigma) {
@@ -285,6 +502,29 @@ public:
         const Eigen::Index size = m_op.rows();
         const int nev = static_cast<int>(std::min<Eigen::Index>(m_o.eigenvalues_per_shift, size - 3));
         const Eigen::Index ncv = std::min<Eigen::Index>(size, 5 * nev / 2 + 20);
+        if (m_o.arnoldi == "compact") {
+            if (!m_op.factored()) {
+                ++m_failed;
+                return true;  // no disc: the cell is split and tried again
+            }
+            // every converged Ritz value from the largest |theta| on is an eigenvalue 1/theta + sigma;
+            // together they are the eigenvalues in the disc |z - sigma| < 1/|theta_last|
+            const int kmax = static_cast<int>(std::min<Eigen::Index>(size - 1, std::max<Eigen::Index>(ncv, m_o.compact_max_steps)));
+            const CompactRitz rz = compact_arnoldi(m_op, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax, m_o.arnoldi_tolerance);
+            m_steps += rz.steps;
+            double thmin = std::numeric_limits<double>::infinity();
+            for (int i = 0; i < rz.converged; ++i) {
+                const cplx th = rz.theta[static_cast<std::size_t>(i)];
+                add(sigma + 1.0 / th);
+                thmin = std::min(thmin, std::abs(th));
+            }
+            if (rz.converged < 1 || !(thmin > 0.0)) {
+                ++m_failed;
+                return true;
+            }
+            m_discs.push_back({sigma, 1.0 / (thmin * (1.0 + 1e-6))});  // margin for the Ritz values' own error
+            return true;
+        }
         Spectra::GenEigsComplexShiftSolver<StructuredShiftInvert> solver(m_op, nev, ncv, sigma.real(), sigma.imag());
         solver.init();
         solver.compute(Spectra::SortRule::LargestMagn, m_o.arnoldi_max_restarts, m_o.arnoldi_tolerance);
@@ -325,8 +565,9 @@ public:
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
         // roughly square cells to start with
         const double w = beta - alpha;
-        const int nx = std::max(1, static_cast<int>(std::ceil(w / std::max(height, 1e-300))));
-        const int ny = std::max(1, static_cast<int>(std::ceil(height / std::max(w, 1e-300))));
+        const int cap = m_res ? 64 : std::numeric_limits<int>::max();  // cells are split as needed anyway
+        const int nx = std::clamp(static_cast<int>(std::ceil(w / std::max(height, 1e-300))), 1, cap);
+        const int ny = std::clamp(static_cast<int>(std::ceil(height / std::max(w, 1e-300))), 1, cap);
         for (int i = 0; i < nx; ++i)
             for (int j = 0; j < ny; ++j)
                 queue.push({alpha + w * i / nx, alpha + w * (i + 1) / nx, height * j / ny, height * (j + 1) / ny});
@@ -345,12 +586,25 @@ public:
             if (std::max(cw, ch) <= 1e-13 * scale_of(cplx(c.x1, c.y1))) return false;
             const double mx = 0.5 * (c.x0 + c.x1), my = 0.5 * (c.y0 + c.y1);
             const cplx centre(mx, c.y0 == 0.0 ? 0.0 : my);
+            bool near_root = true;
+            if (m_res && !c.shifted) {
+                // a root-free disc of the DDE around the cell's centre (valid right of the floor)
+                const double h = 0.5 * std::hypot(cw, ch);
+                const double r = m_res->free_radius(cplx(mx, my), m_floor);
+                if (r >= h) {
+                    ++m_excluded;
+                    continue;
+                }
+                if (r > 0.0) m_discs.push_back({cplx(mx, my), r, true, m_floor});
+                // otherwise split (twice at most before a shift): the halves may be root-free
+                near_root = r < 0.5 * h || c.splits >= 2;
+            }
             // where even the centre is root-free, smaller cells will be too: split instead of
             // a (slow) shift far from the spectrum
             const bool empty_centre = m_gersh.excludes(mx, mx, my, my) && std::max(cw, ch) > 1e-3 * scale_of(centre);
-            if (!c.shifted && !empty_centre) {
+            if (!c.shifted && !empty_centre && near_root) {
                 bool again = false;
-                for (const auto& d : m_discs) again = again || d.centre == centre;
+                for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
                 if (!again) {
                     if (!shift_at(centre)) return false;
                     raise_floor(bounds, count);
@@ -360,6 +614,7 @@ public:
             }
             Cell a = c, b = c;
             a.shifted = b.shifted = false;
+            a.splits = b.splits = c.shifted ? 0 : c.splits + 1;
             if (cw >= ch) {
                 a.x1 = b.x0 = mx;
             } else {
@@ -377,13 +632,23 @@ public:
     /// Distinct eigenvalues with Im >= 0 (real problem: conjugates implied).
     const std::vector<cplx>& values() const { return m_values; }
     int shifts() const { return m_shifts; }
+    int steps() const { return m_steps; }
+    /// max |z| over the cells covered by Arnoldi discs (the part that relies on the collocation)
+    double extent() const { return m_extent; }
     int failed() const { return m_failed; }
     int excluded() const { return m_excluded; }
 
 private:
-    bool covered(const Cell& c) const {
+    /// A cell inside a disc; one inside an Arnoldi disc (not root-free) needs the collocation to
+    /// resolve it: its farthest corner raises extent().
+    bool covered(const Cell& c) {
         for (auto it = m_discs.rbegin(); it != m_discs.rend(); ++it)
-            if (inside(c, *it)) return true;
+            if (c.x0 >= it->valid_from && inside(c, *it)) {
+                if (!it->root_free)
+                    for (double x : {c.x0, c.x1})
+                        for (double y : {c.y0, c.y1}) m_extent = std::max(m_extent, std::abs(cplx(x, y)));
+                return true;
+            }
         return false;
     }
     void add(cplx z) {
@@ -399,7 +664,10 @@ private:
     const ShiftInvertRootOptions& m_o;
     std::vector<Disc> m_discs;
     std::vector<cplx> m_values;
+    ResolventExclusion* m_res;
+    double m_extent = 0.0;
     int m_shifts = 0;
+    int m_steps = 0;
     int m_failed = 0;
     int m_excluded = 0;
     double m_floor = 0.0;
@@ -535,14 +803,20 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
     const double beta = result.right_bound;
     // a deep first strip: the floor rises as soon as `count` eigenvalues are known
     double alpha = std::min(0.0, beta) - 1.0 / tau;
+    const bool compact = so.arnoldi == "compact";
+    // compact: the degree need only resolve the cells covered by Arnoldi discs (raised below),
+    // so a huge root bound (stiff systems) does not set it
+    const double first_radius = bounds.radius(std::min(0.0, beta) - 1.0 / tau);
     int m = options.degree > 0 ? options.degree
-                               : std::clamp(degree_for_radius(bounds.radius(std::min(0.0, beta) - 1.0 / tau), tau), 8, max_degree);
+                               : std::clamp(degree_for_radius(compact ? std::min(first_radius, std::abs(beta) + 8.0 * M_PI / tau) : first_radius, tau),
+                                            8, max_degree);
     const Gershgorin gersh(dde);
+    ResolventExclusion resolvent(dde);
     for (;;) {
         StructuredShiftInvert op(dde, m);
         if (op.rows() < 8)
             throw std::invalid_argument("the sparse path needs (M+1) n >= 8; use the dense path for n = " + std::to_string(n));
-        Covering cover(op, gersh, so);
+        Covering cover(op, gersh, so, compact ? &resolvent : nullptr);
         bool budget = true;
         std::vector<cplx> right;
         for (;;) {
@@ -554,13 +828,16 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
         }
         alpha = cover.floor();
         result.shifts += cover.shifts();
+        result.arnoldi_steps += cover.steps();
         result.factorizations += op.factorizations();
         result.eigenvalues_found = static_cast<int>(cover.values().size());
         const double height = bounds.radius(alpha);
         const double resolved = radius_for_degree(m, tau);
-        // M must resolve every eigenvalue of the rectangle; otherwise raise M and cover again
-        if (budget && options.degree == 0 && resolved < height && m < max_degree) {
-            m = std::min(max_degree, std::max(degree_for_radius(height, tau), static_cast<int>(std::ceil(1.5 * m))));
+        // M must resolve every eigenvalue of the rectangle (compact: of the part covered by
+        // Arnoldi discs; the rest is root-free by Gershgorin or the resolvent); otherwise raise M
+        const double needed = compact ? cover.extent() : height;
+        if (budget && options.degree == 0 && resolved < needed && m < max_degree) {
+            m = std::min(max_degree, std::max(degree_for_radius(needed, tau), static_cast<int>(std::ceil(1.5 * m))));
             continue;
         }
         // the `count` rightmost (plus a cut-off conjugate partner)
@@ -639,6 +916,10 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
                    << result.collocation_error << ")";
         }
         if (cover.failed() > 0) os << "; " << cover.failed() << " Arnoldi runs did not converge and were replaced by smaller cells";
+        if (compact)
+            os << "; compact Arnoldi (" << result.arnoldi_steps << " steps), " << resolvent.tests()
+               << " resolvent tests (root-free discs of Delta, Lanczos norm estimate x1.25)";
+        result.factorizations += resolvent.tests();
         result.message = os.str();
         return result;
     }

@@ -726,7 +726,8 @@ expect_error "1e+09 s" simulate --fleet A_min --t-end 1e9 --out "$tmp/simbig"   
 expect_error "more than this machine has" simulate --fleet A_min --t-end 1e9 --allow-large --out "$tmp/simbig"
 python3 -c "print('time_s,lead_speed_mps'); print('0,20'); print('100000,20')" >"$tmp/longlead.csv"
 expect_error "estimated output files" simulate --fleet A_min --lead "$tmp/longlead.csv" --out "$tmp/simlong"   # was 340 MB written
-printf '{"dimension": 20000, "delays": [1], "A0": {"triplets": []}, "A": [{"triplets": [[0, 0, -1]]}]}\n' >"$tmp/dim20000.json"
+# (a complex value: held dense, so refused; real triplets are held sparse and run)
+printf '{"dimension": 20000, "delays": [1], "A0": {"triplets": []}, "A": [{"triplets": [[0, 0, [-1, 0.5]]]}]}\n' >"$tmp/dim20000.json"
 expect_error "20000-state system" roots --system "$tmp/dim20000.json"
 printf '{"dimension": 2, "delays": [1], "A0": [[1e300, 1e-300], [1e-300, -1e300]], "A": [[[1e-300, 1e300], [0, 1]]]}\n' >"$tmp/range.json"
 expect_error "1e-100 to 1e100" roots --system "$tmp/range.json"                # was a Schur decomposition failure
@@ -1164,6 +1165,39 @@ expect_error "expected at most 1000000 cars for boundary" boundary --th 1.5 --ta
 expect_error "at most 1000000000)" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000001 --no-boundaries --out "$big/d"
 [ ! -e "$big/b.csv" ] && [ ! -e "$big/c.csv" ] && ok || bad "a refused ring size wrote files"
 rm -rf "$big"
+
+# roots --system on a large sparse file (real triplets are held sparse): a delayed reaction-diffusion
+# equation from bench/sparse_systems.py; its rightmost root solves the scalar equation of the first
+# Laplacian mode, lambda = mu + a - b e^{-lambda tau} (Newton in Python from the reported root: an
+# independent check of value and mode), and the path is the sparse one with the compact basis
+bsd=$(mktemp -d)
+python3 "$(dirname "$0")/../../bench/sparse_systems.py" rd --nx 30 --ny 20 --out "$bsd/rd.json"
+"$bin" roots --system "$bsd/rd.json" --format json >"$bsd/rd.out" 2>"$bsd/rd.err" &&
+    python3 - "$bsd/rd.out" <<'PY' && ok || bad "roots --system 600-state reaction-diffusion: wrong root or path"
+import cmath, json, math, sys
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "converged" and d["solver"]["used"] == "sparse", (d["status"], d["solver"])
+assert "compact Arnoldi" in d["message"], d["message"]
+r = d["result"]["roots"]
+assert len(r) >= 6 and r[0]["residual"] < 1e-12, r
+z = complex(r[0]["re"], r[0]["im"])
+mu = -4 * math.sin(math.pi / 62) ** 2 - 4 * 0.37 * math.sin(math.pi / 42) ** 2  # mode (1, 1), nx = 30, ny = 20
+c, b, tau = mu + 0.5, 1.0, 2.0
+w = z
+for _ in range(50):  # Newton on f(w) = w - c + b e^{-w tau}
+    w -= (w - c + b * cmath.exp(-w * tau)) / (1 - b * tau * cmath.exp(-w * tau))
+assert abs(w - z) < 1e-10, (w, z)
+PY
+# a complex triplet makes the file dense: the dense path and its size estimate, as before
+python3 - "$bsd/c.json" <<'PY'
+import json, sys
+json.dump({"dimension": 20, "delays": [1.0], "A0": {"triplets": [[i, i, -1.0] for i in range(20)]},
+           "A": [{"triplets": [[i, (i + 1) % 20, [0.1, 0.2]] for i in range(20)]}]}, open(sys.argv[1], "w"))
+PY
+"$bin" roots --system "$bsd/c.json" --format json >"$bsd/c.out" 2>/dev/null &&
+    python3 -c "import json; d = json.load(open('$bsd/c.out')); assert d['solver']['used'] == 'dense', d['solver']" && ok ||
+    bad "roots --system with complex triplets: not the dense path"
+rm -rf "$bsd"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

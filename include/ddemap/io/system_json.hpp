@@ -9,6 +9,8 @@
 ///
 /// Each matrix is a dense array of rows or {"triplets": [[row, col, value], ...]} (0-based,
 /// repeated entries add up); a value is a number or [re, im]. "A0" may be omitted (zero).
+/// When every matrix is given as triplets with real values the system is held sparse
+/// (LinearDDE sparse storage), otherwise dense.
 
 #include <memory>
 #include <string>
@@ -23,9 +25,13 @@ namespace ddemap {
 /// The size of a system file, read without building the system (so the work can be sized
 /// first): values below the top level's arrays are skipped. 0 for what the text lacks;
 /// std::invalid_argument for text that is not JSON.
+/// A file whose matrices are all real triplets is held sparse (`sparse`, with its number of
+/// triplets in `nonzeros`); the others are held dense.
 struct LinearDdeShape {
     long dimension = 0;
     std::size_t delays = 0;
+    bool sparse = false;
+    long nonzeros = 0;
 };
 LinearDdeShape peek_linear_dde_json(const std::string& text, const std::string& source);
 

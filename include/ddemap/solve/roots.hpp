@@ -52,7 +52,12 @@ struct ShiftInvertRootOptions {
     int max_degree = 200;
     int eigenvalues_per_shift = 32;    ///< nev of each Arnoldi run (ncv = 5 nev / 2 + 20)
     int max_shifts = 5000;             ///< give up (BudgetExhausted) after this many shifts
-    int arnoldi_max_restarts = 400;
+    /// "compact" (default): the Krylov basis stored as one n x r matrix and small coefficients
+    /// and grown without restarts (shift_invert.cpp compact_arnoldi); "spectra": Spectra's
+    /// restarted Arnoldi on the full (M+1) n vectors (the reference, slow for large n).
+    std::string arnoldi = "compact";
+    int compact_max_steps = 200;       ///< compact: Arnoldi steps per shift at most (the basis is not restarted)
+    int arnoldi_max_restarts = 400;    ///< spectra: restarts per shift at most
     double arnoldi_tolerance = 1e-10;  ///< Spectra: |residual| <= tol |Ritz value|
     bool refine = true;                ///< Newton refinement on Delta(lambda) (off: eigenvalues only)
     double collocation_tolerance = 1e-8; ///< |eigenvalue - root| / max(1, |lambda|) accepted
@@ -122,6 +127,7 @@ struct RootResult {
 
     // counters
     int shifts = 0;              ///< Arnoldi runs
+    int arnoldi_steps = 0;       ///< shift_invert (compact): operator applications over all runs
     int factorizations = 0;      ///< sparse LU factorisations (shifts and Newton)
     long evaluations = 0;        ///< contour: evaluations of D along contours
     int contour_counts = 0;      ///< contour: rectangles counted

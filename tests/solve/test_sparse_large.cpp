@@ -1,0 +1,155 @@
+// The compact Krylov path of shift_invert (large sparse systems, issue 13 item 3) against the
+// closed-form (Lambert W) roots of a delayed reaction-diffusion equation and against the reference path
+// (Spectra's Arnoldi on the full collocation vectors) on random sparse systems.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "../tolerances.hpp"
+#include "ddemap/solve/roots.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+
+namespace {
+
+/// u' = dx u_xx + dy u_yy + a u - b u(t - tau) on an nx x ny grid (Dirichlet, lattice units),
+/// as bench/sparse_systems.py writes it.
+LinearDDE reaction_diffusion(int nx, int ny, double dx, double dy, double a, double b, double tau) {
+    const int n = nx * ny;
+    std::vector<Eigen::Triplet<double>> t0, t1;
+    auto idx = [&](int i, int j) { return i + nx * j; };
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const int p = idx(i, j);
+            t0.emplace_back(p, p, -2.0 * dx - 2.0 * dy + a);
+            if (i > 0) t0.emplace_back(p, idx(i - 1, j), dx);
+            if (i < nx - 1) t0.emplace_back(p, idx(i + 1, j), dx);
+            if (j > 0) t0.emplace_back(p, idx(i, j - 1), dy);
+            if (j < ny - 1) t0.emplace_back(p, idx(i, j + 1), dy);
+            t1.emplace_back(p, p, -b);
+        }
+    SparseMatrixXd a0(n, n), a1(n, n);
+    a0.setFromTriplets(t0.begin(), t0.end());
+    a1.setFromTriplets(t1.begin(), t1.end());
+    return LinearDDE(a0, {{a1, tau}});
+}
+
+/// Its roots from the closed form: for each Laplacian eigenvalue mu (sum of the 1-D Dirichlet
+/// eigenvalues -4 d sin^2(j pi / (2 (n + 1)))), c = mu + a and lambda = c + W_k(-b tau e^{-c tau}) / tau.
+/// Each branch |k| <= 4 is found by Newton on lambda - c + b e^{-lambda tau} from the
+/// asymptotic W_k ~ L - log L, L = log z + 2 pi i k (and its conjugate), duplicates removed;
+/// rightmost first.
+std::vector<cplx> closed_form_roots(int nx, int ny, double dx, double dy, double a, double b, double tau) {
+    std::vector<cplx> out;
+    for (int j = 1; j <= nx; ++j)
+        for (int l = 1; l <= ny; ++l) {
+            const double sx = std::sin(j * M_PI / (2.0 * (nx + 1))), sy = std::sin(l * M_PI / (2.0 * (ny + 1)));
+            const double c = -4.0 * dx * sx * sx - 4.0 * dy * sy * sy + a;
+            const cplx z(-b * tau * std::exp(-c * tau), 0.0);
+            for (int k = -4; k <= 4; ++k)
+                for (int side : {1, -1}) {
+                    const cplx big = std::log(z) + cplx(0.0, 2.0 * M_PI * k);
+                    cplx w = big - std::log(big);
+                    if (side < 0) w = std::conj(w);
+                    cplx lambda = c + w / tau;
+                    for (int it = 0; it < 100; ++it) {
+                        const cplx e = b * std::exp(-lambda * tau);
+                        const cplx step = (lambda - c + e) / (1.0 - tau * e);
+                        lambda -= step;
+                        if (std::abs(step) <= 1e-15 * std::max(1.0, std::abs(lambda))) break;
+                    }
+                    if (std::abs(lambda - c + b * std::exp(-lambda * tau)) > 1e-12) continue;
+                    const bool seen = std::any_of(out.begin(), out.end(), [&](cplx x) { return std::abs(x - lambda) < 1e-9; });
+                    if (!seen) out.push_back(lambda);
+                }
+        }
+    std::sort(out.begin(), out.end(), [](cplx x, cplx y) { return x.real() > y.real(); });
+    return out;
+}
+
+/// A random sparse real system: A0 = -2 I + sparse noise, 1..3 delays with sparse matrices.
+LinearDDE random_sparse(int n, int delays, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::uniform_int_distribution<int> pick(0, n - 1);
+    std::vector<Eigen::Triplet<double>> t0;
+    for (int i = 0; i < n; ++i) t0.emplace_back(i, i, -2.0 + 0.5 * u(rng));
+    for (int e = 0; e < 3 * n; ++e) t0.emplace_back(pick(rng), pick(rng), 0.6 * u(rng));
+    SparseMatrixXd a0(n, n);
+    a0.setFromTriplets(t0.begin(), t0.end());
+    std::vector<SparseDelayTerm> terms;
+    for (int k = 0; k < delays; ++k) {
+        std::vector<Eigen::Triplet<double>> t;
+        for (int e = 0; e < 2 * n; ++e) t.emplace_back(pick(rng), pick(rng), 0.8 * u(rng));
+        SparseMatrixXd m(n, n);
+        m.setFromTriplets(t.begin(), t.end());
+        terms.push_back({m, 0.4 + 0.5 * k + 0.1 * u(rng)});
+    }
+    return LinearDDE(a0, terms);
+}
+
+}  // namespace
+
+TEST_CASE("compact Krylov path: reaction-diffusion roots equal the Lambert W closed form, none missed") {
+    const int nx = 12, ny = 9;
+    const double dx = 1.0, dy = 0.37, a = 0.5, b = 1.0, tau = 2.0;
+    const LinearDDE dde = reaction_diffusion(nx, ny, dx, dy, a, b, tau);
+    RootOptions o;
+    o.method = "shift_invert";
+    o.count = 6;
+    const RootResult r = rightmost_roots(dde, o);
+    REQUIRE(r.status == Status::Converged);
+    REQUIRE(r.roots.size() >= 6);
+    const std::vector<cplx> ref = closed_form_roots(nx, ny, dx, dy, a, b, tau);
+    for (const auto& x : r.roots) {
+        double nearest = 1e300;
+        for (cplx z : ref) nearest = std::min(nearest, std::abs(z - x.value));
+        CAPTURE(x.value);
+        CHECK(nearest <= test::tol::root_abs);
+    }
+    // completeness: every closed-form root right of the last listed one is listed
+    const double last = r.roots.back().value.real();
+    const auto right = std::count_if(ref.begin(), ref.end(), [&](cplx z) { return z.real() > last + test::tol::root_abs; });
+    const auto listed = std::count_if(r.roots.begin(), r.roots.end(), [&](const Root& x) { return x.value.real() > last + test::tol::root_abs; });
+    CHECK(right == listed);
+    CHECK(r.message.find("compact Arnoldi") != std::string::npos);
+}
+
+TEST_CASE("compact Krylov path equals the full-basis reference path on random sparse systems") {
+    for (unsigned seed : {11u, 12u, 13u}) {
+        const int delays = 1 + static_cast<int>(seed % 3);
+        const LinearDDE dde = random_sparse(60, delays, seed);
+        RootOptions o;
+        o.method = "shift_invert";
+        o.count = 6;
+        const RootResult fast = rightmost_roots(dde, o);
+        o.shift_invert.arnoldi = "spectra";
+        const RootResult ref = rightmost_roots(dde, o);
+        CAPTURE(seed);
+        REQUIRE(fast.status == Status::Converged);
+        REQUIRE(ref.status == Status::Converged);
+        REQUIRE(fast.roots.size() == ref.roots.size());
+        for (std::size_t i = 0; i < ref.roots.size(); ++i) {
+            CAPTURE(i);
+            CHECK(std::abs(fast.roots[i].value - ref.roots[i].value) <= test::tol::same_root * std::max(1.0, std::abs(ref.roots[i].value)));
+        }
+    }
+}
+
+TEST_CASE("shift_invert.arnoldi and compact_max_steps are validated") {
+    RootOptions o;
+    o.shift_invert.arnoldi = "lanczos";
+    std::string why;
+    CHECK_FALSE(o.is_valid(&why));
+    CHECK(why.find("shift_invert.arnoldi") != std::string::npos);
+    o.shift_invert.arnoldi = "compact";
+    o.shift_invert.compact_max_steps = 1;
+    CHECK_FALSE(o.is_valid(&why));
+    CHECK(why.find("compact_max_steps") != std::string::npos);
+}
+
+TEST_SUITE_END();
