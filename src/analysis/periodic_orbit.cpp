@@ -1074,6 +1074,17 @@ void finish(OrbitBranch& b) {
     }
 }
 
+/// Eigen's products in one thread while a branch is computed: its matrices (d n x d n blocks, a
+/// window of a few hundred values) are too small for OpenMP's threads, which on a loaded machine
+/// spent five times the work in waiting (BENCHMARKS.md). The previous setting is restored.
+struct SingleThreadedEigen {
+    int previous = Eigen::nbThreads();
+    SingleThreadedEigen() { Eigen::setNbThreads(1); }
+    ~SingleThreadedEigen() { Eigen::setNbThreads(previous); }
+    SingleThreadedEigen(const SingleThreadedEigen&) = delete;
+    SingleThreadedEigen& operator=(const SingleThreadedEigen&) = delete;
+};
+
 std::string method_text(const PeriodicMesh& mesh) {
     std::ostringstream s;
     s << "piecewise polynomial collocation, degree " << mesh.degree() << " on " << mesh.intervals()
@@ -1133,6 +1144,7 @@ OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<
 }
 
 OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
     if (!(hopf.omega > 0.0) || !std::isfinite(hopf.omega)) throw std::invalid_argument("orbits from a Hopf point: expected omega > 0");
     if (hopf.q.size() != system.dimension() || hopf.x.size() != system.dimension())
         throw std::invalid_argument("orbits from a Hopf point: x and q must have the system's dimension");
@@ -1175,6 +1187,7 @@ OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& 
 }
 
 OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
     const PeriodicMesh mesh(options.degree, options.intervals);
     if (guess.profile.rows() != mesh.points() || guess.profile.cols() != system.dimension())
         throw std::invalid_argument("orbit guess: expected a profile of (degree x intervals) rows and one column per variable");
