@@ -1,19 +1,27 @@
-// A branch of periodic orbits of the ov ring (Orosz, Wilson, Stepan 2004; alpha = tau = v0 =
-// h_st = 1) from the subcritical Hopf point of ring mode 1 above the inflection of V:
-//   bench_orbits [--points P] [--intervals L] [--degree D] N1 N2 ...
-// For each N: wall time of the branch (P orbits, Floquet multipliers of every orbit), the fold of
-// orbits, the largest |mu_trivial - 1|. The Hopf point comes from the ring modes' closed form
-// (see test_equilibrium_branch.cpp), corrected by Newton, so the equilibrium branch is not timed.
+// A branch of periodic orbits of a car-following ring, every orbit with its Floquet multipliers.
+//   bench_orbits [--model ov|idm] [--points P] [--intervals L] [--degree D] [--repeats R] N1 N2 ...
+// ov (default): the ov ring of Orosz, Wilson, Stepan 2004 (alpha = tau = v0 = h_st = 1) from the
+// subcritical Hopf point of ring mode 1 above the inflection of V (from the ring modes' closed
+// form, corrected by Newton). idm: the IDM ring (th = 1.2 s, tau = 0.6 s, the other parameters
+// at their defaults) from the first Hopf point of its equilibrium branch in the gap from 6 to 40 m,
+// the branch the command line computes with
+//   ddemap orbits --model idm --ring N --th 1.2 --tau 0.6 --par gap --from 6 --to 40 --points P
+// In both cases the Hopf point is not timed. For each N: the median wall and CPU time of the
+// branch over R runs, its folds, period doublings and tori, the largest |mu_trivial - 1|, the
+// Newton iterations, and a few values of the branch (to compare results between builds).
+#include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/traffic/nonlinear_ring.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
 
 using namespace ddemap;
@@ -28,51 +36,122 @@ double bisect(G g, double lo, double hi) {
     }
     return 0.5 * (lo + hi);
 }
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t k = v.size() / 2;
+    return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
+}
+
+struct Problem {
+    std::unique_ptr<NonlinearDDE> system;
+    HopfPoint hopf;
+    PeriodicOrbitOptions options;
+    bool ok = false;
+};
+
+Problem ov_problem(int n) {
+    Problem r;
+    const double pi = 3.14159265358979323846, alpha = 1.0, tau = 1.0;
+    const double theta = 2 * pi / n;
+    const double omega = bisect([&](double w) { return w * tau - theta / 2 + pi / 2 - std::atan(alpha / w); }, 1e-6, 10.0);
+    const double slope = omega * std::sqrt(omega * omega + alpha * alpha) / (2 * alpha * std::sin(theta / 2));
+    auto vprime = [](double h) {
+        const double y = h - 1.0;
+        return 3 * y * y / ((1 + y * y * y) * (1 + y * y * y));
+    };
+    const double h0 = bisect([&](double h) { return vprime(h) - slope; }, 1.0 + std::cbrt(0.5), 20.0);
+    auto ring = std::make_unique<OvRing>(n, alpha, tau, 1.0, 1.0, h0);
+    r.hopf = correct_hopf(*ring, ring->parameter_index("headway"), ring->uniform_flow(), h0, omega);
+    if (r.hopf.status != Status::Converged) return r;
+    ring->set_parameter("headway", r.hopf.par);
+    r.options.parameter = "headway";
+    r.options.from = r.hopf.par - 1.5;
+    r.options.to = r.hopf.par + 1.5;
+    r.system = std::move(ring);
+    r.ok = true;
+    return r;
+}
+
+Problem idm_problem(int n) {
+    Problem r;
+    NonlinearRing ring = make_nonlinear_ring("idm", n, ParameterMap{{"th", 1.2}, {"tau", 0.6}}, "gap", 6.0);
+    EquilibriumBranchOptions eo;
+    eo.parameter = "gap";
+    eo.from = 6.0;
+    eo.to = 40.0;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = equilibrium_branch(*ring.system, ring.uniform_flow, eo);
+    if (eq.hopf.empty()) return r;
+    r.hopf = eq.hopf.front();
+    r.options.parameter = "gap";
+    r.options.from = 6.0;
+    r.options.to = 40.0;
+    r.system = std::move(ring.system);
+    r.ok = r.hopf.status == Status::Converged;
+    return r;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
-    int points = 100, intervals = 40, degree = 4;
+    int points = 100, intervals = 40, degree = 4, repeats = 1;
+    std::string model = "ov";
     std::vector<int> sizes;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--points" && i + 1 < argc) points = std::atoi(argv[++i]);
         else if (a == "--intervals" && i + 1 < argc) intervals = std::atoi(argv[++i]);
         else if (a == "--degree" && i + 1 < argc) degree = std::atoi(argv[++i]);
+        else if (a == "--repeats" && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
+        else if (a == "--model" && i + 1 < argc) model = argv[++i];
         else sizes.push_back(std::atoi(a.c_str()));
     }
+    if (model != "ov" && model != "idm") {
+        std::fprintf(stderr, "bench_orbits: --model ov|idm\n");
+        return 2;
+    }
     if (sizes.empty()) sizes = {5, 10};
-    const double pi = 3.14159265358979323846, alpha = 1.0, tau = 1.0;
-    std::printf("| N cars | states | orbits | wall [s] | CPU [s] | fold headway | max trivial dist | Newton its |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("model %s, degree %d, %d intervals, at most %d orbits, median of %d run(s)\n", model.c_str(), degree, intervals, points, repeats);
+    std::printf("| N cars | states | orbits | wall [s] | CPU [s] | folds | PD | tori | max trivial dist | Newton its |\n"
+                "|---:|---:|---:|---:|---:|---|---|---|---:|---:|\n");
     for (int n : sizes) {
-        const double theta = 2 * pi / n;
-        const double omega = bisect([&](double w) { return w * tau - theta / 2 + pi / 2 - std::atan(alpha / w); }, 1e-6, 10.0);
-        const double slope = omega * std::sqrt(omega * omega + alpha * alpha) / (2 * alpha * std::sin(theta / 2));
-        auto vprime = [](double h) {
-            const double y = h - 1.0;
-            return 3 * y * y / ((1 + y * y * y) * (1 + y * y * y));
-        };
-        const double h0 = bisect([&](double h) { return vprime(h) - slope; }, 1.0 + std::cbrt(0.5), 20.0);
-        OvRing ring(n, alpha, tau, 1.0, 1.0, h0);
-        const HopfPoint hopf = correct_hopf(ring, ring.parameter_index("headway"), ring.uniform_flow(), h0, omega);
-        if (hopf.status != Status::Converged) {
-            std::printf("| %d | Hopf point not converged |\n", n);
+        Problem pr = model == "ov" ? ov_problem(n) : idm_problem(n);
+        if (!pr.ok) {
+            std::printf("| %d | Hopf point not found or not converged |\n", n);
             continue;
         }
-        ring.set_parameter("headway", hopf.par);
-        PeriodicOrbitOptions o;
-        o.parameter = "headway";
-        o.from = hopf.par - 1.5;
-        o.to = hopf.par + 1.5;
+        PeriodicOrbitOptions& o = pr.options;
         o.max_points = points;
         o.intervals = intervals;
         o.degree = degree;
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::clock_t c0 = std::clock();
-        const OrbitBranch b = orbit_branch_from_hopf(ring, hopf, o);
-        const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-        std::printf("| %d | %d | %zu | %.2f | %.2f | %s | %.1e | %d |\n", n, ring.dimension(), b.points.size(), t, cpu,
-                    b.folds.empty() ? "-" : std::to_string(b.folds[0].par).c_str(), b.max_trivial_distance, b.newton_iterations);
+        std::vector<double> walls, cpus;
+        OrbitBranch b;
+        for (int r = 0; r < repeats; ++r) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const std::clock_t c0 = std::clock();
+            b = orbit_branch_from_hopf(*pr.system, pr.hopf, o);
+            walls.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+            cpus.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
+        }
+        auto list = [](const std::vector<double>& v) {
+            std::string s;
+            for (double x : v) s += (s.empty() ? "" : ", ") + std::to_string(x);
+            return s.empty() ? std::string("-") : s;
+        };
+        std::vector<double> folds, pds, tori;
+        for (const auto& f : b.folds) folds.push_back(f.par);
+        for (const auto& x : b.period_doublings) pds.push_back(x.par);
+        for (const auto& x : b.tori) tori.push_back(x.par);
+        std::printf("| %d | %d | %zu | %.2f | %.2f | %s | %s | %s | %.1e | %d |\n", n, pr.system->dimension(), b.points.size(), median(walls),
+                    median(cpus), list(folds).c_str(), list(pds).c_str(), list(tori).c_str(), b.max_trivial_distance, b.newton_iterations);
+        // a few values of the branch, to compare builds: the last orbit and the one in the middle
+        for (std::size_t k : {b.points.size() / 2, b.points.size() - 1}) {
+            if (k >= b.points.size()) continue;
+            const PeriodicOrbit& p = b.points[k];
+            std::printf("    orbit %zu: %s = %.10f, period %.10f, max |mu| nontrivial %.8f, |mu_trivial - 1| %.1e, %d Newton its\n", k,
+                        o.parameter.c_str(), p.par, p.period, p.max_nontrivial, p.trivial_distance, p.iterations);
+        }
+        std::printf("    stop: %s; %s\n", b.stop.c_str(), b.message.c_str());
         std::fflush(stdout);
     }
 }

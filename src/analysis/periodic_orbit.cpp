@@ -9,6 +9,12 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+// GCC 12 reports a false -Wuse-after-free inside Spectra's Hessenberg eigenvector code
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#include <Spectra/GenEigsSolver.h>
+#include <Spectra/MatOp/DenseGenMatProd.h>
+#pragma GCC diagnostic pop
 
 
 namespace ddemap {
@@ -188,15 +194,21 @@ bool assemble(const Setup& c, const Eigen::VectorXd& u, const Eigen::MatrixXd& r
     return F.allFinite();
 }
 
+struct Linearization;
+
 struct Correction {
     bool ok = false;
     int iterations = 0;
+    int jacobians = 0;  // linearisations (condensed) or sparse LU factorisations
     double residual = std::numeric_limits<double>::infinity();
     Eigen::VectorXd tangent;  // [J; a^T]^{-1} e_last at the result (not normalised)
+    std::shared_ptr<const Linearization> lin;  // at the result (condensed path only)
 };
 
-/// Newton on [F(u); a . u - b] = 0 with the phase reference `ref` (x' of the previous orbit).
-Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b,
+/// Newton on [F(u); a . u - b] = 0 with the phase reference `ref` (x' of the previous orbit),
+/// every step with a sparse LU of the whole bordered Jacobian: the path for windows too large
+/// for the condensed form (see Linearization).
+Correction correct_sparse(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b,
                    const PeriodicOrbitOptions& o) {
     Correction r;
     Eigen::VectorXd F;
@@ -224,6 +236,7 @@ Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& re
         if (it == o.max_iterations) break;
         if (!assemble(c, u, ref, &a, b, F, &J)) return r;
         if (!factorize(J)) return r;
+        ++r.jacobians;
         r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
         const Eigen::VectorXd du = lu.solve(F);
         if (!du.allFinite()) return r;
@@ -302,6 +315,366 @@ bool multipliers(const Setup& c, const Eigen::VectorXd& u, std::vector<cplx>& ou
     return true;
 }
 
+using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using SpR = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// The collocation Jacobian at an orbit in the condensed form of the Floquet problem. Ordered as
+/// in multipliers(): the unknowns are the values at the points g = 1..P of the period (M1, whose
+/// column block g - 1 is the orbit's point g mod P) and at the history window g = gmin..0 (M0,
+/// H = (1 - gmin) n columns), so that dF/dX = M1 + M0 E with E picking the window's points from
+/// the orbit. M1 is block lower triangular by mesh intervals (a delayed point is never later
+/// than its collocation point): L diagonal blocks of d n x d n, factorised densely, and the
+/// entries left of them (`lower`). Its forward sweep gives
+///     Y = -M1^{-1} [M0, dF/dT, dF/dp]      (N x (H + 2)),
+/// and with it the Newton system J du = r of the whole bordered Jacobian reduces exactly (a Schur
+/// complement) to the dense (H + 2) x (H + 2) system K in the window values z and (dT, dp):
+///     Y_{b(h)} w - z_h = -x_{b(h)},  ph . Y w = r_ph - ph . x,  a . Y w + (a_T, a_p) . (dT, dp) = r_a - a . x,
+/// with x = M1^{-1} r_coll, w = (z, dT, dp), b(h) the M1 block of window point h, and
+/// du = x + Y w. The rows of Y at the points one period after the window are the monodromy
+/// matrix of the Floquet multipliers. Cost: one sweep with H + 2 right-hand sides per
+/// linearisation, one with one right-hand side per Newton step.
+struct Linearization {
+    long gmin = 0, nh = 0;
+    int H = 0;
+    std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> diag;
+    SpR lower;
+    RowMat Y;
+};
+
+/// The bordering of a linearisation for one corrector: phase row and arclength row (in M1 order) and K.
+struct Border {
+    Eigen::VectorXd ph, a;
+    Eigen::PartialPivLU<Eigen::MatrixXd> K;
+};
+
+/// failed: f or its derivatives not finite at u; too_large: see below; unstable: a singular
+/// diagonal block or Y not finite (the sparse LU of the whole Jacobian is used instead).
+enum class LinStatus { ok, too_large, failed, unstable };
+
+/// The largest window (H = n times its points) and Y (N (H + 2) doubles) of the condensed form;
+/// beyond them the sparse LU of the whole Jacobian is used (correct_sparse).
+constexpr int kMaxWindow = 4000;
+constexpr double kMaxCondensed = 1.6e7;
+
+/// The M1 block (0..P-1) of the orbit's point q (0..P-1): point P of M1 is point 0.
+inline int m1_block(int q, int P) { return q == 0 ? P - 1 : q - 1; }
+/// The orbit's point of window point g (any integer): g mod P.
+inline int wrap_point(long g, int P) { return static_cast<int>(((g % P) + P) % P); }
+
+/// x := M1^{-1} x (any number of columns), by the forward sweep over the intervals.
+void sweep(const Setup& c, const Linearization& lz, RowMat& x) {
+    const int dn = c.d * c.n;
+    for (int i = 0; i < c.L; ++i) {
+        const int r0 = i * dn;
+        for (int q = r0; q < r0 + dn; ++q)
+            for (SpR::InnerIterator it(lz.lower, q); it; ++it) x.row(q) -= it.value() * x.row(it.col());
+        const Eigen::MatrixXd blk = lz.diag[static_cast<std::size_t>(i)].solve(x.middleRows(r0, dn));
+        x.middleRows(r0, dn) = blk;
+    }
+}
+
+/// The linearisation at u (Linearization); too_large when the window or Y exceed the limits above.
+LinStatus linearize(const Setup& c, const Eigen::VectorXd& u, Linearization& lz) {
+    const int N = c.N(), n = c.n, d = c.d, P = c.P, dn = d * n;
+    const double T = u(N);
+    if (!(T > 0.0) || !std::isfinite(u(N + 1))) return LinStatus::failed;
+    const std::vector<double> pv = c.params(u(N + 1));
+    std::vector<double> tau, dtau;
+    try {
+        tau = c.sys.delays(pv);
+        dtau = c.sys.delay_derivatives(pv, c.j);
+    } catch (const std::exception&) {
+        return LinStatus::failed;
+    }
+    double rmax = 0.0;
+    for (double t : tau) {
+        if (!(t >= 0.0) || !std::isfinite(t)) return LinStatus::failed;
+        rmax = std::max(rmax, t / T);
+    }
+    long gmin = 0;
+    if (rmax > 0.0) {
+        const double fl = std::floor(-rmax);
+        double w = -rmax - fl;
+        if (w >= 1.0) w = 0.0;
+        gmin = static_cast<long>(fl) * P + static_cast<long>(c.mesh.interval_of(w)) * d;
+    }
+    const long nh = 1 - gmin;
+    if (nh * n > kMaxWindow || static_cast<double>(N) * static_cast<double>(nh * n + 2) > kMaxCondensed) return LinStatus::too_large;
+    lz.gmin = gmin;
+    lz.nh = nh;
+    lz.H = static_cast<int>(nh * n);
+    const int H = lz.H;
+    std::vector<Eigen::MatrixXd> D(static_cast<std::size_t>(c.L), Eigen::MatrixXd::Zero(dn, dn));
+    std::vector<Triplet> low;
+    low.reserve(static_cast<std::size_t>(N) * static_cast<std::size_t>((c.d + 1) * (c.m + 1) * 2));
+    RowMat B = RowMat::Zero(N, H + 2);  // -[M0, dF/dT, dF/dp]
+    bool structure = true;
+    auto put = [&](int i, long g, int row, const Eigen::MatrixXd* blk, double factor) {
+        if (factor == 0.0) return;
+        if (g >= 1) {
+            const long col = (g - 1) * n;
+            if (col >= static_cast<long>(i) * dn && col < static_cast<long>(i + 1) * dn) {
+                auto db = D[static_cast<std::size_t>(i)].block(row - i * dn, col - static_cast<long>(i) * dn, n, n);
+                if (blk) db += factor * *blk;
+                else db.diagonal().array() += factor;
+            } else if (col < static_cast<long>(i) * dn) {
+                for (int cc = 0; cc < n; ++cc)
+                    for (int r = 0; r < n; ++r) {
+                        const double v = blk ? (*blk)(r, cc) : (r == cc ? 1.0 : 0.0);
+                        if (v != 0.0) low.emplace_back(row + r, static_cast<int>(col) + cc, factor * v);
+                    }
+            } else {
+                structure = false;  // a point later than the interval: not block lower triangular
+            }
+        } else {
+            auto mb = B.block(row, (g - gmin) * n, n, n);
+            if (blk) mb -= factor * *blk;
+            else mb.diagonal().array() -= factor;
+        }
+    };
+    PointData pd;
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < d; ++g) {
+            if (!evaluate_point(c, u, tau, i, g, true, pd)) return LinStatus::failed;
+            const int row = (i * d + g) * n;
+            for (int jj = 0; jj <= d; ++jj) {
+                const long gl = static_cast<long>(i) * d + jj;
+                put(i, gl, row, nullptr, pd.dl[static_cast<std::size_t>(jj)]);
+                put(i, gl, row, &pd.A[0], -T * pd.l[static_cast<std::size_t>(jj)]);
+            }
+            Eigen::VectorXd dT = -pd.f, dp = -T * pd.fp;
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                const long per = static_cast<long>(std::floor(pd.sk[uk]));
+                for (int jj = 0; jj <= d; ++jj)
+                    put(i, per * P + static_cast<long>(pd.lk[uk]) * d + jj, row, &pd.A[uk + 1], -T * pd.lkv[uk][static_cast<std::size_t>(jj)]);
+                const Eigen::VectorXd ad = pd.A[uk + 1] * pd.dxk[uk];
+                dT -= ad * (tau[uk] / T);
+                dp += ad * dtau[uk];
+            }
+            B.block(row, H, n, 1) = -dT;
+            B.block(row, H + 1, n, 1) = -dp;
+        }
+    if (!structure) return LinStatus::too_large;
+    lz.lower.resize(N, N);
+    lz.lower.setFromTriplets(low.begin(), low.end());
+    lz.lower.makeCompressed();
+    lz.diag.clear();
+    lz.diag.reserve(D.size());
+    for (const Eigen::MatrixXd& m : D) {
+        lz.diag.emplace_back(m);
+        if (!(std::abs(lz.diag.back().determinant()) > 0.0)) return LinStatus::unstable;
+    }
+    sweep(c, lz, B);
+    if (!B.allFinite()) return LinStatus::unstable;
+    lz.Y = std::move(B);
+    return LinStatus::ok;
+}
+
+/// The phase row d(phase)/dX (N, in the orbit's order) for the reference x' values `ref`.
+Eigen::VectorXd phase_row(const Setup& c, const Eigen::MatrixXd& ref) {
+    Eigen::VectorXd ph = Eigen::VectorXd::Zero(c.N());
+    std::vector<double> l(static_cast<std::size_t>(c.d) + 1), dl(static_cast<std::size_t>(c.d) + 1);
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < c.d; ++g) {
+            c.mesh.basis(i, c.mesh.collocation_point(i, g), l.data(), dl.data());
+            const double wg = c.mesh.gauss_weights()[static_cast<std::size_t>(g)] * c.mesh.width(i);
+            for (int jj = 0; jj <= c.d; ++jj) {
+                const int col = ((i * c.d + jj) % c.P) * c.n;
+                ph.segment(col, c.n) += (wg * l[static_cast<std::size_t>(jj)]) * ref.row(i * c.d + g).transpose();
+            }
+        }
+    return ph;
+}
+
+/// K of the linearisation for the phase row ph (orbit order) and the arclength row a (N + 2).
+bool border(const Setup& c, const Linearization& lz, const Eigen::VectorXd& ph, const Eigen::VectorXd& a, Border& bd) {
+    const int N = c.N(), n = c.n, P = c.P, H = lz.H;
+    bd.ph.resize(N);
+    bd.a.resize(N);
+    for (int q = 0; q < P; ++q) {
+        const int b = m1_block(q, P);
+        bd.ph.segment(b * n, n) = ph.segment(q * n, n);
+        bd.a.segment(b * n, n) = a.segment(q * n, n);
+    }
+    Eigen::MatrixXd K(H + 2, H + 2);
+    for (long h = 0; h < lz.nh; ++h) {
+        const int b = m1_block(wrap_point(lz.gmin + h, P), P);
+        K.middleRows(h * n, n) = lz.Y.middleRows(static_cast<Eigen::Index>(b) * n, n);
+        K.block(h * n, h * n, n, n).diagonal().array() -= 1.0;
+    }
+    K.row(H) = bd.ph.transpose() * lz.Y;
+    K.row(H + 1) = bd.a.transpose() * lz.Y;
+    K(H + 1, H) += a(N);
+    K(H + 1, H + 1) += a(N + 1);
+    if (!K.allFinite()) return false;
+    bd.K.compute(K);
+    return std::abs(bd.K.determinant()) > 0.0;
+}
+
+/// du with J du = r (the bordered Jacobian of assemble(), N + 2 rows) from the condensed form.
+Eigen::VectorXd condensed_solve(const Setup& c, const Linearization& lz, const Border& bd, const Eigen::VectorXd& r) {
+    const int N = c.N(), n = c.n, P = c.P, H = lz.H;
+    RowMat x = r.head(N);
+    sweep(c, lz, x);
+    const Eigen::Map<const Eigen::VectorXd> xv(x.data(), N);
+    Eigen::VectorXd rk(H + 2);
+    for (long h = 0; h < lz.nh; ++h) {
+        const int b = m1_block(wrap_point(lz.gmin + h, P), P);
+        rk.segment(h * n, n) = -xv.segment(static_cast<Eigen::Index>(b) * n, n);
+    }
+    rk(H) = r(N) - bd.ph.dot(xv);
+    rk(H + 1) = r(N + 1) - bd.a.dot(xv);
+    const Eigen::VectorXd w = bd.K.solve(rk);
+    const Eigen::VectorXd dx = xv + lz.Y * w;
+    Eigen::VectorXd du(N + 2);
+    for (int q = 0; q < P; ++q) du.segment(q * n, n) = dx.segment(static_cast<Eigen::Index>(m1_block(q, P)) * n, n);
+    du(N) = w(H);
+    du(N + 1) = w(H + 1);
+    return du;
+}
+
+/// Newton on [F(u); a . u - b] = 0 (see correct_sparse) in the condensed form: chord steps with
+/// the linearisation `start` (e.g. at the previous orbit of the branch), a new linearisation at
+/// the current iterate when a step contracts by less than kChordContraction, and one at the
+/// result (for the tangent, the multipliers and the next corrector).
+constexpr double kChordContraction = 0.3;
+/// The chord steps go on to this fraction of the Newton tolerance while they contract (the
+/// linearisation for the multipliers is taken there, and |mu_trivial - 1| follows its distance
+/// from the orbit); a step within the tolerance that no longer contracts is at the rounding
+/// floor of the condensed solve and ends them.
+constexpr double kChordTolerance = 1e-2;
+
+Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b,
+                   const PeriodicOrbitOptions& o, std::shared_ptr<const Linearization> start) {
+    Correction r;
+    const int N = c.N();
+    auto fresh = [&](std::shared_ptr<const Linearization>& lz) {
+        auto next = std::make_shared<Linearization>();
+        const LinStatus st = linearize(c, u, *next);
+        ++r.jacobians;
+        if (st != LinStatus::ok) return st;
+        lz = std::move(next);
+        return st;
+    };
+    std::shared_ptr<const Linearization> lz = std::move(start);
+    if (!lz) {
+        const LinStatus st = fresh(lz);
+        if (st == LinStatus::too_large || st == LinStatus::unstable) return correct_sparse(c, u, ref, a, b, o);
+        if (st != LinStatus::ok) return r;
+    }
+    const Eigen::VectorXd ph = phase_row(c, ref);
+    Border bd;
+    if (!border(c, *lz, ph, a, bd)) return correct_sparse(c, u, ref, a, b, o);
+    Eigen::VectorXd F;
+    double previous = std::numeric_limits<double>::infinity();
+    int refreshes = 0;
+    bool converged = false;
+    for (int step = 0; step < 3 * o.max_iterations; ++step) {
+        if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+        r.residual = F.head(N + 1).lpNorm<Eigen::Infinity>();
+        Eigen::VectorXd du = condensed_solve(c, *lz, bd, F);
+        if (!du.allFinite()) return r;
+        double size = du.lpNorm<Eigen::Infinity>();
+        const double target = o.tolerance * std::max(1.0, u.lpNorm<Eigen::Infinity>());
+        const bool slow = step > 0 && size > kChordContraction * previous;
+        if (slow && size <= target) {  // within the tolerance and at the rounding floor of the condensed solve
+            converged = true;
+            break;
+        }
+        if (slow) {
+            if (r.jacobians >= o.max_iterations) return r;
+            ++refreshes;
+            if (fresh(lz) != LinStatus::ok || !border(c, *lz, ph, a, bd)) return r;
+            du = condensed_solve(c, *lz, bd, F);
+            if (!du.allFinite()) return r;
+            size = du.lpNorm<Eigen::Infinity>();
+        }
+        u -= du;
+        ++r.iterations;
+        previous = size;
+        if (size <= kChordTolerance * target) {
+            converged = true;
+            break;
+        }
+    }
+    if (!converged || !assemble(c, u, ref, &a, b, F, nullptr)) return r;
+    // the linearisation at the result (for the tangent [J; a^T]^{-1} e_last, the multipliers and
+    // the next chord), first used for one Newton step: the chord steps converge linearly, so the
+    // result of their last step is only about kChordContraction * tolerance accurate
+    if (fresh(lz) != LinStatus::ok || !border(c, *lz, ph, a, bd)) return r;
+    const Eigen::VectorXd du = condensed_solve(c, *lz, bd, F);
+    if (!du.allFinite()) return r;
+    u -= du;
+    ++r.iterations;
+    if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+    r.residual = F.head(N + 1).lpNorm<Eigen::Infinity>();
+    if (!(r.residual <= o.residual_tolerance)) return r;
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
+    e(N + 1) = 1.0;
+    r.tangent = condensed_solve(c, *lz, bd, e);
+    if (!r.tangent.allFinite()) return r;
+    r.lin = lz;
+    r.ok = true;
+    return r;
+}
+
+/// The eigenvalues of the monodromy matrix: all of them (dense QR) up to kDenseMultipliers, else
+/// the largest in modulus by Arnoldi (Spectra), at least kArnoldiMultipliers and, doubling
+/// their number, until the smallest one found is below kArnoldiFloor in modulus (so every
+/// multiplier outside the disc of that radius is listed); dense QR when Arnoldi fails.
+constexpr int kDenseMultipliers = 200;
+constexpr int kArnoldiMultipliers = 16;
+constexpr double kArnoldiFloor = 0.5;
+
+bool monodromy_eigenvalues(const Eigen::MatrixXd& mono, std::vector<cplx>& out) {
+    const auto H = mono.rows();
+    out.clear();
+    if (H > kDenseMultipliers) {
+        Spectra::DenseGenMatProd<double> op(mono);
+        const double scale = mono.lpNorm<Eigen::Infinity>();
+        for (Eigen::Index nev = kArnoldiMultipliers; 2 * nev + 20 <= H / 2; nev *= 2) {
+            Spectra::GenEigsSolver<Spectra::DenseGenMatProd<double>> es(op, nev, 2 * nev + 20);
+            es.init();
+            es.compute(Spectra::SortRule::LargestMagn, 1000, 1e-13);
+            if (es.info() != Spectra::CompInfo::Successful) break;
+            const Eigen::VectorXcd ev = es.eigenvalues();
+            const Eigen::MatrixXcd vec = es.eigenvectors();
+            if (ev.size() == 0) break;
+            // every Ritz pair checked: |M v - mu v| <= 1e-9 |M| |v|
+            bool good = true;
+            for (Eigen::Index k = 0; k < ev.size() && good; ++k)
+                good = (mono * vec.col(k) - ev(k) * vec.col(k)).norm() <= 1e-9 * scale * vec.col(k).norm();
+            if (!good) break;
+            if (std::abs(ev(ev.size() - 1)) < kArnoldiFloor) {
+                for (Eigen::Index k = 0; k < ev.size(); ++k) out.push_back(ev(k));
+                break;
+            }
+        }
+    }
+    if (out.empty()) {
+        Eigen::EigenSolver<Eigen::MatrixXd> es(mono, false);
+        if (es.info() != Eigen::Success) return false;
+        for (Eigen::Index k = 0; k < H; ++k) out.push_back(es.eigenvalues()(k));
+    }
+    std::sort(out.begin(), out.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
+    return true;
+}
+
+/// Floquet multipliers from the linearisation at the orbit: the monodromy matrix maps the window
+/// values to the values one period later (rows of Y, or of the identity for window points that
+/// are still in the window one period later).
+bool condensed_multipliers(const Setup& c, const Linearization& lz, std::vector<cplx>& out) {
+    const int n = c.n, P = c.P, H = lz.H;
+    Eigen::MatrixXd mono = Eigen::MatrixXd::Zero(H, H);
+    for (long h = 0; h < lz.nh; ++h) {
+        const long g = lz.gmin + h + P;
+        if (g <= 0) mono.block(h * n, (g - lz.gmin) * n, n, n).setIdentity();
+        else mono.middleRows(h * n, n) = lz.Y.block((g - 1) * n, 0, n, H);
+    }
+    return monodromy_eigenvalues(mono, out);
+}
+
 PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correction& r, bool floquet) {
     PeriodicOrbit o;
     o.period = u(c.N());
@@ -322,7 +695,8 @@ PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correct
     o.breakpoints = c.mesh.breakpoints();
     o.residual = r.residual;
     o.iterations = r.iterations;
-    if (floquet && multipliers(c, u, o.multipliers) && !o.multipliers.empty()) {
+    const bool have = floquet && (r.lin ? condensed_multipliers(c, *r.lin, o.multipliers) : multipliers(c, u, o.multipliers));
+    if (have && !o.multipliers.empty()) {
         std::size_t k1 = 0;
         for (std::size_t k = 1; k < o.multipliers.size(); ++k)
             if (std::abs(o.multipliers[k] - 1.0) < std::abs(o.multipliers[k1] - 1.0)) k1 = k;
@@ -350,6 +724,8 @@ std::vector<cplx> nontrivial(const PeriodicOrbit& o) {
 }
 
 constexpr double kRealTolerance = 1e-6;  // |Im mu| below this: a real multiplier
+constexpr double kCrossingTolerance = 1e-9;  // | |mu| - 1 | at a located period doubling or torus
+constexpr double kCrossingJump = 1e-3;  // | |mu| - 1 | still above this on a bracket of 1e-12 h: a jump, not a crossing
 
 int count_pd(const PeriodicOrbit& o) {
     int c = 0;
@@ -364,12 +740,14 @@ int count_torus(const PeriodicOrbit& o) {
     return c;
 }
 
-/// |mu| - 1 of the multiplier of the kind (period doubling: nearest -1; torus: complex, nearest
-/// the unit circle) and that multiplier.
+/// |mu| - 1 of the multiplier of the kind (period doubling: real negative, nearest -1; torus:
+/// complex, nearest the unit circle) and that multiplier; NaN when there is none.
 double crossing_value(const PeriodicOrbit& o, bool pd, cplx& mu) {
-    double best = std::numeric_limits<double>::infinity(), value = 0.0;
+    double best = std::numeric_limits<double>::infinity(), value = std::numeric_limits<double>::quiet_NaN();
     for (cplx z : nontrivial(o)) {
-        const double dist = pd ? std::abs(z + 1.0) : (std::abs(z.imag()) > kRealTolerance ? std::abs(std::abs(z) - 1.0) : best);
+        const bool real = std::abs(z.imag()) <= kRealTolerance;
+        if (pd ? !(real && z.real() < 0.0) : real) continue;
+        const double dist = pd ? std::abs(z + 1.0) : std::abs(std::abs(z) - 1.0);
         if (dist < best) {
             best = dist;
             value = std::abs(z) - 1.0;
@@ -485,6 +863,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
     const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
     const double T0 = u(N);
     const Setup* cur = cp.get();
+    std::shared_ptr<const Linearization> lin_u = first.lin;  // at u: the chord matrix of the next corrector
     auto adapt = [&]() {
         if (!o.adapt) return;
         auto next_mesh = std::make_unique<PeriodicMesh>(c0.mesh.degree(), adapted_breakpoints(*cur, u));
@@ -495,6 +874,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         mesh = std::move(next_mesh);
         cp = std::move(next);
         cur = cp.get();
+        lin_u.reset();  // the next corrector starts with a linearisation on the new mesh
     };
     auto report = [&] {
         if (o.progress) o.progress(static_cast<long>(b.points.size()), o.max_points, b.points.back().par);
@@ -503,6 +883,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
     report();
     const double amp0 = amplitude(b.points.front());
     b.newton_iterations += first.iterations;
+    b.jacobians += first.jacobians;
     double h = o.initial_step;
     b.stop = "max_points";
     adapt();
@@ -511,8 +892,9 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
         Eigen::VectorXd v = u + h * t;
         const Eigen::VectorXd a = c.w.cwiseProduct(t);
-        Correction r = correct(c, v, ref, a, a.dot(u + h * t), o);
+        Correction r = correct(c, v, ref, a, a.dot(u + h * t), o, lin_u);
         b.newton_iterations += r.iterations;
+        b.jacobians += r.jacobians;
         const bool jump = r.ok && c.norm(v - u) > 3.0 * h;
         if (!r.ok || jump) {
             h *= 0.5;
@@ -535,8 +917,9 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
             Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
             e(N + 1) = 1.0;
             Eigen::VectorXd w = v;
-            const Correction rb = correct(c, w, ref, e, bound, o);
+            const Correction rb = correct(c, w, ref, e, bound, o, r.lin);
             b.newton_iterations += rb.iterations;
+            b.jacobians += rb.jacobians;
             if (rb.ok) {
                 b.points.push_back(make_orbit(c, w, rb, o.floquet));
                 report();
@@ -563,8 +946,9 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
             for (int it = 0; it < 40; ++it) {
                 const double s = slo - glo * (shi - slo) / (ghi - glo);
                 Eigen::VectorXd w = uk + s * tk;
-                const Correction rc = correct(c, w, ref, ak, ak.dot(uk + s * tk), o);
+                const Correction rc = correct(c, w, ref, ak, ak.dot(uk + s * tk), o, lin_u);
                 b.newton_iterations += rc.iterations;
+                b.jacobians += rc.jacobians;
                 if (!rc.ok) break;
                 const double gv = (rc.tangent / c.norm(rc.tangent))(N + 1) * (rc.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
                 best = w;
@@ -600,16 +984,68 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
             for (int kind = 0; kind < 2; ++kind) {
                 const bool pd = kind == 0;
                 const int c0 = pd ? count_pd(prev) : count_torus(prev), c1 = pd ? count_pd(orbit) : count_torus(orbit);
-                if (c0 == c1) continue;
+                // a real multiplier through -1 changes the number of real ones < -1 by one; a
+                // complex pair colliding on the real axis there changes it by two
+                if (c0 == c1 || (pd && (c1 - c0) % 2 == 0)) continue;
                 cplx m0, m1;
                 const double g0 = crossing_value(prev, pd, m0), g1 = crossing_value(orbit, pd, m1);
-                const double frac = g0 != g1 ? std::clamp(g0 / (g0 - g1), 0.0, 1.0) : 0.5;
+                if (!std::isfinite(g0) || !std::isfinite(g1) || (g0 < 0.0) == (g1 < 0.0)) continue;  // no multiplier crossed the circle
                 OrbitCrossing x;
                 x.after = after;
+                // the interpolation, kept when the location fails
+                const double frac = std::clamp(g0 / (g0 - g1), 0.0, 1.0);
                 x.par = prev.par + frac * (orbit.par - prev.par);
                 x.period = prev.period + frac * (orbit.period - prev.period);
                 x.multiplier = m1;
-                (pd ? b.period_doublings : b.tori).push_back(x);
+                const Eigen::VectorXd ak = c.w.cwiseProduct(t);
+                double slo = 0.0, shi = ak.dot(v - u), glo = g0, ghi = g1, plo = prev.par, phi = orbit.par;
+                int side = 0;
+                bool jump = false;
+                for (int it = 0; it < 40; ++it) {
+                    const double sm = slo - glo * (shi - slo) / (ghi - glo);
+                    Eigen::VectorXd w = u + sm * t;
+                    const Correction rc = correct(c, w, ref, ak, ak.dot(u + sm * t), o, lin_u);
+                    b.newton_iterations += rc.iterations;
+                    b.jacobians += rc.jacobians;
+                    if (!rc.ok) break;
+                    PeriodicOrbit trial = make_orbit(c, w, rc, true);
+                    cplx mu;
+                    const double gv = crossing_value(trial, pd, mu);
+                    if (!std::isfinite(gv)) break;
+                    if ((gv < 0.0) == (glo < 0.0)) {
+                        slo = sm;
+                        glo = gv;
+                        plo = trial.par;
+                        if (side == -1) ghi *= 0.5;
+                        side = -1;
+                    } else {
+                        shi = sm;
+                        ghi = gv;
+                        phi = trial.par;
+                        if (side == 1) glo *= 0.5;
+                        side = 1;
+                    }
+                    if (std::abs(shi - slo) <= 1e-12 * h && std::abs(gv) > kCrossingJump) {
+                        jump = true;  // g jumps (the multiplier nearest the circle changed): no crossing
+                        break;
+                    }
+                    if (std::abs(gv) <= kCrossingTolerance || std::abs(shi - slo) <= 1e-12 * h) {
+                        x.located = true;
+                        x.par = trial.par;
+                        x.period = trial.period;
+                        x.multiplier = mu.imag() < 0.0 ? std::conj(mu) : mu;
+                        x.accuracy = std::abs(gv);
+                        x.par_bracket = std::abs(phi - plo);
+                        x.orbit = std::move(trial);
+                        break;
+                    }
+                }
+                if (jump) continue;
+                if (!x.located && b.status == Status::Converged) {
+                    b.status = Status::MaxIterations;
+                    b.message = std::string("a ") + (pd ? "period doubling" : "torus bifurcation") + " was detected but not located";
+                }
+                (pd ? b.period_doublings : b.tori).push_back(std::move(x));
             }
         }
         const bool collapsed = amplitude(orbit) < 0.5 * amp0;
@@ -621,7 +1057,10 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         }
         u = v;
         t = tn;
-        if (r.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
+        lin_u = r.lin;
+        // an easy step: the chord iterations converged with at most one new Jacobian besides the
+        // one at the result (sparse path: at most 3 Newton steps)
+        if (r.lin ? r.jacobians <= 2 : r.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
         if (u(N) > o.max_period_factor * T0) {
             b.stop = "period";
             return;
@@ -642,10 +1081,21 @@ void finish(OrbitBranch& b) {
     }
 }
 
+/// Eigen's products in one thread while a branch is computed: its matrices (d n x d n blocks, a
+/// window of a few hundred values) are too small for OpenMP's threads, which on a loaded machine
+/// spent five times the work in waiting (BENCHMARKS.md). The previous setting is restored.
+struct SingleThreadedEigen {
+    int previous = Eigen::nbThreads();
+    SingleThreadedEigen() { Eigen::setNbThreads(1); }
+    ~SingleThreadedEigen() { Eigen::setNbThreads(previous); }
+    SingleThreadedEigen(const SingleThreadedEigen&) = delete;
+    SingleThreadedEigen& operator=(const SingleThreadedEigen&) = delete;
+};
+
 std::string method_text(const PeriodicMesh& mesh) {
     std::ostringstream s;
     s << "piecewise polynomial collocation, degree " << mesh.degree() << " on " << mesh.intervals()
-      << " intervals at Gauss-Legendre points; Newton with a sparse LU (Eigen SparseLU, COLAMD); pseudo-arclength; Floquet multipliers of the collocated monodromy matrix";
+      << " intervals at Gauss-Legendre points; Newton (chord steps) on the system condensed to the history window by a forward sweep over the intervals; pseudo-arclength; Floquet multipliers of the collocated monodromy matrix";
     return s.str();
 }
 
@@ -723,6 +1173,7 @@ std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::strin
 }
 
 OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
     if (!(hopf.omega > 0.0) || !std::isfinite(hopf.omega)) throw std::invalid_argument("orbits from a Hopf point: expected omega > 0");
     if (hopf.q.size() != system.dimension() || hopf.x.size() != system.dimension())
         throw std::invalid_argument("orbits from a Hopf point: x and q must have the system's dimension");
@@ -749,12 +1200,13 @@ OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& 
     Eigen::VectorXd u = uh + options.initial_step * t0;
     const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
     const Eigen::VectorXd a = c.w.cwiseProduct(t0);
-    const Correction r = correct(c, u, ref, a, a.dot(u), options);
+    const Correction r = correct(c, u, ref, a, a.dot(u), options, nullptr);
     if (!r.ok) {
         b.status = Status::MaxIterations;
         b.stop = "first_orbit_failed";
         b.message = "the first orbit from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
         b.newton_iterations = r.iterations;
+        b.jacobians = r.jacobians;
         return b;
     }
     Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
@@ -764,6 +1216,7 @@ OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& 
 }
 
 OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
     const PeriodicMesh mesh(options.degree, options.intervals);
     if (guess.profile.rows() != mesh.points() || guess.profile.cols() != system.dimension())
         throw std::invalid_argument("orbit guess: expected a profile of (degree x intervals) rows and one column per variable");
@@ -782,7 +1235,7 @@ OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess
     const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
     Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
     e(N + 1) = 1.0;
-    const Correction r = correct(c, u, ref, e, guess.par, options);
+    const Correction r = correct(c, u, ref, e, guess.par, options, nullptr);
     if (!r.ok) {
         b.status = Status::MaxIterations;
         b.stop = "first_orbit_failed";

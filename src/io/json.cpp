@@ -489,7 +489,8 @@ std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::strin
     for (const char* key : {"period_doublings", "tori"}) {
         json a = json::array();
         for (const OrbitCrossing& x : std::string(key) == "tori" ? b.tori : b.period_doublings)
-            a.push_back({{"par", num(x.par)}, {"period", num(x.period)}, {"multiplier", pair(x.multiplier)}});
+            a.push_back({{"par", num(x.par)}, {"period", num(x.period)}, {"multiplier", pair(x.multiplier)}, {"located", x.located},
+                         {"accuracy", num(x.accuracy)}, {"par_bracket", num(x.par_bracket)}});
         j[key] = a;
     }
     j["stop"] = b.stop;

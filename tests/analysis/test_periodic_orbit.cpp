@@ -290,9 +290,10 @@ TEST_CASE("orbit options and starts: bad input is std::invalid_argument, a faile
     const OrbitBranch b = orbit_branch_from_guess(sys, g, options("alpha", 1.5, 2.0, 5));
     CHECK(b.status != Status::Converged);
     CHECK(b.stop == "first_orbit_failed");
-    // a guess far from any orbit: no crash, a status
+    // a guess far from any orbit: no crash, a status (from 50 sin + 60 the condensed corrector
+    // reaches the orbit of period 4.02 itself, so the guess is ten times further up)
     const PeriodicMesh mesh(4, 40);
-    for (int i = 0; i < mesh.points(); ++i) g.profile(i, 0) = 50.0 * std::sin(2 * pi * mesh.point(i)) + 60.0;
+    for (int i = 0; i < mesh.points(); ++i) g.profile(i, 0) = 50.0 * std::sin(2 * pi * mesh.point(i)) + 600.0;
     const OrbitBranch far = orbit_branch_from_guess(sys, g, options("alpha", 1.5, 2.0, 5));
     CHECK(far.status != Status::Converged);
     CHECK(far.stop == "first_orbit_failed");
@@ -315,4 +316,60 @@ TEST_CASE("Wright's equation at alpha = 2.9: the adapted mesh gives a more accur
         }
     }
     CHECK(std::abs(period[1] - period[2]) < 0.5 * std::abs(period[0] - period[2]));
+}
+
+TEST_CASE("Mackey-Glass (beta = 2, gamma = 1, n = 9.65): the first period doubling in tau, located, and period T / 2T by simulation on either side") {
+    // x' = beta x(t - tau) / (1 + x(t - tau)^n) - gamma x: equilibrium x = 1, a supercritical Hopf
+    // point in tau, then the period doubling cascade of the stable orbit (Mackey and Glass 1977)
+    ExpressionSystem mg({"x"}, {"beta", "gamma", "n", "tau"}, {2.0, 1.0, 9.65, 0.3}, {"beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"});
+    EquilibriumBranchOptions eo;
+    eo.parameter = "tau";
+    eo.from = 0.3;
+    eo.to = 2.0;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = equilibrium_branch(mg, Eigen::VectorXd::Constant(1, 1.0), eo);
+    REQUIRE(!eq.hopf.empty());
+    const OrbitBranch b = orbit_branch_from_hopf(mg, eq.hopf.front(), options("tau", 0.3, 2.0, 200));
+    REQUIRE(!b.period_doublings.empty());
+    const OrbitCrossing& pd = b.period_doublings.front();
+    REQUIRE(pd.located);
+    CHECK(pd.accuracy <= 1e-9);
+    CHECK(std::abs(pd.multiplier + 1.0) <= 1e-8);  // a real multiplier at -1
+    CHECK(pd.par_bracket < 1e-6);
+    CHECK(pd.orbit.trivial_distance < tol::orbit_trivial_multiplier);
+    // the orbits before it are stable, the ones just after it not (the multiplier left through -1)
+    const auto k = static_cast<std::size_t>(pd.after);
+    CHECK(b.points[k].stable);
+    CHECK(!b.points[k + 1].stable);
+    // independent check by simulation, 0.02 below and above the located tau: successive maxima
+    // of x are equal below (period T) and alternate above (period 2T)
+    auto maxima = [&](double tau) {
+        mg.set_parameter("tau", tau);
+        const DdeSolver s = simulate(mg, [](double, double* y) { y[0] = 0.5; }, 3000.0, 0.005);
+        std::vector<double> m, when;
+        double prev2 = s.value(0, 2500.0 - 0.01), prev = s.value(0, 2500.0);
+        for (double t = 2500.0 + 0.01; t <= 3000.0; t += 0.01) {
+            const double x = s.value(0, t);
+            if (prev > prev2 && prev >= x) {
+                m.push_back(prev);
+                when.push_back(t - 0.01);
+            }
+            prev2 = prev;
+            prev = x;
+        }
+        return std::make_pair(m, when);
+    };
+    const auto below = maxima(pd.par - 0.02), above = maxima(pd.par + 0.02);
+    REQUIRE(below.first.size() > 20);
+    REQUIRE(above.first.size() > 20);
+    double spread_below = 0.0, alternation_above = 1e300, spread_above_2 = 0.0;
+    for (std::size_t i = 1; i < below.first.size(); ++i) spread_below = std::max(spread_below, std::abs(below.first[i] - below.first[i - 1]));
+    for (std::size_t i = 1; i < above.first.size(); ++i) alternation_above = std::min(alternation_above, std::abs(above.first[i] - above.first[i - 1]));
+    for (std::size_t i = 2; i < above.first.size(); ++i) spread_above_2 = std::max(spread_above_2, std::abs(above.first[i] - above.first[i - 2]));
+    CHECK(spread_below < 1e-3);        // one maximum per period: period T
+    CHECK(alternation_above > 1e-2);   // two different maxima ...
+    CHECK(spread_above_2 < 1e-3);      // ... repeating every second one: period 2T
+    // and the period of the simulated orbit below is the located orbit's (to the slope of T over 0.02 in tau)
+    const double T_below = (below.second.back() - below.second.front()) / static_cast<double>(below.second.size() - 1);
+    CHECK(std::abs(T_below - pd.period) < 0.05 * pd.period);
 }

@@ -14,10 +14,16 @@
 /// Newton's Jacobian is exact: the blocks A_k = D_{u_k} f and df/dp from dual numbers, and
 ///     dF/dT = -f - sum_k A_k x'(c_k) tau_k / T,
 ///     dF/dp = -T df/dp + sum_k A_k x'(c_k) d tau_k / dp        (c_k = c - tau_k / T);
-/// it is sparse (the delayed terms couple distant intervals) and solved by a sparse LU,
-/// bordered by the phase row and the pseudo-arclength row: Eigen's supernodal SparseLU with
-/// COLAMD ordering (UMFPACK, through Debian's reference BLAS, took 1.2 to 3.7 times as long on
-/// the ov rings of BENCHMARKS.md: its frontal matrices go through dgemm).
+/// bordered by the phase row and the pseudo-arclength row. It is solved in condensed form: the
+/// collocation matrix of the points of one period is block lower triangular by intervals (a
+/// delayed point is never later than its collocation point) once the values on the history
+/// window [-max tau / T, 0] are taken as separate unknowns, so a forward sweep over the
+/// intervals (dense d n x d n diagonal blocks) reduces the Newton system exactly to a dense
+/// one in the window values, T and p (the monodromy matrix minus the identity, bordered); the
+/// same sweep gives the Floquet monodromy matrix. Chord steps reuse the linearisation of the
+/// previous orbit, a new one is made when a step contracts by less than 0.3, and one at every
+/// orbit found (for its tangent, its multipliers and the next corrector). Windows of more than
+/// 4000 values use Eigen's supernodal SparseLU (COLAMD) of the whole bordered Jacobian instead.
 ///
 /// Mesh adaptation (options.adapt, off by default): after every orbit the breakpoints are moved so that they
 /// equidistribute |x^(d+1)|^(1/(d+1)) (estimated from the jumps of the piecewise constant d-th
@@ -36,15 +42,18 @@
 /// on [0, 1], M1 y_new + M0 y_hist = 0, with y_hist the mesh values (the mesh repeated
 /// periodically) on the intervals that meet [-max tau_k / T, 0]; the monodromy matrix maps
 /// y_hist to the values on the same points shifted by one period (rows of -M1^{-1} M0 or of the
-/// identity), and its eigenvalues (dense) are the multipliers (the zero multipliers of the
-/// points that no delay reaches are left out). The trivial multiplier (the one nearest 1, of
+/// identity), and its eigenvalues are the multipliers (the zero multipliers of the points that
+/// no delay reaches are left out): all of them (dense QR) for matrices up to 200, else the
+/// largest by Arnoldi (Spectra; at least 16, and every one of modulus above 1/2; each Ritz
+/// pair's residual checked, dense QR when one fails). The trivial multiplier (the one nearest 1, of
 /// the eigenvector x') must be 1: |mu_trivial - 1| is the accuracy check.
 ///
 /// Special points along a branch: a fold (the parameter component of the unit tangent changes
 /// sign) is located by Illinois regula falsi in the arclength on that component (each trial
 /// orbit corrected); a period doubling (the number of real multipliers < -1 changes) and a
-/// torus bifurcation (the number of complex multipliers with |mu| > 1 changes) are located by
-/// linear interpolation in p of |mu| - 1 of the multiplier that crosses (between the two orbits).
+/// torus bifurcation (the number of complex multipliers with |mu| > 1 changes) likewise on
+/// |mu| - 1 of the multiplier that crosses (OrbitCrossing). A change of those counts without a
+/// multiplier crossing the unit circle (two multipliers colliding on the real axis) is not reported.
 
 #include <limits>
 #include <string>
@@ -96,7 +105,9 @@ struct PeriodicOrbit {
     Eigen::MatrixXd profile;  ///< L d x n: row i is x at mesh point i (x(1) = row 0)
     std::vector<double> breakpoints;  ///< the mesh t_0 = 0 < ... < t_L = 1 of the profile
     Eigen::VectorXd min, max;  ///< of every variable over the orbit (sampled at 8 d points per interval)
-    std::vector<cplx> multipliers;  ///< by decreasing modulus, the trivial one included
+    /// by decreasing modulus, the trivial one included (for monodromy matrices above 200: the
+    /// largest ones, at least 16 and all of modulus above 1/2)
+    std::vector<cplx> multipliers;
     double trivial_distance = std::numeric_limits<double>::quiet_NaN();  ///< |mu_trivial - 1|
     double max_nontrivial = std::numeric_limits<double>::quiet_NaN();   ///< max |mu| over the others
     bool stable = false;      ///< every nontrivial |mu| < 1 (false without multipliers)
@@ -111,10 +122,21 @@ struct OrbitFold {
     int after = 0;         ///< index of the branch orbit before it
 };
 
-/// A period doubling or a torus bifurcation between orbits after and after + 1.
+/// A period doubling or a torus bifurcation between orbits after and after + 1: the zero of
+///     g(s) = |mu(s)| - 1
+/// along the branch (s the arclength from orbit `after`, each trial orbit corrected and its
+/// multipliers computed), mu the real negative multiplier nearest -1 (period doubling) or the
+/// complex one nearest the unit circle (torus), by Illinois regula falsi from the bracket of the
+/// two orbits until |g| <= 1e-9 (or the bracket is 1e-12 of the step).
 struct OrbitCrossing {
-    double par = 0.0, period = 0.0;  ///< linear interpolation in p of |mu| - 1 (and of T)
-    cplx multiplier;                  ///< the crossing multiplier at the orbit after + 1
+    double par = 0.0, period = 0.0;  ///< of the located orbit (not located: interpolated linearly in g)
+    cplx multiplier;                  ///< the crossing multiplier there (torus: the one with Im >= 0)
+    bool located = false;             ///< the regula falsi reached its tolerance
+    /// | |mu| - 1 | of the crossing multiplier at the located orbit (NaN when not located)
+    double accuracy = std::numeric_limits<double>::quiet_NaN();
+    /// the width in p of the last bracket of the zero (NaN when not located)
+    double par_bracket = std::numeric_limits<double>::quiet_NaN();
+    PeriodicOrbit orbit;              ///< the located orbit (empty when not located)
     int after = 0;
 };
 
@@ -137,6 +159,9 @@ struct OrbitBranch {
     double max_residual = 0.0;          ///< certificate: max over orbits of max |F|
     double max_trivial_distance = 0.0;  ///< certificate: max over orbits of |mu_trivial - 1|
     int newton_iterations = 0;
+    /// Jacobians evaluated and factorised by the correctors (condensed linearisations, or
+    /// sparse LU factorisations where the history window is too large for the condensed form)
+    int jacobians = 0;
 };
 
 /// A starting orbit (e.g. sampled from a simulation): values on the mesh of `mesh`, period, parameter.
