@@ -53,4 +53,15 @@ double ExpPoly::max_delay() const {
     return d;
 }
 
+bool ExpPoly::operator==(const ExpPoly& other) const {
+    if (m_terms.size() != other.m_terms.size()) return false;
+    // delays are distinct after merging, so each term has at most one partner, in any order
+    for (const Term& t : m_terms) {
+        bool found = false;
+        for (const Term& u : other.m_terms) found = found || (u.delay == t.delay && u.coef == t.coef);
+        if (!found) return false;
+    }
+    return true;
+}
+
 }  // namespace ddemap

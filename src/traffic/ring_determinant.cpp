@@ -19,16 +19,8 @@ constexpr std::size_t kParallelTypes = 256;
 /// types per block of the parallel reduction (fixed, so sums do not depend on the thread count)
 constexpr long kTypeBlock = 64;
 
-bool same(const ExpPoly& a, const ExpPoly& b) {
-    const auto &ta = a.terms(), &tb = b.terms();
-    if (ta.size() != tb.size()) return false;
-    for (std::size_t j = 0; j < ta.size(); ++j)
-        if (ta[j].coef != tb[j].coef || ta[j].delay != tb[j].delay) return false;
-    return true;
-}
-
 bool same(const Linearisation& a, const Linearisation& b) {
-    return same(a.gap, b.gap) && same(a.own, b.own) && same(a.lead, b.lead) && a.further.empty() && b.further.empty();
+    return a.gap == b.gap && a.own == b.own && a.lead == b.lead && a.further.empty() && b.further.empty();
 }
 
 

@@ -25,18 +25,10 @@ constexpr int kMaxBlock = 24;
 
 bool finite(cplx z) { return std::isfinite(z.real()) && std::isfinite(z.imag()); }
 
-bool same(const ExpPoly& a, const ExpPoly& b) {
-    const auto &ta = a.terms(), &tb = b.terms();
-    if (ta.size() != tb.size()) return false;
-    for (std::size_t j = 0; j < ta.size(); ++j)
-        if (ta[j].coef != tb[j].coef || ta[j].delay != tb[j].delay) return false;
-    return true;
-}
-
 bool same(const Linearisation& a, const Linearisation& b) {
-    if (!(same(a.gap, b.gap) && same(a.own, b.own) && same(a.lead, b.lead))) return false;
+    if (!(a.gap == b.gap && a.own == b.own && a.lead == b.lead)) return false;
     const bool fa = !a.further.empty() && !a.further[0].empty(), fb = !b.further.empty() && !b.further[0].empty();
-    return fa == fb && (!fa || same(a.further[0], b.further[0]));
+    return fa == fb && (!fa || a.further[0] == b.further[0]);
 }
 
 /// A 2 x 2 complex matrix [[a, b], [c, d]].

@@ -29,6 +29,10 @@ public:
     /// sum_j |c_j| (a bound on |E(i w)| for real w)
     double abs_sum() const;
     double max_delay() const;
+    /// The same terms in any order, coefficient for coefficient and delay for delay (bitwise equal
+    /// doubles): used to group identical cars.
+    bool operator==(const ExpPoly& other) const;
+    bool operator!=(const ExpPoly& other) const { return !(*this == other); }
 
 private:
     std::vector<Term> m_terms;
