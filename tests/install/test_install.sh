@@ -3,12 +3,15 @@
 # the source tree (tests/install/consumer: find_package(ddemap), ddemap::ddemap) configured,
 # built and run against that prefix alone.
 # With the Python module built (PYTHON given): also the installed package imported and used.
-# Usage: test_install.sh BUILD_DIR SOURCE_DIR [CXX_COMPILER [PYTHON]]
+# Usage: test_install.sh BUILD_DIR SOURCE_DIR [CXX_COMPILER [PYTHON [CXX_FLAGS [EXE_LINKER_FLAGS]]]]
+# (the flags of the build being installed: a sanitizer build's libraries need its runtime in the consumer too)
 set -euo pipefail
 build=$1
 source=$2
 compiler=${3:-}
 python=${4:-}
+cxx_flags=${5:-}
+linker_flags=${6:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
@@ -35,6 +38,8 @@ fi
 
 args=(-DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_BUILD_TYPE=Release -DDDEMAP_TESTS_DIR="$source/tests")
 [ -n "$compiler" ] && args+=(-DCMAKE_CXX_COMPILER="$compiler")
+[ -n "$cxx_flags" ] && args+=(-DCMAKE_CXX_FLAGS="$cxx_flags")
+[ -n "$linker_flags" ] && args+=(-DCMAKE_EXE_LINKER_FLAGS="$linker_flags")
 command -v ccache >/dev/null && args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S "$source/tests/install/consumer" -B "$tmp/consumer" "${args[@]}" >"$tmp/configure.log" ||
     { cat "$tmp/configure.log"; fail "the consumer does not configure"; }
