@@ -30,12 +30,12 @@ struct Args {
     bool resume = false;
 } args;
 
-/// The chunks of one run: those still to compute, handed out in order; the results gathered
-/// (values, done) and stored as they arrive. Thread-safe.
+/// The chunks of one run: those still to compute, handed out in order; the results appended
+/// to the chunk store as they arrive (rank 0 keeps no values in memory). Thread-safe.
 class Ledger {
 public:
-    Ledger(const AtlasSpec& spec, AtlasStore& store, std::vector<double>& values, std::vector<char>& done, Progress progress)
-        : m_spec(spec), m_store(store), m_values(values), m_done(done), m_progress(std::move(progress)) {
+    Ledger(const AtlasSpec& spec, AtlasStore& store, std::vector<char>& done, Progress progress)
+        : m_spec(spec), m_store(store), m_done(done), m_progress(std::move(progress)) {
         for (long c = 0; c < spec.chunks(); ++c)
             if (!done[static_cast<std::size_t>(c)]) m_queue.push_back(c);
         m_pending = static_cast<long>(m_queue.size());
@@ -49,7 +49,7 @@ public:
         m_queue.pop_front();
         return c;
     }
-    /// Stores a finished chunk (its values, fsynced in the chunk store).
+    /// Stores a finished chunk (its values, in the chunk store).
     void finish(long c, const double* v, std::size_t count) {
         std::lock_guard<std::mutex> lock(m_mutex);
         const std::size_t nf = atlas_fields().size();
@@ -62,7 +62,6 @@ public:
             m_failed = true;
             throw;
         }
-        std::copy(v, v + count, m_values.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(m_spec.chunk_begin(c)) * nf));
         m_done[static_cast<std::size_t>(c)] = 1;
         ++m_finished;
         if (m_progress) m_progress(m_finished, m_pending);
@@ -80,7 +79,6 @@ public:
 private:
     const AtlasSpec& m_spec;
     AtlasStore& m_store;
-    std::vector<double>& m_values;
     std::vector<char>& m_done;
     Progress m_progress;
     std::mutex m_mutex;
@@ -107,19 +105,23 @@ void compute_locally(const AtlasSpec& spec, Ledger& ledger, int threads) {
     }, policy);
 }
 
-/// Refuses an atlas above the limits before any work: per point 16 values of 8 bytes in memory,
-/// the HDF5 image twice (the in-memory file and its copy) and the figure's sweep points, about
-/// 450 bytes (446 MB measured for 10^6 points);
-/// 88 bytes of HDF5 (9 float64, 3 int32, 4 flags),
-/// and 5e-5 s per ring mode on one core (the sweep's measured cost; N = inf about 12 modes).
+/// Refuses an atlas above the limits before any work. Memory on rank 0: the chunk store's
+/// index and the done flags (9 bytes per chunk), a chunk's values per thread (twice: computed
+/// and its record; 128 bytes per point each), the HDF5 slab (65536 points x 16 doubles, and one
+/// field's copy: 9 MB), the figure's points (at most 250,000 sweep points: 30 MB), and HDF5's
+/// caches (a few MB). Output: 88 bytes of HDF5 per point (9 float64, 3 int32, 4 flags) and,
+/// while it runs, the chunk store (128 bytes per point). Time: 5e-5 s per ring mode on one
+/// core (the sweep's measured cost; N = inf and the winding path about 12 modes at any N).
 void check_atlas_size(const AtlasSpec& spec, int workers) {
+    const bool winding = spec.ring_method_used() == "winding";
     double modes = 0.0;
-    for (int n : spec.rings) modes += n == 0 ? 12.0 : n / 2 + 1.0;
+    for (int n : spec.rings) modes += n == 0 || winding ? 12.0 : n / 2 + 1.0;
     const double per_ring = static_cast<double>(spec.points()) / static_cast<double>(spec.rings.size());
+    const double chunk_bytes = static_cast<double>(spec.chunk_size()) * 128.0;
     std::ostringstream what;
     what << "an atlas of " << spec.points() << " points";
-    check_size("atlas", what.str(), "memory", static_cast<double>(spec.points()) * 450.0);
-    check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * 88.0);
+    check_size("atlas", what.str(), "memory", 9.0 * static_cast<double>(spec.chunks()) + 2.0 * chunk_bytes * (workers + 1) + 5e7);
+    check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * (88.0 + 128.0));
     check_size("atlas", what.str(), "time", per_ring * modes * 5e-5 / std::max(1, workers));
 }
 
@@ -309,7 +311,6 @@ int run_atlas() {
 
     // rank 0: the size guard, the output folder and the chunk store, before any work
     std::string prefix;
-    std::vector<double> values;
     std::vector<char> done;
     std::unique_ptr<AtlasStore> store;
     std::exception_ptr setup_error;
@@ -329,7 +330,7 @@ int run_atlas() {
                 if (!args.resume && store_exists && !run_flags().quiet)
                     std::cerr << "ddemap: atlas: note: the chunks of an earlier run in " << prefix
                               << ".chunks are discarded (--resume continues that run)\n";
-                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, values, done);
+                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, done);
             }
         } catch (...) {
             setup_error = std::current_exception();
@@ -369,7 +370,7 @@ int run_atlas() {
     long computed_points = 0;
     for (long c = 0; c < spec.chunks(); ++c)
         if (!done[static_cast<std::size_t>(c)]) computed_points += spec.chunk_end(c) - spec.chunk_begin(c);
-    Ledger ledger(spec, *store, values, done, progress_printer("atlas", "chunks"));
+    Ledger ledger(spec, *store, done, progress_printer("atlas", "chunks"));
     const long computed = ledger.pending();
     const auto t_compute = std::chrono::steady_clock::now();
 #if DDEMAP_WITH_MPI
@@ -390,26 +391,34 @@ int run_atlas() {
     compute_locally(spec, ledger, threads);
 #endif
     const double compute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_compute).count();
-    store.reset();
-    const std::string h5 = atlas_hdf5(spec, values, text);
-    const std::string svg = atlas_svg(file, values);
-    // the result and the figure appear together; the chunk store goes with the move
-    write_files_atomic({{prefix + ".h5", h5}, {prefix + ".svg", svg}}, {prefix + ".chunks"});
-
+    store->sync();
+    const std::string svg = atlas_svg(file, store->reader());
     const std::size_t nf = atlas_fields().size();
     long classes[4] = {0, 0, 0, 0}, uncertified = 0;
-    for (long i = 0; i < spec.points(); ++i) {
-        const double* v = &values[static_cast<std::size_t>(i) * nf];
-        ++classes[static_cast<int>(v[15])];
-        uncertified += v[14] == 0.0;
+    {
+        std::vector<double> v(static_cast<std::size_t>(spec.chunk_size()) * nf);
+        for (long c = 0; c < spec.chunks(); ++c) {
+            store->read(c, v.data());
+            for (long i = 0; i < spec.chunk_end(c) - spec.chunk_begin(c); ++i) {
+                ++classes[static_cast<int>(v[static_cast<std::size_t>(i) * nf + 15])];
+                uncertified += v[static_cast<std::size_t>(i) * nf + 14] == 0.0;
+            }
+        }
     }
+    // the HDF5 file from the chunk store in slabs (bounded memory at any size), through
+    // DIR/atlas.h5.part, in place while the store still holds every chunk (a crash here leaves a
+    // store that --resume completes without computing); then the figure, with the store removed
+    write_atlas_hdf5(prefix + ".h5", spec, store->reader(), text);
+    store.reset();
+    write_files_atomic({{prefix + ".svg", svg}}, {prefix + ".chunks"});
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::ostringstream out;
     out << "atlas      " << spec.points() << " points in " << spec.chunks() << " chunks of " << spec.chunk_size() << " (" << computed
         << " computed, " << loaded << " resumed) in " << rounded(seconds, 3) << " s";
     if (computed > 0) {
         out << " (" << static_cast<long>(std::lround(computed_points / std::max(compute_seconds, 1e-9))) << " points/s";
-        out << ", " << ranks << (ranks == 1 ? " process" : " processes") << " x " << threads << (threads == 1 ? " thread" : " threads") << ")";
+        out << ", " << ranks << (ranks == 1 ? " process" : " processes") << " x " << threads << (threads == 1 ? " thread" : " threads")
+            << ", ring method " << spec.ring_method_used() << ")";
     }
     out << "\nregions    plant unstable " << classes[0] << ", ring unstable " << classes[1] << ", string unstable " << classes[2]
         << ", string stable " << classes[3];

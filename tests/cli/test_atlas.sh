@@ -36,7 +36,19 @@ fi
 
 # every point against `ddemap sweep` on the same point
 mkdir -p "$tmp/sweeps"
-"$py" "$check" sweep "$tmp/serial/atlas.h5" "$bin" "$tmp/sweeps" && ok || bad "atlas points differ from ddemap sweep"
+"$py" "$check" sweep "$tmp/serial/atlas.h5" "$bin" "$tmp/sweeps" >"$tmp/check.out" && grep -q "ring method winding" "$tmp/check.out" && ok ||
+    bad "atlas points differ from ddemap sweep (or not on the winding path): $(cat "$tmp/check.out")"
+
+# the per-mode ring path (ring_method = "modes") on one (k1, k2) plane per ring size: every point
+# against the sweep with boundaries (which uses that path)
+sed -e 's/^values = \[0.1, 0.4\]/values = [0.4]/' -e 's/^values = \[1.0, 2.0\]/values = [1.0]/' -e 's/^chunk = 16 /ring_method = "modes"\nchunk = 16 /' \
+    "$spec" >"$tmp/modes.toml"
+grep -q '^ring_method = "modes"' "$tmp/modes.toml" && ok || bad "atlas: the modes spec was not made"
+if OMP_NUM_THREADS=2 "$bin" atlas "$tmp/modes.toml" --out "$tmp/modes" --quiet >/dev/null 2>"$tmp/modes.err"; then
+    "$py" "$check" sweep "$tmp/modes/atlas.h5" "$bin" "$tmp/sweeps" && ok || bad "atlas (ring method modes) points differ from ddemap sweep"
+else
+    bad "atlas with ring_method = modes: exit status: $(cat "$tmp/modes.err")"
+fi
 
 # two threads
 OMP_NUM_THREADS=2 "$bin" atlas "$spec" --out "$tmp/threads" --quiet >/dev/null 2>&1 && ok || bad "atlas on two threads: exit status"
@@ -155,6 +167,7 @@ th = 1.5
 name = \"k1\"
 values = [0.1]"
 expect_error "estimated run time" "rings = [1000]
+ring_method = \"modes\"
 [fixed]
 tau = 0.1
 th = 1.5
@@ -162,12 +175,23 @@ th = 1.5
 name = \"k1\"
 lo = 0.1
 hi = 1.0
-count = 1000
+count = 400
 [[axis]]
 name = \"k2\"
 lo = 0.1
 hi = 1.0
-count = 1000"
+count = 400"
+expect_error "expected at most 1000000 cars on the per-mode ring path" "rings = [2000000]
+ring_method = \"modes\"
+[fixed]
+tau = 0.1
+th = 1.5
+$axes"
+expect_error "ring_method: expected \"auto\", \"winding\" or \"modes\"" "ring_method = \"fast\"
+[fixed]
+tau = 0.1
+th = 1.5
+$axes"
 # --out on a file is refused
 touch "$tmp/afile"
 "$bin" atlas "$spec" --out "$tmp/afile" >/dev/null 2>"$tmp/f.err"
