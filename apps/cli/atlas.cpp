@@ -132,6 +132,10 @@ struct Outcome {
 
 #if DDEMAP_WITH_MPI
 constexpr int tag_request = 1, tag_assign = 2, tag_result = 3;
+/// Requests each rank > 0 keeps outstanding: one batch is always waiting at the rank while it
+/// computes another, whatever the delay of rank 0's answer (its coordinator polls, and on a
+/// loaded machine waits for a core).
+constexpr int lookahead = 2;
 
 /// Rank 0 of an MPI run: hands out chunks on request (as many as the asking rank has threads)
 /// and stores the results, while its own threads compute chunks from the same ledger.
@@ -146,7 +150,7 @@ void coordinate(const AtlasSpec& spec, Ledger& ledger, int ranks, int threads) {
         }
         local_done = true;
     });
-    int active = ranks - 1;
+    int active = lookahead * (ranks - 1);  // requests that will still be answered with none
     std::vector<double> buffer;
     try {
         // until every rank was told to stop and every chunk is stored (a rank asks for its next
@@ -170,7 +174,7 @@ void coordinate(const AtlasSpec& spec, Ledger& ledger, int ranks, int threads) {
                     chunks.push_back(c);
                 }
                 MPI_Send(chunks.data(), static_cast<int>(chunks.size()), MPI_LONG_LONG, st.MPI_SOURCE, tag_assign, MPI_COMM_WORLD);
-                if (chunks.empty()) --active;  // that rank stops
+                if (chunks.empty()) --active;  // one of that rank's request streams stops
             } else if (st.MPI_TAG == tag_result) {
                 int count = 0;
                 MPI_Get_count(&st, MPI_DOUBLE, &count);
@@ -206,9 +210,16 @@ std::vector<long long> receive_assignment() {
 /// A rank > 0: asks rank 0 for chunks (as many as it has threads), computes them, sends the
 /// values back (the chunk index first), until rank 0 answers with none. The request for the
 /// next chunks goes out before the current ones are computed, so that the answer is there when
-/// they are done (no idle round trip to rank 0).
+/// they are done (no idle round trip to rank 0); the values go out without waiting (MPI_Isend:
+/// a chunk's message is above the eager limit, and a blocking send would wait until rank 0's
+/// coordinator, which polls, takes it) while the next chunks are computed.
 void serve(const AtlasSpec& spec, int threads) {
-    MPI_Send(&threads, 1, MPI_INT, 0, tag_request, MPI_COMM_WORLD);
+    std::vector<std::vector<double>> sending;  // the previous batch's messages, in flight
+    std::vector<MPI_Request> requests;
+    for (int i = 0; i < lookahead; ++i) MPI_Send(&threads, 1, MPI_INT, 0, tag_request, MPI_COMM_WORLD);
+    // each non-empty answer is followed by one new request, so `lookahead` stay outstanding; the
+    // answers come in order, and once one is empty the ledger is empty: the others are too
+    int open = lookahead;
     for (std::vector<long long> chunks = receive_assignment(); !chunks.empty(); chunks = receive_assignment()) {
         MPI_Send(&threads, 1, MPI_INT, 0, tag_request, MPI_COMM_WORLD);
         const int count = static_cast<int>(chunks.size());
@@ -222,8 +233,14 @@ void serve(const AtlasSpec& spec, int threads) {
             r.push_back(static_cast<double>(chunks[static_cast<std::size_t>(i)]));
             r.insert(r.end(), v.begin(), v.end());
         }, policy);
-        for (const auto& r : results) MPI_Send(r.data(), static_cast<int>(r.size()), MPI_DOUBLE, 0, tag_result, MPI_COMM_WORLD);
+        MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+        sending = std::move(results);
+        requests.assign(sending.size(), MPI_REQUEST_NULL);
+        for (std::size_t i = 0; i < sending.size(); ++i)
+            MPI_Isend(sending[i].data(), static_cast<int>(sending[i].size()), MPI_DOUBLE, 0, tag_result, MPI_COMM_WORLD, &requests[i]);
     }
+    for (--open; open > 0; --open) receive_assignment();  // the other outstanding answers (empty)
+    MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
 }
 
 #endif

@@ -3,9 +3,10 @@
 /// Atlases: the sweep's quantities and verdicts on a grid over up to five model parameters and a
 /// list of ring sizes. The grid is flattened in C order with the ring size outermost and the last
 /// parameter axis innermost, and cut into fixed chunks of consecutive points. A chunk is the unit
-/// of work (of a thread, of an MPI rank, of a resumed run): along a chunk the rightmost roots are
-/// continued from point to point exactly as along a sweep row (detail::evaluate_sweep_point),
-/// starting afresh (collocation) at the chunk's first point and whenever the ring size changes.
+/// of work (of a thread, of an MPI rank, of a resumed run): along a chunk the ring's certificate
+/// (winding tables or per-mode roots, AtlasSpec::ring_method) and the plant's root are continued
+/// from point to point exactly as along a sweep row, starting afresh at the chunk's first point
+/// and whenever the ring size changes.
 /// The values of a point thus depend only on the spec (its chunk), never on which process or
 /// thread computed it or in which order: an atlas is bitwise the same for any schedule.
 
