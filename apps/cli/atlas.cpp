@@ -106,7 +106,7 @@ void compute_locally(const AtlasSpec& spec, Ledger& ledger, int threads) {
 }
 
 /// Refuses an atlas above the limits before any work. Memory on rank 0: the chunk store's
-/// index and the done flags (9 bytes per chunk), a chunk's values per thread (twice: computed
+/// index, the queue of chunks and the done flags (17 bytes per chunk), a chunk's values per thread (twice: computed
 /// and its record; 128 bytes per point each), the HDF5 slab (65536 points x 16 doubles, and one
 /// field's copy: 9 MB), the figure's points (at most 250,000 sweep points: 30 MB), and HDF5's
 /// caches (a few MB). Output: 88 bytes of HDF5 per point (9 float64, 3 int32, 4 flags) and,
@@ -120,7 +120,7 @@ void check_atlas_size(const AtlasSpec& spec, int workers) {
     const double chunk_bytes = static_cast<double>(spec.chunk_size()) * 128.0;
     std::ostringstream what;
     what << "an atlas of " << spec.points() << " points";
-    check_size("atlas", what.str(), "memory", 9.0 * static_cast<double>(spec.chunks()) + 2.0 * chunk_bytes * (workers + 1) + 5e7);
+    check_size("atlas", what.str(), "memory", 17.0 * static_cast<double>(spec.chunks()) + 2.0 * chunk_bytes * (workers + 1) + 5e7);
     check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * (88.0 + 128.0));
     check_size("atlas", what.str(), "time", per_ring * modes * 5e-5 / std::max(1, workers));
 }
