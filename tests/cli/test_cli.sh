@@ -1076,6 +1076,162 @@ pgcount "$pgd/hc.err" '^ddemap: hopf: equilibria [0-9]+/[0-9]+, alpha = ' >/dev/
     bad "hopf --par2: progress lines of the branch and the curve: $(head -3 "$pgd/hc.err")"
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --quiet >/dev/null 2>"$pgd/hc.err"
 [ ! -s "$pgd/hc.err" ] && ok || bad "hopf --quiet still printed: $(head -3 "$pgd/hc.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 12 --format json >"$pgd/or.json" 2>"$pgd/or.err"
+n=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['result']['points']))" "$pgd/or.json" 2>/dev/null || echo none)
+[ "$(pgcount "$pgd/or.err" '^ddemap: orbits: [0-9]+ orbits? \(at most 12\), headway = [-0-9.e]+ \(')" = "$n" ] && ok ||
+    bad "orbits: not one progress line per orbit ($n): $(grep -v equilibria "$pgd/or.err" | head -3)"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 12 --quiet >/dev/null 2>"$pgd/or.err"
+[ ! -s "$pgd/or.err" ] && ok || bad "orbits --quiet still printed: $(head -3 "$pgd/or.err")"
+# SIGINT while the orbits are computed (after the second one): the old output set stays as it was
+mkdir -p "$pgd/int"
+for f in o.csv o.json o.svg; do echo old >"$pgd/int/$f"; done
+python3 - "$bin" "$pgd/int" <<'PY' && ok || bad "orbits interrupted by SIGINT"
+import os, signal, subprocess, sys, time
+bin, d = sys.argv[1], sys.argv[2]
+env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
+p = subprocess.Popen([bin, "orbits", "--model", "ov", "--ring", "10", "--par", "headway", "--from", "1.2", "--to", "3",
+                      "--out", d + "/o", "--svg", d + "/o.svg"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+for line in p.stderr:  # wait for the second orbit: the work is under way
+    if ": 2 orbits (at most" in line:
+        break
+else:
+    sys.exit("the orbits ended before the second orbit was reported")
+p.send_signal(signal.SIGINT)
+p.stderr.close()
+rc = p.wait(timeout=60)
+assert rc == -signal.SIGINT, rc
+left = sorted(os.listdir(d))
+assert left == ["o.csv", "o.json", "o.svg"], left
+assert all(open(os.path.join(d, f)).read() == "old\n" for f in left)
+PY
+
+# ---- orbits --wave: travelling waves of a ring in the reduced form (one car; the leader is the car
+# shifted by K T / N). The 3-car ov ring: the wave agrees with the full ring's branch from the same
+# Hopf point (fold headway, period), and the stability is the full ring's (N <= 10)
+wav="$tmp/waves"; mkdir -p "$wav"
+"$bin" orbits --model ov --ring 3 --wave 1 --par headway --from 3.5 --to 2 --points 40 --format json --out "$wav/w" >"$wav/w.out" &&
+    "$bin" orbits --model ov --ring 3 --par headway --from 3.5 --to 2 --points 40 --format json >"$wav/f.out" &&
+    json_has "$wav/w.out" points folds period_doublings tori wave && [ -s "$wav/w.csv" ] && [ -s "$wav/w.json" ] &&
+    python3 - "$wav/w.out" "$wav/f.out" <<'PY' && ok || bad "orbits --wave 1 --ring 3: the reduced branch differs from the full ring's"
+import json, sys
+w, f = (json.load(open(a))["result"] for a in sys.argv[1:3])
+assert w["wave"]["cars"] == 3 and w["wave"]["wave"] == 1 and w["wave"]["stability"] == "full_ring", w["wave"]
+assert abs(w["wave"]["hopf"]["par"] - f["hopf"]["par"]) < 1e-8
+assert len(w["folds"]) == len(f["folds"]) == 1
+assert abs(w["folds"][0]["par"] - f["folds"][0]["par"]) < 1e-6 and abs(w["folds"][0]["period"] - f["folds"][0]["period"]) < 1e-6
+assert w["points"][-1]["par"] == f["points"][-1]["par"] == 2 and abs(w["points"][-1]["period"] - f["points"][-1]["period"]) < 1e-6
+assert w["points"][-1]["stable"] is True and w["points"][0]["stable"] is False
+assert w["variables"] == ["h0", "v0"]
+PY
+# 1000 cars, 10 per wave: one car's cost; no stability claimed (stable null, the table says not computed)
+"$bin" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --points 5 --format json >"$wav/l.out" &&
+    python3 -c "
+import json; r = json.load(open('$wav/l.out'))['result']
+assert r['wave']['stability'] == 'not_computed' and all(p['stable'] is None and p['multipliers'] == [] for p in r['points']), r['points'][0]
+assert len(r['points']) == 5 and r['certificate']['max_residual'] < 1e-8" && ok || bad "orbits --wave at 1000 cars"
+"$bin" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --points 3 | grep -q "not computed" && ok || bad "orbits --wave table: stability not computed"
+# the other wave number of the same Hopf pair has no wave with omega > 0: UNDECIDED, exit 4, naming the other one
+"$bin" orbits --model ov --ring 5 --wave 4 --par headway --from 3.5 --to 2 >"$wav/u.txt" 2>"$wav/u.err"
+[ $? -eq 4 ] && grep -q "try 1" "$wav/u.err" && ok || bad "orbits --wave 4 --ring 5: not UNDECIDED naming wave number 1"
+expect_error "--wave = '5': expected a wave number from 1 to N - 1 = 4" orbits --model ov --ring 5 --wave 5 --par headway --from 3.5 --to 2 --out "$wav/bad1"
+expect_error "--wave = '0': expected a wave number from 1 to N - 1 = 4" orbits --model ov --ring 5 --wave 0 --par headway --from 3.5 --to 2
+expect_error "--wave = '1' needs a built-in ring" orbits --system "$orb/wright.json" --wave 1 --par alpha --from 1 --to 2 --out "$wav/bad2"
+expect_error "--svg: not available with --wave" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --svg "$wav/bad3.svg"
+expect_error "--initial-step: only with --wave" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --initial-step 0.01
+[ -z "$(ls "$wav" | grep bad)" ] && ok || bad "orbits --wave bad input wrote files: $(ls "$wav")"
+
+# sweep and chart rings up to 10^9 cars on the winding tables; the per-mode path (boundaries) stays at 10^6
+big="$tmp/bigring"; mkdir -p "$big"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000000 --no-boundaries --out "$big/n" --format json >"$big/n.out" 2>/dev/null &&
+    "$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring inf --no-boundaries --out "$big/i" --format json >/dev/null 2>&1 &&
+    python3 - "$big" <<'PY' && ok || bad "sweep --ring 1000000000 --no-boundaries: winding tables, the abscissa and counts of N = inf"
+import csv, json, sys
+d = json.load(open(sys.argv[1] + "/n.out"))
+assert d["solver"]["used"] == "winding" and d["inputs"]["ring"] == 1000000000, (d["solver"], d["inputs"]["ring"])
+n = list(csv.DictReader(open(sys.argv[1] + "/n.csv")))
+i = list(csv.DictReader(open(sys.argv[1] + "/i.csv")))
+assert len(n) == len(i) == 16
+for a, b in zip(n, i):
+    # N = inf unstable: the same sup of the abscissa; N = inf stable: 10^9 cars have no unstable root, only
+    # the smallest wave numbers within the marginal band of the axis (so not "stable" either)
+    if b["ring_stable"] == "false":
+        assert a["ring_stable"] == "false" and int(a["unstable_roots"]) > 0, (a, b)
+        assert abs(float(a["spectral_abscissa"]) - float(b["spectral_abscissa"])) < 1e-10, (a, b)
+    else:
+        assert int(a["unstable_roots"]) == 0 and abs(float(a["spectral_abscissa"])) < 1e-12, (a, b)
+PY
+expect_error "expected at most 1000000 cars for sweep with boundaries" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000001 --out "$big/b"
+expect_error "expected at most 1000000 cars for boundary" boundary --th 1.5 --tau 0.5 --k1 0.1:1 --k2 0.1:1 --ring 2000000 --out "$big/c"
+expect_error "at most 1000000000)" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000001 --no-boundaries --out "$big/d"
+[ ! -e "$big/b.csv" ] && [ ! -e "$big/c.csv" ] && ok || bad "a refused ring size wrote files"
+rm -rf "$big"
+
+# roots --system on a large sparse file (real triplets are held sparse): a delayed reaction-diffusion
+# equation from bench/sparse_systems.py; its rightmost root solves the scalar equation of the first
+# Laplacian mode, lambda = mu + a - b e^{-lambda tau} (Newton in Python from the reported root: an
+# independent check of value and mode), and the path is the sparse one with the compact basis
+bsd=$(mktemp -d)
+python3 "$(dirname "$0")/../../bench/sparse_systems.py" rd --nx 30 --ny 20 --out "$bsd/rd.json"
+"$bin" roots --system "$bsd/rd.json" --format json >"$bsd/rd.out" 2>"$bsd/rd.err" &&
+    python3 - "$bsd/rd.out" <<'PY' && ok || bad "roots --system 600-state reaction-diffusion: wrong root or path"
+import cmath, json, math, sys
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "converged" and d["solver"]["used"] == "sparse", (d["status"], d["solver"])
+assert "compact Arnoldi" in d["message"], d["message"]
+r = d["result"]["roots"]
+assert len(r) >= 6 and r[0]["residual"] < 1e-12, r
+z = complex(r[0]["re"], r[0]["im"])
+mu = -4 * math.sin(math.pi / 62) ** 2 - 4 * 0.37 * math.sin(math.pi / 42) ** 2  # mode (1, 1), nx = 30, ny = 20
+c, b, tau = mu + 0.5, 1.0, 2.0
+w = z
+for _ in range(50):  # Newton on f(w) = w - c + b e^{-w tau}
+    w -= (w - c + b * cmath.exp(-w * tau)) / (1 - b * tau * cmath.exp(-w * tau))
+assert abs(w - z) < 1e-10, (w, z)
+PY
+# a complex triplet makes the file dense: the dense path and its size estimate, as before
+python3 - "$bsd/c.json" <<'PY'
+import json, sys
+json.dump({"dimension": 20, "delays": [1.0], "A0": {"triplets": [[i, i, -1.0] for i in range(20)]},
+           "A": [{"triplets": [[i, (i + 1) % 20, [0.1, 0.2]] for i in range(20)]}]}, open(sys.argv[1], "w"))
+PY
+"$bin" roots --system "$bsd/c.json" --format json >"$bsd/c.out" 2>/dev/null &&
+    python3 -c "import json; d = json.load(open('$bsd/c.out')); assert d['solver']['used'] == 'dense', d['solver']" && ok ||
+    bad "roots --system with complex triplets: not the dense path"
+rm -rf "$bsd"
+
+# ---- progress of roots --fleet/--system (at most one line per contour count, shift or degree when
+# stderr is a file, one per percent of the budget; none with --quiet), SIGINT during a long
+# roots --fleet --out leaves no output file and ends the process by the signal, and a branch's
+# first orbit is "1 orbit"
+rpd="$tmp/root-progress"; mkdir -p "$rpd"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --fleet-pattern "A_min,C_max" --ring 200 >"$rpd/f.out" 2>"$rpd/f.err"
+n=$(sed -n 's/^solver     product, \([0-9]*\) contour counts.*/\1/p' "$rpd/f.out")
+[ -n "$n" ] && grep -q -E '^ddemap: roots: [0-9]+ steps? \(at most 200000\), Re = [-0-9.e]+ \(' "$rpd/f.err" &&
+    [ "$(grep -c '^ddemap: roots:' "$rpd/f.err")" -le "$n" ] && ! grep -q "ddemap:" "$rpd/f.out" && ok ||
+    bad "roots --fleet: no progress line, or more than one per contour count ($n): $(head -3 "$rpd/f.err")"
+grep -q '^ddemap: roots: 1 step (at most' "$rpd/f.err" && ! grep -q ': 1 steps ' "$rpd/f.err" && ok || bad "roots --fleet progress: '1 steps'"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --fleet-pattern "A_min,C_max" --ring 200 --quiet >/dev/null 2>"$rpd/q.err"
+[ ! -s "$rpd/q.err" ] && ok || bad "roots --fleet --quiet still printed: $(head -3 "$rpd/q.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --system "$(dirname "$0")/../../examples/system.json" --format json >/dev/null 2>"$rpd/s.err" &&
+    grep -q -E '^ddemap: roots: [0-9]+ steps? \(at most [0-9]+\), Re = ' "$rpd/s.err" && ok ||
+    bad "roots --system: no progress line: $(head -3 "$rpd/s.err")"
+python3 - "$bin" "$rpd" <<'PY' && ok || bad "roots --fleet interrupted by SIGINT"
+import os, signal, subprocess, sys, time
+bin, d = sys.argv[1], sys.argv[2]
+env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
+p = subprocess.Popen([bin, "roots", "--fleet-pattern", "A_min,C_max", "--ring", "1000000", "--out", d + "/big"],
+                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+line = p.stderr.readline()  # the first contour count: the work is under way (about 20 s in all)
+if ": 1 step (at most" not in line:
+    sys.exit("no progress line for the first contour count: " + line)
+time.sleep(1)
+p.send_signal(signal.SIGINT)
+p.stderr.close()
+rc = p.wait(timeout=60)
+assert rc == -signal.SIGINT, rc
+left = sorted(f for f in os.listdir(d) if f.startswith("big") or f.startswith("."))
+assert left == [], left
+PY
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 2 >"$rpd/o1.out" 2>"$rpd/o1.err"
 grep -q '^ddemap: orbits: 1 orbit (at most 2)' "$rpd/o1.err" && grep -q '^branch     2 orbits, degree' "$rpd/o1.out" &&
     ! grep -q -E '(^|: )1 (orbits|points|waves|steps)' "$rpd/o1.out" "$rpd/o1.err" && ok ||
