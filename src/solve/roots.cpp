@@ -172,16 +172,19 @@ RootResult rightmost_roots(const RootProblem& problem, const RootOptions& option
     const std::string method = choose_root_method(problem, options);
     RootResult r;
     long units = 0;
-    RootOptions counted = options;
-    if (options.progress)
-        counted.progress = [&units, &options](long done, long total, double par) {
-            units = done;
-            options.progress(done, total, par);
-        };
     try {
         // the backends run their loops on this thread (no parallel region): the callback's
         // exception reaches here
-        r = find_backend(method)->solve(problem, counted);
+        if (!options.progress) {
+            r = find_backend(method)->solve(problem, options);
+        } else {
+            RootOptions counted = options;
+            counted.progress = [&units, &options](long done, long total, double par) {
+                units = done;
+                options.progress(done, total, par);
+            };
+            r = find_backend(method)->solve(problem, counted);
+        }
     } catch (const Cancelled&) {
         r = RootResult{};
         r.status = Status::Cancelled;
