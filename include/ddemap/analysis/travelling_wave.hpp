@@ -48,6 +48,7 @@
 /// full_ring_stability = false). The trivial multiplier's distance from 1 then also measures how
 /// far the spread profile is from a collocation solution of the full ring (it is not one exactly).
 
+#include <limits>
 #include <string>
 
 #include "ddemap/analysis/equilibrium_branch.hpp"
@@ -65,6 +66,9 @@ struct TravellingWaveOptions {
     PeriodicOrbitOptions orbit;
     /// the full ring's multipliers are computed for N <= this (their cost grows like N^3)
     int full_ring_floquet_limit = 10;
+    /// K / N < 0.1: start by the homotopy in K / N even when the first wave from the Hopf point
+    /// converges (to check one path against the other)
+    bool force_homotopy = false;
     bool is_valid(std::string* why = nullptr) const;
 };
 
@@ -79,6 +83,10 @@ struct TravellingWaveBranch {
     OrbitBranch branch;
     bool full_ring_stability = false;  ///< the multipliers are the full ring's (N <= limit)
     double max_drift = 0.0;            ///< max |mu| over the orbits (0 for an exact wave)
+    /// long waves (K / N < 0.1 whose first wave from the Hopf point fails): the parameter at
+    /// which the homotopy in K / N ran and its number of steps (NaN and 0 otherwise)
+    double homotopy_par = std::numeric_limits<double>::quiet_NaN();
+    int homotopy_steps = 0;
 };
 
 /// The branch of travelling waves of wave number options.wave born at the mode's Hopf point in
