@@ -37,6 +37,16 @@
 /// of roots: one of the two wave numbers has it at +i omega, the other at -i omega (no wave with
 /// omega > 0), so one of k and N - k is the wave born there.
 ///
+/// Long waves (K / N < 0.1; their harmonics are nearly resonant at the Hopf point, so the first
+/// wave from it may not converge): when it does not, the wave of K / N = 0.1 is started from its
+/// own Hopf point, the largest wave of its branch inside the range (5 % from its faces) is taken,
+/// K / N is lowered to the requested value at that parameter (natural continuation in log K / N,
+/// the period scaled so that T K / N is kept in the predictor, the mesh re-equidistributed after
+/// every step, orbit_mesh.hpp), and the branch is continued both ways in the parameter on a mesh
+/// re-equidistributed after every wave (profile weight lowered 1000 times in the arclength norm),
+/// the side ending at the smaller amplitude first (reversed). The Hopf point reported is still
+/// the requested mode's; the branch need not reach it.
+///
 /// Stability. The reduced form does not give the ring's stability: perturbations of the ring
 /// need not keep the wave structure (they split into N Fourier families; the one-car
 /// variational problem of family j has the leader term multiplied by a factor that depends on
