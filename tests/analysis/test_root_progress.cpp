@@ -41,7 +41,7 @@ MixedRingOptions ring_options(const std::string& method) {
 
 }  // namespace
 
-TEST_CASE("mixed ring, product path: one progress call per contour count; Cancelled gives Status::Cancelled") {
+TEST_CASE("mixed ring, product path: one progress call per contour count, Cancelled gives Status::Cancelled") {
     const Fleet fleet = fleet_from_pattern("A_min,C_max", 60);
     MixedRingOptions o = ring_options("contour");
     const MixedRingResult plain = analyse_mixed_ring(fleet, o);
@@ -71,7 +71,7 @@ TEST_CASE("mixed ring, product path: one progress call per contour count; Cancel
     CHECK(cancelled.roots.message.find("cancelled") != std::string::npos);
 }
 
-TEST_CASE("mixed ring, sparse path: one progress call per Arnoldi shift; Cancelled gives Status::Cancelled") {
+TEST_CASE("mixed ring, sparse path: one progress call per Arnoldi shift, Cancelled gives Status::Cancelled") {
     const Fleet fleet = fleet_from_pattern("A_min,C_max", 20);
     MixedRingOptions o = ring_options("shift_invert");
     Seen seen;
@@ -92,7 +92,7 @@ TEST_CASE("mixed ring, sparse path: one progress call per Arnoldi shift; Cancell
     CHECK(cancelled.verdict == Verdict::Undecided);
 }
 
-TEST_CASE("system roots, dense path: a progress call per degree; Cancelled gives Status::Cancelled; other exceptions pass") {
+TEST_CASE("system roots, dense path: a progress call per degree, Cancelled gives Status::Cancelled, other exceptions pass") {
     // x' = -x(t - 1): the dense path raises M until the roots settle
     const LinearDDE dde(MatrixXc::Zero(1, 1), {{MatrixXc::Constant(1, 1, -1.0), 1.0}});
     RootOptions o;
