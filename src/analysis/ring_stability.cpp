@@ -149,8 +149,17 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             return sr.lowfreq_margin * std::pow(std::abs(z.imag()), lf.decisive_order) / (2.0 * lf.d0 * lf.d0 * lf.gamma_prime0);
         };
         bool met_marginal = false;  // a rightmost root within the band, not on the trivial branch
+        // progress: one unit per wave number solved, of at most the grid + 44 (the golden section's
+        // 2 + 40, the abscissa's wave number and the --count roots there); the bound is lowered
+        // to the exact number once the golden section has ended
+        long solved = 0, units = 0;
+        auto report = [&] {
+            ++solved;
+            if (options.progress) options.progress(solved, std::max(units, solved));
+        };
         auto alpha = [&](double theta, RootResult* keep) {
             const RootResult rr = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -theta)), per);
+            report();
             absorb_status(r, rr);
             if (keep) *keep = rr;
             if (rr.roots.empty()) return rr.spectral_abscissa();
@@ -168,6 +177,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             if (th > 0.0) thetas.push_back(th);
         }
         std::sort(thetas.begin(), thetas.end());
+        units = static_cast<long>(thetas.size()) + 44;
         std::vector<double> values(thetas.size());
         for (std::size_t i = 0; i < thetas.size(); ++i) values[i] = alpha(thetas[i], nullptr);
         std::size_t best = 0;
@@ -193,11 +203,13 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             best_value = fr;
             best_theta = xr;
         }
+        units = solved + (count > 1 ? 2 : 1);
         RootResult at_best;
         alpha(best_theta, &at_best);
         if (count > 1) {  // --count roots at the wave number of the abscissa
             per.count = count;
             const RootResult more = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -best_theta)), per);
+            report();
             if (more.status == Status::Converged) {
                 absorb_status(r, more);
                 at_best = more;
