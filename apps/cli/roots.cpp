@@ -210,7 +210,9 @@ int run_ring(Format format, const std::string& prefix) {
     const std::string method = resolve_ring_method(given, lin);
     const int cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
     const int count = parse_count();
-    const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", cars == 0 ? "wave numbers" : "modes"));
+    // N = inf: the wave numbers of the scan, then the steps of the search for --count roots at the abscissa's
+    const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", cars == 0 ? "wave numbers" : "modes"),
+                                            cars == 0 ? search_progress_printer("roots", "Re") : nullptr);
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
