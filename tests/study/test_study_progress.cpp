@@ -74,7 +74,7 @@ void check_same_growth(const GrowthResult& a, const GrowthResult& b) {
 
 }  // namespace
 
-TEST_CASE("mix: one progress call per arrangement solved; Cancelled gives Status::Cancelled for the points not complete") {
+TEST_CASE("mix: one progress call per arrangement solved, and Cancelled gives Status::Cancelled for the points not complete") {
     const FleetCar x = parse_fleet_car("A_min"), y = parse_fleet_car("C_max");
     MixOptions o = mix_options();
     const std::vector<MixPoint> plain = penetration_study(x, y, o);
@@ -142,7 +142,7 @@ TEST_CASE("mix: a root search cancelled through ring.roots.progress stops the st
     CHECK(r.back().status == Status::Cancelled);
 }
 
-TEST_CASE("growth: one progress call per platoon; Cancelled gives Status::Cancelled for the platoons not simulated (1 and 2 threads)") {
+TEST_CASE("growth: one progress call per platoon, and Cancelled gives Status::Cancelled for the platoons not simulated (1 and 2 threads)") {
     const std::vector<CalibratedVehicle> vehicles = paper_calibration_table();
     const LeadProfile lead = LeadProfile::builtin("dip");
     const std::vector<GrowthResult> plain = disturbance_growth(vehicles, lead, 3);
@@ -191,7 +191,7 @@ TEST_CASE("growth: one progress call per platoon; Cancelled gives Status::Cancel
     }
 }
 
-TEST_CASE("orbits --wave: one progress call per wave of the branch; a throwing callback's exception reaches the caller") {
+TEST_CASE("orbits --wave: one progress call per wave of the branch, and a throwing callback's exception reaches the caller") {
     TravellingWaveOptions o;
     o.model = "ov";
     o.cars = 3;
@@ -225,7 +225,7 @@ TEST_CASE("orbits --wave: one progress call per wave of the branch; a throwing c
     CHECK(calls == 2);
 }
 
-TEST_CASE("ring N = infinity: one progress call per wave number solved, ending at done == total; a throwing callback stops it") {
+TEST_CASE("ring N = infinity: one progress call per wave number solved, ending at done == total, and a throwing callback stops it") {
     const Linearisation lin = test::ovrv(0.2, 0.2, 1.5, 0.1);  // the paper's example
     RingOptions o;
     o.roots.count = 3;
