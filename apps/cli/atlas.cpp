@@ -443,8 +443,8 @@ int run_atlas() {
     out << "\nwrote      " << prefix << ".h5 " << prefix << ".svg\n";
     std::cout << out.str();
     if (uncertified > 0) {
-        std::cerr << "ddemap: atlas undecided (uncertified): " << uncertified
-                  << " points have no certificate even after collocation (see the 'certified' dataset)\n";
+        std::cerr << "ddemap: atlas undecided (uncertified): " << counted(uncertified, "point") << (uncertified == 1 ? " has" : " have")
+                  << " no certificate even after collocation (see the 'certified' dataset)\n";
         return exit_not_converged;
     }
     return exit_ok;

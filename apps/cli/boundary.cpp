@@ -51,7 +51,7 @@ int run_boundary() {
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
     print_output(format, e, csv, [&] {
         std::ostringstream out;
-        out << "boundaries " << b.curves.size() << " curves (" << b.seeds << " seeds on a " << grid << " x " << grid << " grid)\n";
+        out << "boundaries " << counted(static_cast<long long>(b.curves.size()), "curve") << " (" << b.seeds << " seeds on a " << grid << " x " << grid << " grid)\n";
         for (std::size_t i = 0; i < b.curves.size(); ++i) {
             const auto& c = b.curves[i];
             out << "  " << i + 1 << "  " << kind_name(c.kind) << "/" << subkind_name(c.kind);

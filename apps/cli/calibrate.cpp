@@ -127,12 +127,11 @@ int run_calibrate() {
     } else {
         for (const auto& f : args.files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_input_file("DATA.csv", f), f)}, {}, {}});
     }
-    // one progress line per finished fit: ddemap: calibrate: 3/12 fits done (NAME, 0.41 s)
+    // one progress line per finished fit: ddemap: calibrate: fits 3/12 done, NAME in 0.41 s (4.2 s, about 12 s left)
     CarFinished finished;
-    if (cars.size() > 1 && !run_flags().quiet)
-        finished = [](const CarCalibration& c, long done, long total) {
-            std::cerr << "ddemap: calibrate: " << done << "/" << total << " fits done (" << c.car << ", " << rounded(c.fit.seconds, 2) << " s)\n";
-        };
+    if (cars.size() > 1)
+        if (const LabelledProgress line = labelled_progress_printer("calibrate", "fits"))
+            finished = [line](const CarCalibration& c, long done, long total) { line(done, total, c.car + " in " + rounded(c.fit.seconds, 2) + " s"); };
     const std::vector<CarCalibration> results = calibrate_cars(cars, o, ExecutionPolicy{}, finished);
     std::vector<CalibrationResult> fits;
     std::vector<std::string> names;

@@ -1,9 +1,11 @@
 // growth: disturbance growth for every setting of the calibration table.
+#include <algorithm>
 #include <iostream>
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "lead_flags.hpp"
+#include "limits.hpp"
 #include "tables.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
@@ -26,6 +28,7 @@ void add_growth_flags(CLI::App& app) {
     args.lead.add_to(app);
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", false);
     args.format.add_to(app);
+    run_flags().add_to(app, true);
 }
 
 int run_growth() {
@@ -34,7 +37,25 @@ int run_growth() {
     const std::string prefix = args.out.given() ? args.out.prepare("growth") : std::string();
     std::string label;
     const LeadProfile lead = args.lead.parse(label);
-    const auto g = disturbance_growth(paper_calibration_table(), lead, followers);
+    const std::vector<CalibratedVehicle> vehicles = paper_calibration_table();
+    // sized before the work as simulate is: the platoons run in parallel (memory: the largest
+    // ones at once), about 2 us per car and step in all (simulate's measured rate)
+    double largest = 0.0, car_steps = 0.0, steps = 0.0, t_end = 0.0;
+    for (const CalibratedVehicle& v : vehicles) {
+        const SimEstimate size = estimate_simulation(lead, platoon_of(v, followers));
+        largest = std::max(largest, size.memory_bytes);
+        car_steps += size.car_steps;
+        steps = std::max(steps, size.steps);
+        t_end = size.t_end;
+    }
+    const std::string what = std::to_string(vehicles.size()) + " platoons of " + std::to_string(followers) + " followers over " + rounded(t_end, 6) +
+                             " s (" + rounded(steps, 3) + " steps)";
+    const double parallel = static_cast<double>(std::min<long>(thread_count(), static_cast<long>(vehicles.size())));
+    check_size("growth", what, "memory", largest * parallel);
+    check_size("growth", what, "time", car_steps * 2e-6);
+    ExecutionPolicy policy;
+    policy.progress = progress_printer("growth", "platoons");  // one line per platoon simulated
+    const auto g = disturbance_growth(vehicles, lead, followers, SimOptions{}, policy);
     JsonEnvelope e;
     e.command = "growth";
     e.inputs = JsonObject().string("vehicles", "the paper's calibration table (built in)").string("lead", label).integer("followers", followers).str();

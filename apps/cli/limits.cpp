@@ -91,17 +91,25 @@ public:
         }
     }
     /// `what`: the line between the command and the times ("rows 3/200", "37 orbits (at most 100), par = 2.8").
-    void operator()(long done, long total, const std::string& what, bool estimate) {
+    /// `estimate`: the time left follows from done / total; otherwise with `unknown_left` the
+    /// line says "time left unknown" (a search whose total is only a budget), and off a
+    /// terminal lines come at most once a second instead of once per percent of the budget.
+    void operator()(long done, long total, const std::string& what, bool estimate, bool unknown_left = false) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
         if (elapsed < m_delay && !m_shown) return;
         const long percent = total > 0 ? done * 100 / total : 100;
-        if (!m_tty && percent == m_last_percent && done != total) return;
+        if (!m_tty && m_shown && done != total &&
+            (unknown_left ? elapsed - m_last_line < m_delay : percent == m_last_percent))
+            return;
         m_last_percent = percent;
+        m_last_line = elapsed;
         m_shown = true;
         char left[64] = "";
         if (estimate && done > 0 && done < total) {
             const double rest = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
             std::snprintf(left, sizeof left, ", about %s left", human_seconds(rest).c_str());
+        } else if (unknown_left) {
+            std::snprintf(left, sizeof left, "; time left unknown");
         }
         std::fprintf(stderr, "%sddemap: %s: %s (%s%s)%s", m_tty ? "\r" : "", m_command.c_str(), what.c_str(), human_seconds(elapsed).c_str(), left,
                      !m_tty ? "\n" : done == total ? "\033[K\n" : "\033[K");
@@ -115,6 +123,7 @@ private:
     bool m_tty = isatty(2) != 0;
     double m_delay = 1.0;
     long m_last_percent = -1;
+    double m_last_line = 0.0;  ///< elapsed time of the last line
     bool m_shown = false;
     bool m_open = false;  ///< a terminal line without its newline
 };
@@ -127,6 +136,14 @@ Progress progress_printer(const std::string& command, const std::string& unit) {
     return [=](long done, long total) { (*printer)(done, total, unit + " " + std::to_string(done) + "/" + std::to_string(total), true); };
 }
 
+LabelledProgress labelled_progress_printer(const std::string& command, const std::string& unit) {
+    if (run_flags().quiet) return nullptr;
+    auto printer = std::make_shared<Printer>(command);
+    return [=](long done, long total, const std::string& label) {
+        (*printer)(done, total, unit + " " + std::to_string(done) + "/" + std::to_string(total) + " done, " + label, true);
+    };
+}
+
 BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total) {
     if (run_flags().quiet) return nullptr;
     auto printer = std::make_shared<Printer>(command);
@@ -137,6 +154,16 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
                                               : std::to_string(done) + " " + (done == 1 && unit.size() > 1 && unit.back() == 's' ? unit.substr(0, unit.size() - 1) : unit) +
                                                     " (at most " + std::to_string(total) + ")";
         (*printer)(done, total, count + ", " + par + " = " + v, exact_total);
+    };
+}
+
+BranchProgress search_progress_printer(const std::string& command, const std::string& par) {
+    if (run_flags().quiet) return nullptr;
+    auto printer = std::make_shared<Printer>(command);
+    return [=](long done, long total, double value) {
+        char v[32];
+        std::snprintf(v, sizeof v, "%.6g", value);
+        (*printer)(done, total, "step " + std::to_string(done) + " of at most " + std::to_string(total) + ", " + par + " = " + v, false, true);
     };
 }
 

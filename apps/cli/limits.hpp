@@ -2,6 +2,7 @@
 // Bounded and visible work (README "Limits and progress"): the size guard that refuses work
 // whose estimated memory, output or time exceeds a limit before it starts (--allow-large lifts
 // the soft limits, never the machine's memory), and the one progress printer on stderr.
+#include <functional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -42,9 +43,21 @@ std::string human_seconds(double seconds);
 /// --quiet. Returns an empty callback when quiet.
 Progress progress_printer(const std::string& command, const std::string& unit);
 
+/// The same printer with a label for the unit just finished (calibrate's fits):
+/// `command: fits 3/12 done, NAME in 0.41 s (4.2 s, about 12 s left)`, `label` = "NAME in 0.41 s".
+using LabelledProgress = std::function<void(long done, long total, const std::string& label)>;
+LabelledProgress labelled_progress_printer(const std::string& command, const std::string& unit);
+
 /// The same printer for a branch (a continuation), one line per finished point:
 /// `command: 37 orbits (at most 100), headway = 2.81 (4.2 s)`, or with `exact_total` (the
 /// number of points is known) `command: points 37/80, gap = 12.5 (4.2 s, about 3 s left)`.
 BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total);
+
+/// The printer of a search that ends when it has found what it looks for, within a budget of
+/// steps (the root searches of roots --fleet and --system): the budget is a bound, not the work
+/// to come, so no time left is estimated and the line says so:
+/// `command: step 37 of at most 200000, Re = -0.41 (4.2 s; time left unknown)`. On a terminal
+/// one line redrawn in place; otherwise one line per finished step, at most one a second.
+BranchProgress search_progress_printer(const std::string& command, const std::string& par);
 
 }  // namespace ddemap::cli

@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
                  "Rightmost characteristic roots of rings of cars, string stability verdicts."};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string(DDEMAP_VERSION));
-    app.footer("Exit codes: 0 success, 2 bad input, 3 internal error, 4 not converged (undecided), 5 a file could not be written.");
+    app.footer("Exit codes: 0 success, 2 bad input, 3 internal error, 4 not converged (undecided), 5 a file could not be written; "
+               "Ctrl-C ends a command by SIGINT (130 in a shell), its files as before.");
     std::vector<std::pair<CLI::App*, const Command*>> commands;
     for (const Command& c : command_table()) {
         CLI::App* sub = app.add_subcommand(c.name, c.description);

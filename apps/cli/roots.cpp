@@ -40,10 +40,11 @@ int parse_degree() {
 }
 
 /// Progress of the root work of --system and --fleet on stderr (README "Limits and progress"):
-/// `ddemap: roots: 12 steps (at most 200000), Re = -0.53 (4.1 s)`, a step being a contour count
-/// (product), an Arnoldi shift (sparse) or a collocation degree (dense, where the count is M);
-/// the work ends long before its budget, so no time left is estimated.
-BranchProgress root_progress() { return branch_progress_printer("roots", "steps", "Re", false); }
+/// `ddemap: roots: step 12 of at most 200000, Re = -0.53 (4.1 s; time left unknown)`, a step
+/// being a contour count (product), an Arnoldi shift (sparse) or a collocation degree (dense,
+/// where the step shown is M); the search ends when it has found the roots, long before its
+/// budget, so no time left is estimated.
+BranchProgress root_progress() { return search_progress_printer("roots", "Re"); }
 
 /// Prints (and with --out writes PREFIX.csv, PREFIX.json) the command's output.
 void emit(const JsonEnvelope& e, const std::string& csv, const std::string& table, Format format, const std::string& prefix) {
@@ -191,8 +192,9 @@ int run_fleet(Format format, const std::string& prefix) {
     out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
     if (rr.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
     else
-        out << "verdict    " << verdict_word(r.verdict) << " (" << r.unstable_roots << (r.unstable_count_complete ? "" : " or more")
-            << " unstable roots)\n\n";
+        out << "verdict    " << verdict_word(r.verdict) << " ("
+            << (r.unstable_count_complete ? counted(r.unstable_roots, "unstable root") : std::to_string(r.unstable_roots) + " or more unstable roots")
+            << ")\n\n";
     out << roots_table(rr.roots);
     emit(e, roots_csv(rr.roots), out.str(), format, prefix);
     return report_undecided(rr.status, "roots", rr.message);
@@ -208,7 +210,9 @@ int run_ring(Format format, const std::string& prefix) {
     const std::string method = resolve_ring_method(given, lin);
     const int cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
     const int count = parse_count();
-    const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", "modes"));
+    // N = inf: the wave numbers of the scan, then the steps of the search for --count roots at the abscissa's
+    const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", cars == 0 ? "wave numbers" : "modes"),
+                                            cars == 0 ? search_progress_printer("roots", "Re") : nullptr);
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
@@ -242,8 +246,8 @@ int run_ring(Format format, const std::string& prefix) {
     out << "verdict    ring " << verdict_word(r.verdict);
     if (r.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";
     else if (cars > 0 && fast.method_used == "winding")
-        out << " (" << fast.winding.unstable_roots << " unstable roots, " << fast.winding.marginal_roots << " marginal)";
-    else if (cars > 0) out << " (" << r.unstable_roots << " unstable roots, " << r.marginal_roots << " marginal)";
+        out << " (" << counted(fast.winding.unstable_roots, "unstable root") << ", " << fast.winding.marginal_roots << " marginal)";
+    else if (cars > 0) out << " (" << counted(r.unstable_roots, "unstable root") << ", " << r.marginal_roots << " marginal)";
     out << "\n\n";
     out << "  #   mode        theta                re                 im    residual\n";
     int i = 0;

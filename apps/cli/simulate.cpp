@@ -76,7 +76,7 @@ int run_simulate() {
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", simulation_svg(r, label)}});
     print_output(format, e, csv, [&] {
         std::ostringstream s;
-        s << "simulated  " << cars.size() << " followers to t = " << rounded(r.t_end, 5) << " s (" << r.steps << " steps)\n";
+        s << "simulated  " << counted(static_cast<long long>(cars.size()), "follower") << " to t = " << rounded(r.t_end, 5) << " s (" << r.steps << " steps)\n";
         s << "car  name      min speed  speed drop  min gap   events\n";
         for (const auto& c : r.cars) {
             char line[160];

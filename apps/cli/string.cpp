@@ -56,7 +56,7 @@ int run_string() {
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;
     if (cars) {
-        fast = analyse_ring_fast(lin, *cars, method, 0, progress_printer("string", "modes"));
+        fast = analyse_ring_fast(lin, *cars, method, 0, progress_printer("string", *cars == 0 ? "wave numbers" : "modes"));
         ring = fast->ring;
     }
     const RingResult* rp = ring ? &*ring : nullptr;

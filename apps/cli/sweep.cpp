@@ -63,7 +63,7 @@ int run_sweep() {
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;
     e.status = sw.uncertified > 0 ? "uncertified" : "converged";
-    e.message = sw.uncertified > 0 ? std::to_string(sw.uncertified) + " points have no certificate even after collocation (see their 'certified' column)" : "";
+    e.message = sw.uncertified > 0 ? counted(sw.uncertified, "point") + (sw.uncertified == 1 ? " has" : " have") + " no certificate even after collocation (see their 'certified' column)" : "";
     e.result = sweep_json(sw, bp);
     const std::string csv = sweep_csv(sw);
     std::vector<std::pair<std::string, std::string>> files = {
@@ -76,12 +76,12 @@ int run_sweep() {
         for (const auto& p : sw.points) ++classes[region_class(p)];
         std::ostringstream out;
         out << "sweep      " << sw.points.size() << " points in " << rounded(sw.seconds, 3) << " s ("
-            << static_cast<long>(std::lround(sw.points.size() / std::max(sw.seconds, 1e-9))) << " points/s, " << sw.threads << " threads)\n";
+            << static_cast<long>(std::lround(sw.points.size() / std::max(sw.seconds, 1e-9))) << " points/s, " << counted(sw.threads, "thread") << ")\n";
         out << "regions    plant unstable " << classes[0] << ", ring unstable " << classes[1] << ", string unstable " << classes[2]
             << ", string stable " << classes[3];
         if (sw.uncertified > 0) out << " (" << sw.uncertified << " of them UNDECIDED: no certificate)";
         out << "\n";
-        if (bp) out << "boundaries " << b.curves.size() << " curves\n";
+        if (bp) out << "boundaries " << counted(static_cast<long long>(b.curves.size()), "curve") << "\n";
         out << "wrote      ";
         for (const auto& f : files) out << f.first << " ";
         out << "\n";

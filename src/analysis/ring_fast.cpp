@@ -82,10 +82,12 @@ std::vector<RingRoot> neighbour_roots(const Linearisation& lin, int cars, const 
 
 }  // namespace
 
-FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress) {
+FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress,
+                           const BranchProgress& search) {
     FastRing f;
     RingOptions opt;
     opt.progress = progress;
+    if (cars == 0) opt.roots.progress = search;  // N finite: every mode's search would call it
     if (count > 0) opt.roots.count = count;
     if (method == "modes") {
         f.ring = analyse_ring(lin, cars, opt);

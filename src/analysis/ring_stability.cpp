@@ -130,9 +130,11 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
         require_single_leader(lin, "the infinite ring (N = inf)");
         RootOptions per = options.roots;
         per.count = 1;  // the abscissa needs only the rightmost root
+        per.progress = nullptr;  // the scan reports wave numbers (options.progress), not steps
         // the wave number that the peak of |Gamma| drives: Gamma(i w) = e^{i theta}
         StringOptions so;
-        so.roots = options.roots;
+        so.roots = per;  // the plant's roots: not reported either
+        so.roots.count = options.roots.count;
         const StringResult sr = analyse_string(lin, so);
         const LowFrequency& lf = sr.lowfreq;
         const bool series = lf.decisive_order > 0 && lf.gamma_prime0 != 0.0 && lf.d0 != 0.0;
@@ -149,8 +151,18 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             return sr.lowfreq_margin * std::pow(std::abs(z.imag()), lf.decisive_order) / (2.0 * lf.d0 * lf.d0 * lf.gamma_prime0);
         };
         bool met_marginal = false;  // a rightmost root within the band, not on the trivial branch
+        // progress: one unit per wave number solved, of at most the grid + 43 (the golden section's
+        // 2 + 40 and the abscissa's wave number); the bound is lowered to the exact number once
+        // the golden section has ended. The search for the --count roots there (of unknown
+        // length) reports its own steps through options.roots.progress.
+        long solved = 0, units = 0;
+        auto report = [&] {
+            ++solved;
+            if (options.progress) options.progress(solved, std::max(units, solved));
+        };
         auto alpha = [&](double theta, RootResult* keep) {
             const RootResult rr = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -theta)), per);
+            report();
             absorb_status(r, rr);
             if (keep) *keep = rr;
             if (rr.roots.empty()) return rr.spectral_abscissa();
@@ -168,6 +180,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             if (th > 0.0) thetas.push_back(th);
         }
         std::sort(thetas.begin(), thetas.end());
+        units = static_cast<long>(thetas.size()) + 43;
         std::vector<double> values(thetas.size());
         for (std::size_t i = 0; i < thetas.size(); ++i) values[i] = alpha(thetas[i], nullptr);
         std::size_t best = 0;
@@ -193,10 +206,12 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             best_value = fr;
             best_theta = xr;
         }
+        units = solved + 1;
         RootResult at_best;
         alpha(best_theta, &at_best);
         if (count > 1) {  // --count roots at the wave number of the abscissa
             per.count = count;
+            per.progress = options.roots.progress;
             const RootResult more = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -best_theta)), per);
             if (more.status == Status::Converged) {
                 absorb_status(r, more);

@@ -435,7 +435,12 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             double collapse, double T0, int max_points, bool adapt, OrbitBranch& b, double& max_drift) {
     const int N = c.N();
     const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
+    // after every wave added: o.progress (waves so far, max_points, p); it may throw to stop the branch
+    auto report = [&] {
+        if (o.progress) o.progress(static_cast<long>(b.points.size()), max_points, b.points.back().par);
+    };
     b.points.push_back(make_orbit(c, u, first, full, o.parameter, o.floquet));
+    report();
     b.newton_iterations += first.iterations;
     max_drift = std::max(max_drift, std::abs(u(N + 2)));
     const double amp0 = amplitude(b.points.front());
@@ -473,6 +478,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             b.newton_iterations += rb.iterations;
             if (rb.ok) {
                 b.points.push_back(make_orbit(c, wv, rb, full, o.parameter, o.floquet));
+                report();
                 max_drift = std::max(max_drift, std::abs(wv(N + 2)));
             } else {
                 b.status = Status::MaxIterations;
@@ -530,6 +536,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
         max_drift = std::max(max_drift, std::abs(v(N + 2)));
         const bool collapsed = amplitude(orbit) < collapse * amp0;
         b.points.push_back(std::move(orbit));
+        report();
         if (collapsed) {
             b.stop = "hopf";
             break;

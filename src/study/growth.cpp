@@ -16,7 +16,8 @@ std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle
     const double lead_drop = lead.speed(0.0) - lead_min;
     if (!(lead_drop > 0.0)) throw std::invalid_argument("the lead profile has no speed drop: expected a disturbance");
     std::vector<GrowthResult> out(vehicles.size());
-    parallel_for(static_cast<long>(vehicles.size()), [&](long vi) {
+    std::vector<char> simulated(vehicles.size(), 0);  // each task writes only its own entry
+    auto simulate = [&](long vi) {
         const SimResult r = simulate_platoon(lead, platoon_of(vehicles[vi], followers), options);
         GrowthResult g;
         g.name = vehicles[vi].name;
@@ -41,7 +42,18 @@ std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle
             g.failure_gap = ev->gap;
         }
         out[vi] = g;
-    }, policy);
+        simulated[vi] = 1;
+    };
+    try {
+        parallel_for(static_cast<long>(vehicles.size()), simulate, policy);
+    } catch (const Cancelled&) {
+        for (std::size_t vi = 0; vi < vehicles.size(); ++vi)
+            if (!simulated[vi]) {
+                out[vi] = GrowthResult{};
+                out[vi].name = vehicles[vi].name;
+                out[vi].status = Status::Cancelled;
+            }
+    }
     return out;
 }
 

@@ -236,8 +236,9 @@ expect_error "--train = '5'" calibrate "$excerpt" --train 5
 
 # calibrate on several files: one progress line per finished fit on stderr, always {"fits": [...]}
 cp "$excerpt" "$tmp/run2.csv"
-if "$bin" calibrate "$excerpt" "$tmp/run2.csv" --format json >"$tmp/cal2.json" 2>"$tmp/cal2.err"; then
-    grep -q '^ddemap: calibrate: 2/2 fits done (\(run2\|openacc_excerpt_rav4_to_etron\), [0-9.]* s)$' "$tmp/cal2.err" && ok || bad "calibrate progress lines"
+if DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" calibrate "$excerpt" "$tmp/run2.csv" --format json >"$tmp/cal2.json" 2>"$tmp/cal2.err"; then
+    grep -q '^ddemap: calibrate: fits 1/2 done, \(run2\|openacc_excerpt_rav4_to_etron\) in [0-9.e-]* s ([^)]*, about [^)]* left)$' "$tmp/cal2.err" &&
+        grep -q '^ddemap: calibrate: fits 2/2 done, \(run2\|openacc_excerpt_rav4_to_etron\) in [0-9.e-]* s ([^)]*)$' "$tmp/cal2.err" && ok || bad "calibrate progress lines: $(cat "$tmp/cal2.err")"
     python3 -c "import json; r=json.load(open('$tmp/cal2.json'))['result']; assert len(r['fits']) == 2 and r['fits'][1]['name'] == 'run2'" && ok || bad "calibrate two files JSON"
 else
     bad "calibrate two files exit status"
@@ -1200,20 +1201,20 @@ PY
 rm -rf "$bsd"
 
 # ---- progress of roots --fleet/--system (at most one line per contour count, shift or degree when
-# stderr is a file, one per percent of the budget; none with --quiet), SIGINT during a long
+# stderr is a file, at most one a second; none with --quiet), SIGINT during a long
 # roots --fleet --out leaves no output file and ends the process by the signal, and a branch's
 # first orbit is "1 orbit"
 rpd="$tmp/root-progress"; mkdir -p "$rpd"
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --fleet-pattern "A_min,C_max" --ring 200 >"$rpd/f.out" 2>"$rpd/f.err"
 n=$(sed -n 's/^solver     product, \([0-9]*\) contour counts.*/\1/p' "$rpd/f.out")
-[ -n "$n" ] && grep -q -E '^ddemap: roots: [0-9]+ steps? \(at most 200000\), Re = [-0-9.e]+ \(' "$rpd/f.err" &&
+[ -n "$n" ] && grep -q -E '^ddemap: roots: step [0-9]+ of at most 200000, Re = [-0-9.e]+ \([^)]*; time left unknown\)$' "$rpd/f.err" &&
     [ "$(grep -c '^ddemap: roots:' "$rpd/f.err")" -le "$n" ] && ! grep -q "ddemap:" "$rpd/f.out" && ok ||
     bad "roots --fleet: no progress line, or more than one per contour count ($n): $(head -3 "$rpd/f.err")"
-grep -q '^ddemap: roots: 1 step (at most' "$rpd/f.err" && ! grep -q ': 1 steps ' "$rpd/f.err" && ok || bad "roots --fleet progress: '1 steps'"
+grep -q '^ddemap: roots: step 1 of at most' "$rpd/f.err" && ! grep -q ' left)' "$rpd/f.err" && ok || bad "roots --fleet progress: no 'step 1', or an estimate of the time left"
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --fleet-pattern "A_min,C_max" --ring 200 --quiet >/dev/null 2>"$rpd/q.err"
 [ ! -s "$rpd/q.err" ] && ok || bad "roots --fleet --quiet still printed: $(head -3 "$rpd/q.err")"
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --system "$(dirname "$0")/../../examples/system.json" --format json >/dev/null 2>"$rpd/s.err" &&
-    grep -q -E '^ddemap: roots: [0-9]+ steps? \(at most [0-9]+\), Re = ' "$rpd/s.err" && ok ||
+    grep -q -E '^ddemap: roots: step [0-9]+ of at most [0-9]+, Re = ' "$rpd/s.err" && ok ||
     bad "roots --system: no progress line: $(head -3 "$rpd/s.err")"
 python3 - "$bin" "$rpd" <<'PY' && ok || bad "roots --fleet interrupted by SIGINT"
 import os, signal, subprocess, sys, time
@@ -1222,7 +1223,7 @@ env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
 p = subprocess.Popen([bin, "roots", "--fleet-pattern", "A_min,C_max", "--ring", "1000000", "--out", d + "/big"],
                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
 line = p.stderr.readline()  # the first contour count: the work is under way (about 20 s in all)
-if ": 1 step (at most" not in line:
+if ": step 1 of at most" not in line:
     sys.exit("no progress line for the first contour count: " + line)
 time.sleep(1)
 p.send_signal(signal.SIGINT)
@@ -1237,6 +1238,97 @@ grep -q '^ddemap: orbits: 1 orbit (at most 2)' "$rpd/o1.err" && grep -q '^branch
     ! grep -q -E '(^|: )1 (orbits|points|waves|steps)' "$rpd/o1.out" "$rpd/o1.err" && ok ||
     bad "orbits --points 2: not '1 orbit' in the progress: $(grep -h -E '^branch|1 orbit' "$rpd/o1.out" "$rpd/o1.err" | head -3)"
 rm -rf "$rpd"
+
+# ---- progress of mix, growth and orbits --wave: one line per finished unit when stderr is a file
+# (with the time left where the number of units is known), a line redrawn in place with the time
+# left on a terminal, none with --quiet, stdout untouched; SIGINT during mix, growth and
+# orbits --wave with --out leaves the old output set and nothing else; growth is sized before
+# the work; a sweep with one uncertified point says "1 point has"
+spd="$tmp/study-progress"; mkdir -p "$spd"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" mix --x A_min --y C_max --ring 20 --p 0:1:3 --draws 1 --out "$spd/m" >"$spd/m.out" 2>"$spd/m.err"
+[ "$(grep -c -E '^ddemap: mix: arrangements [1-6]/6, p = [0-9.e]+ \(' "$spd/m.err")" = 6 ] && grep -q '^ddemap: mix: arrangements 6/6, p = 1 (' "$spd/m.err" &&
+    grep -q -E '^ddemap: mix: arrangements 1/6, p = 0 \([^)]*, about [^)]* left\)$' "$spd/m.err" && ! grep -q "ddemap:" "$spd/m.out" && ok ||
+    bad "mix: not one progress line per arrangement (6) with the time left: $(head -3 "$spd/m.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" mix --x A_min --y C_max --ring 20 --p 0:1:3 --quiet --out "$spd/m" >/dev/null 2>"$spd/m.err"
+[ ! -s "$spd/m.err" ] && ok || bad "mix --quiet still printed: $(head -3 "$spd/m.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" growth --followers 3 >"$spd/g.out" 2>"$spd/g.err"
+[ "$(grep -c -E '^ddemap: growth: platoons ([1-9]|1[0-4])/14 \(' "$spd/g.err")" = 14 ] && grep -q '^ddemap: growth: platoons 14/14 (' "$spd/g.err" &&
+    ! grep -q "ddemap:" "$spd/g.out" && ok || bad "growth: not one progress line per platoon (14): $(head -3 "$spd/g.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" growth --followers 3 --quiet >/dev/null 2>"$spd/g.err"
+[ ! -s "$spd/g.err" ] && ok || bad "growth --quiet still printed: $(head -3 "$spd/g.err")"
+printf 'time_s,lead_speed_mps\n0,20\n10,19.9\n20,20\n10000000,20\n' >"$spd/lead-long.csv"
+"$bin" growth --lead "$spd/lead-long.csv" --followers 200 --out "$spd/gl" >"$spd/o.txt" 2>"$spd/e.txt"
+[ $? -eq 2 ] && [ ! -s "$spd/o.txt" ] && [ "$(wc -l <"$spd/e.txt")" -eq 1 ] && grep -q "^ddemap: error: 14 platoons of 200 followers over 1e+07 s" "$spd/e.txt" &&
+    [ ! -e "$spd/gl.csv" ] && ok || bad "growth with a lead of 1e7 s: not refused before the work: $(cat "$spd/e.txt")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --wave 1 --par headway --from 3.5 --to 2 --points 6 --format json >"$spd/w.json" 2>"$spd/w.err"
+n=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['result']['points']))" "$spd/w.json" 2>/dev/null || echo none)
+[ "$(grep -c -E '^ddemap: orbits: [0-9]+ waves? \(at most 6\), headway = [-0-9.e]+ \(' "$spd/w.err")" = "$n" ] && grep -q '^ddemap: orbits: 1 wave (at most 6)' "$spd/w.err" && ok ||
+    bad "orbits --wave: not one progress line per wave ($n): $(head -3 "$spd/w.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --wave 1 --par headway --from 3.5 --to 2 --points 6 --quiet >/dev/null 2>"$spd/w.err"
+[ ! -s "$spd/w.err" ] && ok || bad "orbits --wave --quiet still printed: $(head -3 "$spd/w.err")"
+# a terminal: the line is redrawn in place (carriage return) and carries the time left
+python3 - "$bin" "$spd/mt" <<'PY' && ok || bad "mix on a terminal: no line redrawn in place with the time left"
+import os, pty, subprocess, sys
+master, slave = pty.openpty()
+env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
+p = subprocess.run([sys.argv[1], "mix", "--x", "A_min", "--y", "C_max", "--ring", "20", "--p", "0:1:3", "--draws", "1", "--format", "json", "--out", sys.argv[2]],
+                   stdout=subprocess.DEVNULL, stderr=slave, env=env, timeout=120)
+os.close(slave)
+text = b""
+while True:
+    try:
+        chunk = os.read(master, 65536)
+    except OSError:
+        break
+    if not chunk:
+        break
+    text += chunk
+os.close(master)
+text = text.decode()
+assert p.returncode == 0, p.returncode
+assert "\rddemap: mix: arrangements 1/6, p = 0 (" in text and ", about " in text and " left)\x1b[K" in text, repr(text[:300])
+text = text.replace("\r\n", "\n")  # the terminal's own line ends
+assert text.count("\n") == 1 and text.endswith("\x1b[K\n") and "\rddemap: mix: arrangements 6/6, p = 1 (" in text, repr(text[-200:])
+PY
+# SIGINT after the first finished unit: the process ends by the signal, the old set stays as it was
+python3 - "$bin" "$spd" "$spd/lead-1e5.csv" <<'PY' && ok || bad "mix, growth or orbits --wave interrupted by SIGINT"
+import os, signal, subprocess, sys
+bin, d, lead = sys.argv[1], sys.argv[2], sys.argv[3]
+with open(lead, "w") as f:
+    f.write("time_s,lead_speed_mps\n0,20\n10,19.999\n20,20\n100000,20\n")
+env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
+runs = {
+    "mix": (["mix", "--x", "A_min", "--y", "C_max", "--ring", "100000", "--p", "0:1:11"], ": arrangements 1/11,", [".csv", ".json", ".svg"]),
+    "growth": (["growth", "--lead", lead, "--followers", "1"], ": platoons 1/14 (", [".csv", ".json", ".svg"]),
+    "orbits": (["orbits", "--model", "ov", "--ring", "10", "--wave", "1", "--par", "headway", "--from", "3.5", "--to", "2", "--points", "200"],
+               ": 2 waves (at most 200)", [".csv", ".json"]),
+}
+for name, (argv, first, exts) in runs.items():
+    out = os.path.join(d, "int-" + name)
+    os.makedirs(out)
+    for e in exts:
+        with open(os.path.join(out, "o" + e), "w") as f:
+            f.write("old\n")
+    p = subprocess.Popen([bin] + argv + ["--out", out + "/o"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+    for line in p.stderr:  # the work is under way
+        if first in line:
+            break
+    else:
+        sys.exit(name + ": ended before '" + first + "' was reported")
+    p.send_signal(signal.SIGINT)
+    p.stderr.close()
+    rc = p.wait(timeout=60)
+    assert rc == -signal.SIGINT, (name, rc)
+    left = sorted(os.listdir(out))
+    assert left == sorted("o" + e for e in exts), (name, left)
+    assert all(open(os.path.join(out, f)).read() == "old\n" for f in left), name
+PY
+# one uncertified point (k2 = 0 and tau = 0 on a ring of 10^5 cars: roots on the imaginary axis)
+"$bin" sweep --k2 0:0.2:2 --tau 0:0.2:2 --th 1.5 --k1 0.4 --ring 100000 --no-boundaries --out "$spd/s1" >"$spd/s1.out" 2>"$spd/s1.err"
+[ $? -eq 4 ] && grep -q '^ddemap: sweep undecided (uncertified): 1 point has no certificate' "$spd/s1.err" &&
+    grep -q '(1 of them UNDECIDED: no certificate)' "$spd/s1.out" && ! grep -q -E '\b1 (points|curves|threads)\b' "$spd/s1.out" "$spd/s1.err" && ok ||
+    bad "sweep with one uncertified point: $(cat "$spd/s1.err")"
+rm -rf "$spd"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

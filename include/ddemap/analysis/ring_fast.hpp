@@ -31,6 +31,9 @@ struct FastRing {
 /// The ring's verdict and, when `count` > 0, its listed roots. `method` is "winding" or "modes";
 /// the per-mode path needs cars <= kModesMaxCars (checked by the caller). `progress`: the per-mode
 /// path's (RingOptions::progress; it may throw to stop); the winding pass does not report.
-FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress = {});
+/// `search`: N = infinity, the steps of the search for the `count` roots at the abscissa's
+/// wave number (RingOptions::roots.progress).
+FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress = {},
+                           const BranchProgress& search = {});
 
 }  // namespace ddemap

@@ -16,8 +16,13 @@ namespace ddemap {
 struct RingOptions {
     RootOptions roots;      ///< per-mode options; roots.count is the number of roots reported
     int theta_grid = 64;    ///< N = infinity: uniform wave numbers in (0, pi] before refinement
-    /// N finite: after every mode of the first pass over the N/2 + 1 modes (modes done, modes);
-    /// it may throw to stop, and the exception reaches the caller. Not called for N = infinity.
+    /// N finite: after every mode of the first pass over the N/2 + 1 modes (modes done, modes).
+    /// N = infinity: after every wave number of the scan solved (done, at most theta_grid + 13 +
+    /// 43: the grid, the golden section and the abscissa's wave number; the bound becomes the
+    /// exact count once the golden section has ended); the search for roots.count roots at the
+    /// abscissa's wave number, whose length is not known, reports its steps through
+    /// roots.progress instead (the scan's searches do not call it). It may throw to stop, and
+    /// the exception reaches the caller.
     Progress progress;
     void validate() const;
 };

@@ -72,7 +72,11 @@ struct TravellingWaveOptions {
     int cars = 10;             ///< N >= 2 (any size: the cost does not depend on it)
     int wave = 1;              ///< k, 1..N-1
     /// the parameter, range, mesh (degree, intervals), steps and tolerances (adapt is not used:
-    /// the mesh stays uniform; floquet: compute the full ring's multipliers when N is small)
+    /// the mesh stays uniform; floquet: compute the full ring's multipliers when N is small;
+    /// progress: after every wave added, (waves so far, max_points, p), as for orbits: it may
+    /// throw to stop the branch and the exception reaches the caller, no partial branch. Long
+    /// waves reached by the homotopy report the branch of K / N = 0.1 and then each side of the
+    /// requested branch, each counted from 1)
     PeriodicOrbitOptions orbit;
     /// the full ring's multipliers are computed for N <= this (their cost grows like N^3)
     int full_ring_floquet_limit = 10;

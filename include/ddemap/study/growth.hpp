@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ddemap/core/execution.hpp"
+#include "ddemap/core/status.hpp"
 #include "ddemap/analysis/simulate.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 
@@ -22,8 +23,17 @@ struct GrowthResult {
     double failure_time = 0.0;
     double failure_amplification = 0.0;  ///< (v0 - lowest speed up to the event) / lead drop
     double failure_gap = 0.0;
+    /// Converged, or Cancelled when the progress callback stopped the study before this
+    /// vehicle was simulated (then only `name` is set).
+    Status status = Status::Converged;
 };
 
+/// One GrowthResult per vehicle (in order), the platoons simulated in parallel under `policy`.
+/// policy.progress is called after every vehicle simulated, (vehicles done, vehicles), one call
+/// at a time. Throwing ddemap::Cancelled from it stops the study: vehicles not yet started are
+/// skipped, the running ones end, and the result has Status::Cancelled for every vehicle not
+/// simulated (the exception never crosses the parallel region; core/execution.hpp). Any other
+/// exception reaches the caller as it is.
 std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle>& vehicles, const LeadProfile& lead,
                                              int followers, const SimOptions& options = {},
                                              const ExecutionPolicy& policy = {});

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/core/execution.hpp"
 #include "ddemap/traffic/fleet.hpp"
 
 namespace ddemap {
@@ -19,6 +20,14 @@ struct MixOptions {
     int draws = 0;
     unsigned seed = 1;
     MixedRingOptions ring;          ///< speed or length, solver, roots.count
+    /// After every arrangement solved, on the caller's thread: (arrangements solved,
+    /// fractions.size() * (draws + 1), its p). May be empty. Throwing ddemap::Cancelled
+    /// (core/execution.hpp) stops the study, and so does a root search that
+    /// ring.roots.progress cancels: penetration_study then returns every fraction, those whose
+    /// arrangements were not all solved with status Status::Cancelled, stable = false and
+    /// `arrangements` = the ones solved (their abscissae over those; 0 when none). Any other
+    /// exception reaches the caller as it is.
+    BranchProgress progress;
     void validate() const;
 };
 
@@ -37,6 +46,7 @@ struct MixPoint {
     std::string method_used;  ///< the root method of the spread arrangement (contour, dense or shift_invert)
 };
 
+/// The study, one MixPoint per fraction (in order). Cancellation: see MixOptions::progress.
 std::vector<MixPoint> penetration_study(const FleetCar& x, const FleetCar& y, const MixOptions& options);
 
 }  // namespace ddemap
