@@ -266,11 +266,15 @@ RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, Pl
     return rs;
 }
 
-void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks) {
+void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks,
+                      StringGuess* string) {
     StringOptions so;
     so.grid_points = 120;
     int fb = rs.fallbacks;
-    const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
+    RootResult plant_roots = plant.evaluate(lin, fb);
+    std::optional<StringResult> continued;
+    if (string) continued = analyse_string_continued(lin, plant_roots, *string);
+    const StringResult sr = continued ? std::move(*continued) : analyse_string(lin, std::move(plant_roots), so);
     p.spectral_abscissa = rs.spectral_abscissa;
     p.unstable_roots = rs.unstable_roots;
     p.abscissa_mode = rs.abscissa_mode;
@@ -291,6 +295,11 @@ void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTrac
     p.plant_abscissa = sr.plant_abscissa;
     p.plant_stable = sr.plant_stable;
     p.string_stable = sr.string_stable;
+    if (string) {
+        // the next point starts from this maximiser when it is the sup (the only case the shortcut covers)
+        string->have = p.peak_gain >= 1.0 && p.peak_omega > 0.0;
+        string->omega = p.peak_omega;
+    }
     fallbacks += fb;
 }
 
@@ -399,6 +408,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
         std::optional<detail::RingTracker> reference;  // the per-mode path where a winding point is undecided
         detail::RingTracker ring = ring_seed[iy];
         detail::PlantTracker plant = plant_seed[iy];
+        StringGuess string;  // continued along the row only: the same path for any number of threads
         for (int ix = 0; ix < nx; ++ix) {
             SweepPoint& p = result.points[static_cast<std::size_t>(iy) * nx + ix];
             p.x = spec.x.value(ix);
@@ -432,7 +442,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
                 rs = ring.evaluate(lin);
             }
             int fb = 0;
-            detail::fill_sweep_point(lin, rs, plant, p, fb);
+            detail::fill_sweep_point(lin, rs, plant, p, fb, &string);
             for (int m = 0; m < result.modes && !winding; ++m) {
                 result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
             }

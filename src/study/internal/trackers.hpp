@@ -13,6 +13,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/study/sweep.hpp"
+#include "ddemap/analysis/string_stability.hpp"
 
 namespace ddemap::detail {
 
@@ -69,7 +70,11 @@ private:
 /// refined). Fills every field of `p` but x and y; adds the collocation fallbacks to `fallbacks`.
 RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks);
 /// The same with the ring's summary already computed (by the tracker or the winding path): the
-/// plant and string stability, every field of `p` but x and y.
-void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks);
+/// plant and string stability, every field of `p` but x and y. With `string` (a sweep row's
+/// continuation) the string analysis starts from the previous point's maximiser
+/// (analyse_string_continued) and scans the axis only when that cannot certify; `string` is then
+/// updated to this point's maximiser.
+void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks,
+                      StringGuess* string = nullptr);
 
 }  // namespace ddemap::detail
