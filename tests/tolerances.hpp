@@ -165,4 +165,21 @@ constexpr double wave_drift = 1e-6;
 /// eps (measured 3e-16 on a 40 x 40 chart); 1e-12 relative is the certificate's own slack.
 constexpr double string_continued_rel = 1e-12;
 
+/// The torus point of the Duffing oscillator with delayed feedback (DDE-BIFTOOL's minimal demo),
+/// tau and period, located by ddemap against the same point located by DDE-BIFTOOL under Octave
+/// (bench/ddebiftool/duffing_torus.m) on a mesh of the same size (degree 4, uniform, Gauss-Legendre
+/// collocation). The two discretisations are not identical: on 20 intervals the two tau differ
+/// by 2e-8 (ddemap's is 1.6e-8 from its 80-interval value, DDE-BIFTOOL's 4e-9), so the bound is
+/// the mesh error, which from 30 intervals on is below 1.4e-9 for both (the measured difference
+/// of the tools: 5e-10 on 30, 2.5e-10 on 40 intervals); Newton (1e-10 relative) and the location
+/// (the located | |mu| - 1 | is 8e-12) add less. 1e-8, while the neighbouring orbits of
+/// the branch, the bracket of the crossing, are 1e-2 away.
+constexpr double torus_vs_ddebiftool = 1e-8;
+
+/// Relative change of the period of the long travelling wave (ov ring, 1000 cars, K = 1,
+/// reached by the homotopy in K / N) between 100 and 200 adapted intervals of degree 4: the
+/// discretisation error of a profile with fronts of a few cars in a period of 1000; measured
+/// below 1e-6 (3871.642 both); 1e-5.
+constexpr double long_wave_period = 1e-5;
+
 }  // namespace ddemap::test::tol

@@ -30,12 +30,12 @@ struct Args {
     bool resume = false;
 } args;
 
-/// The chunks of one run: those still to compute, handed out in order; the results gathered
-/// (values, done) and stored as they arrive. Thread-safe.
+/// The chunks of one run: those still to compute, handed out in order; the results appended
+/// to the chunk store as they arrive (rank 0 keeps no values in memory). Thread-safe.
 class Ledger {
 public:
-    Ledger(const AtlasSpec& spec, AtlasStore& store, std::vector<double>& values, std::vector<char>& done, Progress progress)
-        : m_spec(spec), m_store(store), m_values(values), m_done(done), m_progress(std::move(progress)) {
+    Ledger(const AtlasSpec& spec, AtlasStore& store, std::vector<char>& done, Progress progress)
+        : m_spec(spec), m_store(store), m_done(done), m_progress(std::move(progress)) {
         for (long c = 0; c < spec.chunks(); ++c)
             if (!done[static_cast<std::size_t>(c)]) m_queue.push_back(c);
         m_pending = static_cast<long>(m_queue.size());
@@ -49,7 +49,7 @@ public:
         m_queue.pop_front();
         return c;
     }
-    /// Stores a finished chunk (its values, fsynced in the chunk store).
+    /// Stores a finished chunk (its values, in the chunk store).
     void finish(long c, const double* v, std::size_t count) {
         std::lock_guard<std::mutex> lock(m_mutex);
         const std::size_t nf = atlas_fields().size();
@@ -62,7 +62,6 @@ public:
             m_failed = true;
             throw;
         }
-        std::copy(v, v + count, m_values.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(m_spec.chunk_begin(c)) * nf));
         m_done[static_cast<std::size_t>(c)] = 1;
         ++m_finished;
         if (m_progress) m_progress(m_finished, m_pending);
@@ -80,7 +79,6 @@ public:
 private:
     const AtlasSpec& m_spec;
     AtlasStore& m_store;
-    std::vector<double>& m_values;
     std::vector<char>& m_done;
     Progress m_progress;
     std::mutex m_mutex;
@@ -107,19 +105,23 @@ void compute_locally(const AtlasSpec& spec, Ledger& ledger, int threads) {
     }, policy);
 }
 
-/// Refuses an atlas above the limits before any work: per point 16 values of 8 bytes in memory,
-/// the HDF5 image twice (the in-memory file and its copy) and the figure's sweep points, about
-/// 450 bytes (446 MB measured for 10^6 points);
-/// 88 bytes of HDF5 (9 float64, 3 int32, 4 flags),
-/// and 5e-5 s per ring mode on one core (the sweep's measured cost; N = inf about 12 modes).
+/// Refuses an atlas above the limits before any work. Memory on rank 0: the chunk store's
+/// index, the queue of chunks and the done flags (17 bytes per chunk), a chunk's values per thread (twice: computed
+/// and its record; 128 bytes per point each), the HDF5 slab (65536 points x 16 doubles, and one
+/// field's copy: 9 MB), the figure's points (at most 250,000 sweep points: 30 MB), and HDF5's
+/// caches (a few MB). Output: 88 bytes of HDF5 per point (9 float64, 3 int32, 4 flags) and,
+/// while it runs, the chunk store (128 bytes per point). Time: 5e-5 s per ring mode on one
+/// core (the sweep's measured cost; N = inf and the winding path about 12 modes at any N).
 void check_atlas_size(const AtlasSpec& spec, int workers) {
+    const bool winding = spec.ring_method_used() == "winding";
     double modes = 0.0;
-    for (int n : spec.rings) modes += n == 0 ? 12.0 : n / 2 + 1.0;
+    for (int n : spec.rings) modes += n == 0 || winding ? 12.0 : n / 2 + 1.0;
     const double per_ring = static_cast<double>(spec.points()) / static_cast<double>(spec.rings.size());
+    const double chunk_bytes = static_cast<double>(spec.chunk_size()) * 128.0;
     std::ostringstream what;
     what << "an atlas of " << spec.points() << " points";
-    check_size("atlas", what.str(), "memory", static_cast<double>(spec.points()) * 450.0);
-    check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * 88.0);
+    check_size("atlas", what.str(), "memory", 17.0 * static_cast<double>(spec.chunks()) + 2.0 * chunk_bytes * (workers + 1) + 5e7);
+    check_size("atlas", what.str(), "output", static_cast<double>(spec.points()) * (88.0 + 128.0));
     check_size("atlas", what.str(), "time", per_ring * modes * 5e-5 / std::max(1, workers));
 }
 
@@ -130,6 +132,10 @@ struct Outcome {
 
 #if DDEMAP_WITH_MPI
 constexpr int tag_request = 1, tag_assign = 2, tag_result = 3;
+/// Requests each rank > 0 keeps outstanding: one batch is always waiting at the rank while it
+/// computes another, whatever the delay of rank 0's answer (its coordinator polls, and on a
+/// loaded machine waits for a core).
+constexpr int lookahead = 2;
 
 /// Rank 0 of an MPI run: hands out chunks on request (as many as the asking rank has threads)
 /// and stores the results, while its own threads compute chunks from the same ledger.
@@ -144,7 +150,7 @@ void coordinate(const AtlasSpec& spec, Ledger& ledger, int ranks, int threads) {
         }
         local_done = true;
     });
-    int active = ranks - 1;
+    int active = lookahead * (ranks - 1);  // requests that will still be answered with none
     std::vector<double> buffer;
     try {
         // until every rank was told to stop and every chunk is stored (a rank asks for its next
@@ -168,7 +174,7 @@ void coordinate(const AtlasSpec& spec, Ledger& ledger, int ranks, int threads) {
                     chunks.push_back(c);
                 }
                 MPI_Send(chunks.data(), static_cast<int>(chunks.size()), MPI_LONG_LONG, st.MPI_SOURCE, tag_assign, MPI_COMM_WORLD);
-                if (chunks.empty()) --active;  // that rank stops
+                if (chunks.empty()) --active;  // one of that rank's request streams stops
             } else if (st.MPI_TAG == tag_result) {
                 int count = 0;
                 MPI_Get_count(&st, MPI_DOUBLE, &count);
@@ -204,9 +210,16 @@ std::vector<long long> receive_assignment() {
 /// A rank > 0: asks rank 0 for chunks (as many as it has threads), computes them, sends the
 /// values back (the chunk index first), until rank 0 answers with none. The request for the
 /// next chunks goes out before the current ones are computed, so that the answer is there when
-/// they are done (no idle round trip to rank 0).
+/// they are done (no idle round trip to rank 0); the values go out without waiting (MPI_Isend:
+/// a chunk's message is above the eager limit, and a blocking send would wait until rank 0's
+/// coordinator, which polls, takes it) while the next chunks are computed.
 void serve(const AtlasSpec& spec, int threads) {
-    MPI_Send(&threads, 1, MPI_INT, 0, tag_request, MPI_COMM_WORLD);
+    std::vector<std::vector<double>> sending;  // the previous batch's messages, in flight
+    std::vector<MPI_Request> requests;
+    for (int i = 0; i < lookahead; ++i) MPI_Send(&threads, 1, MPI_INT, 0, tag_request, MPI_COMM_WORLD);
+    // each non-empty answer is followed by one new request, so `lookahead` stay outstanding; the
+    // answers come in order, and once one is empty the ledger is empty: the others are too
+    int open = lookahead;
     for (std::vector<long long> chunks = receive_assignment(); !chunks.empty(); chunks = receive_assignment()) {
         MPI_Send(&threads, 1, MPI_INT, 0, tag_request, MPI_COMM_WORLD);
         const int count = static_cast<int>(chunks.size());
@@ -220,8 +233,14 @@ void serve(const AtlasSpec& spec, int threads) {
             r.push_back(static_cast<double>(chunks[static_cast<std::size_t>(i)]));
             r.insert(r.end(), v.begin(), v.end());
         }, policy);
-        for (const auto& r : results) MPI_Send(r.data(), static_cast<int>(r.size()), MPI_DOUBLE, 0, tag_result, MPI_COMM_WORLD);
+        MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+        sending = std::move(results);
+        requests.assign(sending.size(), MPI_REQUEST_NULL);
+        for (std::size_t i = 0; i < sending.size(); ++i)
+            MPI_Isend(sending[i].data(), static_cast<int>(sending[i].size()), MPI_DOUBLE, 0, tag_result, MPI_COMM_WORLD, &requests[i]);
     }
+    for (--open; open > 0; --open) receive_assignment();  // the other outstanding answers (empty)
+    MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
 }
 
 #endif
@@ -309,7 +328,6 @@ int run_atlas() {
 
     // rank 0: the size guard, the output folder and the chunk store, before any work
     std::string prefix;
-    std::vector<double> values;
     std::vector<char> done;
     std::unique_ptr<AtlasStore> store;
     std::exception_ptr setup_error;
@@ -329,7 +347,7 @@ int run_atlas() {
                 if (!args.resume && store_exists && !run_flags().quiet)
                     std::cerr << "ddemap: atlas: note: the chunks of an earlier run in " << prefix
                               << ".chunks are discarded (--resume continues that run)\n";
-                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, values, done);
+                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, done);
             }
         } catch (...) {
             setup_error = std::current_exception();
@@ -369,7 +387,7 @@ int run_atlas() {
     long computed_points = 0;
     for (long c = 0; c < spec.chunks(); ++c)
         if (!done[static_cast<std::size_t>(c)]) computed_points += spec.chunk_end(c) - spec.chunk_begin(c);
-    Ledger ledger(spec, *store, values, done, progress_printer("atlas", "chunks"));
+    Ledger ledger(spec, *store, done, progress_printer("atlas", "chunks"));
     const long computed = ledger.pending();
     const auto t_compute = std::chrono::steady_clock::now();
 #if DDEMAP_WITH_MPI
@@ -390,26 +408,34 @@ int run_atlas() {
     compute_locally(spec, ledger, threads);
 #endif
     const double compute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_compute).count();
-    store.reset();
-    const std::string h5 = atlas_hdf5(spec, values, text);
-    const std::string svg = atlas_svg(file, values);
-    // the result and the figure appear together; the chunk store goes with the move
-    write_files_atomic({{prefix + ".h5", h5}, {prefix + ".svg", svg}}, {prefix + ".chunks"});
-
+    store->sync();
+    const std::string svg = atlas_svg(file, store->reader());
     const std::size_t nf = atlas_fields().size();
     long classes[4] = {0, 0, 0, 0}, uncertified = 0;
-    for (long i = 0; i < spec.points(); ++i) {
-        const double* v = &values[static_cast<std::size_t>(i) * nf];
-        ++classes[static_cast<int>(v[15])];
-        uncertified += v[14] == 0.0;
+    {
+        std::vector<double> v(static_cast<std::size_t>(spec.chunk_size()) * nf);
+        for (long c = 0; c < spec.chunks(); ++c) {
+            store->read(c, v.data());
+            for (long i = 0; i < spec.chunk_end(c) - spec.chunk_begin(c); ++i) {
+                ++classes[static_cast<int>(v[static_cast<std::size_t>(i) * nf + 15])];
+                uncertified += v[static_cast<std::size_t>(i) * nf + 14] == 0.0;
+            }
+        }
     }
+    // the HDF5 file from the chunk store in slabs (bounded memory at any size), through
+    // DIR/atlas.h5.part, in place while the store still holds every chunk (a crash here leaves a
+    // store that --resume completes without computing); then the figure, with the store removed
+    write_atlas_hdf5(prefix + ".h5", spec, store->reader(), text);
+    store.reset();
+    write_files_atomic({{prefix + ".svg", svg}}, {prefix + ".chunks"});
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::ostringstream out;
     out << "atlas      " << spec.points() << " points in " << spec.chunks() << " chunks of " << spec.chunk_size() << " (" << computed
         << " computed, " << loaded << " resumed) in " << rounded(seconds, 3) << " s";
     if (computed > 0) {
         out << " (" << static_cast<long>(std::lround(computed_points / std::max(compute_seconds, 1e-9))) << " points/s";
-        out << ", " << ranks << (ranks == 1 ? " process" : " processes") << " x " << threads << (threads == 1 ? " thread" : " threads") << ")";
+        out << ", " << ranks << (ranks == 1 ? " process" : " processes") << " x " << threads << (threads == 1 ? " thread" : " threads")
+            << ", ring method " << spec.ring_method_used() << ")";
     }
     out << "\nregions    plant unstable " << classes[0] << ", ring unstable " << classes[1] << ", string unstable " << classes[2]
         << ", string stable " << classes[3];

@@ -56,7 +56,7 @@ int run_boundary() {
             const auto& c = b.curves[i];
             out << "  " << i + 1 << "  " << kind_name(c.kind) << "/" << subkind_name(c.kind);
             if (c.kind == BoundaryKind::RingHopf) out << " mode " << c.mode;
-            out << ": " << c.points.size() << " points, max residual " << rounded(c.max_residual, 2) << (c.closed ? ", closed" : "") << "\n";
+            out << ": " << counted(static_cast<long long>(c.points.size()), "point") << ", max residual " << rounded(c.max_residual, 2) << (c.closed ? ", closed" : "") << "\n";
         }
         out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
         std::cout << out.str();

@@ -72,7 +72,7 @@ int run_equilibria() {
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
     print_output(format, e, csv, [&] {
         std::ostringstream out;
-        out << "branch     " << b.points.size() << " points in " << args.problem.par << " from " << rounded(o.from) << " towards " << rounded(o.to)
+        out << "branch     " << counted(static_cast<long long>(b.points.size()), "point") << " in " << args.problem.par << " from " << rounded(o.from) << " towards " << rounded(o.to)
             << " (ended: " << to_string(b.stop) << ")\n";
         const std::size_t shown = std::min<std::size_t>(variables.size(), 3);
         out << "  " << pad(args.problem.par, 14);

@@ -12,6 +12,11 @@ namespace ddemap::cli {
 std::string rounded(double v, int digits = 6);
 /// Roots as a numbered human table (rounded).
 std::string roots_table(const std::vector<Root>& roots);
+/// "1 orbit", "3 orbits": the count and the noun, singular for exactly one (`plural`: the
+/// noun's plural when it is not the singular with an "s").
+inline std::string counted(long long n, const std::string& singular, const std::string& plural = {}) {
+    return std::to_string(n) + " " + (n == 1 ? singular : plural.empty() ? singular + "s" : plural);
+}
 /// N, or "inf" for 0.
 inline std::string ring_name(int cars) { return cars == 0 ? "inf" : std::to_string(cars); }
 

@@ -127,7 +127,7 @@ int run_hopf() {
         if (two)
             for (std::size_t k = 0; k < curves.curves.size(); ++k) {
                 const HopfCurve& c = curves.curves[k];
-                out << "curve " << k << "    from Hopf point " << c.start << ": " << c.points.size() << " points in (" << par << ", " << args.par2
+                out << "curve " << k << "    from Hopf point " << c.start << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << args.par2
                     << "), " << to_string(c.status) << "\n";
                 out << "  " << pad(par, 14) << pad(args.par2, 14) << pad("omega", 12) << pad("L1", 13) << "criticality\n";
                 const std::size_t step = std::max<std::size_t>(1, c.points.size() / 20);

@@ -134,7 +134,8 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
         char v[32];
         std::snprintf(v, sizeof v, "%.6g", value);
         const std::string count = exact_total ? unit + " " + std::to_string(done) + "/" + std::to_string(total)
-                                              : std::to_string(done) + " " + unit + " (at most " + std::to_string(total) + ")";
+                                              : std::to_string(done) + " " + (done == 1 && unit.size() > 1 && unit.back() == 's' ? unit.substr(0, unit.size() - 1) : unit) +
+                                                    " (at most " + std::to_string(total) + ")";
         (*printer)(done, total, count + ", " + par + " = " + v, exact_total);
     };
 }

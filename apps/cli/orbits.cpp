@@ -148,7 +148,7 @@ int run_orbits() {
         std::ostringstream out;
         out << "hopf       " << par << " = " << rounded(h.par, 10) << ", omega = " << rounded(h.omega, 10) << ", period 2 pi / omega = "
             << rounded(6.283185307179586 / h.omega, 8) << " (Hopf point " << hopf_index << " of " << eq.hopf.size() << ")\n";
-        out << "branch     " << b.points.size() << " orbits, degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
+        out << "branch     " << counted(static_cast<long long>(b.points.size()), "orbit") << ", degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
         const std::string& v = variables[static_cast<std::size_t>(variable)];
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
         for (const PeriodicOrbit& p : b.points)

@@ -75,8 +75,8 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
         if (w.hopf.status == Status::Converged)
             out << "hopf       " << par << " = " << rounded(w.hopf.par, 10) << ", omega = " << rounded(w.hopf.omega, 10) << " (ring mode " << o.wave
                 << " of " << o.cars << " cars)\n";
-        out << "wave       car i + 1 = car i shifted by " << o.wave << " T / " << o.cars << "; reduced form: one car, " << b.points.size()
-            << " waves, degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
+        out << "wave       car i + 1 = car i shifted by " << o.wave << " T / " << o.cars << "; reduced form: one car, " << counted(static_cast<long long>(b.points.size()), "wave")
+            << ", degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + variables[0], 14) << pad("amp v0", 14) << pad("max|mu|", 12) << "stable\n";
         for (const PeriodicOrbit& p : b.points)
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[0] - p.min[0], 6), 14)

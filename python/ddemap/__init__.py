@@ -25,8 +25,9 @@ released. Ctrl-C (KeyboardInterrupt) stops ``sweep`` and ``boundary`` between gr
 ``classify`` between vehicles (and parameter samples), ``simulate`` between steps,
 ``calibrate`` between fits, ``equilibria`` and ``hopf`` between the points of a branch or a
 Hopf curve, ``orbits`` between orbits, and ``roots``/``string`` with a ring between the modes
-of the per-mode path; ``roots`` of a ``system``, ``mixed_ring`` and the winding pass (each well
-under a second to a few seconds) finish their call first.
+of the per-mode path, ``roots`` of a ``system`` and ``mixed_ring`` between the steps of the root
+search; the winding pass and one dense collocation degree (each well under a second to a few
+seconds) finish first.
 
 Quick start (the paper's stability chart)::
 

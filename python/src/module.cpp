@@ -8,7 +8,7 @@
 // default translation, kept explicit here). Every computation runs with the GIL released; where
 // the library reports progress (sweep rows, boundary seed rows, vehicles and samples of
 // classify, simulated time, calibration fits, the points of equilibrium branches, Hopf curves and
-// orbit branches) the callback checks for Ctrl-C on the main thread and stops the computation
+// orbit branches, the contour counts, shifts and degrees of the roots of mixed rings and systems) the callback checks for Ctrl-C on the main thread and stops the computation
 // (KeyboardInterrupt).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -61,8 +61,9 @@ using namespace ddemap;
 namespace {
 
 /// Thrown by the progress callback when a signal handler raised (Ctrl-C: KeyboardInterrupt);
-/// the Python error stays set and is what the caller sees.
-struct Interrupted : std::exception {
+/// the Python error stays set and is what the caller sees. A ddemap::Cancelled, so the root
+/// computations (rightmost_roots) return Status::Cancelled, turned back into it here.
+struct Interrupted : Cancelled {
     const char* what() const noexcept override { return "interrupted"; }
 };
 
@@ -182,7 +183,9 @@ std::string py_roots_system(const std::string& path, int count, int degree, cons
         }
         lin.emplace(linearise(*file.system, eq.x));
     }
+    o.progress = branch_interruptible();
     const SystemRootResult sr = released([&] { return analyse_system(*lin, o); });
+    if (sr.roots.status == Status::Cancelled) throw Interrupted();  // Ctrl-C: KeyboardInterrupt
     const RootResult& r = sr.roots;
     e.has_solver = true;
     e.solver_given = solver_name(r.method_given);
@@ -523,7 +526,9 @@ std::string py_mixed_ring(const std::string& spec, bool is_pattern, int cars, st
     o.roots.method = root_method(solver);
     o.roots.count = count;
     o.roots.degree = degree;
+    o.roots.progress = branch_interruptible();
     const MixedRingResult r = released([&] { return analyse_mixed_ring(fleet, o); });
+    if (r.roots.status == Status::Cancelled) throw Interrupted();  // Ctrl-C: KeyboardInterrupt
     const RootResult& rr = r.roots;
     JsonEnvelope e;
     e.command = "roots";

@@ -392,3 +392,44 @@ def test_stability_chart_example(tmp_path):
                    check=True, timeout=120)
     with open(png, "rb") as f:
         assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def _interrupted_after(call, fraction):
+    """Times `call()` uninterrupted, then runs it again with SIGINT from a timer thread at
+    `fraction` of that time; returns (uninterrupted time, signal time, time to KeyboardInterrupt)."""
+    start = time.perf_counter()
+    call()
+    t_full = time.perf_counter() - start
+    at = fraction * t_full
+    timer = threading.Timer(at, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        call()
+    took = time.perf_counter() - start
+    timer.join()
+    return t_full, at, took
+
+
+def test_ctrl_c_stops_a_long_mixed_ring():
+    # a 300,000-car ring on the product path (contour counts of a few tenths of a second each)
+    call = lambda: ddemap.mixed_ring("A_min,C_max", ring=300000, count=6)
+    t_full, at, took = _interrupted_after(call, 0.25)
+    assert t_full > 2, t_full  # long enough that stopping early is visible
+    assert took < 0.6 * t_full, (took, at, t_full)
+    # the module still works
+    assert ddemap.mixed_ring("A_min,C_max", ring=20, count=4)["ring_stable"] in (True, False)
+
+
+def test_ctrl_c_stops_a_long_system_roots(tmp_path):
+    # a sparse circulant system x_i' = -x_i + 0.95 x_{i-1}(t - 1) of 3000 states, 30 roots: the
+    # sparse path's Arnoldi shifts, interrupted between shifts
+    n = 3000
+    triplets = [[i, (i - 1) % n, 0.95] for i in range(n)]
+    system = tmp_path / "circulant.json"
+    system.write_text(json.dumps({"dimension": n, "delays": [1.0], "A0": {"triplets": [[i, i, -1.0] for i in range(n)]},
+                                  "A": [{"triplets": triplets}]}))
+    call = lambda: ddemap.roots(system=str(system), count=30, solver="sparse")
+    t_full, at, took = _interrupted_after(call, 0.25)
+    assert t_full > 2, t_full
+    assert took < 0.6 * t_full, (took, at, t_full)

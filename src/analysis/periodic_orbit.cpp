@@ -16,6 +16,7 @@
 #include <Spectra/MatOp/DenseGenMatProd.h>
 #pragma GCC diagnostic pop
 
+#include "analysis/internal/orbit_mesh.hpp"
 
 namespace ddemap {
 
@@ -779,52 +780,9 @@ Setup make_setup(const NonlinearDDE& system, const PeriodicMesh& mesh, const Per
     return c;
 }
 
-/// The mesh that equidistributes |x^(d+1)|^(1/(d+1)) of the orbit u (as in COLSYS and DDE-BIFTOOL):
-/// on interval i the d-th derivative D_i of the polynomial is constant (the d-th difference of its
-/// d + 1 equispaced values over (h_i / d)^d); |x^(d+1)| is estimated from the jumps of D_i to
-/// both neighbours. The density is that estimate to the power 1/(d+1) plus 10 % of its mean (so
-/// that no interval grows without bound where x is nearly polynomial).
+/// The mesh that equidistributes |x^(d+1)|^(1/(d+1)) of the orbit u (analysis/internal/orbit_mesh.hpp).
 std::vector<double> adapted_breakpoints(const Setup& c, const Eigen::VectorXd& u) {
-    const int L = c.L, d = c.d;
-    std::vector<double> binom(static_cast<std::size_t>(d) + 1, 1.0);
-    for (int j = 1; j <= d; ++j) binom[static_cast<std::size_t>(j)] = binom[static_cast<std::size_t>(j - 1)] * (d - j + 1) / j;
-    std::vector<Eigen::VectorXd> D(static_cast<std::size_t>(L));
-    for (int i = 0; i < L; ++i) {
-        Eigen::VectorXd v = Eigen::VectorXd::Zero(c.n);
-        for (int j = 0; j <= d; ++j) {
-            const int pt = (i * d + j) % c.P;
-            v += (((d - j) % 2) ? -1.0 : 1.0) * binom[static_cast<std::size_t>(j)] * u.segment(static_cast<Eigen::Index>(pt) * c.n, c.n);
-        }
-        D[static_cast<std::size_t>(i)] = v / std::pow(c.mesh.width(i) / d, d);
-    }
-    std::vector<double> m(static_cast<std::size_t>(L));
-    double mean = 0.0;
-    for (int i = 0; i < L; ++i) {
-        const int ip = (i + 1) % L, im = (i + L - 1) % L;
-        const auto ui = static_cast<std::size_t>(i);
-        const double wl = (D[ui] - D[static_cast<std::size_t>(im)]).lpNorm<Eigen::Infinity>() / (0.5 * (c.mesh.width(i) + c.mesh.width(im)));
-        const double wr = (D[static_cast<std::size_t>(ip)] - D[ui]).lpNorm<Eigen::Infinity>() / (0.5 * (c.mesh.width(i) + c.mesh.width(ip)));
-        m[ui] = std::pow(0.5 * (wl + wr), 1.0 / (d + 1));
-        mean += m[ui] * c.mesh.width(i);
-    }
-    if (!(mean > 0.0) || !std::isfinite(mean)) return c.mesh.breakpoints();
-    std::vector<double> F(static_cast<std::size_t>(L) + 1, 0.0);
-    for (int i = 0; i < L; ++i) {
-        m[static_cast<std::size_t>(i)] += 0.1 * mean;
-        F[static_cast<std::size_t>(i) + 1] = F[static_cast<std::size_t>(i)] + m[static_cast<std::size_t>(i)] * c.mesh.width(i);
-    }
-    std::vector<double> t(static_cast<std::size_t>(L) + 1);
-    t.front() = 0.0;
-    t.back() = 1.0;
-    int i = 0;
-    for (int k = 1; k < L; ++k) {
-        const double target = F.back() * k / L;
-        while (i + 1 < L && F[static_cast<std::size_t>(i) + 1] <= target) ++i;
-        t[static_cast<std::size_t>(k)] = c.mesh.breakpoints()[static_cast<std::size_t>(i)] + (target - F[static_cast<std::size_t>(i)]) / m[static_cast<std::size_t>(i)];
-    }
-    for (int k = 1; k <= L; ++k)
-        if (!(t[static_cast<std::size_t>(k)] > t[static_cast<std::size_t>(k) - 1])) return c.mesh.breakpoints();
-    return t;
+    return orbit_mesh::equidistributed_breakpoints(c.mesh, c.n, u);
 }
 
 /// The same problem on another mesh of the same degree and number of intervals.

@@ -14,6 +14,8 @@
 #include "ddemap/traffic/nonlinear_ring.hpp"
 #include "ddemap/traffic/ring_car.hpp"
 
+#include "analysis/internal/orbit_mesh.hpp"
+
 namespace ddemap {
 
 namespace {
@@ -26,7 +28,7 @@ using SpD = Eigen::SparseMatrix<double>;
 struct Wave {
     Wave(const RingCar& c, const PeriodicMesh& me) : car(c), mesh(me) {}
     const RingCar& car;
-    const PeriodicMesh& mesh;
+    PeriodicMesh mesh;  // replaced when the mesh is adapted (remesh)
     double kappa = 0.0;  // k / N
     int j = 0, d = 0, L = 0, P = 0;
     std::vector<double> base;
@@ -402,6 +404,326 @@ HopfPoint wave_hopf(const RingCar& car, int j, double from, double to, cplx z) {
     return h;
 }
 
+/// u (or a tangent) on the mesh of c re-represented on `to` (the same degree and number of
+/// intervals): the profile interpolated at the new points, T, p and mu kept.
+Eigen::VectorXd resample(const Wave& c, const PeriodicMesh& to, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd profile(c.P, 2);
+    for (int i = 0; i < c.P; ++i) profile.row(i) = u.segment<2>(2 * i).transpose();
+    Eigen::VectorXd v(u.size());
+    for (int i = 0; i < c.P; ++i) v.segment<2>(2 * i) = orbit_value(c.mesh, profile, to.point(i));
+    v.tail<3>() = u.tail<3>();
+    return v;
+}
+
+/// Moves c's mesh so that it equidistributes |x^(d+1)|^(1/(d+1)) of u (orbit_mesh.hpp); u and
+/// the tangent t (when given, renormalised) are re-represented on it.
+void remesh(Wave& c, Eigen::VectorXd& u, Eigen::VectorXd* t) {
+    const PeriodicMesh next(c.d, orbit_mesh::equidistributed_breakpoints(c.mesh, 2, u));
+    u = resample(c, next, u);
+    if (t) *t = resample(c, next, *t);
+    c.mesh = next;
+    if (t) *t /= c.norm(*t);
+}
+
+/// The branch from the corrected wave u with unit tangent t (the continuation of periodic_orbit's
+/// follow): pseudo-arclength with step control, the range's faces located, folds located by
+/// Illinois regula falsi on the parameter component of the tangent. The branch ends at
+/// max_points waves, on a face of the range, when the amplitude falls below `collapse` times the
+/// first wave's (back at the Hopf point), when the period exceeds max_period_factor T0, or when
+/// the step falls below min_step. With `adapt` the mesh is re-equidistributed after every wave.
+void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const FullRing& full, const PeriodicOrbitOptions& o,
+            double collapse, double T0, int max_points, bool adapt, OrbitBranch& b, double& max_drift) {
+    const int N = c.N();
+    const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
+    b.points.push_back(make_orbit(c, u, first, full, o.parameter, o.floquet));
+    b.newton_iterations += first.iterations;
+    max_drift = std::max(max_drift, std::abs(u(N + 2)));
+    const double amp0 = amplitude(b.points.front());
+    double h = o.initial_step;
+    b.stop = "max_points";
+    if (adapt) remesh(c, u, &t);
+    while (static_cast<int>(b.points.size()) < max_points) {
+        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        Eigen::VectorXd v = u + h * t;
+        const Eigen::VectorXd a = c.w.cwiseProduct(t);
+        Correction rc = correct(c, v, ref, a, a.dot(u + h * t), o);
+        b.newton_iterations += rc.iterations;
+        const bool jump = rc.ok && c.norm(v - u) > 3.0 * h;
+        if (!rc.ok || jump) {
+            h *= 0.5;
+            if (h < o.min_step) {
+                b.stop = "step_below_minimum";
+                b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
+                std::ostringstream s;
+                s << "the corrector failed at " << b.parameter << " = " << v(N + 1) << " with the step below " << o.min_step;
+                b.message = s.str();
+                break;
+            }
+            continue;
+        }
+        Eigen::VectorXd tn = rc.tangent / c.norm(rc.tangent);
+        if (tn.dot(c.w.cwiseProduct(t)) < 0.0) tn = -tn;
+        const double p = v(N + 1);
+        if (p < lo || p > hi) {  // the orbit on the face of the range
+            const double bound = p < lo ? lo : hi;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+            e(N + 1) = 1.0;
+            Eigen::VectorXd wv = v;
+            const Correction rb = correct(c, wv, ref, e, bound, o);
+            b.newton_iterations += rb.iterations;
+            if (rb.ok) {
+                b.points.push_back(make_orbit(c, wv, rb, full, o.parameter, o.floquet));
+                max_drift = std::max(max_drift, std::abs(wv(N + 2)));
+            } else {
+                b.status = Status::MaxIterations;
+                b.message = "the wave on the end of the parameter range did not converge";
+            }
+            b.stop = "bound";
+            break;
+        }
+        // fold: the parameter component of the tangent changes sign; Illinois regula falsi in the
+        // arclength on that component, every trial orbit corrected
+        if (t(N + 1) * tn(N + 1) < 0.0) {
+            OrbitFold f;
+            f.after = static_cast<int>(b.points.size()) - 1;
+            const Eigen::VectorXd ak = c.w.cwiseProduct(t);
+            double slo = 0.0, shi = ak.dot(v - u), glo = t(N + 1), ghi = tn(N + 1);
+            int side = 0;
+            Eigen::VectorXd best = v;
+            Correction bestc = rc;
+            const double sp = std::abs(o.to - o.from);
+            for (int it = 0; it < 40; ++it) {
+                const double s = slo - glo * (shi - slo) / (ghi - glo);
+                Eigen::VectorXd wv = u + s * t;
+                const Correction rf = correct(c, wv, ref, ak, ak.dot(u + s * t), o);
+                b.newton_iterations += rf.iterations;
+                if (!rf.ok) break;
+                const double gv = (rf.tangent / c.norm(rf.tangent))(N + 1) * (rf.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
+                best = wv;
+                bestc = rf;
+                if (std::abs(gv) <= 1e-11 * sp || std::abs(shi - slo) <= 1e-12 * h) {
+                    f.located = true;
+                    break;
+                }
+                if ((gv < 0.0) == (glo < 0.0)) {
+                    slo = s;
+                    glo = gv;
+                    if (side == -1) ghi *= 0.5;
+                    side = -1;
+                } else {
+                    shi = s;
+                    ghi = gv;
+                    if (side == 1) glo *= 0.5;
+                    side = 1;
+                }
+            }
+            f.orbit = make_orbit(c, best, bestc, full, o.parameter, false);
+            f.par = f.orbit.par;
+            f.period = f.orbit.period;
+            if (!f.located && b.status == Status::Converged) {
+                b.status = Status::MaxIterations;
+                b.message = "a fold of travelling waves was detected but not located";
+            }
+            b.folds.push_back(f);
+        }
+        PeriodicOrbit orbit = make_orbit(c, v, rc, full, o.parameter, o.floquet);
+        max_drift = std::max(max_drift, std::abs(v(N + 2)));
+        const bool collapsed = amplitude(orbit) < collapse * amp0;
+        b.points.push_back(std::move(orbit));
+        if (collapsed) {
+            b.stop = "hopf";
+            break;
+        }
+        u = v;
+        t = tn;
+        if (rc.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
+        if (u(N) > o.max_period_factor * T0) {
+            b.stop = "period";
+            break;
+        }
+        if (adapt) remesh(c, u, &t);
+    }
+}
+
+/// The first wave from the Hopf point h (predictor along Re(q e^{2 pi i s}), corrector with the
+/// arclength row along that direction); u and its unit tangent t when the correction is ok.
+Correction first_wave(const Wave& c, const HopfPoint& hopf, const PeriodicOrbitOptions& o, Eigen::VectorXd& u, Eigen::VectorXd& t) {
+    const int N = c.N();
+    Eigen::VectorXd uh(N + 3), t0 = Eigen::VectorXd::Zero(N + 3);
+    for (int i = 0; i < c.P; ++i) {
+        const cplx e = std::exp(cplx(0.0, 2.0 * kPi * c.mesh.point(i)));
+        uh.segment<2>(2 * i) = hopf.x;
+        t0.segment<2>(2 * i) = (hopf.q * e).real();
+    }
+    uh(N) = 2.0 * kPi / hopf.omega;
+    uh(N + 1) = hopf.par;
+    uh(N + 2) = 0.0;
+    t0 /= c.norm(t0);
+    u = uh + o.initial_step * t0;
+    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+    const Eigen::VectorXd a = c.w.cwiseProduct(t0);
+    Correction r = correct(c, u, ref, a, a.dot(u), o);
+    if (r.ok) {
+        t = r.tangent / c.norm(r.tangent);
+        if (t.dot(c.w.cwiseProduct(t0)) < 0.0) t = -t;
+    }
+    return r;
+}
+
+std::string format_q(double q) {
+    std::ostringstream s;
+    s << q;
+    return s.str();
+}
+
+/// The shift fraction q = k / N from which long waves are reached by the homotopy in q.
+constexpr double kHomotopyStart = 0.1;
+
+/// Homotopy in q = c.kappa with the parameter held at p = u(N + 1): natural continuation in log q
+/// from c.kappa down to `target` (steps of factor 0.5 at first, halved on failure, grown by 1.5
+/// after easy corrections up to a factor 0.25), the predictor keeping the profile in s and T q
+/// (the time shift from car to car); after every step the mesh is re-equidistributed and the
+/// wave corrected on it. false when a step in log q falls below 1e-3.
+bool kappa_homotopy(Wave& c, Eigen::VectorXd& u, double target, const PeriodicOrbitOptions& o, int& iterations, int& steps, Correction& last) {
+    const int N = c.N();
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+    e(N + 1) = 1.0;
+    const double p = u(N + 1);
+    double dl = std::log(0.5);
+    while (c.kappa > target) {
+        const double k0 = c.kappa, k1 = std::max(target, k0 * std::exp(dl));
+        Eigen::VectorXd v = u;
+        v(N) = u(N) * k0 / k1;
+        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        c.kappa = k1;
+        const Correction r = correct(c, v, ref, e, p, o);
+        iterations += r.iterations;
+        if (!r.ok) {
+            c.kappa = k0;
+            dl *= 0.5;
+            if (std::abs(dl) < 1e-3) return false;
+            continue;
+        }
+        u = v;
+        last = r;
+        ++steps;
+        const PeriodicMesh old = c.mesh;
+        Eigen::VectorXd w = u;
+        remesh(c, w, nullptr);
+        const Correction rm = correct(c, w, derivative_at_collocation(c, w), e, p, o);
+        iterations += rm.iterations;
+        if (rm.ok) {
+            u = w;
+            last = rm;
+        } else {
+            c.mesh = old;
+        }
+        if (r.iterations <= 3) dl = std::max(std::log(0.25), 1.5 * dl);
+    }
+    return true;
+}
+
+/// Long waves (see the header): the wave of q0 = kHomotopyStart from its own Hopf point, the
+/// homotopy in q down to c.kappa at the parameter of that branch's largest wave inside the range,
+/// then the branch in the parameter in both directions on an adapted mesh, joined at that wave
+/// (the direction that ends at the smaller amplitude, towards the Hopf point, first).
+void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, const PeriodicOrbitOptions& o, double T0, TravellingWaveBranch& res) {
+    OrbitBranch& b = res.branch;
+    const int N = c.N();
+    const double q = c.kappa;
+    auto fail = [&](const std::string& why) {
+        b.points.clear();
+        b.folds.clear();
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = "the first travelling wave from the Hopf point did not converge, and the homotopy in K / N from " + format_q(kHomotopyStart) +
+                    " failed: " + why;
+    };
+    const double phase = 2.0 * kPi * kHomotopyStart;
+    const HopfPoint h0 = wave_hopf(car, j, o.from, o.to, cplx(std::cos(phase), std::sin(phase)));
+    if (h0.status != Status::Converged) return fail("no Hopf point of the shorter wave in the range");
+    c.kappa = kHomotopyStart;
+    const double T00 = 2.0 * kPi / h0.omega;
+    const double wT = c.w(N);
+    c.w(N) = 1.0 / (T00 * T00);
+    Eigen::VectorXd u, t;
+    Correction r = first_wave(c, h0, o, u, t);
+    b.newton_iterations += r.iterations;
+    if (!r.ok) return fail("its first wave did not converge");
+    OrbitBranch b0;
+    b0.parameter = o.parameter;
+    PeriodicOrbitOptions o0 = o;
+    o0.floquet = false;
+    double drift0 = 0.0;
+    const PeriodicMesh mesh0 = c.mesh;
+    follow(c, u, t, r, FullRing{}, o0, 0.5, T00, o.max_points, false, b0, drift0);
+    b.newton_iterations += b0.newton_iterations - r.iterations;
+    c.mesh = mesh0;
+    const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to), margin = 0.05 * (hi - lo);
+    int pick = -1;
+    for (std::size_t i = 0; i < b0.points.size(); ++i) {
+        const PeriodicOrbit& pt = b0.points[i];
+        if (pt.par < lo + margin || pt.par > hi - margin) continue;
+        if (pick < 0 || amplitude(pt) > amplitude(b0.points[static_cast<std::size_t>(pick)])) pick = static_cast<int>(i);
+    }
+    if (pick < 0) return fail("the shorter wave's branch has no wave inside the range");
+    const PeriodicOrbit& start = b0.points[static_cast<std::size_t>(pick)];
+    u.resize(N + 3);
+    for (int i = 0; i < c.P; ++i) u.segment<2>(2 * i) = start.profile.row(i).transpose();
+    u(N) = start.period;
+    u(N + 1) = start.par;
+    u(N + 2) = 0.0;
+    int steps = 0, its = 0;
+    Correction last;
+    remesh(c, u, nullptr);
+    const bool ok = kappa_homotopy(c, u, q, o, its, steps, last);
+    b.newton_iterations += its;
+    c.w(N) = wT;
+    if (!ok) return fail("the homotopy stopped at K / N = " + format_q(c.kappa));
+    res.homotopy_par = u(N + 1);
+    res.homotopy_steps = steps;
+    t = last.tangent / c.norm(last.tangent);
+    // the fronts move along s as the parameter changes: with the profile weighted as on short
+    // waves the steps in the parameter are tiny; its weight is lowered 1000 times
+    Wave c_start = c;
+    c_start.w.head(N) *= 1e-3;
+    OrbitBranch side[2];
+    double drift = 0.0;
+    const int half = std::max(2, (o.max_points + 1) / 2);
+    for (int k = 0; k < 2; ++k) {
+        side[k].parameter = o.parameter;
+        Wave ck = c_start;
+        follow(ck, u, k == 0 ? t : Eigen::VectorXd(-t), last, full, o, 0.0, T0, k == 0 ? half : o.max_points - half + 1, true, side[k], drift);
+        b.newton_iterations += side[k].newton_iterations - (k == 0 ? 0 : last.iterations);
+    }
+    res.max_drift = std::max(res.max_drift, drift);
+    // the side ending at the smaller amplitude (towards the Hopf point) first, reversed
+    const int first = amplitude(side[0].points.back()) <= amplitude(side[1].points.back()) ? 0 : 1;
+    const OrbitBranch& A = side[first];
+    const OrbitBranch& B = side[1 - first];
+    const int nA = static_cast<int>(A.points.size());
+    b.points.assign(A.points.rbegin(), A.points.rend());
+    for (OrbitFold f : A.folds) {
+        f.after = nA - 2 - f.after;
+        b.folds.push_back(f);
+    }
+    std::reverse(b.folds.begin(), b.folds.end());
+    for (std::size_t i = 1; i < B.points.size(); ++i) b.points.push_back(B.points[i]);
+    for (OrbitFold f : B.folds) {
+        f.after += nA - 1;
+        b.folds.push_back(f);
+    }
+    b.stop = B.stop;
+    b.status = B.status;
+    std::ostringstream s;
+    s << b.points.size() << " travelling waves, reached by a homotopy in K / N from " << kHomotopyStart << " at " << o.parameter << " = "
+      << res.homotopy_par << " (" << steps << " steps) and continued both ways on an adapted mesh; towards the Hopf point it ended: " << A.stop;
+    if (!A.message.empty() && A.status != Status::Converged) s << " (" << A.message << ")";
+    s << "; the other way: " << B.stop;
+    if (!B.message.empty() && B.status != Status::Converged) s << " (" << B.message << ")";
+    b.message = s.str();
+}
+
 }  // namespace
 
 bool TravellingWaveOptions::is_valid(std::string* why) const {
@@ -489,139 +811,22 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
     c.w(N + 1) = 1.0 / ((o.to - o.from) * (o.to - o.from));
 
     // the first orbit from the Hopf point along Re(q e^{2 pi i s})
-    Eigen::VectorXd uh(N + 3), t0 = Eigen::VectorXd::Zero(N + 3);
-    for (int i = 0; i < c.P; ++i) {
-        const cplx e = std::exp(cplx(0.0, 2.0 * kPi * mesh.point(i)));
-        uh.segment<2>(2 * i) = res.hopf.x;
-        t0.segment<2>(2 * i) = (res.hopf.q * e).real();
-    }
-    uh(N) = T0;
-    uh(N + 1) = res.hopf.par;
-    uh(N + 2) = 0.0;
-    t0 /= c.norm(t0);
-    Eigen::VectorXd u = uh + o.initial_step * t0;
+    Eigen::VectorXd u, t;
     Correction r;
-    {
-        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
-        const Eigen::VectorXd a = c.w.cwiseProduct(t0);
-        r = correct(c, u, ref, a, a.dot(u), o);
-    }
-    b.newton_iterations += r.iterations;
-    if (!r.ok) {
+    if (!options.force_homotopy || c.kappa >= kHomotopyStart) r = first_wave(c, res.hopf, o, u, t);
+    if (r.ok) {
+        // the branch (uniform mesh)
+        follow(c, u, t, r, full, o, 0.5, T0, o.max_points, false, b, res.max_drift);
+    } else if (c.kappa < kHomotopyStart) {
+        if (!options.force_homotopy) b.newton_iterations += r.iterations;
+        long_wave_branch(c, *car, j, full, o, T0, res);
+        if (b.points.empty()) return res;
+    } else {
+        b.newton_iterations += r.iterations;
         b.status = Status::MaxIterations;
         b.stop = "first_orbit_failed";
         b.message = "the first travelling wave from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
         return res;
-    }
-    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
-    if (t.dot(c.w.cwiseProduct(t0)) < 0.0) t = -t;
-
-    // the branch (the continuation of periodic_orbit's follow, uniform mesh)
-    const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
-    b.points.push_back(make_orbit(c, u, r, full, o.parameter, o.floquet));
-    res.max_drift = std::abs(u(N + 2));
-    const double amp0 = amplitude(b.points.front());
-    double h = o.initial_step;
-    b.stop = "max_points";
-    while (static_cast<int>(b.points.size()) < o.max_points) {
-        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
-        Eigen::VectorXd v = u + h * t;
-        const Eigen::VectorXd a = c.w.cwiseProduct(t);
-        Correction rc = correct(c, v, ref, a, a.dot(u + h * t), o);
-        b.newton_iterations += rc.iterations;
-        const bool jump = rc.ok && c.norm(v - u) > 3.0 * h;
-        if (!rc.ok || jump) {
-            h *= 0.5;
-            if (h < o.min_step) {
-                b.stop = "step_below_minimum";
-                b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
-                std::ostringstream s;
-                s << "the corrector failed at " << b.parameter << " = " << v(N + 1) << " with the step below " << o.min_step;
-                b.message = s.str();
-                break;
-            }
-            continue;
-        }
-        Eigen::VectorXd tn = rc.tangent / c.norm(rc.tangent);
-        if (tn.dot(c.w.cwiseProduct(t)) < 0.0) tn = -tn;
-        const double p = v(N + 1);
-        if (p < lo || p > hi) {  // the orbit on the face of the range
-            const double bound = p < lo ? lo : hi;
-            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
-            e(N + 1) = 1.0;
-            Eigen::VectorXd wv = v;
-            const Correction rb = correct(c, wv, ref, e, bound, o);
-            b.newton_iterations += rb.iterations;
-            if (rb.ok) {
-                b.points.push_back(make_orbit(c, wv, rb, full, o.parameter, o.floquet));
-                res.max_drift = std::max(res.max_drift, std::abs(wv(N + 2)));
-            } else {
-                b.status = Status::MaxIterations;
-                b.message = "the wave on the end of the parameter range did not converge";
-            }
-            b.stop = "bound";
-            break;
-        }
-        // fold: the parameter component of the tangent changes sign; Illinois regula falsi in the
-        // arclength on that component, every trial orbit corrected
-        if (t(N + 1) * tn(N + 1) < 0.0) {
-            OrbitFold f;
-            f.after = static_cast<int>(b.points.size()) - 1;
-            const Eigen::VectorXd ak = c.w.cwiseProduct(t);
-            double slo = 0.0, shi = ak.dot(v - u), glo = t(N + 1), ghi = tn(N + 1);
-            int side = 0;
-            Eigen::VectorXd best = v;
-            Correction bestc = rc;
-            const double sp = std::abs(o.to - o.from);
-            for (int it = 0; it < 40; ++it) {
-                const double s = slo - glo * (shi - slo) / (ghi - glo);
-                Eigen::VectorXd wv = u + s * t;
-                const Correction rf = correct(c, wv, ref, ak, ak.dot(u + s * t), o);
-                b.newton_iterations += rf.iterations;
-                if (!rf.ok) break;
-                const double gv = (rf.tangent / c.norm(rf.tangent))(N + 1) * (rf.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
-                best = wv;
-                bestc = rf;
-                if (std::abs(gv) <= 1e-11 * sp || std::abs(shi - slo) <= 1e-12 * h) {
-                    f.located = true;
-                    break;
-                }
-                if ((gv < 0.0) == (glo < 0.0)) {
-                    slo = s;
-                    glo = gv;
-                    if (side == -1) ghi *= 0.5;
-                    side = -1;
-                } else {
-                    shi = s;
-                    ghi = gv;
-                    if (side == 1) glo *= 0.5;
-                    side = 1;
-                }
-            }
-            f.orbit = make_orbit(c, best, bestc, full, o.parameter, false);
-            f.par = f.orbit.par;
-            f.period = f.orbit.period;
-            if (!f.located && b.status == Status::Converged) {
-                b.status = Status::MaxIterations;
-                b.message = "a fold of travelling waves was detected but not located";
-            }
-            b.folds.push_back(f);
-        }
-        PeriodicOrbit orbit = make_orbit(c, v, rc, full, o.parameter, o.floquet);
-        res.max_drift = std::max(res.max_drift, std::abs(v(N + 2)));
-        const bool collapsed = amplitude(orbit) < 0.5 * amp0;
-        b.points.push_back(std::move(orbit));
-        if (collapsed) {
-            b.stop = "hopf";
-            break;
-        }
-        u = v;
-        t = tn;
-        if (rc.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
-        if (u(N) > o.max_period_factor * T0) {
-            b.stop = "period";
-            break;
-        }
     }
     for (const PeriodicOrbit& pt : b.points) {
         b.max_residual = std::max(b.max_residual, pt.residual);

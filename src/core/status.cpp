@@ -9,6 +9,7 @@ std::string to_string(Status s) {
         case Status::MaxDegreeReached: return "max_degree_reached";
         case Status::NumericalIssue: return "numerical_issue";
         case Status::BudgetExhausted: return "budget_exhausted";
+        case Status::Cancelled: return "cancelled";
     }
     return "unknown";
 }

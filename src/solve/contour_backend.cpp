@@ -32,7 +32,8 @@ struct Cell {
 
 class Locator {
 public:
-    Locator(const CharacteristicFunction& det, const ContourRootOptions& o) : m_det(det), m_o(o) {}
+    Locator(const CharacteristicFunction& det, const ContourRootOptions& o, const BranchProgress& progress)
+        : m_det(det), m_o(o), m_progress(progress) {}
 
     /// Count of a cell (false when a zero lies on its boundary or a budget ran out).
     bool count(Cell& c) {
@@ -42,6 +43,7 @@ public:
                               : count_zeros(m_det, c.x0, c.x1, c.y0, c.y1, m_o.max_arg_step);
         m_evaluations += r.evaluations;
         c.zeros = r.zeros;
+        if (m_progress) m_progress(m_counts, m_o.max_cells, c.x0);  // may throw Cancelled (caught by rightmost_roots)
         return r.ok;
     }
 
@@ -193,6 +195,7 @@ private:
 
     const CharacteristicFunction& m_det;
     const ContourRootOptions& m_o;
+    const BranchProgress& m_progress;
     int m_iterations = 0;
     std::vector<Found> m_found;
     int m_counts = 0;
@@ -222,7 +225,7 @@ RootResult contour_roots(const RootProblem& problem, const RootOptions& options)
     const double beta = bounds.right_bound();
     RootResult result;
     result.right_bound = beta;
-    Locator loc(det, options.contour);
+    Locator loc(det, options.contour, options.progress);
     // the strip [a, beta] x [-R(a), R(a)]; a is moved by a hair when a root lies on its edge
     auto count_from = [&](double a, Cell& cell) {
         for (int attempt = 0; attempt < 6; ++attempt) {

@@ -252,6 +252,8 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         const bool spectral = full && worst_collocation <= o.spectral_tolerance && covers;
         const bool agreed = change <= o.agreement_tolerance && collocated && covers;
         const bool settled = spectral || agreed;
+        // the degree M done (of at most max_degree); may throw Cancelled (caught by rightmost_roots)
+        if (options.progress) options.progress(m, max_degree, sigma);
         if (settled || m >= max_degree) {
             result.roots = current;
             result.degree = m;

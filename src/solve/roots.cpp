@@ -170,7 +170,26 @@ std::string choose_root_method(const RootProblem& problem, const RootOptions& op
 
 RootResult rightmost_roots(const RootProblem& problem, const RootOptions& options) {
     const std::string method = choose_root_method(problem, options);
-    RootResult r = find_backend(method)->solve(problem, options);
+    RootResult r;
+    long units = 0;
+    try {
+        // the backends run their loops on this thread (no parallel region): the callback's
+        // exception reaches here
+        if (!options.progress) {
+            r = find_backend(method)->solve(problem, options);
+        } else {
+            RootOptions counted = options;
+            counted.progress = [&units, &options](long done, long total, double par) {
+                units = done;
+                options.progress(done, total, par);
+            };
+            r = find_backend(method)->solve(problem, counted);
+        }
+    } catch (const Cancelled&) {
+        r = RootResult{};
+        r.status = Status::Cancelled;
+        r.message = "cancelled by the progress callback after " + std::to_string(units) + " units of work (" + method + ")";
+    }
     r.method_given = options.method;
     r.method_used = method;
     r.max_residual = 0.0;

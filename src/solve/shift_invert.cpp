@@ -493,9 +493,17 @@ public:
     Covering(StructuredShiftInvert& op, const Gershgorin& gersh, const ShiftInvertRootOptions& o, ResolventExclusion* resolvent)
         : m_op(op), m_gersh(gersh), m_o(o), m_res(resolvent) {}
 
+    /// Reports every shift to `progress` (may be empty), counting `before` shifts of earlier degrees.
+    void report_to(const BranchProgress& progress, long before) {
+        m_progress = &progress;
+        m_before = before;
+    }
+
     /// Runs one shift (nudged off a singular point); false after max_shifts.
     bool shift_at(cplx sigma) {
         if (m_shifts >= m_o.max_shifts) return false;
+        // the shifts finished so far; may throw Cancelled (caught by rightmost_roots)
+        if (m_progress && *m_progress) (*m_progress)(m_before + m_shifts, m_o.max_shifts, sigma.real());
         ++m_shifts;
         const double nudge = 1e-7 * scale_of(sigma);
         for (int attempt = 0; attempt < 4 && !m_op.factor(sigma); ++attempt) sigma += cplx(nudge, sigma.imag() != 0.0 ? nudge : 0.0);
@@ -667,6 +675,8 @@ private:
     ResolventExclusion* m_res;
     double m_extent = 0.0;
     int m_shifts = 0;
+    const BranchProgress* m_progress = nullptr;
+    long m_before = 0;
     int m_steps = 0;
     int m_failed = 0;
     int m_excluded = 0;
@@ -817,6 +827,7 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
         if (op.rows() < 8)
             throw std::invalid_argument("the sparse path needs (M+1) n >= 8; use the dense path for n = " + std::to_string(n));
         Covering cover(op, gersh, so, compact ? &resolvent : nullptr);
+        cover.report_to(options.progress, result.shifts);
         bool budget = true;
         std::vector<cplx> right;
         for (;;) {

@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "ddemap/analysis/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars, resolve_ring_method
 #include "ddemap/analysis/string_stability.hpp"
 #include "core/internal/text.hpp"
 
@@ -61,6 +62,11 @@ ParameterMap AtlasSpec::parameters_at(long index) const {
     return p;
 }
 
+std::string AtlasSpec::ring_method_used() const {
+    if (axes.empty()) throw std::invalid_argument("an atlas has no axes: expected 2 to 5 swept parameters");
+    return resolve_ring_method(ring_method, make_model(model, parameters_at(0))->linearise());
+}
+
 void AtlasSpec::validate() const {
     if (axes.size() < 2 || axes.size() > 5) {
         throw std::invalid_argument("an atlas has " + std::to_string(axes.size()) + " axes: expected 2 to 5 swept parameters");
@@ -84,6 +90,9 @@ void AtlasSpec::validate() const {
         if (n != 0 && n < 2) throw std::invalid_argument("ring of " + std::to_string(n) + " cars: expected N >= 2 or inf");
         if (!ring_set.insert(n).second) throw std::invalid_argument("rings: a ring size is repeated");
     }
+    for (int n : rings)
+        if (n > kWindingMaxCars)
+            throw std::invalid_argument("ring of " + std::to_string(n) + " cars: expected at most " + std::to_string(kWindingMaxCars) + " cars");
     if (chunk < 0) throw std::invalid_argument("chunk = " + std::to_string(chunk) + ": expected a positive number of points");
     // every corner of the grid builds a model inside the computable range (as a sweep's window)
     const std::size_t corners = std::size_t(1) << axes.size();
@@ -98,6 +107,13 @@ void AtlasSpec::validate() const {
         }
         require_computable(make_model(model, p)->linearise(), "the corner " + where + " of the atlas");
     }
+    // a known method that applies to the model; the per-mode path solves N/2 + 1 modes per point
+    if (ring_method_used() == "modes")
+        for (int n : rings)
+            if (n > kModesMaxCars)
+                throw std::invalid_argument("ring of " + std::to_string(n) + " cars: expected at most " + std::to_string(kModesMaxCars) +
+                                            " cars on the per-mode ring path (ring_method = \"modes\"); the winding tables take up to " +
+                                            std::to_string(kWindingMaxCars));
 }
 
 const std::vector<AtlasField>& atlas_fields() {
@@ -116,7 +132,7 @@ const std::vector<AtlasField>& atlas_fields() {
         {"plant_stable", 'b', "plant verdict: every root of the single car's loop in Re < 0"},
         {"ring_stable", 'b', "ring verdict (certified, nothing on or right of the axis)"},
         {"string_stable", 'b', "string verdict: |Gamma(iw)| <= 1 for all w > 0"},
-        {"certified", 'b', "every ring mode's rightmost root certified by the argument principle"},
+        {"certified", 'b', "the ring's certificate: every mode's rightmost root certified by the argument principle (ring method modes), or the abscissa and the counts by winding tables (ring method winding)"},
         {"region", 'i', "chart class: 0 plant unstable, 1 ring unstable, 2 string unstable, 3 string stable"},
     };
     return fields;
@@ -159,13 +175,20 @@ std::vector<double> evaluate_atlas_chunk(const AtlasSpec& spec, long c) {
     const std::size_t nf = atlas_fields().size();
     const long begin = spec.chunk_begin(c), end = spec.chunk_end(c);
     std::vector<double> out(static_cast<std::size_t>(end - begin) * nf);
-    std::optional<detail::RingTracker> ring;
+    const bool winding = spec.ring_method_used() == "winding";
+    std::optional<detail::RingTracker> ring;       // the per-mode path
+    std::optional<detail::RingTracker> reference;  // the winding path's fallback where undecided
     std::optional<detail::PlantTracker> plant;
+    RingWindingGuess guess;
     int cars = -1;
+    long tables = 0;
+    int winding_fallbacks = 0;
     for (long i = begin; i < end; ++i) {
         const int n = spec.ring_at(i);
         if (n != cars) {  // a fresh start: the first point of the chunk or a new ring size
-            ring.emplace(n);
+            if (!winding) ring.emplace(n);
+            reference.reset();
+            guess = RingWindingGuess{};
             plant.emplace();
             cars = n;
         }
@@ -174,7 +197,12 @@ std::vector<double> evaluate_atlas_chunk(const AtlasSpec& spec, long c) {
         if (!is_computable(lin)) require_computable(lin, "point " + std::to_string(i) + " of the atlas");
         SweepPoint p;
         int fallbacks = 0;
-        detail::evaluate_sweep_point(lin, *ring, *plant, p, fallbacks);
+        if (winding) {
+            const detail::RingSummary rs = detail::winding_ring_summary(lin, n, guess, reference, tables, winding_fallbacks);
+            detail::fill_sweep_point(lin, rs, *plant, p, fallbacks);
+        } else {
+            detail::evaluate_sweep_point(lin, *ring, *plant, p, fallbacks);
+        }
         pack(p, out.data() + static_cast<std::size_t>(i - begin) * nf);
     }
     return out;

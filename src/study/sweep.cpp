@@ -260,6 +260,33 @@ RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
 }
 
 
+RingSummary winding_ring_summary(const Linearisation& lin, int cars, RingWindingGuess& guess, std::optional<RingTracker>& reference,
+                                 long& tables, int& winding_fallbacks) {
+    RingSummary rs;
+    const RingWindingResult w = analyse_ring_winding(lin, cars, {}, guess);
+    tables += w.tables;
+    if (w.status == Status::Converged && w.certified) {
+        guess = w.next;
+        rs.spectral_abscissa = w.spectral_abscissa;
+        rs.abscissa_mode = w.abscissa_mode;
+        rs.abscissa_theta = w.abscissa_theta;
+        rs.unstable_roots = static_cast<int>(w.unstable_roots);
+        rs.stable = w.verdict == Verdict::Stable;
+        rs.certified = true;
+    } else if (cars <= kWindingFallbackCars) {
+        guess = RingWindingGuess{};
+        if (!reference) reference.emplace(cars);
+        rs = reference->evaluate(lin);
+        ++winding_fallbacks;
+    } else {
+        guess = RingWindingGuess{};
+        rs.certified = false;
+        rs.stable = false;
+        rs.spectral_abscissa = w.spectral_abscissa;
+    }
+    return rs;
+}
+
 RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks) {
     const RingSummary rs = ring.evaluate(lin);
     fill_sweep_point(lin, rs, plant, p, fallbacks);
@@ -415,32 +442,9 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
             p.y = spec.y.value(iy);
             const Linearisation lin = model_at(spec, p.x, p.y)->linearise();
             if (!is_computable(lin)) require_computable(lin, point_name(spec, p.x, p.y));
-            detail::RingSummary rs;
-            if (winding) {
-                const RingWindingResult w = analyse_ring_winding(lin, spec.cars, {}, guess);
-                row_tables[iy] += w.tables;
-                if (w.status == Status::Converged && w.certified) {
-                    guess = w.next;
-                    rs.spectral_abscissa = w.spectral_abscissa;
-                    rs.abscissa_mode = w.abscissa_mode;
-                    rs.abscissa_theta = w.abscissa_theta;
-                    rs.unstable_roots = w.unstable_roots;
-                    rs.stable = w.verdict == Verdict::Stable;
-                    rs.certified = true;
-                } else if (spec.cars <= kWindingFallbackCars) {
-                    guess = RingWindingGuess{};
-                    if (!reference) reference.emplace(spec.cars);
-                    rs = reference->evaluate(lin);
-                    ++row_winding_fallbacks[iy];
-                } else {
-                    guess = RingWindingGuess{};
-                    rs.certified = false;
-                    rs.stable = false;
-                    rs.spectral_abscissa = w.spectral_abscissa;
-                }
-            } else {
-                rs = ring.evaluate(lin);
-            }
+            const detail::RingSummary rs = winding ? detail::winding_ring_summary(lin, spec.cars, guess, reference, row_tables[iy],
+                                                                                  row_winding_fallbacks[iy])
+                                                   : ring.evaluate(lin);
             int fb = 0;
             detail::fill_sweep_point(lin, rs, plant, p, fb, &string);
             for (int m = 0; m < result.modes && !winding; ++m) {

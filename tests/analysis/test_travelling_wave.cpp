@@ -233,3 +233,28 @@ TEST_CASE("travelling waves: bad input") {
         CHECK(std::string(e.what()).find("wave = 7") != std::string::npos);
     }
 }
+
+TEST_CASE("travelling waves: the long wave of a 1000-car ring (K = 1) by the homotopy in K / N, converged under mesh refinement" * doctest::test_suite("slow")) {
+    double period[2] = {0.0, 0.0};
+    const int intervals[2] = {100, 200};
+    for (int k = 0; k < 2; ++k) {
+        TravellingWaveOptions o = wave_options(1000, 1, intervals[k], 6, false);
+        const TravellingWaveBranch w = travelling_wave_branch({}, o);
+        INFO(w.branch.message);
+        REQUIRE(w.branch.status == Status::Converged);
+        REQUIRE(w.branch.points.size() >= 2);
+        CHECK(std::isfinite(w.homotopy_par));
+        CHECK(w.homotopy_steps > 0);
+        CHECK(w.branch.max_residual <= 1e-8);
+        CHECK(w.max_drift <= tol::wave_drift);
+        // the wave at the homotopy's parameter: the point where both sides join
+        double best = 1e300;
+        for (const PeriodicOrbit& p : w.branch.points)
+            if (std::abs(p.par - w.homotopy_par) < best) {
+                best = std::abs(p.par - w.homotopy_par);
+                period[k] = p.period;
+            }
+        CHECK(best <= 1e-12);
+    }
+    CHECK(std::abs(period[0] - period[1]) <= tol::long_wave_period * period[1]);
+}

@@ -7,7 +7,9 @@
   atlas_check.py sweep A.h5 DDEMAP SWEEP_DIR
       every point of A against `ddemap sweep` on the same (k1, k2) window for each ring size and
       combination of the outer axes (an independent path through the command line: the sweep
-      continues its roots along other rows): verdicts, certificates, root counts and modes
+      continues its roots along other rows), with the ring method A used (its "ring_method"
+      attribute: "winding" is the sweep without boundaries, "modes" the sweep with boundaries,
+      whose seeds need every mode's root): verdicts, certificates, root counts and modes
       exactly; the real quantities to 1e-8 relative (the same roots reached by Newton from other
       starting points agree to rounding; a quantity found by a maximisation over a grid to its
       stopping tolerance).
@@ -52,6 +54,7 @@ def sweep(path, ddemap, sweep_dir):
         dims = text(f.attrs["dimensions"]).split(",")
         model = text(f.attrs["model"])
         spec = tomllib.loads(text(f.attrs["spec"]))
+        method = text(f.attrs["ring_method"])
         coords = {d: f["coordinates"][d][()] for d in dims}
         data = {k: f[k][()] for k in walk(f) if not k.startswith("coordinates")}
     fixed = spec.get("fixed", {})
@@ -63,8 +66,11 @@ def sweep(path, ddemap, sweep_dir):
     worst = 0.0
     for index in np.ndindex(*[len(coords[d]) for d in outer]):
         ring = int(coords["ring"][index[0]])
-        args = [ddemap, "sweep", "--model", model, "--ring", "inf" if ring == 0 else str(ring), "--no-boundaries",
+        assert method in ("winding", "modes"), f"ring_method attribute {method!r}"
+        args = [ddemap, "sweep", "--model", model, "--ring", "inf" if ring == 0 else str(ring),
                 "--format", "csv", "--quiet", "--out", sweep_dir + "/"]
+        if method == "winding":
+            args.append("--no-boundaries")
         for k, v in fixed.items():
             args += [f"--{k}", repr(float(v))]
         for d, i in zip(outer[1:], index[1:]):
@@ -92,7 +98,7 @@ def sweep(path, ddemap, sweep_dir):
                 assert err <= RTOL, f"{q} differs at {at}: {a!r} vs {b!r}"
             compared += 1
     assert compared == data["region"].size, "not every point was compared"
-    print(f"sweep: {compared} points agree with ddemap sweep (largest relative difference {worst:.2e})")
+    print(f"sweep: {compared} points agree with ddemap sweep, ring method {method} (largest relative difference {worst:.2e})")
 
 
 if __name__ == "__main__":

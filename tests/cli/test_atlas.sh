@@ -36,7 +36,19 @@ fi
 
 # every point against `ddemap sweep` on the same point
 mkdir -p "$tmp/sweeps"
-"$py" "$check" sweep "$tmp/serial/atlas.h5" "$bin" "$tmp/sweeps" && ok || bad "atlas points differ from ddemap sweep"
+"$py" "$check" sweep "$tmp/serial/atlas.h5" "$bin" "$tmp/sweeps" >"$tmp/check.out" && grep -q "ring method winding" "$tmp/check.out" && ok ||
+    bad "atlas points differ from ddemap sweep (or not on the winding path): $(cat "$tmp/check.out")"
+
+# the per-mode ring path (ring_method = "modes") on one (k1, k2) plane per ring size: every point
+# against the sweep with boundaries (which uses that path)
+sed -e 's/^values = \[0.1, 0.4\]/values = [0.4]/' -e 's/^values = \[1.0, 2.0\]/values = [1.0]/' -e 's/^chunk = 16 /ring_method = "modes"\nchunk = 16 /' \
+    "$spec" >"$tmp/modes.toml"
+grep -q '^ring_method = "modes"' "$tmp/modes.toml" && ok || bad "atlas: the modes spec was not made"
+if OMP_NUM_THREADS=2 "$bin" atlas "$tmp/modes.toml" --out "$tmp/modes" --quiet >/dev/null 2>"$tmp/modes.err"; then
+    "$py" "$check" sweep "$tmp/modes/atlas.h5" "$bin" "$tmp/sweeps" && ok || bad "atlas (ring method modes) points differ from ddemap sweep"
+else
+    bad "atlas with ring_method = modes: exit status: $(cat "$tmp/modes.err")"
+fi
 
 # two threads
 OMP_NUM_THREADS=2 "$bin" atlas "$spec" --out "$tmp/threads" --quiet >/dev/null 2>&1 && ok || bad "atlas on two threads: exit status"
@@ -63,9 +75,13 @@ else
 fi
 
 # killed (kill -9) after the first finished chunk, then --resume: nothing finished is recomputed
-# and the result is the same
+# and the result is the same. On the per-mode ring path (the example with ring_method = "modes"),
+# whose run lasts seconds: on the winding path the example can finish before the kill arrives.
+slow="$tmp/slow.toml"
+sed -e 's/^chunk = 16 /ring_method = "modes"\nchunk = 16 /' "$spec" >"$slow"
+OMP_NUM_THREADS=2 "$bin" atlas "$slow" --out "$tmp/slowref" --quiet >/dev/null 2>&1 && ok || bad "atlas (ring method modes): exit status"
 mkdir -p "$tmp/killed"
-OMP_NUM_THREADS=1 "$bin" atlas "$spec" --out "$tmp/killed" --quiet >/dev/null 2>&1 &
+OMP_NUM_THREADS=1 "$bin" atlas "$slow" --out "$tmp/killed" --quiet >/dev/null 2>&1 &
 pid=$!
 header=48                # the store's header
 record=$((24 + 16 * 16 * 8 + 8))  # one chunk of 16 points x 16 values, with its head and checksum
@@ -80,13 +96,13 @@ wait $pid 2>/dev/null
 if [ -f "$tmp/killed/atlas.chunks" ] && [ ! -e "$tmp/killed/atlas.h5" ]; then
     finished=$(( ($(stat -c %s "$tmp/killed/atlas.chunks") - header) / record ))
     [ "$finished" -ge 1 ] && ok || bad "atlas: no chunk finished before the kill"
-    "$bin" atlas "$spec" --out "$tmp/killed" --resume >"$tmp/resume.out" 2>"$tmp/resume.err" && ok || bad "atlas --resume: exit status: $(cat "$tmp/resume.err")"
+    "$bin" atlas "$slow" --out "$tmp/killed" --resume >"$tmp/resume.out" 2>"$tmp/resume.err" && ok || bad "atlas --resume: exit status: $(cat "$tmp/resume.err")"
     grep -q "resumed $finished of 128 chunks" "$tmp/resume.err" && ok || bad "atlas --resume did not take the $finished finished chunks: $(cat "$tmp/resume.err")"
     grep -q "($((128 - finished)) computed, $finished resumed)" "$tmp/resume.out" && ok || bad "atlas --resume recomputed finished chunks: $(cat "$tmp/resume.out")"
-    "$py" "$check" same "$tmp/serial/atlas.h5" "$tmp/killed/atlas.h5" && ok || bad "atlas: killed and resumed differs from serial"
+    "$py" "$check" same "$tmp/slowref/atlas.h5" "$tmp/killed/atlas.h5" && ok || bad "atlas: killed and resumed differs from an uninterrupted run"
     # --resume once more: the finished atlas is recognised, nothing is computed or rewritten
     cp "$tmp/killed/atlas.h5" "$tmp/finished.h5"
-    "$bin" atlas "$spec" --out "$tmp/killed" --resume 2>&1 | grep -q "is complete for this spec: nothing to compute" && ok ||
+    "$bin" atlas "$slow" --out "$tmp/killed" --resume 2>&1 | grep -q "is complete for this spec: nothing to compute" && ok ||
         bad "atlas --resume of a finished atlas recomputed it"
     cmp -s "$tmp/finished.h5" "$tmp/killed/atlas.h5" && ok || bad "atlas --resume of a finished atlas changed it"
 else
@@ -95,7 +111,7 @@ fi
 # interrupted (SIGINT, as Ctrl-C): the store stays, no result and no temporary file; a store of
 # another spec is not resumed
 mkdir -p "$tmp/other"
-sed 's/^chunk = 16 /chunk = 8 /' "$spec" >"$tmp/other.toml"
+sed 's/^chunk = 16 /chunk = 8 /' "$slow" >"$tmp/other.toml"
 set -m  # job control: the background job does not ignore SIGINT (as a non-interactive shell's would)
 OMP_NUM_THREADS=1 "$bin" atlas "$tmp/other.toml" --out "$tmp/other" --quiet >/dev/null 2>&1 &
 pid=$!
@@ -155,6 +171,7 @@ th = 1.5
 name = \"k1\"
 values = [0.1]"
 expect_error "estimated run time" "rings = [1000]
+ring_method = \"modes\"
 [fixed]
 tau = 0.1
 th = 1.5
@@ -162,12 +179,23 @@ th = 1.5
 name = \"k1\"
 lo = 0.1
 hi = 1.0
-count = 1000
+count = 400
 [[axis]]
 name = \"k2\"
 lo = 0.1
 hi = 1.0
-count = 1000"
+count = 400"
+expect_error "expected at most 1000000 cars on the per-mode ring path" "rings = [2000000]
+ring_method = \"modes\"
+[fixed]
+tau = 0.1
+th = 1.5
+$axes"
+expect_error "ring_method: expected \"auto\", \"winding\" or \"modes\"" "ring_method = \"fast\"
+[fixed]
+tau = 0.1
+th = 1.5
+$axes"
 # --out on a file is refused
 touch "$tmp/afile"
 "$bin" atlas "$spec" --out "$tmp/afile" >/dev/null 2>"$tmp/f.err"

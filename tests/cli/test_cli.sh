@@ -1078,7 +1078,7 @@ DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" hopf --system "$tmp/wright.json" --par alp
 [ ! -s "$pgd/hc.err" ] && ok || bad "hopf --quiet still printed: $(head -3 "$pgd/hc.err")"
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 12 --format json >"$pgd/or.json" 2>"$pgd/or.err"
 n=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['result']['points']))" "$pgd/or.json" 2>/dev/null || echo none)
-[ "$(pgcount "$pgd/or.err" '^ddemap: orbits: [0-9]+ orbits \(at most 12\), headway = [-0-9.e]+ \(')" = "$n" ] && ok ||
+[ "$(pgcount "$pgd/or.err" '^ddemap: orbits: [0-9]+ orbits? \(at most 12\), headway = [-0-9.e]+ \(')" = "$n" ] && ok ||
     bad "orbits: not one progress line per orbit ($n): $(grep -v equilibria "$pgd/or.err" | head -3)"
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 12 --quiet >/dev/null 2>"$pgd/or.err"
 [ ! -s "$pgd/or.err" ] && ok || bad "orbits --quiet still printed: $(head -3 "$pgd/or.err")"
@@ -1198,6 +1198,45 @@ PY
     python3 -c "import json; d = json.load(open('$bsd/c.out')); assert d['solver']['used'] == 'dense', d['solver']" && ok ||
     bad "roots --system with complex triplets: not the dense path"
 rm -rf "$bsd"
+
+# ---- progress of roots --fleet/--system (at most one line per contour count, shift or degree when
+# stderr is a file, one per percent of the budget; none with --quiet), SIGINT during a long
+# roots --fleet --out leaves no output file and ends the process by the signal, and a branch's
+# first orbit is "1 orbit"
+rpd="$tmp/root-progress"; mkdir -p "$rpd"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --fleet-pattern "A_min,C_max" --ring 200 >"$rpd/f.out" 2>"$rpd/f.err"
+n=$(sed -n 's/^solver     product, \([0-9]*\) contour counts.*/\1/p' "$rpd/f.out")
+[ -n "$n" ] && grep -q -E '^ddemap: roots: [0-9]+ steps? \(at most 200000\), Re = [-0-9.e]+ \(' "$rpd/f.err" &&
+    [ "$(grep -c '^ddemap: roots:' "$rpd/f.err")" -le "$n" ] && ! grep -q "ddemap:" "$rpd/f.out" && ok ||
+    bad "roots --fleet: no progress line, or more than one per contour count ($n): $(head -3 "$rpd/f.err")"
+grep -q '^ddemap: roots: 1 step (at most' "$rpd/f.err" && ! grep -q ': 1 steps ' "$rpd/f.err" && ok || bad "roots --fleet progress: '1 steps'"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --fleet-pattern "A_min,C_max" --ring 200 --quiet >/dev/null 2>"$rpd/q.err"
+[ ! -s "$rpd/q.err" ] && ok || bad "roots --fleet --quiet still printed: $(head -3 "$rpd/q.err")"
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --system "$(dirname "$0")/../../examples/system.json" --format json >/dev/null 2>"$rpd/s.err" &&
+    grep -q -E '^ddemap: roots: [0-9]+ steps? \(at most [0-9]+\), Re = ' "$rpd/s.err" && ok ||
+    bad "roots --system: no progress line: $(head -3 "$rpd/s.err")"
+python3 - "$bin" "$rpd" <<'PY' && ok || bad "roots --fleet interrupted by SIGINT"
+import os, signal, subprocess, sys, time
+bin, d = sys.argv[1], sys.argv[2]
+env = dict(os.environ, DDEMAP_TEST_PROGRESS_AT_ONCE="1")
+p = subprocess.Popen([bin, "roots", "--fleet-pattern", "A_min,C_max", "--ring", "1000000", "--out", d + "/big"],
+                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+line = p.stderr.readline()  # the first contour count: the work is under way (about 20 s in all)
+if ": 1 step (at most" not in line:
+    sys.exit("no progress line for the first contour count: " + line)
+time.sleep(1)
+p.send_signal(signal.SIGINT)
+p.stderr.close()
+rc = p.wait(timeout=60)
+assert rc == -signal.SIGINT, rc
+left = sorted(f for f in os.listdir(d) if f.startswith("big") or f.startswith("."))
+assert left == [], left
+PY
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" orbits --model ov --ring 3 --par headway --from 2 --to 3.5 --points 2 >"$rpd/o1.out" 2>"$rpd/o1.err"
+grep -q '^ddemap: orbits: 1 orbit (at most 2)' "$rpd/o1.err" && grep -q '^branch     2 orbits, degree' "$rpd/o1.out" &&
+    ! grep -q -E '(^|: )1 (orbits|points|waves|steps)' "$rpd/o1.out" "$rpd/o1.err" && ok ||
+    bad "orbits --points 2: not '1 orbit' in the progress: $(grep -h -E '^branch|1 orbit' "$rpd/o1.out" "$rpd/o1.err" | head -3)"
+rm -rf "$rpd"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

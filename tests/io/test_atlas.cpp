@@ -173,34 +173,85 @@ TEST_CASE("atlas chunks: every point in exactly one chunk, and a chunk's values 
     CHECK(a.size() == 7 * atlas_fields().size());
 }
 
-TEST_CASE("atlas chunks: the points agree with a sweep over the same window (a second continuation path)") {
-    // one (k1, k2) plane: tau = 0.1, th = 1, N = 22; chunks of 2 points (many fresh starts)
-    AtlasSpec one = parse_atlas_spec(edited("values = [0.1, 0.4]", "values = [0.1]"), "a.toml").spec;
-    one.axes[1].values = {1.0};
-    one.rings = {22};
-    one.chunk = 2;
+TEST_CASE("atlas chunks: the points agree with a sweep over the same window (a second continuation path), on both ring methods") {
+    // one (k1, k2) plane: tau = 0.1, th = 1, N = 22 and N = inf; chunks of 2 points (many fresh starts)
+    for (const char* method : {"winding", "modes"}) {
+        for (int cars : {22, 0}) {
+            CAPTURE(method);
+            CAPTURE(cars);
+            AtlasSpec one = parse_atlas_spec(edited("values = [0.1, 0.4]", "values = [0.1]"), "a.toml").spec;
+            one.axes[1].values = {1.0};
+            one.rings = {cars};
+            one.chunk = 2;
+            one.ring_method = method;
+            CHECK(one.ring_method_used() == method);
+            SweepSpec sw;
+            sw.model = "ovrv";
+            sw.fixed = {{"eta", 10.0}, {"tau", 0.1}, {"th", 1.0}};
+            sw.x = one.axes[2].sweep_axis();
+            sw.y = one.axes[3].sweep_axis();
+            sw.cars = cars;
+            sw.ring_method = method;
+            const SweepResult r = run_sweep(sw);
+            REQUIRE(r.ring_method == method);
+            const std::size_t nf = atlas_fields().size();
+            for (long c = 0; c < one.chunks(); ++c) {
+                const std::vector<double> v = evaluate_atlas_chunk(one, c);
+                for (long i = one.chunk_begin(c); i < one.chunk_end(c); ++i) {
+                    const SweepPoint p = atlas_point(&v[static_cast<std::size_t>(i - one.chunk_begin(c)) * nf]);
+                    const int ix = static_cast<int>(i / sw.y.count), iy = static_cast<int>(i % sw.y.count);
+                    const SweepPoint& q = r.at(ix, iy);
+                    CAPTURE(i);
+                    CHECK(p.ring_stable == q.ring_stable);
+                    CHECK(p.string_stable == q.string_stable);
+                    CHECK(p.plant_stable == q.plant_stable);
+                    CHECK(p.certified == q.certified);
+                    CHECK(p.unstable_roots == q.unstable_roots);
+                    CHECK(p.abscissa_mode == q.abscissa_mode);
+                    CHECK(std::abs(p.spectral_abscissa - q.spectral_abscissa) <= test::tol::same_root);
+                    CHECK(std::abs(p.sup_gamma - q.sup_gamma) <= test::tol::reference_sup_rel * q.sup_gamma);
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("atlas spec: the ring method, and rings up to the winding path's limit") {
+    CHECK(parse_atlas_spec(good_spec, "a.toml").spec.ring_method == "auto");
+    CHECK(parse_atlas_spec(good_spec, "a.toml").spec.ring_method_used() == "winding");  // OVRV reacts to the car ahead only
+    CHECK(parse_atlas_spec(edited("chunk = 5", "chunk = 5\nring_method = \"modes\""), "a.toml").spec.ring_method_used() == "modes");
+    CHECK(error_of(edited("chunk = 5", "chunk = 5\nring_method = \"fast\"")).find("a.toml:5: ring_method: expected \"auto\", \"winding\" or \"modes\"") !=
+          std::string::npos);
+    const AtlasFile big = parse_atlas_spec(edited("rings = [22, \"inf\"]", "rings = [1000000000, \"inf\"]"), "a.toml");
+    CHECK(big.spec.rings == std::vector<int>{1000000000, 0});
+    CHECK(error_of(edited("rings = [22, \"inf\"]", "rings = [1000000001]")).find("rings: expected integers N from 2 to 1e9") != std::string::npos);
+    // the per-mode path solves N/2 + 1 modes per point: at most kModesMaxCars
+    CHECK(error_of(edited("chunk = 5", "chunk = 5\nring_method = \"modes\"")).empty());
+    const std::string modes_big = edited("rings = [22, \"inf\"]", "rings = [2000000]\nring_method = \"modes\"");
+    CHECK(error_of(modes_big).find("expected at most 1000000 cars on the per-mode ring path") != std::string::npos);
+    // a ring of 10^9 cars on the winding path: a chunk costs what N = 22 costs, and a point agrees with its sweep
+    AtlasSpec s = big.spec;
+    s.rings = {1000000000};
+    s.axes[0].values = {0.4};
+    s.axes[1].values = {1.0};
+    s.chunk = 3;
+    const std::vector<double> v = evaluate_atlas_chunk(s, 1);
     SweepSpec sw;
     sw.model = "ovrv";
-    sw.fixed = {{"eta", 10.0}, {"tau", 0.1}, {"th", 1.0}};
-    sw.x = one.axes[2].sweep_axis();
-    sw.y = one.axes[3].sweep_axis();
-    sw.cars = 22;
+    sw.fixed = {{"eta", 10.0}, {"tau", 0.4}, {"th", 1.0}};
+    sw.x = s.axes[2].sweep_axis();
+    sw.y = s.axes[3].sweep_axis();
+    sw.cars = 1000000000;
     const SweepResult r = run_sweep(sw);
     const std::size_t nf = atlas_fields().size();
-    for (long c = 0; c < one.chunks(); ++c) {
-        const std::vector<double> v = evaluate_atlas_chunk(one, c);
-        for (long i = one.chunk_begin(c); i < one.chunk_end(c); ++i) {
-            const SweepPoint p = atlas_point(&v[static_cast<std::size_t>(i - one.chunk_begin(c)) * nf]);
-            const int ix = static_cast<int>(i / sw.y.count), iy = static_cast<int>(i % sw.y.count);
-            const SweepPoint& q = r.at(ix, iy);
-            CAPTURE(i);
-            CHECK(p.ring_stable == q.ring_stable);
-            CHECK(p.string_stable == q.string_stable);
-            CHECK(p.plant_stable == q.plant_stable);
-            CHECK(p.unstable_roots == q.unstable_roots);
-            CHECK(std::abs(p.spectral_abscissa - q.spectral_abscissa) <= test::tol::same_root);
-            CHECK(std::abs(p.sup_gamma - q.sup_gamma) <= test::tol::reference_sup_rel * q.sup_gamma);
-        }
+    for (long i = s.chunk_begin(1); i < s.chunk_end(1); ++i) {
+        CAPTURE(i);
+        const SweepPoint p = atlas_point(&v[static_cast<std::size_t>(i - s.chunk_begin(1)) * nf]);
+        const SweepPoint& q = r.at(static_cast<int>(i / sw.y.count), static_cast<int>(i % sw.y.count));
+        CHECK(p.ring_stable == q.ring_stable);
+        CHECK(p.certified == q.certified);
+        CHECK(p.unstable_roots == q.unstable_roots);
+        CHECK(std::abs(p.spectral_abscissa - q.spectral_abscissa) <= test::tol::same_root);
     }
 }
 
@@ -214,20 +265,24 @@ TEST_CASE("atlas store: finished chunks survive, a torn last record is dropped, 
         for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<double>(c) + 1e-3 * static_cast<double>(i);
         return v;
     };
-    std::vector<double> values;
     std::vector<char> done;
     {
-        AtlasStore st(path, s, 42, false, values, done);
+        AtlasStore st(path, s, 42, false, done);
         st.set_sync_interval(0);  // every chunk fdatasynced
         CHECK(st.loaded() == 0);
         for (long c : {3L, 0L, 28L}) {  // 28: the last, shorter chunk
             const auto v = chunk_values(c);
             st.append(c, v.data(), v.size());
         }
+        CHECK_THROWS_AS(st.append(0, chunk_values(0).data(), chunk_values(0).size()), std::invalid_argument);  // twice
+        std::vector<double> back(chunk_values(28).size());
+        st.read(28, back.data());  // read back while it runs
+        CHECK(back == chunk_values(28));
+        CHECK_THROWS_AS(st.read(1, back.data()), std::invalid_argument);  // not stored
     }
     const auto full = fs::file_size(path);
     {
-        AtlasStore st(path, s, 42, true, values, done);
+        AtlasStore st(path, s, 42, true, done);
         CHECK(st.loaded() == 3);
         CHECK(st.dropped_bytes() == 0);
         CHECK(done[0] == 1);
@@ -235,8 +290,10 @@ TEST_CASE("atlas store: finished chunks survive, a torn last record is dropped, 
         CHECK(done[3] == 1);
         CHECK(done[28] == 1);
         const auto v3 = chunk_values(3);
-        CHECK(std::equal(v3.begin(), v3.end(), values.begin() + static_cast<std::ptrdiff_t>(s.chunk_begin(3) * static_cast<long>(nf))));
-        CHECK(values[static_cast<std::size_t>(s.chunk_begin(1)) * nf] == 0.0);
+        std::vector<double> back(v3.size());
+        st.read(3, back.data());
+        CHECK(back == v3);
+        CHECK_THROWS_AS(st.read(1, back.data()), std::invalid_argument);
     }
     // a run killed while writing its fourth record: half a record at the end
     {
@@ -245,16 +302,19 @@ TEST_CASE("atlas store: finished chunks survive, a torn last record is dropped, 
         out << half;
     }
     {
-        AtlasStore st(path, s, 42, true, values, done);
+        AtlasStore st(path, s, 42, true, done);
         CHECK(st.loaded() == 3);
         CHECK(st.dropped_bytes() == 1000);
         const auto v = chunk_values(7);
         st.append(7, v.data(), v.size());  // appended after the last complete record
     }
     {
-        AtlasStore st(path, s, 42, true, values, done);
+        AtlasStore st(path, s, 42, true, done);
         CHECK(st.loaded() == 4);
         CHECK(done[7] == 1);
+        std::vector<double> back(chunk_values(7).size());
+        st.read(7, back.data());
+        CHECK(back == chunk_values(7));
     }
     // a flipped byte inside the last record: its checksum fails, the records before it stay
     {
@@ -264,27 +324,27 @@ TEST_CASE("atlas store: finished chunks survive, a torn last record is dropped, 
         io.put('\x7f');
     }
     {
-        AtlasStore st(path, s, 42, true, values, done);
+        AtlasStore st(path, s, 42, true, done);
         CHECK(st.loaded() == 2);
         CHECK(done[28] == 0);
     }
     // another spec (fingerprint), or not a store: refused with --resume
-    CHECK_THROWS_AS(AtlasStore(path, s, 43, true, values, done), std::invalid_argument);
+    CHECK_THROWS_AS(AtlasStore(path, s, 43, true, done), std::invalid_argument);
     AtlasSpec other = s;
     other.chunk = 6;
-    CHECK_THROWS_AS(AtlasStore(path, other, 42, true, values, done), std::invalid_argument);
+    CHECK_THROWS_AS(AtlasStore(path, other, 42, true, done), std::invalid_argument);
     {
         std::ofstream out(dir.path + "/junk");
         out << "not a store";
     }
-    CHECK_THROWS_AS(AtlasStore(dir.path + "/junk", s, 42, true, values, done), std::invalid_argument);
+    CHECK_THROWS_AS(AtlasStore(dir.path + "/junk", s, 42, true, done), std::invalid_argument);
     // without resume: a fresh store; with resume and no store: a fresh store too
     {
-        AtlasStore st(path, s, 42, false, values, done);
+        AtlasStore st(path, s, 42, false, done);
         CHECK(st.loaded() == 0);
     }
     {
-        AtlasStore st(dir.path + "/new.chunks", s, 42, true, values, done);
+        AtlasStore st(dir.path + "/new.chunks", s, 42, true, done);
         CHECK(st.loaded() == 0);
     }
     CHECK(atlas_fingerprint("a") != atlas_fingerprint("b"));
@@ -314,4 +374,55 @@ TEST_CASE("atlas HDF5: a written file is recognised as the atlas of its spec, an
     CHECK_FALSE(atlas_hdf5_matches(dir.path, good_spec));  // a folder
     write_file_atomic(path, "not HDF5");
     CHECK_FALSE(atlas_hdf5_matches(path, good_spec));
+}
+
+TEST_CASE("atlas HDF5: written in slabs from a chunk reader, the same bytes as in one piece") {
+    TempDir dir;
+    // chunks of 5 across the rows of the last axis (3 points): slabs and chunks never align
+    const AtlasSpec s = parse_atlas_spec(good_spec, "a.toml").spec;
+    const std::size_t nf = atlas_fields().size();
+    std::vector<double> values(static_cast<std::size_t>(s.points()) * nf);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        const std::size_t q = i % nf;
+        const AtlasField& f = atlas_fields()[q];
+        values[i] = f.type == 'f' ? 0.001 * static_cast<double>(i) : f.type == 'i' ? static_cast<double>(i / nf % 1000) - 3.0 : static_cast<double>(i / nf % 2);
+    }
+    const std::string whole = atlas_hdf5(s, values, good_spec);
+    long reads = 0;
+    const AtlasChunkReader read = [&](long c, double* out) {
+        ++reads;
+        std::copy(values.begin() + s.chunk_begin(c) * static_cast<long>(nf), values.begin() + s.chunk_end(c) * static_cast<long>(nf), out);
+    };
+    // slabs of 1 point (the last axis split), 7 (a run of the last axis), 12 and 40 (runs of
+    // planes), and the whole grid in one slab
+    for (long slab : {1L, 7L, 12L, 40L, 1000L}) {
+        CAPTURE(slab);
+        const std::string path = dir.path + "/a.h5";
+        reads = 0;
+        write_atlas_hdf5(path, s, read, good_spec, slab);
+        std::ifstream in(path, std::ios::binary);
+        const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        CHECK(bytes == whole);
+        CHECK(reads >= s.chunks());
+        CHECK(reads <= 2 * s.chunks() + s.points() / slab + 1);  // a chunk is read again only where a slab cuts it
+        CHECK(atlas_hdf5_matches(path, good_spec));
+    }
+    CHECK_THROWS_AS(write_atlas_hdf5(dir.path + "/a.h5", s, read, good_spec, 0), std::invalid_argument);
+    CHECK_THROWS_AS(write_atlas_hdf5(dir.path + "/missing/a.h5", s, read, good_spec), WriteError);
+}
+
+TEST_CASE("atlas figure: from a chunk reader, and thinned to its point budget") {
+    const AtlasFile f = parse_atlas_spec(good_spec, "a.toml");
+    const std::size_t nf = atlas_fields().size();
+    std::vector<double> values(static_cast<std::size_t>(f.spec.points()) * nf, 1.0);
+    const std::string all = atlas_svg(f, values);
+    CHECK(all.find("one point in") == std::string::npos);
+    CHECK(all.find("panels)") == std::string::npos);
+    const AtlasChunkReader read = [&](long c, double* out) {
+        std::copy(values.begin() + f.spec.chunk_begin(c) * static_cast<long>(nf), values.begin() + f.spec.chunk_end(c) * static_cast<long>(nf), out);
+    };
+    CHECK(atlas_svg(f, read) == all);
+    // 12 panels of 4 x 3 points; a budget of 48 points: every second point (2 x 2 per panel)
+    const std::string thin = atlas_svg(f, read, 48);
+    CHECK(thin.find("(one point in 2 along each axis)") != std::string::npos);
 }

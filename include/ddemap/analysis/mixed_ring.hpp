@@ -38,7 +38,9 @@ struct MixedRingResult {
     double product_residual = std::numeric_limits<double>::quiet_NaN();  ///< max |prod Gamma_i - 1| (predecessor laws)
 };
 
-/// Rightmost roots of the ring; std::invalid_argument naming the car when a car's linearisation
+/// Rightmost roots of the ring; options.roots.progress reports the root work (solve/roots.hpp)
+/// and may throw ddemap::Cancelled to stop it: the result then has roots.status
+/// Status::Cancelled, no roots and verdict Undecided. std::invalid_argument naming the car when a car's linearisation
 /// at the equilibrium is outside the computable range (require_computable), before any root work.
 MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& options);
 

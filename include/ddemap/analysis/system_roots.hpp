@@ -17,6 +17,8 @@ struct SystemRootResult {
     Verdict verdict = Verdict::Undecided;
 };
 
+/// options.progress reports the root work (solve/roots.hpp) and may throw ddemap::Cancelled to
+/// stop it: the result then has roots.status Status::Cancelled, no roots and verdict Undecided.
 /// Throws std::invalid_argument for invalid options or a method that does not fit the system
 /// (contour needs a scalar characteristic function; shift_invert real coefficients and a delay).
 SystemRootResult analyse_system(const LinearDDE& dde, const RootOptions& options = {});

@@ -37,6 +37,16 @@
 /// of roots: one of the two wave numbers has it at +i omega, the other at -i omega (no wave with
 /// omega > 0), so one of k and N - k is the wave born there.
 ///
+/// Long waves (K / N < 0.1; their harmonics are nearly resonant at the Hopf point, so the first
+/// wave from it may not converge): when it does not, the wave of K / N = 0.1 is started from its
+/// own Hopf point, the largest wave of its branch inside the range (5 % from its faces) is taken,
+/// K / N is lowered to the requested value at that parameter (natural continuation in log K / N,
+/// the period scaled so that T K / N is kept in the predictor, the mesh re-equidistributed after
+/// every step, orbit_mesh.hpp), and the branch is continued both ways in the parameter on a mesh
+/// re-equidistributed after every wave (profile weight lowered 1000 times in the arclength norm),
+/// the side ending at the smaller amplitude first (reversed). The Hopf point reported is still
+/// the requested mode's; the branch need not reach it.
+///
 /// Stability. The reduced form does not give the ring's stability: perturbations of the ring
 /// need not keep the wave structure (they split into N Fourier families; the one-car
 /// variational problem of family j has the leader term multiplied by a factor that depends on
@@ -48,6 +58,7 @@
 /// full_ring_stability = false). The trivial multiplier's distance from 1 then also measures how
 /// far the spread profile is from a collocation solution of the full ring (it is not one exactly).
 
+#include <limits>
 #include <string>
 
 #include "ddemap/analysis/equilibrium_branch.hpp"
@@ -65,6 +76,9 @@ struct TravellingWaveOptions {
     PeriodicOrbitOptions orbit;
     /// the full ring's multipliers are computed for N <= this (their cost grows like N^3)
     int full_ring_floquet_limit = 10;
+    /// K / N < 0.1: start by the homotopy in K / N even when the first wave from the Hopf point
+    /// converges (to check one path against the other)
+    bool force_homotopy = false;
     bool is_valid(std::string* why = nullptr) const;
 };
 
@@ -79,6 +93,10 @@ struct TravellingWaveBranch {
     OrbitBranch branch;
     bool full_ring_stability = false;  ///< the multipliers are the full ring's (N <= limit)
     double max_drift = 0.0;            ///< max |mu| over the orbits (0 for an exact wave)
+    /// long waves (K / N < 0.1 whose first wave from the Hopf point fails): the parameter at
+    /// which the homotopy in K / N ran and its number of steps (NaN and 0 otherwise)
+    double homotopy_par = std::numeric_limits<double>::quiet_NaN();
+    int homotopy_steps = 0;
 };
 
 /// The branch of travelling waves of wave number options.wave born at the mode's Hopf point in

@@ -11,6 +11,7 @@
 ///     results combined left to right in block order: bitwise the same for 1 or 64 threads.
 /// A later distributed (MPI) policy plugs in here.
 
+#include <exception>
 #include <functional>
 #include <string>
 #include <vector>
@@ -25,6 +26,15 @@ using Progress = std::function<void(long done, long total)>;
 /// the most the branch may have (its max_points budget). Called on the caller's thread; it may
 /// throw to stop the work, and the exception then reaches the caller (no partial result).
 using BranchProgress = std::function<void(long done, long total, double par)>;
+
+/// Thrown by a progress callback to cancel the work. The computations that document it
+/// (rightmost_roots and the analyses built on it: analyse_system, analyse_mixed_ring) catch it
+/// on the caller's thread (never inside a parallel region) and return their result with
+/// Status::Cancelled, no roots and a verdict of Undecided; any other exception a callback throws
+/// reaches the caller as it is.
+struct Cancelled : std::exception {
+    const char* what() const noexcept override { return "cancelled by the progress callback"; }
+};
 
 struct ExecutionPolicy {
     int threads = 0;    ///< 0: the default (OMP_NUM_THREADS, else every core); 1: serial

@@ -13,10 +13,12 @@ enum class Status {
     MaxIterations,     ///< an iteration cap was reached before the convergence test passed
     MaxDegreeReached,  ///< a discretisation cap (degree, mesh) was reached before the result settled
     NumericalIssue,    ///< a singular or non-finite intermediate (a failed factorisation, an overflow)
-    BudgetExhausted    ///< a work budget (cells, shifts, evaluations) ran out
+    BudgetExhausted,   ///< a work budget (cells, shifts, evaluations) ran out
+    Cancelled          ///< the caller's progress callback stopped the work (threw ddemap::Cancelled)
 };
 
-/// "converged", "max_iterations", "max_degree_reached", "numerical_issue", "budget_exhausted"
+/// "converged", "max_iterations", "max_degree_reached", "numerical_issue", "budget_exhausted",
+/// "cancelled"
 std::string to_string(Status s);
 
 /// True for Status::Converged.

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/core/execution.hpp"
 #include "ddemap/core/newton.hpp"
 #include "ddemap/core/status.hpp"
 #include "ddemap/problem/characteristic_function.hpp"
@@ -82,6 +83,13 @@ struct RootOptions {
     DenseRootOptions dense;
     ShiftInvertRootOptions shift_invert;
     ContourRootOptions contour;
+    /// Called on the caller's thread after every unit of work: (units done, the budget of units,
+    /// the current strip floor or shift's real part). dense: after each collocation degree,
+    /// (M, max_degree, sigma) (one degree's eigenvalues are not interrupted); shift_invert:
+    /// before each Arnoldi shift, (shifts done, max_shifts, Re sigma); contour: after each
+    /// rectangle count, (counts done, max_cells, its left edge). May be empty. Throwing ddemap::Cancelled
+    /// (core/execution.hpp) stops the work: rightmost_roots then returns Status::Cancelled.
+    BranchProgress progress;
     /// True when the options are usable; otherwise `why` (if given) names the field, e.g.
     /// "count = 0: expected an integer >= 1", "dense.max_degree: ...".
     bool is_valid(std::string* why = nullptr) const;
@@ -139,6 +147,8 @@ struct RootResult {
 
 /// Rightmost roots of `problem` by the backend options.method names (see the file comment).
 /// Throws std::invalid_argument for invalid options or a forced method that does not apply.
+/// When options.progress throws ddemap::Cancelled: a result with Status::Cancelled, no roots
+/// and a message saying after how many units of work it stopped.
 RootResult rightmost_roots(const RootProblem& problem, const RootOptions& options = {});
 /// The same for a problem without a characteristic function.
 RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options = {});

@@ -65,6 +65,14 @@ private:
     std::optional<cplx> m_guess;
 };
 
+/// The ring's summary at one point on the winding path (analyse_ring_winding, every mode from
+/// winding tables, continued from `guess`, which it updates; sweeps and atlases): where the
+/// tables are undecided, the per-mode path `reference` (made on first use) for
+/// N <= kWindingFallbackCars (N = inf included), counted in `winding_fallbacks`; larger rings get an
+/// uncertified summary. Adds the tables made to `tables`.
+RingSummary winding_ring_summary(const Linearisation& lin, int cars, RingWindingGuess& guess, std::optional<RingTracker>& reference,
+                                 long& tables, int& winding_fallbacks);
+
 /// One point of a sweep (and of an atlas): the ring's and the plant's rightmost roots continued
 /// from the trackers' previous point, then string stability (|Gamma(iw)| on 120 frequencies and
 /// refined). Fills every field of `p` but x and y; adds the collocation fallbacks to `fallbacks`.
