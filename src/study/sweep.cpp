@@ -57,10 +57,28 @@ namespace {
 /// right of a line a little left of z: exactly z (and its twin) means nothing else is further
 /// right. Lines at a distance keep the argument tracking cheap; closer lines only when another
 /// zero is near; the last resort is the line 1e-10 right of z.
-bool is_rightmost(const QuasiPolynomial& f, cplx z) {
+///
+/// With `wide` > 0 the first line lies wide * max(1, |z|) left of z: far from z the phase of f turns
+/// slowly and the count needs fewer samples. Any line left of z certifies z when it counts exactly
+/// z (and its twin); when it counts more (another zero lies between), `wide` is halved for the
+/// caller's next point and the lines below decide (a `wide` of at most 1e-2 is not tried, only grown
+/// by 1.25); when it certifies, `wide` grows back (at most kWideMax). The verdict is the same for any
+/// `wide` whenever the usual lines decide; only the cost differs.
+constexpr double kWideMax = 0.25;
+bool is_rightmost(const QuasiPolynomial& f, cplx z, double* wide = nullptr) {
     const double scale = std::max(1.0, std::abs(z));
     const bool twin = f.is_real() && std::abs(z.imag()) > 1e-12 * scale;
     const int known = twin ? 2 : 1;
+    if (wide && *wide > 1e-2) {
+        const int left = f.zeros_right_of(z.real() - *wide * scale);
+        if (left == known) {
+            *wide = std::min(kWideMax, 1.5 * *wide);
+            return true;
+        }
+        *wide *= 0.5;  // another zero between that line and z (or undecided): the lines below decide
+    } else if (wide) {
+        *wide *= 1.25;  // tried again from the point where it exceeds 1e-2
+    }
     for (double delta : {1e-2, 1e-4, 1e-7}) {
         const int left = f.zeros_right_of(z.real() - delta * scale);
         if (left == known) return true;
@@ -76,13 +94,13 @@ bool is_rightmost(const QuasiPolynomial& f, cplx z) {
 namespace detail {
 
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
-                                  const std::optional<cplx>& guess) {
+                                  const std::optional<cplx>& guess, double* wide) {
     CertifiedRoot out;
     if (guess) {
         cplx z = *guess;
         if (f.newton(z)) {
             out.value = z;
-            if (is_rightmost(f, z)) {
+            if (is_rightmost(f, z, wide)) {
                 out.certified = true;
                 return out;
             }
@@ -233,7 +251,7 @@ RingSummary RingTracker::evaluate(const Linearisation& lin) {
 
 RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
     const QuasiPolynomial f = plant_characteristic(lin);
-    const CertifiedRoot c = certified_rightmost(f, [&] { return plant_dde(lin); }, m_guess);
+    const CertifiedRoot c = certified_rightmost(f, [&] { return plant_dde(lin); }, m_guess, &m_wide);
     fallbacks += c.fell_back;
     m_guess = c.value;
     RootResult rr;

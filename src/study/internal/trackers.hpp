@@ -24,9 +24,12 @@ struct CertifiedRoot {
     bool fell_back = false;  ///< collocation was needed
     int degree = 0;          ///< collocation degree used (0 if none)
 };
-/// `dde` builds the same problem as a LinearDDE for the collocation fallback.
+/// `dde` builds the same problem as a LinearDDE for the collocation fallback. With `wide` (a
+/// tracker's state along a row) the Newton root's certificate counts first on a line `*wide` times
+/// max(1, |z|) left of it, which needs fewer samples than the line 1e-2 left, and adapts `*wide`
+/// (halved when that line holds another zero, grown back to at most 0.25 when it certifies).
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
-                                  const std::optional<cplx>& guess);
+                                  const std::optional<cplx>& guess, double* wide = nullptr);
 
 /// Ring (N >= 2) or N = infinity summary at one point, continuing from the previous point.
 struct RingSummary {
@@ -59,10 +62,14 @@ private:
 class PlantTracker {
 public:
     RootResult evaluate(const Linearisation& lin, int& fallbacks);
-    void reset() { m_guess.reset(); }
+    void reset() {
+        m_guess.reset();
+        m_wide = 0.25;
+    }
 
 private:
     std::optional<cplx> m_guess;
+    double m_wide = 0.25;  // the first certificate line's distance (certified_rightmost)
 };
 
 /// The ring's summary at one point on the winding path (analyse_ring_winding, every mode from
