@@ -28,6 +28,11 @@ double wrap_angle(double a) {
     return a;
 }
 
+/// Roots accounted for by Newton right of the axis (analyse_ring_winding's few-mode shortcut) lie
+/// at least this far right of it, relative to max(1, |z|): clear of the marginal band and of Newton's
+/// rounding.
+constexpr double kAccountedClear = 1e-6;
+
 /// The gap of the sweep's certificates: no zero right of Re z + 1e-10 max(1, |z|).
 double certificate_gap(cplx z) { return 1e-10 * std::max(1.0, std::abs(z)); }
 
@@ -434,6 +439,13 @@ bool ring_winding_applies(const Linearisation& lin) { return lin.further.empty()
 
 namespace {
 
+/// The marginal window of a crossing: modes within band / |re_rate| of its angle have a root
+/// within the marginal band of the axis (Re ~ (phi - angle) re_rate).
+double marginal_window(const RingWindingTable::Jump& j) {
+    const double band = marginal_band(cplx(0.0, j.s));
+    return j.re_rate != 0.0 ? band / std::abs(j.re_rate) : kTwoPi;
+}
+
 /// phi_m = 2 pi m / N, the one formula of this file
 double mode_angle(long long m, int cars) { return kTwoPi * static_cast<double>(m) / cars; }
 
@@ -726,7 +738,79 @@ RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const
         bool done = false;
         double lo = -std::numeric_limits<double>::infinity();
         std::optional<RingWindingTable> lo_table;
-        if (best.have) {
+        // Few modes and a candidate clearly right of the axis: the axis table (which the verdict
+        // needs anyway) counts every mode's roots right of the axis; when Newton finds as many
+        // distinct roots right of the axis in every mode, they are all of them, and the rightmost
+        // is the abscissa without the table on the certificate line.
+        if (few && best.have && best.z.real() > kAccountedClear * std::max(1.0, std::abs(best.z))) {
+            axis = en.table(0.0);
+            if (!axis->ok) return undecided(axis->message);
+            const RingWindingTable& t = *axis;
+            const double branch_sign = margin / lf.gamma_prime0;
+            bool ok = true;
+            for (const auto& j : t.jumps)
+                if (marginal_window(j) >= std::min(j.angle, kTwoPi - j.angle)) ok = false;  // a root near mode 0's axis point
+            Best all;
+            auto clear = [&](cplx z) { return z.real() > kAccountedClear * std::max(1.0, std::abs(z)); };
+            // mode 0 (without its trivial root): Z(0+) less the trivial branch when it bends right
+            if (ok) {
+                const int c0 = t.plant_zeros - t.base - (branch_sign > 0.0 ? 1 : 0);
+                const bool pair = have0 && std::abs(z0.imag()) > 1e-8 * std::max(1.0, std::abs(z0));
+                if (c0 < 0 || c0 > 2) ok = false;
+                else if (c0 > 0 && !(have0 && clear(z0) && c0 == (pair ? 2 : 1))) ok = false;
+                else if (c0 > 0) all = {true, z0, 0, 0.0};
+            }
+            for (long long m = 1; ok && 2 * m <= cars; ++m) {
+                const double phi = mode_angle(m, cars);
+                for (const auto& j : t.jumps)
+                    if (std::abs(phi - j.angle) <= marginal_window(j)) ok = false;  // a root within the band
+                if (!ok) break;
+                const int zm = t.zeros(phi);
+                if (zm < 0) {
+                    ok = false;
+                    break;
+                }
+                if (zm == 0) continue;
+                // seeds: the continued candidate, then the crossings whose branches move right
+                // towards phi (Re ~ (phi - angle) re_rate) and the branch through the trivial root,
+                // nearest first
+                std::vector<std::pair<double, cplx>> seeds;
+                if (best.mode == m || best.mode == cars - m) seeds.push_back({-1.0, best.mode == m ? best.z : std::conj(best.z)});
+                for (const auto& j : t.jumps) {
+                    double d = phi - j.angle;
+                    if (d > M_PI) d -= kTwoPi;
+                    if (d < -M_PI) d += kTwoPi;
+                    if (d * j.re_rate > 0.0) seeds.push_back({std::abs(d), cplx(d * j.re_rate, j.s)});
+                }
+                // the branch through the trivial root when it bends right: Gamma(i w) ~ e^{i Gamma'(0) w}
+                if (branch_sign > 0.0) seeds.push_back({phi, cplx(0.0, phi / lf.gamma_prime0)});
+                std::sort(seeds.begin(), seeds.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+                std::vector<cplx> found;
+                for (std::size_t k = 0; k < seeds.size() && k < static_cast<std::size_t>(zm) + 3 && static_cast<int>(found.size()) < zm; ++k) {
+                    cplx z = seeds[k].second;
+                    if (!mode_newton(en.tf, ring_zeta(static_cast<int>(m), cars), z) || !clear(z)) continue;
+                    bool fresh = true;
+                    for (const cplx& y : found) fresh = fresh && std::abs(z - y) > 1e-6 * std::max(1.0, std::abs(z));
+                    // a real mode (2 m = N) has its roots in conjugate pairs: a complex root accounts for two
+                    if (fresh) {
+                        found.push_back(z);
+                        if (2 * m == cars && std::abs(z.imag()) > 1e-8 * std::max(1.0, std::abs(z))) found.push_back(std::conj(z));
+                    }
+                }
+                if (static_cast<int>(found.size()) != zm) {
+                    ok = false;
+                    break;
+                }
+                for (const cplx& z : found)
+                    if (!all.have || z.real() > all.z.real()) all = {true, z, m, phi};
+            }
+            if (ok && all.have) {
+                best = all;
+                done = true;
+                r.accounted = true;
+            }
+        }
+        if (!done && best.have) {
             const RingWindingTable t = en.table(best.z.real() + certificate_gap(best.z));
             if (!t.ok) return undecided(t.message);
             const long long c = en.right_count(t, bad);
@@ -860,10 +944,7 @@ RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const
     bool marginal = false;
     long long unstable = 0;
     // roots of mode phi near a crossing k: Re ~ (phi - angle_k) re_rate_k
-    auto window = [&](const RingWindingTable::Jump& j) {
-        const double band = marginal_band(cplx(0.0, j.s));
-        return j.re_rate != 0.0 ? band / std::abs(j.re_rate) : kTwoPi;
-    };
+    auto window = [&](const RingWindingTable::Jump& j) { return marginal_window(j); };
     // the branch through the trivial root: Re lambda(theta) ~ margin w^k / (2 d0^2 Gamma'(0)),
     // w = theta / |Gamma'(0)|
     const double branch_sign = margin / lf.gamma_prime0;  // > 0: the branch is unstable

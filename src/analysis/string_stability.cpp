@@ -169,10 +169,12 @@ StringResult analyse_string(const Linearisation& lin, const StringOptions& optio
     return analyse_string(lin, rightmost_roots(plant_dde(lin), ro), options);
 }
 
-StringResult analyse_string(const Linearisation& lin, RootResult plant, const StringOptions& options) {
-    options.validate();
+namespace {
+
+/// The plant's verdict, the low-frequency series and the search range of analyse_string.
+StringResult string_preamble(const Linearisation& lin, const RootResult& plant) {
     StringResult r;
-    r.plant_roots = std::move(plant);
+    r.plant_roots = plant;
     r.plant_abscissa = r.plant_roots.spectral_abscissa();
     r.plant_stable = r.plant_roots.status == Status::Converged && !r.plant_roots.roots.empty() &&
                      r.plant_abscissa < -marginal_band(r.plant_roots.roots.front().value);
@@ -191,12 +193,44 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
         case 8: r.lowfreq_margin = r.lowfreq.c8; break;
         default: r.lowfreq_margin = 0.0;
     }
-
-    const TransferFunction tf(lin);
     const double a = lin.gap.abs_sum(), h = lin.own.abs_sum(), l = lin.lead.abs_sum();
     double w_hi = omega_beyond(a, h, l, 1.0) * 1.01;
     if (!(w_hi > 0.0)) w_hi = 1.0;
     r.omega_search_max = w_hi;
+    return r;
+}
+
+/// Below this frequency the sign of 1 - |Gamma(i w)|^2 may be decided by the low-frequency series.
+double series_range(const Linearisation& lin) {
+    const double coef = std::max({1.0, lin.max_delay(), lin.gap.abs_sum() + lin.own.abs_sum() + lin.lead.abs_sum()});
+    return 1e-2 / coef;
+}
+
+/// sup |Gamma|, its frequency, the peak margin and the verdicts from the lowest loss 1 - |Gamma|^2
+/// (0 for the limit w -> 0) and the lowest loss over the local maxima (2 when there is none).
+void finish_string(StringResult& r, double lowest, double best_w, double lowest_peak) {
+    std::sort(r.peaks.begin(), r.peaks.end(), [](const GainPeak& x, const GainPeak& y) { return x.omega < y.omega; });
+    r.sup_gamma = std::sqrt(1.0 - lowest);
+    r.omega_peak = best_w;
+    // 1 - sqrt(1 - loss) without cancellation
+    r.peak_margin = lowest_peak > 1.0 ? 1.0 : lowest_peak / (1.0 + std::sqrt(1.0 - lowest_peak));
+    r.string_stable = r.plant_stable && r.lowfreq.attenuates && lowest_peak >= 0.0;
+    if (r.plant_verdict == Verdict::Undecided) {
+        r.string_verdict = Verdict::Undecided;
+    } else if (r.plant_verdict == Verdict::Unstable || lowest_peak < 0.0 || (r.lowfreq.decisive_order > 0 && !r.lowfreq.attenuates)) {
+        r.string_verdict = Verdict::Unstable;
+    } else {
+        r.string_verdict = r.string_stable ? Verdict::Stable : Verdict::Marginal;
+    }
+}
+
+}  // namespace
+
+StringResult analyse_string(const Linearisation& lin, RootResult plant, const StringOptions& options) {
+    options.validate();
+    StringResult r = string_preamble(lin, plant);
+    const TransferFunction tf(lin);
+    const double w_hi = r.omega_search_max;
     const double tau = lin.max_delay();
 
     std::vector<double> grid;
@@ -250,8 +284,7 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
 
     // 1 - |Gamma|^2 in its cancellation-free form (TransferFunction::attenuation); where its
     // sign is lost in rounding at small w, the low-frequency series decides (exact there).
-    const double coef = std::max({1.0, tau, a + h + l});
-    const double w_series = 1e-2 / coef;
+    const double w_series = series_range(lin);
     auto loss = [&](double w) {
         double q = 0.0, noise = 0.0;
         // the rounding bound of q matters only where the series may take over
@@ -296,20 +329,257 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
             best_w = w;
         }
     }
-    std::sort(r.peaks.begin(), r.peaks.end(), [](const GainPeak& x, const GainPeak& y) { return x.omega < y.omega; });
-    r.sup_gamma = std::sqrt(1.0 - lowest);
-    r.omega_peak = best_w;
-    // 1 - sqrt(1 - loss) without cancellation
-    r.peak_margin = lowest_peak > 1.0 ? 1.0 : lowest_peak / (1.0 + std::sqrt(1.0 - lowest_peak));
-    r.string_stable = r.plant_stable && r.lowfreq.attenuates && lowest_peak >= 0.0;
-    if (r.plant_verdict == Verdict::Undecided) {
-        r.string_verdict = Verdict::Undecided;
-    } else if (r.plant_verdict == Verdict::Unstable || lowest_peak < 0.0 || (r.lowfreq.decisive_order > 0 && !r.lowfreq.attenuates)) {
-        r.string_verdict = Verdict::Unstable;
-    } else {
-        r.string_verdict = r.string_stable ? Verdict::Stable : Verdict::Marginal;
-    }
+    finish_string(r, lowest, best_w, lowest_peak);
     return r;
+}
+
+namespace {
+
+/// One term c s^p e^{-s d} of D or N (p = 0, 1, 2).
+struct AxisTerm {
+    double c = 0.0;
+    int p = 0;
+    double d = 0.0;
+};
+
+/// D(s) = s^2 - s own(s) + gap(s) and N(s) = gap(s) + s lead(s) as lists of terms, and the bounds
+/// sup_{0 <= w <= b} |d^k/dw^k D(i w)| <= sum_j bound_den[k][j] b^j (k = 0..3; the same for N), the
+/// sums over the terms of term_bound below written as polynomials in b.
+struct AxisTerms {
+    std::vector<AxisTerm> den, num;
+    std::vector<double> delays;  // the distinct delays
+    double bound_den[4][3] = {}, bound_num[4][3] = {};
+};
+
+AxisTerms axis_terms(const Linearisation& lin) {
+    AxisTerms t;
+    t.den.push_back({1.0, 2, 0.0});
+    for (const auto& e : lin.own.terms()) t.den.push_back({-e.coef, 1, e.delay});
+    for (const auto& e : lin.gap.terms()) {
+        t.den.push_back({e.coef, 0, e.delay});
+        t.num.push_back({e.coef, 0, e.delay});
+    }
+    for (const auto& e : lin.lead.terms()) t.num.push_back({e.coef, 1, e.delay});
+    for (const auto* list : {&t.den, &t.num})
+        for (const auto& e : *list)
+            if (std::find(t.delays.begin(), t.delays.end(), e.d) == t.delays.end()) t.delays.push_back(e.d);
+    // |c| C(k, j) p! / (p - j)! |d|^{k - j} b^{p - j} for every term (see power_derivative)
+    static constexpr double binom[4][4] = {{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+    auto fill = [](const std::vector<AxisTerm>& terms, double (*poly)[3]) {
+        for (const auto& e : terms)
+            for (int k = 0; k < 4; ++k) {
+                double fall = 1.0;
+                for (int j = 0; j <= std::min(k, e.p); ++j) {
+                    poly[k][e.p - j] += std::abs(e.c) * binom[k][j] * fall * std::pow(std::abs(e.d), k - j);
+                    fall *= (e.p - j);
+                }
+            }
+    };
+    fill(t.den, t.bound_den);
+    fill(t.num, t.bound_num);
+    return t;
+}
+
+/// Sums over the terms of the bounds of AxisTerms at b: sup over 0 <= w <= b of |d^k/dw^k D(i w)| (or N), k = 0..3.
+struct Bounds {
+    double v[4] = {0, 0, 0, 0};
+};
+Bounds bounds(const double (*poly)[3], double b) {
+    Bounds out;
+    for (int k = 0; k < 4; ++k) out.v[k] = poly[k][0] + b * (poly[k][1] + b * poly[k][2]);
+    return out;
+}
+
+/// D, N and their first two s-derivatives at s = i w, with the sizes of their terms.
+struct AxisSample {
+    double w = 0.0;
+    cplx d[3], n[3];
+    double size_d[2] = {0, 0}, size_n[2] = {0, 0};  // sums of |terms| of D, D' (N, N')
+};
+
+/// d^k/ds^k (s^p e^{-s d}) = e^{-s d} (s^p, p s^{p-1} - d s^p, p (p-1) s^{p-2} - 2 p d s^{p-1} + d^2 s^p), k = 0, 1, 2.
+AxisSample axis_sample(const AxisTerms& t, double w) {
+    AxisSample x;
+    x.w = w;
+    const cplx sp[3] = {cplx(1.0), cplx(0.0, w), cplx(-w * w, 0.0)};  // (i w)^n
+    cplx e[8];
+    const std::size_t nd = std::min<std::size_t>(t.delays.size(), 8);
+    for (std::size_t i = 0; i < nd; ++i) e[i] = t.delays[i] == 0.0 ? cplx(1.0) : std::polar(1.0, -w * t.delays[i]);
+    auto expo = [&](double d) {
+        for (std::size_t i = 0; i < nd; ++i)
+            if (t.delays[i] == d) return e[i];
+        return std::polar(1.0, -w * d);
+    };
+    auto add = [&](const std::vector<AxisTerm>& terms, cplx* out) {
+        for (const auto& term : terms) {
+            const cplx f = term.c * expo(term.d);
+            const int p = term.p;
+            const double d = term.d;
+            const cplx s0 = sp[p], s1 = p >= 1 ? double(p) * sp[p - 1] : cplx(0.0),
+                       s2 = p >= 2 ? double(p * (p - 1)) * sp[p - 2] : cplx(0.0);
+            out[0] += f * s0;
+            out[1] += f * (s1 - d * s0);
+            out[2] += f * (s2 - 2.0 * d * s1 + d * d * s0);
+        }
+    };
+    add(t.den, x.d);
+    add(t.num, x.n);
+    // the sizes of the terms (rounding allowances): the bounds at w
+    const Bounds bd = bounds(t.bound_den, w), bn = bounds(t.bound_num, w);
+    x.size_d[0] = bd.v[0];
+    x.size_d[1] = bd.v[1];
+    x.size_n[0] = bn.v[0];
+    x.size_n[1] = bn.v[1];
+    return x;
+}
+
+/// phi = A |D|^2 - |N|^2 and phi' (d/dw = i d/ds) at a sample, with rounding allowances.
+struct PhiSample {
+    double w = 0.0;
+    double phi = 0.0, phi1 = 0.0, tol0 = 0.0, tol1 = 0.0;
+    double abs_d = 0.0, abs_d1 = 0.0, abs_n = 0.0, abs_n1 = 0.0;
+};
+
+PhiSample phi_sample(const AxisSample& x, double A) {
+    constexpr double eps = std::numeric_limits<double>::epsilon();
+    PhiSample p;
+    p.w = x.w;
+    p.phi = A * std::norm(x.d[0]) - std::norm(x.n[0]);
+    // Re(D_w conj D) = Re(i D_s conj D) = -Im(D_s conj D)
+    p.phi1 = -2.0 * A * std::imag(x.d[1] * std::conj(x.d[0])) + 2.0 * std::imag(x.n[1] * std::conj(x.n[0]));
+    p.tol0 = 64.0 * eps * (A * x.size_d[0] * x.size_d[0] + x.size_n[0] * x.size_n[0]);
+    p.tol1 = 64.0 * eps * 2.0 * (A * x.size_d[0] * x.size_d[1] + x.size_n[0] * x.size_n[1]);
+    p.abs_d = std::sqrt(std::norm(x.d[0]));
+    p.abs_d1 = std::sqrt(std::norm(x.d[1]));
+    p.abs_n = std::sqrt(std::norm(x.n[0]));
+    p.abs_n1 = std::sqrt(std::norm(x.n[1]));
+    return p;
+}
+
+}  // namespace
+
+std::optional<StringResult> analyse_string_continued(const Linearisation& lin, const RootResult& plant,
+                                                     const StringGuess& guess, int budget) {
+    if (!guess.have || !(guess.omega > 0.0) || !std::isfinite(guess.omega)) return std::nullopt;
+    if (!lin.further.empty()) return std::nullopt;
+    StringResult r = string_preamble(lin, plant);
+    const TransferFunction tf(lin);
+    const double w_hi = r.omega_search_max;
+    const double w_series = series_range(lin);
+    const AxisTerms terms = axis_terms(lin);
+    double w = guess.omega;
+    for (int restart = 0; restart <= 4; ++restart) {
+        // Newton on psi = d/dw log |Gamma(i w)|^2 = 0
+        bool converged = false;
+        for (int it = 0; it < 16; ++it) {
+            if (!(w > 0.0 && w < w_hi)) return std::nullopt;
+            const AxisSample x = axis_sample(terms, w);
+            ++r.evaluations;
+            if (x.d[0] == cplx(0.0) || x.n[0] == cplx(0.0)) return std::nullopt;
+            const cplx i(0.0, 1.0);
+            const cplx r1 = i * x.n[1] / x.n[0], r2 = i * x.d[1] / x.d[0];
+            const double psi = 2.0 * std::real(r1 - r2);
+            const double dpsi = 2.0 * std::real(-x.n[2] / x.n[0] - r1 * r1 + x.d[2] / x.d[0] + r2 * r2);
+            if (!(dpsi < 0.0) || !std::isfinite(psi)) return std::nullopt;  // not near a maximum
+            double step = -psi / dpsi;
+            step = std::max(-0.5 * w, std::min(0.5 * w, step));
+            w += step;
+            if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * w) {
+                converged = true;
+                break;
+            }
+        }
+        if (!converged || !(w > w_series && w < w_hi)) return std::nullopt;
+        const double lw = tf.attenuation(w);
+        ++r.evaluations;
+        if (!(lw <= 0.0) || !std::isfinite(lw)) return std::nullopt;  // the highest peak must be the sup
+        const double g = 1.0 - lw;
+        const double A = g * (1.0 + kStringExclusionSlack);
+
+        // the neighbourhood of w*: phi(w* + t) >= phi0 + phi1 t + phi2 t^2 / 2 - M3 |t|^3 / 6
+        const AxisSample xs = axis_sample(terms, w);
+        ++r.evaluations;
+        const PhiSample ps = phi_sample(xs, A);
+        constexpr double eps = std::numeric_limits<double>::epsilon();
+        const double phi2 = 2.0 * A * (-std::real(xs.d[2] * std::conj(xs.d[0])) + std::norm(xs.d[1])) -
+                            2.0 * (-std::real(xs.n[2] * std::conj(xs.n[0])) + std::norm(xs.n[1]));
+        const double tol2 = 64.0 * eps * 2.0 * (A * (xs.size_d[0] * xs.size_d[0] + xs.size_d[1] * xs.size_d[1] * 4.0) +
+                                                 xs.size_n[0] * xs.size_n[0] + xs.size_n[1] * xs.size_n[1] * 4.0 +
+                                                 A * std::abs(xs.d[2]) * xs.size_d[0] + std::abs(xs.n[2]) * xs.size_n[0]);
+        double rho = 0.25 * std::min(w, w_hi - w);
+        bool near_ok = false;
+        const double p2 = phi2 - tol2;
+        if (p2 > 0.0) {
+            for (int k = 0; k < 60; ++k) {
+                const Bounds bd = bounds(terms.bound_den, w + rho), bn = bounds(terms.bound_num, w + rho);
+                const double d0 = std::min(bd.v[0], ps.abs_d + rho * bd.v[1]), d1 = std::min(bd.v[1], ps.abs_d1 + rho * bd.v[2]);
+                const double n0 = std::min(bn.v[0], ps.abs_n + rho * bn.v[1]), n1 = std::min(bn.v[1], ps.abs_n1 + rho * bn.v[2]);
+                const double m3 = 2.0 * A * (bd.v[3] * d0 + 3.0 * bd.v[2] * d1) + 2.0 * (bn.v[3] * n0 + 3.0 * bn.v[2] * n1);
+                const double c2 = 0.5 * p2 - m3 * rho / 6.0;
+                if (c2 > 0.125 * p2) {
+                    const double a1 = std::abs(ps.phi1) + ps.tol1;
+                    near_ok = ps.phi - ps.tol0 - a1 * a1 / (4.0 * c2) > 0.0;
+                    break;
+                }
+                rho *= 0.5;
+            }
+        }
+        if (!near_ok) return std::nullopt;
+
+        // the rest of [0, w_hi] by quadratic Taylor bounds from both ends of each piece
+        std::optional<double> higher;
+        auto sample = [&](double x) {
+            ++r.evaluations;
+            return phi_sample(axis_sample(terms, x), A);
+        };
+        auto piece_ok = [&](const PhiSample& a, const PhiSample& b) {
+            const double h = b.w - a.w;
+            const Bounds bd = bounds(terms.bound_den, b.w), bn = bounds(terms.bound_num, b.w);
+            const double d1 = std::min(bd.v[1], 0.5 * (a.abs_d1 + b.abs_d1 + h * bd.v[2]));
+            const double d0 = std::min(bd.v[0], 0.5 * (a.abs_d + b.abs_d + h * d1));
+            const double n1 = std::min(bn.v[1], 0.5 * (a.abs_n1 + b.abs_n1 + h * bn.v[2]));
+            const double n0 = std::min(bn.v[0], 0.5 * (a.abs_n + b.abs_n + h * n1));
+            const double m2 = 2.0 * A * (bd.v[2] * d0 + d1 * d1) + 2.0 * (bn.v[2] * n0 + n1 * n1);
+            const double q = m2 * h * h / 8.0;
+            const double la = a.phi - a.tol0 + std::min(0.0, (a.phi1 - a.tol1) * 0.5 * h) - q;
+            const double lb = b.phi - b.tol0 + std::min(0.0, -(b.phi1 + b.tol1) * 0.5 * h) - q;
+            return a.phi - a.tol0 > 0.0 && b.phi - b.tol0 > 0.0 && la > 0.0 && lb > 0.0;
+        };
+        auto cover = [&](double lo, double hi) {
+            if (!(hi > lo)) return true;
+            std::vector<std::pair<PhiSample, PhiSample>> stack;
+            stack.push_back({sample(lo), sample(hi)});
+            while (!stack.empty()) {
+                auto [a, b] = stack.back();
+                stack.pop_back();
+                if (a.phi < -a.tol0) {
+                    higher = a.w;
+                    return false;
+                }
+                if (b.phi < -b.tol0) {
+                    higher = b.w;
+                    return false;
+                }
+                if (piece_ok(a, b)) continue;
+                if (r.evaluations > budget) return false;
+                const double m = 0.5 * (a.w + b.w);
+                if (!(m > a.w && m < b.w)) return false;
+                const PhiSample c = sample(m);
+                stack.push_back({c, b});
+                stack.push_back({a, c});
+            }
+            return true;
+        };
+        const bool ok = cover(0.0, w - rho) && cover(w + rho, w_hi);
+        if (ok) {
+            r.peaks.push_back({w, std::sqrt(g)});
+            finish_string(r, lw < 0.0 ? lw : 0.0, lw < 0.0 ? w : 0.0, lw);
+            return r;
+        }
+        if (!higher || *higher <= 0.0) return std::nullopt;
+        w = *higher;  // the neighbour's maximiser was not the highest peak: Newton from the higher point
+    }
+    return std::nullopt;
 }
 
 }  // namespace ddemap

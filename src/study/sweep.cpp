@@ -57,10 +57,28 @@ namespace {
 /// right of a line a little left of z: exactly z (and its twin) means nothing else is further
 /// right. Lines at a distance keep the argument tracking cheap; closer lines only when another
 /// zero is near; the last resort is the line 1e-10 right of z.
-bool is_rightmost(const QuasiPolynomial& f, cplx z) {
+///
+/// With `wide` > 0 the first line lies wide * max(1, |z|) left of z: far from z the phase of f turns
+/// slowly and the count needs fewer samples. Any line left of z certifies z when it counts exactly
+/// z (and its twin); when it counts more (another zero lies between), `wide` is halved for the
+/// caller's next point and the lines below decide (a `wide` of at most 1e-2 is not tried, only grown
+/// by 1.25); when it certifies, `wide` grows back (at most kWideMax). The verdict is the same for any
+/// `wide` whenever the usual lines decide; only the cost differs.
+constexpr double kWideMax = 0.25;
+bool is_rightmost(const QuasiPolynomial& f, cplx z, double* wide = nullptr) {
     const double scale = std::max(1.0, std::abs(z));
     const bool twin = f.is_real() && std::abs(z.imag()) > 1e-12 * scale;
     const int known = twin ? 2 : 1;
+    if (wide && *wide > 1e-2) {
+        const int left = f.zeros_right_of(z.real() - *wide * scale);
+        if (left == known) {
+            *wide = std::min(kWideMax, 1.5 * *wide);
+            return true;
+        }
+        *wide *= 0.5;  // another zero between that line and z (or undecided): the lines below decide
+    } else if (wide) {
+        *wide *= 1.25;  // tried again from the point where it exceeds 1e-2
+    }
     for (double delta : {1e-2, 1e-4, 1e-7}) {
         const int left = f.zeros_right_of(z.real() - delta * scale);
         if (left == known) return true;
@@ -76,13 +94,13 @@ bool is_rightmost(const QuasiPolynomial& f, cplx z) {
 namespace detail {
 
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
-                                  const std::optional<cplx>& guess) {
+                                  const std::optional<cplx>& guess, double* wide) {
     CertifiedRoot out;
     if (guess) {
         cplx z = *guess;
         if (f.newton(z)) {
             out.value = z;
-            if (is_rightmost(f, z)) {
+            if (is_rightmost(f, z, wide)) {
                 out.certified = true;
                 return out;
             }
@@ -233,7 +251,7 @@ RingSummary RingTracker::evaluate(const Linearisation& lin) {
 
 RootResult PlantTracker::evaluate(const Linearisation& lin, int& fallbacks) {
     const QuasiPolynomial f = plant_characteristic(lin);
-    const CertifiedRoot c = certified_rightmost(f, [&] { return plant_dde(lin); }, m_guess);
+    const CertifiedRoot c = certified_rightmost(f, [&] { return plant_dde(lin); }, m_guess, &m_wide);
     fallbacks += c.fell_back;
     m_guess = c.value;
     RootResult rr;
@@ -293,11 +311,15 @@ RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, Pl
     return rs;
 }
 
-void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks) {
+void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks,
+                      StringGuess* string) {
     StringOptions so;
     so.grid_points = 120;
     int fb = rs.fallbacks;
-    const StringResult sr = analyse_string(lin, plant.evaluate(lin, fb), so);
+    RootResult plant_roots = plant.evaluate(lin, fb);
+    std::optional<StringResult> continued;
+    if (string) continued = analyse_string_continued(lin, plant_roots, *string);
+    const StringResult sr = continued ? std::move(*continued) : analyse_string(lin, std::move(plant_roots), so);
     p.spectral_abscissa = rs.spectral_abscissa;
     p.unstable_roots = rs.unstable_roots;
     p.abscissa_mode = rs.abscissa_mode;
@@ -318,6 +340,11 @@ void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTrac
     p.plant_abscissa = sr.plant_abscissa;
     p.plant_stable = sr.plant_stable;
     p.string_stable = sr.string_stable;
+    if (string) {
+        // the next point starts from this maximiser when it is the sup (the only case the shortcut covers)
+        string->have = p.peak_gain >= 1.0 && p.peak_omega > 0.0;
+        string->omega = p.peak_omega;
+    }
     fallbacks += fb;
 }
 
@@ -426,6 +453,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
         std::optional<detail::RingTracker> reference;  // the per-mode path where a winding point is undecided
         detail::RingTracker ring = ring_seed[iy];
         detail::PlantTracker plant = plant_seed[iy];
+        StringGuess string;  // continued along the row only: the same path for any number of threads
         for (int ix = 0; ix < nx; ++ix) {
             SweepPoint& p = result.points[static_cast<std::size_t>(iy) * nx + ix];
             p.x = spec.x.value(ix);
@@ -436,7 +464,7 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
                                                                                   row_winding_fallbacks[iy])
                                                    : ring.evaluate(lin);
             int fb = 0;
-            detail::fill_sweep_point(lin, rs, plant, p, fb);
+            detail::fill_sweep_point(lin, rs, plant, p, fb, &string);
             for (int m = 0; m < result.modes && !winding; ++m) {
                 result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
             }

@@ -206,4 +206,67 @@ TEST_CASE("the winding sweep equals the per-mode sweep and does not depend on th
     CHECK_THROWS_AS(run_sweep(unknown), std::invalid_argument);
 }
 
+TEST_CASE("few modes: roots accounted for right of the axis (one table) give the per-mode abscissa, count and verdict") {
+    // rows continued as a sweep continues them (each point from the previous point's result), at
+    // random rows and across the ring's boundaries; every point against the per-mode ring analysis
+    std::mt19937 rng(4242);
+    std::uniform_real_distribution<double> u(0.01, 1.0);
+    int accounted = 0, points = 0;
+    for (int cars : {5, 22, 64}) {
+        for (int row = 0; row < (cars == 64 ? 1 : 3); ++row) {
+            const double k2 = u(rng);
+            RingWindingGuess g;
+            for (int i = 0; i < 12; ++i) {
+                const double k1 = 0.01 + 0.09 * i;
+                CAPTURE(cars);
+                CAPTURE(k1);
+                CAPTURE(k2);
+                const Linearisation lin = ovrv(k1, k2, 1.5, 0.5);
+                const RingWindingResult w = analyse_ring_winding(lin, cars, {}, g);
+                g = w.next;
+                const RingResult ref = analyse_ring(lin, cars);
+                REQUIRE(w.status == Status::Converged);
+                REQUIRE(ref.status == Status::Converged);
+                CHECK(w.certified);
+                CHECK(w.verdict == ref.verdict);
+                CHECK(w.unstable_roots == ref.unstable_roots);
+                CHECK(std::abs(w.spectral_abscissa - ref.spectral_abscissa) < tol::sweep_vs_point);
+                if (w.accounted) {
+                    ++accounted;
+                    CHECK(w.tables == 1);
+                    CHECK(w.verdict == Verdict::Unstable);
+                    CHECK(w.abscissa_mode == std::min(ref.abscissa_mode, cars - ref.abscissa_mode));  // m and N - m: conjugate roots
+                }
+                ++points;
+            }
+        }
+    }
+    CHECK(accounted >= points / 4);  // the shortcut is taken at most unstable points
+    // next to the ring's boundary, continued from a neighbour 0.01 to the left
+    SweepSpec spec = test::ovrv_chart(11, 22, 1.5, 0.5);
+    spec.ring_method = "modes";
+    const BoundarySet set = trace_boundaries(run_sweep(spec));
+    int checked = 0;
+    for (const auto& c : set.curves) {
+        if (c.kind != BoundaryKind::RingHopf) continue;
+        for (std::size_t i = 0; i < c.points.size(); i += c.points.size() / 3 + 1)
+            for (double side : {-1e-6, 1e-6, 1e-3}) {
+                const double k1 = c.points[i].x + side, k2 = c.points[i].y;
+                if (k1 <= 0.011) continue;
+                CAPTURE(k1);
+                CAPTURE(k2);
+                const RingWindingResult before = analyse_ring_winding(ovrv(k1 - 0.01, k2, 1.5, 0.5), 22);
+                const Linearisation lin = ovrv(k1, k2, 1.5, 0.5);
+                const RingWindingResult w = analyse_ring_winding(lin, 22, {}, before.next);
+                const RingResult ref = analyse_ring(lin, 22);
+                REQUIRE(w.status == Status::Converged);
+                CHECK(w.verdict == ref.verdict);
+                CHECK(w.unstable_roots == ref.unstable_roots);
+                CHECK(std::abs(w.spectral_abscissa - ref.spectral_abscissa) < tol::sweep_vs_point);
+                ++checked;
+            }
+    }
+    CHECK(checked >= 6);
+}
+
 TEST_SUITE_END();

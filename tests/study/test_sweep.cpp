@@ -8,7 +8,9 @@
 
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/solve/roots.hpp"
 #include "ddemap/study/sweep.hpp"
+#include "ddemap/traffic/transfer_function.hpp"
 #include "chart_helpers.hpp"
 
 namespace tol = ddemap::test::tol;
@@ -81,6 +83,39 @@ TEST_CASE("axes and sweep specs are validated") {
     SweepSpec s = ddemap::test::ovrv_chart(3, 22, 1.5, 0.5);
     s.x = parse_axis("k1", "-1:1:3");
     CHECK_THROWS_WITH_AS(s.validate(), "k1 = -1: expected a value >= 0 [1/s^2]", std::invalid_argument);
+}
+
+TEST_CASE("the sweep's plant roots (certified on a wide line first, adapted along the row) equal the per-point collocation roots") {
+    // th = 0.5, tau = 0.8: the plant P = s^2 + (k1 th + k2) s + k1 e^{-s tau} is unstable for large
+    // k1 and small k2 inside the window, so the rows cross the plant's boundary
+    const SweepResult r = run_sweep(ddemap::test::ovrv_chart(21, 22, 0.5, 0.8));
+    std::vector<std::pair<int, int>> where;
+    std::mt19937 rng(31);
+    std::uniform_int_distribution<int> pick(0, 20);
+    for (int i = 0; i < 30; ++i) where.emplace_back(pick(rng), pick(rng));
+    int near_boundary = 0;
+    for (int iy = 0; iy < 21; ++iy)
+        for (int ix = 0; ix + 1 < 21; ++ix)
+            if (r.at(ix, iy).plant_stable != r.at(ix + 1, iy).plant_stable) {
+                where.emplace_back(ix, iy);
+                where.emplace_back(ix + 1, iy);
+                ++near_boundary;
+            }
+    CHECK(near_boundary >= 5);
+    for (const auto& [ix, iy] : where) {
+        const SweepPoint& p = r.at(ix, iy);
+        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
+        RootOptions o;
+        o.count = 2;
+        const RootResult ref = rightmost_roots(plant_dde(lin), o);  // collocation, refined and certified on its own
+        REQUIRE(ref.status == Status::Converged);
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(std::abs(p.plant_abscissa - ref.spectral_abscissa()) < tol::sweep_vs_point);
+        const cplx z = ref.roots.front().value;
+        CHECK(std::abs(p.plant_root - (z.imag() < 0.0 ? std::conj(z) : z)) < tol::sweep_vs_point * std::max(1.0, std::abs(z)));
+        CHECK(p.plant_stable == (ref.spectral_abscissa() < -marginal_band(z)));
+    }
 }
 
 TEST_SUITE_END();

@@ -128,11 +128,16 @@ struct RingWindingResult {
     cplx abscissa_root;             ///< that root (Im >= 0)
     /// The abscissa is certified: no zero of any mode right of spectral_abscissa + gap,
     /// gap = 1e-10 max(1, |root|), and abscissa_root is a zero (Newton to rounding), or the
-    /// abscissa is bracketed by two tables to within that gap.
+    /// abscissa is bracketed by two tables to within that gap, or (`accounted`) every zero right of
+    /// the axis is one of the Newton roots counted by the axis table.
     bool certified = false;
     int tables = 0;                 ///< winding passes made
     long evaluations = 0;
     bool bisected = false;          ///< continuation failed; the abscissa was bracketed by bisection in sigma
+    /// N <= 64 only: every root right of the axis was accounted for (the axis table's count of each
+    /// mode matched by as many distinct Newton roots right of it), so the abscissa is the rightmost of
+    /// them and no table on the certificate line was needed.
+    bool accounted = false;
     RingWindingGuess next;          ///< continuation data for the next point
 };
 
@@ -157,7 +162,14 @@ bool ring_winding_applies(const Linearisation& lin);
 /// or when that count is not 0, the abscissa is bracketed by bisection on the counts (Newton
 /// from the crossings once the bracket is narrow; the bracket itself, 1e-10 wide, otherwise).
 /// When the certified line lies left of -1e-12 max(1, r(0)) the ring is stable without the axis
-/// table.
+/// table. For N <= 64 with a candidate clearly right of the axis (Re z > 1e-6 max(1, |z|)) the axis
+/// table comes first: when every mode's count Z_m(0) (mode 0 without its trivial root; no crossing
+/// whose marginal window holds a mode) is matched by Z_m distinct Newton roots with
+/// Re > 1e-6 max(1, |z|), seeded by the candidate and by the crossings whose branches move right
+/// towards the mode's angle (and the branch through the trivial root when it bends right), those
+/// are all the roots right of the axis and the rightmost of them
+/// is the abscissa (RingWindingResult::accounted; one table instead of two); otherwise the
+/// certificate table follows as above.
 /// std::invalid_argument when cars is not >= 2 or 0, or the law has more than one leader.
 RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const RingWindingOptions& options = {},
                                        const RingWindingGuess& guess = {});

@@ -7,6 +7,7 @@
 /// |Gamma(i w)| <= 1 for every w > 0.
 
 #include <complex>
+#include <optional>
 #include <vector>
 
 #include "ddemap/problem/linear_dde.hpp"
@@ -95,5 +96,36 @@ struct StringResult {
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options = {});
 /// The same with the rightmost plant roots given (rightmost first; e.g. tracked in a sweep).
 StringResult analyse_string(const Linearisation& lin, RootResult plant_roots, const StringOptions& options);
+
+/// Continuation data of the string analysis along a sweep row: the previous point's maximiser of
+/// |Gamma(i w)| (the highest local maximum at w > 0).
+struct StringGuess {
+    bool have = false;
+    double omega = 0.0;
+};
+
+/// The relative slack of the exclusion bound of analyse_string_continued: sup |Gamma(i w)|^2 is
+/// certified to lie in [g, g (1 + kStringExclusionSlack)], g = |Gamma(i w*)|^2 at the peak found.
+constexpr double kStringExclusionSlack = 1e-12;
+
+/// analyse_string with the plant roots given, from a neighbouring point's maximiser instead of
+/// the scan of the axis (a sweep row's continuation). Newton on
+///     psi(w) = d/dw log |Gamma(i w)|^2 = 2 Re(N_w / N - D_w / D) = 0
+/// from guess.omega gives the peak w* (psi'(w*) < 0) and g = 1 - attenuation(w*) = |Gamma(i w*)|^2;
+/// then a certified exclusion bound shows
+///     phi(w) = g (1 + kStringExclusionSlack) |D(i w)|^2 - |N(i w)|^2 >= 0   for 0 <= w <= omega_search_max
+/// (beyond it |Gamma| < 1 <= g by the bound of analyse_string): around w* by the cubic Taylor
+/// bound from w* (|phi'''| bounded by the sums of the absolute values of the derivatives of the
+/// terms c s^p e^{-s d}), elsewhere on pieces [a, b] by the quadratic Taylor bounds from both
+/// ends with |phi''| bounded the same way, pieces halved until they pass; every bound less a
+/// rounding allowance of 64 eps times the sizes of the terms. A sample with phi < 0 is a higher
+/// point (the neighbour's maximiser was the wrong peak): Newton restarts from it (at most 4 times).
+/// Applies only when the highest peak is the supremum (g >= 1) away from the low frequencies
+/// (w* above the range where the series decides); returns std::nullopt when it does not apply or
+/// cannot certify within `budget` evaluations: the caller then runs analyse_string. The result's
+/// `peaks` holds the one certified peak (the highest local maximum); every other field is that of
+/// analyse_string (sup_gamma, omega_peak, peak_margin and the verdicts, to the slack above).
+std::optional<StringResult> analyse_string_continued(const Linearisation& lin, const RootResult& plant_roots,
+                                                     const StringGuess& guess, int budget = 400);
 
 }  // namespace ddemap

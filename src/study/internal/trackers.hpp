@@ -13,6 +13,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/study/sweep.hpp"
+#include "ddemap/analysis/string_stability.hpp"
 
 namespace ddemap::detail {
 
@@ -23,9 +24,12 @@ struct CertifiedRoot {
     bool fell_back = false;  ///< collocation was needed
     int degree = 0;          ///< collocation degree used (0 if none)
 };
-/// `dde` builds the same problem as a LinearDDE for the collocation fallback.
+/// `dde` builds the same problem as a LinearDDE for the collocation fallback. With `wide` (a
+/// tracker's state along a row) the Newton root's certificate counts first on a line `*wide` times
+/// max(1, |z|) left of it, which needs fewer samples than the line 1e-2 left, and adapts `*wide`
+/// (halved when that line holds another zero, grown back to at most 0.25 when it certifies).
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
-                                  const std::optional<cplx>& guess);
+                                  const std::optional<cplx>& guess, double* wide = nullptr);
 
 /// Ring (N >= 2) or N = infinity summary at one point, continuing from the previous point.
 struct RingSummary {
@@ -58,10 +62,14 @@ private:
 class PlantTracker {
 public:
     RootResult evaluate(const Linearisation& lin, int& fallbacks);
-    void reset() { m_guess.reset(); }
+    void reset() {
+        m_guess.reset();
+        m_wide = 0.25;
+    }
 
 private:
     std::optional<cplx> m_guess;
+    double m_wide = 0.25;  // the first certificate line's distance (certified_rightmost)
 };
 
 /// The ring's summary at one point on the winding path (analyse_ring_winding, every mode from
@@ -77,7 +85,11 @@ RingSummary winding_ring_summary(const Linearisation& lin, int cars, RingWinding
 /// refined). Fills every field of `p` but x and y; adds the collocation fallbacks to `fallbacks`.
 RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, PlantTracker& plant, SweepPoint& p, int& fallbacks);
 /// The same with the ring's summary already computed (by the tracker or the winding path): the
-/// plant and string stability, every field of `p` but x and y.
-void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks);
+/// plant and string stability, every field of `p` but x and y. With `string` (a sweep row's
+/// continuation) the string analysis starts from the previous point's maximiser
+/// (analyse_string_continued) and scans the axis only when that cannot certify; `string` is then
+/// updated to this point's maximiser.
+void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks,
+                      StringGuess* string = nullptr);
 
 }  // namespace ddemap::detail
