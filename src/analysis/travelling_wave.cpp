@@ -770,6 +770,8 @@ std::string format_q(double q) {
 
 /// The shift fraction q = k / N from which long waves are reached by the homotopy in q.
 constexpr double kHomotopyStart = 0.1;
+/// The least number of waves of the K / N = 0.1 branch from which the homotopy's start is taken.
+constexpr int kHomotopyBranchPoints = 1000;
 
 /// Homotopy in q = c.kappa with the parameter held at p = u(N + 1): natural continuation in log q
 /// from c.kappa down to `target` (steps of factor 0.5 at first, halved on failure, grown by 1.5
@@ -850,7 +852,9 @@ void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, 
     double drift0 = 0.0;
     const PeriodicMesh mesh0 = c.mesh;
     std::vector<double> defects0;
-    follow(c, u, t, r, FullRing{}, o0, 0.5, T00, o.max_points, false, b0, drift0, defects0, DefectControl{});
+    // at least kHomotopyBranchPoints waves: the branch must pass its fold when it has one (the IDM
+    // ring: the homotopy at a parameter short of the fold meets a fold in K / N, see the header)
+    follow(c, u, t, r, FullRing{}, o0, 0.5, T00, std::max(o.max_points, kHomotopyBranchPoints), false, b0, drift0, defects0, DefectControl{});
     b.newton_iterations += b0.newton_iterations - r.iterations;
     c.mesh = mesh0;
     const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to), margin = 0.05 * (hi - lo);

@@ -150,3 +150,38 @@ TEST_CASE("travelling waves: the resolution control refuses what it cannot resol
     PeriodicOrbit empty;
     CHECK_THROWS_AS(check_wave_on_full_ring("ov", {}, "headway", 1000, 1, 4, empty, 10), std::invalid_argument);
 }
+
+TEST_CASE("travelling waves: the IDM 1000-car ring (K = 1) through the homotopy past the fold of the K / N = 0.1 branch, on the full ring" *
+          doctest::test_suite("slow")) {
+    // th = 1.2 s, tau = 0.6 s, gap from 40 down to 6: the K / N = 0.1 branch (Hopf point at gap
+    // 22.96) folds at gap 19.29 and comes back to large gaps; the homotopy starts beyond that fold
+    // (a start short of it, gap 19.54, met a fold in K / N at 0.086 and failed)
+    const ParameterMap parameters{{"th", 1.2}, {"tau", 0.6}};
+    double period[2] = {0.0, 0.0};
+    const int intervals[2] = {40, 80};
+    for (int k = 0; k < 2; ++k) {
+        TravellingWaveOptions o;
+        o.model = "idm";
+        o.cars = 1000;
+        o.wave = 1;
+        o.orbit.parameter = "gap";
+        o.orbit.from = 40.0;
+        o.orbit.to = 6.0;
+        o.orbit.intervals = intervals[k];
+        o.orbit.max_points = 20;
+        const TravellingWaveBranch w = travelling_wave_branch(parameters, o);
+        INFO(w.branch.message);
+        REQUIRE(w.branch.status == Status::Converged);
+        REQUIRE(std::isfinite(w.homotopy_par));
+        CHECK(w.homotopy_par > 19.29);  // beyond the fold of the K / N = 0.1 branch
+        for (double d : w.defects) CHECK(d <= o.defect_tolerance);
+        for (std::size_t i = 0; i < w.branch.points.size(); i += 5) {
+            const WaveRingCheck c = check_wave_on_full_ring("idm", parameters, "gap", 1000, 1, 4, w.branch.points[i], 100);
+            CAPTURE(w.branch.points[i].par);
+            CHECK(c.relative <= tol::wave_full_ring_defect);
+            CHECK(c.length_error <= tol::wave_ring_length);
+        }
+        period[k] = homotopy_wave(w).period;
+    }
+    CHECK(std::abs(period[0] - period[1]) <= tol::long_wave_period * period[1]);
+}
