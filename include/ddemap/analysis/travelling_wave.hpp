@@ -45,7 +45,22 @@
 /// every step, orbit_mesh.hpp), and the branch is continued both ways in the parameter on a mesh
 /// re-equidistributed after every wave (profile weight lowered 1000 times in the arclength norm),
 /// the side ending at the smaller amplitude first (reversed). The Hopf point reported is still
-/// the requested mode's; the branch need not reach it.
+/// the requested mode's; the branch need not reach it. The K / N = 0.1 branch is followed for at
+/// least 1000 waves so that it passes its fold when it has one: the IDM ring's (th = 1.2, tau =
+/// 0.6) folds at gap 19.29, and a homotopy started short of it (gap 19.54) meets a fold in K / N
+/// (the K / N = 0.086 branch folds at gap 22.30: no such wave at gap 19.54) and fails.
+///
+/// Resolution. Every wave's relative defect between the collocation points (the reduced
+/// equations at the d + 1 representation points of every interval, where collocation does not
+/// hold them; O(h^d), TravellingWaveBranch::defects) is reported. Long waves (homotopy path) keep
+/// it below TravellingWaveOptions::defect_tolerance: the intervals are doubled until the wave
+/// reached by the homotopy is resolved, and a wave of the branch above it is corrected again on a
+/// mesh equidistributed on itself (or with every interval split once the step is small), else with
+/// a shorter step (stop "unresolved" below the minimum step). Waves from their own Hopf point (a
+/// fixed uniform mesh) stop as "unresolved" above unresolved_defect. On 40 intervals the
+/// uncontrolled 1000-car ov wave (K = 1) had period jumps of 2e-3 and spurious folds at defects of
+/// 1e-2 to 1e-1; with the control the intervals go to 80 and 160 and the periods agree with the
+/// 100-interval branch at the same headway to 5e-6.
 ///
 /// Stability. The reduced form does not give the ring's stability: perturbations of the ring
 /// need not keep the wave structure (they split into N Fourier families; the one-car
