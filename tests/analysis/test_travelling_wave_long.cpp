@@ -8,6 +8,8 @@
 
 #include "../tolerances.hpp"
 #include "ddemap/analysis/travelling_wave.hpp"
+#include "ddemap/solve/integrate.hpp"
+#include "ddemap/traffic/nonlinear_ring.hpp"
 
 // Long travelling waves (1000 cars, K = 1) checked independently of the reduced equations: the
 // full ring's 1999 equations on the wave spread to the 1000 cars, and the resolution control
@@ -51,6 +53,54 @@ double period_at(const std::vector<std::pair<double, double>>& b, double p) {
     return std::nan("");
 }
 
+/// The full ov ring of 1000 cars (one headway eliminated) simulated with the project's DDE
+/// integrator (RK4, Hermite history) from the wave's own history on [-tau, 0] to t_end with step
+/// h: max over the 1999 components and the times 1, 2, .., t_end of |X_sim(t) - X_wave(t)|,
+/// divided by the amplitude of car 0's headway.
+double simulated_deviation(const PeriodicOrbit& p, double t_end, double h) {
+    const int cars = 1000;
+    const NonlinearRing ring = make_nonlinear_ring("ov", cars, {{"headway", p.par}});
+    const NonlinearDDE& sys = *ring.system;
+    const int n = sys.dimension();
+    const double tau = sys.delays()[0], T = p.period;
+    const PeriodicMesh mesh(4, p.breakpoints);
+    auto wave_state = [&](double t, double* y) {
+        for (long car = 0; car < cars; ++car) {
+            const Eigen::VectorXd x = wave_car_state(mesh, p, cars, 1, car, t / T - std::floor(t / T));
+            if (car + 1 < cars) y[car] = x(0);
+            y[cars - 1 + car] = x(1);
+        }
+    };
+    double last_t = std::nan("");
+    std::vector<double> cache(static_cast<std::size_t>(n));
+    DdeSolver s(
+        n, 0.0,
+        [&](double t, double* y) {
+            if (t != last_t) {
+                wave_state(t, cache.data());
+                last_t = t;
+            }
+            std::copy(cache.begin(), cache.end(), y);
+        },
+        [&](double t, const double* y, const DdeSolver& sol, double* dy) {
+            Eigen::VectorXd u(2 * n);
+            for (int i = 0; i < n; ++i) {
+                u(i) = y[i];
+                u(n + i) = sol.value(i, t - tau);
+            }
+            const Eigen::VectorXd f = sys.f(u);
+            for (int i = 0; i < n; ++i) dy[i] = f(i);
+        });
+    s.integrate(t_end, h, {});
+    std::vector<double> w(static_cast<std::size_t>(n));
+    double dev = 0.0;
+    for (double t = 1.0; t <= t_end + 1e-9; t += 1.0) {
+        wave_state(t, w.data());
+        for (int i = 0; i < n; ++i) dev = std::max(dev, std::abs(s.value(i, t) - w[static_cast<std::size_t>(i)]));
+    }
+    return dev / (p.max(0) - p.min(0));
+}
+
 }  // namespace
 
 TEST_CASE("travelling waves: the long wave of a 1000-car ring (K = 1) on the full ring's 1999 equations, resolved at 100 and 200 intervals" *
@@ -90,6 +140,17 @@ TEST_CASE("travelling waves: the long wave of a 1000-car ring (K = 1) on the ful
     INFO("full-ring relative defect at 100 intervals " << start_defect[0] << ", at 200 " << start_defect[1]);
     CHECK(start_defect[1] * tol::defect_refinement_factor <= start_defect[0]);
     CHECK(std::abs(homotopy_wave(w100).period - homotopy_wave(w200).period) <= tol::long_wave_period * homotopy_wave(w200).period);
+    // the full ring simulated from the wave's history stays on the wave (20 time units: the
+    // fronts pass about 5 cars)
+    const double dev = simulated_deviation(homotopy_wave(w200), 20.0, 0.02);
+    // the same profile with its period 1e-4 too long (the shift from car to car 0.39 time units
+    // too long) leaves it
+    PeriodicOrbit wrong = homotopy_wave(w200);
+    wrong.period *= 1.0 + 1e-4;
+    const double dev_wrong = simulated_deviation(wrong, 20.0, 0.02);
+    INFO("simulated deviation " << dev << ", with the period 1e-4 too long " << dev_wrong);
+    CHECK(dev <= tol::wave_vs_simulation);
+    CHECK(dev_wrong > 100.0 * tol::wave_vs_simulation);
 }
 
 TEST_CASE("travelling waves: 40 intervals for the 1000-car wave (K = 1) are refined, no spurious folds or periods" * doctest::test_suite("slow")) {

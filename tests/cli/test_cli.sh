@@ -1238,5 +1238,18 @@ grep -q '^ddemap: orbits: 1 orbit (at most 2)' "$rpd/o1.err" && grep -q '^branch
     bad "orbits --points 2: not '1 orbit' in the progress: $(grep -h -E '^branch|1 orbit' "$rpd/o1.out" "$rpd/o1.err" | head -3)"
 rm -rf "$rpd"
 
+# ---- orbits --wave: the resolution of the waves (defect between collocation points) ----
+wrs="$(mktemp -d)"
+# 100 cars per wave on 20 uniform intervals: the branch stops as unresolved, exit 4, every
+# reported wave below the limit 0.1
+"$bin" orbits --model ov --ring 1000 --wave 10 --par headway --from 3.5 --to 2 --initial-step 0.001 --points 40 --intervals 20 --format json >"$wrs/u.json" 2>"$wrs/u.err"
+[ $? -eq 4 ] && grep -q "not resolved" "$wrs/u.err" && python3 -c "
+import json; d = json.load(open('$wrs/u.json')); r = d['result']
+assert r['stop'] == 'unresolved' and len(r['points']) > 0
+assert all(0 <= p['defect'] <= 0.1 for p in r['points'])
+assert r['wave']['max_defect'] == max(p['defect'] for p in r['points']) and r['wave']['intervals_used'] == 20" && ok ||
+    bad "orbits --wave 10 --ring 1000 --intervals 20: not stopped as unresolved with the defects in JSON"
+rm -rf "$wrs"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
