@@ -181,5 +181,23 @@ constexpr double torus_vs_ddebiftool = 1e-8;
 /// discretisation error of a profile with fronts of a few cars in a period of 1000; measured
 /// below 1e-6 (3871.642 both); 1e-5.
 constexpr double long_wave_period = 1e-5;
+/// The full ring's relative defect (check_wave_on_full_ring: max |X' - F(X, X(t - tau))| over the
+/// 2 N - 1 equations on the wave spread to the N cars, relative to max |X'|) of a wave whose
+/// reduced defect the branch holds below TravellingWaveOptions::defect_tolerance = 1e-3: the
+/// same O(h^d) defect of the polynomial sampled at other times (measured 0.2 to 0.7 times the
+/// reduced one, 1000 cars, K = 1) plus the ring-length error (below 1e-11); 1e-3. A wrong shift,
+/// wave number or ring closure gives O(1).
+constexpr double wave_full_ring_defect = 1e-3;
+/// The factor by which a defect O(h^d) (degree d = 4) must at least fall when the number of
+/// intervals is doubled: 2^4 = 16 on halved intervals; 4, because the equidistributed meshes of
+/// the two runs are not exact halves of each other and the waves compared are at slightly
+/// different parameters.
+constexpr double defect_refinement_factor = 4.0;
+/// The full ov ring of 1000 cars simulated (RK4, step 0.02, Hermite history) for 20 time units
+/// from the history of a long wave (K = 1, 200 intervals) against the wave itself, max deviation
+/// over the 1999 components relative to the amplitude of h: the wave's defect (absolute 1e-8 to
+/// 1e-7 in h' and v') integrated over 20 time units and RK4's error (O(h^4) ~ 1e-7 of the
+/// fronts' derivatives) give below 1e-6; measured 2.5e-9; 1e-6.
+constexpr double wave_vs_simulation = 1e-6;
 
 }  // namespace ddemap::test::tol

@@ -79,7 +79,7 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
             out << "hopf       " << par << " = " << rounded(w.hopf.par, 10) << ", omega = " << rounded(w.hopf.omega, 10) << " (ring mode " << o.wave
                 << " of " << o.cars << " cars)\n";
         out << "wave       car i + 1 = car i shifted by " << o.wave << " T / " << o.cars << "; reduced form: one car, " << counted(static_cast<long long>(b.points.size()), "wave")
-            << ", degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
+            << ", degree " << b.degree << " on " << (b.intervals > po.intervals ? "up to " : "") << b.intervals << " intervals (ended: " << b.stop << ")\n";
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + variables[0], 14) << pad("amp v0", 14) << pad("max|mu|", 12) << "stable\n";
         for (const PeriodicOrbit& p : b.points)
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[0] - p.min[0], 6), 14)
@@ -93,7 +93,9 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
                 << rounded(b.max_trivial_distance, 2) << "\n";
         else
             out << "stability  not computed (the full ring's multipliers are computed up to 10 cars; the reduced form alone does not decide the ring's stability)\n";
-        if (!b.points.empty()) out << "accuracy   max residual = " << rounded(b.max_residual, 2) << ", max drift |mu| = " << rounded(w.max_drift, 2) << "\n";
+        if (!b.points.empty())
+            out << "accuracy   max residual = " << rounded(b.max_residual, 2) << ", max drift |mu| = " << rounded(w.max_drift, 2)
+                << ", max relative defect between collocation points = " << rounded(w.max_defect, 2) << "\n";
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
         if (!files.empty()) {
             out << "wrote     ";

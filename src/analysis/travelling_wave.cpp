@@ -159,6 +159,43 @@ Eigen::MatrixXd derivative_at_collocation(const Wave& c, const Eigen::VectorXd& 
     return r;
 }
 
+/// The relative defect of the wave u between the collocation points: at the d + 1 representation
+/// points of every interval (the ends and the points between the Gauss nodes, where the
+/// collocation does not hold the equations), r(s) = x'(s) - T [g(x(s), x(s - tau/T), x(s + kappa),
+/// x(s + kappa - tau/T); p) + mu e_h]; returns max over components c of max_s |r_c| / max_s |x_c'|
+/// (the interval's own polynomial at its ends). For a collocation solution it is
+/// O(h^d |x^(d+1)| / |x'|): the indicator of an unresolved profile. NaN when not finite.
+double reduced_defect(const Wave& c, const Eigen::VectorXd& u) {
+    const int N = c.N();
+    const double T = u(N), p = u(N + 1), mu = u(N + 2);
+    const std::vector<double> pv = c.params(p);
+    const std::vector<double> tau = c.car.delays(pv);
+    std::vector<double> l(static_cast<std::size_t>(c.d) + 1), dl(l), lk(l), dlk(l);
+    Eigen::VectorXd stacked(2 * (c.m + 1));
+    Eigen::Array2d rmax = Eigen::Array2d::Zero(), dmax = Eigen::Array2d::Zero();
+    for (int i = 0; i < c.L; ++i)
+        for (int jj = 0; jj <= c.d; ++jj) {
+            const double s = c.mesh.breakpoints()[static_cast<std::size_t>(i)] + c.mesh.width(i) * jj / c.d;
+            c.mesh.basis(i, s, l.data(), dl.data());
+            const Eigen::Vector2d dx = combine(c, u, i, dl.data());
+            stacked.head<2>() = combine(c, u, i, l.data());
+            for (int k = 0; k < c.m; ++k) {
+                const double sk = s - tau[static_cast<std::size_t>(k)] / T + (RingCar::is_lead(k + 1) ? c.kappa : 0.0);
+                double wrapped = sk - std::floor(sk);
+                if (wrapped >= 1.0) wrapped = 0.0;
+                const int ik = c.mesh.interval_of(wrapped);
+                c.mesh.basis(ik, wrapped, lk.data(), dlk.data());
+                stacked.segment<2>(2 * (k + 1)) = combine(c, u, ik, lk.data());
+            }
+            Eigen::VectorXd f = c.car.f(stacked, pv);
+            f(0) += mu;
+            rmax = rmax.max((dx - T * f).array().abs());
+            dmax = dmax.max(dx.array().abs());
+        }
+    const double r = (rmax / dmax).maxCoeff();
+    return std::isfinite(r) ? r : std::numeric_limits<double>::quiet_NaN();
+}
+
 struct Correction {
     bool ok = false;
     int iterations = 0;
@@ -425,6 +462,57 @@ void remesh(Wave& c, Eigen::VectorXd& u, Eigen::VectorXd* t) {
     if (t) *t /= c.norm(*t);
 }
 
+/// u (or a tangent; profile part 2 P values, then T, p, mu) on the mesh of c re-represented on
+/// `to`, which may have another number of intervals (same degree).
+Eigen::VectorXd resample_to(const Wave& c, const PeriodicMesh& to, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd profile(c.P, 2);
+    for (int i = 0; i < c.P; ++i) profile.row(i) = u.segment<2>(2 * i).transpose();
+    Eigen::VectorXd v(2 * to.points() + 3);
+    for (int i = 0; i < to.points(); ++i) v.segment<2>(2 * i) = orbit_value(c.mesh, profile, to.point(i));
+    v.tail<3>() = u.tail<3>();
+    return v;
+}
+
+/// Sets c's mesh to `to` (any number of intervals of c's degree): the sizes and the profile
+/// weights of the continuation norm (1 / P, as at the start) follow; u is re-represented.
+void apply_mesh(Wave& c, const PeriodicMesh& to) {
+    const int N = c.N();
+    const Eigen::Vector3d tail = c.w.tail<3>();
+    const double profile_weight = c.w(0);
+    c.mesh = to;
+    c.L = to.intervals();
+    c.P = to.points();
+    c.w.resize(c.N() + 3);
+    c.w.head(c.N()).setConstant(profile_weight * static_cast<double>(N) / c.N());
+    c.w.tail<3>() = tail;
+}
+
+void set_mesh(Wave& c, const PeriodicMesh& to, Eigen::VectorXd& u) {
+    u = resample_to(c, to, u);
+    apply_mesh(c, to);
+}
+
+/// Every interval of c's mesh split in two (2 L intervals, the equidistribution kept).
+PeriodicMesh split_mesh(const PeriodicMesh& m) {
+    std::vector<double> t;
+    t.reserve(2 * m.breakpoints().size());
+    for (std::size_t i = 0; i + 1 < m.breakpoints().size(); ++i) {
+        t.push_back(m.breakpoints()[i]);
+        t.push_back(0.5 * (m.breakpoints()[i] + m.breakpoints()[i + 1]));
+    }
+    t.push_back(1.0);
+    return PeriodicMesh(m.degree(), t);
+}
+
+/// The resolution control of follow (reduced_defect): on an adapted mesh a wave whose defect is
+/// above `tolerance` is corrected again on a mesh equidistributed on it, and when still above,
+/// the step is halved (the branch stops as "unresolved" below the minimum step); on a fixed
+/// mesh the branch stops as "unresolved" at a wave whose defect is above `refuse` (0: off).
+struct DefectControl {
+    double tolerance = 0.0, refuse = 0.0;
+    int max_intervals = 0;
+};
+
 /// The branch from the corrected wave u with unit tangent t (the continuation of periodic_orbit's
 /// follow): pseudo-arclength with step control, the range's faces located, folds located by
 /// Illinois regula falsi on the parameter component of the tangent. The branch ends at
@@ -432,8 +520,9 @@ void remesh(Wave& c, Eigen::VectorXd& u, Eigen::VectorXd* t) {
 /// first wave's (back at the Hopf point), when the period exceeds max_period_factor T0, or when
 /// the step falls below min_step. With `adapt` the mesh is re-equidistributed after every wave.
 void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const FullRing& full, const PeriodicOrbitOptions& o,
-            double collapse, double T0, int max_points, bool adapt, OrbitBranch& b, double& max_drift) {
-    const int N = c.N();
+            double collapse, double T0, int max_points, bool adapt, OrbitBranch& b, double& max_drift, std::vector<double>& defects,
+            const DefectControl& dc) {
+    int N = c.N();
     const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
     // after every wave added: o.progress (waves so far, max_points, p); it may throw to stop the branch
     auto report = [&] {
@@ -441,19 +530,95 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
     };
     b.points.push_back(make_orbit(c, u, first, full, o.parameter, o.floquet));
     report();
+
+    defects.push_back(reduced_defect(c, u));
     b.newton_iterations += first.iterations;
     max_drift = std::max(max_drift, std::abs(u(N + 2)));
     const double amp0 = amplitude(b.points.front());
     double h = o.initial_step;
     b.stop = "max_points";
-    if (adapt) remesh(c, u, &t);
+    b.intervals = std::max(b.intervals, c.L);
+    if (adapt && !(dc.tolerance > 0.0)) remesh(c, u, &t);  // with the defect control, only when needed
+    Eigen::MatrixXd ref;
+    Eigen::VectorXd a;
+    // A corrected wave vv (defect dv above the tolerance, adaptive mesh) made resolved: corrected
+    // again on the mesh equidistributed on it, then, when the step h is already small (below
+    // 1e-3 of the largest), on that mesh with every interval split (up to max_intervals); the
+    // condition row is the arclength step h from u along t or, with fixed_par, p = par. On success
+    // c, N, u, t, ref, a, vv, rr and dv are on the new mesh.
+    auto resolve = [&](Eigen::VectorXd& vv, Correction& rr, double& dv, double hh, bool fixed_par, double par) {
+        PeriodicMesh next(c.d, orbit_mesh::equidistributed_breakpoints(c.mesh, 2, vv));
+        const bool may_split = (fixed_par || hh <= 1e-3 * o.max_step) && 2 * c.L <= dc.max_intervals;
+        for (int attempt = 0; attempt < (may_split ? 2 : 1); ++attempt) {
+            if (attempt == 1) next = split_mesh(next);
+            Wave trial = c;
+            apply_mesh(trial, next);
+            const int Nn = trial.N();
+            const Eigen::VectorXd un = resample_to(c, next, u);
+            Eigen::VectorXd tv = resample_to(c, next, t), vn = resample_to(c, next, vv);
+            tv /= trial.norm(tv);
+            const Eigen::MatrixXd refn = derivative_at_collocation(trial, un);
+            Eigen::VectorXd an = trial.w.cwiseProduct(tv), row = an;
+            double rhs = an.dot(un + hh * tv);
+            if (fixed_par) {
+                row = Eigen::VectorXd::Zero(Nn + 3);
+                row(Nn + 1) = 1.0;
+                rhs = par;
+            }
+            const Correction rn = correct(trial, vn, refn, row, rhs, o);
+            b.newton_iterations += rn.iterations;
+            const double dn = rn.ok ? reduced_defect(trial, vn) : std::numeric_limits<double>::quiet_NaN();
+            if (rn.ok && dn <= dc.tolerance && (fixed_par || trial.norm(vn - un) <= 3.0 * hh)) {
+                apply_mesh(c, next);
+                N = c.N();
+                b.intervals = std::max(b.intervals, c.L);
+                u = un;
+                t = tv;
+                vv = vn;
+                rr = rn;
+                ref = refn;
+                a = an;
+                dv = dn;
+                return true;
+            }
+        }
+        return false;
+    };
     while (static_cast<int>(b.points.size()) < max_points) {
-        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        const PeriodicMesh mesh_before = c.mesh;  // resolve() may move u and t to another mesh
+        const Eigen::VectorXd u_before = u, t_before = t;
+        ref = derivative_at_collocation(c, u);
         Eigen::VectorXd v = u + h * t;
-        const Eigen::VectorXd a = c.w.cwiseProduct(t);
+        a = c.w.cwiseProduct(t);
         Correction rc = correct(c, v, ref, a, a.dot(u + h * t), o);
         b.newton_iterations += rc.iterations;
         const bool jump = rc.ok && c.norm(v - u) > 3.0 * h;
+        double dv = rc.ok && !jump ? reduced_defect(c, v) : std::numeric_limits<double>::quiet_NaN();
+        bool unresolved = false;
+        if (rc.ok && !jump && adapt && dc.tolerance > 0.0 && !(dv <= dc.tolerance)) unresolved = !resolve(v, rc, dv, h, false, 0.0);
+        if (unresolved) {
+            // a smaller step first; the mesh is refined only when the step is already small
+            h *= 0.5;
+            if (h < o.min_step) {
+                b.stop = "unresolved";
+                b.status = Status::NumericalIssue;
+                std::ostringstream s;
+                s << "the wave at " << b.parameter << " = " << v(N + 1) << " is not resolved on " << c.L << " adapted intervals (relative defect "
+                  << dv << " between the collocation points, above " << dc.tolerance << ", with the step below " << o.min_step
+                  << "): use more intervals";
+                b.message = s.str();
+                break;
+            }
+            continue;
+        } else if (rc.ok && !jump && !adapt && dc.refuse > 0.0 && !(dv <= dc.refuse)) {
+            b.stop = "unresolved";
+            b.status = Status::NumericalIssue;
+            std::ostringstream s;
+            s << "the wave at " << b.parameter << " = " << v(N + 1) << " is not resolved on " << c.L << " intervals (relative defect " << dv
+              << " between the collocation points, above " << dc.refuse << "): the branch stops there; use more intervals";
+            b.message = s.str();
+            break;
+        }
         if (!rc.ok || jump) {
             h *= 0.5;
             if (h < o.min_step) {
@@ -474,13 +639,33 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
             e(N + 1) = 1.0;
             Eigen::VectorXd wv = v;
-            const Correction rb = correct(c, wv, ref, e, bound, o);
+            Correction rb = correct(c, wv, ref, e, bound, o);
             b.newton_iterations += rb.iterations;
-            if (rb.ok) {
+            double db = rb.ok ? reduced_defect(c, wv) : std::numeric_limits<double>::quiet_NaN();
+            if (rb.ok && adapt && dc.tolerance > 0.0 && !(db <= dc.tolerance) && !resolve(wv, rb, db, h, true, bound)) {
+                // the step overshot the face onto a wave that is not resolved: a shorter step
+                // from u on its own mesh
+                h *= 0.5;
+                if (h >= o.min_step) {
+                    apply_mesh(c, mesh_before);
+                    N = c.N();
+                    u = u_before;
+                    t = t_before;
+                    continue;
+                }
+                b.status = Status::NumericalIssue;
+                std::ostringstream s;
+                s << "the wave on the end of the parameter range (" << b.parameter << " = " << bound << ") is not resolved on " << c.L
+                  << " adapted intervals (relative defect " << db << " above " << dc.tolerance << ")";
+                b.message = s.str();
+                rb.ok = false;
+            } else if (rb.ok) {
                 b.points.push_back(make_orbit(c, wv, rb, full, o.parameter, o.floquet));
                 report();
+
+                defects.push_back(db);
                 max_drift = std::max(max_drift, std::abs(wv(N + 2)));
-            } else {
+            } else if (b.message.empty()) {
                 b.status = Status::MaxIterations;
                 b.message = "the wave on the end of the parameter range did not converge";
             }
@@ -530,6 +715,14 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
                 b.status = Status::MaxIterations;
                 b.message = "a fold of travelling waves was detected but not located";
             }
+            const double df = reduced_defect(c, best), limit = adapt ? dc.tolerance : dc.refuse;
+            if (limit > 0.0 && !(df <= limit) && b.status == Status::Converged) {
+                b.status = Status::NumericalIssue;
+                std::ostringstream s;
+                s << "the fold of travelling waves at " << b.parameter << " = " << f.orbit.par << " is not resolved on " << c.L
+                  << " intervals (relative defect " << df << " above " << limit << "): use more intervals";
+                b.message = s.str();
+            }
             b.folds.push_back(f);
         }
         PeriodicOrbit orbit = make_orbit(c, v, rc, full, o.parameter, o.floquet);
@@ -537,6 +730,8 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
         const bool collapsed = amplitude(orbit) < collapse * amp0;
         b.points.push_back(std::move(orbit));
         report();
+
+        defects.push_back(dv);
         if (collapsed) {
             b.stop = "hopf";
             break;
@@ -548,7 +743,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             b.stop = "period";
             break;
         }
-        if (adapt) remesh(c, u, &t);
+        if (adapt && !(dc.tolerance > 0.0)) remesh(c, u, &t);
     }
 }
 
@@ -585,6 +780,8 @@ std::string format_q(double q) {
 
 /// The shift fraction q = k / N from which long waves are reached by the homotopy in q.
 constexpr double kHomotopyStart = 0.1;
+/// The least number of waves of the K / N = 0.1 branch from which the homotopy's start is taken.
+constexpr int kHomotopyBranchPoints = 1000;
 
 /// Homotopy in q = c.kappa with the parameter held at p = u(N + 1): natural continuation in log q
 /// from c.kappa down to `target` (steps of factor 0.5 at first, halved on failure, grown by 1.5
@@ -634,7 +831,8 @@ bool kappa_homotopy(Wave& c, Eigen::VectorXd& u, double target, const PeriodicOr
 /// homotopy in q down to c.kappa at the parameter of that branch's largest wave inside the range,
 /// then the branch in the parameter in both directions on an adapted mesh, joined at that wave
 /// (the direction that ends at the smaller amplitude, towards the Hopf point, first).
-void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, const PeriodicOrbitOptions& o, double T0, TravellingWaveBranch& res) {
+void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, const TravellingWaveOptions& opt, double T0, TravellingWaveBranch& res) {
+    const PeriodicOrbitOptions& o = opt.orbit;
     OrbitBranch& b = res.branch;
     const int N = c.N();
     const double q = c.kappa;
@@ -663,7 +861,10 @@ void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, 
     o0.floquet = false;
     double drift0 = 0.0;
     const PeriodicMesh mesh0 = c.mesh;
-    follow(c, u, t, r, FullRing{}, o0, 0.5, T00, o.max_points, false, b0, drift0);
+    std::vector<double> defects0;
+    // at least kHomotopyBranchPoints waves: the branch must pass its fold when it has one (the IDM
+    // ring: the homotopy at a parameter short of the fold meets a fold in K / N, see the header)
+    follow(c, u, t, r, FullRing{}, o0, 0.5, T00, std::max(o.max_points, kHomotopyBranchPoints), false, b0, drift0, defects0, DefectControl{});
     b.newton_iterations += b0.newton_iterations - r.iterations;
     c.mesh = mesh0;
     const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to), margin = 0.05 * (hi - lo);
@@ -689,27 +890,62 @@ void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, 
     if (!ok) return fail("the homotopy stopped at K / N = " + format_q(c.kappa));
     res.homotopy_par = u(N + 1);
     res.homotopy_steps = steps;
+    // the number of intervals: every interval split in two (then the mesh equidistributed again)
+    // until the wave's defect is at most half the tolerance (room for the branch), at most
+    // max_intervals
+    for (double d0 = reduced_defect(c, u); opt.defect_tolerance > 0.0 && !(d0 <= 0.5 * opt.defect_tolerance); d0 = reduced_defect(c, u)) {
+        if (2 * c.L > opt.max_intervals) {
+            b.points.clear();
+            b.folds.clear();
+            b.status = Status::NumericalIssue;
+            b.stop = "unresolved";
+            std::ostringstream s;
+            s << "the long wave reached by the homotopy in K / N at " << o.parameter << " = " << res.homotopy_par << " is not resolved on " << c.L
+              << " adapted intervals (relative defect " << d0 << " between the collocation points, above " << 0.5 * opt.defect_tolerance
+              << "), and " << 2 * c.L << " would exceed the limit of " << opt.max_intervals << " intervals";
+            b.message = s.str();
+            return;
+        }
+        set_mesh(c, split_mesh(c.mesh), u);
+        for (int pass = 0; pass < 2; ++pass) {
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(c.N() + 3);
+            e(c.N() + 1) = 1.0;
+            Eigen::VectorXd w = u;
+            if (pass == 1) remesh(c, w, nullptr);
+            const Correction rm = correct(c, w, derivative_at_collocation(c, w), e, res.homotopy_par, o);
+            b.newton_iterations += rm.iterations;
+            if (!rm.ok) return fail("the long wave did not converge on " + std::to_string(c.L) + " intervals");
+            u = w;
+            last = rm;
+        }
+    }
+    b.intervals = c.L;
     t = last.tangent / c.norm(last.tangent);
     // the fronts move along s as the parameter changes: with the profile weighted as on short
     // waves the steps in the parameter are tiny; its weight is lowered 1000 times
     Wave c_start = c;
-    c_start.w.head(N) *= 1e-3;
+    c_start.w.head(c.N()) *= 1e-3;
     OrbitBranch side[2];
+    std::vector<double> side_defects[2];
     double drift = 0.0;
     const int half = std::max(2, (o.max_points + 1) / 2);
     for (int k = 0; k < 2; ++k) {
         side[k].parameter = o.parameter;
         Wave ck = c_start;
-        follow(ck, u, k == 0 ? t : Eigen::VectorXd(-t), last, full, o, 0.0, T0, k == 0 ? half : o.max_points - half + 1, true, side[k], drift);
+        follow(ck, u, k == 0 ? t : Eigen::VectorXd(-t), last, full, o, 0.0, T0, k == 0 ? half : o.max_points - half + 1, true, side[k], drift, side_defects[k],
+               DefectControl{opt.defect_tolerance, 0.0, opt.max_intervals});
         b.newton_iterations += side[k].newton_iterations - (k == 0 ? 0 : last.iterations);
     }
     res.max_drift = std::max(res.max_drift, drift);
+    b.intervals = std::max({b.intervals, side[0].intervals, side[1].intervals});
     // the side ending at the smaller amplitude (towards the Hopf point) first, reversed
     const int first = amplitude(side[0].points.back()) <= amplitude(side[1].points.back()) ? 0 : 1;
     const OrbitBranch& A = side[first];
     const OrbitBranch& B = side[1 - first];
     const int nA = static_cast<int>(A.points.size());
     b.points.assign(A.points.rbegin(), A.points.rend());
+    res.defects.assign(side_defects[first].rbegin(), side_defects[first].rend());
+    res.defects.insert(res.defects.end(), side_defects[1 - first].begin() + 1, side_defects[1 - first].end());
     for (OrbitFold f : A.folds) {
         f.after = nA - 2 - f.after;
         b.folds.push_back(f);
@@ -739,6 +975,9 @@ bool TravellingWaveOptions::is_valid(std::string* why) const {
     else if (cars < 2) w = "cars = " + std::to_string(cars) + ": expected a ring of at least 2 cars";
     else if (wave < 1 || wave > cars - 1) w = "wave = " + std::to_string(wave) + ": expected a wave number from 1 to N - 1 = " + std::to_string(cars - 1);
     else if (full_ring_floquet_limit < 0) w = "full_ring_floquet_limit: expected an integer >= 0";
+    else if (!(defect_tolerance >= 0.0) || !std::isfinite(defect_tolerance)) w = "defect_tolerance: expected a number >= 0";
+    else if (!(unresolved_defect >= 0.0) || !std::isfinite(unresolved_defect)) w = "unresolved_defect: expected a number >= 0";
+    else if (max_intervals < orbit.intervals) w = "max_intervals = " + std::to_string(max_intervals) + ": expected at least the intervals (" + std::to_string(orbit.intervals) + ")";
     else if (!orbit.is_valid(&w)) w = "orbit options: " + w;
     if (!w.empty() && why) *why = w;
     return w.empty();
@@ -748,6 +987,70 @@ Eigen::VectorXd wave_car_state(const PeriodicMesh& mesh, const PeriodicOrbit& or
     // s + car k / N mod 1, the integer part of car k taken first (exact for large N)
     const long shift = static_cast<long>((static_cast<long long>(car) * wave) % cars);
     return orbit_value(mesh, orbit.profile, s + static_cast<double>(shift) / cars);
+}
+
+WaveRingCheck check_wave_on_full_ring(const std::string& model, const ParameterMap& parameters, const std::string& parameter, int cars, int wave,
+                                      int degree, const PeriodicOrbit& orbit, int samples) {
+    if (samples < 1) throw std::invalid_argument("check_wave_on_full_ring: samples = " + std::to_string(samples) + ": expected at least 1");
+    if (orbit.profile.cols() != 2 || orbit.profile.rows() < 1 || !(orbit.period > 0.0))
+        throw std::invalid_argument("check_wave_on_full_ring: expected a travelling wave (a profile of car 0's 2 variables and a period > 0)");
+    if (wave < 1 || wave >= cars) throw std::invalid_argument("check_wave_on_full_ring: wave = " + std::to_string(wave) + ": expected 1 to N - 1");
+    const NonlinearRing ring = make_nonlinear_ring(model, cars, parameters, parameter, orbit.par);
+    const NonlinearDDE& sys = *ring.system;
+    const PeriodicMesh mesh(degree, orbit.breakpoints);
+    if (mesh.points() != orbit.profile.rows()) throw std::invalid_argument("check_wave_on_full_ring: the profile does not match the mesh of the given degree");
+    const int n = sys.dimension(), m = sys.delay_count();
+    const std::vector<double> tau = sys.delays();
+    const double T = orbit.period;
+    const double headway = sys.parameter(model == "ov" ? "headway" : "gap");
+    std::vector<double> l(static_cast<std::size_t>(degree) + 1), dl(l);
+    // car i's (h, v) and d/ds at time s of the period
+    auto car_at = [&](long car, double s, Eigen::Vector2d& x, Eigen::Vector2d* dx) {
+        const long shift = static_cast<long>((static_cast<long long>(car) * wave) % cars);
+        double q = s + static_cast<double>(shift) / cars;
+        q -= std::floor(q);
+        if (q >= 1.0) q = 0.0;
+        const int i = mesh.interval_of(q);
+        mesh.basis(i, q, l.data(), dl.data());
+        x.setZero();
+        if (dx) dx->setZero();
+        for (int j = 0; j <= degree; ++j) {
+            const Eigen::Vector2d xj = orbit.profile.row((i * degree + j) % mesh.points()).transpose();
+            x += l[static_cast<std::size_t>(j)] * xj;
+            if (dx) *dx += dl[static_cast<std::size_t>(j)] * xj;
+        }
+    };
+    WaveRingCheck r;
+    r.samples = samples;
+    Eigen::VectorXd stacked(static_cast<Eigen::Index>(n) * (m + 1)), dX(n);
+    Eigen::Vector2d x, dx;
+    for (int k = 0; k < samples; ++k) {
+        const double s = (k + 0.5) / samples;
+        double length = 0.0;
+        for (int q = 0; q <= m; ++q) {
+            const double sq = q == 0 ? s : s - tau[static_cast<std::size_t>(q - 1)] / T;
+            for (long car = 0; car < cars; ++car) {
+                car_at(car, sq, x, q == 0 ? &dx : nullptr);
+                const Eigen::Index base = static_cast<Eigen::Index>(q) * n;
+                if (car + 1 < cars) stacked(base + car) = x(0);
+                stacked(base + cars - 1 + car) = x(1);
+                if (q == 0) {
+                    length += x(0);
+                    if (car + 1 < cars) dX(car) = dx(0) / T;
+                    dX(cars - 1 + car) = dx(1) / T;
+                }
+            }
+        }
+        r.length_error = std::max(r.length_error, std::abs(length / (cars * headway) - 1.0));
+        const Eigen::VectorXd F = sys.f(stacked);
+        const Eigen::VectorXd d = (dX - F).cwiseAbs();
+        r.defect_h = std::max(r.defect_h, d.head(cars - 1).maxCoeff());
+        r.defect_v = std::max(r.defect_v, d.tail(cars).maxCoeff());
+        r.scale_h = std::max(r.scale_h, dX.head(cars - 1).cwiseAbs().maxCoeff());
+        r.scale_v = std::max(r.scale_v, dX.tail(cars).cwiseAbs().maxCoeff());
+    }
+    r.relative = std::max(r.defect_h / r.scale_h, r.defect_v / r.scale_v);
+    return r;
 }
 
 TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, const TravellingWaveOptions& options) {
@@ -823,10 +1126,10 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
     if (!options.force_homotopy || c.kappa >= kHomotopyStart) r = first_wave(c, res.hopf, o, u, t);
     if (r.ok) {
         // the branch (uniform mesh)
-        follow(c, u, t, r, full, o, 0.5, T0, o.max_points, false, b, res.max_drift);
+        follow(c, u, t, r, full, o, 0.5, T0, o.max_points, false, b, res.max_drift, res.defects, DefectControl{0.0, options.unresolved_defect, 0});
     } else if (c.kappa < kHomotopyStart) {
         if (!options.force_homotopy) b.newton_iterations += r.iterations;
-        long_wave_branch(c, *car, j, full, o, T0, res);
+        long_wave_branch(c, *car, j, full, options, T0, res);
         if (b.points.empty()) return res;
     } else {
         b.newton_iterations += r.iterations;
@@ -835,6 +1138,7 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
         b.message = "the first travelling wave from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
         return res;
     }
+    for (double dfc : res.defects) res.max_defect = std::max(res.max_defect, dfc);
     for (const PeriodicOrbit& pt : b.points) {
         b.max_residual = std::max(b.max_residual, pt.residual);
         if (std::isfinite(pt.trivial_distance)) b.max_trivial_distance = std::max(b.max_trivial_distance, pt.trivial_distance);

@@ -559,6 +559,10 @@ std::string travelling_wave_json(const TravellingWaveBranch& w, const std::vecto
     wave["hopf"] = {{"par", num(w.hopf.par)}, {"omega", num(w.hopf.omega)}, {"status", to_string(w.hopf.status)}};
     wave["stability"] = w.full_ring_stability ? "full_ring" : "not_computed";
     wave["max_drift"] = num(w.max_drift);
+    // the resolution indicator (TravellingWaveBranch::defects) and the largest mesh used
+    wave["max_defect"] = num(w.max_defect);
+    wave["intervals_used"] = w.branch.intervals;
+    for (std::size_t i = 0; i < w.branch.points.size() && i < w.defects.size(); ++i) j["points"][i]["defect"] = num(w.defects[i]);
     j["wave"] = wave;
     return text(j);
 }

@@ -1330,5 +1330,18 @@ PY
     bad "sweep with one uncertified point: $(cat "$spd/s1.err")"
 rm -rf "$spd"
 
+# ---- orbits --wave: the resolution of the waves (defect between collocation points) ----
+wrs="$(mktemp -d)"
+# 100 cars per wave on 20 uniform intervals: the branch stops as unresolved, exit 4, every
+# reported wave below the limit 0.1
+"$bin" orbits --model ov --ring 1000 --wave 10 --par headway --from 3.5 --to 2 --initial-step 0.001 --points 40 --intervals 20 --format json >"$wrs/u.json" 2>"$wrs/u.err"
+[ $? -eq 4 ] && grep -q "not resolved" "$wrs/u.err" && python3 -c "
+import json; d = json.load(open('$wrs/u.json')); r = d['result']
+assert r['stop'] == 'unresolved' and len(r['points']) > 0
+assert all(0 <= p['defect'] <= 0.1 for p in r['points'])
+assert r['wave']['max_defect'] == max(p['defect'] for p in r['points']) and r['wave']['intervals_used'] == 20" && ok ||
+    bad "orbits --wave 10 --ring 1000 --intervals 20: not stopped as unresolved with the defects in JSON"
+rm -rf "$wrs"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

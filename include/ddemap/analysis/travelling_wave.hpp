@@ -45,7 +45,22 @@
 /// every step, orbit_mesh.hpp), and the branch is continued both ways in the parameter on a mesh
 /// re-equidistributed after every wave (profile weight lowered 1000 times in the arclength norm),
 /// the side ending at the smaller amplitude first (reversed). The Hopf point reported is still
-/// the requested mode's; the branch need not reach it.
+/// the requested mode's; the branch need not reach it. The K / N = 0.1 branch is followed for at
+/// least 1000 waves so that it passes its fold when it has one: the IDM ring's (th = 1.2, tau =
+/// 0.6) folds at gap 19.29, and a homotopy started short of it (gap 19.54) meets a fold in K / N
+/// (the K / N = 0.086 branch folds at gap 22.30: no such wave at gap 19.54) and fails.
+///
+/// Resolution. Every wave's relative defect between the collocation points (the reduced
+/// equations at the d + 1 representation points of every interval, where collocation does not
+/// hold them; O(h^d), TravellingWaveBranch::defects) is reported. Long waves (homotopy path) keep
+/// it below TravellingWaveOptions::defect_tolerance: the intervals are doubled until the wave
+/// reached by the homotopy is resolved, and a wave of the branch above it is corrected again on a
+/// mesh equidistributed on itself (or with every interval split once the step is small), else with
+/// a shorter step (stop "unresolved" below the minimum step). Waves from their own Hopf point (a
+/// fixed uniform mesh) stop as "unresolved" above unresolved_defect. On 40 intervals the
+/// uncontrolled 1000-car ov wave (K = 1) had period jumps of 2e-3 and spurious folds at defects of
+/// 1e-2 to 1e-1; with the control the intervals go to 80 and 160 and the periods agree with the
+/// 100-interval branch at the same headway to 5e-6.
 ///
 /// Stability. The reduced form does not give the ring's stability: perturbations of the ring
 /// need not keep the wave structure (they split into N Fourier families; the one-car
@@ -83,6 +98,20 @@ struct TravellingWaveOptions {
     /// K / N < 0.1: start by the homotopy in K / N even when the first wave from the Hopf point
     /// converges (to check one path against the other)
     bool force_homotopy = false;
+    /// Resolution of long waves (reduced_defect, see TravellingWaveBranch::defects): on the
+    /// homotopy path the number of intervals is doubled (every interval split, then the mesh
+    /// equidistributed) until the wave reached by the homotopy has a relative defect of at most
+    /// defect_tolerance / 2, at most max_intervals intervals (otherwise the branch is empty with
+    /// stop "unresolved"); along the branch a wave above defect_tolerance is corrected again on a
+    /// mesh equidistributed on itself, then with a halved step (stop "unresolved" below the
+    /// minimum step). 0: off (the given intervals are kept).
+    double defect_tolerance = 1e-3;
+    int max_intervals = 1600;
+    /// On the fixed uniform mesh (waves from their own Hopf point) the branch stops as
+    /// "unresolved" (Status::NumericalIssue) at the first wave whose relative defect is above
+    /// this: the polynomial misses its equations by more than this fraction of |x'| between the
+    /// collocation points, the profile is not resolved (0: off).
+    double unresolved_defect = 0.1;
     bool is_valid(std::string* why = nullptr) const;
 };
 
@@ -97,6 +126,11 @@ struct TravellingWaveBranch {
     OrbitBranch branch;
     bool full_ring_stability = false;  ///< the multipliers are the full ring's (N <= limit)
     double max_drift = 0.0;            ///< max |mu| over the orbits (0 for an exact wave)
+    /// per wave of branch.points: the relative defect of the reduced equations between the
+    /// collocation points, max_c max_s |x_c'(s) - T (g_c + mu e_h)| / max_s |x_c'(s)| over the d + 1
+    /// representation points of every interval (O(h^d), the resolution indicator); its maximum
+    std::vector<double> defects;
+    double max_defect = 0.0;
     /// long waves (K / N < 0.1 whose first wave from the Hopf point fails): the parameter at
     /// which the homotopy in K / N ran and its number of steps (NaN and 0 otherwise)
     double homotopy_par = std::numeric_limits<double>::quiet_NaN();
@@ -111,5 +145,28 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
 
 /// Car i's state (h_i, v_i) of the wave at time s (of the period): car 0's at s + i k / N.
 Eigen::VectorXd wave_car_state(const PeriodicMesh& mesh, const PeriodicOrbit& orbit, int cars, int wave, long car, double s);
+
+/// A wave checked on the full ring (make_nonlinear_ring: 2 N - 1 equations, the last headway
+/// eliminated through the ring length), independently of the reduced equations: the ring's
+/// state is rebuilt from car 0's piecewise polynomial, X(t) = (h_0..h_{N-2}, v_0..v_{N-1})(t) with
+/// car i at x(t + i k T / N) (wave_car_state), and the full ring's right-hand side F is
+/// evaluated on it at the sample times t_m = (m + 0.5) T / M, m = 0..M-1:
+///     defect_h = max |X_j'(t_m) - F_j(X(t_m), X(t_m - tau); p)| over the headway rows j < N - 1,
+///     defect_v = the same over the N speed rows (the last car's uses the eliminated headway),
+/// X' the derivative of the polynomials (/ T). For a continuous wave both vanish; for a
+/// collocation solution they are the defect between the collocation points, O(h^d). scale_h,
+/// scale_v: max |X_j'(t_m)| over the same rows; relative = max(defect_h / scale_h, defect_v /
+/// scale_v). length_error = max_m |sum_i h_i(t_m) / (N headway) - 1| (h_{N-1} of car N - 1 taken
+/// from the polynomial, not from the elimination). Cost O(N M).
+struct WaveRingCheck {
+    double defect_h = 0.0, defect_v = 0.0, scale_h = 0.0, scale_v = 0.0, relative = 0.0, length_error = 0.0;
+    int samples = 0;
+};
+/// The check above for the wave `orbit` of wave number `wave` on a ring of `cars` cars (2..2000,
+/// as make_nonlinear_ring) of `model` with `parameters` and the branch parameter `parameter` at
+/// orbit.par; the orbit's mesh is PeriodicMesh(degree, orbit.breakpoints). std::invalid_argument
+/// for a ring make_nonlinear_ring refuses, samples < 1 or an orbit without profile.
+WaveRingCheck check_wave_on_full_ring(const std::string& model, const ParameterMap& parameters, const std::string& parameter, int cars, int wave,
+                                      int degree, const PeriodicOrbit& orbit, int samples);
 
 }  // namespace ddemap
