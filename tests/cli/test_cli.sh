@@ -1241,12 +1241,12 @@ rm -rf "$rpd"
 # ---- orbits --max-step: the largest continuation step (weighted norm); longer steps, fewer orbits, the same branch
 msd="$tmp/maxstep"; mkdir -p "$msd"
 echo '{"variables": ["y"], "parameters": {"alpha": 1}, "equations": ["-alpha*y(t - 1)*(1 + y)"], "equilibrium": [0]}' >"$msd/wright.json"
-"$bin" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2.5 --points 1000 --format json >"$msd/s.json" &&
+"$bin" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2.5 --points 1000 --max-step 0.02 --format json >"$msd/s.json" &&
     "$bin" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2.5 --points 1000 --max-step 1 --format json >"$msd/l.json" &&
     python3 - "$msd/s.json" "$msd/l.json" <<'PY' && ok || bad "orbits --max-step 1: not fewer orbits on the same branch"
 import json, sys
 s, l = (json.load(open(f)) for f in sys.argv[1:3])
-assert l["inputs"]["max_step"] == 1 and s["inputs"]["max_step"] == 0.1, (l["inputs"], s["inputs"])
+assert l["inputs"]["max_step"] == 1 and s["inputs"]["max_step"] == 0.02, (l["inputs"], s["inputs"])
 ps, pl = s["result"]["points"], l["result"]["points"]
 assert s["result"]["stop"] == l["result"]["stop"] == "bound"
 assert 3 * len(pl) < len(ps), (len(pl), len(ps))
