@@ -7,12 +7,12 @@
 # DDE-BIFTOOL is not part of ddemap: give the folder of its repository
 # (https://github.com/DDE-BifTool/DDE-Biftool) in DDEBIFTOOL_DIR; without it only ddemap runs, to
 # the gap 22.17044689 that DDE-BIFTOOL's 100 orbits reached (BENCHMARKS.md).
-#   DDEBIFTOOL_DIR=/path/to/DDE-Biftool [MAX_STEP=0.8] [REPEATS=3] bench/ddebiftool/compare.sh [ORBITS]
+#   DDEBIFTOOL_DIR=/path/to/DDE-Biftool [MAX_STEP=0.75] [REPEATS=3] bench/ddebiftool/compare.sh [ORBITS]
 # (from the repository root, after a build). With DDEBIFTOOL_DIR, the stability of every
 # DDE-BIFTOOL orbit is compared with ddemap's at the same gap (compare_stability.py).
 set -euo pipefail
 orbits=${1:-100}
-max_step=${MAX_STEP:-0.8}
+max_step=${MAX_STEP:-0.75}
 repeats=${REPEATS:-3}
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
