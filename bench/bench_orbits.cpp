@@ -1,11 +1,15 @@
 // A branch of periodic orbits of a car-following ring, every orbit with its Floquet multipliers.
-//   bench_orbits [--model ov|idm] [--points P] [--intervals L] [--degree D] [--repeats R] N1 N2 ...
+//   bench_orbits [--model ov|idm] [--points P] [--intervals L] [--degree D] [--repeats R] [--max-step S] [--to G] [--csv FILE] N1 N2 ...
+// --csv FILE: every orbit of the (last) branch, parameter, period, number of nontrivial
+// multipliers with |mu| > 1, the largest nontrivial |mu| and |mu_trivial - 1| (for the point-by-point
+// comparison with DDE-BIFTOOL's stability, bench/ddebiftool/compare_stability.py).
 // ov (default): the ov ring of Orosz, Wilson, Stepan 2004 (alpha = tau = v0 = h_st = 1) from the
 // subcritical Hopf point of ring mode 1 above the inflection of V (from the ring modes' closed
 // form, corrected by Newton). idm: the IDM ring (th = 1.2 s, tau = 0.6 s, the other parameters
-// at their defaults) from the first Hopf point of its equilibrium branch in the gap from 6 to 40 m,
-// the branch the command line computes with
-//   ddemap orbits --model idm --ring N --th 1.2 --tau 0.6 --par gap --from 6 --to 40 --points P
+// at their defaults) from the first Hopf point of its equilibrium branch in the gap from 6 to G m
+// (G = 40 unless --to), the branch the command line computes with
+//   ddemap orbits --model idm --ring N --th 1.2 --tau 0.6 --par gap --from 6 --to G --points P [--max-step S]
+// (--max-step: PeriodicOrbitOptions::max_step, default 0.1).
 // In both cases the Hopf point is not timed. For each N: the median wall and CPU time of the
 // branch over R runs, its folds, period doublings and tori, the largest |mu_trivial - 1|, the
 // Newton iterations, and a few values of the branch (to compare results between builds).
@@ -73,20 +77,20 @@ Problem ov_problem(int n) {
     return r;
 }
 
-Problem idm_problem(int n) {
+Problem idm_problem(int n, double to) {
     Problem r;
     NonlinearRing ring = make_nonlinear_ring("idm", n, ParameterMap{{"th", 1.2}, {"tau", 0.6}}, "gap", 6.0);
     EquilibriumBranchOptions eo;
     eo.parameter = "gap";
     eo.from = 6.0;
-    eo.to = 40.0;
+    eo.to = to;
     eo.roots.count = 2;
     const EquilibriumBranch eq = equilibrium_branch(*ring.system, ring.uniform_flow, eo);
     if (eq.hopf.empty()) return r;
     r.hopf = eq.hopf.front();
     r.options.parameter = "gap";
     r.options.from = 6.0;
-    r.options.to = 40.0;
+    r.options.to = to;
     r.system = std::move(ring.system);
     r.ok = r.hopf.status == Status::Converged;
     return r;
@@ -95,7 +99,8 @@ Problem idm_problem(int n) {
 
 int main(int argc, char** argv) {
     int points = 100, intervals = 40, degree = 4, repeats = 1;
-    std::string model = "ov";
+    double max_step = PeriodicOrbitOptions().max_step, to = 40.0;
+    std::string model = "ov", csv;
     std::vector<int> sizes;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -104,6 +109,9 @@ int main(int argc, char** argv) {
         else if (a == "--degree" && i + 1 < argc) degree = std::atoi(argv[++i]);
         else if (a == "--repeats" && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
         else if (a == "--model" && i + 1 < argc) model = argv[++i];
+        else if (a == "--max-step" && i + 1 < argc) max_step = std::atof(argv[++i]);
+        else if (a == "--to" && i + 1 < argc) to = std::atof(argv[++i]);
+        else if (a == "--csv" && i + 1 < argc) csv = argv[++i];
         else sizes.push_back(std::atoi(a.c_str()));
     }
     if (model != "ov" && model != "idm") {
@@ -111,11 +119,16 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (sizes.empty()) sizes = {5, 10};
-    std::printf("model %s, degree %d, %d intervals, at most %d orbits, median of %d run(s)\n", model.c_str(), degree, intervals, points, repeats);
+    if (!(to > 9.0) || !(max_step >= PeriodicOrbitOptions().initial_step)) {
+        std::fprintf(stderr, "bench_orbits: --to above 9 (the Hopf points lie near 8), --max-step at least the initial step 0.02\n");
+        return 2;
+    }
+    std::printf("model %s, degree %d, %d intervals, at most %d orbits, max step %g, median of %d run(s)\n", model.c_str(), degree, intervals, points,
+                max_step, repeats);
     std::printf("| N cars | states | orbits | wall [s] | CPU [s] | folds | PD | tori | max trivial dist | Newton its |\n"
                 "|---:|---:|---:|---:|---:|---|---|---|---:|---:|\n");
     for (int n : sizes) {
-        Problem pr = model == "ov" ? ov_problem(n) : idm_problem(n);
+        Problem pr = model == "ov" ? ov_problem(n) : idm_problem(n, to);
         if (!pr.ok) {
             std::printf("| %d | Hopf point not found or not converged |\n", n);
             continue;
@@ -124,6 +137,7 @@ int main(int argc, char** argv) {
         o.max_points = points;
         o.intervals = intervals;
         o.degree = degree;
+        o.max_step = max_step;
         std::vector<double> walls, cpus;
         OrbitBranch b;
         for (int r = 0; r < repeats; ++r) {
@@ -152,6 +166,31 @@ int main(int argc, char** argv) {
                         o.parameter.c_str(), p.par, p.period, p.max_nontrivial, p.trivial_distance, p.iterations);
         }
         std::printf("    stop: %s; %s\n", b.stop.c_str(), b.message.c_str());
+        for (const auto& x : b.period_doublings)
+            std::printf("    period doubling: %s = %.10f, bracket %.1e, mu %.8f%+.8fi\n", o.parameter.c_str(), x.par, x.par_bracket, x.multiplier.real(),
+                        x.multiplier.imag());
+        for (const auto& x : b.tori)
+            std::printf("    torus: %s = %.10f, bracket %.1e, mu %.8f%+.8fi\n", o.parameter.c_str(), x.par, x.par_bracket, x.multiplier.real(),
+                        x.multiplier.imag());
+        if (!csv.empty()) {
+            std::FILE* f = std::fopen(csv.c_str(), "w");
+            if (!f) {
+                std::fprintf(stderr, "bench_orbits: cannot write %s\n", csv.c_str());
+                return 5;
+            }
+            std::fprintf(f, "%s,period,nunst,max_nontrivial,trivial_distance\n", o.parameter.c_str());
+            for (const PeriodicOrbit& p : b.points) {
+                // the nontrivial multipliers outside the unit circle (the trivial one: nearest 1)
+                std::size_t k1 = 0;
+                for (std::size_t k = 1; k < p.multipliers.size(); ++k)
+                    if (std::abs(p.multipliers[k] - 1.0) < std::abs(p.multipliers[k1] - 1.0)) k1 = k;
+                int unstable = 0;
+                for (std::size_t k = 0; k < p.multipliers.size(); ++k)
+                    if (k != k1 && std::abs(p.multipliers[k]) > 1.0) ++unstable;
+                std::fprintf(f, "%.12g,%.12g,%d,%.10g,%.3e\n", p.par, p.period, unstable, p.max_nontrivial, p.trivial_distance);
+            }
+            std::fclose(f);
+        }
         std::fflush(stdout);
     }
 }

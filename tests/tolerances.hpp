@@ -200,4 +200,24 @@ constexpr double defect_refinement_factor = 4.0;
 /// fronts' derivatives) give below 1e-6; measured 2.5e-9; 1e-6.
 constexpr double wave_vs_simulation = 1e-6;
 
+/// A branch of periodic orbits computed with long steps (max_step 1 or 2) against the same
+/// branch with short ones (max_step 0.1): the period and the largest nontrivial |mu| of every
+/// long-step orbit against the short-step orbits' values interpolated (cubic, in the parameter)
+/// at its parameter, relative. Both are converged to 1e-10 (Newton) and the interpolation error
+/// of the short-step spacing is below that for these smooth branches; 1e-6, while a different
+/// orbit or branch at the same parameter differs in the first digits.
+constexpr double orbit_step_interpolation = 1e-6;
+
+/// A period doubling or torus point of one branch located with short and with long steps: the
+/// located | |mu| - 1 | <= 1e-9 with d|mu|/dp ~ 0.02 puts each within 5e-8 in p, and the orbits
+/// themselves differ by their Newton tolerance between the runs (measured up to 4e-7 in the gap
+/// on the 10-car IDM ring, whose multipliers reach 3e4); 1e-5, while the bracket of the long
+/// steps is 0.3 to 0.5 in the gap.
+constexpr double orbit_crossing_between_steps = 1e-5;
+
+/// The verified bracket of a located period doubling or torus point (an orbit on either side of
+/// the circle, PeriodicOrbitOptions / OrbitCrossing::par_bracket): 2 | |mu| - 1 | / |d|mu|/dp|
+/// <= 1e-7 in the gap of the IDM ring, or 1e-8 of the step; 1e-6 (the old report gave 0.04).
+constexpr double orbit_crossing_bracket = 1e-6;
+
 }  // namespace ddemap::test::tol

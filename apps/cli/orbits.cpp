@@ -23,7 +23,7 @@ namespace {
 struct Args {
     NonlinearProblemArgs problem;
     std::string hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
-    std::string wave, initial_step;
+    std::string wave, initial_step, max_step;
     CLI::Option* hopf_option = nullptr;
     bool adapt = false;
     FormatArg format;
@@ -59,9 +59,14 @@ void add_orbits_flags(CLI::App& app) {
         ->type_name("K");
     app.add_option("--initial-step", args.initial_step, "--wave: the first step along the branch in its weighted norm (default 0.02; long waves need smaller)")
         ->type_name("H");
+    app.add_option("--max-step", args.max_step,
+                   "the largest step along the branch in its weighted norm (default 0.1; larger steps: fewer orbits for the same stretch, "
+                   "see README)")
+        ->type_name("S");
 }
 
 int run_orbits() {
+    if (!args.max_step.empty() && !args.wave.empty()) throw BadInput("--max-step: not with --wave (the reduced form keeps its step control)");
     if (!args.wave.empty())
         return run_orbits_wave({args.problem, args.wave, args.degree, args.intervals, args.points, args.initial_step, args.svg, args.variable, args.adapt,
                                 args.hopf_option && args.hopf_option->count() > 0, args.format, args.out});
@@ -77,6 +82,12 @@ int run_orbits() {
     o.intervals = static_cast<int>(parse_integer("--intervals", args.intervals, 2, 10000, "an integer between 2 and 10000"));
     o.max_points = static_cast<int>(parse_integer("--points", args.points, 2, 100000, "an integer between 2 and 100000"));
     o.adapt = args.adapt;
+    if (!args.max_step.empty()) {
+        o.max_step = parse_number("--max-step", args.max_step);
+        if (!(o.max_step >= o.initial_step && o.max_step <= 1e6))
+            throw BadInput("--max-step = '" + args.max_step + "': expected a value from " + rounded(o.initial_step, 6) +
+                           " (the first step) to 1e6");
+    }
 
     NonlinearProblemArgs::Problem built = args.problem.load();  // --from != --to checked there
     o.from = built.from;
@@ -95,6 +106,7 @@ int run_orbits() {
     JsonObject& inputs = built.inputs;
     inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf_index).integer("degree", o.degree)
         .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
+    if (!args.max_step.empty()) inputs.number("max_step", o.max_step);  // only when given: the Python binding's envelope has no step option yet
 
     EquilibriumBranchOptions eo;
     eo.parameter = par;

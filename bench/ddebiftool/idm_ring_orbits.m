@@ -9,6 +9,9 @@
 %
 % Run: DDEBIFTOOL_DIR=/path/to/DDE-Biftool octave --no-gui --quiet idm_ring_orbits.m
 % Prints one line "ddebiftool orbits <n> cpu_branch <s> cpu_floquet <s> wall <s> ..." at the end.
+% Optional: ORBITS=<n> (default 100); DDEBIFTOOL_POINTS=<file.csv> writes every orbit (gap, period,
+% number of unstable nontrivial multipliers, |mu_trivial - 1|, the 6 largest nontrivial |mu|) for
+% the point-by-point stability comparison with `ddemap orbits` (not timed).
 ddir = getenv('DDEBIFTOOL_DIR');
 if isempty(ddir)
     disp('DDEBIFTOOL_DIR is not set: skipped');
@@ -79,3 +82,18 @@ periods = arrayfun(@(p) p.period, per.point);
 fprintf('ddebiftool orbits %d cpu_branch %.2f cpu_floquet %.2f cpu %.2f wall %.2f gap %.8f..%.8f period %.8f..%.8f max_trivial %.1e\n', ...
         numel(per.point), cpu_branch, cpu_floquet, cpu_branch + cpu_floquet, wall, min(gaps), max(gaps), min(periods), ...
         max(periods), max(abs(triv)));
+pfile = getenv('DDEBIFTOOL_POINTS');
+if ~isempty(pfile)
+    fid = fopen(pfile, 'w');
+    fprintf(fid, 'gap,period,nunst,trivial_dist,absmu1,absmu2,absmu3,absmu4,absmu5,absmu6\n');
+    for i = 1:numel(per.point)
+        mu = per.point(i).stability.mu(:);
+        [~, it] = min(abs(mu - 1));
+        mu(it) = [];
+        am = sort(abs(mu), 'descend');
+        am = [am; zeros(6, 1)];
+        fprintf(fid, '%.12g,%.12g,%d,%.3e,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n', gaps(i), periods(i), nunst_per(i), ...
+                abs(triv(i)), am(1:6));
+    end
+    fclose(fid);
+end

@@ -1343,5 +1343,26 @@ assert r['wave']['max_defect'] == max(p['defect'] for p in r['points']) and r['w
     bad "orbits --wave 10 --ring 1000 --intervals 20: not stopped as unresolved with the defects in JSON"
 rm -rf "$wrs"
 
+# ---- orbits --max-step: the largest continuation step (weighted norm); longer steps, fewer orbits, the same branch
+msd="$tmp/maxstep"; mkdir -p "$msd"
+echo '{"variables": ["y"], "parameters": {"alpha": 1}, "equations": ["-alpha*y(t - 1)*(1 + y)"], "equilibrium": [0]}' >"$msd/wright.json"
+"$bin" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2.5 --points 1000 --max-step 0.02 --format json >"$msd/s.json" &&
+    "$bin" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2.5 --points 1000 --max-step 1 --format json >"$msd/l.json" &&
+    python3 - "$msd/s.json" "$msd/l.json" <<'PY' && ok || bad "orbits --max-step 1: not fewer orbits on the same branch"
+import json, sys
+s, l = (json.load(open(f)) for f in sys.argv[1:3])
+assert l["inputs"]["max_step"] == 1 and s["inputs"]["max_step"] == 0.02, (l["inputs"], s["inputs"])
+ps, pl = s["result"]["points"], l["result"]["points"]
+assert s["result"]["stop"] == l["result"]["stop"] == "bound"
+assert 3 * len(pl) < len(ps), (len(pl), len(ps))
+# the last orbits are both on the face alpha = 2.5: the same period
+assert abs(ps[-1]["period"] - pl[-1]["period"]) < 1e-6 * ps[-1]["period"], (ps[-1]["period"], pl[-1]["period"])
+PY
+expect_error "--max-step = '0.01': expected a value from 0.02 (the first step) to 1e6" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2 --max-step 0.01 --out "$msd/bad1"
+expect_error "--max-step = 'inf': expected a finite number" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2 --max-step inf
+expect_error "--max-step: not with --wave" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --max-step 1
+[ -z "$(ls "$msd" | grep bad)" ] && ok || bad "orbits --max-step bad input wrote files: $(ls "$msd")"
+rm -rf "$msd"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

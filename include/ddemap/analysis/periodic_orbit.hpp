@@ -50,10 +50,12 @@
 ///
 /// Special points along a branch: a fold (the parameter component of the unit tangent changes
 /// sign) is located by Illinois regula falsi in the arclength on that component (each trial
-/// orbit corrected); a period doubling (the number of real multipliers < -1 changes) and a
-/// torus bifurcation (the number of complex multipliers with |mu| > 1 changes) likewise on
-/// |mu| - 1 of the multiplier that crosses (OrbitCrossing). A change of those counts without a
-/// multiplier crossing the unit circle (two multipliers colliding on the real axis) is not reported.
+/// orbit corrected); a period doubling (a real negative multiplier crosses the unit circle) and a
+/// torus bifurcation (a complex pair crosses it) likewise on |mu| - 1 of the multiplier that
+/// crosses (OrbitCrossing). The multipliers of each kind of two consecutive orbits are paired
+/// by distance, so every crossing of a step is found, also several in one long step; a change of
+/// the number of multipliers outside the circle without a crossing (two multipliers colliding on
+/// the real axis) is not reported.
 
 #include <limits>
 #include <string>
@@ -78,6 +80,11 @@ struct PeriodicOrbitOptions {
     int intervals = 40;      ///< L, the number of mesh intervals (>= 2)
     int max_points = 100;    ///< orbits on the branch, the first included (>= 2)
     double initial_step = 0.02;  ///< h in the weighted norm (also the first orbit's amplitude measure)
+    /// the largest step h in the weighted norm |u| of the continuation (below): h grows by 1.5
+    /// after an easy corrector up to it, and is halved after a failed one. The norm counts the
+    /// root mean square of the profile's values, T / sT and p / |to - from|, so its size follows
+    /// the orbits' amplitude: a branch whose orbits grow to an amplitude A needs about A / max_step
+    /// orbits at least
     double max_step = 0.1;
     double min_step = 1e-6;  ///< the branch ends when the step falls below it
     int max_iterations = 10;      ///< Newton iterations per corrector
@@ -125,9 +132,11 @@ struct OrbitFold {
 /// A period doubling or a torus bifurcation between orbits after and after + 1: the zero of
 ///     g(s) = |mu(s)| - 1
 /// along the branch (s the arclength from orbit `after`, each trial orbit corrected and its
-/// multipliers computed), mu the real negative multiplier nearest -1 (period doubling) or the
-/// complex one nearest the unit circle (torus), by Illinois regula falsi from the bracket of the
-/// two orbits until |g| <= 1e-9 (or the bracket is 1e-12 of the step).
+/// multipliers computed), mu the crossing real negative multiplier (period doubling) or complex
+/// one (torus), followed from the two orbits' by continuity, by Illinois regula falsi from the
+/// bracket of the two orbits until |g| <= 1e-9 (or the bracket is 1e-12 of the step); then an
+/// orbit just beyond the zero is computed and must have g of the other sign: par_bracket is the
+/// width of that verified bracket (a few 1e-8 of the step in the arclength, usually).
 struct OrbitCrossing {
     double par = 0.0, period = 0.0;  ///< of the located orbit (not located: interpolated linearly in g)
     cplx multiplier;                  ///< the crossing multiplier there (torus: the one with Im >= 0)
