@@ -24,10 +24,11 @@ python3 bench/sparse_systems.py rd --nx 1000 --ny 1 --dx 50100.05 --dy 0 --b 1,0
 python3 bench/sparse_systems.py rd --nx 10000 --ny 1 --dx 5001000.05 --dy 0 --b 1,0.3,0.2 --tau 2,0.7,1.3 --out $d/rd10000_3.json
 # a 2-D grid (40 x 25): the low modes are close together
 python3 bench/sparse_systems.py rd --nx 40 --ny 25 --out $d/rd2d1000.json
+python3 bench/sparse_systems.py rd --nx 100 --ny 100 --out $d/rd2d10000.json
 # rings of 500 and 5,000 OVRV cars written out (k1 = 0.2, k2 = 0.4, th = 1.5, tau = 0.5)
 python3 bench/sparse_systems.py ring --cars 500 --out $d/ring1000.json
 python3 bench/sparse_systems.py ring --cars 5000 --out $d/ring10000.json
-for f in rd1000 rd1000_3 rd2d1000 ring1000 rd10000 rd10000_3 ring10000; do
+for f in rd1000 rd1000_3 rd2d1000 ring1000 rd10000 rd10000_3 rd2d10000 ring10000; do
     echo "== $f: compact Krylov"
     timeout "$limit" build/bench/bench_sparse_system $d/$f.json --repeat "$repeat" || echo "(not done in $limit s)"
     case $f in *10000*) ;; *)

@@ -17,6 +17,7 @@
 #pragma GCC diagnostic pop
 
 #include "analysis/internal/orbit_mesh.hpp"
+#include "core/internal/eigen_threads.hpp"
 
 namespace ddemap {
 
@@ -1098,17 +1099,6 @@ void finish(OrbitBranch& b) {
         b.message = s.str();
     }
 }
-
-/// Eigen's products in one thread while a branch is computed: its matrices (d n x d n blocks, a
-/// window of a few hundred values) are too small for OpenMP's threads, which on a loaded machine
-/// spent five times the work in waiting (BENCHMARKS.md). The previous setting is restored.
-struct SingleThreadedEigen {
-    int previous = Eigen::nbThreads();
-    SingleThreadedEigen() { Eigen::setNbThreads(1); }
-    ~SingleThreadedEigen() { Eigen::setNbThreads(previous); }
-    SingleThreadedEigen(const SingleThreadedEigen&) = delete;
-    SingleThreadedEigen& operator=(const SingleThreadedEigen&) = delete;
-};
 
 std::string method_text(const PeriodicMesh& mesh) {
     std::ostringstream s;

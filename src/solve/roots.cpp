@@ -118,6 +118,9 @@ bool RootOptions::is_valid(std::string* why) const {
     } else if (shift_invert.compact_max_steps < 2) {
         os << "shift_invert.compact_max_steps = " << shift_invert.compact_max_steps << ": expected an integer >= 2";
         ok = false;
+    } else if (shift_invert.compact_restarts < 0) {
+        os << "shift_invert.compact_restarts = " << shift_invert.compact_restarts << ": expected an integer >= 0";
+        ok = false;
     } else if (shift_invert.arnoldi_max_restarts < 1) {
         os << "shift_invert.arnoldi_max_restarts = " << shift_invert.arnoldi_max_restarts << ": expected an integer >= 1";
         ok = false;

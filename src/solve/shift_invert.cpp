@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <queue>
 #include <random>
@@ -12,6 +13,7 @@
 #include <Spectra/GenEigsComplexShiftSolver.h>
 
 #include "ddemap/discretize/chebyshev.hpp"
+#include "core/internal/eigen_threads.hpp"
 #include "internal/backends.hpp"
 
 namespace ddemap {
@@ -157,8 +159,31 @@ struct CompactRitz {
     std::vector<cplx> theta;
     int converged = 0;   ///< length of the converged prefix of `theta`
     int steps = 0;       ///< Arnoldi steps taken (sparse solves)
-    int rank = 0;        ///< columns of Q
+    int rank = 0;        ///< columns of Q (at the end)
+    int restarts = 0;    ///< Krylov-Schur restarts
+    int max_rank = 0;    ///< columns of Q at most
 };
+
+/// Swaps the diagonal entries i and i+1 of the upper triangular s (complex Schur form
+/// H = U s U^H) by one unitary rotation G: its first column is the eigenvector
+/// (s_{i,i+1}, s_{i+1,i+1} - s_ii) of the 2 x 2 block for s_{i+1,i+1}, so G^H s G stays
+/// triangular with the two entries exchanged (LAPACK ztrexc); u <- u G.
+void schur_swap(Eigen::MatrixXcd& s, Eigen::MatrixXcd& u, Eigen::Index i) {
+    const cplx a = s(i, i), c = s(i + 1, i + 1);
+    cplx x1 = s(i, i + 1), x2 = c - a;
+    const double nx = std::hypot(std::abs(x1), std::abs(x2));
+    if (nx == 0.0) return;  // a == c and a zero coupling: nothing to exchange
+    x1 /= nx;
+    x2 /= nx;
+    Eigen::Matrix2cd g;
+    g << x1, -std::conj(x2), x2, std::conj(x1);
+    s.middleRows(i, 2) = (g.adjoint() * s.middleRows(i, 2)).eval();
+    s.middleCols(i, 2) = (s.middleCols(i, 2) * g).eval();
+    u.middleCols(i, 2) = (u.middleCols(i, 2) * g).eval();
+    s(i + 1, i) = 0.0;
+    s(i, i) = c;
+    s(i + 1, i + 1) = a;
+}
 
 /// Shift-invert Arnoldi on T = (A_M - sigma I)^{-1} in compact form (TOAR-like): every Krylov
 /// vector of C^{(M+1) n} is stored as V_i = Q a_i, block j of it Q a_i[j, :]^T, with one
@@ -166,97 +191,242 @@ struct CompactRitz {
 /// span(Q) blocks into span(Q, u0) blocks (StructuredShiftInvert::solve_compact), so each step
 /// adds at most one column to Q, orthogonalised against Q (twice), and the Arnoldi
 /// orthogonalisation runs on the coefficients ((M+1) r numbers instead of (M+1) n): with Q
-/// orthonormal, <V_i, V_l> = <a_i, a_l>_F. The basis grows (no restart) until `nev` Ritz values,
-/// largest |theta| first, have |h_{k+1,k}| |y_k| <= tol |theta| (the Arnoldi residual), or
-/// until `max_steps`. Cost per step: one sparse solve, O(n r) for Q, O((M+1) r k) for the rest.
-CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_check, int max_steps, double tol) {
-    const int m = op.degree(), n = op.dimension();
-    const Eigen::Index rows = static_cast<Eigen::Index>(m + 1);
-    const int kmax = std::max(2, max_steps);
-    const int rcap = kmax + 2;
-    Eigen::MatrixXcd q(n, rcap);
-    Eigen::MatrixXcd v = Eigen::MatrixXcd::Zero(rows * rcap, kmax + 1);  // column i: vec(a_i), (M+1) x rcap
-    Eigen::MatrixXcd h = Eigen::MatrixXcd::Zero(kmax + 1, kmax);
-    std::mt19937 rng(20261123);
-    std::uniform_real_distribution<double> unif(-1.0, 1.0);
-    Eigen::VectorXcd q0(n);
-    for (int i = 0; i < n; ++i) q0(i) = unif(rng);
-    q.col(0) = q0 / q0.norm();
-    int r = 1;
-    Eigen::VectorXcd a0(rows);
-    for (Eigen::Index j = 0; j < rows; ++j) a0(j) = unif(rng);
-    v.col(0).head(rows) = a0 / a0.norm();
-    CompactRitz out;
-    const Eigen::VectorXcd& g = op.g();
-    Eigen::MatrixXcd w;
-    int k = 0;
-    int check = std::min(first_check, kmax);
-    bool invariant = false;
-    for (;;) {
-        // one step: v_{k+1} from T v_k
-        {
-            Eigen::Map<const Eigen::MatrixXcd> a(v.col(k).data(), rows, r);
-            Eigen::VectorXcd u0 = op.solve_compact(q.leftCols(r), a, w);
-            Eigen::VectorXcd p = q.leftCols(r).adjoint() * u0;
-            u0.noalias() -= q.leftCols(r) * p;
-            const Eigen::VectorXcd p2 = q.leftCols(r).adjoint() * u0;
-            u0.noalias() -= q.leftCols(r) * p2;
-            p += p2;
-            const double rho = u0.norm();
-            const bool grow = rho > 1e-14 * std::max(p.norm(), 1e-300) && r < rcap;
-            const int r1 = grow ? r + 1 : r;
-            if (grow) q.col(r) = u0 / rho;
-            Eigen::MatrixXcd c(rows, r1);
-            c.row(0).head(r) = p.transpose();
-            c.bottomRows(m).leftCols(r) = w - g * p.transpose();
-            if (grow) {
-                c(0, r) = rho;
-                c.bottomRows(m).col(r) = -rho * g;
-            }
-            r = r1;
-            const Eigen::Index len1 = rows * r;
-            Eigen::Map<Eigen::VectorXcd> x(c.data(), len1);
-            // classical Gram-Schmidt twice on the coefficients
-            Eigen::VectorXcd hk = v.topLeftCorner(len1, k + 1).adjoint() * x;
-            x.noalias() -= v.topLeftCorner(len1, k + 1) * hk;
-            const Eigen::VectorXcd hk2 = v.topLeftCorner(len1, k + 1).adjoint() * x;
-            x.noalias() -= v.topLeftCorner(len1, k + 1) * hk2;
-            hk += hk2;
-            const double beta = x.norm();
-            h.col(k).head(k + 1) = hk;
-            h(k + 1, k) = beta;
-            ++k;
-            if (beta <= 1e-14 * hk.norm() || !std::isfinite(beta)) {
-                invariant = std::isfinite(beta);
-                h(k, k - 1) = 0.0;
+/// orthonormal, <V_i, V_l> = <a_i, a_l>_F. Cost per step: one sparse solve, O(n r) for Q,
+/// O((M+1) r k) for the rest.
+///
+/// The Krylov relation T V_k = V_k H_k + v_{k+1} h_k^T is kept throughout. Ritz values are the
+/// eigenvalues theta of H_k, largest |theta| first; one counts as converged when its residual
+/// |h_k^T y| / |y| <= tol |theta| (y its eigenvector of H_k; for an Arnoldi basis
+/// h_k^T y = h_{k+1,k} y_k), and the run stops when `nev` of them, from the largest on, are
+/// converged without a gap, or (a `goal` radius given) as soon as the disc of the converged
+/// prefix reaches the goal (the cell the shift was placed for is then covered).
+///
+/// Without restarts (restarts = 0) the basis grows to `basis` vectors and stops there.
+/// With restarts (Krylov-Schur, Stewart 2001): at `basis` vectors, H_k = U S U^H (complex
+/// Schur form) is reordered so that the `keep` Ritz values of largest |theta| lead (schur_swap),
+/// and the basis is truncated to V_k U[:, :keep] (coefficients a_i combined, Q untouched), with
+/// H = S[:keep, :keep] and h^T = h_k^T U[:, :keep]; v_{k+1} stays the next vector. This is again a
+/// Krylov relation of the same form (exact), and Arnoldi continues from it. A leading block of
+/// Schur vectors whose couplings satisfy ||h[:j]|| <= 0.01 tol min |theta| is locked (its
+/// couplings set to zero: an invariant subspace to that accuracy; the norms set to zero are
+/// summed and added to every later residual, so the convergence test stays a bound). When r, the columns of Q,
+/// would outgrow its storage, Q is compressed (TOAR): the stacked coefficients
+/// [a_0; ...; a_keep] = X Sigma W^H (SVD), Q <- Q W[:, :r'], a_i <- a_i W[:, :r'], dropping
+/// singular values <= 1e-14 sigma_1 and those beyond the exact rank (the kept subspace is a
+/// Krylov space K_{keep+1}(T, w), and the blocks of T^j w lie in span(blocks of w, j new
+/// columns), so r' <= keep + M + 2 in exact arithmetic).
+class CompactKrylov {
+public:
+    CompactKrylov(const StructuredShiftInvert& op, int basis)
+        : m_op(op), m_m(op.degree()), m_n(op.dimension()), m_rows(op.degree() + 1), m_kmax(std::max(2, basis)) {
+        m_rcap = m_kmax + 2;
+        m_q.resize(m_n, m_rcap);
+        m_v = Eigen::MatrixXcd::Zero(m_rows * m_rcap, m_kmax + 1);  // column i: vec(a_i), (M+1) x rcap
+        m_h = Eigen::MatrixXcd::Zero(m_kmax + 1, m_kmax);
+        std::mt19937 rng(20261123);
+        std::uniform_real_distribution<double> unif(-1.0, 1.0);
+        Eigen::VectorXcd q0(m_n);
+        for (int i = 0; i < m_n; ++i) q0(i) = unif(rng);
+        m_q.col(0) = q0 / q0.norm();
+        Eigen::VectorXcd a0(m_rows);
+        for (Eigen::Index j = 0; j < m_rows; ++j) a0(j) = unif(rng);
+        m_v.col(0).head(m_rows) = a0 / a0.norm();
+    }
+
+    /// The run described above; `first_check`: steps before Ritz values are first computed.
+    /// `goal` > 0: also stop once the converged prefix's disc |z - sigma| < 1/|theta_last|
+    /// (shrunk by the same 1e-6 margin as the covering's) reaches that radius.
+    /// `between` (may be empty) is called before every restart (it may throw, e.g. Cancelled).
+    CompactRitz run(int nev, int first_check, int restarts, int keep, double tol, double goal, const std::function<void()>& between) {
+        CompactRitz out;
+        // a goal may be met long before nev values converge: look from 20 steps on
+        int check = std::min(goal > 0.0 ? std::min(first_check, 20) : first_check, m_kmax);
+        keep = std::clamp(keep, 1, m_kmax - 1);
+        for (;;) {
+            step();
+            ++out.steps;
+            out.max_rank = std::max(out.max_rank, m_r);
+            if (m_k < check && !m_invariant && m_k < m_kmax) continue;
+            ritz(tol, out);
+            if (out.converged >= nev || m_invariant) return out;
+            if (goal > 0.0 && out.converged >= 1 &&
+                1.0 / (std::abs(out.theta[static_cast<std::size_t>(out.converged - 1)]) * (1.0 + 1e-6)) > goal)
+                return out;
+            if (m_k >= m_kmax) {
+                if (out.restarts >= restarts) return out;
+                if (between) between();
+                restart(keep, tol);
+                ++out.restarts;
+                check = std::min(m_kmax, m_k + std::max(10, (m_kmax - m_k) / 2));
             } else {
-                v.col(k).head(len1) = x / beta;
+                check = std::min(m_kmax, m_k + std::max(10, m_k / 2));
             }
         }
-        if (k < check && !invariant && k < kmax) continue;
-        Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(h.topLeftCorner(k, k));
+    }
+
+private:
+    /// One Arnoldi step: v_{k+1} from T v_k.
+    void step() {
+        const int m = m_m, k = m_k;
+        if (m_r == m_rcap) grow_rank_storage();
+        Eigen::Map<const Eigen::MatrixXcd> a(m_v.col(k).data(), m_rows, m_r);
+        Eigen::VectorXcd u0 = m_op.solve_compact(m_q.leftCols(m_r), a, m_w);
+        Eigen::VectorXcd p = m_q.leftCols(m_r).adjoint() * u0;
+        u0.noalias() -= m_q.leftCols(m_r) * p;
+        const Eigen::VectorXcd p2 = m_q.leftCols(m_r).adjoint() * u0;
+        u0.noalias() -= m_q.leftCols(m_r) * p2;
+        p += p2;
+        const double rho = u0.norm();
+        const bool grow = rho > 1e-14 * std::max(p.norm(), 1e-300);
+        const int r1 = grow ? m_r + 1 : m_r;
+        if (grow) m_q.col(m_r) = u0 / rho;
+        const Eigen::VectorXcd& g = m_op.g();
+        Eigen::MatrixXcd c(m_rows, r1);
+        c.row(0).head(m_r) = p.transpose();
+        c.bottomRows(m).leftCols(m_r) = m_w - g * p.transpose();
+        if (grow) {
+            c(0, m_r) = rho;
+            c.bottomRows(m).col(m_r) = -rho * g;
+        }
+        m_r = r1;
+        const Eigen::Index len1 = m_rows * m_r;
+        Eigen::Map<Eigen::VectorXcd> x(c.data(), len1);
+        // classical Gram-Schmidt twice on the coefficients
+        Eigen::VectorXcd hk = m_v.topLeftCorner(len1, k + 1).adjoint() * x;
+        x.noalias() -= m_v.topLeftCorner(len1, k + 1) * hk;
+        const Eigen::VectorXcd hk2 = m_v.topLeftCorner(len1, k + 1).adjoint() * x;
+        x.noalias() -= m_v.topLeftCorner(len1, k + 1) * hk2;
+        hk += hk2;
+        const double beta = x.norm();
+        m_h.col(k).head(k + 1) = hk;
+        m_h(k + 1, k) = beta;
+        ++m_k;
+        if (beta <= 1e-14 * hk.norm() || !std::isfinite(beta)) {
+            m_invariant = std::isfinite(beta);
+            m_h(m_k, m_k - 1) = 0.0;
+        } else {
+            m_v.col(m_k).head(len1) = x / beta;
+        }
+    }
+
+    /// Ritz values of H_k and the converged prefix (written to out).
+    void ritz(double tol, CompactRitz& out) const {
+        const int k = m_k;
         out.theta.clear();
         out.converged = 0;
-        out.steps = k;
-        out.rank = r;
-        if (es.info() != Eigen::Success) return out;
+        out.rank = m_r;
+        Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(m_h.topLeftCorner(k, k));
+        if (es.info() != Eigen::Success) return;
         const Eigen::VectorXcd ev = es.eigenvalues();
         std::vector<int> order(static_cast<std::size_t>(k));
         for (int i = 0; i < k; ++i) order[static_cast<std::size_t>(i)] = i;
         std::sort(order.begin(), order.end(), [&](int x, int y) { return std::abs(ev(x)) > std::abs(ev(y)); });
-        const double hk1 = std::abs(h(k, k - 1));
+        // every check follows at least one Arnoldi step: the last row of H is h_{k+1,k} e_k^T
+        const double hk1 = std::abs(m_h(k, k - 1));
         bool prefix = true;
         for (int i : order) {
             const cplx th = ev(i);
             out.theta.push_back(th);
             const Eigen::VectorXcd y = es.eigenvectors().col(i);
             const double res = hk1 * std::abs(y(k - 1)) / y.norm();
-            prefix = prefix && std::isfinite(th.real()) && std::isfinite(th.imag()) && res <= tol * std::abs(th);
+            // + the couplings set to zero by locking (a bound of their share of the residual)
+            prefix = prefix && std::isfinite(th.real()) && std::isfinite(th.imag()) && res + m_dropped <= tol * std::abs(th);
             if (prefix) ++out.converged;
         }
-        if (out.converged >= nev || invariant || k >= kmax) return out;
-        check = std::min(kmax, k + std::max(10, k / 2));
     }
+
+    /// Krylov-Schur truncation to the `keep` Ritz values of largest |theta| (see the class).
+    void restart(int keep, double tol) {
+        const int k = m_k;
+        Eigen::ComplexSchur<Eigen::MatrixXcd> cs(m_h.topLeftCorner(k, k));
+        Eigen::MatrixXcd s = cs.matrixT();
+        Eigen::MatrixXcd u = cs.matrixU();
+        for (int t = 0; t < keep; ++t) {
+            int j = t;
+            for (int i = t + 1; i < k; ++i)
+                if (std::abs(s(i, i)) > std::abs(s(j, j))) j = i;
+            for (int i = j - 1; i >= t; --i) schur_swap(s, u, i);
+        }
+        Eigen::RowVectorXcd b = m_h.row(k).head(k) * u.leftCols(keep);
+        // locking: a leading block of Schur vectors that is invariant to 0.01 tol
+        double smallest = std::numeric_limits<double>::infinity();
+        int lock = 0;
+        for (int j = 0; j < keep; ++j) {
+            smallest = std::min(smallest, std::abs(s(j, j)));
+            if (b.head(j + 1).norm() > 1e-2 * tol * smallest) break;
+            lock = j + 1;
+        }
+        m_dropped += b.head(lock).norm();
+        b.head(lock).setZero();
+        m_locked = std::max(m_locked, lock);
+        const Eigen::Index len = m_rows * m_r;
+        const Eigen::MatrixXcd kept = m_v.topLeftCorner(len, k) * u.leftCols(keep);
+        const Eigen::VectorXcd next = m_v.col(k).head(len);
+        m_v.setZero();
+        m_v.topLeftCorner(len, keep) = kept;
+        m_v.col(keep).head(len) = next;
+        m_h.setZero();
+        m_h.topLeftCorner(keep, keep) = s.topLeftCorner(keep, keep).triangularView<Eigen::Upper>();
+        m_h.row(keep).head(keep) = b;
+        m_k = keep;
+        // room for the next cycle's new columns of Q
+        if (m_r + (m_kmax - keep) > m_rcap) compress();
+    }
+
+    /// TOAR compression of Q (see the class).
+    void compress() {
+        const int nvec = m_k + 1;
+        Eigen::MatrixXcd c(static_cast<Eigen::Index>(nvec) * m_rows, m_r);
+        for (int i = 0; i < nvec; ++i) c.middleRows(static_cast<Eigen::Index>(i) * m_rows, m_rows) = Eigen::Map<const Eigen::MatrixXcd>(m_v.col(i).data(), m_rows, m_r);
+        Eigen::BDCSVD<Eigen::MatrixXcd> svd(c, Eigen::ComputeThinV);
+        const Eigen::VectorXd& sv = svd.singularValues();
+        int r2 = 0;
+        while (r2 < sv.size() && sv(r2) > 1e-14 * sv(0)) ++r2;
+        // the exact rank is at most keep + M + 2 (see the class): values beyond are rounding
+        // (they pile up over the restarts), unless they are not small (then nothing is cut)
+        const int bound = m_k + m_rows + 1;
+        if (r2 > bound && sv(bound) <= 1e-10 * sv(0)) r2 = bound;
+        r2 = std::max(r2, 1);
+        const Eigen::MatrixXcd w = svd.matrixV().leftCols(r2);
+        const Eigen::MatrixXcd q2 = m_q.leftCols(m_r) * w;
+        m_q.leftCols(r2) = q2;
+        for (int i = 0; i < nvec; ++i) {
+            const Eigen::MatrixXcd a2 = Eigen::Map<const Eigen::MatrixXcd>(m_v.col(i).data(), m_rows, m_r) * w;
+            m_v.col(i).setZero();
+            Eigen::Map<Eigen::MatrixXcd>(m_v.col(i).data(), m_rows, r2) = a2;
+        }
+        m_r = r2;
+    }
+
+    /// More columns for Q (and rows for the coefficients): compression could not make room.
+    void grow_rank_storage() {
+        const Eigen::Index extra = std::max<Eigen::Index>(m_rcap / 2, 16);
+        const Eigen::Index old = m_rcap;
+        m_rcap += extra;
+        m_q.conservativeResize(Eigen::NoChange, m_rcap);
+        m_v.conservativeResize(m_rows * m_rcap, Eigen::NoChange);
+        m_v.bottomRows(m_rows * (m_rcap - old)).setZero();
+    }
+
+    const StructuredShiftInvert& m_op;
+    int m_m, m_n;
+    Eigen::Index m_rows;
+    int m_kmax;
+    Eigen::Index m_rcap;
+    Eigen::MatrixXcd m_q, m_v, m_h, m_w;
+    int m_r = 1;
+    int m_k = 0;
+    int m_locked = 0;       ///< leading Schur vectors locked
+    double m_dropped = 0.0; ///< sum of the norms of the couplings set to zero
+    bool m_invariant = false;
+};
+
+/// The compact Arnoldi run of one shift: `basis` vectors at most, `restarts` Krylov-Schur
+/// restarts (0: none) keeping `keep` Schur vectors.
+CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_check, int basis, int restarts, int keep, double tol,
+                            double goal, const std::function<void()>& between) {
+    CompactKrylov kr(op, basis);
+    return kr.run(nev, first_check, restarts, keep, tol, goal, between);
 }
 
 }  // namespace
@@ -500,7 +670,8 @@ public:
     }
 
     /// Runs one shift (nudged off a singular point); false after max_shifts.
-    bool shift_at(cplx sigma) {
+    /// With restarts, the run stops as soon as its disc has radius `goal` (the cell's reach).
+    bool shift_at(cplx sigma, double goal) {
         if (m_shifts >= m_o.max_shifts) return false;
         // the shifts finished so far; may throw Cancelled (caught by rightmost_roots)
         if (m_progress && *m_progress) (*m_progress)(m_before + m_shifts, m_o.max_shifts, sigma.real());
@@ -518,8 +689,18 @@ public:
             // every converged Ritz value from the largest |theta| on is an eigenvalue 1/theta + sigma;
             // together they are the eigenvalues in the disc |z - sigma| < 1/|theta_last|
             const int kmax = static_cast<int>(std::min<Eigen::Index>(size - 1, std::max<Eigen::Index>(ncv, m_o.compact_max_steps)));
-            const CompactRitz rz = compact_arnoldi(m_op, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax, m_o.arnoldi_tolerance);
+            // restarted: the half of the basis with the largest |theta| is kept (at least nev)
+            const int keep = std::min(kmax - 1, std::max(nev, kmax / 2));
+            const CompactRitz rz = compact_arnoldi(m_op, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax,
+                                                   m_o.compact_restarts, keep, m_o.arnoldi_tolerance,
+                                                   m_o.compact_restarts > 0 ? goal : 0.0, [&] {
+                                                       // a long run reports again (same count) before each restart
+                                                       if (m_progress && *m_progress)
+                                                           (*m_progress)(m_before + m_shifts - 1, m_o.max_shifts, sigma.real());
+                                                   });
             m_steps += rz.steps;
+            m_restarts += rz.restarts;
+            m_max_rank = std::max(m_max_rank, rz.max_rank);
             double thmin = std::numeric_limits<double>::infinity();
             for (int i = 0; i < rz.converged; ++i) {
                 const cplx th = rz.theta[static_cast<std::size_t>(i)];
@@ -614,7 +795,10 @@ public:
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
                 if (!again) {
-                    if (!shift_at(centre)) return false;
+                    double reach = 0.0;  // the cell's farthest corner from the shift
+                    for (double x : {c.x0, c.x1})
+                        for (double y : {c.y0, c.y1}) reach = std::max(reach, std::abs(cplx(x, y) - centre));
+                    if (!shift_at(centre, reach * (1.0 + 1e-9))) return false;
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
@@ -645,6 +829,9 @@ public:
     double extent() const { return m_extent; }
     int failed() const { return m_failed; }
     int excluded() const { return m_excluded; }
+    /// compact: Krylov-Schur restarts over all shifts, and the largest rank of Q met
+    int restarts() const { return m_restarts; }
+    int max_rank() const { return m_max_rank; }
 
 private:
     /// A cell inside a disc; one inside an Arnoldi disc (not root-free) needs the collocation to
@@ -680,6 +867,8 @@ private:
     int m_steps = 0;
     int m_failed = 0;
     int m_excluded = 0;
+    int m_restarts = 0;
+    int m_max_rank = 0;
     double m_floor = 0.0;
     double m_height = std::numeric_limits<double>::infinity();
 
@@ -802,6 +991,7 @@ std::string shift_invert_why_not(const RootProblem& problem, const RootOptions& 
 }
 
 RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& options) {
+    const SingleThreadedEigen single;  // the Krylov products are too small for OpenMP's threads
     const LinearDDE dde = problem.dde.to_sparse();
     const ShiftInvertRootOptions& so = options.shift_invert;
     const int max_degree = std::max(so.max_degree, options.degree);
@@ -822,6 +1012,7 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
                                             8, max_degree);
     const Gershgorin gersh(dde);
     ResolventExclusion resolvent(dde);
+    int max_rank = 0;
     for (;;) {
         StructuredShiftInvert op(dde, m);
         if (op.rows() < 8)
@@ -840,6 +1031,8 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
         alpha = cover.floor();
         result.shifts += cover.shifts();
         result.arnoldi_steps += cover.steps();
+        result.arnoldi_restarts += cover.restarts();
+        max_rank = std::max(max_rank, cover.max_rank());
         result.factorizations += op.factorizations();
         result.eigenvalues_found = static_cast<int>(cover.values().size());
         const double height = bounds.radius(alpha);
@@ -928,7 +1121,8 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
         }
         if (cover.failed() > 0) os << "; " << cover.failed() << " Arnoldi runs did not converge and were replaced by smaller cells";
         if (compact)
-            os << "; compact Arnoldi (" << result.arnoldi_steps << " steps), " << resolvent.tests()
+            os << "; compact Arnoldi (" << result.arnoldi_steps << " steps, " << result.arnoldi_restarts
+               << " Krylov-Schur restarts, rank of Q <= " << max_rank << "), " << resolvent.tests()
                << " resolvent tests (root-free discs of Delta, Lanczos norm estimate x1.25)";
         result.factorizations += resolvent.tests();
         result.message = os.str();

@@ -140,6 +140,74 @@ TEST_CASE("compact Krylov path equals the full-basis reference path on random sp
     }
 }
 
+namespace {
+
+/// Every listed root is a closed-form root (test::tol::root_abs) and every closed-form root right
+/// of the last listed one is listed.
+void check_against_closed_form(const RootResult& r, const std::vector<cplx>& ref) {
+    for (const auto& x : r.roots) {
+        double nearest = 1e300;
+        for (cplx z : ref) nearest = std::min(nearest, std::abs(z - x.value));
+        CAPTURE(x.value);
+        CHECK(nearest <= test::tol::root_abs);
+    }
+    const double last = r.roots.back().value.real();
+    const auto right = std::count_if(ref.begin(), ref.end(), [&](cplx z) { return z.real() > last + test::tol::root_abs; });
+    const auto listed = std::count_if(r.roots.begin(), r.roots.end(), [&](const Root& x) { return x.value.real() > last + test::tol::root_abs; });
+    CHECK(right == listed);
+}
+
+}  // namespace
+
+TEST_CASE("restarted compact Krylov path: a cluster of nearly equal Laplacian modes, every closed-form root found") {
+    // dy = 0.97 dx: the modes (i, j) and (j, i) are nearly equal, and the 12 rightmost roots come
+    // from a cluster of pairs (0.002 to 0.02 apart); a basis of 60 vectors (nev 16) must restart
+    const int nx = 16, ny = 16;
+    const double dx = 1.0, dy = 0.97, a = 0.5, b = 1.0, tau = 2.0;
+    const LinearDDE dde = reaction_diffusion(nx, ny, dx, dy, a, b, tau);
+    RootOptions o;
+    o.method = "shift_invert";
+    o.count = 12;
+    o.shift_invert.eigenvalues_per_shift = 16;
+    o.shift_invert.compact_max_steps = 60;
+    o.shift_invert.compact_restarts = 40;
+    const RootResult r = rightmost_roots(dde, o);
+    REQUIRE(r.status == Status::Converged);
+    REQUIRE(r.roots.size() >= 12);
+    CHECK(r.arnoldi_restarts > 0);
+    check_against_closed_form(r, closed_form_roots(nx, ny, dx, dy, a, b, tau));
+}
+
+TEST_CASE("restarted and unrestarted compact Krylov runs give the same roots") {
+    auto same = [](const RootResult& x, const RootResult& y) {
+        REQUIRE(x.status == Status::Converged);
+        REQUIRE(y.status == Status::Converged);
+        REQUIRE(x.roots.size() == y.roots.size());
+        for (std::size_t i = 0; i < x.roots.size(); ++i) {
+            CAPTURE(i);
+            CHECK(std::abs(x.roots[i].value - y.roots[i].value) <= test::tol::same_root * std::max(1.0, std::abs(y.roots[i].value)));
+        }
+    };
+    std::vector<LinearDDE> problems{reaction_diffusion(12, 9, 1.0, 0.37, 0.5, 1.0, 2.0)};
+    for (unsigned seed : {21u, 22u}) problems.push_back(random_sparse(80, 1 + static_cast<int>(seed % 3), seed));
+    for (std::size_t p = 0; p < problems.size(); ++p) {
+        CAPTURE(p);
+        RootOptions o;
+        o.method = "shift_invert";
+        o.count = 8;
+        o.shift_invert.eigenvalues_per_shift = 12;
+        o.shift_invert.compact_max_steps = 50;  // small: the restarted runs do restart
+        o.shift_invert.compact_restarts = 40;
+        const RootResult restarted = rightmost_roots(problems[p], o);
+        o.shift_invert.compact_max_steps = 400;  // large enough to converge without restarts
+        o.shift_invert.compact_restarts = 0;
+        const RootResult plain = rightmost_roots(problems[p], o);
+        CHECK(restarted.arnoldi_restarts > 0);
+        CHECK(plain.arnoldi_restarts == 0);
+        same(restarted, plain);
+    }
+}
+
 TEST_CASE("shift_invert.arnoldi and compact_max_steps are validated") {
     RootOptions o;
     o.shift_invert.arnoldi = "lanczos";
@@ -150,6 +218,10 @@ TEST_CASE("shift_invert.arnoldi and compact_max_steps are validated") {
     o.shift_invert.compact_max_steps = 1;
     CHECK_FALSE(o.is_valid(&why));
     CHECK(why.find("compact_max_steps") != std::string::npos);
+    o.shift_invert.compact_max_steps = 200;
+    o.shift_invert.compact_restarts = -1;
+    CHECK_FALSE(o.is_valid(&why));
+    CHECK(why.find("compact_restarts") != std::string::npos);
 }
 
 TEST_SUITE_END();

@@ -54,10 +54,14 @@ struct ShiftInvertRootOptions {
     int eigenvalues_per_shift = 32;    ///< nev of each Arnoldi run (ncv = 5 nev / 2 + 20)
     int max_shifts = 5000;             ///< give up (BudgetExhausted) after this many shifts
     /// "compact" (default): the Krylov basis stored as one n x r matrix and small coefficients
-    /// and grown without restarts (shift_invert.cpp compact_arnoldi); "spectra": Spectra's
+    /// (shift_invert.cpp CompactKrylov), Krylov-Schur restarted; "spectra": Spectra's
     /// restarted Arnoldi on the full (M+1) n vectors (the reference, slow for large n).
     std::string arnoldi = "compact";
-    int compact_max_steps = 200;       ///< compact: Arnoldi steps per shift at most (the basis is not restarted)
+    int compact_max_steps = 200;       ///< compact: basis vectors at most (without restarts: Arnoldi steps per shift at most)
+    /// compact: Krylov-Schur restarts per shift at most (each keeps the half of the basis with the
+    /// largest |Ritz values| and adds compact_max_steps / 2 steps); 0 = no restart (the basis
+    /// grows to compact_max_steps and the run stops there)
+    int compact_restarts = 20;
     int arnoldi_max_restarts = 400;    ///< spectra: restarts per shift at most
     double arnoldi_tolerance = 1e-10;  ///< Spectra: |residual| <= tol |Ritz value|
     bool refine = true;                ///< Newton refinement on Delta(lambda) (off: eigenvalues only)
@@ -136,6 +140,7 @@ struct RootResult {
     // counters
     int shifts = 0;              ///< Arnoldi runs
     int arnoldi_steps = 0;       ///< shift_invert (compact): operator applications over all runs
+    int arnoldi_restarts = 0;    ///< shift_invert (compact): Krylov-Schur restarts over all runs
     int factorizations = 0;      ///< sparse LU factorisations (shifts and Newton)
     long evaluations = 0;        ///< contour: evaluations of D along contours
     int contour_counts = 0;      ///< contour: rectangles counted
