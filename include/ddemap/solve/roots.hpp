@@ -60,8 +60,9 @@ struct ShiftInvertRootOptions {
     int compact_max_steps = 200;       ///< compact: basis vectors at most (without restarts: Arnoldi steps per shift at most)
     /// compact: Krylov-Schur restarts per shift at most (each keeps the half of the basis with the
     /// largest |Ritz values| and adds compact_max_steps / 2 steps); 0 = no restart (the basis
-    /// grows to compact_max_steps and the run stops there)
-    int compact_restarts = 20;
+    /// grows to compact_max_steps and the run stops there; the default: on long rings written out
+    /// the restarted runs measured slower, BENCHMARKS.md)
+    int compact_restarts = 0;
     int arnoldi_max_restarts = 400;    ///< spectra: restarts per shift at most
     double arnoldi_tolerance = 1e-10;  ///< Spectra: |residual| <= tol |Ritz value|
     bool refine = true;                ///< Newton refinement on Delta(lambda) (off: eigenvalues only)
