@@ -59,11 +59,19 @@ int run_growth() {
     JsonEnvelope e;
     e.command = "growth";
     e.inputs = JsonObject().string("vehicles", "the paper's calibration table (built in)").string("lead", label).integer("followers", followers).str();
+    for (const GrowthResult& r : g)  // the envelope's status: the first platoon that is undecided
+        if (r.status != Status::Converged && e.status == "converged") {
+            e.status = to_string(r.status);
+            e.message = r.name + ": " + r.message;
+        }
     e.result = growth_json(g, label);
     const std::string csv = growth_csv(g);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", growth_svg(g, label)}});
     print_output(format, e, csv, [&] { std::cout << growth_table(g); });
-    return exit_ok;
+    int code = exit_ok;  // a diverged platoon is undecided: its reason on stderr, exit 4
+    for (const GrowthResult& r : g)
+        if (r.status != Status::Converged) code = report_undecided(r.status, "growth of " + r.name, r.message);
+    return code;
 }
 
 }  // namespace ddemap::cli

@@ -87,7 +87,8 @@ std::string growth_table(const std::vector<GrowthResult>& g) {
         for (std::size_t i = 0; i < r.amplification.size() && i < 8; ++i) out << " " << rounded(r.amplification[i], 3);
         if (r.amplification.size() > 8) out << " ...";
         out << "   ";
-        if (r.failed_at) out << "car " << r.failed_at << " (" << r.failure << " at t = " << rounded(r.failure_time, 4) << " s)";
+        if (r.status != Status::Converged) out << "UNDECIDED (" << to_string(r.status) << ")";
+        else if (r.failed_at) out << "car " << r.failed_at << " (" << r.failure << " at t = " << rounded(r.failure_time, 4) << " s)";
         else out << "none";
         out << "\n";
     }

@@ -186,7 +186,7 @@ std::string growth_csv(const std::vector<GrowthResult>& g) {
     for (const auto& r : g) {
         for (std::size_t i = 0; i < r.amplification.size(); ++i) {
             out << r.name << "," << i + 1 << "," << format_exact(r.speed_drop[i]) << "," << format_exact(r.amplification[i]) << ","
-                << format_exact(r.min_gap[i]) << ",\n";
+                << format_exact(r.min_gap[i]) << "," << (r.status == Status::Converged ? "" : to_string(r.status)) << "\n";
         }
         if (r.failed_at) {
             out << r.name << "," << r.failed_at << ",," << format_exact(r.failure_amplification) << "," << format_exact(r.failure_gap)

@@ -369,7 +369,8 @@ std::string growth_json(const std::vector<GrowthResult>& g, const std::string& l
     json arr = json::array();
     for (const auto& r : g) {
         arr.push_back({{"name", r.name}, {"speed_drop", r.speed_drop}, {"amplification", r.amplification}, {"min_gap", r.min_gap},
-                       {"failed_at", r.failed_at}, {"failure", r.failure}, {"failure_time", num(r.failure_time)}});
+                       {"failed_at", r.failed_at}, {"failure", r.failure}, {"failure_time", num(r.failure_time)},
+                       {"status", to_string(r.status)}, {"message", r.message}});
     }
     return text(json{{"lead", lead}, {"vehicles", arr}});
 }

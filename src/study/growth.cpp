@@ -34,6 +34,10 @@ std::vector<GrowthResult> disturbance_growth(const std::vector<CalibratedVehicle
             g.amplification.push_back(c.speed_drop / lead_drop);
             g.min_gap.push_back(c.min_gap);
         }
+        if (r.status != Status::Converged) {  // a diverged run is no growth result: undecided
+            g.status = r.status;
+            g.message = r.message;
+        }
         if (ev) {
             g.failed_at = first;
             g.failure = ev->type;

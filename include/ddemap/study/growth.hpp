@@ -23,9 +23,12 @@ struct GrowthResult {
     double failure_time = 0.0;
     double failure_amplification = 0.0;  ///< (v0 - lowest speed up to the event) / lead drop
     double failure_gap = 0.0;
-    /// Converged, or Cancelled when the progress callback stopped the study before this
-    /// vehicle was simulated (then only `name` is set).
+    /// Converged; NumericalIssue when the platoon's simulation diverged (SimResult::status; the
+    /// positions are then from the run up to the divergence, not a result: undecided, and
+    /// `message` says where); or Cancelled when the progress callback stopped the study before
+    /// this vehicle was simulated (then only `name` is set).
     Status status = Status::Converged;
+    std::string message;  ///< why, when status is not Converged
 };
 
 /// One GrowthResult per vehicle (in order), the platoons simulated in parallel under `policy`.
