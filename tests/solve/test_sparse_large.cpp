@@ -92,6 +92,21 @@ LinearDDE random_sparse(int n, int delays, unsigned seed) {
     return LinearDDE(a0, terms);
 }
 
+/// Every listed root is a closed-form root (test::tol::root_abs) and every closed-form root right
+/// of the last listed one is listed.
+void check_against_closed_form(const RootResult& r, const std::vector<cplx>& ref) {
+    for (const auto& x : r.roots) {
+        double nearest = 1e300;
+        for (cplx z : ref) nearest = std::min(nearest, std::abs(z - x.value));
+        CAPTURE(x.value);
+        CHECK(nearest <= test::tol::root_abs);
+    }
+    const double last = r.roots.back().value.real();
+    const auto right = std::count_if(ref.begin(), ref.end(), [&](cplx z) { return z.real() > last + test::tol::root_abs; });
+    const auto listed = std::count_if(r.roots.begin(), r.roots.end(), [&](const Root& x) { return x.value.real() > last + test::tol::root_abs; });
+    CHECK(right == listed);
+}
+
 }  // namespace
 
 TEST_CASE("compact Krylov path: reaction-diffusion roots equal the Lambert W closed form, none missed") {
@@ -104,18 +119,7 @@ TEST_CASE("compact Krylov path: reaction-diffusion roots equal the Lambert W clo
     const RootResult r = rightmost_roots(dde, o);
     REQUIRE(r.status == Status::Converged);
     REQUIRE(r.roots.size() >= 6);
-    const std::vector<cplx> ref = closed_form_roots(nx, ny, dx, dy, a, b, tau);
-    for (const auto& x : r.roots) {
-        double nearest = 1e300;
-        for (cplx z : ref) nearest = std::min(nearest, std::abs(z - x.value));
-        CAPTURE(x.value);
-        CHECK(nearest <= test::tol::root_abs);
-    }
-    // completeness: every closed-form root right of the last listed one is listed
-    const double last = r.roots.back().value.real();
-    const auto right = std::count_if(ref.begin(), ref.end(), [&](cplx z) { return z.real() > last + test::tol::root_abs; });
-    const auto listed = std::count_if(r.roots.begin(), r.roots.end(), [&](const Root& x) { return x.value.real() > last + test::tol::root_abs; });
-    CHECK(right == listed);
+    check_against_closed_form(r, closed_form_roots(nx, ny, dx, dy, a, b, tau));  // and completeness
     CHECK(r.message.find("compact Arnoldi") != std::string::npos);
 }
 
@@ -139,25 +143,6 @@ TEST_CASE("compact Krylov path equals the full-basis reference path on random sp
         }
     }
 }
-
-namespace {
-
-/// Every listed root is a closed-form root (test::tol::root_abs) and every closed-form root right
-/// of the last listed one is listed.
-void check_against_closed_form(const RootResult& r, const std::vector<cplx>& ref) {
-    for (const auto& x : r.roots) {
-        double nearest = 1e300;
-        for (cplx z : ref) nearest = std::min(nearest, std::abs(z - x.value));
-        CAPTURE(x.value);
-        CHECK(nearest <= test::tol::root_abs);
-    }
-    const double last = r.roots.back().value.real();
-    const auto right = std::count_if(ref.begin(), ref.end(), [&](cplx z) { return z.real() > last + test::tol::root_abs; });
-    const auto listed = std::count_if(r.roots.begin(), r.roots.end(), [&](const Root& x) { return x.value.real() > last + test::tol::root_abs; });
-    CHECK(right == listed);
-}
-
-}  // namespace
 
 TEST_CASE("restarted compact Krylov path: a cluster of nearly equal Laplacian modes, every closed-form root found") {
     // dy = 0.97 dx: the modes (i, j) and (j, i) are nearly equal, and the 12 rightmost roots come
