@@ -514,9 +514,10 @@ struct DefectControl {
     int max_intervals = 0;
 };
 
-/// The branch from the corrected wave u with unit tangent t (the continuation of periodic_orbit's
-/// follow): pseudo-arclength with step control, the range's faces located, folds located by
-/// Illinois regula falsi on the parameter component of the tangent. The branch ends at
+/// The branch from the corrected wave u with unit tangent t: pseudo-arclength with the step
+/// control of periodic_orbit's branches, the range's faces located, and the special points of
+/// every step by the same code (orbit_continuation.hpp: folds; with the full ring's multipliers
+/// period doublings and tori), with the reduced corrector and the wave's orbits. The branch ends at
 /// max_points waves, on a face of the range, when the amplitude falls below `collapse` times the
 /// first wave's (back at the Hopf point), when the period exceeds max_period_factor T0, or when
 /// the step falls below min_step. With `adapt` the mesh is re-equidistributed after every wave.
