@@ -250,7 +250,7 @@ TEST_CASE("travelling waves (ov, 5 cars): long steps find the same fold of the w
     }
 }
 
-TEST_CASE("travelling waves (IDM, 5 cars): long steps give the same branch, period doubling and torus; both at the full ring's") {
+TEST_CASE("travelling waves (IDM, 5 cars): long steps give the same branch, period doubling and torus, both at the full ring's") {
     // the wave branch of `orbits --model idm --ring 5 --th 1.2 --tau 0.6 --wave 1` from its Hopf
     // point at gap 8.048 to gap 22, with the full ring's multipliers along the wave: a torus
     // bifurcation near gap 20.4575 and a period doubling near 21.0402, as on the full ring's own
