@@ -220,4 +220,12 @@ constexpr double orbit_crossing_between_steps = 1e-5;
 /// <= 1e-7 in the gap of the IDM ring, or 1e-8 of the step; 1e-6 (the old report gave 0.04).
 constexpr double orbit_crossing_bracket = 1e-6;
 
+/// The fold of one travelling-wave branch located with short and with long steps (max_step 0.1
+/// against 1 and 2, the same mesh): each is located to |t_p| <= 1e-11 |to - from| (regula falsi on
+/// the tangent's parameter component, so p to second order in that) on orbits converged to 1e-10
+/// relative (Newton, max |u| ~ 19, the period); measured 1.4e-13 in the headway and the period
+/// (relative); 1e-8, while the long steps' bracket of the fold is 0.02 to 0.2 in the headway.
+/// Also the slack of "no wave of the branch beyond its fold".
+constexpr double wave_fold_between_steps = 1e-8;
+
 }  // namespace ddemap::test::tol

@@ -66,10 +66,9 @@ void add_orbits_flags(CLI::App& app) {
 }
 
 int run_orbits() {
-    if (!args.max_step.empty() && !args.wave.empty()) throw BadInput("--max-step: not with --wave (the reduced form keeps its step control)");
     if (!args.wave.empty())
         return run_orbits_wave({args.problem, args.wave, args.degree, args.intervals, args.points, args.initial_step, args.svg, args.variable, args.adapt,
-                                args.hopf_option && args.hopf_option->count() > 0, args.format, args.out});
+                                args.hopf_option && args.hopf_option->count() > 0, args.format, args.out, args.max_step});
     if (!args.initial_step.empty()) throw BadInput("--initial-step: only with --wave (expected --wave K)");
     const Format format = args.format.parse();
     const std::string prefix = args.out.given() ? args.out.prepare("orbits", {".csv", ".json"}) : std::string();
@@ -168,16 +167,7 @@ int run_orbits() {
                 << pad(rounded(p.max_nontrivial, 4), 12) << pad(rounded(p.trivial_distance, 2), 12) << (p.stable ? "yes" : "no") << "\n";
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
-        auto crossing = [&](const char* label, const OrbitCrossing& x) {
-            if (x.located)
-                out << label << par << " = " << rounded(x.par, 10) << ", period " << rounded(x.period, 8) << ", mu = " << rounded(x.multiplier.real(), 8)
-                    << (x.multiplier.imag() != 0.0 ? " +/- " + rounded(x.multiplier.imag(), 8) + "i" : std::string()) << " (located: ||mu| - 1| = "
-                    << rounded(x.accuracy, 2) << ", bracket " << rounded(x.par_bracket, 2) << " in " << par << ")\n";
-            else
-                out << label << par << " ~ " << rounded(x.par, 6) << ", period " << rounded(x.period, 6) << " (not located: interpolated)\n";
-        };
-        for (const OrbitCrossing& x : b.period_doublings) crossing("doubling   ", x);
-        for (const OrbitCrossing& x : b.tori) crossing("torus      ", x);
+        out << crossing_lines(b);
         if (!b.points.empty())
             out << "accuracy   max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", max residual = " << rounded(b.max_residual, 2) << "\n";
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";

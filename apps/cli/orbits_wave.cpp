@@ -23,6 +23,22 @@ std::string pad(std::string s, std::size_t w) {
 }
 }  // namespace
 
+std::string crossing_lines(const OrbitBranch& b) {
+    std::ostringstream out;
+    const std::string& par = b.parameter;
+    auto crossing = [&](const char* label, const OrbitCrossing& x) {
+        if (x.located)
+            out << label << par << " = " << rounded(x.par, 10) << ", period " << rounded(x.period, 8) << ", mu = " << rounded(x.multiplier.real(), 8)
+                << (x.multiplier.imag() != 0.0 ? " +/- " + rounded(x.multiplier.imag(), 8) + "i" : std::string()) << " (located: ||mu| - 1| = "
+                << rounded(x.accuracy, 2) << ", bracket " << rounded(x.par_bracket, 2) << " in " << par << ")\n";
+        else
+            out << label << par << " ~ " << rounded(x.par, 6) << ", period " << rounded(x.period, 6) << " (not located: interpolated)\n";
+    };
+    for (const OrbitCrossing& x : b.period_doublings) crossing("doubling   ", x);
+    for (const OrbitCrossing& x : b.tori) crossing("torus      ", x);
+    return out.str();
+}
+
 int run_orbits_wave(const OrbitsWaveArgs& a) {
     if (a.problem.model.empty())
         throw BadInput("--wave = '" + a.wave + "' needs a built-in ring (--model ov|idm --ring N): a --system file has no ring to travel on");
@@ -46,8 +62,15 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
     po.max_points = static_cast<int>(parse_integer("--points", a.points, 2, 100000, "an integer between 2 and 100000"));
     if (!a.initial_step.empty()) {
         po.initial_step = parse_number("--initial-step", a.initial_step);
-        if (!(po.initial_step >= po.min_step && po.initial_step <= po.max_step))
-            throw BadInput("--initial-step = '" + a.initial_step + "': expected a value from 1e-6 to 0.1");
+        const double upper = a.max_step.empty() ? po.max_step : 1e6;  // with --max-step: checked against it below
+        if (!(po.initial_step >= po.min_step && po.initial_step <= upper))
+            throw BadInput("--initial-step = '" + a.initial_step + "': expected a value from 1e-6 to " + rounded(upper, 6) +
+                           (a.max_step.empty() ? std::string(" (the largest step, --max-step)") : std::string()));
+    }
+    if (!a.max_step.empty()) {  // as orbits: the largest step of the same step control (analysis/internal/orbit_continuation.hpp)
+        po.max_step = parse_number("--max-step", a.max_step);
+        if (!(po.max_step >= po.initial_step && po.max_step <= 1e6))
+            throw BadInput("--max-step = '" + a.max_step + "': expected a value from " + rounded(po.initial_step, 6) + " (the first step) to 1e6");
     }
     // one line per wave: ddemap: orbits: 37 waves (at most 100), headway = 2.81 (4.2 s)
     po.progress = branch_progress_printer("orbits", "waves", po.parameter, false);
@@ -59,6 +82,7 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
     JsonObject& inputs = built.inputs;
     inputs.string("par", po.parameter).number("from", po.from).number("to", po.to).integer("wave", o.wave).integer("degree", po.degree)
         .integer("intervals", po.intervals).integer("points", po.max_points).number("initial_step", po.initial_step);
+    if (!a.max_step.empty()) inputs.number("max_step", po.max_step);  // only when given, as orbits
     JsonEnvelope e;
     e.command = "orbits";
     e.inputs = inputs.str();
@@ -87,6 +111,7 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
                 << (p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
+        out << crossing_lines(b);
         if (b.points.empty()) {
         } else if (w.full_ring_stability)
             out << "stability  Floquet multipliers of the full ring of " << o.cars << " cars along the wave; max |mu_trivial - 1| = "

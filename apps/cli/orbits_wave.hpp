@@ -4,6 +4,7 @@
 #include <string>
 
 #include "common.hpp"
+#include "ddemap/analysis/periodic_orbit.hpp"
 #include "nonlinear_flags.hpp"
 
 namespace ddemap::cli {
@@ -15,7 +16,13 @@ struct OrbitsWaveArgs {
     bool hopf_given = false;
     const FormatArg& format;
     const OutArg& out;
+    std::string max_step = {};  ///< --max-step (empty: the default of PeriodicOrbitOptions)
 };
+
+/// The table lines of the period doublings and tori of a branch (orbits and orbits --wave):
+/// "doubling   p = .., period .., mu = .. (located: ||mu| - 1| = .., bracket .. in p)", or
+/// "p ~ .. (not located: interpolated)".
+std::string crossing_lines(const OrbitBranch& b);
 
 /// Runs `orbits --wave` (exit code as the other commands).
 int run_orbits_wave(const OrbitsWaveArgs& a);

@@ -16,6 +16,7 @@
 #include <Spectra/MatOp/DenseGenMatProd.h>
 #pragma GCC diagnostic pop
 
+#include "analysis/internal/orbit_continuation.hpp"
 #include "analysis/internal/orbit_mesh.hpp"
 #include "core/internal/eigen_threads.hpp"
 
@@ -714,78 +715,6 @@ PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correct
 /// max over the variables of max - min: 0 for an equilibrium.
 double amplitude(const PeriodicOrbit& o) { return (o.max - o.min).maxCoeff(); }
 
-/// The nontrivial multipliers (the one nearest 1 removed).
-std::vector<cplx> nontrivial(const PeriodicOrbit& o) {
-    std::vector<cplx> v = o.multipliers;
-    if (v.empty()) return v;
-    std::size_t k1 = 0;
-    for (std::size_t k = 1; k < v.size(); ++k)
-        if (std::abs(v[k] - 1.0) < std::abs(v[k1] - 1.0)) k1 = k;
-    v.erase(v.begin() + static_cast<std::ptrdiff_t>(k1));
-    return v;
-}
-
-constexpr double kRealTolerance = 1e-6;  // |Im mu| below this: a real multiplier
-constexpr double kCrossingTolerance = 1e-9;  // | |mu| - 1 | at a located period doubling or torus
-constexpr double kCrossingJump = 1e-3;  // | |mu| - 1 | still above this on a bracket of 1e-12 h: a jump, not a crossing
-/// the most a crossing multiplier may move in one step of the branch (or away from its linear
-/// prediction in the location): farther apart, two multipliers are not the same one followed
-/// (e.g. a complex pair that met the real axis paired with a small one)
-constexpr double kCrossingMove = 0.25;
-
-/// The nontrivial multipliers of one kind: real negative (period doubling) or complex with
-/// Im > 0 (torus; one of each conjugate pair).
-std::vector<cplx> of_kind(const PeriodicOrbit& o, bool pd) {
-    std::vector<cplx> v;
-    for (cplx z : nontrivial(o)) {
-        const bool real = std::abs(z.imag()) <= kRealTolerance;
-        if (pd ? (real && z.real() < 0.0) : (!real && z.imag() > 0.0)) v.push_back(z);
-    }
-    return v;
-}
-
-/// The multipliers of one kind that cross the unit circle between two orbits a and b of a branch:
-/// the multipliers of that kind of a and of b are paired greedily by increasing distance
-/// |mu_a - mu_b| up to kCrossingMove (each used once: one that has no partner of its kind nearby,
-/// such as one of a complex pair that meets the real axis, is left alone), and a pair crosses
-/// when |mu| - 1 changes sign between a and b. Every crossing of a step is found, also when several multipliers cross in one
-/// step, or one leaves the circle while another enters it; a change of the number of multipliers
-/// outside the circle without a crossing (two multipliers colliding on the real axis) gives none.
-std::vector<std::pair<cplx, cplx>> circle_crossings(const PeriodicOrbit& a, const PeriodicOrbit& b, bool pd) {
-    const std::vector<cplx> ma = of_kind(a, pd), mb = of_kind(b, pd);
-    struct Pair {
-        double dist;
-        std::size_t i, j;
-    };
-    std::vector<Pair> pairs;
-    for (std::size_t i = 0; i < ma.size(); ++i)
-        for (std::size_t j = 0; j < mb.size(); ++j) pairs.push_back({std::abs(ma[i] - mb[j]), i, j});
-    std::sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) { return x.dist < y.dist; });
-    std::vector<bool> used_a(ma.size(), false), used_b(mb.size(), false);
-    std::vector<std::pair<cplx, cplx>> out;
-    for (const Pair& q : pairs) {
-        if (q.dist > kCrossingMove) break;
-        if (used_a[q.i] || used_b[q.j]) continue;
-        used_a[q.i] = used_b[q.j] = true;
-        if ((std::abs(ma[q.i]) < 1.0) != (std::abs(mb[q.j]) < 1.0)) out.push_back({ma[q.i], mb[q.j]});
-    }
-    return out;
-}
-
-/// |mu| - 1 of the multiplier of the kind nearest `predicted` (the crossing multiplier followed
-/// along the branch) and that multiplier; NaN when the orbit has none of that kind.
-double tracked_value(const PeriodicOrbit& o, bool pd, cplx predicted, cplx& mu) {
-    double best = std::numeric_limits<double>::infinity(), value = std::numeric_limits<double>::quiet_NaN();
-    for (cplx z : of_kind(o, pd)) {
-        if (std::abs(z - predicted) < best) {
-            best = std::abs(z - predicted);
-            value = std::abs(z) - 1.0;
-            mu = z;
-        }
-    }
-    return value;
-}
-
 Setup make_setup(const NonlinearDDE& system, const PeriodicMesh& mesh, const PeriodicOrbitOptions& o, double period_scale) {
     std::string why;
     if (!o.is_valid(&why)) throw std::invalid_argument("periodic orbit options: " + why);
@@ -839,99 +768,6 @@ Eigen::VectorXd resample(const Setup& from, const Setup& to, const Eigen::Vector
     return v;
 }
 
-/// Locates one crossing multiplier (mu0 at `prev` = u, mu1 at `orbit` = v, u + s1 t predicted)
-/// by Illinois regula falsi in the arclength s along the tangent t on g(s) = |mu(s)| - 1, mu(s)
-/// the multiplier of the kind nearest the linear interpolation of the bracket ends' ones; then
-/// checks a small bracket: the orbit a little beyond the zero (2 |g| / |g'| and at least 1e-8 h
-/// in s, widened tenfold up to 4 times) must have g of the other sign, and par_bracket is the
-/// width in p of that bracket (else of the regula falsi's last one). A crossing whose g still
-/// jumps by more than kCrossingJump over a bracket of 1e-12 h, or whose multiplier is found
-/// farther than kCrossingMove from its prediction, is no crossing (dropped).
-void locate_crossing(const Setup& c, const Eigen::VectorXd& u, const Eigen::VectorXd& t, const Eigen::VectorXd& v, const Eigen::MatrixXd& ref,
-                     double h, const PeriodicOrbit& prev, const PeriodicOrbit& orbit, const std::pair<cplx, cplx>& crossing, bool pd, int after,
-                     const PeriodicOrbitOptions& o, const std::shared_ptr<const Linearization>& lin_u, OrbitBranch& b) {
-    OrbitCrossing x;
-    x.after = after;
-    const double g0 = std::abs(crossing.first) - 1.0, g1 = std::abs(crossing.second) - 1.0;
-    // the interpolation, kept when the location fails
-    const double frac = std::clamp(g0 / (g0 - g1), 0.0, 1.0);
-    x.par = prev.par + frac * (orbit.par - prev.par);
-    x.period = prev.period + frac * (orbit.period - prev.period);
-    x.multiplier = crossing.second;
-    const Eigen::VectorXd ak = c.w.cwiseProduct(t);
-    // the orbit at arclength s along t from u, corrected, with its multipliers
-    auto orbit_at = [&](double s, PeriodicOrbit& out) {
-        Eigen::VectorXd w = u + s * t;
-        const Correction rc = correct(c, w, ref, ak, ak.dot(u + s * t), o, lin_u);
-        b.newton_iterations += rc.iterations;
-        b.jacobians += rc.jacobians;
-        if (!rc.ok) return false;
-        out = make_orbit(c, w, rc, true);
-        return true;
-    };
-    double slo = 0.0, shi = ak.dot(v - u), glo = g0, ghi = g1, plo = prev.par, phi = orbit.par;
-    double glo_true = g0, ghi_true = g1;  // without the Illinois halving
-    cplx mlo = crossing.first, mhi = crossing.second;
-    int side = 0;
-    for (int it = 0; it < 40; ++it) {
-        const double sm = slo - glo * (shi - slo) / (ghi - glo);
-        PeriodicOrbit trial;
-        if (!orbit_at(sm, trial)) break;
-        cplx mu;
-        const cplx predicted = mlo + (mhi - mlo) * ((sm - slo) / (shi - slo));
-        const double gv = tracked_value(trial, pd, predicted, mu);
-        if (!std::isfinite(gv)) break;
-        if (std::abs(mu - predicted) > kCrossingMove) return;  // not one multiplier followed continuously: no crossing
-        if ((gv < 0.0) == (glo < 0.0)) {
-            slo = sm;
-            glo = glo_true = gv;
-            plo = trial.par;
-            mlo = mu;
-            if (side == -1) ghi *= 0.5;
-            side = -1;
-        } else {
-            shi = sm;
-            ghi = ghi_true = gv;
-            phi = trial.par;
-            mhi = mu;
-            if (side == 1) glo *= 0.5;
-            side = 1;
-        }
-        if (std::abs(shi - slo) <= 1e-12 * h && std::abs(gv) > kCrossingJump) return;  // g jumps: no crossing
-        if (std::abs(gv) <= kCrossingTolerance || std::abs(shi - slo) <= 1e-12 * h) {
-            x.located = true;
-            x.par = trial.par;
-            x.period = trial.period;
-            x.multiplier = mu.imag() < 0.0 ? std::conj(mu) : mu;
-            x.accuracy = std::abs(gv);
-            x.par_bracket = std::abs(phi - plo);
-            // a small bracket around the zero: an orbit just beyond it, on the other side
-            const double slope = (ghi_true - glo_true) / (shi - slo);
-            double delta = std::max(2.0 * std::abs(gv / slope), 1e-8 * h);
-            const double dir = (gv < 0.0) == (slope > 0.0) ? 1.0 : -1.0;  // towards the zero
-            for (int k = 0; k < 4 && std::isfinite(delta); ++k, delta *= 10.0) {
-                const double s2 = sm + dir * delta;
-                if (s2 <= std::min(slo, shi) || s2 >= std::max(slo, shi)) break;  // the regula falsi's bracket is the smaller one
-                PeriodicOrbit beyond;
-                if (!orbit_at(s2, beyond)) break;
-                cplx m2;
-                const double g2 = tracked_value(beyond, pd, mu, m2);
-                if (std::isfinite(g2) && (g2 < 0.0) != (gv < 0.0)) {
-                    x.par_bracket = std::abs(beyond.par - trial.par);
-                    break;
-                }
-            }
-            x.orbit = std::move(trial);
-            break;
-        }
-    }
-    if (!x.located && b.status == Status::Converged) {
-        b.status = Status::MaxIterations;
-        b.message = std::string("a ") + (pd ? "period doubling" : "torus bifurcation") + " was detected but not located";
-    }
-    (pd ? b.period_doublings : b.tori).push_back(std::move(x));
-}
-
 /// Follows the branch from the corrected first orbit u with unit tangent t.
 void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const PeriodicOrbitOptions& o,
             OrbitBranch& b) {
@@ -963,21 +799,21 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
     const double amp0 = amplitude(b.points.front());
     b.newton_iterations += first.iterations;
     b.jacobians += first.jacobians;
-    double h = o.initial_step;
+    orbit_continuation::StepControl step(o);
     b.stop = "max_points";
     adapt();
     while (static_cast<int>(b.points.size()) < o.max_points) {
         const Setup& c = *cur;
+        const double h = step.h();
         const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
         Eigen::VectorXd v = u + h * t;
         const Eigen::VectorXd a = c.w.cwiseProduct(t);
         Correction r = correct(c, v, ref, a, a.dot(u + h * t), o, lin_u);
         b.newton_iterations += r.iterations;
         b.jacobians += r.jacobians;
-        const bool jump = r.ok && c.norm(v - u) > 3.0 * h;
+        const bool jump = r.ok && step.jumped(c.norm(v - u));
         if (!r.ok || jump) {
-            h *= 0.5;
-            if (h < o.min_step) {
+            if (!step.shrink()) {
                 b.stop = "step_below_minimum";
                 b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
                 std::ostringstream s;
@@ -1011,61 +847,41 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         }
         PeriodicOrbit orbit = make_orbit(c, v, r, o.floquet);
         const int after = static_cast<int>(b.points.size()) - 1;
-        // fold: the parameter component of the tangent changes sign
-        if (t(N + 1) * tn(N + 1) < 0.0) {
-            OrbitFold f;
-            f.after = after;
-            const Eigen::VectorXd tk = t, uk = u;
-            const Eigen::VectorXd ak = c.w.cwiseProduct(tk);
-            double slo = 0.0, shi = ak.dot(v - uk), glo = tk(N + 1), ghi = tn(N + 1);
-            int side = 0;
+        // folds, period doublings and tori of this step (analysis/internal/orbit_continuation.hpp)
+        {
+            const Eigen::VectorXd ak = c.w.cwiseProduct(t);
             Eigen::VectorXd best = v;
             Correction bestc = r;
-            const double sp = std::abs(o.to - o.from);
-            for (int it = 0; it < 40; ++it) {
-                const double s = slo - glo * (shi - slo) / (ghi - glo);
-                Eigen::VectorXd w = uk + s * tk;
-                const Correction rc = correct(c, w, ref, ak, ak.dot(uk + s * tk), o, lin_u);
+            orbit_continuation::Probe probe;
+            probe.fold_trial = [&](double s, double& g) {
+                Eigen::VectorXd w = u + s * t;
+                const Correction rc = correct(c, w, ref, ak, ak.dot(u + s * t), o, lin_u);
                 b.newton_iterations += rc.iterations;
                 b.jacobians += rc.jacobians;
-                if (!rc.ok) break;
-                const double gv = (rc.tangent / c.norm(rc.tangent))(N + 1) * (rc.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
+                if (!rc.ok) return false;
+                g = (rc.tangent / c.norm(rc.tangent))(N + 1) * (rc.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
                 best = w;
                 bestc = rc;
-                if (std::abs(gv) <= 1e-11 * sp || std::abs(shi - slo) <= 1e-12 * h) {
-                    f.located = true;
-                    break;
-                }
-                if ((gv < 0.0) == (glo < 0.0)) {
-                    slo = s;
-                    glo = gv;
-                    if (side == -1) ghi *= 0.5;
-                    side = -1;
-                } else {
-                    shi = s;
-                    ghi = gv;
-                    if (side == 1) glo *= 0.5;
-                    side = 1;
-                }
-            }
-            f.orbit = make_orbit(c, best, bestc, o.floquet);
-            f.par = f.orbit.par;
-            f.period = f.orbit.period;
-            if (!f.located && b.status == Status::Converged) {
-                b.status = Status::MaxIterations;
-                b.message = "a fold of periodic orbits was detected but not located";
-            }
-            b.folds.push_back(f);
-        }
-        // period doubling and torus: the multipliers that cross the unit circle in this step
-        const PeriodicOrbit& prev = b.points.back();
-        if (o.floquet && !prev.multipliers.empty() && !orbit.multipliers.empty()) {
-            for (int kind = 0; kind < 2; ++kind) {
-                const bool pd = kind == 0;
-                for (const auto& crossing : circle_crossings(prev, orbit, pd)) {
-                    locate_crossing(c, u, t, v, ref, h, prev, orbit, crossing, pd, after, o, lin_u, b);
-                }
-            }
+                return true;
+            };
+            probe.fold_orbit = [&] { return make_orbit(c, best, bestc, o.floquet); };
+            probe.orbit_at = [&](double s, PeriodicOrbit& out) {
+                Eigen::VectorXd w = u + s * t;
+                const Correction rc = correct(c, w, ref, ak, ak.dot(u + s * t), o, lin_u);
+                b.newton_iterations += rc.iterations;
+                b.jacobians += rc.jacobians;
+                if (!rc.ok) return false;
+                out = make_orbit(c, w, rc, true);
+                return true;
+            };
+            orbit_continuation::Step st;
+            st.after = after;
+            st.length = ak.dot(v - u);
+            st.h = h;
+            st.t_par = t(N + 1);
+            st.tn_par = tn(N + 1);
+            st.par_scale = std::abs(o.to - o.from);
+            orbit_continuation::special_points(st, b.points.back(), orbit, o.floquet, "periodic orbits", probe, b);
         }
         const bool collapsed = amplitude(orbit) < 0.5 * amp0;
         b.points.push_back(std::move(orbit));
@@ -1079,7 +895,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         lin_u = r.lin;
         // an easy step: the chord iterations converged with at most one new Jacobian besides the
         // one at the result (sparse path: at most 3 Newton steps)
-        if (r.lin ? r.jacobians <= 2 : r.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
+        step.accepted(r.lin ? r.jacobians <= 2 : r.iterations <= 3);
         if (u(N) > o.max_period_factor * T0) {
             b.stop = "period";
             return;

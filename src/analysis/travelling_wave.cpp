@@ -14,6 +14,7 @@
 #include "ddemap/traffic/nonlinear_ring.hpp"
 #include "ddemap/traffic/ring_car.hpp"
 
+#include "analysis/internal/orbit_continuation.hpp"
 #include "analysis/internal/orbit_mesh.hpp"
 
 namespace ddemap {
@@ -513,9 +514,10 @@ struct DefectControl {
     int max_intervals = 0;
 };
 
-/// The branch from the corrected wave u with unit tangent t (the continuation of periodic_orbit's
-/// follow): pseudo-arclength with step control, the range's faces located, folds located by
-/// Illinois regula falsi on the parameter component of the tangent. The branch ends at
+/// The branch from the corrected wave u with unit tangent t: pseudo-arclength with the step
+/// control of periodic_orbit's branches, the range's faces located, and the special points of
+/// every step by the same code (orbit_continuation.hpp: folds; with the full ring's multipliers
+/// period doublings and tori), with the reduced corrector and the wave's orbits. The branch ends at
 /// max_points waves, on a face of the range, when the amplitude falls below `collapse` times the
 /// first wave's (back at the Hopf point), when the period exceeds max_period_factor T0, or when
 /// the step falls below min_step. With `adapt` the mesh is re-equidistributed after every wave.
@@ -535,7 +537,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
     b.newton_iterations += first.iterations;
     max_drift = std::max(max_drift, std::abs(u(N + 2)));
     const double amp0 = amplitude(b.points.front());
-    double h = o.initial_step;
+    orbit_continuation::StepControl step(o);
     b.stop = "max_points";
     b.intervals = std::max(b.intervals, c.L);
     if (adapt && !(dc.tolerance > 0.0)) remesh(c, u, &t);  // with the defect control, only when needed
@@ -587,19 +589,19 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
     while (static_cast<int>(b.points.size()) < max_points) {
         const PeriodicMesh mesh_before = c.mesh;  // resolve() may move u and t to another mesh
         const Eigen::VectorXd u_before = u, t_before = t;
+        const double h = step.h();
         ref = derivative_at_collocation(c, u);
         Eigen::VectorXd v = u + h * t;
         a = c.w.cwiseProduct(t);
         Correction rc = correct(c, v, ref, a, a.dot(u + h * t), o);
         b.newton_iterations += rc.iterations;
-        const bool jump = rc.ok && c.norm(v - u) > 3.0 * h;
+        const bool jump = rc.ok && step.jumped(c.norm(v - u));
         double dv = rc.ok && !jump ? reduced_defect(c, v) : std::numeric_limits<double>::quiet_NaN();
         bool unresolved = false;
         if (rc.ok && !jump && adapt && dc.tolerance > 0.0 && !(dv <= dc.tolerance)) unresolved = !resolve(v, rc, dv, h, false, 0.0);
         if (unresolved) {
             // a smaller step first; the mesh is refined only when the step is already small
-            h *= 0.5;
-            if (h < o.min_step) {
+            if (!step.shrink()) {
                 b.stop = "unresolved";
                 b.status = Status::NumericalIssue;
                 std::ostringstream s;
@@ -620,8 +622,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             break;
         }
         if (!rc.ok || jump) {
-            h *= 0.5;
-            if (h < o.min_step) {
+            if (!step.shrink()) {
                 b.stop = "step_below_minimum";
                 b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
                 std::ostringstream s;
@@ -645,8 +646,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             if (rb.ok && adapt && dc.tolerance > 0.0 && !(db <= dc.tolerance) && !resolve(wv, rb, db, h, true, bound)) {
                 // the step overshot the face onto a wave that is not resolved: a shorter step
                 // from u on its own mesh
-                h *= 0.5;
-                if (h >= o.min_step) {
+                if (step.shrink()) {
                     apply_mesh(c, mesh_before);
                     N = c.N();
                     u = u_before;
@@ -672,60 +672,52 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             b.stop = "bound";
             break;
         }
-        // fold: the parameter component of the tangent changes sign; Illinois regula falsi in the
-        // arclength on that component, every trial orbit corrected
-        if (t(N + 1) * tn(N + 1) < 0.0) {
-            OrbitFold f;
-            f.after = static_cast<int>(b.points.size()) - 1;
+        PeriodicOrbit orbit = make_orbit(c, v, rc, full, o.parameter, o.floquet);
+        // folds, and with the full ring's multipliers period doublings and tori, of this step: the
+        // detection and location of periodic_orbit's branches (analysis/internal/orbit_continuation.hpp)
+        {
             const Eigen::VectorXd ak = c.w.cwiseProduct(t);
-            double slo = 0.0, shi = ak.dot(v - u), glo = t(N + 1), ghi = tn(N + 1);
-            int side = 0;
             Eigen::VectorXd best = v;
             Correction bestc = rc;
-            const double sp = std::abs(o.to - o.from);
-            for (int it = 0; it < 40; ++it) {
-                const double s = slo - glo * (shi - slo) / (ghi - glo);
+            orbit_continuation::Probe probe;
+            probe.fold_trial = [&](double s, double& g) {
                 Eigen::VectorXd wv = u + s * t;
                 const Correction rf = correct(c, wv, ref, ak, ak.dot(u + s * t), o);
                 b.newton_iterations += rf.iterations;
-                if (!rf.ok) break;
-                const double gv = (rf.tangent / c.norm(rf.tangent))(N + 1) * (rf.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
+                if (!rf.ok) return false;
+                g = (rf.tangent / c.norm(rf.tangent))(N + 1) * (rf.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
                 best = wv;
                 bestc = rf;
-                if (std::abs(gv) <= 1e-11 * sp || std::abs(shi - slo) <= 1e-12 * h) {
-                    f.located = true;
-                    break;
+                return true;
+            };
+            probe.fold_orbit = [&] { return make_orbit(c, best, bestc, full, o.parameter, false); };
+            probe.orbit_at = [&](double s, PeriodicOrbit& out) {
+                Eigen::VectorXd wv = u + s * t;
+                const Correction rx = correct(c, wv, ref, ak, ak.dot(u + s * t), o);
+                b.newton_iterations += rx.iterations;
+                if (!rx.ok) return false;
+                out = make_orbit(c, wv, rx, full, o.parameter, true);
+                return true;
+            };
+            orbit_continuation::Step st;
+            st.after = static_cast<int>(b.points.size()) - 1;
+            st.length = ak.dot(v - u);
+            st.h = h;
+            st.t_par = t(N + 1);
+            st.tn_par = tn(N + 1);
+            st.par_scale = std::abs(o.to - o.from);
+            const bool crossings = o.floquet && full.system != nullptr;
+            if (orbit_continuation::special_points(st, b.points.back(), orbit, crossings, "travelling waves", probe, b)) {
+                const double df = reduced_defect(c, best), limit = adapt ? dc.tolerance : dc.refuse;
+                if (limit > 0.0 && !(df <= limit) && b.status == Status::Converged) {
+                    b.status = Status::NumericalIssue;
+                    std::ostringstream s;
+                    s << "the fold of travelling waves at " << b.parameter << " = " << b.folds.back().orbit.par << " is not resolved on " << c.L
+                      << " intervals (relative defect " << df << " above " << limit << "): use more intervals";
+                    b.message = s.str();
                 }
-                if ((gv < 0.0) == (glo < 0.0)) {
-                    slo = s;
-                    glo = gv;
-                    if (side == -1) ghi *= 0.5;
-                    side = -1;
-                } else {
-                    shi = s;
-                    ghi = gv;
-                    if (side == 1) glo *= 0.5;
-                    side = 1;
-                }
             }
-            f.orbit = make_orbit(c, best, bestc, full, o.parameter, false);
-            f.par = f.orbit.par;
-            f.period = f.orbit.period;
-            if (!f.located && b.status == Status::Converged) {
-                b.status = Status::MaxIterations;
-                b.message = "a fold of travelling waves was detected but not located";
-            }
-            const double df = reduced_defect(c, best), limit = adapt ? dc.tolerance : dc.refuse;
-            if (limit > 0.0 && !(df <= limit) && b.status == Status::Converged) {
-                b.status = Status::NumericalIssue;
-                std::ostringstream s;
-                s << "the fold of travelling waves at " << b.parameter << " = " << f.orbit.par << " is not resolved on " << c.L
-                  << " intervals (relative defect " << df << " above " << limit << "): use more intervals";
-                b.message = s.str();
-            }
-            b.folds.push_back(f);
         }
-        PeriodicOrbit orbit = make_orbit(c, v, rc, full, o.parameter, o.floquet);
         max_drift = std::max(max_drift, std::abs(v(N + 2)));
         const bool collapsed = amplitude(orbit) < collapse * amp0;
         b.points.push_back(std::move(orbit));
@@ -738,7 +730,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
         }
         u = v;
         t = tn;
-        if (rc.iterations <= 3) h = std::min(o.max_step, 1.5 * h);
+        step.accepted(rc.iterations <= 3);
         if (u(N) > o.max_period_factor * T0) {
             b.stop = "period";
             break;
@@ -839,6 +831,8 @@ void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, 
     auto fail = [&](const std::string& why) {
         b.points.clear();
         b.folds.clear();
+        b.period_doublings.clear();
+        b.tori.clear();
         b.status = Status::MaxIterations;
         b.stop = "first_orbit_failed";
         b.message = "the first travelling wave from the Hopf point did not converge, and the homotopy in K / N from " + format_q(kHomotopyStart) +
@@ -897,6 +891,8 @@ void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, 
         if (2 * c.L > opt.max_intervals) {
             b.points.clear();
             b.folds.clear();
+            b.period_doublings.clear();
+            b.tori.clear();
             b.status = Status::NumericalIssue;
             b.stop = "unresolved";
             std::ostringstream s;
@@ -955,6 +951,20 @@ void long_wave_branch(Wave& c, const RingCar& car, int j, const FullRing& full, 
     for (OrbitFold f : B.folds) {
         f.after += nA - 1;
         b.folds.push_back(f);
+    }
+    // period doublings and tori (only with the full ring's multipliers) renumbered the same way
+    for (int k = 0; k < 2; ++k) {
+        std::vector<OrbitCrossing>& out = k == 0 ? b.period_doublings : b.tori;
+        const std::vector<OrbitCrossing>& a_side = k == 0 ? A.period_doublings : A.tori;
+        const std::vector<OrbitCrossing>& b_side = k == 0 ? B.period_doublings : B.tori;
+        for (auto it = a_side.rbegin(); it != a_side.rend(); ++it) {
+            out.push_back(*it);
+            out.back().after = nA - 2 - it->after;
+        }
+        for (OrbitCrossing x : b_side) {
+            x.after += nA - 1;
+            out.push_back(x);
+        }
     }
     b.stop = B.stop;
     b.status = B.status;

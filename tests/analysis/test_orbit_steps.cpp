@@ -8,6 +8,7 @@
 #include "../tolerances.hpp"
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/analysis/travelling_wave.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/traffic/nonlinear_ring.hpp"
 
@@ -157,4 +158,157 @@ TEST_CASE("IDM ring of 5 cars: long steps find the same period doubling and toru
     }
     CHECK(std::abs(fine.period_doublings[0].multiplier + 1.0) <= 1e-8);
     CHECK(fine.tori[0].multiplier.imag() > 0.1);
+}
+
+// ---- travelling waves (analysis/travelling_wave.hpp): the same step control and special points
+// (analysis/internal/orbit_continuation.hpp), so the same guarantees with long steps
+
+namespace {
+
+/// The wave branch of wave number 1 on a 5-car ring; the full ring's multipliers with `floquet`.
+TravellingWaveBranch wave_branch(const std::string& model, const ParameterMap& parameters, const std::string& par, double from, double to,
+                                 double max_step, int intervals, bool floquet) {
+    TravellingWaveOptions o;
+    o.model = model;
+    o.cars = 5;
+    o.wave = 1;
+    o.orbit.parameter = par;
+    o.orbit.from = from;
+    o.orbit.to = to;
+    o.orbit.max_points = 3000;
+    o.orbit.max_step = max_step;
+    o.orbit.intervals = intervals;
+    o.orbit.floquet = floquet;
+    return travelling_wave_branch(parameters, o);
+}
+
+/// The full ring's orbits (one headway eliminated) from its first Hopf point in [from, to].
+OrbitBranch full_ring_branch(const std::string& model, const ParameterMap& parameters, const std::string& par, double from, double to,
+                             double max_step, bool floquet) {
+    const NonlinearRing ring = make_nonlinear_ring(model, 5, parameters, par, from);
+    EquilibriumBranchOptions eo;
+    eo.parameter = par;
+    eo.from = from;
+    eo.to = to;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = equilibrium_branch(*ring.system, ring.uniform_flow, eo);
+    REQUIRE(!eq.hopf.empty());
+    PeriodicOrbitOptions o;
+    o.parameter = par;
+    o.from = from;
+    o.to = to;
+    o.max_points = 3000;
+    o.max_step = max_step;
+    o.floquet = floquet;
+    return orbit_branch_from_hopf(*ring.system, eq.hopf.front(), o);
+}
+
+}  // namespace
+
+TEST_CASE("travelling waves (ov, 5 cars): long steps find the same fold of the wave branch, at the full ring's fold and above every wave") {
+    // the subcritical wave branch from the Hopf point at headway 2.62 folds at headway 3.1078
+    // (README) and comes back to headway 2: the fold is the largest headway of the branch
+    const OrbitBranch full = full_ring_branch("ov", {}, "headway", 3.5, 2.0, 0.1, false);
+    REQUIRE(full.status == Status::Converged);
+    REQUIRE(full.folds.size() == 1);
+    REQUIRE(full.folds[0].located);
+    const TravellingWaveBranch fine = wave_branch("ov", {}, "headway", 3.5, 2.0, 0.1, 40, false);
+    const TravellingWaveBranch fine20 = wave_branch("ov", {}, "headway", 3.5, 2.0, 0.1, 20, false);
+    for (const TravellingWaveBranch* w : {&fine, &fine20}) {
+        REQUIRE(w->branch.status == Status::Converged);
+        REQUIRE(w->branch.folds.size() == 1);
+        REQUIRE(w->branch.folds[0].located);
+    }
+    const double fold = fine.branch.folds[0].par;
+    // the fine branch's own scan: no wave beyond the fold, and the fold between its neighbours
+    double largest = -1.0;
+    for (const PeriodicOrbit& p : fine.branch.points) largest = std::max(largest, p.par);
+    MESSAGE("fold of waves at headway " << fold << ", the fine branch's largest headway " << largest << ", the full ring's fold "
+                                        << full.folds[0].par << " (20 intervals: " << fine20.branch.folds[0].par << ")");
+    CHECK(largest <= fold + tol::wave_fold_between_steps);
+    const auto after = static_cast<std::size_t>(fine.branch.folds[0].after);
+    REQUIRE(after + 1 < fine.branch.points.size());
+    CHECK(fine.branch.points[after].par < fold);
+    CHECK(fine.branch.points[after + 1].par < fold);
+    // the full ring's fold (its own equations, 9 of them): within the mesh change of the reduced form
+    CHECK(std::abs(fold - full.folds[0].par) <= std::abs(fold - fine20.branch.folds[0].par) + tol::wave_vs_full_ring_floor);
+    for (double step : {1.0, 2.0}) {
+        CAPTURE(step);
+        const TravellingWaveBranch coarse = wave_branch("ov", {}, "headway", 3.5, 2.0, step, 40, false);
+        REQUIRE(coarse.branch.status == Status::Converged);
+        CHECK(coarse.branch.stop == "bound");
+        MESSAGE("max_step " << step << ": " << coarse.branch.points.size() << " waves against " << fine.branch.points.size());
+        CHECK(coarse.branch.points.size() < fine.branch.points.size());
+        REQUIRE(coarse.branch.folds.size() == 1);  // not missed
+        REQUIRE(coarse.branch.folds[0].located);
+        CHECK(std::abs(coarse.branch.folds[0].par - fold) <= tol::wave_fold_between_steps);  // nor misplaced
+        CHECK(std::abs(coarse.branch.folds[0].period - fine.branch.folds[0].period) <= tol::wave_fold_between_steps * fine.branch.folds[0].period);
+        // the same branch: both end on headway 2 (located exactly) with the same wave
+        REQUIRE(coarse.branch.points.back().par == 2.0);
+        CHECK(std::abs(coarse.branch.points.back().period - fine.branch.points.back().period) <=
+              tol::orbit_step_interpolation * fine.branch.points.back().period);
+    }
+}
+
+TEST_CASE("travelling waves (IDM, 5 cars): long steps give the same branch, period doubling and torus, both at the full ring's") {
+    // the wave branch of `orbits --model idm --ring 5 --th 1.2 --tau 0.6 --wave 1` from its Hopf
+    // point at gap 8.048 to gap 22, with the full ring's multipliers along the wave: a torus
+    // bifurcation near gap 20.4575 and a period doubling near 21.0402, as on the full ring's own
+    // branch (test above: the same Hopf point, the same orbits)
+    const ParameterMap idm{{"th", 1.2}, {"tau", 0.6}};
+    const TravellingWaveBranch fine = wave_branch("idm", idm, "gap", 6.0, 22.0, 0.1, 40, true);
+    const TravellingWaveBranch fine20 = wave_branch("idm", idm, "gap", 6.0, 22.0, 1.0, 20, true);
+    for (const TravellingWaveBranch* w : {&fine, &fine20}) {
+        REQUIRE(w->full_ring_stability);
+        REQUIRE(w->branch.status == Status::Converged);
+        REQUIRE(w->branch.stop == "bound");
+        REQUIRE(w->branch.period_doublings.size() == 1);
+        REQUIRE(w->branch.tori.size() == 1);
+    }
+    REQUIRE(monotone_in_par(fine.branch));
+    CHECK(fine.branch.folds.empty());
+    for (double step : {1.0, 2.0}) {
+        CAPTURE(step);
+        const TravellingWaveBranch coarse = wave_branch("idm", idm, "gap", 6.0, 22.0, step, 40, true);
+        REQUIRE(coarse.branch.status == Status::Converged);
+        CHECK(coarse.branch.stop == "bound");
+        MESSAGE("max_step " << step << ": " << coarse.branch.points.size() << " waves against " << fine.branch.points.size());
+        CHECK(coarse.branch.points.size() * 3 < fine.branch.points.size());
+        const auto d = branch_difference(fine.branch, coarse.branch);
+        MESSAGE("largest relative differences: period " << d.first << ", max |mu| " << d.second);
+        CHECK(d.first <= tol::orbit_step_interpolation);
+        CHECK(d.second <= tol::orbit_step_interpolation);
+        REQUIRE(coarse.branch.period_doublings.size() == 1);
+        REQUIRE(coarse.branch.tori.size() == 1);
+        const OrbitCrossing* pairs[2][2] = {{&fine.branch.period_doublings[0], &coarse.branch.period_doublings[0]},
+                                            {&fine.branch.tori[0], &coarse.branch.tori[0]}};
+        for (const auto& pr : pairs) {
+            REQUIRE(pr[0]->located);
+            REQUIRE(pr[1]->located);
+            CHECK(std::abs(pr[0]->par - pr[1]->par) <= tol::orbit_crossing_between_steps);
+            CHECK(std::abs(pr[0]->multiplier - pr[1]->multiplier) <= tol::orbit_crossing_between_steps);
+            CHECK(pr[1]->par_bracket <= tol::orbit_crossing_bracket);
+        }
+    }
+    // the located crossings: on the circle, a verified small bracket between their neighbours
+    for (const OrbitCrossing* x : {&fine.branch.period_doublings[0], &fine.branch.tori[0]}) {
+        CHECK(x->accuracy <= 1e-9);
+        CHECK(x->par_bracket <= tol::orbit_crossing_bracket);
+        const auto after = static_cast<std::size_t>(x->after);
+        CHECK((x->par - fine.branch.points[after].par) * (x->par - fine.branch.points[after + 1].par) < 0.0);
+    }
+    CHECK(std::abs(fine.branch.period_doublings[0].multiplier + 1.0) <= 1e-8);
+    CHECK(fine.branch.tori[0].multiplier.imag() > 0.1);
+    // the full ring's own branch (9 equations; long steps, which locate the same points: test
+    // above): the same period doubling and torus, within the mesh change of the reduced form
+    const OrbitBranch full = full_ring_branch("idm", idm, "gap", 6.0, 22.0, 1.0, true);
+    REQUIRE(full.status == Status::Converged);
+    REQUIRE(full.period_doublings.size() == 1);
+    REQUIRE(full.tori.size() == 1);
+    const double wpd = fine.branch.period_doublings[0].par, wt = fine.branch.tori[0].par;
+    MESSAGE("period doubling: wave " << wpd << " (20 intervals " << fine20.branch.period_doublings[0].par << "), full ring " << full.period_doublings[0].par
+                                     << "; torus: wave " << wt << " (20 intervals " << fine20.branch.tori[0].par << "), full ring " << full.tori[0].par);
+    CHECK(std::abs(wpd - full.period_doublings[0].par) <= std::abs(wpd - fine20.branch.period_doublings[0].par) + tol::wave_vs_full_ring_floor);
+    CHECK(std::abs(wt - full.tori[0].par) <= std::abs(wt - fine20.branch.tori[0].par) + tol::wave_vs_full_ring_floor);
+    CHECK(std::abs(fine.branch.tori[0].multiplier - full.tori[0].multiplier) <= tol::wave_full_ring_multipliers);
 }

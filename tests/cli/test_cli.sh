@@ -1360,9 +1360,39 @@ assert abs(ps[-1]["period"] - pl[-1]["period"]) < 1e-6 * ps[-1]["period"], (ps[-
 PY
 expect_error "--max-step = '0.01': expected a value from 0.02 (the first step) to 1e6" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2 --max-step 0.01 --out "$msd/bad1"
 expect_error "--max-step = 'inf': expected a finite number" orbits --system "$msd/wright.json" --par alpha --from 1 --to 2 --max-step inf
-expect_error "--max-step: not with --wave" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --max-step 1
+expect_error "--max-step = '0.01': expected a value from 0.02 (the first step) to 1e6" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --max-step 0.01 --out "$msd/bad2"
 [ -z "$(ls "$msd" | grep bad)" ] && ok || bad "orbits --max-step bad input wrote files: $(ls "$msd")"
 rm -rf "$msd"
+
+# ---- orbits --wave --max-step: the waves share the step control and special points of orbits
+wms="$tmp/wavemaxstep"; mkdir -p "$wms"
+"$bin" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --points 100 --quiet --format json >"$wms/s.json" &&
+    "$bin" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --points 100 --max-step 2 --quiet --format json >"$wms/l.json" &&
+    python3 - "$wms/s.json" "$wms/l.json" <<'PY' && ok || bad "orbits --wave --max-step 2: not fewer waves with the same fold"
+import json, sys
+s, l = (json.load(open(f)) for f in sys.argv[1:3])
+assert l["inputs"]["max_step"] == 2 and "max_step" not in s["inputs"], (l["inputs"], s["inputs"])
+rs, rl = s["result"], l["result"]
+assert rs["stop"] == rl["stop"] == "bound" and len(rl["points"]) < len(rs["points"]), (len(rl["points"]), len(rs["points"]))
+assert len(rs["folds"]) == len(rl["folds"]) == 1 and rs["folds"][0]["located"] and rl["folds"][0]["located"]
+assert abs(rs["folds"][0]["par"] - rl["folds"][0]["par"]) < 1e-8, (rs["folds"], rl["folds"])
+assert rs["period_doublings"] == rl["period_doublings"] == [] and rs["tori"] == rl["tori"] == []
+PY
+# the IDM wave with the full ring's multipliers: a period doubling and a torus, in JSON and in the table
+"$bin" orbits --model idm --ring 5 --th 1.2 --tau 0.6 --wave 1 --par gap --from 6 --to 22 --points 300 --max-step 1 --quiet --format json >"$wms/i.json" &&
+    "$bin" orbits --model idm --ring 5 --th 1.2 --tau 0.6 --wave 1 --par gap --from 6 --to 22 --points 300 --max-step 1 --quiet >"$wms/i.txt" &&
+    grep -q "^doubling   gap = 21.0402" "$wms/i.txt" && grep -q "^torus      gap = 20.4574" "$wms/i.txt" && python3 - "$wms/i.json" <<'PY' && ok || bad "orbits --wave 1 on the 5-car IDM ring: no period doubling and torus: $(grep -E 'doubling|torus' "$wms/i.txt")"
+import json, sys
+r = json.load(open(sys.argv[1]))["result"]
+pd, to = r["period_doublings"], r["tori"]
+assert len(pd) == 1 and len(to) == 1 and pd[0]["located"] and to[0]["located"], (pd, to)
+assert abs(pd[0]["par"] - 21.0402) < 1e-4 and abs(to[0]["par"] - 20.4575) < 1e-4, (pd, to)
+assert pd[0]["par_bracket"] < 1e-6 and to[0]["par_bracket"] < 1e-6 and abs(pd[0]["multiplier"][0] + 1) < 1e-8
+PY
+expect_error "--initial-step = '0.5': expected a value from 1e-6 to 0.1 (the largest step, --max-step)" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --initial-step 0.5
+"$bin" orbits --model ov --ring 5 --wave 1 --par headway --from 3.5 --to 2 --points 3 --initial-step 0.5 --max-step 1 --quiet --format json >"$wms/big.json" 2>/dev/null
+[ $? -ne 2 ] && ok || bad "orbits --wave --initial-step 0.5 --max-step 1: refused"
+rm -rf "$wms"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -27,6 +27,14 @@
 /// and the length row's derivative in p is -1 when p is the headway (gap). The size is
 /// 2 L d + 3 whatever N is.
 ///
+/// Continuation: the step control and the special points of periodic_orbit.hpp's branches (the
+/// same code): pseudo-arclength in the weighted norm (the profile, T / T_H, p / |to - from|; mu not
+/// weighted) with the step halved after a failed corrector and grown by 1.5 after an easy one
+/// up to orbit.max_step; folds in the parameter located by regula falsi on the tangent's
+/// parameter component; with the full ring's multipliers (below) period doublings and tori
+/// (OrbitCrossing: the multipliers of consecutive waves paired by distance, each crossing located
+/// on |mu| - 1 with a verified bracket).
+///
 /// Start: the Hopf point of ring mode k on the uniform flow, i.e. of the 2 x 2 characteristic
 /// matrix  Delta_k(lambda) = lambda I - A_0 - A_1 e^{-lambda tau} - z (A_2 + A_3 e^{-lambda tau}),
 /// z = exp(2 pi i k / N) (the leader of a wave x e^{i omega t} is z times the car at omega T = 2 pi):
