@@ -1364,5 +1364,18 @@ expect_error "--max-step: not with --wave" orbits --model ov --ring 5 --wave 1 -
 [ -z "$(ls "$msd" | grep bad)" ] && ok || bad "orbits --max-step bad input wrote files: $(ls "$msd")"
 rm -rf "$msd"
 
+# ---- mix: sized before any work (time, memory, output); refused in one line naming the rings and the limit
+mxd="$tmp/mixsize"; mkdir -p "$mxd"
+expect_error "101 arrangements of a 1000000-car ring (product path): estimated run time .* is above the limit 10 min (--allow-large runs it anyway)" \
+    mix --x A_min --y C_max --ring 1000000 --p 0:1:101 --out "$mxd/a"
+expect_error "1000100000 arrangements of a 40-car ring (product path): estimated run time" mix --x A_min --y C_max --ring 40 --p 0:1:100000 --draws 10000 --out "$mxd/b"
+expect_error "11 arrangements of a 100-car ring (dense path): estimated run time" mix --x A_min --y C_max --ring 100 --solver dense --out "$mxd/c"
+expect_error "11 arrangements of a 5000-car ring (sparse path): estimated run time" mix --x A_min --y C_max --ring 5000 --solver sparse --out "$mxd/d"
+expect_error "of memory, more than this machine has" mix --x A_min --y C_max --ring 3000 --solver dense --p 0:1:2 --allow-large --out "$mxd/e"
+[ -z "$(ls "$mxd")" ] && ok || bad "mix refused by its size guard wrote files: $(ls "$mxd")"
+# within the limits it runs
+"$bin" mix --x A_min --y C_max --ring 40 --p 0:1:3 --out "$mxd/ok" >/dev/null && [ -s "$mxd/ok.csv" ] && ok || bad "mix: a small study refused"
+rm -rf "$mxd"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
