@@ -394,25 +394,19 @@ def test_ctrl_c_stops_a_long_sweep():
 
 
 def test_ctrl_c_stops_orbits_and_a_later_call_works():
-    # SIGINT from a timer thread while the orbits are computed: the 10-car IDM ring's branch of 100
-    # orbits, timed uninterrupted first, is interrupted a fifth into its orbit phase
+    # SIGINT while the orbits are computed: the 10-car IDM ring's branch of 100 orbits, measured
+    # uninterrupted first (CPU time of the main thread, where the library computes), is
+    # interrupted a fifth into its orbit phase
     ring = dict(model="idm", ring=10, th=1.2, tau=0.6)
-    start = time.perf_counter()
+    start = _main_thread_cpu()
     branch = ddemap.equilibria("gap", 6, 40, count=2, **ring)
-    t_branch = time.perf_counter() - start
-    start = time.perf_counter()
+    t_branch = _main_thread_cpu() - start
+    start = _main_thread_cpu()
     full = ddemap.orbits("gap", 6, 40, points=100, **ring)
-    t_full = time.perf_counter() - start
+    t_full = _main_thread_cpu() - start
     assert len(full["points"]["par"]) == 100
     phase = t_full - t_branch  # the orbits themselves
-    at = t_branch + 0.2 * phase
-    timer = threading.Timer(at, os.kill, (os.getpid(), signal.SIGINT))
-    start = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        ddemap.orbits("gap", 6, 40, points=100, **ring)
-    took = time.perf_counter() - start
-    timer.join()
+    at, took = _interrupted_at(lambda: ddemap.orbits("gap", 6, 40, points=100, **ring), t_branch + 0.2 * phase)
     # stopped within a few orbits of the signal (100 orbits take `phase`), long before the branch would end
     assert took - at < max(0.5, 0.2 * phase), (took, at, phase)
     assert took < t_branch + 0.6 * phase, (took, t_branch, phase)
@@ -435,22 +429,18 @@ def _main_thread_cpu():
     return time.clock_gettime(time.pthread_getcpuclockid(threading.main_thread().ident))
 
 
-def _interrupted_after(call, fraction):
-    """Runs `call()` uninterrupted and measures the main thread's CPU time it needs (`full`), then
-    runs it again with a watcher thread that sends SIGINT once the call has used `fraction` of
-    that CPU time. Returns (full, CPU time at the signal, CPU time at the KeyboardInterrupt), the
-    last two from the start of the interrupted call. The signal is placed by the work done, not
-    by the clock, so a busier or idler machine neither lets the call finish before it nor
+def _interrupted_at(call, at):
+    """Runs `call()` with a watcher thread that sends SIGINT once the call has used `at` seconds
+    of the main thread's CPU time; returns (CPU time at the signal, CPU time at the
+    KeyboardInterrupt), both from the start of the call. The signal is placed by the work done,
+    not by the clock, so a busier or idler machine neither lets the call finish before it nor
     delays it; and the KeyboardInterrupt must come from inside the call (pytest.raises)."""
-    start = _main_thread_cpu()
-    call()
-    full = _main_thread_cpu() - start
     sent, done = [], threading.Event()
 
     def watch(begin):
         while not done.is_set():
             used = _main_thread_cpu() - begin
-            if used >= fraction * full:
+            if used >= at:
                 sent.append(used)
                 os.kill(os.getpid(), signal.SIGINT)
                 return
@@ -467,7 +457,17 @@ def _interrupted_after(call, fraction):
         done.set()
         watcher.join()
     assert sent, "no signal was sent"
-    return full, sent[0], took
+    return sent[0], took
+
+
+def _interrupted_after(call, fraction):
+    """Runs `call()` uninterrupted and measures the main thread's CPU time it needs (`full`),
+    then runs it again interrupted once it has used `fraction` of that (_interrupted_at).
+    Returns (full, CPU time at the signal, CPU time at the KeyboardInterrupt)."""
+    start = _main_thread_cpu()
+    call()
+    full = _main_thread_cpu() - start
+    return (full, *_interrupted_at(call, fraction * full))
 
 
 def test_ctrl_c_stops_a_long_mixed_ring():
