@@ -1377,5 +1377,15 @@ expect_error "of memory, more than this machine has" mix --x A_min --y C_max --r
 "$bin" mix --x A_min --y C_max --ring 40 --p 0:1:3 --out "$mxd/ok" >/dev/null && [ -s "$mxd/ok.csv" ] && ok || bad "mix: a small study refused"
 rm -rf "$mxd"
 
+# ---- roots --ring inf: the search's progress is also called within a long dense degree (M = 216, 434 complex
+# states, in stages); off a terminal that adds no line: one line per finished step, step numbers increasing, no NaN
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --k1 5 --k2 0.2 --th 1.5 --tau 0.2 --ring inf --count 5 >/dev/null 2>"$tmp/steps.txt" &&
+    python3 - "$tmp/steps.txt" <<'PY' && ok || bad "roots --ring inf: the search's progress lines repeat a step or show NaN: $(cat "$tmp/steps.txt")"
+import re, sys
+steps = [int(m.group(1)) for m in re.finditer(r"roots: step (\d+) of at most", open(sys.argv[1]).read())]
+assert len(steps) >= 2 and steps == sorted(set(steps)), steps
+assert "nan" not in open(sys.argv[1]).read().lower()
+PY
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
