@@ -106,7 +106,7 @@ public:
         x.p = {s, d, (dd.real() * dd.real() + dd.imag() * dd.imag()) / nd};
         x.g2 = std::norm(x.g);
         x.dg2 = std::norm(x.dg);
-        x.rate = (x.dg / x.g).real();
+        x.rate = (x.dg.real() * gr + x.dg.imag() * gi) / x.g2;  // Re(dGamma/ds conj(Gamma)) / |Gamma|^2
         x.speed2 = x.dg2 / std::max(x.g2, 0.25);
         x.ell = nn > 0.0 ? 0.5 * std::log(nn / nd) : -std::numeric_limits<double>::infinity();
         if (m_sigma == 0.0 && std::abs(x.ell) < 1e-6) {
@@ -528,25 +528,50 @@ bool mode_newton(const TransferFunction& tf, cplx zeta, cplx& z) {
     return s.status == Status::Converged;
 }
 
-/// Phi'(lambda) = Gamma'/Gamma = N'/N - D'/D
-cplx log_rate(const TransferFunction& tf, cplx z) {
-    cplx n, d, dn, dd;
-    tf.evaluate(z, n, d, dn, dd);
-    return dn / n - dd / d;
+/// N, D and their first and second derivatives at z (one exponential per term):
+/// N = gap + z lead, N' = gap' + lead + z lead', N'' = gap'' + 2 lead' + z lead'',
+/// D = z^2 - z own + gap, D' = 2 z - own - z own' + gap', D'' = 2 - 2 own' - z own'' + gap''.
+struct Derivatives2 {
+    cplx n, d, dn, dd, ddn, ddd;
+};
+Derivatives2 derivatives2(const Linearisation& lin, cplx z) {
+    // e(z) = sum c e^{-z d}, e' = -sum d c e^{-z d}, e'' = sum d^2 c e^{-z d}
+    auto ev = [&](const ExpPoly& p, cplx out[3]) {
+        out[0] = out[1] = out[2] = 0.0;
+        for (const auto& t : p.terms()) {
+            const cplx e = t.delay == 0.0 ? cplx(t.coef) : t.coef * std::exp(-z * t.delay);
+            out[0] += e;
+            out[1] -= t.delay * e;
+            out[2] += t.delay * t.delay * e;
+        }
+    };
+    cplx g[3], o[3], l[3];
+    ev(lin.gap, g);
+    ev(lin.own, o);
+    ev(lin.lead, l);
+    Derivatives2 r;
+    r.n = g[0] + z * l[0];
+    r.dn = g[1] + l[0] + z * l[1];
+    r.ddn = g[2] + 2.0 * l[1] + z * l[2];
+    r.d = z * z - z * o[0] + g[0];
+    r.dd = 2.0 * z - o[0] - z * o[1] + g[1];
+    r.ddd = 2.0 - 2.0 * o[1] - z * o[2] + g[2];
+    return r;
 }
 
 /// The maximum of Re lambda on the level curve |Gamma(lambda)| = 1: Newton on
 /// log|Gamma| = 0, Im Phi'(lambda) = 0 (the gradient of log|Gamma| is horizontal there).
+/// The Jacobian uses Phi'' = N''/N - (N'/N)^2 - D''/D + (D'/D)^2 (one evaluation per step).
 bool level_maximum(const TransferFunction& tf, cplx& z) {
+    const Linearisation& lin = tf.linearisation();
     for (int it = 0; it < 40; ++it) {
-        cplx n, d, dn, dd;
-        tf.evaluate(z, n, d, dn, dd);
-        if (n == cplx(0.0) || d == cplx(0.0)) return false;
-        const double f1 = 0.5 * std::log(std::norm(n) / std::norm(d));
-        const cplx r1 = dn / n - dd / d;
+        const Derivatives2 v = derivatives2(lin, z);
+        if (v.n == cplx(0.0) || v.d == cplx(0.0)) return false;
+        const double f1 = 0.5 * std::log(std::norm(v.n) / std::norm(v.d));
+        const cplx qn = v.dn / v.n, qd = v.dd / v.d;
+        const cplx r1 = qn - qd;
         const double f2 = r1.imag();
-        const double hstep = 1e-6 * std::max(1.0, std::abs(z));
-        const cplx r2 = (log_rate(tf, z + hstep) - log_rate(tf, z - hstep)) / (2.0 * hstep);
+        const cplx r2 = v.ddn / v.n - qn * qn - v.ddd / v.d + qd * qd;
         // d f1/dx = Re Phi', d f1/dy = -Im Phi'; d f2/dx = Im Phi'', d f2/dy = Re Phi''
         const double a11 = r1.real(), a12 = -r1.imag(), a21 = r2.imag(), a22 = r2.real();
         const double det = a11 * a22 - a12 * a21;
