@@ -220,4 +220,20 @@ constexpr double orbit_crossing_between_steps = 1e-5;
 /// <= 1e-7 in the gap of the IDM ring, or 1e-8 of the step; 1e-6 (the old report gave 0.04).
 constexpr double orbit_crossing_bracket = 1e-6;
 
+/// The matrix-free Floquet multipliers of a travelling wave on the full ring (wave_stability.hpp:
+/// all 2 N headways, the ring length projected out, Arnoldi with relative tolerance 1e-10)
+/// against the dense path's (periodic_orbit's monodromy of the ring with one headway
+/// eliminated, dense QR) on the same mesh and spread profile: the same discrete eigenvalues, so
+/// they differ only by rounding amplified by the eigenvalues' condition and the Arnoldi
+/// tolerance (measured below 1e-9 for |mu| > 1e-3 on the ov and idm rings of 5 and 10 cars);
+/// 1e-7, while a wrong coupling or a missed projection moves them by O(1e-2) or more.
+constexpr double wave_matrix_free_vs_dense = 1e-7;
+/// Simulation of the full ring (RK4, step 0.05) started on a wave with a small kick: an unstable
+/// wave's distance from its orbit must grow by at least this factor in 4 periods (predicted
+/// max |mu|^4 ~ 3^4 = 81 for the ov wave of the test, a transient aside); a stable wave's must
+/// fall below wave_simulation_decay of its start in 12 periods (predicted |mu|^12 ~ 0.6 for the
+/// idm wave of the test, the grid of 4000 phases adding ~1e-3 of the amplitude to each distance).
+constexpr double wave_simulation_growth = 10.0;
+constexpr double wave_simulation_decay = 0.9;
+
 }  // namespace ddemap::test::tol

@@ -15,6 +15,7 @@ struct OrbitsWaveArgs {
     bool hopf_given = false;
     const FormatArg& format;
     const OutArg& out;
+    bool no_stability = false;  ///< --no-stability: no multipliers for N > 10 (the matrix-free path)
 };
 
 /// Runs `orbits --wave` (exit code as the other commands).
