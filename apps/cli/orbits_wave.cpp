@@ -85,10 +85,13 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
         out << "wave       car i + 1 = car i shifted by " << o.wave << " T / " << o.cars << "; reduced form: one car, " << counted(static_cast<long long>(b.points.size()), "wave")
             << ", degree " << b.degree << " on " << (b.intervals > po.intervals ? "up to " : "") << b.intervals << " intervals (ended: " << b.stop << ")\n";
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + variables[0], 14) << pad("amp v0", 14) << pad("max|mu|", 12) << "stable\n";
-        for (const PeriodicOrbit& p : b.points)
+        for (std::size_t i = 0; i < b.points.size(); ++i) {
+            const PeriodicOrbit& p = b.points[i];
+            const bool undecided = w.stability_method == "matrix_free" && (i >= w.stability.size() || w.stability[i].status != Status::Converged);
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[0] - p.min[0], 6), 14)
                 << pad(rounded(p.max[1] - p.min[1], 6), 14) << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12)
-                << (p.multipliers.empty() ? (w.stability_method == "matrix_free" ? "undecided" : "not computed") : p.stable ? "yes" : "no") << "\n";
+                << (undecided ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
+        }
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
         if (b.points.empty()) {
