@@ -234,4 +234,28 @@ constexpr double orbit_crossing_bracket = 1e-6;
 /// Also the slack of "no wave of the branch beyond its fold".
 constexpr double wave_fold_between_steps = 1e-8;
 
+/// The matrix-free Floquet multipliers of a travelling wave on the full ring (wave_stability.hpp:
+/// all 2 N headways, the ring length projected out, Arnoldi with relative tolerance 1e-10)
+/// against the dense path's (periodic_orbit's monodromy of the ring with one headway
+/// eliminated, dense QR) on the same mesh and spread profile: the same discrete eigenvalues, so
+/// they differ only by rounding amplified by the eigenvalues' condition and the Arnoldi
+/// tolerance (measured 8e-14 at most for |mu| > 1e-3 on the ov and idm rings of 5 and 10 cars);
+/// 1e-10, the Arnoldi tolerance (relative to |mu| <= 60 here, so up to 6e-9 in principle, but the
+/// converged pairs are far more accurate), while a wrong coupling or a missed projection moves
+/// them by O(1e-2) or more.
+constexpr double wave_matrix_free_vs_dense = 1e-10;
+/// Simulation of the full ring (RK4, step 0.05) started on a wave with a small kick: an unstable
+/// wave's distance from its orbit must grow by at least this factor in 8 periods (max |mu| =
+/// 4.6 for the ov wave of the test: 4.6^8 ~ 2e5 for the unstable mode's share of the kick;
+/// measured 736, from 1e-4 to 0.074); a stable wave's must fall below wave_simulation_decay of
+/// its start in 12 periods (max |mu| = 0.954 for the idm wave of the test, 0.954^12 = 0.57;
+/// measured 0.18, the faster modes gone; the grid of 4000 phases adds ~1e-3 of the amplitude to
+/// each distance).
+constexpr double wave_simulation_growth = 10.0;
+constexpr double wave_simulation_decay = 0.9;
+/// The trivial multiplier's distance from 1 under halving of the mesh width (degree 4: an
+/// O(h^4) error falls 16 times; measured 32 and 18 for the 20-car idm wave, 3.3e-6, 1.0e-7,
+/// 5.7e-9 on 13, 26, 52 intervals): it must fall at least this many times per halving.
+constexpr double wave_trivial_refinement = 4.0;
+
 }  // namespace ddemap::test::tol

@@ -74,6 +74,10 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
     }
     // one line per wave: ddemap: orbits: 37 waves (at most 100), headway = 2.81 (4.2 s)
     po.progress = branch_progress_printer("orbits", "waves", po.parameter, false);
+    // N > 10: the full ring's multipliers of every wave by the matrix-free path, after the
+    // branch, one progress line per wave (ddemap: orbits: 3 waves with multipliers (of 30), ...)
+    o.sparse_floquet = !a.no_stability;
+    o.stability_progress = branch_progress_printer("orbits", "waves with multipliers", po.parameter, true);
     const ParameterMap parameters = built.system->parameters();  // --par at --from, the others as given or default
     const TravellingWaveBranch w = travelling_wave_branch(parameters, o);
     const OrbitBranch& b = w.branch;
@@ -105,23 +109,35 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
         out << "wave       car i + 1 = car i shifted by " << o.wave << " T / " << o.cars << "; reduced form: one car, " << counted(static_cast<long long>(b.points.size()), "wave")
             << ", degree " << b.degree << " on " << (b.intervals > po.intervals ? "up to " : "") << b.intervals << " intervals (ended: " << b.stop << ")\n";
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + variables[0], 14) << pad("amp v0", 14) << pad("max|mu|", 12) << "stable\n";
-        for (const PeriodicOrbit& p : b.points)
+        for (std::size_t i = 0; i < b.points.size(); ++i) {
+            const PeriodicOrbit& p = b.points[i];
+            const bool undecided = w.stability_method == "matrix_free" && (i >= w.stability.size() || w.stability[i].status != Status::Converged);
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[0] - p.min[0], 6), 14)
                 << pad(rounded(p.max[1] - p.min[1], 6), 14) << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12)
-                << (p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
+                << (undecided ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
+        }
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
         out << crossing_lines(b);
         if (b.points.empty()) {
+        } else if (w.full_ring_stability && w.stability_method == "matrix_free") {
+            out << "stability  Floquet multipliers of the full ring of " << o.cars << " cars along the wave (matrix-free: Arnoldi, largest ones); max |mu_trivial - 1| = "
+                << rounded(b.max_trivial_distance, 2) << "\n";
+            for (std::size_t i = 0; i < w.stability.size(); ++i)
+                if (w.stability[i].status != Status::Converged)
+                    out << "  wave " << i + 1 << " (" << par << " = " << rounded(b.points[i].par, 8) << "): undecided, " << w.stability[i].message << "\n";
         } else if (w.full_ring_stability)
             out << "stability  Floquet multipliers of the full ring of " << o.cars << " cars along the wave; max |mu_trivial - 1| = "
                 << rounded(b.max_trivial_distance, 2) << "\n";
         else
-            out << "stability  not computed (the full ring's multipliers are computed up to 10 cars; the reduced form alone does not decide the ring's stability)\n";
+            out << "stability  not computed (" << (a.no_stability ? "--no-stability" : "the full ring's multipliers need --ring up to 10 or the matrix-free path")
+                << "; the reduced form alone does not decide the ring's stability)\n";
         if (!b.points.empty())
             out << "accuracy   max residual = " << rounded(b.max_residual, 2) << ", max drift |mu| = " << rounded(w.max_drift, 2)
                 << ", max relative defect between collocation points = " << rounded(w.max_defect, 2) << "\n";
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
+        else if (w.stability_status != Status::Converged)
+            out << "verdict    UNDECIDED (" << to_string(w.stability_status) << "): " << w.stability_message << "\n";
         if (!files.empty()) {
             out << "wrote     ";
             for (const auto& f : files) out << " " << f.first;
@@ -129,6 +145,8 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
         }
         std::cout << out.str();
     });
+    if (b.status == Status::Converged && w.stability_status != Status::Converged)
+        return report_undecided(w.stability_status, "orbits", w.stability_message);
     return report_undecided(b.status, "orbits", b.message);
 }
 

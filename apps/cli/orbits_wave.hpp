@@ -17,6 +17,7 @@ struct OrbitsWaveArgs {
     const FormatArg& format;
     const OutArg& out;
     std::string max_step = {};  ///< --max-step (empty: the default of PeriodicOrbitOptions)
+    bool no_stability = false;  ///< --no-stability: no multipliers for N > 10 (the matrix-free path)
 };
 
 /// The table lines of the period doublings and tori of a branch (orbits and orbits --wave):

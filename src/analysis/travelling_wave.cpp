@@ -16,6 +16,7 @@
 
 #include "analysis/internal/orbit_continuation.hpp"
 #include "analysis/internal/orbit_mesh.hpp"
+#include "analysis/internal/wave_stability_pass.hpp"
 
 namespace ddemap {
 
@@ -989,6 +990,7 @@ bool TravellingWaveOptions::is_valid(std::string* why) const {
     else if (!(unresolved_defect >= 0.0) || !std::isfinite(unresolved_defect)) w = "unresolved_defect: expected a number >= 0";
     else if (max_intervals < orbit.intervals) w = "max_intervals = " + std::to_string(max_intervals) + ": expected at least the intervals (" + std::to_string(orbit.intervals) + ")";
     else if (!orbit.is_valid(&w)) w = "orbit options: " + w;
+    else if (!stability.is_valid(&w)) w = "stability options: " + w;
     if (!w.empty() && why) *why = w;
     return w.empty();
 }
@@ -1085,7 +1087,8 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
           << " cars in the reduced form (one car, the leader shifted by k T / N): piecewise polynomial collocation, degree " << o.degree << " on "
           << o.intervals << " intervals at Gauss-Legendre points; Newton with a sparse LU (Eigen SparseLU, COLAMD); pseudo-arclength; "
           << (options.cars <= options.full_ring_floquet_limit && o.floquet ? "Floquet multipliers of the full ring along the wave"
-                                                                             : "no Floquet multipliers (the ring's stability is not computed)");
+              : o.floquet && options.sparse_floquet ? "Floquet multipliers of the full ring along the wave, matrix-free (Arnoldi on the monodromy applied by sparse sweeps)"
+                                                    : "no Floquet multipliers (the ring's stability is not computed)");
         b.method = s.str();
     }
     ParameterMap at_from = parameters;
@@ -1149,11 +1152,15 @@ TravellingWaveBranch travelling_wave_branch(const ParameterMap& parameters, cons
         return res;
     }
     for (double dfc : res.defects) res.max_defect = std::max(res.max_defect, dfc);
+    if (o.floquet && options.sparse_floquet && !full.system) wave_stability::matrix_free_pass(parameters, options, res);
     for (const PeriodicOrbit& pt : b.points) {
         b.max_residual = std::max(b.max_residual, pt.residual);
         if (std::isfinite(pt.trivial_distance)) b.max_trivial_distance = std::max(b.max_trivial_distance, pt.trivial_distance);
     }
-    res.full_ring_stability = full.system != nullptr;
+    if (full.system) {
+        res.full_ring_stability = true;
+        res.stability_method = "dense";
+    }
     if (b.message.empty()) {
         std::ostringstream s;
         s << b.points.size() << " travelling waves, ended: " << b.stop;

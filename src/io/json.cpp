@@ -559,6 +559,18 @@ std::string travelling_wave_json(const TravellingWaveBranch& w, const std::vecto
     wave["shift"] = num(static_cast<double>(w.wave) / w.cars);
     wave["hopf"] = {{"par", num(w.hopf.par)}, {"omega", num(w.hopf.omega)}, {"status", to_string(w.hopf.status)}};
     wave["stability"] = w.full_ring_stability ? "full_ring" : "not_computed";
+    // the method of the multipliers: "dense" (N <= 10), "matrix_free" (Arnoldi; per wave its
+    // status and message, stable null when undecided) or "none"
+    wave["stability_method"] = w.stability_method;
+    if (w.stability_method == "matrix_free") {
+        for (std::size_t i = 0; i < w.branch.points.size() && i < w.stability.size(); ++i) {
+            const WaveStability& s = w.stability[i];
+            j["points"][i]["stability_status"] = to_string(s.status);
+            j["points"][i]["stability_message"] = s.message;
+            if (s.status != Status::Converged) j["points"][i]["stable"] = nullptr;
+        }
+        wave["stability_status"] = to_string(w.stability_status);
+    }
     wave["max_drift"] = num(w.max_drift);
     // the resolution indicator (TravellingWaveBranch::defects) and the largest mesh used
     wave["max_defect"] = num(w.max_defect);

@@ -76,7 +76,9 @@
 /// the multiplier itself, so it is not a monodromy of the reduced equations). Here the
 /// multipliers are those of the full ring (make_nonlinear_ring, one headway eliminated) along the
 /// wave spread to all cars, x_i(s) = x(s + i k / N), by periodic_orbit's monodromy
-/// (orbit_multipliers), for N <= full_ring_floquet_limit; for larger N no multiplier is
+/// (orbit_multipliers), for N <= full_ring_floquet_limit; for larger N with sparse_floquet by
+/// the matrix-free path of wave_stability.hpp (Arnoldi on the monodromy applied by sparse
+/// sweeps; a verdict per wave, undecided with a reason when not certain), else no multiplier is
 /// computed and the stability is not decided (stable = false, multipliers empty,
 /// full_ring_stability = false). The trivial multiplier's distance from 1 then also measures how
 /// far the spread profile is from a collocation solution of the full ring (it is not one exactly).
@@ -86,6 +88,7 @@
 
 #include "ddemap/analysis/equilibrium_branch.hpp"
 #include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/analysis/wave_stability.hpp"
 #include "ddemap/core/types.hpp"
 
 namespace ddemap {
@@ -103,6 +106,13 @@ struct TravellingWaveOptions {
     PeriodicOrbitOptions orbit;
     /// the full ring's multipliers are computed for N <= this (their cost grows like N^3)
     int full_ring_floquet_limit = 10;
+    /// N > full_ring_floquet_limit (and floquet on): the full ring's multipliers of every wave
+    /// by the matrix-free path of wave_stability.hpp, after the branch (off by default: on long
+    /// rings it costs far more than the branch; `orbits --wave` turns it on)
+    bool sparse_floquet = false;
+    WaveStabilityOptions stability;  ///< its Arnoldi settings
+    /// after every wave of that pass: (waves done, waves of the branch, p); it may throw to stop
+    BranchProgress stability_progress;
     /// K / N < 0.1: start by the homotopy in K / N even when the first wave from the Hopf point
     /// converges (to check one path against the other)
     bool force_homotopy = false;
@@ -132,7 +142,16 @@ struct TravellingWaveBranch {
     /// the orbits: profile = car 0's (h, v) on the mesh (points() x 2), min/max of h and v;
     /// multipliers: the full ring's (see the file comment) or empty
     OrbitBranch branch;
-    bool full_ring_stability = false;  ///< the multipliers are the full ring's (N <= limit)
+    bool full_ring_stability = false;  ///< the multipliers are the full ring's (either path)
+    /// "dense" (N <= full_ring_floquet_limit, periodic_orbit's monodromy of the ring),
+    /// "matrix_free" (wave_stability.hpp) or "none"
+    std::string stability_method = "none";
+    /// matrix_free: per wave of branch.points its result (the wave's multipliers, stable and
+    /// trivial_distance are copied from it; stable only for Verdict::Stable); Converged when
+    /// every wave's verdict is decided, else the status of the first undecided one with a message
+    std::vector<WaveStability> stability;
+    Status stability_status = Status::Converged;
+    std::string stability_message;
     double max_drift = 0.0;            ///< max |mu| over the orbits (0 for an exact wave)
     /// per wave of branch.points: the relative defect of the reduced equations between the
     /// collocation points, max_c max_s |x_c'(s) - T (g_c + mu e_h)| / max_s |x_c'(s)| over the d + 1
