@@ -111,7 +111,7 @@ constexpr double kShortDelay = 1e-3;
 /// the n roots right of -1/tau are one per disc, and all others have Re < -1/tau. Norms are
 /// 2-norms computed in floating point (V^{-1} from an LU solve), not interval bounds.
 /// Returns the radii, or an empty vector when a condition fails.
-constexpr double kCertifiedShortDelay = 0.01;
+constexpr double kCertifiedShortDelay = 0.1;
 
 std::vector<double> short_delay_discs(const LinearDDE& dde, const Eigen::VectorXcd& mu, const MatrixXc& v, double& q_out) {
     const Eigen::Index n = mu.size();
@@ -263,10 +263,10 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
     const double short_floor = -1.0 / tau;
     const double short_radius = dde.root_bound(short_floor);
     // Beyond R tau <= kShortDelay the same path is taken when the certificate of
-    // short_delay_discs holds (large gains with a short delay: R tau up to 1, where the
+    // short_delay_discs holds (large gains with a short delay: R tau up to 0.1, where the
     // collocation's eigenvalues near the axis are spoiled by rounding in entries of size M^2/tau).
     const bool short_by_radius = std::isfinite(short_radius) && short_radius * tau <= kShortDelay;
-    const bool try_discs = !short_by_radius && std::isfinite(short_radius) && short_radius * tau <= 1.0 && dde.dimension() <= 64;
+    const bool try_discs = !short_by_radius && std::isfinite(short_radius) && short_radius * tau <= 0.1 && dde.dimension() <= 64;
     if (options.degree == 0 && (short_by_radius || try_discs)) {
         const MatrixXc limit = dde.ode_limit();
         std::vector<cplx> ev;
