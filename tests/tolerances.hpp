@@ -43,6 +43,13 @@ constexpr double finite_difference = 1e-7;
 /// roots move by O(|lambda|^2 tau) with |lambda| < 1 there (measured ~0.06); 1 bounds it with
 /// margin, so |alpha(tau) - alpha(0)| <= tau_continuity tau (+ rounding) must hold.
 constexpr double tau_continuity = 1.0;
+/// A root of a DDE with a short delay against the tau = 0 root it continues, relative to
+/// c tau |lambda| (c the sum of the absolute coefficients): |e^{-lambda tau} - 1| <= e |lambda| tau
+/// for Re(lambda) tau >= -1 and the delayed terms are at most c, so the move is at most
+/// about e c tau |lambda| times |lambda| / |D'(lambda)| (measured for the
+/// large-gain OVRV modes tested: at most 1.8e-4, the roots move far less than this scale); 1e-3
+/// bounds it with margin while a wrong root (a different tau = 0 root) is off by O(1).
+constexpr double short_delay_move = 1e-3;
 
 /// The same sum of squares accumulated in a different order or grouping (a stacked objective
 /// against the sample-weighted mean of its parts, an RMSE pooled from one run): a few thousand

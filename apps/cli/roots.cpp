@@ -248,7 +248,12 @@ int run_ring(Format format, const std::string& prefix) {
     else if (cars > 0 && fast.method_used == "winding")
         out << " (" << counted(fast.winding.unstable_roots, "unstable root") << ", " << fast.winding.marginal_roots << " marginal)";
     else if (cars > 0) out << " (" << counted(r.unstable_roots, "unstable root") << ", " << r.marginal_roots << " marginal)";
-    out << "\n\n";
+    out << "\n";
+    // the verdict is the certified winding pass's; a listing that did not converge is marked as such
+    if (fast.method_used == "winding" && r.verdict != Verdict::Undecided && r.status != Status::Converged)
+        out << "roots      UNSETTLED (" << to_string(r.status) << "): the verdict above is certified by the winding count alone; "
+            << "the rows below are not certified\n";
+    out << "\n";
     out << "  #   mode        theta                re                 im    residual\n";
     int i = 0;
     for (const auto& x : r.roots) {

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "ddemap/discretize/collocation.hpp"
 #include "internal/backends.hpp"
@@ -94,6 +96,48 @@ namespace {
 
 /// R(-1/tau) tau below which the roots come from the ODE limit (see dense_roots).
 constexpr double kShortDelay = 1e-3;
+
+/// The short-delay certificate in the eigenbasis of the tau -> 0 limit L = A0 + sum_k A_k.
+/// With L V = V diag(mu) + F (F the rounding residual of the computed decomposition) and
+/// E(lambda) = sum_k A_k (e^{-lambda tau_k} - 1), Delta(lambda) = V [lambda I - diag(mu) -
+/// V^{-1} (F + E(lambda)) V] V^{-1}. For Re(lambda) >= -1/tau, |e^{-lambda tau_k} - 1| <=
+/// e tau_k |lambda|, so ||V^{-1} (F + E) V|| <= q |lambda| + f with
+///     q = e sum_k tau_k ||V^{-1} A_k V||,   f = ||V^{-1} F||.
+/// A root there has min_i |lambda - mu_i| <= q |lambda| + f, hence (q < 1) lies in a disc
+///     |lambda - mu_i| <= rho_i = 2 (q |mu_i| + f) / (1 - q) + tiny.
+/// When q <= kCertifiedShortDelay, the discs are pairwise disjoint and all lie in Re > -1/tau,
+/// the homotopy t (F + E), t in [0, 1], keeps Delta nonsingular on every circle, so each disc
+/// holds exactly one root (with multiplicity) and every root with Re >= -1/tau is in a disc:
+/// the n roots right of -1/tau are one per disc, and all others have Re < -1/tau. Norms are
+/// 2-norms computed in floating point (V^{-1} from an LU solve), not interval bounds.
+/// Returns the radii, or an empty vector when a condition fails.
+constexpr double kCertifiedShortDelay = 0.1;
+
+std::vector<double> short_delay_discs(const LinearDDE& dde, const Eigen::VectorXcd& mu, const MatrixXc& v, double& q_out) {
+    const Eigen::Index n = mu.size();
+    if (n != dde.dimension() || v.rows() != n || v.cols() != n) return {};
+    Eigen::PartialPivLU<MatrixXc> lu(v);
+    const MatrixXc w = lu.inverse();
+    if (!w.allFinite()) return {};
+    auto norm2 = [](const MatrixXc& m) { return Eigen::JacobiSVD<MatrixXc>(m).singularValues()(0); };
+    double q = 0.0;
+    for (const auto& t : dde.delayed()) q += t.delay * norm2(w * t.matrix * v);
+    q *= std::exp(1.0);
+    const MatrixXc residual = dde.ode_limit() * v - v * mu.asDiagonal();
+    const double f = norm2(w * residual) + norm2(w * v - MatrixXc::Identity(n, n)) * mu.cwiseAbs().maxCoeff();
+    q_out = q;
+    if (!std::isfinite(q) || !std::isfinite(f) || q > kCertifiedShortDelay) return {};
+    const double floor = -1.0 / dde.max_delay();
+    std::vector<double> rho(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i) {
+        rho[static_cast<std::size_t>(i)] = 2.0 * (q * std::abs(mu[i]) + f) / (1.0 - q) + 1e-300;
+        if (!(mu[i].real() - rho[static_cast<std::size_t>(i)] > floor)) return {};
+    }
+    for (Eigen::Index i = 0; i < n; ++i)
+        for (Eigen::Index j = i + 1; j < n; ++j)
+            if (!(std::abs(mu[i] - mu[j]) > rho[static_cast<std::size_t>(i)] + rho[static_cast<std::size_t>(j)])) return {};
+    return rho;
+}
 
 /// Newton on det Delta from `guess` (the one Newton loop); true when converged (or stalled
 /// near a multiple root) with a residual below the tolerance.
@@ -218,23 +262,51 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
     // [-tau, 0] would need entries of size 1/tau (overflow for tau -> 0) for the same roots.
     const double short_floor = -1.0 / tau;
     const double short_radius = dde.root_bound(short_floor);
-    if (options.degree == 0 && std::isfinite(short_radius) && short_radius * tau <= kShortDelay) {
+    // Beyond R tau <= kShortDelay the same path is taken when the certificate of
+    // short_delay_discs holds (large gains with a short delay: R tau up to 0.1, where the
+    // collocation's eigenvalues near the axis are spoiled by rounding in entries of size M^2/tau).
+    const bool short_by_radius = std::isfinite(short_radius) && short_radius * tau <= kShortDelay;
+    const bool try_discs = !short_by_radius && std::isfinite(short_radius) && short_radius * tau <= 0.1 && dde.dimension() <= 64;
+    if (options.degree == 0 && (short_by_radius || try_discs)) {
         const MatrixXc limit = dde.ode_limit();
         std::vector<cplx> ev;
+        Eigen::VectorXcd mu;
+        MatrixXc vectors;
         bool ok = true;
         if (dde.is_real()) {
-            Eigen::EigenSolver<Eigen::MatrixXd> es(limit.real(), false);
+            Eigen::EigenSolver<Eigen::MatrixXd> es(limit.real(), try_discs);
             ok = es.info() == Eigen::Success;
-            if (ok) ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+            if (ok) {
+                mu = es.eigenvalues();
+                if (try_discs) vectors = es.eigenvectors();
+            }
         } else {
-            Eigen::ComplexEigenSolver<MatrixXc> es(limit, false);
+            Eigen::ComplexEigenSolver<MatrixXc> es(limit, try_discs);
             ok = es.info() == Eigen::Success;
-            if (ok) ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+            if (ok) {
+                mu = es.eigenvalues();
+                if (try_discs) vectors = es.eigenvectors();
+            }
+        }
+        if (ok) ev.assign(mu.data(), mu.data() + mu.size());
+        double q = 0.0;
+        std::vector<double> rho;
+        if (ok && try_discs) {
+            rho = short_delay_discs(dde, mu, vectors, q);
+            ok = !rho.empty();
         }
         int dropped = 0;
         std::vector<Root> all = ok ? refine_all(dde, ev, options, dropped, result.newton_iterations) : std::vector<Root>{};
         // every eigenvalue must give its own root (n of them): else the collocation path decides
-        if (ok && static_cast<int>(all.size()) == dde.dimension()) {
+        bool complete = ok && static_cast<int>(all.size()) == dde.dimension();
+        if (complete && try_discs) {  // and, certified, exactly one root in each disc
+            for (std::size_t i = 0; i < rho.size(); ++i) {
+                int inside = 0;
+                for (const auto& x : all) inside += std::abs(x.value - mu[static_cast<Eigen::Index>(i)]) <= rho[i] ? 1 : 0;
+                if (inside != 1) complete = false;
+            }
+        }
+        if (complete) {
             double worst = 0.0;
             for (const auto& x : all) worst = std::max(worst, x.collocation_error / scale_of(x.value));
             result.roots = cut_rightmost(all, options.count);
@@ -246,9 +318,16 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
             result.status = Status::Converged;
             std::ostringstream os;
             os.precision(3);
-            os << "short delay (R tau = " << short_radius * tau << " <= " << kShortDelay << "): the " << dde.dimension()
-               << " roots with Re >= -1/tau = " << short_floor << " refined by Newton from the eigenvalues of the tau -> 0 limit"
-               << " (moved by at most " << worst << " relative)";
+            if (try_discs) {
+                os << "short delay (certified: q = e sum tau_k ||V^-1 A_k V|| = " << q << " <= " << kCertifiedShortDelay
+                   << "): exactly one root in a disc about each of the " << dde.dimension()
+                   << " eigenvalues of the tau -> 0 limit, none elsewhere with Re >= -1/tau = " << short_floor
+                   << ", refined by Newton (moved by at most " << worst << " relative)";
+            } else {
+                os << "short delay (R tau = " << short_radius * tau << " <= " << kShortDelay << "): the " << dde.dimension()
+                   << " roots with Re >= -1/tau = " << short_floor << " refined by Newton from the eigenvalues of the tau -> 0 limit"
+                   << " (moved by at most " << worst << " relative)";
+            }
             result.message = os.str();
             return result;
         }

@@ -1442,5 +1442,21 @@ expect_error "--no-stability: only with --wave" orbits --system "$wms/wright.jso
 [ -z "$(ls "$wms" | grep bad)" ] && ok || bad "orbits --no-stability bad input wrote files"
 rm -rf "$wms"
 
+# ---- large gains with a short delay: the certified short-delay path settles every mode (exit 0, M = 0, a verdict,
+# under 5 s); where a mode's listing still does not settle, the certified winding verdict is kept and the table is
+# marked UNSETTLED with exit 4 (never a bare verdict next to a non-converged status)
+s0=$(date +%s)
+"$bin" roots --k1 1e6 --k2 0.2 --th 1.5 --tau 1e-9 >"$tmp/stiff.txt" 2>"$tmp/stiff.err" &&
+    grep -q '^verdict    ring STABLE' "$tmp/stiff.txt" && grep -q 'M = 0 (converged)' "$tmp/stiff.txt" &&
+    ! grep -q 'UNSETTLED' "$tmp/stiff.txt" && [ $(( $(date +%s) - s0 )) -le 5 ] &&
+    ok || bad "roots --k1 1e6 --tau 1e-9: converged with a verdict, exit 0, within 5 s: $(cat "$tmp/stiff.txt" "$tmp/stiff.err" | tail -3)"
+"$bin" roots --k1 1e3 --k2 0.2 --th 1e-3 --tau 1e-3 >"$tmp/stiff2.txt" 2>"$tmp/stiff2.err"; rc=$?
+if [ $rc -eq 0 ]; then
+    ! grep -q 'UNSETTLED' "$tmp/stiff2.txt" && ok || bad "roots --k1 1e3 --th 1e-3 --tau 1e-3: exit 0 with an UNSETTLED table"
+else
+    [ $rc -eq 4 ] && grep -q '^roots      UNSETTLED (max_degree_reached)' "$tmp/stiff2.txt" && grep -q 'undecided' "$tmp/stiff2.err" &&
+        ok || bad "roots --k1 1e3 --th 1e-3 --tau 1e-3: exit $rc without the UNSETTLED mark and the reason on stderr"
+fi
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
