@@ -58,6 +58,17 @@ for got, ref in ((h["par"], 0.470819628936), (h["omega"], 3.872983346207), (h["l
     assert abs(got - ref) <= 1e-9 * abs(ref), (got, ref)
 PY
 
+# Beyond a21 = 2.25 (sqrt(a12 a21) = kappa - beta) a real root crosses 0: the branch point of
+# the nonzero equilibria (demo1_simple.m: "the branch point at a21=2.25"), not a Hopf point. Before
+# it the unstable complex pair meets on the real axis (a21 ~ 2.22), which must not count as a
+# Hopf point either; today `equilibria` lists "hopf a21 = 2.25, omega = 1e-18" as converged.
+"$bin" equilibria --system "$tmp/neuron.json" --par a21 --from 0.3 --to 3 --format json >"$tmp/ne.json" 2>/dev/null
+python3 - "$tmp/ne.json" <<'PY' && ok || bad "equilibria: the branch point at a21 = 2.25 is listed as a Hopf point with omega = 0"
+import json, sys
+h = json.load(open(sys.argv[1]))["result"]["hopf"]
+assert all(p["omega"] > 1e-3 for p in h) and len(h) == 1, h
+PY
+
 # The neuron's orbit at a21 = 2 (degree 4, 40 intervals): DDE-BIFTOOL period 16.82535883, largest
 # nontrivial multiplier 0.071805, stable. DDE-BIFTOOL adapts its mesh, ddemap keeps it uniform:
 # the periods differ by 5e-7 on this mesh, hence 2e-6.
