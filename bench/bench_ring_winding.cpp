@@ -104,9 +104,9 @@ int main(int argc, char** argv) {
         }
         const double ring_us = std::chrono::duration<double>(clock_type::now() - r0).count() / n * 1e6;
         std::printf("N = %-8s winding  %.3f s (min %.3f, max %.3f): %.0f points/s; %.2f tables and %.0f evaluations per point, "
-                    "%d fallbacks, %d uncertified; ring part alone %.1f us/point (1 thread)\n",
+                    "%d fallbacks, %d uncertified, %d collocation starts; ring part alone %.1f us/point (1 thread)\n",
                     name.c_str(), fast_s, *std::min_element(times.begin(), times.end()), *std::max_element(times.begin(), times.end()),
-                    n / fast_s, fr.winding_tables / n, evaluations / n, fr.winding_fallbacks, fr.uncertified, ring_us);
+                    n / fast_s, fr.winding_tables / n, evaluations / n, fr.winding_fallbacks, fr.uncertified, fr.fallbacks, ring_us);
         if (cars > kWindingFallbackCars) {
             std::printf("N = %-8s modes    skipped (%d modes per point)\n", name.c_str(), cars / 2 + 1);
             continue;

@@ -26,6 +26,12 @@ constexpr double product_residual = 1e-10;
 /// A sweep point's spectral abscissa against the per-point computation (README claim: exact to
 /// 1e-8; both certify the same rightmost root, which agrees to ~1e-14 in practice).
 constexpr double sweep_vs_point = 1e-8;
+/// N, D, N', D' of a transfer function on a vertical line by TransferFunction::Line (the factors
+/// e^{-sigma d} formed once, real arithmetic) against TransferFunction::evaluate (complex
+/// exponentials): the same sums in another order, so they agree to a few ulps of the sizes of the
+/// terms (|lambda|^2 + |lambda| sum|own| + sum|gap| ... <= ~1e3 here); 1e-13 relative to those
+/// sizes leaves a margin of about 100.
+constexpr double line_vs_evaluate = 1e-13;
 /// Continued ring Hopf curves against the closed-form D-subdivision curves (README claim: 1e-8;
 /// points are corrected by Newton to 1e-13 relative in the unit window).
 constexpr double boundary_closed_form = 1e-8;

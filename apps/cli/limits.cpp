@@ -160,10 +160,17 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
 BranchProgress search_progress_printer(const std::string& command, const std::string& par) {
     if (run_flags().quiet) return nullptr;
     auto printer = std::make_shared<Printer>(command);
+    auto last = std::make_shared<long>(-1);
+    const bool tty = isatty(2) != 0;
     return [=](long done, long total, double value) {
+        // a step repeated from within a long one (the dense eigenvalues): on a terminal the
+        // time is redrawn, otherwise one line per finished step is kept
+        if (!tty && done == *last) return;
+        *last = done;
         char v[32];
         std::snprintf(v, sizeof v, "%.6g", value);
-        (*printer)(done, total, "step " + std::to_string(done) + " of at most " + std::to_string(total) + ", " + par + " = " + v, false, true);
+        const std::string at = std::isfinite(value) ? ", " + par + " = " + v : std::string();  // NaN: before the first step
+        (*printer)(done, total, "step " + std::to_string(done) + " of at most " + std::to_string(total) + at, false, true);
     };
 }
 

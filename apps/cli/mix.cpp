@@ -1,4 +1,5 @@
 // mix: the penetration-rate study (study/penetration) on a ring of N cars.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -36,8 +37,43 @@ void add_mix_flags(CLI::App& app) {
     app.add_option("--solver", args.solver, "auto, product, dense or sparse (as roots --fleet)")->capture_default_str();
     args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", true);
     args.format.add_to(app);
-    run_flags().add_to(app, false);
+    run_flags().add_to(app, true);
 }
+
+namespace {
+
+/// The size guard of mix, before any work: every arrangement is one mixed ring of N cars (2N
+/// states) solved on its own, one after the other. Per arrangement, in CPU time of one core
+/// (A_min and C_max, measured with mix --quiet): the product path about 1e-5 s per car (0.27 s
+/// at N = 40,000) and 2 kB per car; the sparse path about 4e-5 n^1.6 s (n = 2N states: 0.53 s
+/// at N = 200; the exponent from N = 200 and 1,000) and 25 kB per state; the dense path about
+/// 1e-5 n^3 s (1.6 s at N = 30), its collocation matrix of (M + 1) n complex rows held dense
+/// (about 16 (32 n)^2 bytes at the degrees these rings reach: 240 MB at N = 60). The output:
+/// about 600 bytes per fraction (a CSV row, a JSON record and an SVG marker).
+void size_mix(const MixOptions& o) {
+    const double arrangements = static_cast<double>(o.fractions.size()) * (o.draws + 1.0);
+    const double cars = o.cars, n = 2.0 * o.cars;
+    const std::string& method = o.ring.roots.method;
+    double seconds = 0.0, bytes = 0.0;
+    if (method == "dense") {
+        seconds = 1e-5 * n * n * n;
+        bytes = 16.0 * (32.0 * n) * (32.0 * n);
+    } else if (method == "shift_invert") {
+        seconds = 4e-5 * std::pow(n, 1.6);
+        bytes = 2.5e4 * n;
+    } else {  // auto: the product path (every law reacts to the car ahead, ccc also to the car two ahead)
+        seconds = 1e-5 * cars;
+        bytes = 2e3 * cars;
+    }
+    char what[160];
+    std::snprintf(what, sizeof what, "%.0f arrangement%s of a %d-car ring (%s path)", arrangements, arrangements == 1.0 ? "" : "s", o.cars,
+                  solver_name(method == "auto" ? std::string("contour") : method).c_str());
+    check_size("mix", what, "memory", bytes);
+    check_size("mix", what, "output", 600.0 * static_cast<double>(o.fractions.size()));
+    check_size("mix", what, "time", seconds * arrangements);
+}
+
+}  // namespace
 
 int run_mix() {
     const Format format = args.format.parse();
@@ -55,6 +91,7 @@ int run_mix() {
     o.ring.roots.method = root_method(args.solver);
     o.ring.roots.count = 4;
     o.validate();
+    size_mix(o);
     const std::string prefix = args.out.prepare("mix");
     // one line per arrangement solved: ddemap: mix: arrangements 3/11, p = 0.2 (1.2 s, about 3 s left)
     o.progress = branch_progress_printer("mix", "arrangements", "p", true);

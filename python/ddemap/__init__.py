@@ -492,17 +492,23 @@ def hopf(par, from_, to, system=None, model=None, ring=None, par2=None, from2=No
                                 max_points))
 
 
-def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False, **parameters):
+def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False,
+           max_step=None, **parameters):
     """The branch of periodic orbits born at a Hopf point (``ddemap orbits``).
 
     The problem as in :func:`equilibria`; the equilibrium branch from ``from_`` to ``to`` gives
     the Hopf points, number ``hopf`` (from 0) starts the orbits: piecewise polynomials of degree
     ``degree`` on ``intervals`` mesh intervals, the period an unknown, at most ``points`` orbits.
+    ``max_step`` (the command's ``--max-step``; default 0.1 when None): the largest step along
+    the branch in its weighted norm, from 0.02 (the first step) to 1e6; a larger one covers the
+    same stretch of the branch with fewer orbits (README, orbits).
     Returns ``points`` (``par``, ``period`` [time units of the system], ``min``, ``max`` per
     variable, ``stable``, ``multipliers``: Floquet multipliers as [re, im]), ``folds``,
     ``period_doublings``, ``tori``: the command's JSON.
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
+    step = None if max_step is None else _number("max_step", max_step)
     return _result(_ddemap.orbits(sys_, model_, n, p, par, _number("from_", from_), _number("to", to),
                                   _integer("hopf", hopf, 0, 1000000), _integer("degree", degree, 1, 20),
-                                  _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000), bool(adapt)))
+                                  _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000), bool(adapt),
+                                  step))

@@ -141,7 +141,10 @@ std::string py_roots(const std::string& model_name, const ParameterMap& values, 
     // as the command: the verdict from one winding pass where it applies (analysis/ring_fast.hpp)
     const std::string method = resolve_ring_method("auto", lin);
     const Progress progress = interruptible();
-    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count, progress); });
+    // N = inf: the search for the `count` roots at the abscissa's wave number checks too (its
+    // dense degrees, and the stages within a long one)
+    const BranchProgress search = branch_interruptible();
+    const FastRing fast = released([&] { return analyse_ring_fast(lin, cars, method, count, progress, search); });
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";
@@ -649,9 +652,15 @@ std::string py_hopf(const std::string& system_file, const std::string& model, in
 }
 
 std::string py_orbits(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
-                      double from, double to, int hopf, int degree, int intervals, int points, bool adapt) {
-    NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
+                      double from, double to, int hopf, int degree, int intervals, int points, bool adapt, std::optional<double> max_step) {
     PeriodicOrbitOptions o;
+    if (max_step) {  // as orbits --max-step, checked before any work
+        if (!(*max_step >= o.initial_step && *max_step <= 1e6))
+            throw std::invalid_argument("max_step = " + json_number(*max_step) + ": expected a value from " + json_number(o.initial_step) +
+                                        " (the first step) to 1e6");
+        o.max_step = *max_step;
+    }
+    NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
     o.parameter = par;
     o.from = from;
     o.to = to;
@@ -661,6 +670,7 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     o.adapt = adapt;
     pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf).integer("degree", o.degree)
         .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
+    if (max_step) pb.inputs.number("max_step", o.max_step);  // only when given, as the command's envelope
     EquilibriumBranchOptions eo;
     eo.parameter = par;
     eo.from = o.from;
@@ -703,7 +713,7 @@ PYBIND11_MODULE(_ddemap, m) {
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
-        } catch (const Interrupted&) {
+        } catch (const Cancelled&) {  // Interrupted, or the library passing on a search it stopped
             if (!PyErr_Occurred()) PyErr_SetNone(PyExc_KeyboardInterrupt);
         } catch (const std::invalid_argument& e) {
             PyErr_SetString(PyExc_ValueError, e.what());
@@ -728,5 +738,5 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("max_points"));
     m.def("orbits", &py_orbits, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
-          py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"));
+          py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"), py::arg("max_step"));
 }

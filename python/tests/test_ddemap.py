@@ -275,6 +275,41 @@ def test_orbits():
         ddemap.orbits("headway", 2, 3.5, model="ov", ring=3, hopf=7, points=12)
 
 
+def _tolerance(name):
+    """A tolerance of tests/tolerances.hpp (the one list of them, with why each has its size)."""
+    with open(os.path.join(SOURCE, "tests", "tolerances.hpp")) as f:
+        for line in f:
+            words = line.split()
+            if words[:4] == ["constexpr", "double", name, "="]:
+                return float(words[4].rstrip(";"))
+    raise KeyError(name)
+
+
+def test_orbits_max_step():
+    # max_step is the command's --max-step: the same envelope (inputs include it) ...
+    ring = dict(model="ov", ring=3)
+    r = ddemap.orbits("headway", 2, 3.5, points=200, max_step=1, **ring)
+    same_envelope(r, cli_json("orbits", "--model", "ov", "--ring", 3, "--par", "headway", "--from", 2, "--to", 3.5, "--points", 200,
+                              "--max-step", 1))
+    assert r.inputs["max_step"] == 1
+    # ... and the same branch as with the default step: from the Hopf point (headway 2.49) both
+    # end on the face headway = 2, on the same orbit, the longer steps with fewer orbits
+    short = ddemap.orbits("headway", 2, 3.5, points=200, **ring)
+    assert "max_step" not in short.inputs
+    assert r["stop"] == short["stop"] == "bound"
+    assert r["points"]["par"][-1] == 2 and short["points"]["par"][-1] == 2
+    assert len(r["points"]["par"]) < len(short["points"]["par"])
+    t_long, t_short = r["points"]["period"][-1], short["points"]["period"][-1]
+    assert abs(t_long - t_short) <= _tolerance("orbit_step_interpolation") * t_short, (t_long, t_short)
+    # a bad value is ValueError naming it, with the command's range
+    for bad in (0.01, 2e6):
+        with pytest.raises(ValueError, match=r"max_step = .*: expected a value from 0\.02 \(the first step\) to 1e6"):
+            ddemap.orbits("headway", 2, 3.5, max_step=bad, **ring)
+        cli("orbits", "--model", "ov", "--ring", 3, "--par", "headway", "--from", 2, "--to", 3.5, "--max-step", bad, expect=2)
+    with pytest.raises(ValueError, match="max_step = nan: expected a finite number"):
+        ddemap.orbits("headway", 2, 3.5, max_step=float("nan"), **ring)
+
+
 def flags(params):
     out = []
     for k, v in params.items():
@@ -359,25 +394,19 @@ def test_ctrl_c_stops_a_long_sweep():
 
 
 def test_ctrl_c_stops_orbits_and_a_later_call_works():
-    # SIGINT from a timer thread while the orbits are computed: the 10-car IDM ring's branch of 100
-    # orbits, timed uninterrupted first, is interrupted a fifth into its orbit phase
+    # SIGINT while the orbits are computed: the 10-car IDM ring's branch of 100 orbits, measured
+    # uninterrupted first (CPU time of the main thread, where the library computes), is
+    # interrupted a fifth into its orbit phase
     ring = dict(model="idm", ring=10, th=1.2, tau=0.6)
-    start = time.perf_counter()
+    start = _main_thread_cpu()
     branch = ddemap.equilibria("gap", 6, 40, count=2, **ring)
-    t_branch = time.perf_counter() - start
-    start = time.perf_counter()
+    t_branch = _main_thread_cpu() - start
+    start = _main_thread_cpu()
     full = ddemap.orbits("gap", 6, 40, points=100, **ring)
-    t_full = time.perf_counter() - start
+    t_full = _main_thread_cpu() - start
     assert len(full["points"]["par"]) == 100
     phase = t_full - t_branch  # the orbits themselves
-    at = t_branch + 0.2 * phase
-    timer = threading.Timer(at, os.kill, (os.getpid(), signal.SIGINT))
-    start = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        ddemap.orbits("gap", 6, 40, points=100, **ring)
-    took = time.perf_counter() - start
-    timer.join()
+    at, took = _interrupted_at(lambda: ddemap.orbits("gap", 6, 40, points=100, **ring), t_branch + 0.2 * phase)
     # stopped within a few orbits of the signal (100 orbits take `phase`), long before the branch would end
     assert took - at < max(0.5, 0.2 * phase), (took, at, phase)
     assert took < t_branch + 0.6 * phase, (took, t_branch, phase)
@@ -394,29 +423,63 @@ def test_stability_chart_example(tmp_path):
         assert f.read(8) == b"\x89PNG\r\n\x1a\n"
 
 
+def _main_thread_cpu():
+    """CPU seconds of the main thread, where the library computes (the GIL released, the same
+    thread): unlike wall time, the machine's load does not change how much of it a call needs."""
+    return time.clock_gettime(time.pthread_getcpuclockid(threading.main_thread().ident))
+
+
+def _interrupted_at(call, at):
+    """Runs `call()` with a watcher thread that sends SIGINT once the call has used `at` seconds
+    of the main thread's CPU time; returns (CPU time at the signal, CPU time at the
+    KeyboardInterrupt), both from the start of the call. The signal is placed by the work done,
+    not by the clock, so a busier or idler machine neither lets the call finish before it nor
+    delays it; and the KeyboardInterrupt must come from inside the call (pytest.raises)."""
+    sent, done = [], threading.Event()
+
+    def watch(begin):
+        while not done.is_set():
+            used = _main_thread_cpu() - begin
+            if used >= at:
+                sent.append(used)
+                os.kill(os.getpid(), signal.SIGINT)
+                return
+            time.sleep(0.002)
+
+    begin = _main_thread_cpu()
+    watcher = threading.Thread(target=watch, args=(begin,))
+    watcher.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+        took = _main_thread_cpu() - begin
+    finally:
+        done.set()
+        watcher.join()
+    assert sent, "no signal was sent"
+    return sent[0], took
+
+
 def _interrupted_after(call, fraction):
-    """Times `call()` uninterrupted, then runs it again with SIGINT from a timer thread at
-    `fraction` of that time; returns (uninterrupted time, signal time, time to KeyboardInterrupt)."""
-    start = time.perf_counter()
+    """Runs `call()` uninterrupted and measures the main thread's CPU time it needs (`full`),
+    then runs it again interrupted once it has used `fraction` of that (_interrupted_at).
+    Returns (full, CPU time at the signal, CPU time at the KeyboardInterrupt)."""
+    start = _main_thread_cpu()
     call()
-    t_full = time.perf_counter() - start
-    at = fraction * t_full
-    timer = threading.Timer(at, os.kill, (os.getpid(), signal.SIGINT))
-    start = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        call()
-    took = time.perf_counter() - start
-    timer.join()
-    return t_full, at, took
+    full = _main_thread_cpu() - start
+    return (full, *_interrupted_at(call, fraction * full))
 
 
 def test_ctrl_c_stops_a_long_mixed_ring():
-    # a 300,000-car ring on the product path (contour counts of a few tenths of a second each)
+    # a 300,000-car ring on the product path (contour counts of a few tenths of a second each),
+    # interrupted a quarter into its work
     call = lambda: ddemap.mixed_ring("A_min,C_max", ring=300000, count=6)
-    t_full, at, took = _interrupted_after(call, 0.25)
-    assert t_full > 2, t_full  # long enough that stopping early is visible
-    assert took < 0.6 * t_full, (took, at, t_full)
+    full, at, took = _interrupted_after(call, 0.25)
+    assert full > 1, full  # long enough that stopping early is visible
+    # the callback checks after every contour count (at most 20 times a second): the call stops
+    # within a few counts of the signal, long before its end (it would need 0.75 full more)
+    assert took - at <= 0.35 * full, (took, at, full)
+    assert took < 0.6 * full, (took, at, full)
     # the module still works
     assert ddemap.mixed_ring("A_min,C_max", ring=20, count=4)["ring_stable"] in (True, False)
 
@@ -430,6 +493,23 @@ def test_ctrl_c_stops_a_long_system_roots(tmp_path):
     system.write_text(json.dumps({"dimension": n, "delays": [1.0], "A0": {"triplets": [[i, i, -1.0] for i in range(n)]},
                                   "A": [{"triplets": triplets}]}))
     call = lambda: ddemap.roots(system=str(system), count=30, solver="sparse")
-    t_full, at, took = _interrupted_after(call, 0.25)
-    assert t_full > 2, t_full
-    assert took < 0.6 * t_full, (took, at, t_full)
+    full, at, took = _interrupted_after(call, 0.25)
+    assert full > 1, full
+    # checked before every shift: stopped within a few shifts of the signal, long before the end
+    assert took - at <= 0.35 * full, (took, at, full)
+    assert took < 0.6 * full, (took, at, full)
+
+
+def test_ctrl_c_stops_the_dense_step_of_an_infinite_ring():
+    # N = inf near the edge of the computable range: after a short scan of wave numbers, the search
+    # for the 5 roots at the abscissa's wave number climbs from M = 22 to M = 400 in one dense degree (a
+    # complex eigenvalue problem of 802 states, most of the call). The check comes between stages
+    # of that eigenvalue problem (every 16 Householder columns or 32 QR steps), so a signal half
+    # way through the call stops it within a small part of the whole, where it used to run the
+    # degree to its end.
+    call = lambda: ddemap.roots(k1=19, k2=0.2, th=1.5, tau=0.2, ring="inf", count=5)
+    full, at, took = _interrupted_after(call, 0.5)
+    assert full > 1, full
+    assert took - at <= 0.1 * full, (took, at, full)
+    # the module still works, and gives the ring's verdict
+    assert ddemap.roots(k1=0.2, k2=0.2, th=1.5, tau=0.1, ring="inf", count=2)["ring_stable"] in (True, False)

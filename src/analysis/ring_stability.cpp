@@ -213,6 +213,7 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             per.count = count;
             per.progress = options.roots.progress;
             const RootResult more = rightmost_roots(ring_mode_dde(lin, std::polar(1.0, -best_theta)), per);
+            if (more.status == Status::Cancelled) throw Cancelled();  // the callback's stop reaches the caller
             if (more.status == Status::Converged) {
                 absorb_status(r, more);
                 at_best = more;

@@ -71,12 +71,16 @@ struct Sample {
     PhaseSample p;     // P with |P'/P|^2
     double ell = 0.0;  // log |Gamma|
     int side = 0;      // -1 inside the unit circle, +1 outside, 0 on it to rounding
+    // formed once per sample (piece() looks at each sample up to three times)
+    double rate = 0.0;    // d log|Gamma| / ds = Re(dGamma/ds / Gamma)
+    double speed2 = 0.0;  // |dGamma/ds|^2 / max(|Gamma|^2, 1/4)
+    double g2 = 0.0, dg2 = 0.0;  // |Gamma|^2, |dGamma/ds|^2
 };
 
 class LineSampler {
 public:
     LineSampler(const TransferFunction& tf, const Linearisation& lin, double sigma, int budget)
-        : budget(budget), m_tf(tf), m_sigma(sigma), m_sizes(sizes_at(lin, sigma)) {}
+        : budget(budget), m_tf(tf), m_line(tf, sigma), m_sigma(sigma), m_sizes(sizes_at(lin, sigma)) {}
     int budget;
     bool failed = false;
     long evaluations = 0;
@@ -86,17 +90,24 @@ public:
         ++evaluations;
         Sample x;
         x.s = s;
-        const cplx lambda(m_sigma, s);
         cplx n, d, dn, dd;
-        m_tf.evaluate(lambda, n, d, dn, dd);
-        if (d == cplx(0.0) || !std::isfinite(std::norm(d)) || !std::isfinite(std::norm(n))) {
+        m_line(s, n, d, dn, dd);  // one sin/cos per delay, real arithmetic
+        const double nn = n.real() * n.real() + n.imag() * n.imag(), nd = d.real() * d.real() + d.imag() * d.imag();
+        if (nd == 0.0 || !std::isfinite(nd) || !std::isfinite(nn)) {
             fail("a zero of the plant's P on the line");
             return x;
         }
-        x.g = n / d;
-        x.dg = cplx(0.0, 1.0) * (dn * d - n * dd) / (d * d);
-        x.p = {s, d, std::norm(dd) / std::norm(d)};
-        const double nn = std::norm(n), nd = std::norm(d);
+        // Gamma = N conj(D) / |D|^2 and dGamma/ds = i Gamma' = i (N' - Gamma D') / D
+        const double gr = (n.real() * d.real() + n.imag() * d.imag()) / nd, gi = (n.imag() * d.real() - n.real() * d.imag()) / nd;
+        x.g = cplx(gr, gi);
+        const double ur = dn.real() - (gr * dd.real() - gi * dd.imag()), ui = dn.imag() - (gr * dd.imag() + gi * dd.real());
+        const double vr = (ur * d.real() + ui * d.imag()) / nd, vi = (ui * d.real() - ur * d.imag()) / nd;  // (N' - Gamma D') / D
+        x.dg = cplx(-vi, vr);
+        x.p = {s, d, (dd.real() * dd.real() + dd.imag() * dd.imag()) / nd};
+        x.g2 = std::norm(x.g);
+        x.dg2 = std::norm(x.dg);
+        x.rate = (x.dg.real() * gr + x.dg.imag() * gi) / x.g2;  // Re(dGamma/ds conj(Gamma)) / |Gamma|^2
+        x.speed2 = x.dg2 / std::max(x.g2, 0.25);
         x.ell = nn > 0.0 ? 0.5 * std::log(nn / nd) : -std::numeric_limits<double>::infinity();
         if (m_sigma == 0.0 && std::abs(x.ell) < 1e-6) {
             if (s == 0.0) {  // Gamma(0) = 1: the tangency, decided by the series
@@ -110,7 +121,7 @@ public:
             }
         } else {
             // rounding of |N| and |D| relative to the sizes of their terms
-            const double al = std::abs(lambda);
+            const double al = std::sqrt(m_sigma * m_sigma + s * s);  // |lambda|
             const double big_d = al * al + al * m_sizes.own + m_sizes.gap, big_n = m_sizes.gap + al * m_sizes.lead;
             const double tol = 8.0 * kEps * (big_d / std::sqrt(nd) + big_n / std::sqrt(std::max(nn, 1e-300)));
             x.side = x.ell > tol ? 1 : (x.ell < -tol ? -1 : 0);
@@ -127,11 +138,11 @@ public:
 
 private:
     const TransferFunction& m_tf;
+    TransferFunction::Line m_line;
     double m_sigma;
     Sizes m_sizes;
 };
 
-double mag(cplx z) { return std::sqrt(std::norm(z)); }
 
 /// Signed crossings of the ray {p + t u : t > 0} by the segment from x to y: +1 when the
 /// segment passes it counter-clockwise about p. Summed over a closed polygon that keeps away
@@ -146,7 +157,7 @@ int ray_crossing(cplx x, cplx y, cplx p, cplx u) {
 }
 
 /// d log|Gamma| / ds
-double ell_rate(const Sample& x) { return (x.dg / x.g).real(); }
+double ell_rate(const Sample& x) { return x.rate; }
 int sign_of(double v) { return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0); }
 
 /// One pass along [0, r] (see the file comment of the header for the acceptance tests).
@@ -216,19 +227,17 @@ struct Pass {
         const Sample m = f(0.5 * (a.s + b.s));
         if (f.failed) return;
         const double h = 0.5 * (b.s - a.s);
-        const double e = std::sqrt(std::max({std::norm(a.dg), std::norm(m.dg), std::norm(b.dg)})) * h;
+        const double e = std::sqrt(std::max({a.dg2, m.dg2, b.dg2})) * h;
         // Gamma resolved as the tracker resolves a phase (where |Gamma| >= 1/2, near the circle)
         constexpr double kEighth = 0.39269908169872414;  // pi / 8
         const double limit = kEighth * kEighth / (h * h);
-        auto speed2 = [](const Sample& x) {
-            return std::norm(x.dg) / std::max(std::norm(x.g), 0.25);
-        };
+        auto speed2 = [](const Sample& x) { return x.speed2; };
         auto within_quarter = [](cplx y, cplx x) {
             const cplx w = y * std::conj(x);
             return w.real() > std::abs(w.imag());
         };
         bool resolved = speed2(a) < limit && speed2(m) < limit && speed2(b) < limit && phase_piece_resolved(a.p, m.p, b.p);
-        if (resolved && std::min({std::norm(a.g), std::norm(m.g), std::norm(b.g)}) >= 0.25)
+        if (resolved && std::min({a.g2, m.g2, b.g2}) >= 0.25)
             resolved = within_quarter(m.g, a.g) && within_quarter(b.g, m.g);
         if (resolved) {
             // l = log|Gamma| on a half piece stays on its side of 0 when the Taylor bounds
@@ -382,7 +391,7 @@ RingWindingTable winding_table(const TransferFunction& gamma, double sigma, int 
         // and pc (then curve and chord wind alike); a step too close is sampled finer.
         int crossings = 0;
         bool clear = true;
-        auto far = [&](cplx g, double e) { return mag(g - p) > e && mag(g - pc) > e; };
+        auto far = [&](cplx g, double e) { return std::norm(g - p) > e * e && std::norm(g - pc) > e * e; };  // |g - p| > e
         auto count = [&](cplx g0, cplx g1) {
             // the mirror half (s from -r to 0) runs through the conjugate samples in reverse order
             crossings += ray_crossing(g0, g1, p, p) - ray_crossing(std::conj(g0), std::conj(g1), p, p);
@@ -398,7 +407,7 @@ RingWindingTable winding_table(const TransferFunction& gamma, double sigma, int 
                 clear = false;
                 return;
             }
-            const double e = 0.5 * (y.s - x.s) * std::sqrt(std::max({std::norm(x.dg), std::norm(z.dg), std::norm(y.dg)}));
+            const double e = 0.5 * (y.s - x.s) * std::sqrt(std::max({x.dg2, z.dg2, y.dg2}));
             if (far(x.g, e) && far(z.g, e) && far(y.g, e)) {
                 count(x.g, z.g);
                 count(z.g, y.g);
@@ -519,25 +528,50 @@ bool mode_newton(const TransferFunction& tf, cplx zeta, cplx& z) {
     return s.status == Status::Converged;
 }
 
-/// Phi'(lambda) = Gamma'/Gamma = N'/N - D'/D
-cplx log_rate(const TransferFunction& tf, cplx z) {
-    cplx n, d, dn, dd;
-    tf.evaluate(z, n, d, dn, dd);
-    return dn / n - dd / d;
+/// N, D and their first and second derivatives at z (one exponential per term):
+/// N = gap + z lead, N' = gap' + lead + z lead', N'' = gap'' + 2 lead' + z lead'',
+/// D = z^2 - z own + gap, D' = 2 z - own - z own' + gap', D'' = 2 - 2 own' - z own'' + gap''.
+struct Derivatives2 {
+    cplx n, d, dn, dd, ddn, ddd;
+};
+Derivatives2 derivatives2(const Linearisation& lin, cplx z) {
+    // e(z) = sum c e^{-z d}, e' = -sum d c e^{-z d}, e'' = sum d^2 c e^{-z d}
+    auto ev = [&](const ExpPoly& p, cplx out[3]) {
+        out[0] = out[1] = out[2] = 0.0;
+        for (const auto& t : p.terms()) {
+            const cplx e = t.delay == 0.0 ? cplx(t.coef) : t.coef * std::exp(-z * t.delay);
+            out[0] += e;
+            out[1] -= t.delay * e;
+            out[2] += t.delay * t.delay * e;
+        }
+    };
+    cplx g[3], o[3], l[3];
+    ev(lin.gap, g);
+    ev(lin.own, o);
+    ev(lin.lead, l);
+    Derivatives2 r;
+    r.n = g[0] + z * l[0];
+    r.dn = g[1] + l[0] + z * l[1];
+    r.ddn = g[2] + 2.0 * l[1] + z * l[2];
+    r.d = z * z - z * o[0] + g[0];
+    r.dd = 2.0 * z - o[0] - z * o[1] + g[1];
+    r.ddd = 2.0 - 2.0 * o[1] - z * o[2] + g[2];
+    return r;
 }
 
 /// The maximum of Re lambda on the level curve |Gamma(lambda)| = 1: Newton on
 /// log|Gamma| = 0, Im Phi'(lambda) = 0 (the gradient of log|Gamma| is horizontal there).
+/// The Jacobian uses Phi'' = N''/N - (N'/N)^2 - D''/D + (D'/D)^2 (one evaluation per step).
 bool level_maximum(const TransferFunction& tf, cplx& z) {
+    const Linearisation& lin = tf.linearisation();
     for (int it = 0; it < 40; ++it) {
-        cplx n, d, dn, dd;
-        tf.evaluate(z, n, d, dn, dd);
-        if (n == cplx(0.0) || d == cplx(0.0)) return false;
-        const double f1 = 0.5 * std::log(std::norm(n) / std::norm(d));
-        const cplx r1 = dn / n - dd / d;
+        const Derivatives2 v = derivatives2(lin, z);
+        if (v.n == cplx(0.0) || v.d == cplx(0.0)) return false;
+        const double f1 = 0.5 * std::log(std::norm(v.n) / std::norm(v.d));
+        const cplx qn = v.dn / v.n, qd = v.dd / v.d;
+        const cplx r1 = qn - qd;
         const double f2 = r1.imag();
-        const double hstep = 1e-6 * std::max(1.0, std::abs(z));
-        const cplx r2 = (log_rate(tf, z + hstep) - log_rate(tf, z - hstep)) / (2.0 * hstep);
+        const cplx r2 = v.ddn / v.n - qn * qn - v.ddd / v.d + qd * qd;
         // d f1/dx = Re Phi', d f1/dy = -Im Phi'; d f2/dx = Im Phi'', d f2/dy = Re Phi''
         const double a11 = r1.real(), a12 = -r1.imag(), a21 = r2.imag(), a22 = r2.real();
         const double det = a11 * a22 - a12 * a21;

@@ -11,10 +11,27 @@ namespace ddemap {
 LowFrequency low_frequency_expansion(const Linearisation& lin) {
     require_single_leader(lin, "the low-frequency string condition");
     constexpr int K = 8;
+    // every Taylor coefficient of gap, own, lead in one pass over the terms: the same products
+    // and sums, in the same order, as ExpPoly::taylor(n) for each n
+    auto taylor = [](const ExpPoly& e, double* out) {
+        for (int n = 0; n <= K; ++n) out[n] = 0.0;
+        for (const auto& t : e.terms()) {
+            double p = t.coef;
+            out[0] += p;
+            for (int k = 1; k <= K; ++k) {
+                p *= -t.delay / k;
+                out[k] += p;
+            }
+        }
+    };
+    double tg[K + 1], to[K + 1], tl[K + 1];
+    taylor(lin.gap, tg);
+    taylor(lin.own, to);
+    taylor(lin.lead, tl);
     double dn[K + 1], nn[K + 1];
     for (int n = 0; n <= K; ++n) {
-        dn[n] = (n == 2 ? 1.0 : 0.0) + lin.gap.taylor(n) - (n >= 1 ? lin.own.taylor(n - 1) : 0.0);
-        nn[n] = lin.gap.taylor(n) + (n >= 1 ? lin.lead.taylor(n - 1) : 0.0);
+        dn[n] = (n == 2 ? 1.0 : 0.0) + tg[n] - (n >= 1 ? to[n - 1] : 0.0);
+        nn[n] = tg[n] + (n >= 1 ? tl[n - 1] : 0.0);
     }
     // F(i w) = sum F_n i^n w^n = R(w) + i I(w); |F|^2 coefficients by convolution
     auto split = [](const double* f, double* r, double* i) {

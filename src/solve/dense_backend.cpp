@@ -3,6 +3,7 @@
 // with the degree raised until the rightmost roots settle (MATH.md section 5).
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -14,12 +15,68 @@
 
 namespace ddemap {
 
-bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out) {
+namespace {
+
+/// A matrix of at least this many rows has its complex eigenvalues computed in stages with
+/// `check` between them (smaller ones take well under a tenth of a second in one piece).
+constexpr Eigen::Index kStagedRows = 200;
+/// Hessenberg columns reduced, and QR steps of the Schur iteration done, between two checks.
+constexpr Eigen::Index kColumnsPerCheck = 16;
+constexpr Eigen::Index kStepsPerCheck = 32;
+
+/// The eigenvalues of a complex matrix as Eigen::ComplexEigenSolver computes them (Householder
+/// reduction to Hessenberg form H = Q^* A Q, then single-shift QR steps until H is triangular,
+/// the diagonal sorted by modulus), with `check` called after every kColumnsPerCheck columns of
+/// the reduction and every kStepsPerCheck QR steps. The reduction is Eigen's, step for step;
+/// the QR iteration is Eigen's ComplexSchur resumed from its own partial result, with the same
+/// total budget of 30 steps per row (only its count of steps on the current eigenvalue, which
+/// triggers an exceptional shift after 10 and 30, restarts at a check). false: no convergence.
+bool staged_complex_eigenvalues(MatrixXc a, const std::function<void()>& check, std::vector<cplx>& out) {
+    const Eigen::Index n = a.rows();
+    Eigen::VectorXcd h_coeffs(n - 1), temp(n);
+    for (Eigen::Index i = 0; i < n - 1; ++i) {  // HessenbergDecomposition::_compute
+        const Eigen::Index rest = n - i - 1;
+        double beta;
+        cplx h;
+        a.col(i).tail(rest).makeHouseholderInPlace(h, beta);
+        a.col(i).coeffRef(i + 1) = beta;
+        h_coeffs.coeffRef(i) = h;
+        a.bottomRightCorner(rest, rest).applyHouseholderOnTheLeft(a.col(i).tail(rest - 1), h, &temp.coeffRef(0));
+        a.rightCols(rest).applyHouseholderOnTheRight(a.col(i).tail(rest - 1), std::conj(h), &temp.coeffRef(0));
+        if (check && (i + 1) % kColumnsPerCheck == 0) check();
+    }
+    if (n > 2) a.bottomLeftCorner(n - 2, n - 2).triangularView<Eigen::Lower>().setZero();  // matrixH()
+    Eigen::ComplexSchur<MatrixXc> schur(n);
+    const Eigen::Index budget = Eigen::ComplexSchur<MatrixXc>::m_maxIterationsPerRow * n;
+    for (Eigen::Index used = 0;; used += kStepsPerCheck) {
+        const Eigen::Index steps = std::min(kStepsPerCheck, budget - used);
+        schur.setMaxIterations(steps);
+        schur.computeFromHessenberg(a, a, /*computeU=*/false);
+        if (schur.info() == Eigen::Success) break;
+        if (used + steps >= budget) return false;
+        a = schur.matrixT();  // still Hessenberg, similar to the input: resume from it
+        if (check) check();
+    }
+    Eigen::VectorXcd values = schur.matrixT().diagonal();
+    for (Eigen::Index i = 0; i < n; ++i) {  // ComplexEigenSolver::sortEigenvalues
+        Eigen::Index k;
+        values.cwiseAbs().tail(n - i).minCoeff(&k);
+        if (k != 0) std::swap(values[k + i], values[i]);
+    }
+    out.assign(values.data(), values.data() + n);
+    return true;
+}
+
+}  // namespace
+
+bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out, const std::function<void()>& check) {
     const MatrixXc a = collocation_matrix(dde.is_sparse() ? dde.to_dense() : dde, degree);
     if (dde.is_real()) {
         Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(a.real()), /*computeEigenvectors=*/false);
         if (es.info() != Eigen::Success) return false;
         out.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+    } else if (a.rows() >= kStagedRows) {
+        return staged_complex_eigenvalues(a, check, out);
     } else {
         Eigen::ComplexEigenSolver<MatrixXc> es(a, /*computeEigenvectors=*/false);
         if (es.info() != Eigen::Success) return false;
@@ -201,9 +258,15 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
     std::vector<Root> previous;
     std::size_t previous_in_strip = 0;
     int previous_degree = 0;
+    double previous_sigma = std::numeric_limits<double>::quiet_NaN();
+    // within one degree (a complex eigenvalue problem of (M+1) n >= 200 states): the last report
+    // repeated between stages of the eigenvalues (the degree done before, 0 and NaN before the
+    // first), so that a callback throwing Cancelled stops a long degree too
+    std::function<void()> within;
+    if (options.progress) within = [&] { options.progress(previous_degree, max_degree, previous_sigma); };
     for (;;) {
         std::vector<cplx> values;
-        if (!collocation_eigenvalues(dde, m, values)) {
+        if (!collocation_eigenvalues(dde, m, values, within)) {
             result.status = Status::NumericalIssue;
             result.degree = m;
             result.roots = previous;
@@ -288,6 +351,7 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         previous = current;
         previous_in_strip = in_strip;
         previous_degree = m;
+        previous_sigma = sigma;
         int next = static_cast<int>(std::ceil(1.5 * m));
         if (covered < needed) next = std::max(next, degree_for_radius(needed, tau));
         m = std::min(next, max_degree);

@@ -91,6 +91,10 @@ bool is_rightmost(const QuasiPolynomial& f, cplx z, double* wide = nullptr) {
 
 }  // namespace
 
+/// Offsets (times max(1, |guess|)) of the two starts off the real axis tried after a real guess
+/// (certified_rightmost): pairs born from two real zeros start with small imaginary parts.
+constexpr double kOffAxisNear = 0.05, kOffAxisFar = 0.2;
+
 namespace detail {
 
 CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<LinearDDE()>& dde,
@@ -103,6 +107,20 @@ CertifiedRoot certified_rightmost(const QuasiPolynomial& f, const std::function<
             if (is_rightmost(f, z, wide)) {
                 out.certified = true;
                 return out;
+            }
+        }
+        // A real guess of a real f keeps Newton on the real axis: where two real zeros have met and
+        // left it as a complex pair (or the rightmost zero is now a pair next to a real one), start
+        // off the axis. Any start is allowed: the certificate decides, as for the guess itself.
+        if (f.is_real() && guess->imag() == 0.0) {
+            const double scale = std::max(1.0, std::abs(*guess));
+            for (double off : {kOffAxisNear, kOffAxisFar}) {
+                cplx w(guess->real(), off * scale);
+                if (f.newton(w) && is_rightmost(f, w)) {
+                    out.value = w;
+                    out.certified = true;
+                    return out;
+                }
             }
         }
     }

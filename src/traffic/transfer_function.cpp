@@ -58,6 +58,46 @@ void TransferFunction::evaluate(cplx s, cplx& n, cplx& d, cplx& dn, cplx& dd) co
     dd = 2.0 * s - own - s * down + dgap;
 }
 
+TransferFunction::Line::Line(const TransferFunction& tf, double sigma) : m_sigma(sigma) {
+    for (const auto& g : tf.m_groups) {
+        if (g.delay == 0.0) {
+            m_gap0 += g.gap;
+            m_own0 += g.own;
+            m_lead0 += g.lead;
+        } else {
+            const double f = sigma == 0.0 ? 1.0 : std::exp(-sigma * g.delay);
+            m_terms.push_back({g.delay, g.gap * f, g.own * f, g.lead * f});
+        }
+    }
+}
+
+void TransferFunction::Line::operator()(double s, cplx& n, cplx& d, cplx& dn, cplx& dd) const {
+    // sums of coefficient * e^{-lambda delay} (re, im) and of -delay * coefficient * e^{-lambda delay}
+    double gr = m_gap0, gi = 0.0, orr = m_own0, oi = 0.0, lr = m_lead0, li = 0.0;
+    double dgr = 0.0, dgi = 0.0, dor = 0.0, doi = 0.0, dlr = 0.0, dli = 0.0;
+    for (const auto& t : m_terms) {
+        const double c = std::cos(s * t.delay), sn = std::sin(s * t.delay);  // one sincos
+        const double agr = t.gap * c, agi = -t.gap * sn, aor = t.own * c, aoi = -t.own * sn, alr = t.lead * c, ali = -t.lead * sn;
+        gr += agr;
+        gi += agi;
+        orr += aor;
+        oi += aoi;
+        lr += alr;
+        li += ali;
+        dgr -= t.delay * agr;
+        dgi -= t.delay * agi;
+        dor -= t.delay * aor;
+        doi -= t.delay * aoi;
+        dlr -= t.delay * alr;
+        dli -= t.delay * ali;
+    }
+    const double a = m_sigma, b = s;  // lambda = a + i b
+    n = cplx(gr + a * lr - b * li, gi + a * li + b * lr);
+    d = cplx(a * a - b * b - (a * orr - b * oi) + gr, 2.0 * a * b - (a * oi + b * orr) + gi);
+    dn = cplx(dgr + lr + a * dlr - b * dli, dgi + li + a * dli + b * dlr);
+    dd = cplx(2.0 * a - orr - (a * dor - b * doi) + dgr, 2.0 * b - oi - (a * doi + b * dor) + dgi);
+}
+
 cplx TransferFunction::numerator(cplx s) const {
     cplx n, d;
     evaluate(s, n, d);

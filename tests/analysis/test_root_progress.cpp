@@ -5,10 +5,18 @@
 // mixed_ring from Python); any other exception reaches the caller as it is.
 #include <doctest/doctest.h>
 
+#include <complex>
 #include <stdexcept>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/discretize/collocation.hpp"
+#include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/ring.hpp"
+#include "fleet_helpers.hpp"
 #include "ddemap/analysis/system_roots.hpp"
 #include "ddemap/traffic/fleet.hpp"
 
@@ -113,4 +121,48 @@ TEST_CASE("system roots, dense path: a progress call per degree, Cancelled gives
     CHECK_FALSE(cancelled.stable);
     o.progress = [](long, long, double) { throw std::runtime_error("not a cancellation"); };
     CHECK_THROWS_AS(analyse_system(dde, o), std::runtime_error);
+}
+
+TEST_CASE("dense eigenvalues in stages: Eigen's values in one piece, checks between the stages, and a throwing check stops them") {
+    // a complex mode of the infinite ring (theta = 1) at degree 120: a 242-state complex eigenvalue problem
+    const Linearisation lin = test::ovrv(0.2, 0.2, 1.5, 0.1);
+    const LinearDDE dde = ring_mode_dde(lin, std::polar(1.0, -1.0));
+    const Eigen::ComplexEigenSolver<MatrixXc> whole(collocation_matrix(dde, 120), false);
+    REQUIRE(whole.info() == Eigen::Success);
+    long calls = 0;
+    std::vector<cplx> staged;
+    REQUIRE(collocation_eigenvalues(dde, 120, staged, [&] { ++calls; }));
+    // the reduction is Eigen's step for step and the QR steps resume from Eigen's own partial
+    // result: the same values in the same order
+    REQUIRE(staged.size() == static_cast<std::size_t>(whole.eigenvalues().size()));
+    for (std::size_t i = 0; i < staged.size(); ++i) CHECK(staged[i] == whole.eigenvalues()[static_cast<Eigen::Index>(i)]);
+    CHECK(calls >= 241 / 16);  // every 16 Householder columns at least
+    long stopped = 0;
+    CHECK_THROWS_AS(collocation_eigenvalues(dde, 120, staged, [&] {
+                        if (++stopped == 3) throw Cancelled();
+                    }),
+                    Cancelled);
+    CHECK(stopped == 3);
+    // a small problem (82 states) is one piece
+    calls = 0;
+    REQUIRE(collocation_eigenvalues(dde, 40, staged, [&] { ++calls; }));
+    CHECK(calls == 0);
+}
+
+TEST_CASE("ring N = inf: the search stopped within its one long dense degree stops the ring (Cancelled reaches the caller)") {
+    // near the edge of the computable range the search for 5 roots at the abscissa's wave number
+    // climbs from M = 22 to M = 400 in one degree (802 complex states, seconds); its progress is
+    // called within that degree with the last report repeated
+    const Linearisation lin = test::ovrv(19, 0.2, 1.5, 0.2);
+    RingOptions o;
+    o.roots.count = 5;
+    std::vector<long> done;
+    o.roots.progress = [&](long d, long, double) {
+        const bool repeated = !done.empty() && done.back() == d;
+        done.push_back(d);
+        if (repeated) throw Cancelled();
+    };
+    CHECK_THROWS_AS(analyse_ring(lin, 0, o), Cancelled);
+    REQUIRE(done.size() == 2);
+    CHECK(done[0] > 0);  // the first degree finished, then a call from within the next one
 }

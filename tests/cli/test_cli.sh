@@ -1394,5 +1394,28 @@ expect_error "--initial-step = '0.5': expected a value from 1e-6 to 0.1 (the lar
 [ $? -ne 2 ] && ok || bad "orbits --wave --initial-step 0.5 --max-step 1: refused"
 rm -rf "$wms"
 
+# ---- mix: sized before any work (time, memory, output); refused in one line naming the rings and the limit
+mxd="$tmp/mixsize"; mkdir -p "$mxd"
+expect_error "101 arrangements of a 1000000-car ring (product path): estimated run time .* is above the limit 10 min (--allow-large runs it anyway)" \
+    mix --x A_min --y C_max --ring 1000000 --p 0:1:101 --out "$mxd/a"
+expect_error "1000100000 arrangements of a 40-car ring (product path): estimated run time" mix --x A_min --y C_max --ring 40 --p 0:1:100000 --draws 10000 --out "$mxd/b"
+expect_error "11 arrangements of a 100-car ring (dense path): estimated run time" mix --x A_min --y C_max --ring 100 --solver dense --out "$mxd/c"
+expect_error "11 arrangements of a 5000-car ring (sparse path): estimated run time" mix --x A_min --y C_max --ring 5000 --solver sparse --out "$mxd/d"
+expect_error "of memory, more than this machine has" mix --x A_min --y C_max --ring 3000 --solver dense --p 0:1:2 --allow-large --out "$mxd/e"
+[ -z "$(ls "$mxd")" ] && ok || bad "mix refused by its size guard wrote files: $(ls "$mxd")"
+# within the limits it runs
+"$bin" mix --x A_min --y C_max --ring 40 --p 0:1:3 --out "$mxd/ok" >/dev/null && [ -s "$mxd/ok.csv" ] && ok || bad "mix: a small study refused"
+rm -rf "$mxd"
+
+# ---- roots --ring inf: the search's progress is also called within a long dense degree (M = 216, 434 complex
+# states, in stages); off a terminal that adds no line: one line per finished step, step numbers increasing, no NaN
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" roots --k1 5 --k2 0.2 --th 1.5 --tau 0.2 --ring inf --count 5 >/dev/null 2>"$tmp/steps.txt" &&
+    python3 - "$tmp/steps.txt" <<'PY' && ok || bad "roots --ring inf: the search's progress lines repeat a step or show NaN: $(cat "$tmp/steps.txt")"
+import re, sys
+steps = [int(m.group(1)) for m in re.finditer(r"roots: step (\d+) of at most", open(sys.argv[1]).read())]
+assert len(steps) >= 2 and steps == sorted(set(steps)), steps
+assert "nan" not in open(sys.argv[1]).read().lower()
+PY
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -119,3 +119,44 @@ TEST_CASE("the sweep's plant roots (certified on a wide line first, adapted alon
 }
 
 TEST_SUITE_END();
+
+TEST_SUITE_BEGIN("fast");
+
+TEST_CASE("the sweep's plant roots where two real roots meet and leave the real axis: Newton started off the axis, equal to the collocation roots") {
+    // th = 1.5, tau = 0.5: along the rows the plant's rightmost root switches between a real root
+    // and a complex pair; Newton from a real guess stays real, so the pair is reached from starts
+    // off the axis (certified_rightmost) instead of a collocation solve
+    const SweepResult r = run_sweep(ddemap::test::ovrv_chart(30, 22, 1.5, 0.5));
+    std::vector<std::pair<int, int>> where;
+    int to_pair = 0;
+    for (int iy = 0; iy < 30; ++iy)
+        for (int ix = 0; ix + 1 < 30; ++ix) {
+            const bool real0 = r.at(ix, iy).plant_root.imag() == 0.0, real1 = r.at(ix + 1, iy).plant_root.imag() == 0.0;
+            if (real0 != real1) {
+                where.emplace_back(ix, iy);
+                where.emplace_back(ix + 1, iy);
+                to_pair += real0 && !real1;
+            }
+        }
+    CAPTURE(to_pair);
+    CAPTURE(r.fallbacks);
+    CHECK(to_pair >= 5);
+    // each of those switches needed a collocation solve before; now at most a few points do
+    CHECK(r.fallbacks < to_pair);
+    for (const auto& [ix, iy] : where) {
+        const SweepPoint& p = r.at(ix, iy);
+        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
+        RootOptions o;
+        o.count = 2;
+        const RootResult ref = rightmost_roots(plant_dde(lin), o);  // collocation, refined and certified on its own
+        REQUIRE(ref.status == Status::Converged);
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(std::abs(p.plant_abscissa - ref.spectral_abscissa()) < tol::sweep_vs_point);
+        const cplx z = ref.roots.front().value;
+        CHECK(std::abs(p.plant_root - (z.imag() < 0.0 ? std::conj(z) : z)) < tol::sweep_vs_point * std::max(1.0, std::abs(z)));
+        CHECK(p.plant_stable == (ref.spectral_abscissa() < -marginal_band(z)));
+    }
+}
+
+TEST_SUITE_END();

@@ -22,7 +22,8 @@ struct RingOptions {
     /// exact count once the golden section has ended); the search for roots.count roots at the
     /// abscissa's wave number, whose length is not known, reports its steps through
     /// roots.progress instead (the scan's searches do not call it). It may throw to stop, and
-    /// the exception reaches the caller.
+    /// the exception reaches the caller; so does a ddemap::Cancelled thrown by roots.progress
+    /// (which is also called within a long dense degree of that search: solve/roots.hpp).
     Progress progress;
     void validate() const;
 };

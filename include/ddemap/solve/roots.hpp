@@ -21,6 +21,7 @@
 /// complex coefficients or an ODE; otherwise shift_invert. A forced method that does not apply
 /// throws std::invalid_argument saying why.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,7 +91,10 @@ struct RootOptions {
     ContourRootOptions contour;
     /// Called on the caller's thread after every unit of work: (units done, the budget of units,
     /// the current strip floor or shift's real part). dense: after each collocation degree,
-    /// (M, max_degree, sigma) (one degree's eigenvalues are not interrupted); shift_invert:
+    /// (M, max_degree, sigma); within a degree whose eigenvalue problem is complex with
+    /// (M+1) n >= 200 states also between its stages (collocation_eigenvalues), the last call
+    /// repeated (the previous degree and its sigma; 0 and NaN within the first degree) so that
+    /// Cancelled stops it there (a real one is not interrupted); shift_invert:
     /// before each Arnoldi shift, (shifts done, max_shifts, Re sigma); contour: after each
     /// rectangle count, (counts done, max_cells, its left edge). May be empty. Throwing ddemap::Cancelled
     /// (core/execution.hpp) stops the work: rightmost_roots then returns Status::Cancelled.
@@ -181,8 +185,11 @@ double radius_for_degree(int degree, double tau);
 std::vector<Root> cut_rightmost(const std::vector<Root>& all, int count);
 /// All eigenvalues of the degree-M dense collocation matrix (real arithmetic for a real DDE);
 /// false when the QR algorithm failed. (The dense backend's eigen-solver, also used for the
-/// cheap guesses of the sweep's certified roots.)
-bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out);
+/// cheap guesses of the sweep's certified roots.) A complex matrix of 200 rows or more is done
+/// in stages (Householder reduction to Hessenberg form, then chunks of QR steps) and `check`
+/// (may be empty) is called between them, every 16 columns and every 32 steps: it may throw
+/// (ddemap::Cancelled) to stop a long eigenvalue problem. A real matrix is one piece.
+bool collocation_eigenvalues(const LinearDDE& dde, int degree, std::vector<cplx>& out, const std::function<void()>& check = {});
 /// Rightmost first, ties: larger imaginary part first.
 bool rightmost_first(const Root& a, const Root& b);
 

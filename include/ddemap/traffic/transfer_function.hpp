@@ -44,6 +44,28 @@ public:
     double attenuation(double w, double* q = nullptr, double* q_noise = nullptr) const;
     const Linearisation& linearisation() const { return m_lin; }
 
+    /// N, D, N' and D' at lambda = sigma + i s for many s on one vertical line Re lambda = sigma:
+    /// the factors e^{-sigma d} of the delays are formed once, and each point costs one sin/cos per
+    /// distinct nonzero delay and real arithmetic,
+    ///     e^{-lambda d} = e^{-sigma d} (cos(s d) - i sin(s d)),
+    ///     N = gap + lambda lead, D = lambda^2 - lambda own + gap,
+    ///     N' = gap' + lead + lambda lead', D' = 2 lambda - own - lambda own' + gap'
+    /// (' = d/dlambda; the same values as evaluate() up to rounding).
+    class Line {
+    public:
+        Line(const TransferFunction& tf, double sigma);
+        void operator()(double s, cplx& n, cplx& d, cplx& dn, cplx& dd) const;
+        double sigma() const { return m_sigma; }
+
+    private:
+        struct Term {
+            double delay, gap, own, lead;  // coefficients times e^{-sigma delay}
+        };
+        double m_sigma;
+        double m_gap0 = 0.0, m_own0 = 0.0, m_lead0 = 0.0;  // the undelayed terms
+        std::vector<Term> m_terms;                          // the delayed ones
+    };
+
 private:
     Linearisation m_lin;
     struct DelayGroup {
