@@ -74,7 +74,7 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
     for (const EquilibriumPoint& p : b.points)
         out += "point," + format_exact(p.par) + xs(p.x) + "," + format_exact(p.abscissa) + "," + std::to_string(p.unstable) + "," +
                (p.stable ? "true" : "false") + ",," + to_string(p.roots_status) + "\n";
-    for (const FoldPoint& f : b.folds) out += "fold," + format_exact(f.par) + xs(f.x) + ",,,,," + to_string(f.status) + "\n";
+    for (const FoldPoint& f : b.folds) out += f.kind + "," + format_exact(f.par) + xs(f.x) + ",,,,," + to_string(f.status) + "\n";
     for (const HopfPoint& h : b.hopf)
         out += "hopf," + format_exact(h.par) + xs(h.x) + ",,,," + format_exact(h.omega) + "," + to_string(h.status) + "\n";
     return out;

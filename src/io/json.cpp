@@ -160,6 +160,7 @@ std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vecto
     json folds = json::array();
     for (const FoldPoint& f : b.folds) {
         json o;
+        o["kind"] = f.kind;
         o["par"] = num(f.par);
         o["x"] = vec(f.x);
         o["status"] = to_string(f.status);
