@@ -65,6 +65,9 @@ int run_equilibria() {
     JsonEnvelope e;
     e.command = "equilibria";
     e.inputs = inputs.str();
+    e.has_solver = true;  // the roots of every equilibrium; special points by Newton on their defining systems
+    e.solver_given = solver_name(o.roots.method);
+    e.solver_used = e.solver_given;
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, variables);

@@ -1,6 +1,7 @@
 #include "ddemap/analysis/equilibrium_branch.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -502,8 +503,13 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
                 : !roots_ok ? Status::MaxDegreeReached
                 : !special_ok ? Status::MaxIterations
                               : Status::Converged;
+    std::string cm = c.message;  // the engine names unknowns by index: the last one is the parameter
+    const std::string unknown = "unknown " + std::to_string(n);
+    for (std::size_t at = cm.find(unknown); at != std::string::npos; at = cm.find(unknown, at + 1))
+        if (at + unknown.size() == cm.size() || !std::isdigit(static_cast<unsigned char>(cm[at + unknown.size()])))
+            cm.replace(at, unknown.size(), "the parameter " + options.parameter);
     br.message = std::to_string(br.points.size()) + " points, " + std::to_string(br.folds.size()) + " folds, " + std::to_string(br.hopf.size()) +
-                 " Hopf points; the branch ended: " + to_string(c.stop) + (c.message.empty() ? "" : " (" + c.message + ")");
+                 " Hopf points; the branch ended: " + to_string(c.stop) + (cm.empty() ? "" : " (" + cm + ")");
     if (!roots_ok) br.message += "; the roots did not converge at some points";
     if (!special_ok) br.message += "; a fold, branch point or Hopf point was not located";
     return br;

@@ -238,8 +238,24 @@ bool locate_fold(const Step& step, const Probe& probe) {
 
 }  // namespace
 
+void check_accuracy(PeriodicOrbit& o) {
+    if (!(o.trivial_distance > orbit_accuracy_limit)) return;
+    o.stable = false;
+    o.undecided = "|mu_trivial - 1| = " + detail::format_number(o.trivial_distance) + " > " + detail::format_number(orbit_accuracy_limit) +
+                  ": the orbit failed its accuracy check";
+}
+
 bool special_points(const Step& step, const PeriodicOrbit& prev, const PeriodicOrbit& next, bool multipliers, const std::string& what,
                     const Probe& probe, OrbitBranch& b) {
+    // an orbit that failed its accuracy check gives no special points (and the branch is undecided)
+    if (!prev.undecided.empty() || !next.undecided.empty()) {
+        if (b.status == Status::Converged) {
+            b.status = Status::NumericalIssue;
+            b.message = "the orbit at " + detail::format_number((prev.undecided.empty() ? next : prev).par) + " failed its accuracy check (" +
+                        (prev.undecided.empty() ? next : prev).undecided + "): no stability verdict or special points there";
+        }
+        return false;
+    }
     bool folded = false;
     // fold: the parameter component of the tangent changes sign
     if (step.t_par * step.tn_par < 0.0) {

@@ -88,7 +88,7 @@ std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string
     const std::string empty_extremes(2 * variables.size(), ',');
     auto finite = [](double v) { return std::isfinite(v) ? format_exact(v) : std::string(); };
     auto row = [&](const std::string& kind, const PeriodicOrbit& p) {
-        std::string r = kind + "," + format_exact(p.par) + "," + format_exact(p.period) + "," + (p.multipliers.empty() ? "" : p.stable ? "true" : "false") +
+        std::string r = kind + "," + format_exact(p.par) + "," + format_exact(p.period) + "," + (p.multipliers.empty() || !p.undecided.empty() ? "" : p.stable ? "true" : "false") +
                         "," + finite(p.trivial_distance) + "," + finite(p.max_nontrivial);
         for (Eigen::Index i = 0; i < p.min.size(); ++i) r += "," + format_exact(p.min[i]);
         for (Eigen::Index i = 0; i < p.max.size(); ++i) r += "," + format_exact(p.max[i]);

@@ -476,7 +476,8 @@ std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::strin
         o["period"] = num(p.period);
         o["min"] = vec(p.min);
         o["max"] = vec(p.max);
-        o["stable"] = p.stable;
+        o["stable"] = p.undecided.empty() ? json(p.stable) : json(nullptr);
+        if (!p.undecided.empty()) o["undecided"] = p.undecided;
         json m = json::array();
         for (std::size_t k = 0; k < p.multipliers.size() && static_cast<int>(k) < multipliers; ++k) m.push_back(pair(p.multipliers[k]));
         o["multipliers"] = m;
