@@ -77,6 +77,10 @@ void annotate_option_types(CLI::App& app, const std::string& command) {
             continue;
         }
         const std::string name = o->get_lnames().front();
+        if (name == "ring" && (command == "equilibria" || command == "hopf" || command == "orbits")) {  // --model ov|idm: finite rings only
+            o->type_name("N");
+            continue;
+        }
         if (o->get_group() == "Model" && name != "model" && (command == "sweep" || command == "boundary"))
             o->type_name(command == "sweep" ? "NUMBER|LO:HI:COUNT" : "NUMBER|LO:HI");
         if (o->get_type_name() != "TEXT") continue;

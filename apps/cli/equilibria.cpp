@@ -65,6 +65,9 @@ int run_equilibria() {
     JsonEnvelope e;
     e.command = "equilibria";
     e.inputs = inputs.str();
+    e.has_solver = true;  // the roots of every equilibrium; special points by Newton on their defining systems
+    e.solver_given = solver_name(o.roots.method);
+    e.solver_used = e.solver_given;
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, variables);
@@ -84,7 +87,7 @@ int run_equilibria() {
             out << pad(rounded(p.abscissa, 6), 14) << pad(std::to_string(p.unstable), 10) << (p.stable ? "yes" : "no") << "\n";
         }
         for (const FoldPoint& f : b.folds)
-            out << "fold       " << args.problem.par << " = " << rounded(f.par, 12) << " (" << to_string(f.status) << ", residual " << rounded(f.residual, 2)
+            out << pad(f.kind + " ", 11) << args.problem.par << " = " << rounded(f.par, 12) << " (" << to_string(f.status) << ", residual " << rounded(f.residual, 2)
                 << ")\n";
         for (const HopfPoint& h : b.hopf)
             out << "hopf       " << args.problem.par << " = " << rounded(h.par, 12) << ", omega = " << rounded(h.omega, 12) << " (" << to_string(h.status)

@@ -84,6 +84,9 @@ int run_hopf() {
     JsonEnvelope e;
     e.command = "hopf";
     e.inputs = inputs.str();
+    e.has_solver = true;  // the roots of every equilibrium; special points by Newton on their defining systems
+    e.solver_given = solver_name(o.roots.method);
+    e.solver_used = e.solver_given;
     std::string csv;
     Status status = Status::Converged;
     std::string message;

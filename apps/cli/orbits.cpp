@@ -168,7 +168,7 @@ int run_orbits() {
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
         for (const PeriodicOrbit& p : b.points)
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[variable] - p.min[variable], 6), 14)
-                << pad(rounded(p.max_nontrivial, 4), 12) << pad(rounded(p.trivial_distance, 2), 12) << (p.stable ? "yes" : "no") << "\n";
+                << pad(rounded(p.max_nontrivial, 4), 12) << pad(rounded(p.trivial_distance, 2), 12) << (!p.undecided.empty() ? "undecided" : p.stable ? "yes" : "no") << "\n";
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
         out << crossing_lines(b);

@@ -114,7 +114,7 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
             const bool undecided = w.stability_method == "matrix_free" && (i >= w.stability.size() || w.stability[i].status != Status::Converged);
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[0] - p.min[0], 6), 14)
                 << pad(rounded(p.max[1] - p.min[1], 6), 14) << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12)
-                << (undecided ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
+                << (undecided || (!p.multipliers.empty() && !p.undecided.empty()) ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
         }
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";

@@ -597,6 +597,9 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
     JsonEnvelope e;
     e.command = "equilibria";
     e.inputs = pb.inputs.str();
+    e.has_solver = true;  // as the CLI: the root method (its names there: shift_invert = sparse, contour = product)
+    e.solver_given = o.roots.method == "shift_invert" ? "sparse" : o.roots.method == "contour" ? "product" : o.roots.method;
+    e.solver_used = e.solver_given;
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, pb.variables);
@@ -634,6 +637,9 @@ std::string py_hopf(const std::string& system_file, const std::string& model, in
     JsonEnvelope e;
     e.command = "hopf";
     e.inputs = pb.inputs.str();
+    e.has_solver = true;  // as the CLI (equilibria)
+    e.solver_given = o.roots.method == "shift_invert" ? "sparse" : o.roots.method == "contour" ? "product" : o.roots.method;
+    e.solver_used = e.solver_given;
     if (two) {
         co.branch.progress = branch_interruptible();
         co.progress = branch_interruptible();

@@ -1,6 +1,7 @@
 #include "ddemap/analysis/equilibrium_branch.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -64,7 +65,7 @@ private:
 /// Newton on a square system F(z) = 0 with the exact Jacobian J(z) of F; |F|_max at every
 /// iterate where a step was computed is appended to `history`.
 NewtonSummary newton_square(Eigen::VectorXd& z, const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&, Eigen::MatrixXd*)>& F,
-                            const NewtonOptions& options, std::vector<double>& history) {
+                            const NewtonOptions& options, std::vector<double>& history, bool minimum_norm = false) {
     return newton(
         z,
         [&](const Eigen::VectorXd& x, Eigen::VectorXd& dx) {
@@ -73,9 +74,12 @@ NewtonSummary newton_square(Eigen::VectorXd& z, const std::function<bool(const E
             if (!F(x, f, &j) || !f.allFinite()) return NewtonStep::Singular;
             history.push_back(f.cwiseAbs().maxCoeff());
             if (history.back() == 0.0) return NewtonStep::Exact;
+            if (!j.allFinite()) return NewtonStep::Singular;
             const Eigen::FullPivLU<Eigen::MatrixXd> lu(j);
-            if (!j.allFinite() || !lu.isInvertible()) return NewtonStep::Singular;
-            dx = lu.solve(f);
+            if (lu.isInvertible()) dx = lu.solve(f);
+            else if (minimum_norm) dx = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(j).solve(f);  // Gauss-Newton, minimum-norm step
+            else return NewtonStep::Singular;
+            if (!dx.allFinite()) return NewtonStep::Singular;
             return NewtonStep::Ok;
         },
         options);
@@ -268,8 +272,22 @@ bool hopf_system(const NonlinearDDE& system, int j, const VectorXc& q0, const Ei
     return out.allFinite() && (!jac || jac->allFinite());
 }
 
+namespace {
+/// Newton on the fold system; minimum_norm: minimum-norm steps where its Jacobian is singular
+/// (at a symmetric pitchfork the fold system is singular along the crossing branch, and it is
+/// consistent there: Gauss-Newton converges to the branch point).
+FoldPoint correct_steady_state(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, const NewtonOptions& options,
+                               double residual_tolerance, bool minimum_norm);
+}  // namespace
+
 FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, const NewtonOptions& options,
                        double residual_tolerance) {
+    return correct_steady_state(system, j, x0, par0, options, residual_tolerance, false);
+}
+
+namespace {
+FoldPoint correct_steady_state(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, const NewtonOptions& options,
+                               double residual_tolerance, bool minimum_norm) {
     check_parameter(system, j);
     check_derivatives(system);
     const int n = system.dimension();
@@ -285,7 +303,7 @@ FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd&
     auto F = [&](const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac) { return fold_system(system, j, v0, z, out, jac); };
     Eigen::VectorXd z(2 * n + 1);
     z << x0, par0, v0;
-    const NewtonSummary s = newton_square(z, F, options, r.residuals);
+    const NewtonSummary s = newton_square(z, F, options, r.residuals, minimum_norm);
     Eigen::VectorXd f;
     r.iterations = s.iterations;
     if (z.allFinite() && F(z, f, nullptr)) r.residual = f.cwiseAbs().maxCoeff();
@@ -295,6 +313,7 @@ FoldPoint correct_fold(const NonlinearDDE& system, int j, const Eigen::VectorXd&
     r.status = converged(s.status) && !(r.residual <= residual_tolerance) ? Status::NumericalIssue : s.status;
     return r;
 }
+}  // namespace
 
 HopfPoint correct_hopf(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, double omega0, const VectorXc& q0in,
                        const NewtonOptions& options, double residual_tolerance) {
@@ -406,18 +425,44 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         br.folds.push_back(std::move(f));
     }
 
-    // Hopf candidates between consecutive points: a complex root (Im > 0) whose nearest partner at
-    // the next point has a real part of the other sign; and, where no such pair is matched, a
-    // change in the number of roots with Re > 0, Im > 0 (the root nearest the axis).
-    auto complex_unstable = [](const EquilibriumPoint& p) {
-        int c = 0;
-        for (const cplx& r : p.roots)
-            if (r.imag() > 0.0 && r.real() > marginal_band(r)) ++c;
-        return c;
-    };
-    auto add_hopf = [&](const EquilibriumPoint& from, double omega, int after) {
-        HopfPoint h = correct_hopf(system, j, from.x, from.par, omega, {}, options.special, options.special_residual);
+    // Steady-state bifurcations: det(A_0 + ... + A_m) = det Delta(0) changes sign between two
+    // points, i.e. an odd number of real roots crosses 0. Where the step holds no fold (the
+    // tangent test above), it is a branch point, located by Newton on the same system as a fold.
+    std::vector<double> dets;
+    for (std::size_t k = 0; k < c.points.size(); ++k) {
+        Eigen::MatrixXd jac;
+        dets.push_back(curve.jacobian(c.points[k], jac) ? jac.leftCols(n).determinant() : std::numeric_limits<double>::quiet_NaN());
+    }
+    std::vector<int> real_crossing(br.points.size(), 0);  // +-1 at step k when det Delta(0) changes sign there
+    for (std::size_t k = 0; k + 1 < dets.size(); ++k) {
+        if (!(dets[k] * dets[k + 1] < 0.0)) continue;
+        real_crossing[k] = 1;
+        bool fold_here = false;
+        for (const FoldPoint& f : br.folds) fold_here = fold_here || f.after == static_cast<int>(k);
+        if (fold_here) continue;
+        const std::size_t from = std::abs(dets[k]) <= std::abs(dets[k + 1]) ? k : k + 1;
+        FoldPoint f = correct_steady_state(system, j, br.points[from].x, br.points[from].par, options.special, options.special_residual, true);
+        f.kind = "branch_point";
+        f.after = static_cast<int>(k);
+        special_ok = special_ok && converged(f.status);
+        br.folds.push_back(std::move(f));
+    }
+    std::sort(br.folds.begin(), br.folds.end(), [](const FoldPoint& x, const FoldPoint& y) { return x.after < y.after; });
+
+    // Hopf candidates between consecutive points: a genuine complex root (Im > kComplexFloor
+    // |lambda|) whose nearest genuine complex partner at the next point has a real part of the
+    // other sign; and, where these matched crossings do not account for the change in the number
+    // of unstable roots (counted with conjugates, less one for a real root through 0), the
+    // complex root nearest the axis. A complex pair that meets on the real axis (two real roots
+    // after it) changes no count and a real root through 0 is a branch point or fold: neither
+    // is a Hopf candidate, and a corrected point with omega <= kComplexFloor max(1, |lambda|) is
+    // dropped (a real root at 0, not a Hopf point).
+    constexpr double kComplexFloor = 1e-6;
+    auto genuine = [](const cplx& r) { return r.imag() > kComplexFloor * std::max(1.0, std::abs(r)); };
+    auto add_hopf = [&](const EquilibriumPoint& from, const cplx& root, int after) {
+        HopfPoint h = correct_hopf(system, j, from.x, from.par, root.imag(), {}, options.special, options.special_residual);
         h.after = after;
+        if (!(h.omega > kComplexFloor * std::max(1.0, std::abs(root)))) return;  // converged to a real root at 0
         for (const HopfPoint& o : br.hopf)
             if (converged(h.status) && converged(o.status) && std::abs(o.par - h.par) <= 1e-8 * std::max(1.0, std::abs(h.par)) &&
                 std::abs(o.omega - h.omega) <= 1e-8 * std::max(1.0, h.omega))
@@ -430,22 +475,23 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         const EquilibriumPoint& b = br.points[k + 1];
         int net = 0;  // matched crossings: +1 to the right, -1 to the left
         for (const cplx& ra : a.roots) {
-            if (!(ra.imag() > 0.0)) continue;
+            if (!genuine(ra)) continue;
             const cplx* nearest = nullptr;
             for (const cplx& rb : b.roots)
-                if (rb.imag() > 0.0 && (!nearest || std::abs(rb - ra) < std::abs(*nearest - ra))) nearest = &rb;
+                if (genuine(rb) && (!nearest || std::abs(rb - ra) < std::abs(*nearest - ra))) nearest = &rb;
             if (!nearest || (ra.real() > 0.0) == (nearest->real() > 0.0)) continue;
             net += nearest->real() > 0.0 ? 1 : -1;
             const bool from_a = std::abs(ra.real()) <= std::abs(nearest->real());
-            add_hopf(from_a ? a : b, from_a ? ra.imag() : nearest->imag(), static_cast<int>(k));
+            add_hopf(from_a ? a : b, from_a ? ra : *nearest, static_cast<int>(k));
         }
-        if (complex_unstable(b) - complex_unstable(a) == net) continue;
+        const int change = b.unstable - a.unstable - 2 * net;  // what the matched crossings leave unexplained
+        if (std::abs(change) <= real_crossing[k]) continue;
         const EquilibriumPoint* from = nullptr;
         cplx best(std::numeric_limits<double>::infinity(), 0.0);
         for (const EquilibriumPoint* p : {&a, &b})
             for (const cplx& r : p->roots)
-                if (r.imag() > 0.0 && std::abs(r.real()) < std::abs(best.real())) best = r, from = p;
-        if (from) add_hopf(*from, best.imag(), static_cast<int>(k));
+                if (genuine(r) && std::abs(r.real()) < std::abs(best.real())) best = r, from = p;
+        if (from) add_hopf(*from, best, static_cast<int>(k));
     }
     std::sort(br.hopf.begin(), br.hopf.end(), [](const HopfPoint& x, const HopfPoint& y) { return x.after < y.after; });
 
@@ -457,10 +503,15 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
                 : !roots_ok ? Status::MaxDegreeReached
                 : !special_ok ? Status::MaxIterations
                               : Status::Converged;
+    std::string cm = c.message;  // the engine names unknowns by index: the last one is the parameter
+    const std::string unknown = "unknown " + std::to_string(n);
+    for (std::size_t at = cm.find(unknown); at != std::string::npos; at = cm.find(unknown, at + 1))
+        if (at + unknown.size() == cm.size() || !std::isdigit(static_cast<unsigned char>(cm[at + unknown.size()])))
+            cm.replace(at, unknown.size(), "the parameter " + options.parameter);
     br.message = std::to_string(br.points.size()) + " points, " + std::to_string(br.folds.size()) + " folds, " + std::to_string(br.hopf.size()) +
-                 " Hopf points; the branch ended: " + to_string(c.stop) + (c.message.empty() ? "" : " (" + c.message + ")");
+                 " Hopf points; the branch ended: " + to_string(c.stop) + (cm.empty() ? "" : " (" + cm + ")");
     if (!roots_ok) br.message += "; the roots did not converge at some points";
-    if (!special_ok) br.message += "; a fold or Hopf point was not located";
+    if (!special_ok) br.message += "; a fold, branch point or Hopf point was not located";
     return br;
 }
 

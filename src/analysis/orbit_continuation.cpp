@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/internal/text.hpp"
+
 namespace ddemap::orbit_continuation {
 
 namespace {
@@ -90,8 +92,8 @@ double tracked_value(const PeriodicOrbit& o, bool pd, cplx predicted, cplx& mu) 
 /// width in p of that bracket (else of the regula falsi's last one). A crossing whose g still
 /// jumps by more than kCrossingJump over a bracket of 1e-12 h, or whose multiplier is found
 /// farther than kCrossingMove from its prediction, is no crossing (dropped).
-void locate_crossing(const Step& step, const PeriodicOrbit& prev, const PeriodicOrbit& orbit, const std::pair<cplx, cplx>& crossing, bool pd,
-                     const std::function<bool(double, PeriodicOrbit&)>& orbit_at, OrbitBranch& b) {
+void locate_crossing(const Step& step, double s_lo, double s_hi, const PeriodicOrbit& prev, const PeriodicOrbit& orbit,
+                     const std::pair<cplx, cplx>& crossing, bool pd, const std::function<bool(double, PeriodicOrbit&)>& orbit_at, OrbitBranch& b) {
     const int after = step.after;
     const double h = step.h;
     OrbitCrossing x;
@@ -102,7 +104,7 @@ void locate_crossing(const Step& step, const PeriodicOrbit& prev, const Periodic
     x.par = prev.par + frac * (orbit.par - prev.par);
     x.period = prev.period + frac * (orbit.period - prev.period);
     x.multiplier = crossing.second;
-    double slo = 0.0, shi = step.length, glo = g0, ghi = g1, plo = prev.par, phi = orbit.par;
+    double slo = s_lo, shi = s_hi, glo = g0, ghi = g1, plo = prev.par, phi = orbit.par;
     double glo_true = g0, ghi_true = g1;  // without the Illinois halving
     cplx mlo = crossing.first, mhi = crossing.second;
     int side = 0;
@@ -165,6 +167,50 @@ void locate_crossing(const Step& step, const PeriodicOrbit& prev, const Periodic
     (pd ? b.period_doublings : b.tori).push_back(std::move(x));
 }
 
+/// Counts that need no pairing: real nontrivial multipliers < -1 (a period doubling changes its
+/// parity), nontrivial multipliers outside the unit circle.
+struct Counts {
+    int pd = 0, unstable = 0;
+};
+Counts counts(const PeriodicOrbit& o) {
+    Counts c;
+    for (cplx z : nontrivial(o)) {
+        if (!(std::abs(z) > 1.0)) continue;
+        ++c.unstable;
+        if (std::abs(z.imag()) <= kRealTolerance && z.real() < 0.0) ++c.pd;
+    }
+    return c;
+}
+
+/// The period doublings and tori between the orbits a (at s = s0) and c (at s1) of one step:
+/// the crossings paired by distance, located; where the counts show a change that the pairing
+/// does not (the parity of the number of real multipliers < -1 changes and no real negative
+/// multiplier was paired across -1; or the number of unstable multipliers changes with no
+/// crossing and no fold in the step) the interval is halved (the orbit at its middle corrected,
+/// up to depth 6) and each half searched again. Still unexplained: the branch is undecided.
+void crossings_in(const Step& step, double s0, double s1, const PeriodicOrbit& a, const PeriodicOrbit& c, bool folded, int depth, const Probe& probe,
+                  OrbitBranch& b) {
+    const std::vector<std::pair<cplx, cplx>> pds = circle_crossings(a, c, true), tori = circle_crossings(a, c, false);
+    const Counts ca = counts(a), cc = counts(c);
+    const bool unexplained = ((ca.pd - cc.pd) % 2 != 0 && pds.empty()) || (ca.unstable != cc.unstable && pds.empty() && tori.empty() && !folded);
+    if (unexplained) {
+        PeriodicOrbit mid;
+        const double sm = 0.5 * (s0 + s1);
+        if (depth < 6 && probe.orbit_at(sm, mid) && !mid.multipliers.empty()) {
+            crossings_in(step, s0, sm, a, mid, folded, depth + 1, probe, b);
+            crossings_in(step, sm, s1, mid, c, folded, depth + 1, probe, b);
+            return;
+        }
+        if (b.status == Status::Converged) {
+            b.status = Status::NumericalIssue;
+            b.message = "the number of unstable multipliers changes from " + std::to_string(ca.unstable) + " to " + std::to_string(cc.unstable) +
+                        " between the orbits at " + detail::format_number(a.par) + " and " + detail::format_number(c.par) + " but no special point was found there";
+        }
+    }
+    for (const auto& x : pds) locate_crossing(step, s0, s1, a, c, x, true, probe.orbit_at, b);
+    for (const auto& x : tori) locate_crossing(step, s0, s1, a, c, x, false, probe.orbit_at, b);
+}
+
 /// The fold of a step (see special_points): Illinois regula falsi in s on the parameter component
 /// g of the unit tangent, from the bracket (0, t_par), (length, tn_par); every trial orbit corrected.
 bool locate_fold(const Step& step, const Probe& probe) {
@@ -192,8 +238,24 @@ bool locate_fold(const Step& step, const Probe& probe) {
 
 }  // namespace
 
+void check_accuracy(PeriodicOrbit& o) {
+    if (!(o.trivial_distance > orbit_accuracy_limit)) return;
+    o.stable = false;
+    o.undecided = "|mu_trivial - 1| = " + detail::format_number(o.trivial_distance) + " > " + detail::format_number(orbit_accuracy_limit) +
+                  ": the orbit failed its accuracy check";
+}
+
 bool special_points(const Step& step, const PeriodicOrbit& prev, const PeriodicOrbit& next, bool multipliers, const std::string& what,
                     const Probe& probe, OrbitBranch& b) {
+    // an orbit that failed its accuracy check gives no special points (and the branch is undecided)
+    if (!prev.undecided.empty() || !next.undecided.empty()) {
+        if (b.status == Status::Converged) {
+            b.status = Status::NumericalIssue;
+            b.message = "the orbit at " + detail::format_number((prev.undecided.empty() ? next : prev).par) + " failed its accuracy check (" +
+                        (prev.undecided.empty() ? next : prev).undecided + "): no stability verdict or special points there";
+        }
+        return false;
+    }
     bool folded = false;
     // fold: the parameter component of the tangent changes sign
     if (step.t_par * step.tn_par < 0.0) {
@@ -212,10 +274,7 @@ bool special_points(const Step& step, const PeriodicOrbit& prev, const PeriodicO
     }
     // period doubling and torus: the multipliers that cross the unit circle in this step
     if (multipliers && !prev.multipliers.empty() && !next.multipliers.empty()) {
-        for (int kind = 0; kind < 2; ++kind) {
-            const bool pd = kind == 0;
-            for (const auto& crossing : circle_crossings(prev, next, pd)) locate_crossing(step, prev, next, crossing, pd, probe.orbit_at, b);
-        }
+        crossings_in(step, 0.0, step.length, prev, next, folded, 0, probe, b);
     }
     return folded;
 }

@@ -708,6 +708,7 @@ PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correct
         for (std::size_t k = 0; k < o.multipliers.size(); ++k)
             if (k != k1) o.max_nontrivial = std::max(o.max_nontrivial, std::abs(o.multipliers[k]));
         o.stable = o.max_nontrivial < 1.0;
+        orbit_continuation::check_accuracy(o);
     }
     return o;
 }

@@ -74,7 +74,7 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
     for (const EquilibriumPoint& p : b.points)
         out += "point," + format_exact(p.par) + xs(p.x) + "," + format_exact(p.abscissa) + "," + std::to_string(p.unstable) + "," +
                (p.stable ? "true" : "false") + ",," + to_string(p.roots_status) + "\n";
-    for (const FoldPoint& f : b.folds) out += "fold," + format_exact(f.par) + xs(f.x) + ",,,,," + to_string(f.status) + "\n";
+    for (const FoldPoint& f : b.folds) out += f.kind + "," + format_exact(f.par) + xs(f.x) + ",,,,," + to_string(f.status) + "\n";
     for (const HopfPoint& h : b.hopf)
         out += "hopf," + format_exact(h.par) + xs(h.x) + ",,,," + format_exact(h.omega) + "," + to_string(h.status) + "\n";
     return out;
@@ -88,7 +88,7 @@ std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string
     const std::string empty_extremes(2 * variables.size(), ',');
     auto finite = [](double v) { return std::isfinite(v) ? format_exact(v) : std::string(); };
     auto row = [&](const std::string& kind, const PeriodicOrbit& p) {
-        std::string r = kind + "," + format_exact(p.par) + "," + format_exact(p.period) + "," + (p.multipliers.empty() ? "" : p.stable ? "true" : "false") +
+        std::string r = kind + "," + format_exact(p.par) + "," + format_exact(p.period) + "," + (p.multipliers.empty() || !p.undecided.empty() ? "" : p.stable ? "true" : "false") +
                         "," + finite(p.trivial_distance) + "," + finite(p.max_nontrivial);
         for (Eigen::Index i = 0; i < p.min.size(); ++i) r += "," + format_exact(p.min[i]);
         for (Eigen::Index i = 0; i < p.max.size(); ++i) r += "," + format_exact(p.max[i]);

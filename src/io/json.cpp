@@ -160,6 +160,7 @@ std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vecto
     json folds = json::array();
     for (const FoldPoint& f : b.folds) {
         json o;
+        o["kind"] = f.kind;
         o["par"] = num(f.par);
         o["x"] = vec(f.x);
         o["status"] = to_string(f.status);
@@ -475,7 +476,8 @@ std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::strin
         o["period"] = num(p.period);
         o["min"] = vec(p.min);
         o["max"] = vec(p.max);
-        o["stable"] = p.stable;
+        o["stable"] = p.undecided.empty() ? json(p.stable) : json(nullptr);
+        if (!p.undecided.empty()) o["undecided"] = p.undecided;
         json m = json::array();
         for (std::size_t k = 0; k < p.multipliers.size() && static_cast<int>(k) < multipliers; ++k) m.push_back(pair(p.multipliers[k]));
         o["multipliers"] = m;

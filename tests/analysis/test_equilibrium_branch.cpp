@@ -372,3 +372,29 @@ TEST_CASE("fold and Hopf points: Newton with the exact Jacobian converges quadra
         CHECK(r->back() <= 1e-13);
     }
 }
+
+TEST_CASE("neuron (DDE-BIFTOOL demo): the branch point a21 = (kappa - beta)^2 / a12 is a branch point, not a Hopf point") {
+    // Shayer and Campbell's two-neuron model at x = 0 (tanh'(0) = 1): Delta(0) = [kappa - beta, -a12;
+    // -a21, kappa - beta], det Delta(0) = (kappa - beta)^2 - a12 a21: a real root crosses 0 at
+    // a21 = (kappa - beta)^2 / a12 = 2.25. The unstable complex pair of the Hopf point at
+    // a21 = 0.807 meets the real axis shortly before (a21 ~ 2.22): neither is a Hopf point.
+    ExpressionSystem sys({"x1", "x2"}, {"kappa", "beta", "a12", "a21", "tau1", "tau2", "taus"}, {0.5, -1.0, 1.0, 0.3, 0.2, 0.2, 1.5},
+                         {"-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                          "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"});
+    for (double from : {0.3, 2.2}) {
+        CAPTURE(from);
+        EquilibriumBranchOptions o;
+        o.parameter = "a21";
+        o.from = from;
+        o.to = from < 1.0 ? 3.0 : 2.35;
+        const EquilibriumBranch br = equilibrium_branch(sys, Eigen::VectorXd::Zero(2), o);
+        CHECK(br.status == Status::Converged);
+        REQUIRE(br.folds.size() == 1);
+        CHECK(br.folds[0].kind == "branch_point");
+        CHECK(br.folds[0].status == Status::Converged);
+        CHECK(std::abs(br.folds[0].par - 2.25) < tol::special_point);
+        CHECK(br.folds[0].x.cwiseAbs().maxCoeff() < tol::special_point);
+        for (const HopfPoint& h : br.hopf) CHECK(h.omega > 0.1);
+        CHECK(br.hopf.size() == (from < 1.0 ? 1u : 0u));
+    }
+}

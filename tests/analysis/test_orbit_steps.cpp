@@ -312,3 +312,35 @@ TEST_CASE("travelling waves (IDM, 5 cars): long steps give the same branch, peri
     CHECK(std::abs(wt - full.tori[0].par) <= std::abs(wt - fine20.branch.tori[0].par) + tol::wave_vs_full_ring_floor);
     CHECK(std::abs(fine.branch.tori[0].multiplier - full.tori[0].multiplier) <= tol::wave_full_ring_multipliers);
 }
+
+TEST_CASE("Mackey-Glass (DDE-BIFTOOL demo): the period doubling with max_step 0.5 is the one found with short steps") {
+    // x' = 2 x(t - tau) / (1 + x(t - tau)^10) - x, the branch in tau from the Hopf point. With
+    // max_step 0.5 the real multiplier jumps from -0.99 to -1.63 in one step (farther than the
+    // pairing allows): the parity of the number of multipliers < -1 changes, the step is halved
+    // until the pairing sees the crossing. The reference is the branch with max_step 0.02.
+    const ExpressionSystem sys({"x"}, {"beta", "n", "tau", "gamma"}, {2.0, 10.0, 0.0, 1.0}, {"beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"});
+    EquilibriumBranchOptions eo;
+    eo.parameter = "tau";
+    eo.from = 0.0;
+    eo.to = 2.0;
+    const EquilibriumBranch eq = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 1.0), eo);
+    REQUIRE(eq.hopf.size() == 1);
+    PeriodicOrbitOptions o;
+    o.parameter = "tau";
+    o.from = 0.0;
+    o.to = 2.0;
+    o.intervals = 40;
+    o.max_points = 1000;
+    o.max_step = 0.02;
+    const OrbitBranch fine = orbit_branch_from_hopf(sys, eq.hopf[0], o);
+    o.max_step = 0.5;
+    const OrbitBranch coarse = orbit_branch_from_hopf(sys, eq.hopf[0], o);
+    REQUIRE(fine.status == Status::Converged);
+    REQUIRE(coarse.status == Status::Converged);
+    CHECK(coarse.points.size() * 3 < fine.points.size());
+    REQUIRE(fine.period_doublings.size() == 1);
+    REQUIRE(coarse.period_doublings.size() == 1);
+    CHECK(coarse.period_doublings[0].located);
+    MESSAGE("period doubling: tau " << fine.period_doublings[0].par << " (max_step 0.02), " << coarse.period_doublings[0].par << " (0.5)");
+    CHECK(std::abs(coarse.period_doublings[0].par - fine.period_doublings[0].par) <= tol::special_point);
+}

@@ -1458,5 +1458,35 @@ else
         ok || bad "roots --k1 1e3 --th 1e-3 --tau 1e-3: exit $rc without the UNSETTLED mark and the reason on stderr"
 fi
 
+# ---- review 12: the neuron's branch point a21 = 2.25 (det Delta(0) = (kappa - beta)^2 - a12 a21
+# changes sign) is a "branch_point" in "folds", not a Hopf point; JSON solver {given, used};
+# branch messages name the parameter; --ring of the nonlinear commands takes N only
+r12="$tmp/r12"; mkdir -p "$r12"
+cat >"$r12/neuron.json" <<'EOF'
+{ "variables": ["x1", "x2"],
+  "parameters": {"kappa": 0.5, "beta": -1, "a12": 1, "a21": 0.3, "tau1": 0.2, "tau2": 0.2, "taus": 1.5},
+  "equations": ["-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"],
+  "equilibrium": [0, 0] }
+EOF
+"$bin" equilibria --system "$r12/neuron.json" --par a21 --from 2.2 --to 2.35 --format json >"$r12/e.json" 2>/dev/null &&
+    python3 - "$r12/e.json" <<'PY' && ok || bad "equilibria: the neuron's branch point is not a located branch_point, or the message does not name the parameter"
+import json, sys
+d = json.load(open(sys.argv[1])); r = d["result"]
+assert d["solver"]["given"] and d["solver"]["used"], d["solver"]
+assert r["hopf"] == [], r["hopf"]
+assert [f["kind"] for f in r["folds"]] == ["branch_point"] and abs(r["folds"][0]["par"] - 2.25) < 1e-9, r["folds"]
+assert "parameter a21" in d["message"] and "unknown 2" not in d["message"], d["message"]
+PY
+"$bin" hopf --system "$r12/neuron.json" --par a21 --from 0.3 --to 3 --format json >"$r12/h.json" 2>/dev/null &&
+    python3 - "$r12/h.json" <<'PY' && ok || bad "hopf: solver null or the branch point listed as a Hopf point"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["solver"] is not None and "given" in d["solver"] and "used" in d["solver"], d["solver"]
+assert len(d["result"]["hopf"]) == 1 and d["result"]["hopf"][0]["omega"] > 0.7, d["result"]["hopf"]
+PY
+"$bin" orbits --help | grep -q -- "--ring N " && ! "$bin" orbits --help | grep -q "N|inf" && ok || bad "orbits --help: --ring offers inf, which it refuses"
+rm -rf "$r12"
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

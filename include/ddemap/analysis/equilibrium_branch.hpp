@@ -7,6 +7,8 @@
 /// Special points:
 ///  - fold: the tangent's parameter component changes sign (a test function of the engine); then
 ///    Newton on the fold system  g(x, p) = 0,  (sum_k A_k) v = 0,  v0 . v = 1  (2n + 1 unknowns);
+///  - branch point: det(A_0 + ... + A_m) = det Delta(0) changes sign in a step without a fold
+///    (an odd number of real roots crosses 0); Newton on the fold system (FoldPoint::kind);
 ///  - Hopf: a root with Im > 0 and its nearest partner at the next point have real parts of
 ///    opposite signs (and, when these matched crossings do not account for the change in the
 ///    number of roots with Re > 0 and Im > 0, the root nearest the axis; two crossings of one
@@ -72,7 +74,13 @@ struct EquilibriumPoint {
     Status roots_status = Status::Converged;
 };
 
+/// A steady-state bifurcation: a real root of the characteristic equation at 0 (det(A_0 + ... +
+/// A_m) = 0). kind "fold" where the branch turns back (the tangent's parameter component changes
+/// sign), "branch_point" where det(A_0 + ... + A_m) changes sign between two points but the
+/// branch goes on (a pitchfork or transcritical point: another branch of equilibria crosses).
+/// Both are located by Newton on the fold system.
 struct FoldPoint {
+    std::string kind = "fold";  ///< "fold" or "branch_point"
     double par = 0.0;
     Eigen::VectorXd x;
     Status status = Status::MaxIterations;

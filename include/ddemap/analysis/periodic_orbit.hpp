@@ -105,6 +105,10 @@ struct PeriodicOrbitOptions {
     bool is_valid(std::string* why = nullptr) const;
 };
 
+/// The accuracy check of an orbit's multipliers: |mu_trivial - 1| above this leaves its
+/// stability undecided (accurate orbits have 1e-15 to 1e-5; near a homoclinic end it reaches 1).
+inline constexpr double orbit_accuracy_limit = 1e-2;
+
 /// One orbit: mesh values, period, parameter and what is derived from them.
 struct PeriodicOrbit {
     double par = 0.0;
@@ -117,7 +121,10 @@ struct PeriodicOrbit {
     std::vector<cplx> multipliers;
     double trivial_distance = std::numeric_limits<double>::quiet_NaN();  ///< |mu_trivial - 1|
     double max_nontrivial = std::numeric_limits<double>::quiet_NaN();   ///< max |mu| over the others
-    bool stable = false;      ///< every nontrivial |mu| < 1 (false without multipliers)
+    bool stable = false;      ///< every nontrivial |mu| < 1 (false without multipliers or when undecided)
+    /// non-empty: the orbit failed its accuracy check (trivial_distance > orbit_accuracy_limit):
+    /// no stability verdict (`stable` false, JSON null) and no special points next to it; the reason
+    std::string undecided;
     double residual = std::numeric_limits<double>::infinity();  ///< max |F| (collocation and phase)
     int iterations = 0;       ///< Newton iterations of its corrector
 };

@@ -88,7 +88,7 @@ std::string ring_roots_json(const RingResult& r);
 /// roots of any linear DDE (analyse_system)
 std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& r);
 /// an equilibrium branch: {"parameter", "variables", "points": [{"par", "x", "abscissa",
-/// "unstable", "stable", "roots_status", "roots": [[re, im], ...]}], "folds": [{"par", "x", "status",
+/// "unstable", "stable", "roots_status", "roots": [[re, im], ...]}], "folds": [{"kind" ("fold" or "branch_point"), "par", "x", "status",
 /// "residual"}], "hopf": [{"par", "omega", "x", "status", "residual"}], "stop"}
 std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vector<std::string>& variables);
 /// roots of a mixed ring (analyse_mixed_ring)

@@ -61,6 +61,10 @@ struct Probe {
     std::function<bool(double s, PeriodicOrbit& out)> orbit_at;
 };
 
+/// The accuracy check: trivial_distance > orbit_accuracy_limit makes the orbit undecided
+/// (stable = false, `undecided` the reason).
+void check_accuracy(PeriodicOrbit& o);
+
 /// Detects and locates the special points of one step and appends them to b:
 /// - a fold when the parameter component of the tangent changes sign (t_par tn_par < 0): Illinois
 ///   regula falsi in s on that component, until it is below 1e-11 par_scale or the bracket below
