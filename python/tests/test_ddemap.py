@@ -353,7 +353,7 @@ def test_the_gil_is_released_during_a_computation():
     done = threading.Event()
 
     def work():
-        ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 80), k2=(0.01, 1, 80), ring=22, boundaries=False)
+        ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 200), k2=(0.01, 1, 200), ring=22, boundaries=False)
         done.set()
 
     t = threading.Thread(target=work)
