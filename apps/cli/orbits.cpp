@@ -27,6 +27,7 @@ struct Args {
     CLI::Option* hopf_option = nullptr;
     bool adapt = false;
     bool no_stability = false;
+    bool stability = false;
     FormatArg format;
     OutArg out;
 } args;
@@ -62,6 +63,9 @@ void add_orbits_flags(CLI::App& app) {
         ->type_name("H");
     app.add_flag("--no-stability", args.no_stability,
                  "--wave on more than 10 cars: skip the full ring's Floquet multipliers (matrix-free Arnoldi; on long rings far costlier than the branch)");
+    app.add_flag("--stability", args.stability,
+                 "--wave on more than 200 cars: compute the full ring's Floquet multipliers anyway (minutes per wave on 1000 cars; "
+                 "by default not computed above 200 cars)");
     app.add_option("--max-step", args.max_step,
                    "the largest step along the branch in its weighted norm (default 0.1; larger steps: fewer orbits for the same stretch, "
                    "see README)")
@@ -71,9 +75,10 @@ void add_orbits_flags(CLI::App& app) {
 int run_orbits() {
     if (!args.wave.empty())
         return run_orbits_wave({args.problem, args.wave, args.degree, args.intervals, args.points, args.initial_step, args.svg, args.variable, args.adapt,
-                                args.hopf_option && args.hopf_option->count() > 0, args.format, args.out, args.max_step, args.no_stability});
+                                args.hopf_option && args.hopf_option->count() > 0, args.format, args.out, args.max_step, args.no_stability, args.stability});
     if (!args.initial_step.empty()) throw BadInput("--initial-step: only with --wave (expected --wave K)");
     if (args.no_stability) throw BadInput("--no-stability: only with --wave (expected --wave K)");
+    if (args.stability) throw BadInput("--stability: only with --wave (expected --wave K)");
     const Format format = args.format.parse();
     const std::string prefix = args.out.given() ? args.out.prepare("orbits", {".csv", ".json"}) : std::string();
     const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);

@@ -76,7 +76,13 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
     po.progress = branch_progress_printer("orbits", "waves", po.parameter, false);
     // N > 10: the full ring's multipliers of every wave by the matrix-free path, after the
     // branch, one progress line per wave (ddemap: orbits: 3 waves with multipliers (of 30), ...)
-    o.sparse_floquet = !a.no_stability;
+    if (a.stability && a.no_stability) throw BadInput("--stability and --no-stability: expected at most one of them");
+    // the matrix-free multipliers cost 0.2 s per wave on 100 cars but 23-30 s (K = 100) to far more
+    // (K = 1, 10: a uniform mesh of thousands of intervals) on 1000 cars (BENCHMARKS.md): by default
+    // only up to wave_stability_default_cars, beyond with --stability
+    constexpr int wave_stability_default_cars = 200;
+    const bool too_long = o.cars > wave_stability_default_cars && !a.stability;
+    o.sparse_floquet = !a.no_stability && !too_long;
     o.stability_progress = branch_progress_printer("orbits", "waves with multipliers", po.parameter, true);
     const ParameterMap parameters = built.system->parameters();  // --par at --from, the others as given or default
     const TravellingWaveBranch w = travelling_wave_branch(parameters, o);
@@ -130,7 +136,10 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
             out << "stability  Floquet multipliers of the full ring of " << o.cars << " cars along the wave; max |mu_trivial - 1| = "
                 << rounded(b.max_trivial_distance, 2) << "\n";
         else
-            out << "stability  not computed (" << (a.no_stability ? "--no-stability" : "the full ring's multipliers need --ring up to 10 or the matrix-free path")
+            out << "stability  not computed (" << (a.no_stability ? std::string("--no-stability")
+                                                   : too_long ? "more than " + std::to_string(wave_stability_default_cars) +
+                                                                    " cars: the matrix-free multipliers take minutes per wave; --stability computes them"
+                                                              : std::string("the full ring's multipliers need --ring up to 10 or the matrix-free path"))
                 << "; the reduced form alone does not decide the ring's stability)\n";
         if (!b.points.empty())
             out << "accuracy   max residual = " << rounded(b.max_residual, 2) << ", max drift |mu| = " << rounded(w.max_drift, 2)

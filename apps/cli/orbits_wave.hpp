@@ -18,6 +18,7 @@ struct OrbitsWaveArgs {
     const OutArg& out;
     std::string max_step = {};  ///< --max-step (empty: the default of PeriodicOrbitOptions)
     bool no_stability = false;  ///< --no-stability: no multipliers for N > 10 (the matrix-free path)
+    bool stability = false;     ///< --stability: the matrix-free multipliers also for N > wave_stability_default_cars
 };
 
 /// The table lines of the period doublings and tori of a branch (orbits and orbits --wave):

@@ -1488,5 +1488,11 @@ PY
 "$bin" orbits --help | grep -q -- "--ring N " && ! "$bin" orbits --help | grep -q "N|inf" && ok || bad "orbits --help: --ring offers inf, which it refuses"
 rm -rf "$r12"
 
+# ---- orbits --wave above 200 cars: the matrix-free multipliers only with --stability (minutes per wave)
+"$bin" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --points 3 --quiet >"$tmp/w1000.txt" &&
+    grep -q "^stability  not computed (more than 200 cars" "$tmp/w1000.txt" && ok || bad "orbits --wave --ring 1000: multipliers computed by default: $(grep stability "$tmp/w1000.txt")"
+expect_error "--stability and --no-stability: expected at most one of them" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --stability --no-stability
+expect_error "--stability: only with --wave (expected --wave K)" orbits --model ov --ring 5 --par headway --from 3.5 --to 2 --stability
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
