@@ -85,6 +85,25 @@ TEST_CASE("axes and sweep specs are validated") {
     CHECK_THROWS_WITH_AS(s.validate(), "k1 = -1: expected a value >= 0 [1/s^2]", std::invalid_argument);
 }
 
+// the sweep's plant root, abscissa and verdict at each of `where` against the collocation roots
+// of the plant alone (refined and certified on their own)
+static void check_plant_against_collocation(const SweepResult& r, const std::vector<std::pair<int, int>>& where) {
+    for (const auto& [ix, iy] : where) {
+        const SweepPoint& p = r.at(ix, iy);
+        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
+        RootOptions o;
+        o.count = 2;
+        const RootResult ref = rightmost_roots(plant_dde(lin), o);  // collocation, refined and certified on its own
+        REQUIRE(ref.status == Status::Converged);
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(std::abs(p.plant_abscissa - ref.spectral_abscissa()) < tol::sweep_vs_point);
+        const cplx z = ref.roots.front().value;
+        CHECK(std::abs(p.plant_root - (z.imag() < 0.0 ? std::conj(z) : z)) < tol::sweep_vs_point * std::max(1.0, std::abs(z)));
+        CHECK(p.plant_stable == (ref.spectral_abscissa() < -marginal_band(z)));
+    }
+}
+
 TEST_CASE("the sweep's plant roots (certified on a wide line first, adapted along the row) equal the per-point collocation roots") {
     // th = 0.5, tau = 0.8: the plant P = s^2 + (k1 th + k2) s + k1 e^{-s tau} is unstable for large
     // k1 and small k2 inside the window, so the rows cross the plant's boundary
@@ -102,20 +121,7 @@ TEST_CASE("the sweep's plant roots (certified on a wide line first, adapted alon
                 ++near_boundary;
             }
     CHECK(near_boundary >= 5);
-    for (const auto& [ix, iy] : where) {
-        const SweepPoint& p = r.at(ix, iy);
-        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
-        RootOptions o;
-        o.count = 2;
-        const RootResult ref = rightmost_roots(plant_dde(lin), o);  // collocation, refined and certified on its own
-        REQUIRE(ref.status == Status::Converged);
-        CAPTURE(p.x);
-        CAPTURE(p.y);
-        CHECK(std::abs(p.plant_abscissa - ref.spectral_abscissa()) < tol::sweep_vs_point);
-        const cplx z = ref.roots.front().value;
-        CHECK(std::abs(p.plant_root - (z.imag() < 0.0 ? std::conj(z) : z)) < tol::sweep_vs_point * std::max(1.0, std::abs(z)));
-        CHECK(p.plant_stable == (ref.spectral_abscissa() < -marginal_band(z)));
-    }
+    check_plant_against_collocation(r, where);
 }
 
 TEST_SUITE_END();
@@ -143,20 +149,7 @@ TEST_CASE("the sweep's plant roots where two real roots meet and leave the real 
     CHECK(to_pair >= 5);
     // each of those switches needed a collocation solve before; now at most a few points do
     CHECK(r.fallbacks < to_pair);
-    for (const auto& [ix, iy] : where) {
-        const SweepPoint& p = r.at(ix, iy);
-        const Linearisation lin = model_at(r.spec, p.x, p.y)->linearise();
-        RootOptions o;
-        o.count = 2;
-        const RootResult ref = rightmost_roots(plant_dde(lin), o);  // collocation, refined and certified on its own
-        REQUIRE(ref.status == Status::Converged);
-        CAPTURE(p.x);
-        CAPTURE(p.y);
-        CHECK(std::abs(p.plant_abscissa - ref.spectral_abscissa()) < tol::sweep_vs_point);
-        const cplx z = ref.roots.front().value;
-        CHECK(std::abs(p.plant_root - (z.imag() < 0.0 ? std::conj(z) : z)) < tol::sweep_vs_point * std::max(1.0, std::abs(z)));
-        CHECK(p.plant_stable == (ref.spectral_abscissa() < -marginal_band(z)));
-    }
+    check_plant_against_collocation(r, where);
 }
 
 TEST_SUITE_END();
