@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs the README examples of the continuation commands (equilibria, hopf, orbits,
-# orbits --wave, sweep) with two builds of ddemap and compares their stdout, stderr, exit codes
-# and written files byte for byte (wall-clock times masked). Used to check that a refactoring of
+# orbits --wave, sweep) and a few more that reach other paths (rejected steps, the homotopy of
+# long waves) with two builds of ddemap and compares their stdout, stderr, exit codes and
+# written files byte for byte (wall-clock times masked). Used to check that a refactoring of
 # the continuation code leaves every output unchanged.
 #   scripts/compare-continuation-outputs.sh OLD_DDEMAP NEW_DDEMAP [WORKDIR]
 # Exit 0 when everything is identical, 1 otherwise (the differences are printed).
@@ -31,12 +32,20 @@ commands=(
   "orbits --model ov --ring 1000 --wave 10 --par headway --from 3.5 --to 2 --initial-step 0.001 --points 30"
   "orbits --model ov --ring 1000 --wave 1 --par headway --from 3.5 --to 2 --points 30 --format json"
   "orbits --model ov --ring 1000 --wave 2 --par headway --from 3.5 --to 2 --points 30 --intervals 80 --format json"
+  # rejected steps (the README examples above never reject one): orbits (and a branch that ends
+  # below min_step, exit 4), the curve of Hopf points and the stability boundaries
+  # (continue_branch), travelling waves
+  "orbits --system wright.json --par alpha --from 1 --to 4 --points 60 --max-step 5"
+  "hopf --system examples/duffing.json --par tau --from 0 --to 40 --par2 b --from2 -2 --to2 2"
+  "boundary --th 1.0 --tau 0.5 --k1 0.001:2 --k2 0.001:2 --out curves"
+  "orbits --model ov --ring 1000 --wave 1 --par headway --from 3.5 --to 1.2 --points 100 --format json"
+  "orbits --model ov --ring 201 --wave 3 --par headway --from 3.5 --to 1.2 --points 100 --max-step 5"
 )
 # wall-clock times are the only outputs allowed to differ: the timings of the sweep and the
 # progress lines on stderr (printed once a run has taken a second)
 mask() { sed -E -e 's/in [0-9.e+-]+ s \([0-9.e+-]+ points\/s/in T s (R points\/s/' \
                 -e 's/"(seconds|points_per_second|wall_seconds)": *[0-9.e+-]+/"\1": T/g' \
-                -e '/^ddemap: [a-z]+: .*\([0-9.]+ s(, about [0-9.e+-]+ s left)?\)$/d' "$1"; }
+                -e '/^ddemap: [a-z]+: .*\([0-9.]+ [a-z]+(, about [0-9.e+-]+ [a-z]+ left|; time left unknown)?\)$/d' "$1"; }
 run() {  # binary dir
     mkdir -p "$2/maps" && cd "$2" || exit 3
     ln -sfn "$src/examples" examples

@@ -21,6 +21,7 @@
 
 namespace ddemap {
 
+/// The numbers of the rules (each caller keeps its own through them).
 struct StepControlOptions {
     double initial_step = 0.01;  ///< h_0
     double min_step = 1e-8;      ///< a rejection that leaves h < min_step ends the continuation
