@@ -264,5 +264,9 @@ constexpr double wave_simulation_decay = 0.9;
 /// O(h^4) error falls 16 times; measured 32 and 18 for the 20-car idm wave, 3.3e-6, 1.0e-7,
 /// 5.7e-9 on 13, 26, 52 intervals): it must fall at least this many times per halving.
 constexpr double wave_trivial_refinement = 4.0;
+/// Points of continue_branch on a straight line against the arclengths its step rules give: the
+/// predictor lies on the line, so each point is a sum of ~40 steps of size <= 0.1 with rounding
+/// ~1e-17 each; 1e-13 leaves a wide margin and still catches any step of another size.
+constexpr double line_steps = 1e-13;
 
 }  // namespace ddemap::test::tol

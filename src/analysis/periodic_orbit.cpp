@@ -800,7 +800,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
     const double amp0 = amplitude(b.points.front());
     b.newton_iterations += first.iterations;
     b.jacobians += first.jacobians;
-    orbit_continuation::StepControl step(o);
+    StepControl step(orbit_continuation::step_control_options(o));
     b.stop = "max_points";
     adapt();
     while (static_cast<int>(b.points.size()) < o.max_points) {
@@ -814,7 +814,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         b.jacobians += r.jacobians;
         const bool jump = r.ok && step.jumped(c.norm(v - u));
         if (!r.ok || jump) {
-            if (!step.shrink()) {
+            if (!step.reject()) {
                 b.stop = "step_below_minimum";
                 b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
                 std::ostringstream s;
@@ -896,7 +896,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         lin_u = r.lin;
         // an easy step: the chord iterations converged with at most one new Jacobian besides the
         // one at the result (sparse path: at most 3 Newton steps)
-        step.accepted(r.lin ? r.jacobians <= 2 : r.iterations <= 3);
+        step.accept(r.lin ? r.jacobians <= 2 : r.iterations <= 3);
         if (u(N) > o.max_period_factor * T0) {
             b.stop = "period";
             return;

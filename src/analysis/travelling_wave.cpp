@@ -11,6 +11,7 @@
 #include <Eigen/SparseLU>
 
 #include "ddemap/solve/roots.hpp"
+#include "ddemap/solve/step_control.hpp"
 #include "ddemap/traffic/nonlinear_ring.hpp"
 #include "ddemap/traffic/ring_car.hpp"
 
@@ -539,7 +540,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
     b.newton_iterations += first.iterations;
     max_drift = std::max(max_drift, std::abs(u(N + 2)));
     const double amp0 = amplitude(b.points.front());
-    orbit_continuation::StepControl step(o);
+    StepControl step(orbit_continuation::step_control_options(o));
     b.stop = "max_points";
     b.intervals = std::max(b.intervals, c.L);
     if (adapt && !(dc.tolerance > 0.0)) remesh(c, u, &t);  // with the defect control, only when needed
@@ -548,9 +549,10 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
     // A corrected wave vv (defect dv above the tolerance, adaptive mesh) made resolved: corrected
     // again on the mesh equidistributed on it, then, when the step h is already small (below
     // 1e-3 of the largest), on that mesh with every interval split (up to max_intervals); the
-    // condition row is the arclength step h from u along t or, with fixed_par, p = par. On success
-    // c, N, u, t, ref, a, vv, rr and dv are on the new mesh.
-    auto resolve = [&](Eigen::VectorXd& vv, Correction& rr, double& dv, double hh, bool fixed_par, double par) {
+    // condition row is the arclength step h from u along t (and the result no jump) or, with
+    // fixed_par, p = par. On success c, N, u, t, ref, a, vv, rr and dv are on the new mesh.
+    auto resolve = [&](Eigen::VectorXd& vv, Correction& rr, double& dv, bool fixed_par, double par) {
+        const double hh = step.h();
         PeriodicMesh next(c.d, orbit_mesh::equidistributed_breakpoints(c.mesh, 2, vv));
         const bool may_split = (fixed_par || hh <= 1e-3 * o.max_step) && 2 * c.L <= dc.max_intervals;
         for (int attempt = 0; attempt < (may_split ? 2 : 1); ++attempt) {
@@ -572,7 +574,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             const Correction rn = correct(trial, vn, refn, row, rhs, o);
             b.newton_iterations += rn.iterations;
             const double dn = rn.ok ? reduced_defect(trial, vn) : std::numeric_limits<double>::quiet_NaN();
-            if (rn.ok && dn <= dc.tolerance && (fixed_par || trial.norm(vn - un) <= 3.0 * hh)) {
+            if (rn.ok && dn <= dc.tolerance && (fixed_par || trial.norm(vn - un) <= step.jump_limit())) {
                 apply_mesh(c, next);
                 N = c.N();
                 b.intervals = std::max(b.intervals, c.L);
@@ -600,10 +602,10 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
         const bool jump = rc.ok && step.jumped(c.norm(v - u));
         double dv = rc.ok && !jump ? reduced_defect(c, v) : std::numeric_limits<double>::quiet_NaN();
         bool unresolved = false;
-        if (rc.ok && !jump && adapt && dc.tolerance > 0.0 && !(dv <= dc.tolerance)) unresolved = !resolve(v, rc, dv, h, false, 0.0);
+        if (rc.ok && !jump && adapt && dc.tolerance > 0.0 && !(dv <= dc.tolerance)) unresolved = !resolve(v, rc, dv, false, 0.0);
         if (unresolved) {
             // a smaller step first; the mesh is refined only when the step is already small
-            if (!step.shrink()) {
+            if (!step.reject()) {
                 b.stop = "unresolved";
                 b.status = Status::NumericalIssue;
                 std::ostringstream s;
@@ -624,7 +626,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             break;
         }
         if (!rc.ok || jump) {
-            if (!step.shrink()) {
+            if (!step.reject()) {
                 b.stop = "step_below_minimum";
                 b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
                 std::ostringstream s;
@@ -645,10 +647,10 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
             Correction rb = correct(c, wv, ref, e, bound, o);
             b.newton_iterations += rb.iterations;
             double db = rb.ok ? reduced_defect(c, wv) : std::numeric_limits<double>::quiet_NaN();
-            if (rb.ok && adapt && dc.tolerance > 0.0 && !(db <= dc.tolerance) && !resolve(wv, rb, db, h, true, bound)) {
+            if (rb.ok && adapt && dc.tolerance > 0.0 && !(db <= dc.tolerance) && !resolve(wv, rb, db, true, bound)) {
                 // the step overshot the face onto a wave that is not resolved: a shorter step
                 // from u on its own mesh
-                if (step.shrink()) {
+                if (step.reject()) {
                     apply_mesh(c, mesh_before);
                     N = c.N();
                     u = u_before;
@@ -732,7 +734,7 @@ void follow(Wave& c, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& fir
         }
         u = v;
         t = tn;
-        step.accepted(rc.iterations <= 3);
+        step.accept(rc.iterations <= 3);
         if (u(N) > o.max_period_factor * T0) {
             b.stop = "period";
             break;
@@ -779,17 +781,24 @@ constexpr int kHomotopyBranchPoints = 1000;
 
 /// Homotopy in q = c.kappa with the parameter held at p = u(N + 1): natural continuation in log q
 /// from c.kappa down to `target` (steps of factor 0.5 at first, halved on failure, grown by 1.5
-/// after easy corrections up to a factor 0.25), the predictor keeping the profile in s and T q
-/// (the time shift from car to car); after every step the mesh is re-equidistributed and the
-/// wave corrected on it. false when a step in log q falls below 1e-3.
+/// after easy corrections up to a factor 0.25: the StepControl of solve/step_control.hpp on
+/// h = -log of the factor), the predictor keeping the profile in s and T q (the time shift from
+/// car to car); after every step the mesh is re-equidistributed and the wave corrected on it.
+/// false when a step in log q falls below 1e-3.
 bool kappa_homotopy(Wave& c, Eigen::VectorXd& u, double target, const PeriodicOrbitOptions& o, int& iterations, int& steps, Correction& last) {
     const int N = c.N();
     Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
     e(N + 1) = 1.0;
     const double p = u(N + 1);
-    double dl = std::log(0.5);
+    StepControlOptions so;
+    so.initial_step = -std::log(0.5);
+    so.max_step = -std::log(0.25);
+    so.min_step = 1e-3;
+    so.shrink_factor = 0.5;
+    so.grow_factor = 1.5;
+    StepControl step(so);
     while (c.kappa > target) {
-        const double k0 = c.kappa, k1 = std::max(target, k0 * std::exp(dl));
+        const double k0 = c.kappa, k1 = std::max(target, k0 * std::exp(-step.h()));
         Eigen::VectorXd v = u;
         v(N) = u(N) * k0 / k1;
         const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
@@ -798,8 +807,7 @@ bool kappa_homotopy(Wave& c, Eigen::VectorXd& u, double target, const PeriodicOr
         iterations += r.iterations;
         if (!r.ok) {
             c.kappa = k0;
-            dl *= 0.5;
-            if (std::abs(dl) < 1e-3) return false;
+            if (!step.reject()) return false;
             continue;
         }
         u = v;
@@ -816,7 +824,7 @@ bool kappa_homotopy(Wave& c, Eigen::VectorXd& u, double target, const PeriodicOr
         } else {
             c.mesh = old;
         }
-        if (r.iterations <= 3) dl = std::max(std::log(0.25), 1.5 * dl);
+        step.accept(r.iterations <= 3);
     }
     return true;
 }

@@ -6,6 +6,8 @@
 
 #include <Eigen/Dense>
 
+#include "ddemap/solve/step_control.hpp"
+
 namespace ddemap {
 
 namespace {
@@ -248,19 +250,27 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
         return e;
     };
 
-    double h = options.initial_step;
+    StepControlOptions so;
+    so.initial_step = options.initial_step;
+    so.min_step = options.min_step;
+    so.max_step = options.max_step;
+    so.grow_factor = options.grow_factor;
+    so.max_jump = options.max_jump;
+    so.shrink_factor = 0.5;  // h halved after a rejection (not an option of the engine)
+    StepControl step(so);
     Status last_failure = Status::MaxIterations;
     while (static_cast<int>(r.points.size()) < options.max_points) {
+        const double h = step.h();
+        // true when the step fell below min_step
         auto reject = [&](Status failure) {
             ++r.rejected_steps;
             last_failure = failure;
-            h *= 0.5;
-            return h < options.min_step;
+            return !step.reject();
         };
         Eigen::VectorXd v = u + h * t;
         const CorrectorResult cr = correct(sp, v, t, t.dot(v), newton_options);
         r.newton_iterations += cr.iterations;
-        if (!converged(cr.status) || (v - u).norm() > options.max_jump * h) {
+        if (!converged(cr.status) || step.jumped((v - u).norm())) {
             if (reject(converged(cr.status) ? Status::NumericalIssue : cr.status))
                 return finish(ContinuationStop::StepBelowMinimum, last_failure, "the step fell below min_step");
             continue;
@@ -284,7 +294,7 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
             w(face) = bound;
             const CorrectorResult cb = correct(sp, w, Eigen::VectorXd::Unit(m, face), bound, newton_options);
             r.newton_iterations += cb.iterations;
-            bool ok = converged(cb.status) && (w - u).norm() <= options.max_jump * h;
+            bool ok = converged(cb.status) && (w - u).norm() <= step.jump_limit();
             for (int i = 0; i < m && ok; ++i)
                 ok = i == face || (w(i) >= lo(i) - bound_slack && w(i) <= hi(i) + bound_slack);
             const std::string which = "the bound of unknown " + std::to_string(face);
@@ -339,7 +349,7 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
         u = v;
         t = tv;
         g = gv;
-        if (cr.iterations <= options.grow_iterations) h = std::min(options.max_step, options.grow_factor * h);
+        step.accept(cr.iterations <= options.grow_iterations);
     }
     return finish(ContinuationStop::MaxPoints, Status::BudgetExhausted, "max_points points");
 }

@@ -11,7 +11,8 @@
 ///              oriented so that t_{k+1} . t_k > 0).
 /// A step is rejected and h halved when the corrector fails, when |u_{k+1} - u_k| > max_jump h
 /// or when the angle between t_k and t_{k+1} exceeds max_angle; h grows by grow_factor (up to
-/// max_step) after a corrector that took at most grow_iterations iterations.
+/// max_step) after a corrector that took at most grow_iterations iterations (the rules of
+/// StepControl, solve/step_control.hpp).
 /// Events: a box lower <= u <= upper (the branch ends exactly on the face it crosses, located by
 /// Newton on [F(u); u_i - bound] = 0) and scalar test functions g(u, t) whose sign changes
 /// between consecutive points are located on the curve by Illinois regula falsi in the

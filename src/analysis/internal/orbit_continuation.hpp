@@ -5,38 +5,29 @@
 // detection and location of the special points of a step (folds, period doublings, tori; see
 // analysis/periodic_orbit.hpp). The two differ in their equations, correctors and multipliers:
 // those enter through the callbacks of Probe.
-#include <algorithm>
 #include <functional>
 #include <string>
 
 #include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/solve/step_control.hpp"
 
 namespace ddemap::orbit_continuation {
 
-/// The step h (in the weighted norm of the branch) of the pseudo-arclength continuation: the
-/// predictor u + h t; a corrected orbit farther than 3 h from u is a jump (to another branch:
-/// rejected like a failed corrector); after a rejection h is halved and the branch ends when it
-/// falls below min_step; after an easy corrector (the caller's criterion) h grows by 1.5 up to
-/// max_step.
-class StepControl {
-public:
-    explicit StepControl(const PeriodicOrbitOptions& o) : m_h(o.initial_step), m_min(o.min_step), m_max(o.max_step) {}
-    double h() const { return m_h; }
-    /// |v - u| > 3 h: the corrector left the branch
-    bool jumped(double distance) const { return distance > 3.0 * m_h; }
-    /// h halved after a rejected step; false when it fell below min_step (the branch ends)
-    bool shrink() {
-        m_h *= 0.5;
-        return m_h >= m_min;
-    }
-    /// after an accepted orbit: h = min(max_step, 1.5 h) when the corrector was easy
-    void accepted(bool easy) {
-        if (easy) m_h = std::min(m_max, 1.5 * m_h);
-    }
-
-private:
-    double m_h, m_min, m_max;
-};
+/// The step control of the pseudo-arclength continuation of a branch (solve/step_control.hpp):
+/// h in the weighted norm of the branch, the predictor u + h t; a corrected orbit farther than
+/// 3 h from u is a jump (to another branch: rejected like a failed corrector); after a rejection
+/// h is halved and the branch ends when it falls below min_step; after an easy corrector (the
+/// caller's criterion) h grows by 1.5 up to max_step.
+inline StepControlOptions step_control_options(const PeriodicOrbitOptions& o) {
+    StepControlOptions s;
+    s.initial_step = o.initial_step;
+    s.min_step = o.min_step;
+    s.max_step = o.max_step;
+    s.shrink_factor = 0.5;
+    s.grow_factor = 1.5;
+    s.max_jump = 3.0;
+    return s;
+}
 
 /// One accepted step of a branch: from orbit `after` of the branch (u, unit tangent t) to the new
 /// orbit v (unit tangent tn, oriented along t). The special points are located on the line
