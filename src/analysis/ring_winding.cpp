@@ -509,6 +509,16 @@ Totals mode_totals(const RingWindingTable& t, int cars) {
     return out;
 }
 
+}  // namespace
+
+long long RingWindingTable::mode_zeros(int cars) const {
+    if (cars < 2) throw std::invalid_argument("mode_zeros: expected cars >= 2");
+    const Totals t = mode_totals(*this, cars);
+    return t.negative ? -1 : t.zeros;
+}
+
+namespace {
+
 /// Newton on f_m = P - zeta_m Q from z (in place).
 bool mode_newton(const TransferFunction& tf, cplx zeta, cplx& z) {
     NewtonOptions o;
