@@ -29,6 +29,7 @@ void add_boundary_flags(CLI::App& app) {
     args.out.add_to(app, "PREFIX.csv (one row per curve point) and PREFIX.json", true);
     app.add_option("--ring-curves", args.ring_curves,
                    "ring Hopf curves: all (every mode's), envelope (only the boundary of the ring-stable region, any N), auto (all up to 64 cars)")
+        ->type_name("all|envelope|auto")
         ->capture_default_str();
     app.add_option("--seed-grid", args.grid, "grid points per axis used to seed the branches")->capture_default_str();
     args.format.add_to(app);

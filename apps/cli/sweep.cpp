@@ -34,6 +34,7 @@ void add_sweep_flags(CLI::App& app) {
     app.add_flag("--no-boundaries", args.no_boundaries, "skip the boundary continuation");
     app.add_option("--ring-curves", args.ring_curves,
                    "ring Hopf curves: all (every mode's), envelope (only the boundary of the ring-stable region, any N), auto (all up to 64 cars)")
+        ->type_name("all|envelope|auto")
         ->capture_default_str();
     args.format.add_to(app);
     run_flags().add_to(app, true);

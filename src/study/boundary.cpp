@@ -365,6 +365,32 @@ void trace_envelope(const SweepResult& sweep, const BoundaryOptions& options, Bo
         }
     };
 
+    // frequencies where |f_m(i w)| has its smallest local minima at a point (signed: mode m's
+    // crossings at w < 0 are mode N - m's at -w), for a seed whose root frequency is unknown
+    auto frequency_guesses = [&](int mode, const Eigen::VectorXd& at) {
+        const Problem p(spec, BoundaryKind::RingHopf, mode);
+        constexpr int samples = 800;
+        std::vector<std::pair<double, double>> values;  // (w, |f|) on w = +-1e-3 .. +-50, geometric
+        Eigen::VectorXd u = at, f;
+        for (int side = -1; side <= 1; side += 2)
+            for (int k = 0; k < samples; ++k) {
+                u(2) = side * 1e-3 * std::pow(5e4, k / (samples - 1.0));
+                values.emplace_back(u(2), p.residual(u, f) ? f.norm() : std::numeric_limits<double>::infinity());
+            }
+        std::vector<std::pair<double, double>> minima;  // (|f|, w)
+        for (int side = 0; side < 2; ++side)
+            for (int k = 1; k + 1 < samples; ++k) {
+                const auto& v = values[static_cast<std::size_t>(side * samples + k)];
+                if (v.second < values[static_cast<std::size_t>(side * samples + k - 1)].second &&
+                    v.second <= values[static_cast<std::size_t>(side * samples + k + 1)].second)
+                    minima.emplace_back(v.second, v.first);
+            }
+        std::sort(minima.begin(), minima.end());
+        std::vector<double> out;
+        for (std::size_t i = 0; i < minima.size() && i < 4; ++i) out.push_back(minima[i].second);
+        return out;
+    };
+
     // seeds: grid edges with unstable ring roots at one end only (both ends certified); the mode is the
     // abscissa mode at the unstable end, the frequency its root's
     for (int iy = 0; iy < ny; ++iy)
@@ -397,7 +423,7 @@ void trace_envelope(const SweepResult& sweep, const BoundaryOptions& options, Bo
                 }
                 if (known) continue;
                 const int mode = unstable.abscissa_mode;
-                if (mode < 0 || !(unstable.abscissa_omega > 0.0)) {
+                if (mode < 0) {
                     ++set.rejected;
                     continue;
                 }
@@ -413,10 +439,21 @@ void trace_envelope(const SweepResult& sweep, const BoundaryOptions& options, Bo
                 for (int attempt = 0; attempt < 40 && !traced; ++attempt) {
                     int next = -1;
                     double next_omega = 0.0;
-                    for (double sign : {1.0, -1.0}) {
+                    std::vector<double> guesses;
+                    if (seed_omega > 0.0) guesses = {seed_omega, -seed_omega};
+                    bool scanned = false;
+                    for (std::size_t gi = 0; gi < guesses.size() || !scanned; ++gi) {
+                        if (gi == guesses.size()) {  // the root's frequency failed (or is 0: a real root): scan
+                            scanned = true;
+                            if (next >= 0) break;  // it was right, the mode was not
+                            const std::vector<double> more = frequency_guesses(seed_mode, start);
+                            guesses.insert(guesses.end(), more.begin(), more.end());
+                            if (gi == guesses.size()) break;
+                        }
+                        const double sign = guesses[gi] > 0.0 ? 1.0 : -1.0;
                         Problem p(spec, BoundaryKind::RingHopf, seed_mode);
                         Eigen::VectorXd u = start;
-                        u(2) = sign * seed_omega;
+                        u(2) = guesses[gi];
                         const int fixed = dir == 0 ? 1 : 0;
                         const CorrectorResult cr = correct(p, u, Eigen::VectorXd::Unit(3, fixed), u(fixed));
                         if (!converged(cr.status) || !inside(u) || (u.head(2) - start.head(2)).norm() > 2.0 * cell || sign * u(2) <= 0.0) continue;
@@ -426,7 +463,7 @@ void trace_envelope(const SweepResult& sweep, const BoundaryOptions& options, Bo
                             const Linearisation lin = model_at(spec, frame.x(u(0)), frame.y(u(1)))->linearise();
                             const RingWindingResult w = analyse_ring_winding(lin, cars);
                             if (w.status == Status::Converged && w.verdict == Verdict::Unstable && w.abscissa_mode >= 0 &&
-                                w.abscissa_mode != std::min(seed_mode, cars - seed_mode) && std::abs(w.abscissa_root.imag()) > 0.0) {
+                                w.abscissa_mode != std::min(seed_mode, cars - seed_mode)) {
                                 next = w.abscissa_mode;
                                 next_omega = std::abs(w.abscissa_root.imag());
                             }
