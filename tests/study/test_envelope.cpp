@@ -165,6 +165,37 @@ TEST_CASE("the envelope of a ring of 10^6 cars: arcs on their modes' curves from
     check_edges_crossed(sw, env);
 }
 
+TEST_CASE("a 2-car ring whose unstable side has a real rightmost root: the seed finds the crossing by a frequency scan") {
+    SweepSpec spec;
+    spec.fixed = {{"th", 0.6}, {"tau", 0.9}};
+    spec.x = parse_axis("k1", "0.01:3:41");
+    spec.y = parse_axis("k2", "0.01:3:41");
+    spec.cars = 2;
+    const SweepResult sw = run_sweep(spec);
+    bool real_root = false;  // the premise: the winding sweep gives frequency 0 at some unstable point
+    for (const auto& p : sw.points) real_root = real_root || (p.unstable_roots > 0 && p.abscissa_omega == 0.0);
+    CHECK(real_root);
+    const BoundarySet env = trace(sw, RingCurves::Envelope);
+    SweepSpec modes = spec;
+    modes.ring_method = "modes";
+    const BoundarySet all = trace(run_sweep(modes), RingCurves::All);
+    int arcs = 0;
+    for (const auto& c : env.curves) {
+        if (c.kind != BoundaryKind::RingHopf) continue;
+        ++arcs;
+        const BoundaryCurve* same = nullptr;
+        for (const auto& a : all.curves)
+            if (a.kind == BoundaryKind::RingHopf && a.mode == c.mode) same = &a;
+        REQUIRE(same != nullptr);
+        for (const auto& p : c.points) {
+            CHECK(boundary_residual(spec, BoundaryKind::RingHopf, c.mode, p) < 1e-10);
+            CHECK(polyline_distance(spec, X(spec, p.x), Y(spec, p.y), *same) < tol::envelope_vs_all);
+        }
+    }
+    CHECK(arcs >= 1);
+    check_edges_crossed(sw, env);
+}
+
 TEST_CASE("N = inf: the boundaries from the winding sweep equal those from the per-mode sweep") {
     SweepSpec spec = ddemap::test::ovrv_chart(31, 0, 1.5, 0.5);
     const BoundarySet a = trace(run_sweep(spec), RingCurves::Auto);
