@@ -49,7 +49,7 @@ RingCurves parse_ring_curves(const std::string& text) {
 }
 
 RingCurves resolve_ring_curves(RingCurves r, const SweepSpec& spec) {
-    if (spec.cars == 0) return RingCurves::Envelope;  // no ring Hopf curves at N = inf: nothing per mode
+    if (spec.cars == 0) return r == RingCurves::Auto ? RingCurves::Envelope : r;  // N = inf: no ring Hopf curves either way
     const bool applies = ring_winding_applies(model_at(spec, spec.x.lo, spec.y.lo)->linearise());
     if (r == RingCurves::Envelope && !applies)
         throw std::invalid_argument("ring curves envelope: the model '" + spec.model + "' uses more than the car ahead; expected ring curves all or auto");

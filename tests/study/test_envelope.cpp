@@ -241,7 +241,8 @@ TEST_CASE("ring curves: names, auto by ring size, envelope refused for a law wit
     CHECK(ring_curves_name(RingCurves::Envelope) == "envelope");
     CHECK(resolve_ring_curves(RingCurves::Auto, ddemap::test::ovrv_chart(5, kEnvelopeAutoCars, 1.5, 0.5)) == RingCurves::All);
     CHECK(resolve_ring_curves(RingCurves::Auto, ddemap::test::ovrv_chart(5, kEnvelopeAutoCars + 1, 1.5, 0.5)) == RingCurves::Envelope);
-    CHECK(resolve_ring_curves(RingCurves::All, ddemap::test::ovrv_chart(5, 0, 1.5, 0.5)) == RingCurves::Envelope);
+    CHECK(resolve_ring_curves(RingCurves::Auto, ddemap::test::ovrv_chart(5, 0, 1.5, 0.5)) == RingCurves::Envelope);
+    CHECK(resolve_ring_curves(RingCurves::All, ddemap::test::ovrv_chart(5, 0, 1.5, 0.5)) == RingCurves::All);
     SweepSpec ccc = ddemap::test::ovrv_chart(5, 100, 1.5, 0.5);
     ccc.model = "ccc";
     ccc.fixed["k3"] = 0.2;

@@ -64,8 +64,9 @@ constexpr int kEnvelopeAutoCars = 64;
 std::string ring_curves_name(RingCurves r);
 /// Parses "all", "envelope" or "auto" (std::invalid_argument otherwise).
 RingCurves parse_ring_curves(const std::string& text);
-/// All or Envelope: what `r` means for this sweep (Auto resolved as above; N = inf: Envelope,
-/// i.e. no per-mode work). std::invalid_argument for Envelope on a law with more than one leader.
+/// All or Envelope: what `r` means for this sweep (Auto resolved as above; at N = inf, where
+/// neither draws a ring curve nor needs the per-mode sweep, Auto is Envelope). std::invalid_argument
+/// for Envelope on a finite ring of a law with more than one leader.
 RingCurves resolve_ring_curves(RingCurves r, const SweepSpec& spec);
 
 struct BoundaryOptions {
