@@ -269,4 +269,21 @@ constexpr double wave_trivial_refinement = 4.0;
 /// ~1e-17 each; 1e-13 leaves a wide margin and still catches any step of another size.
 constexpr double line_steps = 1e-13;
 
+/// Ring envelope arcs (study/boundary.hpp RingCurves::Envelope) against the per-mode curves of
+/// RingCurves::All (the same equation traced from other seeds): distance of an envelope point to
+/// the polyline of the all-curve of its mode, in window units. The polyline's chords (steps up
+/// to 0.02 of the window) sag below the curve by h^2 kappa / 8 <= 5e-4 for curvature kappa <= 10
+/// (measured: the OVRV windows of the tests have kappa < 5); 1e-3 is above that and far below
+/// the spacing of neighbouring modes' curves (> 0.02 at N <= 100 in these windows).
+constexpr double envelope_vs_all = 1e-3;
+/// The per-mode ring analysis at a point of an envelope arc: the crossing pair's real part is
+/// |F| / |f'(i w)| with the continuation's residual |F| <= 1e-11 (max_residual, checked) and
+/// |f'| >~ 0.05 in these windows, so <= 2e-10; 1e-9 bounds it with margin, and the other modes'
+/// roots must lie left of -1e-9 (away from a corner their distance from the axis is ~1e-3).
+constexpr double envelope_abscissa = 1e-9;
+/// Grid points that lie within a polyline's chord sag of an envelope arc (see envelope_vs_all)
+/// may see the chord on the wrong side; an edge whose ring verdict changes is crossed by an arc or
+/// has an end within this distance (window units) of one.
+constexpr double envelope_edge = 1e-3;
+
 }  // namespace ddemap::test::tol

@@ -43,8 +43,9 @@ SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::str
 void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels) {
     if (spec.cars > kModesMaxCars && sweep_ring_method(spec) == "modes")
         throw BadInput("--ring = " + std::to_string(spec.cars) + ": expected at most " + std::to_string(kModesMaxCars) + " cars for " +
-                       (command == "boundary" ? std::string("boundary (its seeds need every mode's root, one by one)")
-                                              : command + " with boundaries (their seeds need every mode's root, one by one; without boundaries the winding tables take up to " +
+                       (command == "boundary" ? std::string("boundary --ring-curves all (its seeds need every mode's root, one by one; --ring-curves envelope takes up to ") +
+                                                    std::to_string(kWindingMaxCars) + ")"
+                                              : command + " with every mode's ring curve (their seeds need every mode's root, one by one; the envelope or no boundaries take up to " +
                                                     std::to_string(kWindingMaxCars) + ")"));
     const double points = static_cast<double>(spec.x.count) * static_cast<double>(spec.y.count) * static_cast<double>(panels);
     // N = inf: a frequency scan, about 12 modes' work; the winding path: about that at any N
@@ -54,6 +55,16 @@ void check_sweep_size(const SweepSpec& spec, const std::string& command, bool wr
     check_size(command, what, "memory", points * (600.0 + 16.0 * modes));
     if (writes_grid) check_size(command, what, "output", points * 180.0);
     check_size(command, what, "time", points * modes * 5e-5 / std::max(1, thread_count()));
+}
+
+RingCurves parse_ring_curves_flag(const std::string& text, const SweepSpec& spec) {
+    try {
+        return resolve_ring_curves(parse_ring_curves(text), spec);
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        const std::size_t colon = what.find(": ");
+        throw BadInput("--ring-curves = '" + text + "': " + (colon == std::string::npos ? what : what.substr(colon + 2)));
+    }
 }
 
 std::string fixed_title(const SweepSpec& spec) {

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "common.hpp"
+#include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
 
 namespace ddemap::cli {
@@ -15,6 +16,10 @@ SweepSpec sweep_spec(const ModelArgs& model, const RingArg& ring, const std::str
 /// (`writes_grid`) and 5e-5 s per mode on one core (measured, BENCHMARKS.md).
 /// `panels`: that many grids of this size (a chart).
 void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels = 1);
+
+/// --ring-curves all|envelope|auto resolved for this window (All or Envelope; BadInput naming
+/// the flag for an unknown name or envelope on a law with more than one leader).
+RingCurves parse_ring_curves_flag(const std::string& text, const SweepSpec& spec);
 
 /// "ovrv, th = 1.5, tau = 0.5, N = 22"
 std::string fixed_title(const SweepSpec& spec);

@@ -248,7 +248,7 @@ def string(model="ovrv", ring=None, **parameters):
     return _result(_ddemap.string(model, _parameters(parameters), None if ring is None else _ring(ring)))
 
 
-def sweep(model="ovrv", ring=22, x=None, boundaries=True, **parameters):
+def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", **parameters):
     """A stability chart over two model parameters (``ddemap sweep``).
 
     Give exactly two parameters as ``(LO, HI, COUNT)`` (the axes, COUNT >= 2 grid points from
@@ -257,7 +257,9 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, **parameters):
     axis (default: the alphabetically first). At each grid point the rightmost root of every
     ring mode and of the plant is continued along the rows and certified by the argument
     principle; the string-stability quantities are those of :func:`string`. ``boundaries``:
-    also trace the stability boundaries by continuation. Runs in parallel (OMP_NUM_THREADS);
+    also trace the stability boundaries by continuation; ``ring_curves``: "all" (every ring
+    mode's Hopf curve), "envelope" (only the boundary of the ring-stable region, any ring size)
+    or "auto" (all up to 64 cars), as ``--ring-curves``. Runs in parallel (OMP_NUM_THREADS);
     the result does not depend on the number of threads.
 
     Returns the keys of the command's JSON (``regions``, ``points``, ``degree``, ``fallbacks``,
@@ -274,7 +276,7 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, **parameters):
     """
     fixed, axes = _axes(parameters, x, True)
     (xn, xt), (yn, yt) = _axis_text(axes[0], 0), _axis_text(axes[1], 0)
-    envelope, grid, curves = _ddemap.sweep(model, fixed, xn, xt, yn, yt, _ring(ring), bool(boundaries))
+    envelope, grid, curves = _ddemap.sweep(model, fixed, xn, xt, yn, yt, _ring(ring), bool(boundaries), str(ring_curves))
     r = _result(envelope)
     r["grid"] = grid
     r["x"]["values"] = grid["x"]
@@ -284,7 +286,7 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, **parameters):
     return r
 
 
-def boundary(model="ovrv", ring=22, seed_grid=41, **parameters):
+def boundary(model="ovrv", ring=22, seed_grid=41, ring_curves="auto", **parameters):
     """Stability boundaries in a window of two parameters, by continuation (``ddemap boundary``).
 
     Give exactly two parameters as ``(LO, HI)`` (the window) and the others as numbers. A
@@ -292,6 +294,7 @@ def boundary(model="ovrv", ring=22, seed_grid=41, **parameters):
     Hopf curves ``f(i w; p1, p2) = 0`` of the plant and of every ring mode, the low-frequency
     curve ``c2(p1, p2) = 0`` and the peak curve ``|Gamma(iw)|^2 = 1, d/dw |Gamma|^2 = 0``; each
     branch is continued both ways by pseudo-arclength continuation and cut at the window edges.
+    ``ring_curves``: which ring Hopf curves, as in :func:`sweep`.
 
     Returns the command's JSON keys (``curves`` summary replaced, ``seeds``,
     ``rejected_seeds``, ``seconds``) with ``curves`` a list of dicts: ``branch``, ``kind``
@@ -303,7 +306,7 @@ def boundary(model="ovrv", ring=22, seed_grid=41, **parameters):
     seed_grid = _integer("seed_grid", seed_grid, 5, 2001)
     fixed, axes = _axes(parameters, None, False)
     (xn, xt), (yn, yt) = _axis_text(axes[0], seed_grid), _axis_text(axes[1], seed_grid)
-    envelope, curves = _ddemap.boundary(model, fixed, xn, xt, yn, yt, _ring(ring), seed_grid)
+    envelope, curves = _ddemap.boundary(model, fixed, xn, xt, yn, yt, _ring(ring), seed_grid, str(ring_curves))
     r = _result(envelope)
     summary = r["curves"]
     for i, c in enumerate(curves):  # the JSON's per-curve summary, then the arrays

@@ -286,15 +286,19 @@ py::list curves_arrays(const BoundarySet& b) {
 }
 
 py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
-                const std::string& y_name, const std::string& y_text, int cars, bool boundaries) {
+                const std::string& y_name, const std::string& y_text, int cars, bool boundaries, const std::string& ring_curves_text) {
     SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
-    if (boundaries) spec.ring_method = "modes";  // as the CLI: the boundary seeds need every mode's root
+    const RingCurves ring_curves = resolve_ring_curves(parse_ring_curves(ring_curves_text), spec);
+    // as the CLI: every mode's curve needs every mode's root; the envelope takes the winding sweep
+    if (boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
+    BoundaryOptions bo;
+    bo.ring_curves = ring_curves;
     ExecutionPolicy policy;
     policy.progress = interruptible();
     BoundarySet b;
     const SweepResult sw = released([&] {
         SweepResult r = run_sweep(spec, policy);
-        if (boundaries) b = trace_boundaries(r);
+        if (boundaries) b = trace_boundaries(r, bo);
         return r;
     });
     const BoundarySet* bp = boundaries ? &b : nullptr;
@@ -302,7 +306,7 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     e.command = "sweep";
     JsonObject in;
     sweep_inputs(spec, in);
-    e.inputs = in.boolean("boundaries", boundaries).str();
+    e.inputs = in.boolean("boundaries", boundaries).string("ring_curves", ring_curves_name(ring_curves)).str();
     e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;
@@ -343,17 +347,20 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
 }
 
 py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
-                   const std::string& y_name, const std::string& y_text, int cars, int seed_grid) {
+                   const std::string& y_name, const std::string& y_text, int cars, int seed_grid, const std::string& ring_curves_text) {
     SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
-    spec.ring_method = "modes";  // as the CLI: the boundary seeds need every mode's root
+    const RingCurves ring_curves = resolve_ring_curves(parse_ring_curves(ring_curves_text), spec);
+    if (ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";  // as the CLI: every mode's root
+    BoundaryOptions bo;
+    bo.ring_curves = ring_curves;
     ExecutionPolicy policy;
     policy.progress = interruptible();
-    const BoundarySet b = released([&] { return trace_boundaries(run_sweep(spec, policy)); });
+    const BoundarySet b = released([&] { return trace_boundaries(run_sweep(spec, policy), bo); });
     JsonEnvelope e;
     e.command = "boundary";
     JsonObject in;
     sweep_inputs(spec, in);
-    e.inputs = in.integer("seed_grid", seed_grid).str();
+    e.inputs = in.integer("seed_grid", seed_grid).string("ring_curves", ring_curves_name(ring_curves)).str();
     e.message = b.rejected > 0 ? std::to_string(b.rejected) + " seeds failed their Newton correction (the branches through the others were traced)" : "";
     e.result = boundary_json(b);
     return py::make_tuple(envelope_json(e), curves_arrays(b));
@@ -729,9 +736,9 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("roots_system", &py_roots_system, py::arg("system"), py::arg("count"), py::arg("degree"), py::arg("solver"));
     m.def("string", &py_string, py::arg("model"), py::arg("parameters"), py::arg("ring"));
     m.def("sweep", &py_sweep, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"), py::arg("y_axis"),
-          py::arg("ring"), py::arg("boundaries"));
+          py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"));
     m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
-          py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"));
+          py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"), py::arg("ring_curves"));
     m.def("classify", &py_classify, py::arg("vehicles"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"));
     m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("lead_profile"), py::arg("lead"), py::arg("on_event"), py::arg("t_end"),
           py::arg("step"), py::arg("output_dt"));

@@ -509,6 +509,16 @@ Totals mode_totals(const RingWindingTable& t, int cars) {
     return out;
 }
 
+}  // namespace
+
+long long RingWindingTable::mode_zeros(int cars) const {
+    if (cars < 2) throw std::invalid_argument("mode_zeros: expected cars >= 2");
+    const Totals t = mode_totals(*this, cars);
+    return t.negative ? -1 : t.zeros;
+}
+
+namespace {
+
 /// Newton on f_m = P - zeta_m Q from z (in place).
 bool mode_newton(const TransferFunction& tf, cplx zeta, cplx& z) {
     NewtonOptions o;
@@ -995,10 +1005,12 @@ RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const
         for (const auto& j : t.jumps) {
             const double w = window(j);
             const long long a = modes_below(j.angle - w, cars), b = modes_below(std::nextafter(j.angle + w, 10.0), cars);
-            for (long long m = a + 1; m <= b; ++m) {  // modes within the window
+            // modes a+1..b lie within the window: those on the side where the table counts them right
+            // of the axis are within the band (counted in O(1): a huge ring holds many there)
+            if (b > a) {
                 marginal = true;
-                const bool above = mode_angle(m, cars) >= j.angle;
-                if (above == (j.re_rate > 0.0)) --unstable;  // counted right of the axis, but within the band
+                const long long below = std::max(0LL, std::min(b, modes_below(j.angle, cars)) - a);  // angle < j.angle
+                unstable -= j.re_rate > 0.0 ? (b - a) - below : below;
             }
         }
         // the smallest wave numbers on the trivial branch, within the band

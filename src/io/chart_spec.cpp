@@ -58,7 +58,8 @@ SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel) {
     s.x = spec.x;
     s.y = spec.y;
     s.cars = spec.cars;
-    if (spec.boundaries) s.ring_method = "modes";  // the boundary seeds need every mode's root
+    // every mode's ring curve needs every mode's root; the envelope is seeded from the winding sweep
+    if (spec.boundaries && s.cars > 0 && resolve_ring_curves(spec.ring_curves, s) == RingCurves::All) s.ring_method = "modes";
     return s;
 }
 
@@ -98,7 +99,7 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     }
     ChartSpec spec;
     static const char* known[] = {"title", "model", "ring", "fixed", "x", "y", "columns", "panel_width",
-                                  "panel_height", "boundaries", "panel", "vehicles"};
+                                  "panel_height", "boundaries", "ring_curves", "panel", "vehicles"};
     for (const auto& [k, v] : root) {
         const std::string key(k.str());
         if (std::find_if(std::begin(known), std::end(known), [&](const char* s) { return key == s; }) == std::end(known)) {
@@ -139,6 +140,12 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     size("panel_width", spec.panel_width);
     size("panel_height", spec.panel_height);
     if (auto b = root["boundaries"].value<bool>()) spec.boundaries = *b;
+    if (const toml::node* rc = root.get("ring_curves")) {
+        const auto v = rc->value<std::string>();
+        if (!v || (*v != "all" && *v != "envelope" && *v != "auto"))
+            throw std::invalid_argument(where(source, *rc) + ": ring_curves: expected \"all\", \"envelope\" or \"auto\"");
+        spec.ring_curves = parse_ring_curves(*v);
+    }
     if (const toml::node* v = root.get("vehicles")) {
         if (v->value<std::string>() != std::optional<std::string>("paper")) {
             throw std::invalid_argument(where(source, *v) + ": vehicles: expected \"paper\" (the built-in calibration table)");
@@ -199,13 +206,14 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
     out.sweeps.resize(n);
     out.boundaries.resize(n);
     for (std::size_t i = 0; i < n; ++i) {  // every panel checked (the computable range at its corners) before any work
-        out.specs[i] = panel_sweep(spec, i);
-        if (spec.boundaries) out.specs[i].ring_method = "modes";  // the boundary seeds need every mode's root
+        out.specs[i] = panel_sweep(spec, i);  // the ring method the boundaries need
         out.specs[i].validate();
     }
     for (std::size_t i = 0; i < n; ++i) {
         out.sweeps[i] = run_sweep(out.specs[i], per_panel);
-        if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i]);
+        BoundaryOptions bo;
+        bo.ring_curves = spec.ring_curves;
+        if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i], bo);
         if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(n));
     }
     std::vector<ChartPanel> panels(n);

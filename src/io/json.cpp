@@ -330,7 +330,8 @@ std::string sweep_json(const SweepResult& sw, const BoundarySet* b) {
     j["points_per_second"] = sw.seconds > 0 ? sw.points.size() / sw.seconds : 0.0;
     if (b) {
         j["boundaries"] = {{"curves", b->curves.size()}, {"seeds", b->seeds}, {"rejected_seeds", b->rejected},
-                           {"seconds", b->seconds}};
+                           {"seconds", b->seconds}, {"ring_curves", ring_curves_name(b->ring_curves)},
+                           {"off_envelope_seeds", b->off_envelope}, {"corners", b->corners}};
     }
     return text(j);
 }
@@ -343,7 +344,8 @@ std::string boundary_json(const BoundarySet& b) {
                           {"mode", c.kind == BoundaryKind::RingHopf ? json(c.mode) : json(nullptr)},
                           {"points", c.points.size()}, {"max_residual", num(c.max_residual)}, {"closed", c.closed}});
     }
-    return text(json{{"curves", curves}, {"seeds", b.seeds}, {"rejected_seeds", b.rejected}, {"seconds", b.seconds}});
+    return text(json{{"curves", curves}, {"seeds", b.seeds}, {"rejected_seeds", b.rejected}, {"seconds", b.seconds},
+                     {"ring_curves", ring_curves_name(b.ring_curves)}, {"off_envelope_seeds", b.off_envelope}, {"corners", b.corners}});
 }
 
 std::string simulation_json(const SimResult& r, const std::string& lead) {

@@ -9,9 +9,12 @@
 #include <Eigen/Dense>
 
 #include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/ring_winding.hpp"
 #include "ddemap/analysis/string_stability.hpp"
 #include "ddemap/problem/quasi_polynomial.hpp"
 #include "ddemap/solve/continuation.hpp"
+#include "ddemap/traffic/ring.hpp"
+#include "ddemap/traffic/transfer_function.hpp"
 
 namespace ddemap {
 
@@ -27,6 +30,76 @@ std::string subkind_name(BoundaryKind k) {
         case BoundaryKind::Peak: return "peak";
     }
     return "unknown";
+}
+
+std::string ring_curves_name(RingCurves r) {
+    switch (r) {
+        case RingCurves::All: return "all";
+        case RingCurves::Envelope: return "envelope";
+        case RingCurves::Auto: return "auto";
+    }
+    return "unknown";
+}
+
+RingCurves parse_ring_curves(const std::string& text) {
+    if (text == "all") return RingCurves::All;
+    if (text == "envelope") return RingCurves::Envelope;
+    if (text == "auto") return RingCurves::Auto;
+    throw std::invalid_argument("ring curves '" + text + "': expected all, envelope or auto");
+}
+
+RingCurves resolve_ring_curves(RingCurves r, const SweepSpec& spec) {
+    if (spec.cars == 0) return r == RingCurves::Auto ? RingCurves::Envelope : r;  // N = inf: no ring Hopf curves either way
+    const bool applies = ring_winding_applies(model_at(spec, spec.x.lo, spec.y.lo)->linearise());
+    if (r == RingCurves::Envelope && !applies)
+        throw std::invalid_argument("ring curves envelope: the model '" + spec.model + "' uses more than the car ahead; expected ring curves all or auto");
+    if (r == RingCurves::Auto) return applies && spec.cars > kEnvelopeAutoCars ? RingCurves::Envelope : RingCurves::All;
+    return r;
+}
+
+bool on_ring_envelope(const SweepSpec& spec, int mode, double x, double y, double omega) {
+    if (spec.cars <= 0) throw std::invalid_argument("on_ring_envelope: expected a finite ring (N >= 2)");
+    Linearisation lin;
+    try {
+        lin = model_at(spec, x, y)->linearise();
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+    if (!is_computable(lin)) return false;
+    const int n = spec.cars;
+    const int low = std::min(((mode % n) + n) % n, n - ((mode % n) + n) % n);  // m or N - m, whichever is <= N/2
+    // the crossing as the guess of the abscissa's Newton steps (root Im >= 0: mode m at omega > 0, N - m below)
+    RingWindingGuess guess;
+    const int carrier = omega >= 0.0 ? ((mode % n) + n) % n : (n - ((mode % n) + n) % n) % n;
+    if (carrier == 0) {
+        guess.have_mode0 = true;
+        guess.mode0 = cplx(0.0, std::abs(omega));
+    } else {
+        guess.have = true;
+        guess.mode = carrier;
+        guess.root = cplx(0.0, std::abs(omega));
+    }
+    RingWindingResult w;
+    try {
+        w = analyse_ring_winding(lin, n, {}, guess);
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+    if (w.status != Status::Converged) {
+        // the axis table is undecided when the crossing pair sits within rounding of the tangency
+        // at s = 0 (a huge ring's smallest wave numbers): count the roots of every mode right of
+        // the line Re = 1e-10 max(1, |omega|) instead (mode 0 on its own, without its trivial root)
+        const double sigma = 1e-10 * std::max(1.0, std::abs(omega));
+        const RingWindingTable t = ring_winding_table(TransferFunction(lin), sigma);
+        if (!t.ok) return false;  // undecided: the arc ends (never a guess)
+        const int zeros0 = ring_mode0_characteristic(lin).zeros_right_of(sigma);
+        if (zeros0 != 0) return false;
+        return t.mode_zeros(n) == 0;
+    }
+    if (w.verdict == Verdict::Stable || w.verdict == Verdict::Marginal) return true;
+    if (w.verdict != Verdict::Unstable) return false;
+    // only the traced pair (within rounding of the axis) right of it
+    return w.unstable_roots <= 2 && w.abscissa_mode == low && w.spectral_abscissa < 1e-9 * std::max(1.0, std::abs(w.abscissa_root));
 }
 
 void BoundaryOptions::validate() const {
@@ -148,18 +221,285 @@ double boundary_residual(const SweepSpec& spec, BoundaryKind kind, int mode, con
     return f.norm();
 }
 
+namespace {
+
+/// Do the segments a-b and c-d (scaled coordinates) cross or touch?
+bool segments_meet(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy) {
+    auto orient = [](double px, double py, double qx, double qy, double rx, double ry) {
+        const double v = (qx - px) * (ry - py) - (qy - py) * (rx - px);
+        return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0);
+    };
+    const int o1 = orient(ax, ay, bx, by, cx, cy), o2 = orient(ax, ay, bx, by, dx, dy);
+    const int o3 = orient(cx, cy, dx, dy, ax, ay), o4 = orient(cx, cy, dx, dy, bx, by);
+    return o1 != o2 && o3 != o4;
+}
+
+/// The curve from a backward and a forward branch through the same start (backward reversed).
+void append_branches(BoundaryCurve& curve, const Problem& p, const ContinuationResult& bwd, const ContinuationResult& fwd) {
+    std::vector<Eigen::VectorXd> all;
+    if (!bwd.points.empty()) all.assign(bwd.points.rbegin(), bwd.points.rend() - 1);
+    all.insert(all.end(), fwd.points.begin(), fwd.points.end());
+    for (const auto& v : all) {
+        BoundaryPoint bp{p.x(v(0)), p.y(v(1)), v.size() == 3 ? v(2) : 0.0};
+        if (!curve.points.empty()) {
+            const auto& q = curve.points.back();
+            if (std::abs(q.x - bp.x) + std::abs(q.y - bp.y) + std::abs(q.omega - bp.omega) < 1e-13) continue;
+        }
+        curve.points.push_back(bp);
+    }
+}
+
+/// The envelope's arcs (BoundaryOptions: RingCurves::Envelope), appended to set.curves.
+void trace_envelope(const SweepResult& sweep, const BoundaryOptions& options, BoundarySet& set) {
+    const SweepSpec& spec = sweep.spec;
+    const int nx = spec.x.count, ny = spec.y.count, cars = spec.cars;
+    const double cell = 1.0 / std::min(nx - 1, ny - 1);
+    const std::size_t first_arc = set.curves.size();
+    std::vector<int> arc_mode;  // every arc's traced mode (before relabelling), omega sign included in the curve
+    const int max_arcs = std::max(200, 20 * (nx + ny));
+
+    // scaled coordinates of a boundary point
+    const Problem frame(spec, BoundaryKind::RingHopf, 0);
+    auto envelope_test = [&](int mode) {
+        TestFunction g;
+        g.name = "another mode unstable";
+        g.terminal = true;
+        g.value = [&spec, mode, &frame](const Eigen::VectorXd& u, const Eigen::VectorXd&) {
+            return on_ring_envelope(spec, mode, frame.x(u(0)), frame.y(u(1)), u(2)) ? 1.0 : -1.0;
+        };
+        return g;
+    };
+    auto ok_at = [&](int mode, const Eigen::VectorXd& u) { return inside(u) && on_ring_envelope(spec, mode, frame.x(u(0)), frame.y(u(1)), u(2)); };
+    auto arc_length = [&](const BoundaryCurve& c) {
+        double l = 0.0;
+        for (std::size_t i = 0; i + 1 < c.points.size(); ++i)
+            l += std::hypot(frame.X(c.points[i + 1].x) - frame.X(c.points[i].x), frame.Y(c.points[i + 1].y) - frame.Y(c.points[i].y));
+        return l;
+    };
+    // a corner to continue from: the end point of an arc and the direction it was going
+    struct Corner {
+        Eigen::VectorXd u, t;
+        int mode;
+    };
+    std::vector<Corner> corners;
+
+    // one arc of `mode` through u (on its Hopf curve and on the envelope), traced both ways
+    // (`both`) or only along +t, starting with `prefix` (the corner it comes from)
+    auto trace_arc = [&](int mode, const Eigen::VectorXd& u, const Eigen::VectorXd& t, bool both, const Eigen::VectorXd* prefix) {
+        Problem p(spec, BoundaryKind::RingHopf, mode);
+        p.keep_omega_sign(u);
+        const ContinuationOptions eo = engine_options(options, 3);
+        const std::vector<TestFunction> tests{envelope_test(mode)};
+        const ContinuationResult fwd = continue_branch(p, u, t, eo, tests);
+        if (fwd.points.empty()) return false;
+        ContinuationResult bwd;
+        if (both && fwd.stop != ContinuationStop::ClosedLoop) bwd = continue_branch(p, u, -t, eo, tests);
+        BoundaryCurve curve;
+        curve.kind = BoundaryKind::RingHopf;
+        curve.mode = mode;
+        curve.closed = fwd.stop == ContinuationStop::ClosedLoop || bwd.stop == ContinuationStop::ClosedLoop;
+        curve.max_residual = std::max(fwd.max_residual, bwd.max_residual);
+        if (prefix) curve.points.push_back({p.x((*prefix)(0)), p.y((*prefix)(1)), (*prefix)(2)});
+        append_branches(curve, p, bwd, fwd);
+        const bool chain = arc_length(curve) >= 1e-3 * cell;  // far below a pixel: the scallops of a huge ring
+        if (chain && fwd.stop == ContinuationStop::TerminalEvent) corners.push_back({fwd.points.back(), fwd.tangents.back(), mode});
+        if (chain && bwd.stop == ContinuationStop::TerminalEvent) corners.push_back({bwd.points.back(), bwd.tangents.back(), mode});
+        // a crossing at negative frequency is the conjugate mode's at positive frequency
+        if (curve.mode > 0 && curve.points[curve.points.size() / 2].omega < 0.0) {
+            curve.mode = cars - curve.mode;
+            for (auto& bp : curve.points) bp.omega = -bp.omega;
+        }
+        set.curves.push_back(std::move(curve));
+        arc_mode.push_back(mode);
+        return true;
+    };
+
+    // the next mode at a corner: the one unstable just past it; its arc starts at the corner
+    auto follow_corners = [&] {
+        while (!corners.empty() && static_cast<int>(set.curves.size() - first_arc) < max_arcs) {
+            const Corner c = corners.back();
+            corners.pop_back();
+            Eigen::VectorXd beyond = c.u + 1e-6 * c.t;
+            Linearisation lin;
+            try {
+                lin = model_at(spec, frame.x(beyond(0)), frame.y(beyond(1)))->linearise();
+            } catch (const std::invalid_argument&) {
+                continue;
+            }
+            if (!inside(beyond) || !is_computable(lin)) continue;
+            const RingWindingResult w = analyse_ring_winding(lin, cars);
+            if (w.status != Status::Converged || w.verdict != Verdict::Unstable || w.abscissa_mode < 0) continue;
+            const int next = w.abscissa_mode;
+            const double omega = std::abs(w.abscissa_root.imag());
+            if (!(omega > 0.0)) continue;
+            // already reached by an arc of that mode?
+            bool known = false;
+            for (std::size_t i = 0; i < arc_mode.size() && !known; ++i) {
+                if (arc_mode[i] != next) continue;
+                const auto& pts = set.curves[first_arc + i].points;
+                for (const auto* e : {&pts.front(), &pts.back()})
+                    known = known || std::hypot(frame.X(e->x) - c.u(0), frame.Y(e->y) - c.u(1)) < 1e-5;
+            }
+            if (known) continue;
+            bool done = false;
+            for (double sign : {1.0, -1.0}) {
+                for (int fixed = 0; fixed < 2 && !done; ++fixed) {
+                    Problem p(spec, BoundaryKind::RingHopf, next);
+                    Eigen::VectorXd u = c.u;
+                    u(2) = sign * omega;
+                    const CorrectorResult cr = correct(p, u, Eigen::VectorXd::Unit(3, fixed), u(fixed));
+                    if (!converged(cr.status) || (u.head(2) - c.u.head(2)).norm() > 1e-4 || sign * u(2) <= 0.0) continue;
+                    Eigen::VectorXd t;
+                    if (!tangent(p, u, Eigen::VectorXd(), t)) continue;
+                    for (double d : {1.0, -1.0}) {
+                        Eigen::VectorXd v = u + 1e-6 * d * t;
+                        const Eigen::VectorXd dir = d * t;
+                        if (!converged(correct(p, v, dir, dir.dot(v)).status) || !ok_at(next, v)) continue;
+                        ++set.corners;
+                        done = trace_arc(next, v, dir, false, &u);
+                        break;
+                    }
+                }
+                if (done) break;
+            }
+        }
+    };
+
+    // frequencies where |f_m(i w)| has its smallest local minima at a point (signed: mode m's
+    // crossings at w < 0 are mode N - m's at -w), for a seed whose root frequency is unknown
+    auto frequency_guesses = [&](int mode, const Eigen::VectorXd& at) {
+        const Problem p(spec, BoundaryKind::RingHopf, mode);
+        constexpr int samples = 800;
+        std::vector<std::pair<double, double>> values;  // (w, |f|) on w = +-1e-3 .. +-50, geometric
+        Eigen::VectorXd u = at, f;
+        for (int side = -1; side <= 1; side += 2)
+            for (int k = 0; k < samples; ++k) {
+                u(2) = side * 1e-3 * std::pow(5e4, k / (samples - 1.0));
+                values.emplace_back(u(2), p.residual(u, f) ? f.norm() : std::numeric_limits<double>::infinity());
+            }
+        std::vector<std::pair<double, double>> minima;  // (|f|, w)
+        for (int side = 0; side < 2; ++side)
+            for (int k = 1; k + 1 < samples; ++k) {
+                const auto& v = values[static_cast<std::size_t>(side * samples + k)];
+                if (v.second < values[static_cast<std::size_t>(side * samples + k - 1)].second &&
+                    v.second <= values[static_cast<std::size_t>(side * samples + k + 1)].second)
+                    minima.emplace_back(v.second, v.first);
+            }
+        std::sort(minima.begin(), minima.end());
+        std::vector<double> out;
+        for (std::size_t i = 0; i < minima.size() && i < 4; ++i) out.push_back(minima[i].second);
+        return out;
+    };
+
+    // seeds: grid edges with unstable ring roots at one end only (both ends certified); the mode is the
+    // abscissa mode at the unstable end, the frequency its root's
+    for (int iy = 0; iy < ny; ++iy)
+        for (int ix = 0; ix < nx; ++ix)
+            for (int dir = 0; dir < 2; ++dir) {
+                const int jx = ix + (dir == 0), jy = iy + (dir == 1);
+                if (jx >= nx || jy >= ny) continue;
+                const SweepPoint &a = sweep.at(ix, iy), &b = sweep.at(jx, jy);
+                // unstable: a root right of the marginal band (a marginal point is on the stable side:
+                // a huge ring's smallest wave numbers have roots within rounding of the axis)
+                if (!a.certified || !b.certified || (a.unstable_roots > 0) == (b.unstable_roots > 0)) continue;
+                const SweepPoint& unstable = a.unstable_roots > 0 ? a : b;
+                ++set.seeds;
+                const double ex0 = ix / (nx - 1.0), ey0 = iy / (ny - 1.0), ex1 = jx / (nx - 1.0), ey1 = jy / (ny - 1.0);
+                // already crossed by an arc?
+                bool known = false;
+                for (std::size_t ci = first_arc; ci < set.curves.size() && !known; ++ci) {
+                    const auto& pts = set.curves[ci].points;
+                    for (std::size_t i = 0; i + 1 < pts.size() && !known; ++i)
+                        known = segments_meet(ex0, ey0, ex1, ey1, frame.X(pts[i].x), frame.Y(pts[i].y), frame.X(pts[i + 1].x), frame.Y(pts[i + 1].y));
+                }
+                // or near an arc of the same mode (the polyline's chords may pass a grid point that lies
+                // within their sag of the curve on the wrong side)
+                const Problem same(spec, BoundaryKind::RingHopf, unstable.abscissa_mode);
+                const double sx = ex0 + 0.5 * (ex1 - ex0), sy = ey0 + 0.5 * (ey1 - ey0);
+                for (std::size_t i = 0; i < arc_mode.size() && !known; ++i) {
+                    if (arc_mode[i] != unstable.abscissa_mode) continue;
+                    const auto& pts = set.curves[first_arc + i].points;
+                    for (std::size_t k = 0; k + 1 < pts.size() && !known; ++k) known = segment_distance(sx, sy, pts[k], pts[k + 1], same) < 0.75 * cell;
+                }
+                if (known) continue;
+                const int mode = unstable.abscissa_mode;
+                if (mode < 0) {
+                    ++set.rejected;
+                    continue;
+                }
+                const double sa = a.spectral_abscissa, sb = b.spectral_abscissa;
+                const double s = std::isfinite(sa) && std::isfinite(sb) && sa != sb ? std::clamp(sa / (sa - sb), 0.0, 1.0) : 0.5;
+                Eigen::VectorXd start(3);
+                start << ex0 + s * (ex1 - ex0), ey0 + s * (ey1 - ey0), 0.0;
+                bool traced = false, corrected = false;
+                int seed_mode = mode;
+                double seed_omega = unstable.abscissa_omega;
+                // the abscissa mode at the unstable end need not be the first to cross (a huge ring's
+                // smallest wave numbers): off the envelope, the mode rightmost there is tried next
+                for (int attempt = 0; attempt < 40 && !traced; ++attempt) {
+                    int next = -1;
+                    double next_omega = 0.0;
+                    std::vector<double> guesses;
+                    if (seed_omega > 0.0) guesses = {seed_omega, -seed_omega};
+                    bool scanned = false;
+                    for (std::size_t gi = 0; gi < guesses.size() || !scanned; ++gi) {
+                        if (gi == guesses.size()) {  // the root's frequency failed (or is 0: a real root): scan
+                            scanned = true;
+                            if (next >= 0) break;  // it was right, the mode was not
+                            const std::vector<double> more = frequency_guesses(seed_mode, start);
+                            guesses.insert(guesses.end(), more.begin(), more.end());
+                            if (gi == guesses.size()) break;
+                        }
+                        const double sign = guesses[gi] > 0.0 ? 1.0 : -1.0;
+                        Problem p(spec, BoundaryKind::RingHopf, seed_mode);
+                        Eigen::VectorXd u = start;
+                        u(2) = guesses[gi];
+                        const int fixed = dir == 0 ? 1 : 0;
+                        const CorrectorResult cr = correct(p, u, Eigen::VectorXd::Unit(3, fixed), u(fixed));
+                        if (!converged(cr.status) || !inside(u) || (u.head(2) - start.head(2)).norm() > 2.0 * cell || sign * u(2) <= 0.0) continue;
+                        corrected = true;
+                        if (!ok_at(seed_mode, u)) {
+                            if (next >= 0) continue;
+                            const Linearisation lin = model_at(spec, frame.x(u(0)), frame.y(u(1)))->linearise();
+                            const RingWindingResult w = analyse_ring_winding(lin, cars);
+                            if (w.status == Status::Converged && w.verdict == Verdict::Unstable && w.abscissa_mode >= 0 &&
+                                w.abscissa_mode != std::min(seed_mode, cars - seed_mode)) {
+                                next = w.abscissa_mode;
+                                next_omega = std::abs(w.abscissa_root.imag());
+                            }
+                            continue;
+                        }
+                        Eigen::VectorXd t;
+                        if (!tangent(p, u, Eigen::VectorXd(), t)) continue;
+                        traced = trace_arc(seed_mode, u, t, true, nullptr);
+                        if (traced) break;
+                    }
+                    if (traced || next < 0) break;
+                    seed_mode = next;
+                    seed_omega = next_omega;
+                }
+                if (!traced) ++(corrected ? set.off_envelope : set.rejected);
+                follow_corners();
+            }
+}
+
+}  // namespace
+
 BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& options) {
     options.validate();
-    if (sweep.spec.cars > 0 && sweep.modes == 0) {
-        // a winding sweep holds no per-mode roots; the ring Hopf seeds need them
+    const RingCurves ring_curves = resolve_ring_curves(options.ring_curves, sweep.spec);
+    if (sweep.spec.cars > 0 && sweep.modes == 0 && ring_curves == RingCurves::All) {
+        // a winding sweep holds no per-mode roots; the ring Hopf seeds of every mode need them
         SweepSpec spec = sweep.spec;
         spec.ring_method = "modes";
         return trace_boundaries(run_sweep(spec), options);
     }
+    const bool envelope = ring_curves == RingCurves::Envelope && sweep.spec.cars > 0;
     const auto t0 = std::chrono::steady_clock::now();
     const SweepSpec& spec = sweep.spec;
     const int nx = spec.x.count, ny = spec.y.count;
     BoundarySet set;
+    set.ring_curves = ring_curves;
 
     // seeds: sign changes between neighbouring grid points, along x and along y
     std::vector<Seed> seeds;
@@ -181,7 +521,7 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
     };
     add_pairs([&](int ix, int iy) { return sweep.at(ix, iy).plant_root.real(); }, BoundaryKind::PlantHopf, -1,
               [&](int ix, int iy) { return std::abs(sweep.at(ix, iy).plant_root.imag()); });
-    for (int m = 0; m < sweep.modes; ++m) {
+    for (int m = 0; m < sweep.modes && !envelope; ++m) {
         auto root = [&](int ix, int iy) {
             return sweep.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * sweep.modes + m];
         };
@@ -240,18 +580,7 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
         curve.mode = sd.mode;
         curve.closed = fwd.stop == ContinuationStop::ClosedLoop || bwd.stop == ContinuationStop::ClosedLoop;
         curve.max_residual = std::max(fwd.max_residual, bwd.max_residual);
-        // the backward branch reversed, the seed, the forward branch
-        std::vector<Eigen::VectorXd> all;
-        if (!bwd.points.empty()) all.assign(bwd.points.rbegin(), bwd.points.rend() - 1);
-        all.insert(all.end(), fwd.points.begin(), fwd.points.end());
-        for (const auto& v : all) {
-            BoundaryPoint bp{p.x(v(0)), p.y(v(1)), v.size() == 3 ? v(2) : 0.0};
-            if (!curve.points.empty()) {
-                const auto& q = curve.points.back();
-                if (std::abs(q.x - bp.x) + std::abs(q.y - bp.y) + std::abs(q.omega - bp.omega) < 1e-13) continue;
-            }
-            curve.points.push_back(bp);
-        }
+        append_branches(curve, p, bwd, fwd);
         // a ring crossing at negative frequency is the conjugate mode's at positive frequency
         if (curve.kind == BoundaryKind::RingHopf && curve.mode > 0 && !curve.points.empty() &&
             curve.points[curve.points.size() / 2].omega < 0.0) {
@@ -261,6 +590,7 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
         set.curves.push_back(std::move(curve));
         traced_mode.push_back(sd.mode);
     }
+    if (envelope) trace_envelope(sweep, options, set);
     set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return set;
 }

@@ -199,6 +199,7 @@ RingSummary RingTracker::evaluate(const Linearisation& lin) {
         s.spectral_abscissa = roots[best].value.real();
         s.abscissa_mode = static_cast<int>(best);
         s.abscissa_theta = m_thetas[best];
+        s.abscissa_omega = std::abs(roots[best].value.imag());
         bool marginal = false;
         for (std::size_t i = 0; i < n; ++i) {
             const cplx z = roots[i].value;
@@ -306,6 +307,7 @@ RingSummary winding_ring_summary(const Linearisation& lin, int cars, RingWinding
         rs.spectral_abscissa = w.spectral_abscissa;
         rs.abscissa_mode = w.abscissa_mode;
         rs.abscissa_theta = w.abscissa_theta;
+        rs.abscissa_omega = std::abs(w.abscissa_root.imag());
         rs.unstable_roots = static_cast<int>(w.unstable_roots);
         rs.stable = w.verdict == Verdict::Stable;
         rs.certified = true;
@@ -341,6 +343,7 @@ void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTrac
     p.spectral_abscissa = rs.spectral_abscissa;
     p.unstable_roots = rs.unstable_roots;
     p.abscissa_mode = rs.abscissa_mode;
+    p.abscissa_omega = rs.abscissa_omega;
     p.ring_stable = rs.stable;
     p.certified = rs.certified;
     p.sup_gamma = sr.sup_gamma;

@@ -1141,7 +1141,7 @@ expect_error "--svg: not available with --wave" orbits --model ov --ring 5 --wav
 expect_error "--initial-step: only with --wave" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --initial-step 0.01
 [ -z "$(ls "$wav" | grep bad)" ] && ok || bad "orbits --wave bad input wrote files: $(ls "$wav")"
 
-# sweep and chart rings up to 10^9 cars on the winding tables; the per-mode path (boundaries) stays at 10^6
+# sweep and chart rings up to 10^9 cars on the winding tables; the per-mode path (--ring-curves all) stays at 10^6
 big="$tmp/bigring"; mkdir -p "$big"
 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000000 --no-boundaries --out "$big/n" --format json >"$big/n.out" 2>/dev/null &&
     "$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring inf --no-boundaries --out "$big/i" --format json >/dev/null 2>&1 &&
@@ -1161,8 +1161,8 @@ for a, b in zip(n, i):
     else:
         assert int(a["unstable_roots"]) == 0 and abs(float(a["spectral_abscissa"])) < 1e-12, (a, b)
 PY
-expect_error "expected at most 1000000 cars for sweep with boundaries" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000001 --out "$big/b"
-expect_error "expected at most 1000000 cars for boundary" boundary --th 1.5 --tau 0.5 --k1 0.1:1 --k2 0.1:1 --ring 2000000 --out "$big/c"
+expect_error "expected at most 1000000 cars for sweep with every mode's ring curve" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000001 --ring-curves all --out "$big/b"
+expect_error "expected at most 1000000 cars for boundary --ring-curves all" boundary --th 1.5 --tau 0.5 --k1 0.1:1 --k2 0.1:1 --ring 2000000 --ring-curves all --out "$big/c"
 expect_error "at most 1000000000)" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000001 --no-boundaries --out "$big/d"
 [ ! -e "$big/b.csv" ] && [ ! -e "$big/c.csv" ] && ok || bad "a refused ring size wrote files"
 rm -rf "$big"
@@ -1493,6 +1493,50 @@ rm -rf "$r12"
     grep -q "^stability  not computed (more than 200 cars" "$tmp/w1000.txt" && ok || bad "orbits --wave --ring 1000: multipliers computed by default: $(grep stability "$tmp/w1000.txt")"
 expect_error "--stability and --no-stability: expected at most one of them" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --stability --no-stability
 expect_error "--stability: only with --wave (expected --wave K)" orbits --model ov --ring 5 --par headway --from 3.5 --to 2 --stability
+
+# ---- ring curves: every mode's Hopf curve (all) or only the boundary of the ring-stable region
+# (envelope, seeded from the winding sweep, any N); auto = all up to 64 cars
+env="$tmp/envelope"; mkdir -p "$env"
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:41 --k2 0.01:1:41 --ring 22 --out "$env/a" --format json >"$env/a.out" 2>/dev/null &&
+    "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:41 --k2 0.01:1:41 --ring 22 --ring-curves envelope --out "$env/e" --format json >"$env/e.out" 2>/dev/null &&
+    python3 - "$env" <<'PY' && ok || bad "sweep --ring 22: auto draws every mode's curve, envelope only the ring-stable region's boundary"
+import csv, json, sys
+a = json.load(open(sys.argv[1] + "/a.out")); e = json.load(open(sys.argv[1] + "/e.out"))
+assert a["solver"]["used"] == "modes" and e["solver"]["used"] == "winding", (a["solver"], e["solver"])
+assert a["inputs"]["ring_curves"] == "all" and e["inputs"]["ring_curves"] == "envelope"
+ring = lambda p: {r["branch"] for r in csv.DictReader(open(sys.argv[1] + p)) if r["subkind"] == "ring"}
+na, ne = len(ring("/a-boundaries.csv")), len(ring("/e-boundaries.csv"))
+assert na >= 5 and 1 <= ne < na, (na, ne)
+assert e["result"]["boundaries"]["ring_curves"] == "envelope"
+PY
+# a ring of 10^6 cars with boundaries: accepted (the envelope by default), on the winding tables, in seconds
+start=$(date +%s.%N)
+"$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:60 --k2 0.01:1:60 --ring 1000000 --out "$env/m" --format json >"$env/m.out" 2>/dev/null &&
+    python3 - "$env" "$start" "$(date +%s.%N)" <<'PY' && ok || bad "sweep --ring 1000000 with boundaries: refused, slow, or without a ring arc"
+import csv, json, sys
+d = json.load(open(sys.argv[1] + "/m.out"))
+assert d["solver"]["used"] == "winding" and d["inputs"]["ring_curves"] == "envelope", (d["solver"], d["inputs"])
+rows = list(csv.DictReader(open(sys.argv[1] + "/m-boundaries.csv")))
+assert any(r["subkind"] == "ring" and int(r["mode"]) > 0 for r in rows)
+assert float(sys.argv[3]) - float(sys.argv[2]) < 20, "took %.1f s" % (float(sys.argv[3]) - float(sys.argv[2]))
+PY
+"$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --ring 1000000000 --out "$env/b" >/dev/null 2>&1 && grep -q ',hopf,ring,' "$env/b.csv" &&
+    ok || bad "boundary --ring 1000000000: the envelope"
+cat >"$env/c.toml" <<'TOML'
+model = "ovrv"
+ring = 1000
+ring_curves = "envelope"
+fixed = { th = 1.5, tau = 0.5 }
+x = { name = "k1", lo = 0.01, hi = 1, count = 30 }
+y = { name = "k2", lo = 0.01, hi = 1, count = 30 }
+[[panel]]
+TOML
+"$bin" chart "$env/c.toml" --out "$env/c" >/dev/null 2>&1 && grep -q 'id="panel1-boundaries"' "$env/c.svg" && grep -q 'ring Hopf' "$env/c.svg" &&
+    ok || bad "chart with ring_curves = envelope"
+expect_error "--ring-curves = 'some': expected all, envelope or auto" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring-curves some --out "$env/x"
+expect_error "uses more than the car ahead" sweep --model ccc --th 1.5 --tau 0.5 --k3 0.2 --tau2 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring-curves envelope --out "$env/x"
+[ ! -e "$env/x.csv" ] && ok || bad "a refused --ring-curves wrote files"
+rm -rf "$env"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -90,6 +90,9 @@ struct RingWindingTable {
     int winding(double phi) const;
     /// Z(phi) = plant_zeros - W(phi): zeros right of sigma of the mode zeta = e^{-i phi}.
     int zeros(double phi) const { return plant_zeros - winding(phi); }
+    /// Sum over the modes m = 1..N-1 of Z(2 pi m / N) (one term per interval between jump
+    /// angles; mode 0 is not included), or -1 when an interval holding a mode has Z < 0.
+    long long mode_zeros(int cars) const;
 };
 
 /// The table on Re lambda = sigma for one car's transfer function (real coefficients, one leader).

@@ -12,6 +12,7 @@
 #include "ddemap/core/execution.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/traffic/model.hpp"
+#include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/analysis/classify.hpp"
 
@@ -32,6 +33,9 @@ struct ChartSpec {
     int columns = 3;
     double panel_width = 260, panel_height = 220;
     bool boundaries = true;
+    /// ring Hopf curves of the boundaries (key ring_curves = "all" | "envelope" | "auto",
+    /// study/boundary.hpp RingCurves)
+    RingCurves ring_curves = RingCurves::Auto;
     std::vector<PanelSpec> panels;
 };
 

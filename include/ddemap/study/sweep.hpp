@@ -53,6 +53,7 @@ struct SweepPoint {
     double spectral_abscissa = 0.0;
     long long unstable_roots = 0;  ///< over all modes (-1 for N = infinity)
     int abscissa_mode = 0;
+    double abscissa_omega = 0.0;  ///< finite N: |Im| of that mode's rightmost root (the boundary seeds' frequency)
     double sup_gamma = 1.0, omega_peak = 0.0;
     double lowfreq_margin = 0.0;
     double peak_gain = 0.0;   ///< highest local maximum of |Gamma(iw)| at w > 0 (0 if none)

@@ -36,6 +36,7 @@ struct RingSummary {
     double spectral_abscissa = 0.0;  ///< trivial zero excluded
     int abscissa_mode = 0;           ///< -1 for N = infinity
     double abscissa_theta = 0.0;
+    double abscissa_omega = 0.0;     ///< |Im| of the rightmost root (finite N)
     int unstable_roots = 0;          ///< over all modes (-1 for N = infinity)
     bool stable = false;
     bool certified = true;           ///< every mode's rightmost root certified
