@@ -144,10 +144,13 @@ FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string
     r.trivial_branch_stable = cars == 0 && w.verdict != Verdict::Unstable;
     // the listed rightmost root is the winding abscissa's root when within its certificate gap
     // 1e-10 max(1, |z|): the abscissa is then reported as that root's real part and mode, so the
-    // table's first root and the abscissa are the same number
+    // table's first root and the abscissa are the same number (but never with the sign the
+    // verdict contradicts: an unstable ring keeps a positive abscissa, a stable one a negative)
     if (!r.roots.empty() && !w.abscissa_is_limit) {
         const RingRoot& top = r.roots.front();
-        if (std::abs(top.root.value.real() - w.spectral_abscissa) <= 1e-10 * std::max(1.0, std::abs(top.root.value))) {
+        const double re = top.root.value.real();
+        const bool sign_ok = (w.verdict != Verdict::Unstable || re > 0.0) && (w.verdict != Verdict::Stable || re < 0.0);
+        if (sign_ok && std::abs(re - w.spectral_abscissa) <= 1e-10 * std::max(1.0, std::abs(top.root.value))) {
             r.spectral_abscissa = top.root.value.real();
             if (cars > 0) r.abscissa_mode = top.mode;
             r.abscissa_theta = top.theta;

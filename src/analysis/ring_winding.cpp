@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ddemap/analysis/string_stability.hpp"
+#include "core/internal/text.hpp"
 #include "ddemap/core/newton.hpp"
 #include "ddemap/core/phase_tracking.hpp"
 #include "ddemap/problem/quasi_polynomial.hpp"
@@ -1033,6 +1034,14 @@ RingWindingResult analyse_ring_winding(const Linearisation& lin, int cars, const
             unstable += c0;
         }
         if (unstable < 0) return undecided("winding table: inconsistent marginal counts");
+        // The count finds roots right of the axis but the located rightmost root lies left of
+        // it: both certificates hold only if those roots are within the abscissa's gap of the
+        // axis, so the rightmost root is not resolved and no verdict is given.
+        if (unstable > 0 && r.spectral_abscissa <= 0.0)
+            return undecided("the count finds " + std::to_string(unstable) +
+                             " roots right of the axis, but the rightmost root located is at Re = " +
+                             detail::format_number(r.spectral_abscissa) + ", left of it (certificate line Re = " +
+                             detail::format_number(line) + "): the rightmost root is not resolved");
         r.unstable_roots = unstable;
         r.marginal_roots = marginal ? 1 : 0;
     } else {

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <random>
 
+#include "ddemap/analysis/ring_fast.hpp"
 #include "ddemap/analysis/ring_stability.hpp"
 #include "ddemap/analysis/ring_winding.hpp"
 #include "ddemap/study/boundary.hpp"
@@ -270,3 +271,47 @@ TEST_CASE("few modes: roots accounted for right of the axis (one table) give the
 }
 
 TEST_SUITE_END();
+
+namespace {
+
+/// A verdict and its abscissa never contradict each other: unstable means a positive abscissa,
+/// stable a negative one (anything else must be marginal or undecided).
+void check_sign(const Linearisation& lin, int cars) {
+    const RingWindingResult w = analyse_ring_winding(lin, cars);
+    if (w.verdict == Verdict::Unstable) CHECK(w.spectral_abscissa > 0.0);
+    if (w.verdict == Verdict::Stable) CHECK(w.spectral_abscissa < 0.0);
+    const FastRing f = analyse_ring_fast(lin, cars, "winding", 6);
+    if (f.ring.verdict == Verdict::Unstable) CHECK(f.ring.spectral_abscissa > 0.0);
+    if (f.ring.verdict == Verdict::Stable) CHECK(f.ring.spectral_abscissa < 0.0);
+}
+
+}  // namespace
+
+TEST_CASE("on huge rings the verdict and the abscissa agree in sign within rounding of the boundary") {
+    // two points where they did not: a count of roots right of the axis with a located rightmost
+    // root left of it (N = 10^6), and a listed root's real part of the wrong sign (N = 10^9)
+    check_sign(ovrv(0.48136463760710274, 0.46374907192550308, 1.5, 0.2), 1000000);
+    check_sign(ovrv(0.26871233702204367, 0.59870149670221018, 1.5, 0.2), 1000000000);
+    // across the boundary along k1 at fixed k2: the crossing by bisection on the verdict, then
+    // points 1e-15 to 1e-8 (relative) on either side of it
+    for (const int cars : {1000000, 1000000000}) {
+        for (const double k2 : {0.46374907192550308, 0.59870149670221018, 0.35}) {
+            auto unstable = [&](double k1) { return analyse_ring_winding(ovrv(k1, k2, 1.5, 0.2), cars).verdict == Verdict::Unstable; };
+            double lo = 0.05, hi = 1.5;
+            const bool ulo = unstable(lo);
+            REQUIRE(ulo != unstable(hi));
+            for (int i = 0; i < 55; ++i) {
+                const double mid = 0.5 * (lo + hi);
+                (unstable(mid) == ulo ? lo : hi) = mid;
+            }
+            CAPTURE(cars);
+            CAPTURE(k2);
+            for (int e = 8; e <= 15; ++e)
+                for (const double s : {-1.0, 1.0}) {
+                    const double k1 = lo * (1.0 + s * std::pow(10.0, -e));
+                    CAPTURE(k1);
+                    check_sign(ovrv(k1, k2, 1.5, 0.2), cars);
+                }
+        }
+    }
+}
