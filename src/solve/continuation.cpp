@@ -61,8 +61,19 @@ bool central_difference_jacobian(const ContinuationProblem& problem, const Eigen
         Eigen::VectorXd up = u, um = u, fp, fm;
         up(c) += h;
         um(c) -= h;
-        if (!problem.residual(up, fp) || !problem.residual(um, fm)) return false;
-        j.col(c) = (fp - fm) / (2.0 * h);
+        const bool plus = problem.residual(up, fp), minus = problem.residual(um, fm);
+        if (plus && minus) {
+            j.col(c) = (fp - fm) / (2.0 * h);
+            continue;
+        }
+        // within h of the edge of the problem's domain (e.g. a gain of 0): the one-sided
+        // second-order difference (-3 f(u) + 4 f(u + s h) - f(u + 2 s h)) / (2 s h), s = +-1
+        if (!plus && !minus) return false;
+        const double s = plus ? 1.0 : -1.0;
+        Eigen::VectorXd u2 = u, f0, f2;
+        u2(c) += 2.0 * s * h;
+        if (!problem.residual(u, f0) || !problem.residual(u2, f2)) return false;
+        j.col(c) = (4.0 * (plus ? fp : fm) - 3.0 * f0 - f2) / (2.0 * s * h);
     }
     return true;
 }
@@ -267,40 +278,60 @@ ContinuationResult continue_branch(const ContinuationProblem& problem, const Eig
             last_failure = failure;
             return !step.reject();
         };
-        Eigen::VectorXd v = u + h * t;
-        const CorrectorResult cr = correct(sp, v, t, t.dot(v), newton_options);
-        r.newton_iterations += cr.iterations;
-        if (!converged(cr.status) || step.jumped((v - u).norm())) {
-            if (reject(converged(cr.status) ? Status::NumericalIssue : cr.status))
-                return finish(ContinuationStop::StepBelowMinimum, last_failure, "the step fell below min_step");
-            continue;
-        }
-
-        // a face of the box crossed: the first one along u -> v, located exactly on it
-        int face = -1;
-        double bound = 0.0, first = inf;
-        for (int i = 0; i < m; ++i) {
-            if (v(i) >= lo(i) && v(i) <= hi(i)) continue;
-            const double edge = v(i) < lo(i) ? lo(i) : hi(i);
-            const double fraction = (edge - u(i)) / (v(i) - u(i));
-            if (fraction < first) {
-                first = fraction;
-                face = i;
-                bound = edge;
+        // the first face of the box crossed along u -> x (face -1: x is inside the box)
+        auto first_face = [&](const Eigen::VectorXd& x, int& face, double& bound) {
+            face = -1;
+            double first = inf;
+            for (int i = 0; i < m; ++i) {
+                if (x(i) >= lo(i) && x(i) <= hi(i)) continue;
+                const double edge = x(i) < lo(i) ? lo(i) : hi(i);
+                const double fraction = (edge - u(i)) / (x(i) - u(i));
+                if (fraction < first) {
+                    first = fraction;
+                    face = i;
+                    bound = edge;
+                }
             }
-        }
-        if (face >= 0) {
-            Eigen::VectorXd w = u, tw;
+        };
+        // the branch's point on that face, corrected with the face's coordinate held at the bound
+        auto locate_on_face = [&](int face, double bound, Eigen::VectorXd& w, CorrectorResult& cb) {
+            w = u;
             w(face) = bound;
-            const CorrectorResult cb = correct(sp, w, Eigen::VectorXd::Unit(m, face), bound, newton_options);
+            cb = correct(sp, w, Eigen::VectorXd::Unit(m, face), bound, newton_options);
             r.newton_iterations += cb.iterations;
             bool ok = converged(cb.status) && (w - u).norm() <= step.jump_limit();
             for (int i = 0; i < m && ok; ++i)
                 ok = i == face || (w(i) >= lo(i) - bound_slack && w(i) <= hi(i) + bound_slack);
-            const std::string which = "the bound of unknown " + std::to_string(face);
-            if (!ok)
+            return ok;
+        };
+        int face = -1;
+        double bound = 0.0;
+        Eigen::VectorXd w, tw;
+        CorrectorResult cb;
+
+        Eigen::VectorXd v = u + h * t;
+        const CorrectorResult cr = correct(sp, v, t, t.dot(v), newton_options);
+        r.newton_iterations += cr.iterations;
+        if (!converged(cr.status) || step.jumped((v - u).norm())) {
+            // A predictor beyond a face of the box where the corrector failed (the problem may not
+            // be defined beyond it, e.g. a gain below 0): the face's point is tried before the
+            // step is halved, so a branch ends on the face rather than min_step short of it.
+            first_face(u + h * t, face, bound);
+            const bool landed = !converged(cr.status) && face >= 0 && locate_on_face(face, bound, w, cb);
+            if (!landed) {
+                if (reject(converged(cr.status) ? Status::NumericalIssue : cr.status))
+                    return finish(ContinuationStop::StepBelowMinimum, last_failure, "the step fell below min_step");
+                continue;
+            }
+        } else {
+            // a face of the box crossed: the first one along u -> v, located exactly on it
+            first_face(v, face, bound);
+            if (face >= 0 && !locate_on_face(face, bound, w, cb))
                 return finish(ContinuationStop::Bound, converged(cb.status) ? Status::Converged : cb.status,
-                              "crossed " + which + " where the crossing could not be located");
+                              "crossed the bound of unknown " + std::to_string(face) + " where the crossing could not be located");
+        }
+        if (face >= 0) {
+            const std::string which = "the bound of unknown " + std::to_string(face);
             if (!tangent(sp, w, t, tw)) tw = t;
             ContinuationEvent e;
             e.kind = ContinuationEvent::Kind::Bound;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "ddemap/solve/continuation.hpp"
+#include "tolerances.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -131,7 +132,9 @@ TEST_CASE("continuation: the folds of x = y^3 - y are the zeros of the tangent's
         o.upper = vec({1e3, 2.0});
         o.scale = scale;
         const ContinuationResult r = continue_branch(cubic, vec({-6.0, -2.0}), vec({0.0, 1.0}), o, {fold});
-        CHECK(r.stop == ContinuationStop::Bound);
+        CAPTURE(r.message);
+    CAPTURE(r.points.size());
+    CHECK(r.stop == ContinuationStop::Bound);
         CHECK(r.status == Status::Converged);
         // the branch ends exactly on the face y = 2, where x = 8 - 2
         CHECK(r.points.back()(1) == 2.0);
@@ -261,3 +264,48 @@ TEST_CASE("continuation: invalid options are refused with the field's name") {
 }
 
 TEST_SUITE_END();
+
+namespace {
+
+/// F(x, y) = y - x^2, defined only for x >= 0 (like a gain that cannot be negative); the
+/// Jacobian by central_difference_jacobian.
+class HalfParabola final : public ContinuationProblem {
+public:
+    int equations() const override { return 1; }
+    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
+        if (u(0) < 0.0) return false;
+        f.resize(1);
+        f(0) = u(1) - u(0) * u(0);
+        return true;
+    }
+    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override { return central_difference_jacobian(*this, u, j); }
+};
+
+}  // namespace
+
+TEST_CASE("continuation: a branch reaches a face of the box where the problem ends (one-sided differences)") {
+    const HalfParabola p;
+    // within h = 1e-7 of x = 0 the central difference would evaluate F at x < 0
+    Eigen::MatrixXd j;
+    for (const double x : {0.0, 1e-9, 5e-8}) {
+        CAPTURE(x);
+        REQUIRE(central_difference_jacobian(p, vec({x, x * x}), j));
+        CHECK(std::abs(j(0, 0) - (-2.0 * x)) <= ddemap::test::tol::finite_difference);
+        CHECK(std::abs(j(0, 1) - 1.0) <= ddemap::test::tol::finite_difference);
+    }
+    CHECK_FALSE(central_difference_jacobian(p, vec({-1.0, 1.0}), j));
+    // from (0.5, 0.25) towards x = 0 in the box [0, 1] x [-1, 1]: the branch ends exactly on the face x = 0
+    ContinuationOptions o;
+    o.initial_step = 0.05;
+    o.max_step = 0.1;
+    o.lower = vec({0.0, -1.0});  // y = x^2 touches y = 0 only at the corner
+    o.upper = vec({1.0, 1.0});
+    const VectorXd t = vec({-1.0, -1.0}).normalized();
+    const ContinuationResult r = continue_branch(p, vec({0.5, 0.25}), t, o);
+    CAPTURE(r.message);
+    CAPTURE(r.points.size());
+    CHECK(r.stop == ContinuationStop::Bound);
+    REQUIRE(!r.points.empty());
+    CHECK(r.points.back()(0) == 0.0);
+    CHECK(std::abs(r.points.back()(1)) <= ddemap::test::tol::boundary_closed_form);
+}

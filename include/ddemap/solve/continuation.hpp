@@ -52,7 +52,10 @@ public:
 };
 
 /// Central differences: J(:, c) = (F(u + h e_c) - F(u - h e_c)) / (2 h),
-/// h = relative_step * max(1, |u_c|). False when F fails at a shifted point.
+/// h = relative_step * max(1, |u_c|). Where F fails on one side only (u within h of the edge of
+/// the problem's domain), the one-sided second-order difference
+/// (-3 F(u) + 4 F(u + s h e_c) - F(u + 2 s h e_c)) / (2 s h) towards the side s = +-1 where it
+/// does not. False when F fails on both sides or at u.
 bool central_difference_jacobian(const ContinuationProblem& problem, const Eigen::VectorXd& u, Eigen::MatrixXd& j,
                                  double relative_step = 1e-7);
 
