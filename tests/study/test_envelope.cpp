@@ -84,6 +84,21 @@ void check_edges_crossed(const SweepResult& sw, const BoundarySet& set) {
     CHECK(edges > 0);
 }
 
+/// The same curves, bit for bit: kind, mode and every point.
+void check_same_curves(const BoundarySet& a, const BoundarySet& b) {
+    REQUIRE(a.curves.size() == b.curves.size());
+    for (std::size_t i = 0; i < a.curves.size(); ++i) {
+        CHECK(a.curves[i].kind == b.curves[i].kind);
+        CHECK(a.curves[i].mode == b.curves[i].mode);
+        REQUIRE(a.curves[i].points.size() == b.curves[i].points.size());
+        for (std::size_t k = 0; k < a.curves[i].points.size(); ++k) {
+            CHECK(a.curves[i].points[k].x == b.curves[i].points[k].x);
+            CHECK(a.curves[i].points[k].y == b.curves[i].points[k].y);
+            CHECK(a.curves[i].points[k].omega == b.curves[i].points[k].omega);
+        }
+    }
+}
+
 }  // namespace
 
 TEST_CASE("envelope arcs lie on their modes' Hopf curves, the ones RingCurves::All traces (N = 22, 100)") {
@@ -201,17 +216,8 @@ TEST_CASE("N = inf: the boundaries from the winding sweep equal those from the p
     const BoundarySet a = trace(run_sweep(spec), RingCurves::Auto);
     spec.ring_method = "modes";
     const BoundarySet b = trace(run_sweep(spec), RingCurves::All);
-    REQUIRE(a.curves.size() == b.curves.size());
     CHECK(a.curves.size() >= 1);
-    for (std::size_t i = 0; i < a.curves.size(); ++i) {
-        CHECK(a.curves[i].kind == b.curves[i].kind);
-        REQUIRE(a.curves[i].points.size() == b.curves[i].points.size());
-        for (std::size_t k = 0; k < a.curves[i].points.size(); ++k) {
-            CHECK(a.curves[i].points[k].x == b.curves[i].points[k].x);
-            CHECK(a.curves[i].points[k].y == b.curves[i].points[k].y);
-            CHECK(a.curves[i].points[k].omega == b.curves[i].points[k].omega);
-        }
-    }
+    check_same_curves(a, b);
 }
 
 TEST_CASE("the envelope is the same for 1 and 2 threads") {
@@ -221,16 +227,7 @@ TEST_CASE("the envelope is the same for 1 and 2 threads") {
     two.threads = 2;
     const BoundarySet a = trace(run_sweep(spec, one), RingCurves::Envelope);
     const BoundarySet b = trace(run_sweep(spec, two), RingCurves::Envelope);
-    REQUIRE(a.curves.size() == b.curves.size());
-    for (std::size_t i = 0; i < a.curves.size(); ++i) {
-        CHECK(a.curves[i].mode == b.curves[i].mode);
-        REQUIRE(a.curves[i].points.size() == b.curves[i].points.size());
-        for (std::size_t k = 0; k < a.curves[i].points.size(); ++k) {
-            CHECK(a.curves[i].points[k].x == b.curves[i].points[k].x);
-            CHECK(a.curves[i].points[k].y == b.curves[i].points[k].y);
-            CHECK(a.curves[i].points[k].omega == b.curves[i].points[k].omega);
-        }
-    }
+    check_same_curves(a, b);
 }
 
 TEST_CASE("ring curves: names, auto by ring size, envelope refused for a law with two leaders") {
