@@ -52,7 +52,7 @@ RingCurves resolve_ring_curves(RingCurves r, const SweepSpec& spec) {
     if (spec.cars == 0) return r == RingCurves::Auto ? RingCurves::Envelope : r;  // N = inf: no ring Hopf curves either way
     const bool applies = ring_winding_applies(model_at(spec, spec.x.lo, spec.y.lo)->linearise());
     if (r == RingCurves::Envelope && !applies)
-        throw std::invalid_argument("ring curves envelope: the model '" + spec.model + "' uses more than the car ahead; expected ring curves all or auto");
+        throw std::invalid_argument("ring curves envelope: the model '" + spec.model + "' uses more than the car ahead; expected a law of the car ahead only");
     if (r == RingCurves::Auto) return applies && spec.cars > kEnvelopeAutoCars ? RingCurves::Envelope : RingCurves::All;
     return r;
 }

@@ -386,6 +386,10 @@ void SweepSpec::validate() const {
         for (double yv : {y.lo, y.hi})
             require_computable(model_at(*this, xv, yv)->linearise(), "the corner " + x.name + " = " + detail::format_number(xv) + ", " +
                                                                         y.name + " = " + detail::format_number(yv) + " of the window");
+    // every point's string verdict is the low-frequency condition and the peak of |Gamma|, which
+    // need a law of the car ahead only: refuse others here, before any message about ring methods
+    // or curves suggests an alternative that would fail on the same ground
+    require_single_leader(model_at(*this, x.lo, y.lo)->linearise(), "a sweep's string verdict (the low-frequency string condition)");
     // a known method that applies to the model; the per-mode path solves N/2 + 1 modes per point
     if (sweep_ring_method(*this) == "modes" && cars > kModesMaxCars)
         throw std::invalid_argument("ring of " + std::to_string(cars) + " cars: expected at most " + std::to_string(kModesMaxCars) +

@@ -1534,7 +1534,8 @@ TOML
 "$bin" chart "$env/c.toml" --out "$env/c" >/dev/null 2>&1 && grep -q 'id="panel1-boundaries"' "$env/c.svg" && grep -q 'ring Hopf' "$env/c.svg" &&
     ok || bad "chart with ring_curves = envelope"
 expect_error "--ring-curves = 'some': expected all, envelope or auto" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring-curves some --out "$env/x"
-expect_error "uses more than the car ahead" sweep --model ccc --th 1.5 --tau 0.5 --k3 0.2 --tau2 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring-curves envelope --out "$env/x"
+expect_error "string verdict (the low-frequency string condition) needs a law that uses only the car ahead" sweep --model ccc --th 1.5 --tau 0.5 --k3 0.2 --tau2 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring-curves envelope --out "$env/x"
+expect_error "uses only the car ahead; this one uses 2 cars ahead" boundary --model ccc --th 1.5 --tau 0.5 --k3 0.2 --tau2 0.5 --k1 0.1:1 --k2 0.1:1 --ring-curves all --out "$env/x"
 [ ! -e "$env/x.csv" ] && ok || bad "a refused --ring-curves wrote files"
 rm -rf "$env"
 
