@@ -11,6 +11,10 @@
             s_i' = v_{i-1} - v_i,
             v_i' = k1 s_i(t - tau) - (k1 th + k2) v_i + k2 v_{i-1}(t - tau)
         (car 1 follows car N); `ddemap roots --ring N` with the same k1, k2, th, tau is the reference.
+  net   a random delayed network of n nodes (fixed seed): x' = -d x + W0 x + W1 x(t - tau), W0 and W1
+        with `--degree` entries per row at random columns, normal weights of standard deviation
+        s0 / sqrt(degree) and s1 / sqrt(degree) (no clustered spectrum: the rightmost roots are
+        separated, unlike rd and ring).
 
 Examples:
   python3 bench/sparse_systems.py rd --nx 100 --ny 100 --out out/rd10000.json
@@ -19,6 +23,7 @@ Examples:
 """
 import argparse
 import json
+import random
 import sys
 
 
@@ -64,6 +69,22 @@ def ring(args):
     return {"comment": comment, "dimension": 2 * cars, "delays": [args.tau], "A0": {"triplets": a0}, "A": [{"triplets": a1}]}
 
 
+def net(args):
+    rng = random.Random(args.seed)
+    n, deg = args.n, args.degree
+    def random_rows(sd):
+        t = []
+        for i in range(n):
+            for j in rng.sample(range(n), deg):
+                t.append([i, j, rng.gauss(0.0, sd / deg ** 0.5)])
+        return t
+    a0 = [[i, i, -args.d] for i in range(n)] + random_rows(args.s0)
+    a1 = random_rows(args.s1)
+    comment = ("random delayed network of %d nodes, %d entries per row: x' = -%g x + W0 x + W1 x(t - %g), sd %g / sqrt(%d) and %g / sqrt(%d), seed %d"
+               % (n, deg, args.d, args.tau, args.s0, deg, args.s1, deg, args.seed))
+    return {"comment": comment, "dimension": n, "delays": [args.tau], "A0": {"triplets": a0}, "A": [{"triplets": a1}]}
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="kind", required=True)
@@ -81,10 +102,18 @@ def main():
     g.add_argument("--k2", type=float, default=0.4)
     g.add_argument("--th", type=float, default=1.5)
     g.add_argument("--tau", type=float, default=0.5)
-    for s in (r, g):
+    w = sub.add_parser("net")
+    w.add_argument("--n", type=int, default=10000)
+    w.add_argument("--degree", type=int, default=4)
+    w.add_argument("--d", type=float, default=1.0)
+    w.add_argument("--s0", type=float, default=0.5)
+    w.add_argument("--s1", type=float, default=0.8)
+    w.add_argument("--tau", type=float, default=1.0)
+    w.add_argument("--seed", type=int, default=1)
+    for s in (r, g, w):
         s.add_argument("--out", required=True)
     args = p.parse_args()
-    system = rd(args) if args.kind == "rd" else ring(args)
+    system = {"rd": rd, "ring": ring, "net": net}[args.kind](args)
     with open(args.out, "w") as f:
         json.dump(system, f, separators=(",", ":"))
         f.write("\n")
