@@ -83,6 +83,17 @@ TEST_CASE("axes and sweep specs are validated") {
     SweepSpec s = ddemap::test::ovrv_chart(3, 22, 1.5, 0.5);
     s.x = parse_axis("k1", "-1:1:3");
     CHECK_THROWS_WITH_AS(s.validate(), "k1 = -1: expected a value >= 0 [1/s^2]", std::invalid_argument);
+    // a law of more than the car ahead is refused up front, for the reason that holds whatever the
+    // ring method or curves (the string verdict of every point needs the car ahead only)
+    SweepSpec ccc = ddemap::test::ovrv_chart(3, 22, 1.5, 0.5);
+    ccc.model = "ccc";
+    ccc.fixed["k3"] = 0.2;
+    ccc.fixed["tau2"] = 0.5;
+    CHECK_THROWS_WITH_AS(ccc.validate(),
+                         "a sweep's string verdict (the low-frequency string condition) needs a law that uses only the car ahead; this one uses 2 cars ahead (analyse it as a ring or a fleet)",
+                         std::invalid_argument);
+    ccc.ring_method = "modes";
+    CHECK_THROWS_AS(ccc.validate(), std::invalid_argument);
 }
 
 // the sweep's plant root, abscissa and verdict at each of `where` against the collocation roots
