@@ -165,6 +165,11 @@ LinearDDE::LinearDDE(MatrixXc a0, std::vector<DelayTerm> delayed) : m_a0(std::mo
     m_bounds.n = m_n;
     m_bounds.n0 = spectral_norm(m_a0);
     m_bounds.mu = log_norm(m_a0);
+    {
+        const MatrixXc k = cplx(0.0, -0.5) * (m_a0 - m_a0.adjoint());  // Hermitian
+        Eigen::SelfAdjointEigenSolver<MatrixXc> es(k, Eigen::EigenvaluesOnly);
+        m_bounds.skew = es.eigenvalues().size() ? es.eigenvalues().cwiseAbs().maxCoeff() : 0.0;
+    }
     for (const auto& t : m_delayed) {
         m_bounds.terms.push_back({spectral_norm(t.matrix), t.delay});
         for (int j = 0; j < m_n; ++j)
@@ -209,6 +214,7 @@ LinearDDE::LinearDDE(SparseMatrixXd a0, std::vector<SparseDelayTerm> delayed) : 
     m_bounds.n = m_n;
     m_bounds.n0 = norm2_bound(m_sa0);
     m_bounds.mu = log_norm_bound(m_sa0);
+    m_bounds.skew = norm2_bound(SparseMatrixXd(0.5 * (m_sa0 - SparseMatrixXd(m_sa0.transpose()))));
     for (const auto& t : m_sdelayed) {
         m_bounds.terms.push_back({norm2_bound(t.matrix), t.delay});
         for (int k = 0; k < t.matrix.outerSize(); ++k)

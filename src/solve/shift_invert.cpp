@@ -749,7 +749,7 @@ public:
     /// Cells are taken rightmost first. False when the shift budget ran out.
     bool cover(double alpha, double beta, const Bounds& bounds, int count) {
         m_floor = alpha;
-        const double height = bounds.radius(alpha);
+        const double height = bounds.height(alpha);
         auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
         // roughly square cells to start with
@@ -881,7 +881,7 @@ private:
         if (re.size() < std::size_t(count)) return;
         std::nth_element(re.begin(), re.begin() + (count - 1), re.end(), std::greater<double>());
         m_floor = std::max(m_floor, re[count - 1]);
-        m_height = bounds.radius(m_floor);
+        m_height = bounds.height(m_floor);
     }
 };
 
@@ -1035,7 +1035,7 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
         max_rank = std::max(max_rank, cover.max_rank());
         result.factorizations += op.factorizations();
         result.eigenvalues_found = static_cast<int>(cover.values().size());
-        const double height = bounds.radius(alpha);
+        const double height = bounds.height(alpha);
         const double resolved = radius_for_degree(m, tau);
         // M must resolve every eigenvalue of the rectangle (compact: of the part covered by
         // Arnoldi discs; the rest is root-free by Gershgorin or the resolvent); otherwise raise M

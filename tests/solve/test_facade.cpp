@@ -195,6 +195,55 @@ TEST_CASE("the root bound holds for every root found, on both storages") {
     CHECK(dense.to_sparse().sparse_delayed().size() == ring.dde.sparse_delayed().size());
 }
 
+TEST_CASE("the height bound |Im lambda| <= H(Re lambda) holds for every root found, and ignores ||A0|| when A0 is symmetric") {
+    // random nonsymmetric systems (dense path, many roots) on both storages
+    std::mt19937 rng(41);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (int trial = 0; trial < 6; ++trial) {
+        const int n = 3 + trial % 3;
+        MatrixXc a0(n, n), a1(n, n);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                a0(i, j) = g(rng) + (i == j ? -1.0 : 0.0);
+                a1(i, j) = 0.6 * g(rng);
+            }
+        const LinearDDE dde(a0, {{a1, 0.5 + 0.3 * trial}});
+        RootOptions o;
+        o.method = "dense";
+        o.count = 40;
+        const RootResult r = rightmost_roots(dde, o);
+        REQUIRE(r.status == Status::Converged);
+        REQUIRE(r.roots.size() >= 20);
+        const LinearDDE sparse = dde.to_sparse();
+        for (const auto& x : r.roots) {
+            CAPTURE(x.value);
+            CHECK(std::abs(x.value.imag()) <= dde.bounds().height(x.value.real()) * (1.0 + 1e-12));
+            CHECK(std::abs(x.value.imag()) <= sparse.bounds().height(x.value.real()) * (1.0 + 1e-12));
+            CHECK(dde.bounds().height(x.value.real()) <= dde.bounds().radius(x.value.real()) * (1.0 + 1e-12));
+        }
+    }
+    // u' = d u_xx - u(t - 1) on 50 points with ||A0|| = 4 d: the roots' |Im| stays below
+    // e^{-Re tau} whatever d, while the disc bound R grows with d
+    for (double d : {1.0, 1e6}) {
+        std::vector<Eigen::Triplet<double>> t0, t1;
+        const int n = 50;
+        for (int i = 0; i < n; ++i) {
+            t0.emplace_back(i, i, -2.0 * d + 0.4);
+            if (i > 0) t0.emplace_back(i, i - 1, d);
+            if (i + 1 < n) t0.emplace_back(i, i + 1, d);
+            t1.emplace_back(i, i, -1.0);
+        }
+        SparseMatrixXd a0(n, n), a1(n, n);
+        a0.setFromTriplets(t0.begin(), t0.end());
+        a1.setFromTriplets(t1.begin(), t1.end());
+        const LinearDDE dde(a0, {{a1, 1.0}});
+        for (double a : {-0.5, 0.0, 0.3}) {
+            CHECK(dde.bounds().height(a) == doctest::Approx(std::exp(-a)).epsilon(1e-14));
+            CHECK(dde.bounds().radius(a) >= 4.0 * d);
+        }
+    }
+}
+
 TEST_CASE("RootOptions::is_valid names the field in the API's words") {
     std::string why = "untouched";
     CHECK(RootOptions{}.is_valid(&why));

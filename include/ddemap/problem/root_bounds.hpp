@@ -9,7 +9,10 @@
 /// Re(lambda) >= a satisfies
 ///     |lambda| <= R(a) = ||A0|| + min( || sum_k |A_k| e^{-a tau_k} ||, sum_k ||A_k|| e^{-a tau_k} ),
 ///     Re(lambda) <= beta, the fixed point of x = mu + (the same delayed norm at x),
-/// with mu >= mu_2(A0) (the log-norm). ||.|| is the 2-norm (dense storage) or its bound
+/// with mu >= mu_2(A0) (the log-norm), and (numerical range: lambda = v^H A0 v + v^H (sum_k A_k
+/// e^{-lambda tau_k}) v for the unit null vector v, and |Im v^H A0 v| = |v^H K v|)
+///     |Im(lambda)| <= H(a) = min( R(a), ||K|| + (the same delayed norm at a) ),  K = (A0 - A0^H) / 2i,
+/// which for a symmetric A0 (a discretised diffusion) does not grow with ||A0||. ||.|| is the 2-norm (dense storage) or its bound
 /// sqrt(||.||_1 ||.||_inf) (sparse storage); the entrywise form is the tighter one when, as in
 /// a ring, each row has few delays, the termwise one for a few dense matrices.
 ///
@@ -17,6 +20,7 @@
 ///     ||Delta(lambda) v|| / (||v|| (|lambda| + R(Re lambda))),
 /// and without a vector (dense storage) its minimum over v, sigma_min(Delta(lambda)) / scale.
 
+#include <algorithm>
 #include <vector>
 
 #include "ddemap/core/types.hpp"
@@ -39,12 +43,15 @@ struct RootBounds {
     int n = 0;
     double n0 = 0.0;              ///< ||A0|| (or its bound)
     double mu = 0.0;              ///< >= mu_2(A0)
+    double skew = 0.0;            ///< >= ||(A0 - A0^H) / 2i|| (0 for a symmetric A0)
     std::vector<Entry> entries;   ///< every nonzero of every delayed matrix
     std::vector<Term> terms;      ///< one per delayed matrix
     /// min( || sum_k |A_k| e^{-a tau_k} ||, sum_k ||A_k|| e^{-a tau_k} )
     double delayed_norm(double a) const;
     /// R(a) = ||A0|| + delayed_norm(a)
     double radius(double a) const { return n0 + delayed_norm(a); }
+    /// H(a) = min(R(a), skew + delayed_norm(a)): no root with Re >= a has |Im| > H(a)
+    double height(double a) const { return std::min(n0, skew) + delayed_norm(a); }
     /// beta: the fixed point of x = mu + delayed_norm(x)
     double right_bound() const;
     /// |lambda| + R(Re lambda): the scale of Delta(lambda) in relative residuals

@@ -11,7 +11,7 @@
 ///    the eigenvalues to spectral accuracy). Any coefficients, ODEs included.
 ///  - "shift_invert": the rightmost eigenvalues of the collocation matrix by shift-and-invert
 ///    Arnoldi on a structured operator, every eigenvalue of a rectangle [alpha, beta] x
-///    [-R(alpha), R(alpha)] found (discs of completeness), each refined by Newton on the DDE.
+///    [-H(alpha), H(alpha)] found (discs of completeness), each refined by Newton on the DDE.
 ///    Large real systems with delays (shift_invert.hpp).
 ///  - "contour": the argument principle on a scalar characteristic function D = det Delta
 ///    (problem/characteristic_function.hpp): all zeros of the rectangle counted and located.
@@ -137,7 +137,7 @@ struct RootResult {
     double covered_radius = 0.0; ///< |lambda| up to which the collocation resolves e^{lambda theta}
     double strip_floor = 0.0;    ///< alpha: every root with Re >= alpha is in `roots` or right of them
     double right_bound = 0.0;    ///< beta: no root has Re > beta (shift_invert, contour)
-    double height = 0.0;         ///< R(alpha): no root with Re >= alpha has |Im| > height (shift_invert, contour)
+    double height = 0.0;         ///< no root with Re >= alpha has |Im| > height (shift_invert: H(alpha), contour: R(alpha); root_bounds.hpp)
     int eigenvalues_found = 0;   ///< shift_invert: distinct eigenvalues met; contour: zeros counted in the rectangle
     double max_residual = 0.0;   ///< max residual over the roots
     int dropped = 0;             ///< dense: candidates dropped (Newton failed, spurious or duplicate)

@@ -15,10 +15,11 @@
 /// (M+1) n matrix is never formed.
 ///
 /// Shift strategy (completeness). Every root with Re(lambda) >= alpha satisfies
-/// Re(lambda) <= beta and |Im(lambda)| <= R(alpha), with (RootBounds, problem/root_bounds.hpp)
+/// Re(lambda) <= beta and |Im(lambda)| <= H(alpha), with (RootBounds, problem/root_bounds.hpp)
 ///     beta:  the fixed point of x = mu(A0) + N(x)  (mu the log-norm),
-///     R(a) = ||A0|| + N(a),   N(a) = min(|| sum_k |A_k| e^{-a tau_k} ||, sum_k ||A_k|| e^{-a tau_k}).
-/// The rectangle [alpha, beta] x [0, R(alpha)] (real problems: the lower half is its mirror) is
+///     H(a) = min(||A0||, ||(A0 - A0^T) / 2||) + N(a),   N(a) = min(|| sum_k |A_k| e^{-a tau_k} ||, sum_k ||A_k|| e^{-a tau_k})
+/// (the numerical range of A0: a symmetric A0, a discretised diffusion, adds nothing to H however
+/// large its norm). The rectangle [alpha, beta] x [0, H(alpha)] (real problems: the lower half is its mirror) is
 /// covered by discs: a shift sigma whose Arnoldi run returns the nev eigenvalues of largest
 /// |nu(lambda)|, nu = (1/(lambda - sigma) + 1/(lambda - conj sigma)) / 2 (Spectra's operator
 /// Re((A_M - sigma I)^{-1})), has found every eigenvalue with |nu| > nu_min; that set contains
