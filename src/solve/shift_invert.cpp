@@ -704,7 +704,7 @@ public:
             double thmin = std::numeric_limits<double>::infinity();
             for (int i = 0; i < rz.converged; ++i) {
                 const cplx th = rz.theta[static_cast<std::size_t>(i)];
-                add(sigma + 1.0 / th);
+                add(sigma + 1.0 / th, sigma);
                 thmin = std::min(thmin, std::abs(th));
             }
             if (rz.converged < 1 || !(thmin > 0.0)) {
@@ -722,7 +722,7 @@ public:
         for (Eigen::Index i = 0; i < ev.size(); ++i) {
             const cplx z = ev(i);
             if (!std::isfinite(z.real()) || !std::isfinite(z.imag())) continue;
-            add(z);
+            add(z, sigma);
             const cplx nu = 0.5 * (1.0 / (z - sigma) + 1.0 / (z - std::conj(sigma)));
             numin = std::min(numin, std::abs(nu));
         }
@@ -846,12 +846,20 @@ private:
             }
         return false;
     }
-    void add(cplx z) {
+    /// An eigenvalue z = sigma + 1/theta from a Ritz value converged to |residual| <= tol |theta|:
+    /// its error is about tol |z - sigma| (|d theta| / |theta|^2, times the eigenvalue's condition),
+    /// so the same eigenvalue met twice (from two shifts, or a pair's two members from one
+    /// complex shift, the far one less accurate) can differ by more than rounding: on a stiff
+    /// system (||A0|| = 2e7) a pair's members came out 2.9e-10 apart. Values closer than ten
+    /// times their two errors are one eigenvalue.
+    void add(cplx z, cplx sigma) {
+        const double error = std::max(1e-10 * scale_of(z), 10.0 * m_o.arnoldi_tolerance * std::abs(z - sigma));
         if (z.imag() < 0.0) z = std::conj(z);
         if (z.imag() <= 1e-12 * scale_of(z)) z.imag(0.0);  // a real eigenvalue, not a pair
-        for (cplx w : m_values)
-            if (std::abs(w - z) <= 1e-10 * scale_of(z)) return;
+        for (std::size_t i = 0; i < m_values.size(); ++i)
+            if (std::abs(m_values[i] - z) <= std::max(error, m_errors[i])) return;
         m_values.push_back(z);
+        m_errors.push_back(error);
     }
 
     StructuredShiftInvert& m_op;
@@ -859,6 +867,7 @@ private:
     const ShiftInvertRootOptions& m_o;
     std::vector<Disc> m_discs;
     std::vector<cplx> m_values;
+    std::vector<double> m_errors;  ///< the error of each value (add)
     ResolventExclusion* m_res;
     double m_extent = 0.0;
     int m_shifts = 0;
@@ -1087,11 +1096,17 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
             if (so.refine) result.collocation_error = std::max(result.collocation_error, r.collocation_error / scale_of(r.value));
             max_residual = std::max(max_residual, r.residual);
         }
-        // two refined roots on one root: a duplicate, the collocation did not separate them
+        // two refined roots on one root: a duplicate, the collocation did not separate them. A
+        // refined root is known to about its absolute backward error ||Delta v|| / ||v|| =
+        // residual (|lambda| + R): Newton stops at that noise, which on a stiff system (||A0|| =
+        // 2e7) is 1e-9, far above rounding
+        auto noise = [&](const Root& x) { return x.residual * bounds.scale(x.value); };
         int duplicates = 0;
         for (std::size_t i = 0; i < result.roots.size(); ++i)
-            for (std::size_t j = i + 1; j < result.roots.size(); ++j)
-                if (std::abs(result.roots[i].value - result.roots[j].value) <= 1e-10 * scale_of(result.roots[i].value)) ++duplicates;
+            for (std::size_t j = i + 1; j < result.roots.size(); ++j) {
+                const Root &a = result.roots[i], &b = result.roots[j];
+                if (std::abs(a.value - b.value) <= std::max(1e-10 * scale_of(a.value), 10.0 * (noise(a) + noise(b)))) ++duplicates;
+            }
         const bool accurate = result.collocation_error <= so.collocation_tolerance;
         if (so.refine && options.degree == 0 && budget && (!accurate || duplicates > 0) && m < max_degree) {
             m = std::min(max_degree, static_cast<int>(std::ceil(1.5 * m)));
