@@ -211,8 +211,10 @@ void schur_swap(Eigen::MatrixXcd& s, Eigen::MatrixXcd& u, Eigen::Index i) {
 /// couplings set to zero: an invariant subspace to that accuracy; the norms set to zero are
 /// summed and added to every later residual, so the convergence test stays a bound). When r, the columns of Q,
 /// would outgrow its storage, Q is compressed (TOAR): the stacked coefficients
-/// [a_0; ...; a_keep] = X Sigma W^H (SVD), Q <- Q W[:, :r'], a_i <- a_i W[:, :r'], dropping
-/// singular values <= 1e-14 sigma_1 and those beyond the exact rank (the kept subspace is a
+/// [a_0; ...; a_keep] = X Sigma W^H (SVD), Q <- Q conj(W[:, :r']), a_i <- a_i W[:, :r'] (block j
+/// of V_i is Q a_i[j, :]^T, and every transposed row a_i[j, :]^T lies in the span of conj(W)'s
+/// columns), dropping singular values <= 1e-14 sigma_1 and those beyond the exact rank when
+/// below 1e-13 sigma_1 (the kept subspace is a
 /// Krylov space K_{keep+1}(T, w), and the blocks of T^j w lie in span(blocks of w, j new
 /// columns), so r' <= keep + M + 2 in exact arithmetic).
 class CompactKrylov {
@@ -385,10 +387,10 @@ private:
         // the exact rank is at most keep + M + 2 (see the class): values beyond are rounding
         // (they pile up over the restarts), unless they are not small (then nothing is cut)
         const int bound = m_k + m_rows + 1;
-        if (r2 > bound && sv(bound) <= 1e-10 * sv(0)) r2 = bound;
+        if (r2 > bound && sv(bound) <= 1e-13 * sv(0)) r2 = bound;
         r2 = std::max(r2, 1);
         const Eigen::MatrixXcd w = svd.matrixV().leftCols(r2);
-        const Eigen::MatrixXcd q2 = m_q.leftCols(m_r) * w;
+        const Eigen::MatrixXcd q2 = m_q.leftCols(m_r) * w.conjugate();
         m_q.leftCols(r2) = q2;
         for (int i = 0; i < nvec; ++i) {
             const Eigen::MatrixXcd a2 = Eigen::Map<const Eigen::MatrixXcd>(m_v.col(i).data(), m_rows, m_r) * w;
@@ -431,21 +433,41 @@ CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_
 
 }  // namespace
 
-SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int degree, const std::vector<cplx>& shifts, int nev) {
+SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int degree, const std::vector<cplx>& shifts, int nev,
+                                                 const SparseEigenOptions& options) {
     const LinearDDE dde = input.to_sparse();
     if (dde.is_ode()) throw std::invalid_argument("the sparse path needs at least one delay");
     if (degree < 2) throw std::invalid_argument("collocation degree must be >= 2");
+    if (options.arnoldi != "spectra" && options.arnoldi != "compact")
+        throw std::invalid_argument("arnoldi = '" + options.arnoldi + "': expected spectra or compact");
     StructuredShiftInvert op(dde, degree);
     const Eigen::Index size = op.rows();
     if (nev < 1 || nev > size - 3) throw std::invalid_argument("nev: expected 1 <= nev <= size - 3");
+    if (options.arnoldi == "compact" && (options.basis <= nev || options.basis >= size || options.restarts < 0))
+        throw std::invalid_argument("compact Arnoldi: expected nev < basis < (M+1) n and restarts >= 0");
+    if (!(options.tolerance > 0.0)) throw std::invalid_argument("tolerance: expected > 0");
     SparseEigenResult out;
     for (cplx sigma : shifts) {
-        const Eigen::Index ncv = std::min<Eigen::Index>(size, std::max<Eigen::Index>(2 * nev + 1, 20));
-        Spectra::GenEigsComplexShiftSolver<StructuredShiftInvert> solver(op, nev, ncv, sigma.real(), sigma.imag());
-        solver.init();
-        solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-        if (solver.info() != Spectra::CompInfo::Successful) out.status = Status::NumericalIssue;
-        const Eigen::VectorXcd ev = solver.eigenvalues();
+        Eigen::VectorXcd ev;
+        if (options.arnoldi == "compact") {
+            if (!op.factor(sigma)) {
+                out.status = Status::NumericalIssue;
+                continue;
+            }
+            const CompactRitz rz = compact_arnoldi(op, nev, std::min(options.basis, 2 * nev + 20), options.basis, options.restarts,
+                                                   std::max(nev, options.basis / 2), options.tolerance, 0.0, {});
+            out.restarts += rz.restarts;
+            if (rz.converged < nev) out.status = Status::NumericalIssue;
+            ev.resize(rz.converged);
+            for (int i = 0; i < rz.converged; ++i) ev(i) = sigma + 1.0 / rz.theta[static_cast<std::size_t>(i)];
+        } else {
+            const Eigen::Index ncv = std::min<Eigen::Index>(size, std::max<Eigen::Index>(2 * nev + 1, 20));
+            Spectra::GenEigsComplexShiftSolver<StructuredShiftInvert> solver(op, nev, ncv, sigma.real(), sigma.imag());
+            solver.init();
+            solver.compute(Spectra::SortRule::LargestMagn, 1000, options.tolerance);
+            if (solver.info() != Spectra::CompInfo::Successful) out.status = Status::NumericalIssue;
+            ev = solver.eigenvalues();
+        }
         for (Eigen::Index i = 0; i < ev.size(); ++i) {
             const cplx z = ev(i);
             const bool dup = std::any_of(out.values.begin(), out.values.end(),

@@ -77,4 +77,46 @@ TEST_CASE("structured shift-invert eigenvalues equal the dense collocation eigen
     }
 }
 
+TEST_CASE("restarted compact Krylov runs at complex shifts find the dense collocation eigenvalues") {
+    // A basis of 24 vectors for 8 eigenvalues: the runs restart and compress their n x r basis
+    // (TOAR). At a complex shift the coefficients are complex, and the compressed basis must be
+    // Q conj(W) for coefficients a W (a wrong conjugate broke the Krylov relation by O(|theta|)
+    // and produced 'converged' Ritz values that were no eigenvalues).
+    for (unsigned seed : {1u, 2u, 3u}) {
+        std::vector<double> delays;
+        const LinearDDE dde = random_ring(8, seed, delays);
+        const int degree = 12;
+        const MatrixXc a = collocation_matrix(dde.to_dense(), degree);
+        Eigen::ComplexEigenSolver<MatrixXc> es(a, false);
+        const std::vector<cplx> shifts{cplx(0.1, 0.6), cplx(-0.2, 1.1), cplx(0.05, 0.3)};
+        SparseEigenOptions o;
+        o.arnoldi = "compact";
+        o.basis = 24;
+        o.restarts = 60;
+        o.tolerance = 1e-12;
+        const SparseEigenResult sp = sparse_collocation_eigenvalues(dde, degree, shifts, 8, o);
+        CAPTURE(seed);
+        CHECK(sp.status == Status::Converged);
+        CHECK(sp.restarts > 0);
+        REQUIRE(sp.values.size() >= 8);
+        for (cplx z : sp.values) {
+            double nearest = 1e300;
+            for (Eigen::Index i = 0; i < es.eigenvalues().size(); ++i) nearest = std::min(nearest, std::abs(es.eigenvalues()(i) - z));
+            CAPTURE(z);
+            CHECK(nearest < 1e-9 * std::max(1.0, std::abs(z)));
+        }
+        // and the 8 nearest each shift are all there
+        for (cplx sigma : shifts) {
+            std::vector<cplx> ev(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
+            std::sort(ev.begin(), ev.end(), [&](cplx x, cplx y) { return std::abs(x - sigma) < std::abs(y - sigma); });
+            for (int i = 0; i < 8; ++i) {
+                const bool found = std::any_of(sp.values.begin(), sp.values.end(), [&](cplx z) { return std::abs(z - ev[i]) < 1e-9; });
+                CAPTURE(sigma);
+                CAPTURE(i);
+                CHECK(found);
+            }
+        }
+    }
+}
+
 TEST_SUITE_END();

@@ -27,6 +27,7 @@
 /// for a real shift). Cells of the rectangle not inside a disc get a shift at their centre and
 /// are split until covered. alpha is lowered until `count` eigenvalues lie right of it.
 
+#include <string>
 #include <vector>
 
 #include "ddemap/core/status.hpp"
@@ -35,15 +36,29 @@
 namespace ddemap {
 
 /// Eigenvalues of the degree-M collocation matrix nearest the given complex shifts (nev per
-/// shift, by Spectra's complex shift-invert Arnoldi on the structured operator), merged.
+/// shift, by shift-invert Arnoldi on the structured operator), merged.
 /// The status is NumericalIssue if any shift's Arnoldi iteration did not converge.
 struct SparseEigenResult {
     std::vector<cplx> values;
     Status status = Status::Converged;
     int factorizations = 0;
+    int restarts = 0;  ///< compact: Krylov-Schur restarts over all shifts
+};
+
+/// How each shift's Arnoldi run is made: "spectra" (Spectra's restarted Arnoldi on the full
+/// (M+1) n vectors) or "compact" (the Krylov basis of rightmost_roots' shift_invert backend: one
+/// n x r matrix and small coefficients, `basis` vectors at most, up to `restarts` Krylov-Schur
+/// restarts keeping half of them; the nev values of largest |1 / (lambda - sigma)| converged to
+/// |residual| <= tolerance |theta|).
+struct SparseEigenOptions {
+    std::string arnoldi = "spectra";
+    int basis = 200;
+    int restarts = 0;
+    double tolerance = 1e-12;
 };
 
 /// For a real DDE with at least one delay (sparse storage, or dense storage made sparse).
-SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& dde, int degree, const std::vector<cplx>& shifts, int nev);
+SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& dde, int degree, const std::vector<cplx>& shifts, int nev,
+                                                 const SparseEigenOptions& options = {});
 
 }  // namespace ddemap
