@@ -110,6 +110,11 @@ double RootBounds::right_bound() const {
     return hi;
 }
 
+bool RootBounds::excludes(double x, double y) const {
+    const double dx = std::max(0.0, x - mu), dy = std::max(0.0, y - std::min(n0, skew));
+    return std::hypot(dx, dy) > delayed_norm(x) * (1.0 + 1e-12);
+}
+
 double relative_residual(const LinearDDE& dde, cplx lambda, const VectorXc& v) {
     const double norm = v.norm();
     if (!(norm > 0.0) || !std::isfinite(norm)) return std::numeric_limits<double>::infinity();

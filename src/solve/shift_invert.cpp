@@ -789,7 +789,7 @@ public:
             c.x0 = std::max(c.x0, m_floor);
             c.y1 = std::min(c.y1, m_height);
             if (covered(c)) continue;
-            if (m_gersh.excludes(c.x0, c.x1, c.y0, c.y1)) {
+            if (bounds.excludes(c.x0, c.y0) || m_gersh.excludes(c.x0, c.x1, c.y0, c.y1)) {
                 ++m_excluded;
                 continue;
             }

@@ -220,6 +220,10 @@ TEST_CASE("the height bound |Im lambda| <= H(Re lambda) holds for every root fou
             CHECK(std::abs(x.value.imag()) <= dde.bounds().height(x.value.real()) * (1.0 + 1e-12));
             CHECK(std::abs(x.value.imag()) <= sparse.bounds().height(x.value.real()) * (1.0 + 1e-12));
             CHECK(dde.bounds().height(x.value.real()) <= dde.bounds().radius(x.value.real()) * (1.0 + 1e-12));
+            // nor does the numerical range exclude a quadrant that holds a root
+            const double x0 = x.value.real() - 1e-9, y0 = std::abs(x.value.imag()) - 1e-9;
+            CHECK_FALSE(dde.bounds().excludes(x0, y0));
+            CHECK_FALSE(sparse.bounds().excludes(x0, y0));
         }
     }
     // u' = d u_xx - u(t - 1) on 50 points with ||A0|| = 4 d: the roots' |Im| stays below
@@ -240,6 +244,10 @@ TEST_CASE("the height bound |Im lambda| <= H(Re lambda) holds for every root fou
         for (double a : {-0.5, 0.0, 0.3}) {
             CHECK(dde.bounds().height(a) == doctest::Approx(std::exp(-a)).epsilon(1e-14));
             CHECK(dde.bounds().radius(a) >= 4.0 * d);
+            // W(A0) is real (mu = 0.4 by Gershgorin): right of a the roots are within e^{-a} of it
+            CHECK(dde.bounds().excludes(a, 1.001 * std::exp(-a)));
+            CHECK_FALSE(dde.bounds().excludes(a, 0.999 * std::exp(-a)));
+            CHECK(dde.bounds().excludes(0.4 + 1.001 * std::exp(-a), 0.0));  // right of mu + N(a) >= mu + N(x)
         }
     }
 }

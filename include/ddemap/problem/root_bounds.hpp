@@ -52,6 +52,10 @@ struct RootBounds {
     double radius(double a) const { return n0 + delayed_norm(a); }
     /// H(a) = min(R(a), skew + delayed_norm(a)): no root with Re >= a has |Im| > H(a)
     double height(double a) const { return std::min(n0, skew) + delayed_norm(a); }
+    /// True when no root z has Re z >= x and |Im z| >= y: a root's distance to the numerical
+    /// range W(A0), which lies in (-inf, mu] x [-skew, skew], is at most N(Re z) <= N(x), so none
+    /// lies where hypot(max(0, x - mu), max(0, y - skew)) > N(x).
+    bool excludes(double x, double y) const;
     /// beta: the fixed point of x = mu + delayed_norm(x)
     double right_bound() const;
     /// |lambda| + R(Re lambda): the scale of Delta(lambda) in relative residuals
