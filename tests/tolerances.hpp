@@ -10,6 +10,11 @@ constexpr double root_abs = 1e-12;
 /// moves a root of condition ~1 by as much (measured: 7e-11); 1e-8 bounds it, while the
 /// closed-form roots compared are more than 0.3 apart.
 constexpr double stiff_root_abs = 1e-8;
+/// A root-free radius against the same formula evaluated with the exact sigma_min and norms
+/// (dense SVD of a 24 x 24 Delta): the radius is bracketed by inequalities that hold exactly
+/// (a Lanczos Ritz value never exceeds the largest eigenvalue), so only rounding (~1e-14 relative)
+/// separates them; 1e-10 relative.
+constexpr double radius_formula_rel = 1e-10;
 /// Rightmost roots against the 40-digit reference data (issue requirement: 1e-10).
 constexpr double reference_root = 1e-10;
 /// sup |Gamma(iw)| against the reference data, relative (issue requirement: 1e-8).

@@ -609,13 +609,27 @@ public:
     }
 };
 
-/// Root-free discs of the DDE itself from the resolvent norm: for |z - z_c| <= r,
-///     sigma_min(Delta(z)) >= sigma_min(Delta(z_c)) - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}
-/// (L bounds ||Delta'|| right of x0), so Delta(z) is nonsingular in the disc of radius
-/// sigma_min(Delta(z_c)) / L. sigma_min = 1 / ||Delta(z_c)^{-1}||: the norm is estimated by
-/// Lanczos on Delta^{-H} Delta^{-1} (one sparse LU of Delta(z_c), two solves per step, full
-/// reorthogonalisation) until the estimate changes by less than 1e-4 over a step, and taken
-/// 25% larger (Lanczos approaches it from below). Independent of the collocation degree.
+/// ||A||_2 <= sqrt(||A||_1 ||A||_inf)
+double norm2_bound(const SpC& a) {
+    Eigen::VectorXd rows = Eigen::VectorXd::Zero(a.rows()), cols = Eigen::VectorXd::Zero(a.cols());
+    for (int k = 0; k < a.outerSize(); ++k)
+        for (SpC::InnerIterator it(a, k); it; ++it) {
+            rows(it.row()) += std::abs(it.value());
+            cols(it.col()) += std::abs(it.value());
+        }
+    return a.rows() > 0 ? std::sqrt(rows.maxCoeff() * cols.maxCoeff()) : 0.0;
+}
+
+/// Root-free discs of the DDE itself from the resolvent norm: for |z - z_c| <= r (right of x0),
+///     sigma_min(Delta(z)) >= s - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}     (L >= ||Delta'||),
+///     sigma_min(Delta(z)) >= s - r L1 - r^2 M2 / 2,   L1 >= ||Delta'(z_c)||,  M2 = sum_k tau_k^2 ||A_k|| e^{-x0 tau_k} (>= ||Delta''||),
+/// s = sigma_min(Delta(z_c)), so Delta(z) is nonsingular in the disc of the larger radius of
+/// s / L and 2 s / (L1 + sqrt(L1^2 + 2 M2 s)). The second is the larger near z_c when the delayed
+/// terms of Delta' = I + sum_k tau_k A_k e^{-z tau_k} partly cancel (L1 is the bound
+/// sqrt(||.||_1 ||.||_inf) of that matrix at z_c). s = 1 / ||Delta(z_c)^{-1}||: the norm is
+/// estimated by Lanczos on Delta^{-H} Delta^{-1} (one sparse LU of Delta(z_c), two solves per
+/// step, full reorthogonalisation) until the estimate changes by less than 1e-4 over a step, and
+/// taken 25% larger (Lanczos approaches it from below). Independent of the collocation degree.
 class ResolventExclusion {
 public:
     explicit ResolventExclusion(const LinearDDE& dde) : m_dde(dde), m_n(dde.dimension()) {
@@ -638,10 +652,16 @@ public:
         Eigen::MatrixXcd basis(m_n, kmax + 1);
         Eigen::VectorXcd x(m_n);
         for (int i = 0; i < m_n; ++i) x(i) = cplx(u(rng), u(rng));
+        // the previous test's leading vector (a nearby point: nearly the same singular vector),
+        // plus as much of a random one, so that the start misses no direction more than a
+        // random start would (and the estimate is given 6 steps at least to find a larger one)
+        if (m_previous.size() == m_n) x = m_previous + x / x.norm();
         basis.col(0) = x / x.norm();
         Eigen::MatrixXd t = Eigen::MatrixXd::Zero(kmax + 1, kmax + 1);
         double estimate = 0.0;
+        int steps = 0;
         for (int k = 0; k < kmax; ++k) {
+            steps = k + 1;
             const Eigen::VectorXcd y = m_lu.solve(basis.col(k));
             Eigen::VectorXcd w;
             if (!m_lu.adjoint_solve(y, w) || !w.allFinite()) return 0.0;  // w = Delta^{-H} Delta^{-1} q_k
@@ -654,19 +674,33 @@ public:
             t(k + 1, k) = t(k, k + 1) = beta;
             Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(k + 1, k + 1), Eigen::EigenvaluesOnly);
             const double next = es.eigenvalues().maxCoeff();
-            const bool settled = k > 2 && std::abs(next - estimate) <= 1e-4 * next;
+            const bool settled = k > 4 && std::abs(next - estimate) <= 1e-4 * next;
             estimate = next;
             if (settled || beta <= 1e-13 * next) break;
             if (k + 1 == kmax) return 0.0;  // not settled: no claim
             basis.col(k + 1) = w / beta;
         }
         if (!(estimate > 0.0) || !std::isfinite(estimate)) return 0.0;
-        const double inverse_norm = 1.25 * std::sqrt(estimate);
-        double lipschitz = 1.0;
-        for (const auto& [norm, delay] : m_terms) lipschitz += delay * norm * std::exp(-x0 * delay);
-        return 1.0 / (inverse_norm * lipschitz);
+        {
+            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(steps, steps));
+            Eigen::Index top;
+            es.eigenvalues().maxCoeff(&top);
+            m_previous = basis.leftCols(steps) * es.eigenvectors().col(top).cast<cplx>();
+            m_previous /= m_previous.norm();
+        }
+        m_steps += steps;
+        const double smin = 1.0 / (1.25 * std::sqrt(estimate));
+        double lipschitz = 1.0, second = 0.0;
+        for (const auto& [norm, delay] : m_terms) {
+            lipschitz += delay * norm * std::exp(-x0 * delay);
+            second += delay * delay * norm * std::exp(-x0 * delay);
+        }
+        const double local = std::min(lipschitz, norm2_bound(m_dde.sparse_characteristic_derivative(zc)));
+        return std::max(smin / lipschitz, 2.0 * smin / (local + std::sqrt(local * local + 2.0 * second * smin)));
     }
     int tests() const { return m_tests; }
+    /// Lanczos steps over all tests (two sparse solves each)
+    long steps() const { return m_steps; }
 
 private:
     const LinearDDE& m_dde;
@@ -675,7 +709,22 @@ private:
     AdjointUmfPackLU m_lu;
     std::vector<std::pair<double, double>> m_terms;
     int m_tests = 0;
+    long m_steps = 0;
+    Eigen::VectorXcd m_previous;  ///< the last test's leading Lanczos vector (a start for the next)
 };
+
+}  // namespace
+
+double root_free_radius(const LinearDDE& input, cplx z, double x0) {
+    const LinearDDE dde = input.to_sparse();
+    if (!dde.is_real() || dde.is_ode()) throw std::invalid_argument("root_free_radius: expected a real DDE with at least one delay");
+    if (!std::isfinite(z.real()) || !std::isfinite(z.imag()) || !std::isfinite(x0))
+        throw std::invalid_argument("root_free_radius: expected a finite point and x0");
+    ResolventExclusion test(dde);
+    return test.free_radius(z, x0);
+}
+
+namespace {
 
 /// The covering: discs of completeness around the shifts, root-free Gershgorin cells, and
 /// the distinct eigenvalues met.
@@ -799,14 +848,17 @@ public:
             const cplx centre(mx, c.y0 == 0.0 ? 0.0 : my);
             bool near_root = true;
             if (m_res && !c.shifted) {
-                // a root-free disc of the DDE around the cell's centre (valid right of the floor)
+                // a root-free disc of the DDE around the cell's centre, valid right of x0: the
+                // cell lies right of both the floor and mx - h, and the Lipschitz bound of Delta
+                // is the smaller the farther right it holds
                 const double h = 0.5 * std::hypot(cw, ch);
-                const double r = m_res->free_radius(cplx(mx, my), m_floor);
+                const double x0 = std::max(m_floor, mx - h);
+                const double r = m_res->free_radius(cplx(mx, my), x0);
                 if (r >= h) {
                     ++m_excluded;
                     continue;
                 }
-                if (r > 0.0) m_discs.push_back({cplx(mx, my), r, true, m_floor});
+                if (r > 0.0) m_discs.push_back({cplx(mx, my), r, true, x0});
                 // otherwise split (twice at most before a shift): the halves may be root-free
                 near_root = r < 0.5 * h || c.splits >= 2;
             }
@@ -1160,7 +1212,7 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
         if (compact)
             os << "; compact Arnoldi (" << result.arnoldi_steps << " steps, " << result.arnoldi_restarts
                << " Krylov-Schur restarts, rank of Q <= " << max_rank << "), " << resolvent.tests()
-               << " resolvent tests (root-free discs of Delta, Lanczos norm estimate x1.25)";
+               << " resolvent tests (root-free discs of Delta, Lanczos norm estimate x1.25, " << resolvent.steps() << " Lanczos steps)";
         result.factorizations += resolvent.tests();
         result.message = os.str();
         return result;

@@ -9,6 +9,7 @@
 
 #include "../tolerances.hpp"
 #include "ddemap/solve/roots.hpp"
+#include "ddemap/solve/shift_invert.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -194,6 +195,49 @@ TEST_CASE("restarted and unrestarted compact Krylov runs give the same roots") {
         CHECK(restarted.arnoldi_restarts > 0);
         CHECK(plain.arnoldi_restarts == 0);
         same(restarted, plain);
+    }
+}
+
+TEST_CASE("root_free_radius: no root of a dense computation lies in the disc, and the radius is the formula's") {
+    // random sparse systems: every root right of the dense path's certified floor is known.
+    // The radius must (1) hold no root, (2) be at most the formula with the exact sigma_min and
+    // the exact ||Delta'(z)||, and (3) at least s / (1.25 L) with the exact s (a Lanczos estimate
+    // of ||Delta^{-1}||^2 never exceeds it).
+    for (unsigned seed : {31u, 32u, 33u}) {
+        const LinearDDE dde = random_sparse(24, 1 + static_cast<int>(seed % 2), seed);
+        RootOptions o;
+        o.method = "dense";
+        o.count = 40;
+        const RootResult r = rightmost_roots(dde.to_dense(), o);
+        REQUIRE(r.status == Status::Converged);
+        const double floor = r.strip_floor;
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<double> ux(floor + 1.0, floor + 2.5), uy(0.0, 3.0);
+        for (int k = 0; k < 25; ++k) {
+            const cplx z(ux(rng), uy(rng));
+            const double x0 = z.real() - 1.0;
+            const double rad = root_free_radius(dde, z, x0);
+            double nearest = 1e300;
+            for (const auto& x : r.roots) nearest = std::min(nearest, std::abs(x.value - z));
+            const Eigen::MatrixXcd d = Eigen::MatrixXcd(dde.sparse_characteristic_matrix(z));
+            const double s = Eigen::JacobiSVD<Eigen::MatrixXcd>(d).singularValues().minCoeff();
+            const double l1 = Eigen::JacobiSVD<Eigen::MatrixXcd>(Eigen::MatrixXcd(dde.sparse_characteristic_derivative(z)))
+                                  .singularValues()
+                                  .maxCoeff();
+            double lip = 1.0, m2 = 0.0;
+            for (const auto& t : dde.bounds().terms) {
+                lip += t.delay * t.norm * std::exp(-x0 * t.delay);
+                m2 += t.delay * t.delay * t.norm * std::exp(-x0 * t.delay);
+            }
+            const double lo = s / (1.25 * lip);
+            const double hi = std::max(s / lip, 2.0 * s / (l1 + std::sqrt(l1 * l1 + 2.0 * m2 * s)));
+            CAPTURE(seed);
+            CAPTURE(z);
+            CHECK(rad < 1.0);
+            CHECK(rad <= nearest);
+            CHECK(rad >= lo * (1.0 - test::tol::radius_formula_rel));
+            CHECK(rad <= hi * (1.0 + test::tol::radius_formula_rel));
+        }
     }
 }
 

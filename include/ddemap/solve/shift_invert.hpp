@@ -61,4 +61,13 @@ struct SparseEigenOptions {
 SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& dde, int degree, const std::vector<cplx>& shifts, int nev,
                                                  const SparseEigenOptions& options = {});
 
+/// The resolvent test of rightmost_roots' shift_invert covering: a radius r such that Delta has
+/// no root in the disc |lambda - z| < r right of x0 (take x0 <= Re z - r for the whole disc),
+///     r = max( s / L, 2 s / (L1 + sqrt(L1^2 + 2 M2 s)) ),   s = sigma_min(Delta(z)),
+///     L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k},  L1 >= ||Delta'(z)||,  M2 = sum_k tau_k^2 ||A_k|| e^{-x0 tau_k},
+/// s from Lanczos on Delta(z)^{-H} Delta(z)^{-1} (one sparse LU) settled to 1e-4 and taken 25%
+/// smaller: an estimate, not a proven bound. 0 when Delta(z) is singular to working precision
+/// or the estimate did not settle. A real DDE with at least one delay.
+double root_free_radius(const LinearDDE& dde, cplx z, double x0);
+
 }  // namespace ddemap
