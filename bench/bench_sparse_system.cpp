@@ -1,6 +1,6 @@
 // Times rightmost_roots on a `roots --system` file with the sparse path (BENCHMARKS.md
 // "Large sparse systems"): the compact Krylov basis (default) or Spectra's full basis.
-//   build/bench/bench_sparse_system FILE.json [--arnoldi compact|spectra] [--count C] [--repeat R] [--restarts K] [--basis B] [--verbose 1]
+//   build/bench/bench_sparse_system FILE.json [--arnoldi compact|spectra] [--count C] [--repeat R] [--restarts K] [--basis B] [--nev E] [--verbose 1]
 // Prints one line per run (seconds, degree, shifts, Arnoldi steps, factorisations, status) and the
 // roots of the last run (full precision, for comparison with bench_slepc).
 #include <algorithm>
@@ -18,7 +18,7 @@
 
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: bench_sparse_system FILE.json [--arnoldi compact|spectra] [--count C] [--repeat R] [--restarts K] [--basis B] [--verbose 1]\n");
+        std::fprintf(stderr, "usage: bench_sparse_system FILE.json [--arnoldi compact|spectra] [--count C] [--repeat R] [--restarts K] [--basis B] [--nev E] [--verbose 1]\n");
         return 2;
     }
     ddemap::RootOptions o;
@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
         else if (f == "--count") o.count = std::atoi(argv[i + 1]);
         else if (f == "--restarts") o.shift_invert.compact_restarts = std::atoi(argv[i + 1]);
         else if (f == "--basis") o.shift_invert.compact_max_steps = std::atoi(argv[i + 1]);
+        else if (f == "--nev") o.shift_invert.eigenvalues_per_shift = std::atoi(argv[i + 1]);
         else if (f == "--verbose") verbose = std::atoi(argv[i + 1]) != 0;
         else if (f == "--repeat") repeat = std::atoi(argv[i + 1]);
         else {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <random>
 #include <sstream>
@@ -239,10 +240,12 @@ public:
     /// `goal` > 0: also stop once the converged prefix's disc |z - sigma| < 1/|theta_last|
     /// (shrunk by the same 1e-6 margin as the covering's) reaches that radius.
     /// `between` (may be empty) is called before every restart (it may throw, e.g. Cancelled).
-    CompactRitz run(int nev, int first_check, int restarts, int keep, double tol, double goal, const std::function<void()>& between) {
+    CompactRitz run(int nev, int first_check, int restarts, int keep, double tol, double goal, int probe,
+                    const std::function<void()>& between) {
         CompactRitz out;
         // a goal may be met long before nev values converge: look from 20 steps on
         int check = std::min(goal > 0.0 ? std::min(first_check, 20) : first_check, m_kmax);
+        if (probe > 0) check = std::min(check, probe);
         keep = std::clamp(keep, 1, m_kmax - 1);
         for (;;) {
             step();
@@ -251,6 +254,9 @@ public:
             if (m_k < check && !m_invariant && m_k < m_kmax) continue;
             ritz(tol, out);
             if (out.converged >= nev || m_invariant) return out;
+            // a probe: nothing converged yet, the shift sees a cluster from afar (the caller
+            // moves it to the dominant Ritz value's estimate)
+            if (probe > 0 && out.steps >= probe && out.converged == 0) return out;
             if (goal > 0.0 && out.converged >= 1 &&
                 1.0 / (std::abs(out.theta[static_cast<std::size_t>(out.converged - 1)]) * (1.0 + 1e-6)) > goal)
                 return out;
@@ -423,12 +429,32 @@ private:
     bool m_invariant = false;
 };
 
-/// The compact Arnoldi run of one shift: `basis` vectors at most, `restarts` Krylov-Schur
-/// restarts (0: none) keeping `keep` Schur vectors.
-CompactRitz compact_arnoldi(const StructuredShiftInvert& op, int nev, int first_check, int basis, int restarts, int keep, double tol,
-                            double goal, const std::function<void()>& between) {
-    CompactKrylov kr(op, basis);
-    return kr.run(nev, first_check, restarts, keep, tol, goal, between);
+/// The compact Arnoldi run of one shift (op factorised at sigma): `basis` vectors at most,
+/// `restarts` Krylov-Schur restarts (0: none) keeping `keep` Schur vectors.
+/// A shift on an eigenvalue (a bound that is attained, as beta of a circulant system, or the
+/// root lambda = 0 of a ring at a cell's centre) gives that one |theta| ~ 1/eps, and every
+/// Krylov vector then carries a component eps |theta_1| along it: the other Ritz values lose that
+/// much accuracy (converged duplicates 2e-10 apart). Such a run (eps |theta_1| > tol |theta_2| /
+/// 100: more than a hundredth of the convergence test) is made again a tenth of the distance to
+/// the next eigenvalue away (along the real axis for a real shift); `sigma` is set to the shift
+/// used, and false is returned when op could not be factorised there.
+bool compact_arnoldi(StructuredShiftInvert& op, cplx& sigma, int nev, int first_check, int basis, int restarts, int keep, double tol,
+                     double goal, int probe, const std::function<void()>& between, CompactRitz& out) {
+    out = CompactKrylov(op, basis).run(nev, first_check, restarts, keep, tol, goal, probe, between);
+    const auto& th = out.theta;
+    const double eps = std::numeric_limits<double>::epsilon();
+    if (th.size() < 2 || !(eps * std::abs(th[0]) > 0.01 * tol * std::abs(th[1])) || !(std::abs(th[1]) > 0.0)) return true;
+    const cplx away = -(1.0 / th[0]) / std::abs(1.0 / th[0]);
+    sigma += (0.1 / std::abs(th[1])) * (sigma.imag() == 0.0 ? cplx(away.real() < 0.0 ? -1.0 : 1.0, 0.0) : away);
+    const int steps = out.steps;
+    if (!op.factor(sigma)) {
+        out = CompactRitz{};
+        out.steps = steps;
+        return false;
+    }
+    out = CompactKrylov(op, basis).run(nev, first_check, restarts, keep, tol, goal, probe, between);
+    out.steps += steps;
+    return true;
 }
 
 }  // namespace
@@ -450,12 +476,18 @@ SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int deg
     for (cplx sigma : shifts) {
         Eigen::VectorXcd ev;
         if (options.arnoldi == "compact") {
-            if (!op.factor(sigma)) {
+            // nudged off an exactly singular shift, as the covering's
+            for (int attempt = 0; attempt < 4 && !op.factor(sigma); ++attempt) sigma += 1e-7 * std::max(1.0, std::abs(sigma));
+            if (!op.factored()) {
                 out.status = Status::NumericalIssue;
                 continue;
             }
-            const CompactRitz rz = compact_arnoldi(op, nev, std::min(options.basis, 2 * nev + 20), options.basis, options.restarts,
-                                                   std::max(nev, options.basis / 2), options.tolerance, 0.0, {});
+            CompactRitz rz;
+            if (!compact_arnoldi(op, sigma, nev, std::min(options.basis, 2 * nev + 20), options.basis, options.restarts,
+                                 std::max(nev, options.basis / 2), options.tolerance, 0.0, 0, {}, rz)) {
+                out.status = Status::NumericalIssue;
+                continue;
+            }
             out.restarts += rz.restarts;
             if (rz.converged < nev) out.status = Status::NumericalIssue;
             ev.resize(rz.converged);
@@ -742,7 +774,10 @@ public:
 
     /// Runs one shift (nudged off a singular point); false after max_shifts.
     /// With restarts, the run stops as soon as its disc has radius `goal` (the cell's reach).
-    bool shift_at(cplx sigma, double goal) {
+    /// `probe` > 0 (compact): a run with nothing converged after that many steps stops, and
+    /// hint() is then the estimate sigma + 1/theta_1 of the eigenvalue it saw best.
+    bool shift_at(cplx sigma, double goal, int probe = 0) {
+        m_hint.reset();
         if (m_shifts >= m_o.max_shifts) return false;
         // the shifts finished so far; may throw Cancelled (caught by rightmost_roots)
         if (m_progress && *m_progress) (*m_progress)(m_before + m_shifts, m_o.max_shifts, sigma.real());
@@ -762,14 +797,19 @@ public:
             const int kmax = static_cast<int>(std::min<Eigen::Index>(size - 1, std::max<Eigen::Index>(ncv, m_o.compact_max_steps)));
             // restarted: the half of the basis with the largest |theta| is kept (at least nev)
             const int keep = std::min(kmax - 1, std::max(nev, kmax / 2));
-            const CompactRitz rz = compact_arnoldi(m_op, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax,
-                                                   m_o.compact_restarts, keep, m_o.arnoldi_tolerance,
-                                                   m_o.compact_restarts > 0 ? goal : 0.0, [&] {
-                                                       // a long run reports again (same count) before each restart
-                                                       if (m_progress && *m_progress)
-                                                           (*m_progress)(m_before + m_shifts - 1, m_o.max_shifts, sigma.real());
-                                                   });
+            CompactRitz rz;
+            const bool factored = compact_arnoldi(m_op, sigma, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax,
+                                                  m_o.compact_restarts, keep, m_o.arnoldi_tolerance,
+                                                  m_o.compact_restarts > 0 ? goal : 0.0, probe, [&] {
+                                                      // a long run reports again (same count) before each restart
+                                                      if (m_progress && *m_progress)
+                                                          (*m_progress)(m_before + m_shifts - 1, m_o.max_shifts, sigma.real());
+                                                  }, rz);
             m_steps += rz.steps;
+            if (!factored) {
+                ++m_failed;
+                return true;
+            }
             m_restarts += rz.restarts;
             m_max_rank = std::max(m_max_rank, rz.max_rank);
             double thmin = std::numeric_limits<double>::infinity();
@@ -780,6 +820,10 @@ public:
             }
             if (rz.converged < 1 || !(thmin > 0.0)) {
                 ++m_failed;
+                if (!rz.theta.empty() && std::abs(rz.theta.front()) > 0.0) {
+                    const cplx z = sigma + 1.0 / rz.theta.front();
+                    if (std::isfinite(z.real()) && std::isfinite(z.imag())) m_hint = z.imag() < 0.0 ? std::conj(z) : z;
+                }
                 return true;
             }
             m_discs.push_back({sigma, 1.0 / (thmin * (1.0 + 1e-6))});  // margin for the Ritz values' own error
@@ -815,12 +859,44 @@ public:
         return true;
     }
 
-    /// Covers [floor, beta] x [0, R(floor)], floor starting at alpha and raised, as eigenvalues
+    /// Shifts at sigma for the cell c. A run that converges nothing (a cluster seen from afar:
+    /// its eigenvalues have nearly equal |1/(lambda - sigma)|, and Arnoldi does not separate
+    /// them) is moved to the eigenvalue it saw best, where the cluster's members are far apart
+    /// in 1/(lambda - sigma), at most twice, when that estimate lies in the cell's reach (inside
+    /// the rectangle, and not in a disc already). `probe`: the first run stops after that many
+    /// steps when nothing has converged (the first shift, far right of the spectrum).
+    /// False when the shift budget ran out.
+    bool shift_near(cplx sigma, const Cell& c, double beta, int probe = 0) {
+        const double far = reach(c, sigma);
+        for (int hop = 0;; ++hop) {
+            if (!shift_at(sigma, reach(c, sigma), hop == 0 ? probe : 0)) return false;
+            if (hop == 2 || !m_hint) return true;
+            const cplx next = *m_hint;
+            if (next.real() < m_floor || next.real() > beta || next.imag() > m_height || std::abs(next - sigma) > far) return true;
+            for (const auto& d : m_discs)
+                if (!d.root_free && std::abs(next - d.centre) < d.radius) return true;
+            // not onto the estimate itself: a shift within rounding of an eigenvalue makes
+            // the operator's other directions inaccurate (its LU is nearly singular)
+            sigma = next + 0.05 * (sigma - next);
+        }
+    }
+
+    /// Covers [floor, beta] x [0, H(floor)], floor starting at alpha and raised, as eigenvalues
     /// are found, to the count-th rightmost one met (cells left of it are no longer needed).
-    /// Cells are taken rightmost first. False when the shift budget ran out.
+    /// Cells are taken rightmost first. The first shift is a probe on the real axis at beta,
+    /// moved to the eigenvalues nearest it (shift_near): the rightmost ones found first raise
+    /// the floor before the rectangle is split. False when the shift budget ran out.
     bool cover(double alpha, double beta, const Bounds& bounds, int count) {
         m_floor = alpha;
         const double height = bounds.height(alpha);
+        m_height = std::min(m_height, height);
+        if (m_discs.empty()) {
+            const Cell all{alpha, beta, 0.0, height};
+            // a little right of beta: the bound can be attained (a circulant system's rightmost root)
+            const cplx seed(beta + 0.05 * (beta - alpha), 0.0);
+            if (!shift_near(seed, all, beta, m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 4) : 0)) return false;
+            raise_floor(bounds, count);
+        }
         auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
         // roughly square cells to start with
@@ -869,10 +945,7 @@ public:
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
                 if (!again) {
-                    double reach = 0.0;  // the cell's farthest corner from the shift
-                    for (double x : {c.x0, c.x1})
-                        for (double y : {c.y0, c.y1}) reach = std::max(reach, std::abs(cplx(x, y) - centre));
-                    if (!shift_at(centre, reach * (1.0 + 1e-9))) return false;
+                    if (!shift_near(centre, c, beta)) return false;
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
@@ -908,6 +981,13 @@ public:
     int max_rank() const { return m_max_rank; }
 
 private:
+    /// The distance from sigma to the cell's farthest corner (a little more).
+    static double reach(const Cell& c, cplx sigma) {
+        double r = 0.0;
+        for (double x : {c.x0, c.x1})
+            for (double y : {c.y0, c.y1}) r = std::max(r, std::abs(cplx(x, y) - sigma));
+        return r * (1.0 + 1e-9);
+    }
     /// A cell inside a disc; one inside an Arnoldi disc (not root-free) needs the collocation to
     /// resolve it: its farthest corner raises extent().
     bool covered(const Cell& c) {
@@ -954,6 +1034,7 @@ private:
     int m_max_rank = 0;
     double m_floor = 0.0;
     double m_height = std::numeric_limits<double>::infinity();
+    std::optional<cplx> m_hint;  ///< the last probe's estimate of the eigenvalue it saw best (upper half)
 
     void raise_floor(const Bounds& bounds, int count) {
         std::vector<double> re;
@@ -1108,8 +1189,13 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
             budget = cover.cover(alpha, beta, bounds, options.count);
             right = with_conjugates(cover.values(), cover.floor());
             if (!budget || right.size() >= std::size_t(options.count)) break;
-            // fewer than `count` eigenvalues right of alpha: widen the strip
-            alpha -= std::max(beta - alpha, 1.0 / tau);
+            // fewer than `count` eigenvalues right of alpha: widen the strip, to the count-th
+            // rightmost eigenvalue met so far when the discs reached that far left
+            const std::vector<cplx> met = with_conjugates(cover.values(), -std::numeric_limits<double>::infinity());
+            if (met.size() >= std::size_t(options.count) && met[options.count - 1].real() < alpha)
+                alpha = met[options.count - 1].real();
+            else
+                alpha -= std::max(beta - alpha, 1.0 / tau);
         }
         alpha = cover.floor();
         result.shifts += cover.shifts();
