@@ -864,7 +864,7 @@ public:
     /// them) is moved to the eigenvalue it saw best, where the cluster's members are far apart
     /// in 1/(lambda - sigma), at most twice, when that estimate lies in the cell's reach (inside
     /// the rectangle, and not in a disc already). `probe`: the first run stops after that many
-    /// steps when nothing has converged (the first shift, far right of the spectrum).
+    /// steps when nothing has converged.
     /// False when the shift budget ran out.
     bool shift_near(cplx sigma, const Cell& c, double beta, int probe = 0) {
         const double far = reach(c, sigma);
@@ -897,6 +897,10 @@ public:
             if (!shift_near(seed, all, beta, m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 4) : 0)) return false;
             raise_floor(bounds, count);
         }
+        // a cell's shift gives up after half the basis when nothing converged (a cluster seen from
+        // afar, or eigenvalues outside the cell's reach): it is moved or the cell split, and the
+        // halves' resolvent tests are cheaper than the rest of a run that converges nothing
+        const int probe = m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 2) : 0;
         auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
         // roughly square cells to start with
@@ -935,8 +939,9 @@ public:
                     continue;
                 }
                 if (r > 0.0) m_discs.push_back({cplx(mx, my), r, true, x0});
-                // otherwise split (twice at most before a shift): the halves may be root-free
-                near_root = r < 0.5 * h || c.splits >= 2;
+                // otherwise split (twice at most before a shift) unless the disc is much smaller
+                // than the cell (a root near its centre): the halves may be root-free
+                near_root = r < 0.25 * h || c.splits >= 2;
             }
             // where even the centre is root-free, smaller cells will be too: split instead of
             // a (slow) shift far from the spectrum
@@ -945,7 +950,7 @@ public:
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
                 if (!again) {
-                    if (!shift_near(centre, c, beta)) return false;
+                    if (!shift_near(centre, c, beta, probe)) return false;
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
