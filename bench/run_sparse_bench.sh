@@ -3,7 +3,7 @@
 # reference, 10^3 only) and SLEPc's NEP (NLEIGS), side by side (BENCHMARKS.md "Large sparse systems").
 # SLEPc is a bench-only dependency: installed here (Debian libslepc-complex-dev), not by
 # scripts/install-deps.sh; bench_slepc is built only when it is found.
-#   bash bench/run_sparse_bench.sh [REPEAT] [TIMEOUT_S]
+#   bash bench/run_sparse_bench.sh [REPEAT] [TIMEOUT_S]      (SPECTRA=0 skips the full-basis reference)
 set -u
 cd "$(dirname "$0")/.."
 repeat="${1:-3}"
@@ -28,10 +28,12 @@ python3 bench/sparse_systems.py rd --nx 100 --ny 100 --out $d/rd2d10000.json
 # rings of 500 and 5,000 OVRV cars written out (k1 = 0.2, k2 = 0.4, th = 1.5, tau = 0.5)
 python3 bench/sparse_systems.py ring --cars 500 --out $d/ring1000.json
 python3 bench/sparse_systems.py ring --cars 5000 --out $d/ring10000.json
-for f in rd1000 rd1000_3 rd2d1000 ring1000 rd10000 rd10000_3 rd2d10000 ring10000; do
+# a random network (x' = -x + W0 x + W1 x(t - 1), 4 entries per row): no structure, LUs fill in
+python3 bench/sparse_systems.py net --n 1000 --out $d/net1000.json
+for f in rd1000 rd1000_3 rd2d1000 ring1000 net1000 rd10000 rd10000_3 rd2d10000 ring10000; do
     echo "== $f: compact Krylov"
     timeout "$limit" build/bench/bench_sparse_system $d/$f.json --repeat "$repeat" || echo "(not done in $limit s)"
-    case $f in *10000*) ;; *)
+    case "$f:${SPECTRA:-1}" in *10000*|*:0) ;; *)
         echo "== $f: Spectra (full basis, the reference)"
         timeout "$limit" build/bench/bench_sparse_system $d/$f.json --arnoldi spectra --repeat 1 || echo "(not done in $limit s)";;
     esac
