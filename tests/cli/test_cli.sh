@@ -319,6 +319,41 @@ zd = [complex(r["re"], r["im"]) for r in d["result"]["roots"]]
 assert len(zs) >= 6 and all(min(abs(z - w) for w in zd) < 1e-9 for z in zs), (zs, zd)
 PY
 
+# a stiff 400-state delayed diffusion u' = 0.05 u_xx + 0.5 u - u(t - 2) on (0, 1): the sparse path's
+# output is bitwise identical for 1 and 2 threads, and its roots are the Lambert-W closed form
+# (mode k: lambda + mu_k - 0.5 = -exp(-2 lambda), mu_k = 0.05 (n+1)^2 4 sin^2(k pi / (2 (n+1))))
+python3 - >"$tmp/diff.json" <<'PY'
+import json
+n, c = 400, 0.05 * 401 ** 2
+a0 = [[i, i, -2 * c + 0.5] for i in range(n)] + [[i, i + 1, c] for i in range(n - 1)] + [[i + 1, i, c] for i in range(n - 1)]
+print(json.dumps({"dimension": n, "delays": [2.0], "A0": {"triplets": a0}, "A": [{"triplets": [[i, i, -1.0] for i in range(n)]}]}))
+PY
+OMP_NUM_THREADS=1 "$bin" roots --system "$tmp/diff.json" --count 6 --solver sparse --format json >"$tmp/diff1.json" &&
+    OMP_NUM_THREADS=2 "$bin" roots --system "$tmp/diff.json" --count 6 --solver sparse --format json >"$tmp/diff2.json" &&
+    cmp -s "$tmp/diff1.json" "$tmp/diff2.json" && ok || bad "roots --system (sparse): output depends on the number of threads"
+python3 - "$tmp/diff1.json" <<'PY' && ok || bad "roots --system (sparse, stiff diffusion) against the Lambert-W closed form"
+import json, sys, cmath, math
+e = json.load(open(sys.argv[1]))
+assert e["status"] == "converged" and e["solver"]["used"] == "sparse", (e["status"], e["solver"])
+n = 400
+def branch(mu, z):  # Newton on lambda + mu - 0.5 + exp(-2 lambda) = 0 from z
+    for _ in range(100):
+        f = z + mu - 0.5 + cmath.exp(-2 * z)
+        z -= f / (1 - 2 * cmath.exp(-2 * z))
+    return z
+ref = []
+for k in range(1, 6):
+    mu = 0.05 * 401 ** 2 * 4 * math.sin(k * math.pi / 802) ** 2
+    for z0 in (complex(0.3, 0.6), complex(0, 1.0), complex(-0.3, 3.5)):
+        z = branch(mu, z0)
+        if abs(z + mu - 0.5 + cmath.exp(-2 * z)) < 1e-12 and all(abs(z - w) > 1e-8 for w in ref):
+            ref += [z, z.conjugate()]
+zs = [complex(r["re"], r["im"]) for r in e["result"]["roots"]]
+assert len(zs) >= 6, zs
+# every listed root is a closed-form root (the stiff tolerance: rounding eps ||A0|| ~ 1e-11)
+assert all(min(abs(z - w) for w in ref) < 1e-8 for z in zs), (zs, sorted(ref, key=lambda z: -z.real)[:8])
+PY
+
 # mixed fleets: roots --fleet-pattern / --fleet, bad fleet files, mix
 "$bin" roots --fleet-pattern "A_min,E_min*2" --ring 12 --count 4 --format json >"$tmp/fleet.json" &&
     json_has "$tmp/fleet.json" roots spectral_abscissa ring_stable trivial_root_found product_residual strip_floor status degree_reason && ok || bad "roots --fleet-pattern json"
