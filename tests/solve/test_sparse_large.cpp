@@ -207,7 +207,7 @@ TEST_CASE("root_free_radius: no root of a dense computation lies in the disc, an
         const LinearDDE dde = random_sparse(24, 1 + static_cast<int>(seed % 2), seed);
         RootOptions o;
         o.method = "dense";
-        o.count = 40;
+        o.count = 20;
         const RootResult r = rightmost_roots(dde.to_dense(), o);
         REQUIRE(r.status == Status::Converged);
         const double floor = r.strip_floor;
