@@ -39,18 +39,6 @@ bool all_finite(const SparseMatrixXd& m) {
     return true;
 }
 
-/// ||A||_2 <= sqrt(||A||_1 ||A||_inf)
-double norm2_bound(const SparseMatrixXd& a) {
-    Eigen::VectorXd rows = Eigen::VectorXd::Zero(a.rows()), cols = Eigen::VectorXd::Zero(a.cols());
-    for (int k = 0; k < a.outerSize(); ++k)
-        for (SparseMatrixXd::InnerIterator it(a, k); it; ++it) {
-            rows(it.row()) += std::abs(it.value());
-            cols(it.col()) += std::abs(it.value());
-        }
-    const double r = rows.size() ? rows.maxCoeff() : 0.0, c = cols.size() ? cols.maxCoeff() : 0.0;
-    return std::sqrt(r * c);
-}
-
 /// mu_2(A) = lambda_max((A + A^T)/2) <= max_i (a_ii + sum_{j != i} |a_ij + a_ji| / 2) (Gershgorin)
 double log_norm_bound(const SparseMatrixXd& a) {
     const SparseMatrixXd sym = 0.5 * (a + SparseMatrixXd(a.transpose()));

@@ -14,6 +14,7 @@
 #include <Spectra/GenEigsComplexShiftSolver.h>
 
 #include "ddemap/discretize/chebyshev.hpp"
+#include "ddemap/problem/root_bounds.hpp"
 #include "core/internal/eigen_threads.hpp"
 #include "internal/backends.hpp"
 
@@ -640,17 +641,6 @@ public:
         return code == 0;
     }
 };
-
-/// ||A||_2 <= sqrt(||A||_1 ||A||_inf)
-double norm2_bound(const SpC& a) {
-    Eigen::VectorXd rows = Eigen::VectorXd::Zero(a.rows()), cols = Eigen::VectorXd::Zero(a.cols());
-    for (int k = 0; k < a.outerSize(); ++k)
-        for (SpC::InnerIterator it(a, k); it; ++it) {
-            rows(it.row()) += std::abs(it.value());
-            cols(it.col()) += std::abs(it.value());
-        }
-    return a.rows() > 0 ? std::sqrt(rows.maxCoeff() * cols.maxCoeff()) : 0.0;
-}
 
 /// Root-free discs of the DDE itself from the resolvent norm: for |z - z_c| <= r (right of x0),
 ///     sigma_min(Delta(z)) >= s - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}     (L >= ||Delta'||),

@@ -21,6 +21,7 @@
 /// and without a vector (dense storage) its minimum over v, sigma_min(Delta(lambda)) / scale.
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "ddemap/core/types.hpp"
@@ -28,6 +29,20 @@
 namespace ddemap {
 
 class LinearDDE;
+
+/// ||A||_2 <= sqrt(||A||_1 ||A||_inf): the 2-norm bound of sparse storage (0 for an empty
+/// matrix), for any Eigen sparse matrix, real or complex.
+template <class Sparse>
+double norm2_bound(const Sparse& a) {
+    Eigen::VectorXd rows = Eigen::VectorXd::Zero(a.rows()), cols = Eigen::VectorXd::Zero(a.cols());
+    for (Eigen::Index k = 0; k < a.outerSize(); ++k)
+        for (typename Sparse::InnerIterator it(a, k); it; ++it) {
+            rows(it.row()) += std::abs(it.value());
+            cols(it.col()) += std::abs(it.value());
+        }
+    const double r = rows.size() ? rows.maxCoeff() : 0.0, c = cols.size() ? cols.maxCoeff() : 0.0;
+    return std::sqrt(r * c);
+}
 
 /// The bounds above for one DDE (computed once, when the LinearDDE is built).
 struct RootBounds {
