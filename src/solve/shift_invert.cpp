@@ -430,6 +430,14 @@ private:
     bool m_invariant = false;
 };
 
+/// Factorises op at sigma, nudged off an exactly singular shift (at most 4 times by
+/// 1e-7 max(1, |sigma|), along the real axis for a real shift); false when it stays singular.
+bool factor_near(StructuredShiftInvert& op, cplx& sigma) {
+    const double nudge = 1e-7 * std::max(1.0, std::abs(sigma));
+    for (int attempt = 0; attempt < 4 && !op.factor(sigma); ++attempt) sigma += cplx(nudge, sigma.imag() != 0.0 ? nudge : 0.0);
+    return op.factored();
+}
+
 /// The compact Arnoldi run of one shift (op factorised at sigma): `basis` vectors at most,
 /// `restarts` Krylov-Schur restarts (0: none) keeping `keep` Schur vectors.
 /// A shift on an eigenvalue (a bound that is attained, as beta of a circulant system, or the
@@ -477,9 +485,7 @@ SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int deg
     for (cplx sigma : shifts) {
         Eigen::VectorXcd ev;
         if (options.arnoldi == "compact") {
-            // nudged off an exactly singular shift, as the covering's
-            for (int attempt = 0; attempt < 4 && !op.factor(sigma); ++attempt) sigma += 1e-7 * std::max(1.0, std::abs(sigma));
-            if (!op.factored()) {
+            if (!factor_near(op, sigma)) {
                 out.status = Status::NumericalIssue;
                 continue;
             }
@@ -772,8 +778,7 @@ public:
         // the shifts finished so far; may throw Cancelled (caught by rightmost_roots)
         if (m_progress && *m_progress) (*m_progress)(m_before + m_shifts, m_o.max_shifts, sigma.real());
         ++m_shifts;
-        const double nudge = 1e-7 * scale_of(sigma);
-        for (int attempt = 0; attempt < 4 && !m_op.factor(sigma); ++attempt) sigma += cplx(nudge, sigma.imag() != 0.0 ? nudge : 0.0);
+        factor_near(m_op, sigma);
         const Eigen::Index size = m_op.rows();
         const int nev = static_cast<int>(std::min<Eigen::Index>(m_o.eigenvalues_per_shift, size - 3));
         const Eigen::Index ncv = std::min<Eigen::Index>(size, 5 * nev / 2 + 20);
