@@ -878,7 +878,7 @@ public:
 
     /// Covers [floor, beta] x [0, H(floor)], floor starting at alpha and raised, as eigenvalues
     /// are found, to the count-th rightmost one met (cells left of it are no longer needed).
-    /// Cells are taken rightmost first. The first shift is a probe on the real axis at beta,
+    /// Cells are taken rightmost first. The first shift is a probe on the real axis just right of beta,
     /// moved to the eigenvalues nearest it (shift_near): the rightmost ones found first raise
     /// the floor before the rectangle is split. False when the shift budget ran out.
     bool cover(double alpha, double beta, const Bounds& bounds, int count) {
