@@ -24,6 +24,9 @@ constexpr double reference_sup_rel = 1e-8;
 constexpr double reference_omega_rel = 1e-6;
 /// Same root from two algorithms in double precision (dense full ring vs Fourier modes).
 constexpr double same_root = 1e-10;
+/// A tall complex product Q p or Q^H w (n = 1000, r <= 130) summed in another order than
+/// Eigen's: the rounding of either is at most r eps ||Q|| ||p|| (~3e-14 relative here); 1e-12.
+constexpr double kernel_rel = 1e-12;
 /// Collocation eigenvalues from the sparse shift-invert against a dense eigen-decomposition of
 /// the same matrix (issue requirement: 1e-9; both are backward stable, |lambda| <= ~3 here).
 constexpr double sparse_vs_dense = 1e-9;

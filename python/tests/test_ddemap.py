@@ -485,14 +485,14 @@ def test_ctrl_c_stops_a_long_mixed_ring():
 
 
 def test_ctrl_c_stops_a_long_system_roots(tmp_path):
-    # a sparse circulant system x_i' = -x_i + 0.95 x_{i-1}(t - 1) of 3000 states, 100 roots (a
-    # dense band of them, about 3 s): the sparse path's Arnoldi shifts, interrupted between shifts
-    n = 3000
+    # a sparse circulant system x_i' = -x_i + 0.95 x_{i-1}(t - 1) of 6000 states, 200 roots (a
+    # dense band of them, about 2.5 s): the sparse path's Arnoldi shifts, interrupted between shifts
+    n = 6000
     triplets = [[i, (i - 1) % n, 0.95] for i in range(n)]
     system = tmp_path / "circulant.json"
     system.write_text(json.dumps({"dimension": n, "delays": [1.0], "A0": {"triplets": [[i, i, -1.0] for i in range(n)]},
                                   "A": [{"triplets": triplets}]}))
-    call = lambda: ddemap.roots(system=str(system), count=100, solver="sparse")
+    call = lambda: ddemap.roots(system=str(system), count=200, solver="sparse")
     full, at, took = _interrupted_after(call, 0.25)
     assert full > 1, full
     # checked before every shift: stopped within a few shifts of the signal, long before the end
