@@ -848,6 +848,7 @@ public:
             }
             if (rz.converged < 1 || !(thmin > 0.0)) {
                 ++m_failed;
+                m_failed_at.push_back(sigma);
                 if (!rz.theta.empty() && std::abs(rz.theta.front()) > 0.0) {
                     const cplx z = sigma + 1.0 / rz.theta.front();
                     if (std::isfinite(z.real()) && std::isfinite(z.imag())) m_hint = z.imag() < 0.0 ? std::conj(z) : z;
@@ -897,7 +898,7 @@ public:
     bool shift_near(cplx sigma, const Cell& c, double beta, int probe = 0) {
         const double far = reach(c, sigma);
         for (int hop = 0;; ++hop) {
-            if (!shift_at(sigma, reach(c, sigma), hop == 0 ? probe : 0)) return false;
+            if (!shift_at(sigma, reach(c, sigma), probe)) return false;
             if (hop == 2 || !m_hint) return true;
             const cplx next = *m_hint;
             if (next.real() < m_floor || next.real() > beta || next.imag() > m_height || std::abs(next - sigma) > far) return true;
@@ -925,10 +926,10 @@ public:
             if (!shift_near(seed, all, beta, m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 4) : 0)) return false;
             raise_floor(bounds, count);
         }
-        // a cell's shift gives up after half the basis when nothing converged (a cluster seen from
-        // afar, or eigenvalues outside the cell's reach): it is moved or the cell split, and the
-        // halves' resolvent tests are cheaper than the rest of a run that converges nothing
-        const int probe = m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 2) : 0;
+        // a cell's shift gives up when nothing converged (a cluster seen from afar, or eigenvalues
+        // outside the cell's reach) once it cost as much as a resolvent test: it is moved or the
+        // cell split, and the halves' resolvent tests are cheaper than the rest of such a run
+        auto probe = [&] { return m_o.arnoldi == "compact" ? probe_steps() : 0; };
         auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
         // roughly square cells to start with
@@ -977,8 +978,10 @@ public:
             if (!c.shifted && !empty_centre && near_root) {
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
+                // nor where a run converged nothing (it would again: same operator, same start)
+                for (cplx f : m_failed_at) again = again || f == centre;
                 if (!again) {
-                    if (!shift_near(centre, c, beta, probe)) return false;
+                    if (!shift_near(centre, c, beta, probe())) return false;
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
@@ -1014,6 +1017,34 @@ public:
     int max_rank() const { return m_max_rank; }
 
 private:
+    /// The steps a cell's probe may take before it gives up: the most, in [20, basis / 2], whose
+    /// work is at most that of one resolvent test. Work in flops (a complex multiply-add is 8),
+    /// from the last LU of the shift (UMFPACK's flop count F, nonzeros Z of L and U), the
+    /// dimension n, degree M, K delays, and S, the Lanczos steps per test so far (25 before any):
+    ///     LU     F + 1000 n        (UMFPACK's cost per row besides flops: 2.2 ms at n = 10^4, F = 1.4e5)
+    ///     solve  8 Z + 100 n
+    ///     test   LU + S (2 solve + 12 n S)      (reorthogonalised: 3 passes over S/2 vectors)
+    ///     probe  LU + sum_{j <= P} (solve + 8 (4 + K) n j + 24 (M + 1) j^2)
+    /// (after j steps Q has about j columns, read 1 + K times in the solve and 3 times by CGS2,
+    /// and the coefficients (M + 1) j x j are read 3 times). Where LUs are cheap and the basis
+    /// costly (a ring of 10^4 states: P = 27) a probe stops early; where LUs fill in (a random
+    /// network: one LU costs 100 steps) it runs to half the basis, as before this model.
+    int probe_steps() const {
+        const double n = m_op.dimension(), m1 = m_op.degree() + 1.0, k = m_op.delays();
+        const double s = m_res && m_res->tests() > 0 ? static_cast<double>(m_res->steps()) / m_res->tests() : 25.0;
+        const double lu = m_op.lu_flops() + 1000.0 * n, solve = 8.0 * m_op.lu_nonzeros() + 100.0 * n;
+        const double test = lu + s * (2.0 * solve + 12.0 * n * s);
+        const int cap = std::max(20, m_o.compact_max_steps / 2);
+        double work = 0.0;  // the LU is paid whether the run goes on or not
+        int p = 0;
+        while (p < cap) {
+            const double j = p + 1.0;
+            work += solve + 8.0 * (4.0 + k) * n * j + 24.0 * m1 * j * j;
+            if (work > 2.0 * test) break;
+            ++p;
+        }
+        return std::max(std::min(20, cap), p);
+    }
     /// The distance from sigma to the cell's farthest corner (a little more).
     static double reach(const Cell& c, cplx sigma) {
         double r = 0.0;
@@ -1067,6 +1098,7 @@ private:
     int m_max_rank = 0;
     double m_floor = 0.0;
     double m_height = std::numeric_limits<double>::infinity();
+    std::vector<cplx> m_failed_at;  ///< shifts whose compact run converged nothing
     std::optional<cplx> m_hint;  ///< the last probe's estimate of the eigenvalue it saw best (upper half)
 
     void raise_floor(const Bounds& bounds, int count) {
