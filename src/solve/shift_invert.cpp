@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/UmfPackSupport>
 #include <Spectra/GenEigsComplexShiftSolver.h>
@@ -660,7 +661,7 @@ public:
             if ((ratio < 1.0 - 1e-12).all()) return true;
             // Collatz-Wielandt: rho(diag^{-1} W) >= min_i ratio_i, and no scaling d makes the
             // rows dominant once rho >= 1
-            if (ratio.minCoeff() >= 1.0) return false;
+            if ((ratio >= 1.0).all()) return false;  // (a NaN ratio is not >= 1: no early claim)
             d = (t.array() / diag.array()).matrix() + d;  // Perron vector of diag^{-1} W (shifted by I)
             d /= d.maxCoeff();
             if (d.minCoeff() <= 0.0 || !d.allFinite()) return false;
@@ -750,6 +751,7 @@ public:
             m_previous /= m_previous.norm();
         }
         m_steps += steps;
+        ++m_settled;
         const double smin = 1.0 / (1.25 * std::sqrt(estimate));
         double lipschitz = 1.0, second = 0.0;
         for (const auto& [norm, delay] : m_terms) {
@@ -760,8 +762,9 @@ public:
         return std::max(smin / lipschitz, 2.0 * smin / (local + std::sqrt(local * local + 2.0 * second * smin)));
     }
     int tests() const { return m_tests; }
-    /// Lanczos steps over all tests (two sparse solves each)
+    /// Lanczos steps over the tests that settled (two sparse solves each), and their number
     long steps() const { return m_steps; }
+    int settled() const { return m_settled; }
 
 private:
     const LinearDDE& m_dde;
@@ -770,6 +773,7 @@ private:
     UmfLU m_lu;
     std::vector<std::pair<double, double>> m_terms;
     int m_tests = 0;
+    int m_settled = 0;
     long m_steps = 0;
     Eigen::VectorXcd m_previous;  ///< the last test's leading Lanczos vector (a start for the next)
 };
@@ -807,6 +811,7 @@ public:
     /// hint() is then the estimate sigma + 1/theta_1 of the eigenvalue it saw best.
     bool shift_at(cplx sigma, double goal, int probe = 0) {
         m_hint.reset();
+        const cplx requested = sigma;  // (factor_near may nudge sigma)
         if (m_shifts >= m_o.max_shifts) return false;
         // the shifts finished so far; may throw Cancelled (caught by rightmost_roots)
         if (m_progress && *m_progress) (*m_progress)(m_before + m_shifts, m_o.max_shifts, sigma.real());
@@ -848,7 +853,7 @@ public:
             }
             if (rz.converged < 1 || !(thmin > 0.0)) {
                 ++m_failed;
-                m_failed_at.push_back(sigma);
+                m_failed_at.push_back({requested, probe});
                 if (!rz.theta.empty() && std::abs(rz.theta.front()) > 0.0) {
                     const cplx z = sigma + 1.0 / rz.theta.front();
                     if (std::isfinite(z.real()) && std::isfinite(z.imag())) m_hint = z.imag() < 0.0 ? std::conj(z) : z;
@@ -892,7 +897,7 @@ public:
     /// its eigenvalues have nearly equal |1/(lambda - sigma)|, and Arnoldi does not separate
     /// them) is moved to the eigenvalue it saw best, where the cluster's members are far apart
     /// in 1/(lambda - sigma), at most twice, when that estimate lies in the cell's reach (inside
-    /// the rectangle, and not in a disc already). `probe`: the first run stops after that many
+    /// the rectangle, and not in a disc already). `probe`: each run stops after that many
     /// steps when nothing has converged.
     /// False when the shift budget ran out.
     bool shift_near(cplx sigma, const Cell& c, double beta, int probe = 0) {
@@ -927,8 +932,8 @@ public:
             raise_floor(bounds, count);
         }
         // a cell's shift gives up when nothing converged (a cluster seen from afar, or eigenvalues
-        // outside the cell's reach) once it cost as much as a resolvent test: it is moved or the
-        // cell split, and the halves' resolvent tests are cheaper than the rest of such a run
+        // outside the cell's reach) once it cost as much as two resolvent tests: it is moved or
+        // the cell split, and the halves' tests are cheaper than the rest of such a run
         auto probe = [&] { return m_o.arnoldi == "compact" ? probe_steps() : 0; };
         auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
@@ -978,10 +983,12 @@ public:
             if (!c.shifted && !empty_centre && near_root) {
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
-                // nor where a run converged nothing (it would again: same operator, same start)
-                for (cplx f : m_failed_at) again = again || f == centre;
+                // nor where a run converged nothing in as many steps as this one may take (it would
+                // again: same operator, same start)
+                const int steps = probe();
+                for (const auto& f : m_failed_at) again = again || (f.first == centre && f.second > 0 && f.second >= steps);
                 if (!again) {
-                    if (!shift_near(centre, c, beta, probe())) return false;
+                    if (!shift_near(centre, c, beta, steps)) return false;
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
@@ -1018,20 +1025,21 @@ public:
 
 private:
     /// The steps a cell's probe may take before it gives up: the most, in [20, basis / 2], whose
-    /// work is at most that of one resolvent test. Work in flops (a complex multiply-add is 8),
-    /// from the last LU of the shift (UMFPACK's flop count F, nonzeros Z of L and U), the
-    /// dimension n, degree M, K delays, and S, the Lanczos steps per test so far (25 before any):
+    /// work is at most that of two resolvent tests (the halves of a split cell). Work in flops
+    /// (a complex multiply-add is 8), from the last shift's LU (UMFPACK's flop count F, nonzeros
+    /// Z of L and U; the pattern is the same at every shift), the dimension n, degree M, K
+    /// delays, and S, the Lanczos steps per settled test so far (25 before any):
     ///     LU     F + 1000 n        (UMFPACK's cost per row besides flops: 2.2 ms at n = 10^4, F = 1.4e5)
     ///     solve  8 Z + 100 n
-    ///     test   LU + S (2 solve + 12 n S)      (reorthogonalised: 3 passes over S/2 vectors)
+    ///     test   LU + S (2 solve + 12 n S)      (reorthogonalised in full: 3 passes over S/2 vectors)
     ///     probe  LU + sum_{j <= P} (solve + 8 (4 + K) n j + 24 (M + 1) j^2)
     /// (after j steps Q has about j columns, read 1 + K times in the solve and 3 times by CGS2,
     /// and the coefficients (M + 1) j x j are read 3 times). Where LUs are cheap and the basis
-    /// costly (a ring of 10^4 states: P = 27) a probe stops early; where LUs fill in (a random
+    /// costly (a ring of 10^4 states: P = 36) a probe stops early; where LUs fill in (a random
     /// network: one LU costs 100 steps) it runs to half the basis, as before this model.
     int probe_steps() const {
         const double n = m_op.dimension(), m1 = m_op.degree() + 1.0, k = m_op.delays();
-        const double s = m_res && m_res->tests() > 0 ? static_cast<double>(m_res->steps()) / m_res->tests() : 25.0;
+        const double s = m_res && m_res->settled() > 0 ? static_cast<double>(m_res->steps()) / m_res->settled() : 25.0;
         const double lu = m_op.lu_flops() + 1000.0 * n, solve = 8.0 * m_op.lu_nonzeros() + 100.0 * n;
         const double test = lu + s * (2.0 * solve + 12.0 * n * s);
         const int cap = std::max(20, m_o.compact_max_steps / 2);
@@ -1098,7 +1106,7 @@ private:
     int m_max_rank = 0;
     double m_floor = 0.0;
     double m_height = std::numeric_limits<double>::infinity();
-    std::vector<cplx> m_failed_at;  ///< shifts whose compact run converged nothing
+    std::vector<std::pair<cplx, int>> m_failed_at;  ///< shifts (as asked) whose run converged nothing, and its probe length
     std::optional<cplx> m_hint;  ///< the last probe's estimate of the eigenvalue it saw best (upper half)
 
     void raise_floor(const Bounds& bounds, int count) {

@@ -20,7 +20,7 @@ namespace ddemap::detail {
 using GsMatrix = Eigen::Ref<const Eigen::MatrixXcd>;
 
 /// Rows per block: 256 rows of 200 complex columns are 800 KiB.
-constexpr Eigen::Index kGsRows = 256;
+inline constexpr Eigen::Index kGsRows = 256;
 
 /// w[i0:i0+b] += Q[i0:i0+b, :] p (column-major Q with leading dimension ld), four columns at a time.
 inline void add_times_rows(const std::complex<double>* q, Eigen::Index ld, Eigen::Index i0, Eigen::Index b,
