@@ -560,8 +560,7 @@ SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int deg
 
 namespace {
 
-double scale_of(cplx z) { return std::max(1.0, std::abs(z)); }
-
+using detail::scale_of;  // max(1, |z|), internal/backends.hpp
 using Bounds = RootBounds;
 
 }  // namespace
