@@ -930,10 +930,6 @@ public:
             if (!shift_near(seed, all, beta, m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 4) : 0)) return false;
             raise_floor(bounds, count);
         }
-        // a cell's shift gives up when nothing converged (a cluster seen from afar, or eigenvalues
-        // outside the cell's reach) once it cost as much as two resolvent tests: it is moved or
-        // the cell split, and the halves' tests are cheaper than the rest of such a run
-        auto probe = [&] { return m_o.arnoldi == "compact" ? probe_steps() : 0; };
         auto later = [](const Cell& a, const Cell& b) { return a.x1 != b.x1 ? a.x1 < b.x1 : a.y0 > b.y0; };
         std::priority_queue<Cell, std::vector<Cell>, decltype(later)> queue(later);
         // roughly square cells to start with
@@ -982,12 +978,17 @@ public:
             if (!c.shifted && !empty_centre && near_root) {
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
-                // nor where a run converged nothing in as many steps as this one may take (it would
-                // again: same operator, same start)
-                const int steps = probe();
-                for (const auto& f : m_failed_at) again = again || (f.first == centre && f.second > 0 && f.second >= steps);
+                // a cell's shift gives up when nothing converged (a cluster seen from afar, or
+                // eigenvalues outside the cell's reach) once it cost as much as two resolvent
+                // tests: it is moved or the cell split, and the halves' tests are cheaper than
+                // the rest of such a run. Not again where a run converged nothing in as many
+                // steps as this one may take (0: the whole basis): it would again (same operator,
+                // same start).
+                const int probe = m_o.arnoldi == "compact" ? probe_steps() : 0;
+                for (const auto& [at, steps] : m_failed_at)
+                    again = again || (at == centre && (steps == 0 || (probe > 0 && steps >= probe)));
                 if (!again) {
-                    if (!shift_near(centre, c, beta, steps)) return false;
+                    if (!shift_near(centre, c, beta, probe)) return false;
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
