@@ -288,8 +288,11 @@ public:
     /// `goal` > 0: also stop once the converged prefix's disc |z - sigma| < 1/|theta_last|
     /// (shrunk by the same 1e-6 margin as the covering's) reaches that radius.
     /// `between` (may be empty) is called before every restart (it may throw, e.g. Cancelled).
+    /// `costly` (may be empty): asked at a check where something converged but not yet nev,
+    /// with the steps taken, those up to the next check and the converged count; true stops the
+    /// run there (its disc is then the converged prefix's, as at any other stop).
     CompactRitz run(int nev, int first_check, int restarts, int keep, double tol, double goal, int probe,
-                    const std::function<void()>& between) {
+                    const std::function<void()>& between, const std::function<bool(int, int, int)>& costly) {
         CompactRitz out;
         // a goal may be met long before nev values converge: look from 20 steps on
         int check = std::min(goal > 0.0 ? std::min(first_check, 20) : first_check, m_kmax);
@@ -316,6 +319,7 @@ public:
                 check = std::min(m_kmax, m_k + std::max(10, (m_kmax - m_k) / 2));
             } else {
                 check = std::min(m_kmax, m_k + std::max(10, m_k / 2));
+                if (out.converged >= 1 && costly && costly(m_k, check, out.converged)) return out;
             }
         }
     }
@@ -487,8 +491,9 @@ bool factor_near(StructuredShiftInvert& op, cplx& sigma) {
 /// the next eigenvalue away (along the real axis for a real shift); `sigma` is set to the shift
 /// used, and false is returned when op could not be factorised there.
 bool compact_arnoldi(StructuredShiftInvert& op, cplx& sigma, int nev, int first_check, int basis, int restarts, int keep, double tol,
-                     double goal, int probe, const std::function<void()>& between, CompactRitz& out) {
-    out = CompactKrylov(op, basis).run(nev, first_check, restarts, keep, tol, goal, probe, between);
+                     double goal, int probe, const std::function<void()>& between, const std::function<bool(int, int, int)>& costly,
+                     CompactRitz& out) {
+    out = CompactKrylov(op, basis).run(nev, first_check, restarts, keep, tol, goal, probe, between, costly);
     const auto& th = out.theta;
     const double eps = std::numeric_limits<double>::epsilon();
     if (th.size() < 2 || !(eps * std::abs(th[0]) > 0.01 * tol * std::abs(th[1])) || !(std::abs(th[1]) > 0.0)) return true;
@@ -500,7 +505,7 @@ bool compact_arnoldi(StructuredShiftInvert& op, cplx& sigma, int nev, int first_
         out.steps = steps;
         return false;
     }
-    out = CompactKrylov(op, basis).run(nev, first_check, restarts, keep, tol, goal, probe, between);
+    out = CompactKrylov(op, basis).run(nev, first_check, restarts, keep, tol, goal, probe, between, costly);
     out.steps += steps;
     return true;
 }
@@ -530,7 +535,7 @@ SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& input, int deg
             }
             CompactRitz rz;
             if (!compact_arnoldi(op, sigma, nev, std::min(options.basis, 2 * nev + 20), options.basis, options.restarts,
-                                 std::max(nev, options.basis / 2), options.tolerance, 0.0, 0, {}, rz)) {
+                                 std::max(nev, options.basis / 2), options.tolerance, 0.0, 0, {}, {}, rz)) {
                 out.status = Status::NumericalIssue;
                 continue;
             }
@@ -578,6 +583,7 @@ struct Cell {
     double x0, x1, y0, y1;
     bool shifted = false;
     int splits = 0;  ///< splits since a shift was last tried (a root on a corner stops the halving)
+    int halvings = 0;  ///< splits instead of a resolvent test (an expensive LU, a Gershgorin root-free centre)
 };
 
 bool inside(const Cell& c, const Disc& d) {
@@ -667,6 +673,10 @@ public:
         }
         return false;
     }
+
+    /// The work of a cell test at most in flops (60 Perron iterations over the pattern, and
+    /// the assembly), for the covering's cost model.
+    double work() const { return 62.0 * 4.0 * static_cast<double>(m_p.nonZeros()) + 4.0 * m_n; }
 
 private:
     int m_n;
@@ -830,13 +840,27 @@ public:
             // restarted: the half of the basis with the largest |theta| is kept (at least nev)
             const int keep = std::min(kmax - 1, std::max(nev, kmax / 2));
             CompactRitz rz;
+            // with resolvent tests at hand, a run whose disc is not empty stops where its steps
+            // up to the next check would cost more than five tests: the cells the larger disc
+            // would still reach are then tested (or shifted at) on their own. Five, measured:
+            // with 2 to 4 the rings took 10-50 % more shifts (the band of roots along the floor
+            // is covered by Arnoldi discs, not by tests); the stiff 1-D problems gain 3-7 fold
+            // from 2 to 8 alike.
+            std::function<bool(int, int, int)> costly;
+            if (m_res && m_o.compact_restarts == 0)
+                costly = [this](int k, int next, int converged) {
+                    if (converged < m_count) return false;
+                    double work = 0.0;
+                    for (int j = k + 1; j <= next; ++j) work += step_work(j);
+                    return work > 5.0 * test_work();
+                };
             const bool factored = compact_arnoldi(m_op, sigma, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax,
                                                   m_o.compact_restarts, keep, m_o.arnoldi_tolerance,
                                                   m_o.compact_restarts > 0 ? goal : 0.0, probe, [&] {
                                                       // a long run reports again (same count) before each restart
                                                       if (m_progress && *m_progress)
                                                           (*m_progress)(m_before + m_shifts - 1, m_o.max_shifts, sigma.real());
-                                                  }, rz);
+                                                  }, costly, rz);
             m_steps += rz.steps;
             if (!factored) {
                 ++m_failed;
@@ -921,6 +945,7 @@ public:
     /// the floor before the rectangle is split. False when the shift budget ran out.
     bool cover(double alpha, double beta, const Bounds& bounds, int count) {
         m_floor = alpha;
+        m_count = std::max(1, count);
         const double height = bounds.height(alpha);
         m_height = std::min(m_height, height);
         if (m_discs.empty()) {
@@ -955,6 +980,33 @@ public:
             if (std::max(cw, ch) <= 1e-13 * scale_of(cplx(c.x1, c.y1))) return false;
             const double mx = 0.5 * (c.x0 + c.x1), my = 0.5 * (c.y0 + c.y1);
             const cplx centre(mx, c.y0 == 0.0 ? 0.0 : my);
+            // where even the centre is root-free (Gershgorin), smaller cells will be too (asked
+            // once, when needed)
+            std::optional<bool> free_centre;
+            auto empty_centre = [&] {
+                if (!free_centre) free_centre = m_gersh.excludes(mx, mx, my, my) && std::max(cw, ch) > 1e-3 * scale_of(centre);
+                return *free_centre;
+            };
+            auto split = [&queue, cw, ch, mx, my](const Cell& whole, int splits, int halvings) {
+                Cell a = whole, b = whole;
+                a.shifted = b.shifted = false;
+                a.splits = b.splits = splits;
+                a.halvings = b.halvings = halvings;
+                if (cw >= ch) {
+                    a.x1 = b.x0 = mx;
+                } else {
+                    a.y1 = b.y0 = my;
+                }
+                queue.push(a);
+                queue.push(b);
+            };
+            // where a resolvent test's LU costs a hundred Gershgorin tests (heavy fill: a random
+            // network) and the centre is root-free by Gershgorin, the halves, then the quarters
+            // and eighths, are tried by Gershgorin first
+            if (m_res && !c.shifted && c.halvings < 3 && test_work() > 100.0 * m_gersh.work() && empty_centre()) {
+                split(c, c.splits, c.halvings + 1);
+                continue;
+            }
             bool near_root = true;
             if (m_res && !c.shifted) {
                 // a root-free disc of the DDE around the cell's centre, valid right of x0: the
@@ -972,10 +1024,8 @@ public:
                 // than the cell (a root near its centre): the halves may be root-free
                 near_root = r < 0.25 * h || c.splits >= 2;
             }
-            // where even the centre is root-free, smaller cells will be too: split instead of
-            // a (slow) shift far from the spectrum
-            const bool empty_centre = m_gersh.excludes(mx, mx, my, my) && std::max(cw, ch) > 1e-3 * scale_of(centre);
-            if (!c.shifted && !empty_centre && near_root) {
+            // a root-free centre: split instead of a (slow) shift far from the spectrum
+            if (!c.shifted && near_root && !empty_centre()) {
                 bool again = false;
                 for (const auto& d : m_discs) again = again || (!d.root_free && d.centre == centre);
                 // a cell's shift gives up when nothing converged (a cluster seen from afar, or
@@ -994,16 +1044,7 @@ public:
                 c.shifted = true;
                 if (covered(c)) continue;
             }
-            Cell a = c, b = c;
-            a.shifted = b.shifted = false;
-            a.splits = b.splits = c.shifted ? 0 : c.splits + 1;
-            if (cw >= ch) {
-                a.x1 = b.x0 = mx;
-            } else {
-                a.y1 = b.y0 = my;
-            }
-            queue.push(a);
-            queue.push(b);
+            split(c, c.shifted ? 0 : c.splits + 1, c.halvings);
         }
         return true;
     }
@@ -1038,20 +1079,29 @@ private:
     /// costly (a ring of 10^4 states: P = 36) a probe stops early; where LUs fill in (a random
     /// network: one LU costs 100 steps) it runs to half the basis, as before this model.
     int probe_steps() const {
-        const double n = m_op.dimension(), m1 = m_op.degree() + 1.0, k = m_op.delays();
-        const double s = m_res && m_res->settled() > 0 ? static_cast<double>(m_res->steps()) / m_res->settled() : 25.0;
-        const double lu = m_op.lu_flops() + 1000.0 * n, solve = 8.0 * m_op.lu_nonzeros() + 100.0 * n;
-        const double test = lu + s * (2.0 * solve + 12.0 * n * s);
+        const double test = test_work();
         const int cap = std::max(20, m_o.compact_max_steps / 2);
         double work = 0.0;  // the LU is paid whether the run goes on or not
         int p = 0;
         while (p < cap) {
-            const double j = p + 1.0;
-            work += solve + 8.0 * (4.0 + k) * n * j + 24.0 * m1 * j * j;
+            work += step_work(p + 1);
             if (work > 2.0 * test) break;
             ++p;
         }
         return std::max(std::min(20, cap), p);
+    }
+    /// The model's work of one sparse solve (see probe_steps).
+    double solve_work() const { return 8.0 * m_op.lu_nonzeros() + 100.0 * m_op.dimension(); }
+    /// The model's work of a resolvent test (see probe_steps).
+    double test_work() const {
+        const double n = m_op.dimension();
+        const double s = m_res && m_res->settled() > 0 ? static_cast<double>(m_res->steps()) / m_res->settled() : 25.0;
+        return m_op.lu_flops() + 1000.0 * n + s * (2.0 * solve_work() + 12.0 * n * s);
+    }
+    /// The model's work of Arnoldi step j (see probe_steps).
+    double step_work(int j) const {
+        const double n = m_op.dimension(), m1 = m_op.degree() + 1.0, k = m_op.delays();
+        return solve_work() + 8.0 * (4.0 + k) * n * j + 24.0 * m1 * double(j) * j;
     }
     /// The distance from sigma to the cell's farthest corner (a little more).
     static double reach(const Cell& c, cplx sigma) {
@@ -1105,6 +1155,7 @@ private:
     int m_restarts = 0;
     int m_max_rank = 0;
     double m_floor = 0.0;
+    int m_count = 1;  ///< the roots asked for (cover)
     double m_height = std::numeric_limits<double>::infinity();
     std::vector<std::pair<cplx, int>> m_failed_at;  ///< shifts (as asked) whose run converged nothing, and its probe length
     std::optional<cplx> m_hint;  ///< the last probe's estimate of the eigenvalue it saw best (upper half)
