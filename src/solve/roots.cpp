@@ -90,6 +90,9 @@ bool RootOptions::is_valid(std::string* why) const {
     } else if (dense.max_degree < 2) {
         os << "dense.max_degree = " << dense.max_degree << ": expected an integer >= 2";
         ok = false;
+    } else if (dense.max_rows < 3) {
+        os << "dense.max_rows = " << dense.max_rows << ": expected an integer >= 3";
+        ok = false;
     } else if (method == "dense" && degree > dense.max_degree) {
         os << "degree = " << degree << " exceeds dense.max_degree = " << dense.max_degree;
         ok = false;

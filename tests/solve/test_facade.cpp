@@ -13,6 +13,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
+#include "tolerances.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -286,6 +287,39 @@ TEST_CASE("RootOptions::is_valid names the field in the API's words") {
     o = RootOptions{};
     o.dense.depth = -1.0;
     CHECK(message(o) == "dense.depth = -1: expected a finite value >= 0 (0 = automatic)");
+    o = RootOptions{};
+    o.dense.max_rows = 2;
+    CHECK(message(o) == "dense.max_rows = 2: expected an integer >= 3");
+}
+
+TEST_CASE("dense path: the collocation matrix stays within dense.max_rows, and a degree beyond it stops undecided") {
+    // 12 states, one delay (fixed seed): the 60 rightmost roots lie deep in the left half plane,
+    // where |Im lambda| is large and the degree must grow (without the cap: to M = 400)
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const int n = 12;
+    MatrixXc a0 = MatrixXc::Zero(n, n), a1 = MatrixXc::Zero(n, n);
+    for (int i = 0; i < n; ++i) {
+        a0(i, i) = -2.0 + 0.5 * u(rng);
+        for (int j = 0; j < n; ++j) a1(i, j) = 0.4 * u(rng);
+    }
+    const LinearDDE dde(a0, {{a1, 0.9}});
+    RootOptions o = with("dense", 60);
+    o.dense.max_rows = 240;  // M <= 19
+    const RootResult capped = rightmost_roots(dde, o);
+    CHECK(capped.status == Status::BudgetExhausted);
+    CHECK((capped.degree + 1) * n <= 240);
+    CHECK(capped.message.find("dense.max_rows = 240") != std::string::npos);
+    // a few roots settle within the cap: the same as without it
+    o.count = 4;
+    const RootResult few = rightmost_roots(dde, o);
+    REQUIRE(few.status == Status::Converged);
+    CHECK((few.degree + 1) * n <= 240);
+    const RootResult free = rightmost_roots(dde, with("dense", 4));
+    REQUIRE(free.status == Status::Converged);
+    REQUIRE(few.roots.size() == free.roots.size());
+    for (std::size_t i = 0; i < few.roots.size(); ++i)
+        CHECK(std::abs(few.roots[i].value - free.roots[i].value) <= test::tol::same_root * std::max(1.0, std::abs(free.roots[i].value)));
 }
 
 TEST_SUITE_END();

@@ -37,6 +37,12 @@ namespace ddemap {
 /// Options of the dense backend.
 struct DenseRootOptions {
     int max_degree = 400;                ///< never exceed this collocation degree M
+    /// Never build a collocation matrix of more than this many rows, (M + 1) n: the dense
+    /// eigen-solver's time grows like their cube (Eigen's real solver, one core: 2 s at 1,000
+    /// rows, 19 s at 2,000, about a minute at 3,000) and its memory like their square. A degree
+    /// that would need more stops the run undecided (BudgetExhausted) instead of running for hours
+    /// (12 states and 120 roots asked for M = 400, 4,812 rows, before this cap).
+    int max_rows = 3000;
     double agreement_tolerance = 1e-11;  ///< roots equal between degrees (relative to max(1,|lambda|))
     double collocation_tolerance = 1e-5; ///< |eigenvalue - refined root| <= tol * max(1,|lambda|)
     /// One degree suffices when every eigenvalue is already this close (relative) to its refined
