@@ -123,7 +123,7 @@ int run_system(Format format, const std::string& prefix) {
     out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delays().size() << " delays)\n";
     out << equilibrium_line;
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
-    out << "trusted    " << r.message << "\n";
+    out << (r.status == Status::Converged ? "trusted    " : "why not    ") << r.message << "\n";
     // no root computed (an empty spectrum or a failed solver): the table says so, never "-inf"
     out << "abscissa   " << (std::isfinite(s.spectral_abscissa) ? rounded(s.spectral_abscissa, 10) : std::string("none (no root was computed)")) << "\n";
     out << "verdict    " << verdict_word(s.verdict);
@@ -183,7 +183,7 @@ int run_fleet(Format format, const std::string& prefix) {
     else
         out << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations << " LU factorisations";
     out << " (" << to_string(rr.status) << ")\n";
-    out << "trusted    " << rr.message << "\n";
+    out << (rr.status == Status::Converged ? "trusted    " : "why not    ") << rr.message << "\n";
     out << "trivial    "
         << (r.trivial_found ? "lambda = 0 found (|lambda| = " + rounded(r.trivial_root, 3) + "), left out"
                             : std::string("not among the rightmost roots"))
