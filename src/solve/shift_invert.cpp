@@ -840,12 +840,14 @@ public:
             // restarted: the half of the basis with the largest |theta| is kept (at least nev)
             const int keep = std::min(kmax - 1, std::max(nev, kmax / 2));
             CompactRitz rz;
-            // with resolvent tests at hand, a run whose disc is not empty stops where its steps
-            // up to the next check would cost more than five tests: the cells the larger disc
-            // would still reach are then tested (or shifted at) on their own. Five, measured:
-            // with 2 to 4 the rings took 10-50 % more shifts (the band of roots along the floor
-            // is covered by Arnoldi discs, not by tests); the stiff 1-D problems gain 3-7 fold
-            // from 2 to 8 alike.
+            // with resolvent tests at hand, a run whose disc holds `count` eigenvalues stops where
+            // its steps up to the next check would cost more than five tests: the cells the
+            // larger disc would still reach are then tested (or shifted at) on their own. Five,
+            // measured on the bench files (BENCHMARKS.md): with 2 to 4 the 5,000-car ring took
+            // 113 shifts instead of 90 (its band of roots along the floor is covered by Arnoldi
+            // discs, not by tests), with 8 the 3-delay 1-D problem at 10^4 states 201 LUs instead
+            // of 108; the 1-D and 2-D problems gain 2-7 fold from 2 to 8 alike. Fewer than
+            // `count` in the disc: no stop (a CCC ring's strip then widened to 5,000 shifts).
             std::function<bool(int, int, int)> costly;
             if (m_res && m_o.compact_restarts == 0)
                 costly = [this](int k, int next, int converged) {
