@@ -48,7 +48,9 @@ namespace {
 /// at N = 40,000) and 2 kB per car; the sparse path about 4e-5 n^1.6 s (n = 2N states: 0.53 s
 /// at N = 200; the exponent from N = 200 and 1,000) and 25 kB per state; the dense path about
 /// 1e-5 n^3 s (1.6 s at N = 30), its collocation matrix of (M + 1) n complex rows held dense
-/// (about 16 (32 n)^2 bytes at the degrees these rings reach: 240 MB at N = 60). The output:
+/// (about 16 (32 n)^2 bytes at the degrees these rings reach: 240 MB at N = 60; the degree
+/// grows only to DenseRootOptions::max_rows = 3000 rows, so above about 50 cars the dense
+/// path may stop undecided, budget_exhausted, rather than use more). The output:
 /// about 600 bytes per fraction (a CSV row, a JSON record and an SVG marker).
 void size_mix(const MixOptions& o) {
     const double arrangements = static_cast<double>(o.fractions.size()) * (o.draws + 1.0);

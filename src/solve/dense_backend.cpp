@@ -333,10 +333,13 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         }
     }
     const int max_degree = std::max(o.max_degree, options.degree);
-    // the largest degree whose collocation matrix has at most max_rows rows
+    // the largest degree whose collocation matrix has at most max_rows rows; the first degree is
+    // computed whatever its size (a given degree as asked, an automatic one not above the cap
+    // unless M = 8 is), later ones not beyond the larger of the two
     const int row_degree = o.max_rows / std::max(1, dde.dimension()) - 1;
     int m = options.degree > 0 ? options.degree : std::clamp(degree_for_radius(dde.root_bound(0.0), tau), 8, max_degree);
-    if (options.degree == 0) m = std::min(m, std::max(row_degree, 2));
+    if (options.degree == 0) m = std::min(m, std::max(row_degree, 8));
+    const int cap_degree = std::max(row_degree, m);
     std::vector<Root> previous;
     std::size_t previous_in_strip = 0;
     int previous_degree = 0;
@@ -347,18 +350,18 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
     std::function<void()> within;
     if (options.progress) within = [&] { options.progress(previous_degree, max_degree, previous_sigma); };
     for (;;) {
-        if (m > row_degree) {
-            // the roots of the last degree (if any) did not settle: they are returned, undecided
+        if (m > cap_degree) {
+            // (never the first degree) the roots of the last one did not settle: they are
+            // returned, undecided
             result.status = Status::BudgetExhausted;
             result.degree = previous_degree;
             result.roots = previous;
+            result.covered_radius = radius_for_degree(previous_degree, tau);
+            result.strip_floor = previous_sigma;
             std::ostringstream os;
-            os << "degree M=" << m << " needs a dense eigenproblem of (M+1) n = " << static_cast<long>(m + 1) * dde.dimension()
-               << " rows, more than dense.max_rows = " << o.max_rows;
-            if (previous_degree > 0) os << "; the roots of M=" << previous_degree << " did not settle";
-            os << " (ask for fewer roots";
-            if (dde.is_real() && !dde.is_ode()) os << ", or use the sparse path";
-            os << ")";
+            os << "the roots of M=" << previous_degree << " did not settle, and M=" << m << " needs a dense eigenproblem of (M+1) n = "
+               << (static_cast<long>(m) + 1) * dde.dimension() << " rows, more than dense.max_rows = " << o.max_rows
+               << " (ask for fewer roots, or " << (dde.is_real() ? "use the sparse path" : "raise dense.max_rows") << ")";
             result.message = os.str();
             return result;
         }
@@ -452,8 +455,8 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         int next = static_cast<int>(std::ceil(1.5 * m));
         if (covered < needed) next = std::max(next, degree_for_radius(needed, tau));
         m = std::min(next, max_degree);
-        // the largest degree within max_rows is tried before giving up
-        if (m > row_degree && row_degree > previous_degree) m = row_degree;
+        // the largest degree within the cap is tried before giving up
+        if (m > cap_degree && cap_degree > previous_degree) m = cap_degree;
     }
 }
 

@@ -674,8 +674,8 @@ public:
         return false;
     }
 
-    /// The work of a cell test at most in flops (60 Perron iterations over the pattern, and
-    /// the assembly), for the covering's cost model.
+    /// The work of a cell test in flops, roughly (60 Perron iterations over the pattern, and
+    /// the assembly; more with many delays), for the covering's cost model.
     double work() const { return 62.0 * 4.0 * static_cast<double>(m_p.nonZeros()) + 4.0 * m_n; }
 
 private:

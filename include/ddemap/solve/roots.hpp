@@ -37,11 +37,14 @@ namespace ddemap {
 /// Options of the dense backend.
 struct DenseRootOptions {
     int max_degree = 400;                ///< never exceed this collocation degree M
-    /// Never build a collocation matrix of more than this many rows, (M + 1) n: the dense
-    /// eigen-solver's time grows like their cube (Eigen's real solver, one core: 2 s at 1,000
-    /// rows, 19 s at 2,000, about a minute at 3,000) and its memory like their square. A degree
-    /// that would need more stops the run undecided (BudgetExhausted) instead of running for hours
-    /// (12 states and 120 roots asked for M = 400, 4,812 rows, before this cap).
+    /// The degree grows only while the collocation matrix keeps at most this many rows, (M + 1) n
+    /// (or those of the first degree, which is always computed: the given one, or an automatic
+    /// one of at most this size unless M = 8 is larger). The dense eigen-solver's time grows
+    /// like their cube (Eigen's real solver, one core: 2 s at 1,000 rows, 19 s at 2,000, about a
+    /// minute at 3,000) and its memory like their square. The largest degree within the cap is
+    /// tried; if its roots do not settle either, the run stops undecided (BudgetExhausted)
+    /// instead of running for an hour (24 states and 120 roots climbed to M = 400, 9,624 rows,
+    /// before this cap).
     int max_rows = 3000;
     double agreement_tolerance = 1e-11;  ///< roots equal between degrees (relative to max(1,|lambda|))
     double collocation_tolerance = 1e-5; ///< |eigenvalue - refined root| <= tol * max(1,|lambda|)
