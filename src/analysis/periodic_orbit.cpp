@@ -10,11 +10,16 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 // GCC 12 reports a false -Wuse-after-free inside Spectra's Hessenberg eigenvector code
+// (as in wave_stability.cpp: clang has no such warning and warns of its name)
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuse-after-free"
+#endif
 #include <Spectra/GenEigsSolver.h>
 #include <Spectra/MatOp/DenseGenMatProd.h>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 #include "analysis/internal/orbit_continuation.hpp"
 #include "analysis/internal/orbit_mesh.hpp"
