@@ -294,7 +294,7 @@ TEST_CASE("RootOptions::is_valid names the field in the API's words") {
 
 TEST_CASE("dense path: the collocation matrix stays within dense.max_rows, and a degree beyond it stops undecided") {
     // 12 states, one delay (fixed seed): the 60 rightmost roots lie deep in the left half plane,
-    // where |Im lambda| is large and the degree must grow (without the cap: to M = 400)
+    // where |Im lambda| is large and the degree must grow beyond M = 19
     std::mt19937 rng(41);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     const int n = 12;
