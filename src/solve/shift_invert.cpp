@@ -687,16 +687,23 @@ private:
 };
 
 
-/// Root-free discs of the DDE itself from the resolvent norm: for |z - z_c| <= r (right of x0),
-///     sigma_min(Delta(z)) >= s - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}     (L >= ||Delta'||),
+/// Root-free discs of the DDE itself from the resolvent norm, two bounds; the disc is that of
+/// the larger radius. With h = z - z_c, E_k = e^{-z_c tau_k}, Delta = Delta(z_c), s = sigma_min(Delta):
+///  1. sigma_min(Delta(z)) >= s - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}     (L >= ||Delta'||),
 ///     sigma_min(Delta(z)) >= s - r L1 - r^2 M2 / 2,   L1 >= ||Delta'(z_c)||,  M2 = sum_k tau_k^2 ||A_k|| e^{-x0 tau_k} (>= ||Delta''||),
-/// s = sigma_min(Delta(z_c)), so Delta(z) is nonsingular in the disc of the larger radius of
-/// s / L and 2 s / (L1 + sqrt(L1^2 + 2 M2 s)). The second is the larger near z_c when the delayed
-/// terms of Delta' = I + sum_k tau_k A_k e^{-z tau_k} partly cancel (L1 is the bound
-/// sqrt(||.||_1 ||.||_inf) of that matrix at z_c). s = 1 / ||Delta(z_c)^{-1}||: the norm is
-/// estimated by Lanczos on Delta^{-H} Delta^{-1} (one sparse LU of Delta(z_c), two solves per
-/// step, reorthogonalised) until the estimate changes by less than 1e-4 over a step, and
-/// taken 25% larger (Lanczos approaches it from below). Independent of the collocation degree.
+///     so Delta(z) is nonsingular in the disc |h| < r right of x0 for the larger radius of s / L and
+///     2 s / (L1 + sqrt(L1^2 + 2 M2 s)). The second is the larger near z_c when the delayed terms
+///     of Delta' = I + sum_k tau_k A_k e^{-z tau_k} partly cancel (L1 is the bound
+///     sqrt(||.||_1 ||.||_inf) of that matrix at z_c).
+///  2. Delta(z) = Delta [I + Delta^{-1} (h Delta'(z_c) - sum_k E_k rho(h tau_k) A_k)], rho(w) = e^{-w} - 1 + w,
+///     |rho(w)| <= g(|w|) = e^{|w|} - 1 - |w|, so Delta(z) is nonsingular in the whole disc |h| < r when
+///         r a + sum_k |E_k| g(r tau_k) ||A_k|| / s <= 1,   a = ||Delta^{-1} Delta'(z_c)||.
+///     a <= ||Delta^{-1}|| ||Delta'(z_c)|| = L1 / s at most, and much less when Delta'(z_c) is
+///     small along Delta's near-null directions (a non-normal Delta: a random network).
+/// The norms ||Delta^{-1}|| = 1 / s and a are estimated by Lanczos on Delta^{-H} Delta^{-1} and
+/// Delta'^H Delta^{-H} Delta^{-1} Delta' (one sparse LU of Delta(z_c), two solves per step,
+/// reorthogonalised) until the estimate changes by less than 1e-4 over a step, and taken 25%
+/// larger (Lanczos approaches them from below). Independent of the collocation degree.
 class ResolventExclusion {
 public:
     explicit ResolventExclusion(const LinearDDE& dde) : m_dde(dde), m_n(dde.dimension()) {
@@ -708,31 +715,86 @@ public:
     }
 
     /// The radius of a root-free disc around z_c (right of x0), 0 when Delta(z_c) is singular.
-    double free_radius(cplx zc, double x0) {
+    /// `thrifty` (the covering): bound 2 only when bound 1 falls short of `need` and the LU
+    /// costs more than another Lanczos run; otherwise both bounds, always.
+    double free_radius(cplx zc, double x0, double need = std::numeric_limits<double>::infinity(), bool thrifty = false) {
         ++m_tests;
         m_d = m_dde.sparse_characteristic_matrix(zc) + cplx(0.0) * m_pattern;
         m_d.makeCompressed();
         m_lu.factorize_counted(m_d);
         if (m_lu.info() != Eigen::Success) return 0.0;
+        int steps = 0;
+        const double inverse2 = top_eigenvalue(nullptr, m_previous, steps);  // ||Delta^{-1}||^2
+        if (!(inverse2 > 0.0)) return 0.0;
+        m_steps += steps;
+        ++m_settled;
+        const SpC derivative = m_dde.sparse_characteristic_derivative(zc);
+        const double smin = 1.0 / (1.25 * std::sqrt(inverse2));
+        double lipschitz = 1.0, second = 0.0;
+        for (const auto& [norm, delay] : m_terms) {
+            lipschitz += delay * norm * std::exp(-x0 * delay);
+            second += delay * delay * norm * std::exp(-x0 * delay);
+        }
+        const double local = std::min(lipschitz, norm2_bound(derivative));
+        const double first = std::max(smin / lipschitz, 2.0 * smin / (local + std::sqrt(local * local + 2.0 * second * smin)));
+        // bound 2 costs another Lanczos run, about as long as the first: tried only when the
+        // first did not reach `need` and the LU (UMFPACK's flops, plus its cost per row, as in the
+        // covering's cost model) costs at least as much as that run, so that a test it saves is
+        // worth more than it costs (a random network's filled LU; not a ring's or a grid's)
+        const double solve = 8.0 * m_lu.nonzeros() + 100.0 * m_n;
+        if (thrifty && (first >= need || m_lu.flops() + 1000.0 * m_n < steps * 2.0 * solve)) return first;
+        // bound 2: the largest r with f(r) = r a + sum_k |E_k| g(r tau_k) ||A_k|| / s <= 1 (f is
+        // increasing and f(1 / a) >= 1: bisection keeps the side where f <= 1)
+        steps = 0;
+        const double a2 = top_eigenvalue(&derivative, m_previous_derivative, steps);  // ||Delta^{-1} Delta'||^2
+        if (!(a2 > 0.0)) return first;
+        m_steps += steps;
+        const double a = 1.25 * std::sqrt(a2);
+        auto f = [&](double r) {
+            double v = r * a;
+            for (const auto& [norm, delay] : m_terms) {
+                const double w = r * delay;
+                v += std::exp(-zc.real() * delay) * (std::expm1(w) - w) * norm / smin;
+            }
+            return v;
+        };
+        double lo = 0.0, hi = 1.0 / a;
+        for (int it = 0; it < 60 && hi - lo > 1e-14 * hi; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (f(mid) <= 1.0 ? lo : hi) = mid;
+        }
+        return std::max(first, lo);
+    }
+    int tests() const { return m_tests; }
+    /// Lanczos steps over the tests that settled (two sparse solves each), and their number
+    long steps() const { return m_steps; }
+    int settled() const { return m_settled; }
+
+private:
+    /// The largest eigenvalue of B^H B, B = Delta^{-1} P (P = I when null) with the LU at hand, by
+    /// Lanczos from `previous` (the last test's leading vector, at a nearby point nearly the
+    /// same) plus as much of a random vector, so that the start misses no direction more than a
+    /// random start would; settled when it changes by less than 1e-4 over a step (6 steps at
+    /// least). 0 when not settled in 40 steps or a solve fails. Adds the steps to `steps`.
+    double top_eigenvalue(const SpC* p, Eigen::VectorXcd& previous, int& steps) {
         const int kmax = std::min(m_n, 40);
         std::mt19937 rng(977);
         std::uniform_real_distribution<double> u(-1.0, 1.0);
         Eigen::MatrixXcd basis(m_n, kmax + 1);
         Eigen::VectorXcd x(m_n);
         for (int i = 0; i < m_n; ++i) x(i) = cplx(u(rng), u(rng));
-        // the previous test's leading vector (a nearby point: nearly the same singular vector),
-        // plus as much of a random one, so that the start misses no direction more than a
-        // random start would (and the estimate is given 6 steps at least to find a larger one)
-        if (m_previous.size() == m_n) x = m_previous + x / x.norm();
+        if (previous.size() == m_n) x = previous + x / x.norm();
         basis.col(0) = x / x.norm();
         Eigen::MatrixXd t = Eigen::MatrixXd::Zero(kmax + 1, kmax + 1);
         double estimate = 0.0;
-        int steps = 0;
+        int used = 0;
         for (int k = 0; k < kmax; ++k) {
-            steps = k + 1;
-            const Eigen::VectorXcd y = m_lu.solve(basis.col(k));
+            used = k + 1;
+            const Eigen::VectorXcd y = p ? Eigen::VectorXcd(m_lu.solve(Eigen::VectorXcd(*p * basis.col(k))))
+                                         : Eigen::VectorXcd(m_lu.solve(basis.col(k)));
             Eigen::VectorXcd w;
-            if (!m_lu.adjoint_solve(y, w) || !w.allFinite()) return 0.0;  // w = Delta^{-H} Delta^{-1} q_k
+            if (!m_lu.adjoint_solve(y, w) || !w.allFinite()) return 0.0;  // w = Delta^{-H} Delta^{-1} P q_k
+            if (p) w = p->adjoint() * w;
             // against the whole basis twice while that costs less than the step's two solves
             // (about 3 n (k + 1) against 2 nnz(L + U) multiply-adds), then only against q_k and
             // q_{k-1} (local reorthogonalisation: the top Ritz value converges first, before
@@ -752,30 +814,15 @@ public:
             basis.col(k + 1) = w / beta;
         }
         if (!(estimate > 0.0) || !std::isfinite(estimate)) return 0.0;
-        {
-            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(steps, steps));
-            Eigen::Index top;
-            es.eigenvalues().maxCoeff(&top);
-            m_previous = basis.leftCols(steps) * es.eigenvectors().col(top).cast<cplx>();
-            m_previous /= m_previous.norm();
-        }
-        m_steps += steps;
-        ++m_settled;
-        const double smin = 1.0 / (1.25 * std::sqrt(estimate));
-        double lipschitz = 1.0, second = 0.0;
-        for (const auto& [norm, delay] : m_terms) {
-            lipschitz += delay * norm * std::exp(-x0 * delay);
-            second += delay * delay * norm * std::exp(-x0 * delay);
-        }
-        const double local = std::min(lipschitz, norm2_bound(m_dde.sparse_characteristic_derivative(zc)));
-        return std::max(smin / lipschitz, 2.0 * smin / (local + std::sqrt(local * local + 2.0 * second * smin)));
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(used, used));
+        Eigen::Index top;
+        es.eigenvalues().maxCoeff(&top);
+        previous = basis.leftCols(used) * es.eigenvectors().col(top).cast<cplx>();
+        previous /= previous.norm();
+        steps += used;
+        return estimate;
     }
-    int tests() const { return m_tests; }
-    /// Lanczos steps over the tests that settled (two sparse solves each), and their number
-    long steps() const { return m_steps; }
-    int settled() const { return m_settled; }
 
-private:
     const LinearDDE& m_dde;
     int m_n;
     SpC m_pattern, m_d;
@@ -785,6 +832,7 @@ private:
     int m_settled = 0;
     long m_steps = 0;
     Eigen::VectorXcd m_previous;  ///< the last test's leading Lanczos vector (a start for the next)
+    Eigen::VectorXcd m_previous_derivative;  ///< the same for Delta^{-1} Delta' (bound 2)
 };
 
 }  // namespace
@@ -1016,7 +1064,7 @@ public:
                 // is the smaller the farther right it holds
                 const double h = 0.5 * std::hypot(cw, ch);
                 const double x0 = std::max(m_floor, mx - h);
-                const double r = m_res->free_radius(cplx(mx, my), x0);
+                const double r = m_res->free_radius(cplx(mx, my), x0, h, true);
                 if (r >= h) {
                     ++m_excluded;
                     continue;

@@ -63,11 +63,15 @@ SparseEigenResult sparse_collocation_eigenvalues(const LinearDDE& dde, int degre
 
 /// The resolvent test of rightmost_roots' shift_invert covering: a radius r such that Delta has
 /// no root in the disc |lambda - z| < r right of x0 (take x0 <= Re z - r for the whole disc),
-///     r = max( s / L, 2 s / (L1 + sqrt(L1^2 + 2 M2 s)) ),   s = sigma_min(Delta(z)),
-///     L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k},  L1 >= ||Delta'(z)||,  M2 = sum_k tau_k^2 ||A_k|| e^{-x0 tau_k},
-/// s from Lanczos on Delta(z)^{-H} Delta(z)^{-1} (one sparse LU) settled to 1e-4 and taken 25%
-/// smaller: an estimate, not a proven bound. 0 when Delta(z) is singular to working precision
-/// or the estimate did not settle. A real DDE with at least one delay.
+/// the larger of two bounds (s = sigma_min(Delta(z)), E_k = e^{-z tau_k}):
+///     r1 = max( s / L, 2 s / (L1 + sqrt(L1^2 + 2 M2 s)) ),
+///         L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k},  L1 >= ||Delta'(z)||,  M2 = sum_k tau_k^2 ||A_k|| e^{-x0 tau_k},
+///     r2 = the largest r with  r a + sum_k |E_k| (e^{r tau_k} - 1 - r tau_k) ||A_k|| / s <= 1,
+///         a = ||Delta(z)^{-1} Delta'(z)||  (valid in the whole disc, whatever x0),
+/// s and a from Lanczos on Delta^{-H} Delta^{-1} and Delta'^H Delta^{-H} Delta^{-1} Delta' (one
+/// sparse LU) settled to 1e-4, s taken 25% smaller and a 25% larger: estimates, not proven
+/// bounds. 0 when Delta(z) is singular to working precision or the estimate of s did not
+/// settle (r1 alone when that of a did not). A real DDE with at least one delay.
 double root_free_radius(const LinearDDE& dde, cplx z, double x0);
 
 }  // namespace ddemap
