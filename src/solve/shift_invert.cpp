@@ -698,7 +698,7 @@ private:
 ///  2. Delta(z) = Delta [I + Delta^{-1} (h Delta'(z_c) - sum_k E_k rho(h tau_k) A_k)], rho(w) = e^{-w} - 1 + w,
 ///     |rho(w)| <= g(|w|) = e^{|w|} - 1 - |w|, so Delta(z) is nonsingular in the whole disc |h| < r when
 ///         r a + sum_k |E_k| g(r tau_k) ||A_k|| / s <= 1,   a = ||Delta^{-1} Delta'(z_c)||.
-///     a <= ||Delta^{-1}|| ||Delta'(z_c)|| = L1 / s at most, and much less when Delta'(z_c) is
+///     a <= ||Delta^{-1}|| ||Delta'(z_c)|| <= L1 / s, and much less when Delta'(z_c) is
 ///     small along Delta's near-null directions (a non-normal Delta: a random network).
 /// The norms ||Delta^{-1}|| = 1 / s and a are estimated by Lanczos on Delta^{-H} Delta^{-1} and
 /// Delta'^H Delta^{-H} Delta^{-1} Delta' (one sparse LU of Delta(z_c), two solves per step,
