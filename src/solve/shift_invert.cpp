@@ -687,6 +687,13 @@ private:
 };
 
 
+/// The covering's cost model, in flops (a complex multiply-add is 8), of one sparse LU and of
+/// one solve with it: UMFPACK's flop count F and the nonzeros Z of L and U, n rows,
+///     LU  F + 1000 n   (UMFPACK's cost per row besides flops: 2.2 ms at n = 10^4, F = 1.4e5),
+///     solve  8 Z + 100 n.
+double lu_work(double flops, double n) { return flops + 1000.0 * n; }
+double solve_work(double nonzeros, double n) { return 8.0 * nonzeros + 100.0 * n; }
+
 /// Root-free discs of the DDE itself from the resolvent norm, two bounds; the disc is that of
 /// the larger radius. With h = z - z_c, E_k = e^{-z_c tau_k}, Delta = Delta(z_c), s = sigma_min(Delta):
 ///  1. sigma_min(Delta(z)) >= s - r L,   L = 1 + sum_k tau_k ||A_k|| e^{-x0 tau_k}     (L >= ||Delta'||),
@@ -715,9 +722,9 @@ public:
     }
 
     /// The radius of a root-free disc around z_c (right of x0), 0 when Delta(z_c) is singular.
-    /// `thrifty` (the covering): bound 2 only when bound 1 falls short of `need` and the LU
-    /// costs more than another Lanczos run; otherwise both bounds, always.
-    double free_radius(cplx zc, double x0, double need = std::numeric_limits<double>::infinity(), bool thrifty = false) {
+    /// With a finite `need` (the covering's cell), bound 2 is tried only when bound 1 falls short
+    /// of it and the LU costs more than another Lanczos run; without, both bounds always.
+    double free_radius(cplx zc, double x0, double need = std::numeric_limits<double>::infinity()) {
         ++m_tests;
         m_d = m_dde.sparse_characteristic_matrix(zc) + cplx(0.0) * m_pattern;
         m_d.makeCompressed();
@@ -738,11 +745,12 @@ public:
         const double local = std::min(lipschitz, norm2_bound(derivative));
         const double first = std::max(smin / lipschitz, 2.0 * smin / (local + std::sqrt(local * local + 2.0 * second * smin)));
         // bound 2 costs another Lanczos run, about as long as the first: tried only when the
-        // first did not reach `need` and the LU (UMFPACK's flops, plus its cost per row, as in the
-        // covering's cost model) costs at least as much as that run, so that a test it saves is
-        // worth more than it costs (a random network's filled LU; not a ring's or a grid's)
-        const double solve = 8.0 * m_lu.nonzeros() + 100.0 * m_n;
-        if (thrifty && (first >= need || m_lu.flops() + 1000.0 * m_n < steps * 2.0 * solve)) return first;
+        // first did not reach `need` and the LU costs at least as much as that run (the
+        // covering's cost model), so that a test it saves is worth more than it costs (a random
+        // network's filled LU; not a ring's or a grid's)
+        if (std::isfinite(need) &&
+            (first >= need || lu_work(m_lu.flops(), m_n) < steps * 2.0 * solve_work(m_lu.nonzeros(), m_n)))
+            return first;
         // bound 2: the largest r with f(r) = r a + sum_k |E_k| g(r tau_k) ||A_k|| / s <= 1 (f is
         // increasing and f(1 / a) >= 1: bisection keeps the side where f <= 1)
         steps = 0;
@@ -766,7 +774,8 @@ public:
         return std::max(first, lo);
     }
     int tests() const { return m_tests; }
-    /// Lanczos steps over the tests that settled (two sparse solves each), and their number
+    /// Lanczos steps (two sparse solves each) over the tests whose first estimate settled, bound
+    /// 2's runs included, and the number of those tests
     long steps() const { return m_steps; }
     int settled() const { return m_settled; }
 
@@ -1064,7 +1073,7 @@ public:
                 // is the smaller the farther right it holds
                 const double h = 0.5 * std::hypot(cw, ch);
                 const double x0 = std::max(m_floor, mx - h);
-                const double r = m_res->free_radius(cplx(mx, my), x0, h, true);
+                const double r = m_res->free_radius(cplx(mx, my), x0, h);
                 if (r >= h) {
                     ++m_excluded;
                     continue;
@@ -1141,12 +1150,12 @@ private:
         return std::max(std::min(20, cap), p);
     }
     /// The model's work of one sparse solve (see probe_steps).
-    double solve_work() const { return 8.0 * m_op.lu_nonzeros() + 100.0 * m_op.dimension(); }
+    double solve_work() const { return ddemap::solve_work(m_op.lu_nonzeros(), m_op.dimension()); }
     /// The model's work of a resolvent test (see probe_steps).
     double test_work() const {
         const double n = m_op.dimension();
         const double s = m_res && m_res->settled() > 0 ? static_cast<double>(m_res->steps()) / m_res->settled() : 25.0;
-        return m_op.lu_flops() + 1000.0 * n + s * (2.0 * solve_work() + 12.0 * n * s);
+        return lu_work(m_op.lu_flops(), n) + s * (2.0 * solve_work() + 12.0 * n * s);
     }
     /// The model's work of Arnoldi step j (see probe_steps).
     double step_work(int j) const {

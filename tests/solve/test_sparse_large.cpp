@@ -244,9 +244,11 @@ TEST_CASE("root_free_radius: no root of a dense computation lies in the disc, an
                 }
                 return lo2;
             };
-            const double lo = std::max(s / (1.25 * lip), second(1.25 * a, s / 1.25));
-            const double hi = std::max({s / lip, 2.0 * s / (l1 + std::sqrt(l1 * l1 + 2.0 * m2 * s)), second(a, s)});
-            second_larger += second(1.25 * a, s / 1.25) > std::max(s / lip, 2.0 * s / (l1 + std::sqrt(l1 * l1 + 2.0 * m2 * s)));
+            const double first_hi = std::max(s / lip, 2.0 * s / (l1 + std::sqrt(l1 * l1 + 2.0 * m2 * s)));
+            const double second_lo = second(1.25 * a, s / 1.25);
+            const double lo = std::max(s / (1.25 * lip), second_lo);
+            const double hi = std::max(first_hi, second(a, s));
+            second_larger += second_lo > first_hi;
             CAPTURE(seed);
             CAPTURE(z);
             CHECK(rad < z.real() - floor);  // the disc lies right of the floor: its roots are all known
