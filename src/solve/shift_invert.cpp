@@ -18,6 +18,7 @@
 #include "ddemap/problem/root_bounds.hpp"
 #include "core/internal/eigen_threads.hpp"
 #include "internal/backends.hpp"
+#include "internal/disc_cover.hpp"
 #include "internal/gram_schmidt.hpp"
 
 namespace ddemap {
@@ -572,12 +573,7 @@ using Bounds = RootBounds;
 
 namespace {
 
-struct Disc {
-    cplx centre;
-    double radius = 0.0;
-    bool root_free = false;  ///< no root of the DDE inside (resolvent), rather than "every collocation eigenvalue inside found"
-    double valid_from = -std::numeric_limits<double>::infinity();  ///< root_free: the claim holds right of this line
-};
+using detail::Disc;
 
 struct Cell {
     double x0, x1, y0, y1;
@@ -585,14 +581,6 @@ struct Cell {
     int splits = 0;  ///< splits since a shift was last tried (a root on a corner stops the halving)
     int halvings = 0;  ///< splits instead of a resolvent test (an expensive LU, a Gershgorin root-free centre)
 };
-
-bool inside(const Cell& c, const Disc& d) {
-    const double r2 = d.radius * d.radius;
-    for (double x : {c.x0, c.x1})
-        for (double y : {c.y0, c.y1})
-            if (std::norm(cplx(x, y) - d.centre) >= r2) return false;
-    return true;
-}
 
 /// Root-free cells by the Gershgorin theorem for Delta(z) (nonlinear in z): Delta(z) is
 /// nonsingular when D^{-1} Delta(z) D is strictly diagonally dominant by rows for a positive
@@ -1030,7 +1018,11 @@ public:
             if (c.x1 < m_floor || c.y0 > m_height) continue;
             c.x0 = std::max(c.x0, m_floor);
             c.y1 = std::min(c.y1, m_height);
-            if (covered(c)) continue;
+            if (const auto left = uncovered(c)) {
+                c = *left;  // the rest lies in discs
+            } else {
+                continue;
+            }
             if (bounds.excludes(c.x0, c.y0) || m_gersh.excludes(c.x0, c.x1, c.y0, c.y1)) {
                 ++m_excluded;
                 continue;
@@ -1046,15 +1038,15 @@ public:
                 if (!free_centre) free_centre = m_gersh.excludes(mx, mx, my, my) && std::max(cw, ch) > 1e-3 * scale_of(centre);
                 return *free_centre;
             };
-            auto split = [&queue, cw, ch, mx, my](const Cell& whole, int splits, int halvings) {
+            auto split = [&queue](const Cell& whole, int splits, int halvings) {
                 Cell a = whole, b = whole;
                 a.shifted = b.shifted = false;
                 a.splits = b.splits = splits;
                 a.halvings = b.halvings = halvings;
-                if (cw >= ch) {
-                    a.x1 = b.x0 = mx;
+                if (whole.x1 - whole.x0 >= whole.y1 - whole.y0) {
+                    a.x1 = b.x0 = 0.5 * (whole.x0 + whole.x1);
                 } else {
-                    a.y1 = b.y0 = my;
+                    a.y1 = b.y0 = 0.5 * (whole.y0 + whole.y1);
                 }
                 queue.push(a);
                 queue.push(b);
@@ -1101,7 +1093,11 @@ public:
                     raise_floor(bounds, count);
                 }
                 c.shifted = true;
-                if (covered(c)) continue;
+                if (const auto left = uncovered(c)) {
+                    c = *left;
+                } else {
+                    continue;
+                }
             }
             split(c, c.shifted ? 0 : c.splits + 1, c.halvings);
         }
@@ -1169,17 +1165,22 @@ private:
             for (double y : {c.y0, c.y1}) r = std::max(r, std::abs(cplx(x, y) - sigma));
         return r * (1.0 + 1e-9);
     }
-    /// A cell inside a disc; one inside an Arnoldi disc (not root-free) needs the collocation to
+    /// The part of the cell not yet covered (detail::uncovered_part, 64 pieces at most): nullopt
+    /// when the union of the discs covers it, else the bounding box of the pieces left, the
+    /// cell's flags kept. A piece inside an Arnoldi disc (not root-free) needs the collocation to
     /// resolve it: its farthest corner raises extent().
-    bool covered(const Cell& c) {
-        for (auto it = m_discs.rbegin(); it != m_discs.rend(); ++it)
-            if (c.x0 >= it->valid_from && inside(c, *it)) {
-                if (!it->root_free)
-                    for (double x : {c.x0, c.x1})
-                        for (double y : {c.y0, c.y1}) m_extent = std::max(m_extent, std::abs(cplx(x, y)));
-                return true;
-            }
-        return false;
+    std::optional<Cell> uncovered(const Cell& c) {
+        const auto left = detail::uncovered_part(detail::Rect{c.x0, c.x1, c.y0, c.y1}, m_discs, 6, [this](const detail::Rect& p) {
+            for (double x : {p.x0, p.x1})
+                for (double y : {p.y0, p.y1}) m_extent = std::max(m_extent, std::abs(cplx(x, y)));
+        });
+        if (!left) return std::nullopt;
+        Cell part = c;
+        part.x0 = left->x0;
+        part.x1 = left->x1;
+        part.y0 = left->y0;
+        part.y1 = left->y1;
+        return part;
     }
     /// An eigenvalue z = sigma + 1/theta from a Ritz value converged to |residual| <= tol |theta|:
     /// its error is about tol |z - sigma| (|d theta| / |theta|^2, times the eigenvalue's condition),
