@@ -24,8 +24,9 @@
 /// |nu(lambda)|, nu = (1/(lambda - sigma) + 1/(lambda - conj sigma)) / 2 (Spectra's operator
 /// Re((A_M - sigma I)^{-1})), has found every eigenvalue with |nu| > nu_min; that set contains
 /// the disc |z - sigma| < rho with (1/rho - 1/(2 Im sigma - rho)) / 2 = nu_min (rho = 1/nu_min
-/// for a real shift). Cells of the rectangle not inside the union of the discs are shrunk to the
-/// part left, get a shift (or a resolvent test) at its centre and are split until covered. alpha is lowered until `count` eigenvalues lie right of it.
+/// for a real shift). Cells of the rectangle not inside the union of the discs are shrunk to
+/// the part left, get a shift (or a resolvent test) at their centre and are split until
+/// covered. alpha is lowered until `count` eigenvalues lie right of it.
 
 #include <string>
 #include <vector>

@@ -32,7 +32,7 @@ inline bool rect_in_disc(const Rect& r, const Disc& d) {
     const double r2 = d.radius * d.radius;
     for (double x : {r.x0, r.x1})
         for (double y : {r.y0, r.y1})
-            if (std::norm(std::complex<double>(x, y) - d.centre) >= r2) return false;
+            if (!(std::norm(std::complex<double>(x, y) - d.centre) < r2)) return false;  // (a NaN radius covers nothing)
     return true;
 }
 
@@ -46,14 +46,13 @@ inline bool disc_meets(const Rect& r, const Disc& d) {
 }
 
 namespace cover_detail {
-template <class OnArnoldi>
-bool cover_piece(const Rect& p, const std::vector<Disc>& discs, const std::vector<std::size_t>& near, int depth,
-                 Rect& box, OnArnoldi& on_arnoldi) {
+inline bool cover_piece(const Rect& p, const std::vector<Disc>& discs, const std::vector<std::size_t>& near, int depth,
+                        Rect& box, std::vector<Rect>& arnoldi) {
     for (const bool root_free : {true, false})
         for (const std::size_t i : near) {
             const Disc& d = discs[i];
             if (d.root_free != root_free || p.x0 < d.valid_from || !rect_in_disc(p, d)) continue;
-            if (!root_free) on_arnoldi(p);
+            if (!root_free) arnoldi.push_back(p);
             return true;
         }
     std::vector<std::size_t> still;
@@ -72,8 +71,8 @@ bool cover_piece(const Rect& p, const std::vector<Disc>& discs, const std::vecto
     } else {
         a.y1 = b.y0 = 0.5 * (p.y0 + p.y1);
     }
-    const bool first = cover_piece(a, discs, still, depth - 1, box, on_arnoldi);
-    const bool second = cover_piece(b, discs, still, depth - 1, box, on_arnoldi);
+    const bool first = cover_piece(a, discs, still, depth - 1, box, arnoldi);
+    const bool second = cover_piece(b, discs, still, depth - 1, box, arnoldi);
     return first && second;
 }
 }  // namespace cover_detail
@@ -83,9 +82,9 @@ bool cover_piece(const Rect& p, const std::vector<Disc>& discs, const std::vecto
 /// most); a piece is covered when it lies inside one disc, a root-free one only where the piece
 /// lies right of its valid_from, root-free discs tried first. A sufficient test: a covered
 /// answer is always right, a piece that the union covers only in parts finer than the last
-/// halving counts as left. `on_arnoldi(piece)` is called for each piece covered by an Arnoldi
-/// disc (the covering raises the extent the collocation must resolve), also when the answer
-/// is a box.
+/// halving counts as left. `on_arnoldi(piece)` is called for each piece that is covered by an
+/// Arnoldi disc and not inside the box returned (the covering raises the extent the collocation
+/// must resolve; the box is looked at again, or shown root-free, by the caller).
 template <class OnArnoldi>
 std::optional<Rect> uncovered_part(const Rect& r, const std::vector<Disc>& discs, int depth, OnArnoldi on_arnoldi) {
     std::vector<std::size_t> near;
@@ -93,7 +92,11 @@ std::optional<Rect> uncovered_part(const Rect& r, const std::vector<Disc>& discs
         if (disc_meets(r, discs[i])) near.push_back(i);
     constexpr double inf = std::numeric_limits<double>::infinity();
     Rect box{inf, -inf, inf, -inf};
-    if (cover_detail::cover_piece(r, discs, near, depth, box, on_arnoldi)) return std::nullopt;
+    std::vector<Rect> arnoldi;
+    const bool covered = cover_detail::cover_piece(r, discs, near, depth, box, arnoldi);
+    for (const Rect& p : arnoldi)
+        if (covered || p.x0 < box.x0 || p.x1 > box.x1 || p.y0 < box.y0 || p.y1 > box.y1) on_arnoldi(p);
+    if (covered) return std::nullopt;
     return box;
 }
 
