@@ -575,8 +575,8 @@ namespace {
 
 using detail::Disc;
 
-struct Cell {
-    double x0, x1, y0, y1;
+/// A rectangle of the covering and what was tried on it.
+struct Cell : detail::Rect {
     bool shifted = false;
     int splits = 0;  ///< splits since a shift was last tried (a root on a corner stops the halving)
     int halvings = 0;  ///< splits instead of a resolvent test (an expensive LU, a Gershgorin root-free centre)
@@ -996,7 +996,7 @@ public:
         const double height = bounds.height(alpha);
         m_height = std::min(m_height, height);
         if (m_discs.empty()) {
-            const Cell all{alpha, beta, 0.0, height};
+            const Cell all{{alpha, beta, 0.0, height}};
             // a little right of beta: the bound can be attained (a circulant system's rightmost root)
             const cplx seed(beta + 0.05 * (beta - alpha), 0.0);
             if (!shift_near(seed, all, beta, m_o.arnoldi == "compact" ? std::max(20, m_o.compact_max_steps / 4) : 0)) return false;
@@ -1011,7 +1011,7 @@ public:
         const int ny = std::clamp(static_cast<int>(std::ceil(height / std::max(w, 1e-300))), 1, cap);
         for (int i = 0; i < nx; ++i)
             for (int j = 0; j < ny; ++j)
-                queue.push({alpha + w * i / nx, alpha + w * (i + 1) / nx, height * j / ny, height * (j + 1) / ny});
+                queue.push(Cell{{alpha + w * i / nx, alpha + w * (i + 1) / nx, height * j / ny, height * (j + 1) / ny}});
         while (!queue.empty()) {
             Cell c = queue.top();
             queue.pop();
@@ -1170,16 +1170,13 @@ private:
     /// cell's flags kept. A piece inside an Arnoldi disc (not root-free) needs the collocation to
     /// resolve it: its farthest corner raises extent().
     std::optional<Cell> uncovered(const Cell& c) {
-        const auto left = detail::uncovered_part(detail::Rect{c.x0, c.x1, c.y0, c.y1}, m_discs, 6, [this](const detail::Rect& p) {
+        const auto left = detail::uncovered_part(c, m_discs, 6, [this](const detail::Rect& p) {
             for (double x : {p.x0, p.x1})
                 for (double y : {p.y0, p.y1}) m_extent = std::max(m_extent, std::abs(cplx(x, y)));
         });
         if (!left) return std::nullopt;
         Cell part = c;
-        part.x0 = left->x0;
-        part.x1 = left->x1;
-        part.y0 = left->y0;
-        part.y1 = left->y1;
+        static_cast<detail::Rect&>(part) = *left;
         return part;
     }
     /// An eigenvalue z = sigma + 1/theta from a Ritz value converged to |residual| <= tol |theta|:
