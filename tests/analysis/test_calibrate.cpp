@@ -1,5 +1,5 @@
 // Calibration: synthetic recovery (data from the platoon simulator, with noise) and real
-// measured traces (../shared/data/acc when present).
+// measured traces (data/openacc of the repository).
 #include <doctest/doctest.h>
 
 #include <cmath>

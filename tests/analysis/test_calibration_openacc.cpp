@@ -1,5 +1,5 @@
-// Calibration on the 12 measured OpenACC traces (../shared/data/acc, or the folder named by the
-// environment variable DDEMAP_ACC_DATA): every fit converges, other design seeds find the
+// Calibration on the 12 measured OpenACC traces (data/openacc of the repository, or the folder
+// named by the environment variable DDEMAP_ACC_DATA): every fit converges, other design seeds find the
 // same minimum, every fit reports intervals and its warnings.
 #include <doctest/doctest.h>
 
@@ -18,14 +18,12 @@ using namespace ddemap;
 
 TEST_CASE("real OpenACC traces: converged fits, repeatable over design seeds, intervals and warnings, the model beats the naive predictor, th(L) > th(S)" * doctest::test_suite("reference")) {
     const char* env = std::getenv("DDEMAP_ACC_DATA");
-    const std::string dir = env ? std::string(env) : std::string(DDEMAP_TEST_DATA) + "/../../../shared/data/acc/openacc_zalazone";
-    if (!std::filesystem::exists(dir)) {
-        MESSAGE("shared data not found at " << dir << " (set DDEMAP_ACC_DATA): skipped");
-        return;
-    }
+    const std::string dir = env ? std::string(env) : std::string(DDEMAP_REPO_DATA) + "/openacc";
+    REQUIRE_MESSAGE(std::filesystem::is_directory(dir), "the OpenACC traces are missing: " << dir);
     std::vector<std::string> files;
     for (const auto& e : std::filesystem::directory_iterator(dir))
-        if (e.path().extension() == ".csv") files.push_back(e.path().string());
+        if (e.path().extension() == ".csv" && e.path().filename().string().rfind("openacc_", 0) == 0)
+            files.push_back(e.path().string());
     std::sort(files.begin(), files.end());
     REQUIRE(files.size() == 12);
     std::vector<Trace> traces;
