@@ -1,5 +1,5 @@
-// Calibration: synthetic recovery (data from the platoon simulator, with noise) and real
-// measured traces (../shared/data/acc when present).
+// Calibration: synthetic recovery (data from the platoon simulator, with noise); the measured
+// OpenACC traces (data/openacc/) are fitted in test_calibration_openacc.cpp.
 #include <doctest/doctest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Calibration on the 12 measured OpenACC traces (../shared/data/acc, or the folder named by the
+// Calibration on the 12 measured OpenACC traces (data/openacc/ of the repository, or the folder named by the
 // environment variable DDEMAP_ACC_DATA): every fit converges, other design seeds find the
 // same minimum, every fit reports intervals and its warnings.
 #include <doctest/doctest.h>
@@ -18,9 +18,9 @@ using namespace ddemap;
 
 TEST_CASE("real OpenACC traces: converged fits, repeatable over design seeds, intervals and warnings, the model beats the naive predictor, th(L) > th(S)" * doctest::test_suite("reference")) {
     const char* env = std::getenv("DDEMAP_ACC_DATA");
-    const std::string dir = env ? std::string(env) : std::string(DDEMAP_TEST_DATA) + "/../../../shared/data/acc/openacc_zalazone";
+    const std::string dir = env ? std::string(env) : std::string(DDEMAP_TEST_DATA) + "/../../data/openacc";
     if (!std::filesystem::exists(dir)) {
-        MESSAGE("shared data not found at " << dir << " (set DDEMAP_ACC_DATA): skipped");
+        MESSAGE("OpenACC data not found at " << dir << " (set DDEMAP_ACC_DATA): skipped");
         return;
     }
     std::vector<std::string> files;
