@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Rejects an include of a higher layer (ARCHITECTURE.md): each layer may use only the layers
+# Rejects an include of a higher layer (docs/code-layout.md): each layer may use only the layers
 # listed before it. Checks include/ddemap/<layer>/ and src/<layer>/; exit 1 on a violation.
 set -euo pipefail
 cd "$(dirname "$0")/.."
