@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/calibrate.hpp"
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/calibration/calibrate.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/core/execution.hpp"
 
 using namespace ddemap;

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/equilibrium_branch.hpp"
-#include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/traffic/nonlinear_ring.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
 

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/ring_winding.hpp"
+#include "ddemap/analysis/stability/ring_winding.hpp"
 #include "ddemap/core/execution.hpp"
 #include "ddemap/study/sweep.hpp"
 

@@ -16,8 +16,8 @@
 
 
 #include "ddemap/core/execution.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/study/sweep.hpp"
 
 using namespace ddemap;

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/travelling_wave.hpp"
+#include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 
 using namespace ddemap;
 

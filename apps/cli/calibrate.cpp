@@ -11,7 +11,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "limits.hpp"
-#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/io/calibration_report.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"

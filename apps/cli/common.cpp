@@ -6,7 +6,7 @@
 
 #include <unistd.h>
 
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/io/vehicle_files.hpp"
 

@@ -9,7 +9,7 @@
 #include "format.hpp"
 #include "limits.hpp"
 #include "nonlinear_flags.hpp"
-#include "ddemap/analysis/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"

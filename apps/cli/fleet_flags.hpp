@@ -3,7 +3,7 @@
 #include <string>
 
 #include "common.hpp"
-#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/stability/mixed_ring.hpp"
 
 namespace ddemap::cli {
 

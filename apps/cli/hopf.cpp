@@ -10,7 +10,7 @@
 #include "format.hpp"
 #include "limits.hpp"
 #include "nonlinear_flags.hpp"
-#include "ddemap/analysis/hopf.hpp"
+#include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/io/hopf_output.hpp"
 #include "ddemap/io/json.hpp"

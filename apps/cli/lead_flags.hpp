@@ -4,7 +4,7 @@
 #include <string>
 
 #include "common.hpp"
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 
 namespace ddemap::cli {
 

@@ -8,7 +8,7 @@
 
 #include "format.hpp"
 #include "limits.hpp"
-#include "ddemap/analysis/travelling_wave.hpp"
+#include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/io/json.hpp"
@@ -67,7 +67,7 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
             throw BadInput("--initial-step = '" + a.initial_step + "': expected a value from 1e-6 to " + rounded(upper, 6) +
                            (a.max_step.empty() ? std::string(" (the largest step, --max-step)") : std::string()));
     }
-    if (!a.max_step.empty()) {  // as orbits: the largest step of the same step control (analysis/internal/orbit_continuation.hpp)
+    if (!a.max_step.empty()) {  // as orbits: the largest step of the same step control (analysis/bifurcation/internal/orbit_continuation.hpp)
         po.max_step = parse_number("--max-step", a.max_step);
         if (!(po.max_step >= po.initial_step && po.max_step <= 1e6))
             throw BadInput("--max-step = '" + a.max_step + "': expected a value from " + rounded(po.initial_step, 6) + " (the first step) to 1e6");

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "common.hpp"
-#include "ddemap/analysis/periodic_orbit.hpp"
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "nonlinear_flags.hpp"
 
 namespace ddemap::cli {

@@ -7,7 +7,7 @@
 #include "common.hpp"
 #include "lead_flags.hpp"
 #include "limits.hpp"
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
 #include "ddemap/io/svg.hpp"

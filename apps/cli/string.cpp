@@ -9,9 +9,9 @@
 #include "common.hpp"
 #include "limits.hpp"
 #include "ring_fast.hpp"
-#include "ddemap/analysis/ring_fast.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_fast.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/svg.hpp"
 

@@ -1,6 +1,6 @@
 #include "sweep_flags.hpp"
 
-#include "ddemap/analysis/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars
+#include "ddemap/analysis/stability/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars
 #include "ddemap/io/svg.hpp"
 #include "limits.hpp"
 

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/study/growth.hpp"
 
 namespace ddemap::cli {

@@ -1,6 +1,6 @@
 // The dense backend of rightmost_roots: all eigenvalues of the Chebyshev collocation matrix
 // (Eigen's QR algorithm, real arithmetic for real problems), each refined by Newton on det Delta,
-// with the degree raised until the rightmost roots settle (MATH.md section 5).
+// with the degree raised until the rightmost roots settle (docs/mathematics.md section 5).
 
 #include <algorithm>
 #include <functional>

@@ -9,8 +9,8 @@
 #include <set>
 #include <stdexcept>
 
-#include "ddemap/analysis/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars, resolve_ring_method
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars, resolve_ring_method
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "core/internal/text.hpp"
 
 namespace ddemap {

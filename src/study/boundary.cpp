@@ -8,9 +8,9 @@
 
 #include <Eigen/Dense>
 
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/ring_winding.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/ring_winding.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/problem/quasi_polynomial.hpp"
 #include "ddemap/solve/continuation.hpp"
 #include "ddemap/traffic/ring.hpp"

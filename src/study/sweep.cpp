@@ -13,10 +13,10 @@
 #include <stdexcept>
 
 #include "ddemap/solve/roots.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars
-#include "ddemap/analysis/ring_winding.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/ring_fast.hpp"  // kModesMaxCars, kWindingMaxCars
+#include "ddemap/analysis/stability/ring_winding.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "core/internal/text.hpp"
 
 namespace ddemap {

@@ -4,8 +4,8 @@
 #include <random>
 
 #include "ddemap/problem/quasi_polynomial.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "fleet_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");

@@ -8,7 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "ddemap/discretize/collocation.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/solve/shift_invert.hpp"
 
 TEST_SUITE_BEGIN("fast");

@@ -1,4 +1,4 @@
-// Boundary continuation against the closed-form D-subdivision curves of OVRV (MATH.md sec. 4).
+// Boundary continuation against the closed-form D-subdivision curves of OVRV (docs/mathematics.md section 4).
 #include <doctest/doctest.h>
 
 #include "tolerances.hpp"
@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "ddemap/study/boundary.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "chart_helpers.hpp"
 
 namespace tol = ddemap::test::tol;

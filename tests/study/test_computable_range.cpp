@@ -5,9 +5,9 @@
 
 #include <stdexcept>
 
-#include "ddemap/analysis/classify.hpp"
-#include "ddemap/analysis/mixed_ring.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/classify.hpp"
+#include "ddemap/analysis/stability/mixed_ring.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/study/penetration.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/traffic/model.hpp"

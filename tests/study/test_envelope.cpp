@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "chart_helpers.hpp"
 

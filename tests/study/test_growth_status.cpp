@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 

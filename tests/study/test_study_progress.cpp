@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/travelling_wave.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/study/penetration.hpp"
 #include "ddemap/traffic/fleet.hpp"

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/traffic/transfer_function.hpp"

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include "ddemap/analysis/equilibrium_branch.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/idm_ring.hpp"
 #include "ddemap/traffic/model.hpp"

@@ -10,7 +10,7 @@
 #include <Eigen/Dense>
 
 #include "ddemap/study/penetration.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"

@@ -5,8 +5,8 @@
 #include <random>
 
 #include "ddemap/study/penetration.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/traffic/ring_system.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"

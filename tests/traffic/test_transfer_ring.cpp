@@ -11,8 +11,8 @@
 
 #include <Eigen/Dense>
 
-#include "ddemap/analysis/mixed_ring.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
+#include "ddemap/analysis/stability/mixed_ring.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"

@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "ddemap/analysis/calibrate.hpp"
+#include "ddemap/analysis/calibration/calibrate.hpp"
 
 namespace ddemap {
 

@@ -14,7 +14,7 @@
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
-#include "ddemap/analysis/classify.hpp"
+#include "ddemap/analysis/stability/classify.hpp"
 
 namespace ddemap {
 

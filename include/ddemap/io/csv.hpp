@@ -6,13 +6,13 @@
 
 #include <vector>
 
-#include "ddemap/analysis/calibrate.hpp"
-#include "ddemap/analysis/classify.hpp"
-#include "ddemap/analysis/equilibrium_branch.hpp"
-#include "ddemap/analysis/periodic_orbit.hpp"
-#include "ddemap/analysis/ring_stability.hpp"
-#include "ddemap/analysis/simulate.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/calibration/calibrate.hpp"
+#include "ddemap/analysis/stability/classify.hpp"
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/study/penetration.hpp"

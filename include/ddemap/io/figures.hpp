@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/calibrate.hpp"
-#include "ddemap/analysis/equilibrium_branch.hpp"
-#include "ddemap/analysis/periodic_orbit.hpp"
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/calibration/calibrate.hpp"
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/study/penetration.hpp"

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/hopf.hpp"
+#include "ddemap/analysis/bifurcation/hopf.hpp"
 
 namespace ddemap {
 

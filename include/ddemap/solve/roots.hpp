@@ -5,7 +5,7 @@
 ///     RootResult r = rightmost_roots(problem, options);   // options.method = "auto" by default
 ///
 /// Backends (each in its own file, registered in src/solve/roots.cpp):
-///  - "dense": all eigenvalues of the Chebyshev collocation of the generator (MATH.md 5), each
+///  - "dense": all eigenvalues of the Chebyshev collocation of the generator (docs/mathematics.md section 5), each
 ///    refined by Newton on det Delta, lambda <- lambda - 1 / trace(Delta^{-1} Delta'), with the
 ///    degree M increased until the rightmost roots are unchanged between two degrees (or equal
 ///    the eigenvalues to spectral accuracy). Any coefficients, ODEs included.

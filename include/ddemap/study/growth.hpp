@@ -7,7 +7,7 @@
 
 #include "ddemap/core/execution.hpp"
 #include "ddemap/core/status.hpp"
-#include "ddemap/analysis/simulate.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 
 namespace ddemap {

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "ddemap/analysis/mixed_ring.hpp"
+#include "ddemap/analysis/stability/mixed_ring.hpp"
 #include "ddemap/core/execution.hpp"
 #include "ddemap/traffic/fleet.hpp"
 

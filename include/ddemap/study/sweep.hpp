@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "ddemap/analysis/ring_winding.hpp"  // kWindingFallbackCars
+#include "ddemap/analysis/stability/ring_winding.hpp"  // kWindingFallbackCars
 #include "ddemap/core/execution.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/solve/roots.hpp"

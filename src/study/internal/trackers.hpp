@@ -13,7 +13,7 @@
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/study/sweep.hpp"
-#include "ddemap/analysis/string_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
 
 namespace ddemap::detail {
 

@@ -1,0 +1,216 @@
+#pragma once
+/// \file periodic_orbit.hpp
+/// Periodic orbits of a nonlinear DDE x'(t) = f(x(t), x(t - tau_1), ..., x(t - tau_m); p)
+/// (problem/nonlinear_dde.hpp) and their branches in one parameter p.
+///
+/// Discretisation (discretize/periodic_mesh.hpp): time scaled by the period T, s = t / T in
+/// [0, 1], x is a continuous piecewise polynomial of degree d on L intervals, given by its
+/// values at the L d mesh points (x(1) = x(0)). The equations are
+///     x'(c) = T f(x(c), x((c - tau_1 / T) mod 1), ..., x((c - tau_m / T) mod 1); p)
+/// at the L d Gauss-Legendre collocation points c (delayed values by the piecewise polynomial's
+/// Lagrange interpolation), and the integral phase condition against a reference orbit x_ref
+/// (the previous orbit of the branch),  int_0^1 x(s) . x_ref'(s) ds = 0  (Gauss quadrature,
+/// exact for these polynomials): L d n + 1 equations in the L d n + 2 unknowns (x, T, p).
+/// Newton's Jacobian is exact: the blocks A_k = D_{u_k} f and df/dp from dual numbers, and
+///     dF/dT = -f - sum_k A_k x'(c_k) tau_k / T,
+///     dF/dp = -T df/dp + sum_k A_k x'(c_k) d tau_k / dp        (c_k = c - tau_k / T);
+/// bordered by the phase row and the pseudo-arclength row. It is solved in condensed form: the
+/// collocation matrix of the points of one period is block lower triangular by intervals (a
+/// delayed point is never later than its collocation point) once the values on the history
+/// window [-max tau / T, 0] are taken as separate unknowns, so a forward sweep over the
+/// intervals (dense d n x d n diagonal blocks) reduces the Newton system exactly to a dense
+/// one in the window values, T and p (the monodromy matrix minus the identity, bordered); the
+/// same sweep gives the Floquet monodromy matrix. Chord steps reuse the linearisation of the
+/// previous orbit, a new one is made when a step contracts by less than 0.3, and one at every
+/// orbit found (for its tangent, its multipliers and the next corrector). Windows of more than
+/// 4000 values use Eigen's supernodal SparseLU (COLAMD) of the whole bordered Jacobian instead.
+///
+/// Mesh adaptation (options.adapt, off by default): after every orbit the breakpoints are moved so that they
+/// equidistribute |x^(d+1)|^(1/(d+1)) (estimated from the jumps of the piecewise constant d-th
+/// derivative between intervals), as in COLSYS and DDE-BIFTOOL, and the orbit and the tangent
+/// are interpolated onto the new mesh before the next step.
+///
+/// Continuation: pseudo-arclength in the weighted norm
+///     |u|^2 = (1 / (L d)) sum_i |x_i|^2 / sx^2 + (T / sT)^2 + (p / sp)^2
+/// (sx = 1, sT = the first period, sp = |to - from|), tangent predictor, step halved on a
+/// failed corrector and grown by 1.5 after an easy one. From a Hopf point (x*, p_H, omega, q):
+/// the first orbit is corrected from x* + eps Re(q e^{2 pi i s}), T = 2 pi / omega, p = p_H
+/// with the step condition along that direction (the equilibrium is excluded by it).
+///
+/// Floquet multipliers (DDE-BIFTOOL's approach, Engelborghs et al. 2000): the collocation
+/// equations of the variational equation y' = T (A_0(s) y(s) + sum_k A_k(s) y(s - tau_k / T))
+/// on [0, 1], M1 y_new + M0 y_hist = 0, with y_hist the mesh values (the mesh repeated
+/// periodically) on the intervals that meet [-max tau_k / T, 0]; the monodromy matrix maps
+/// y_hist to the values on the same points shifted by one period (rows of -M1^{-1} M0 or of the
+/// identity), and its eigenvalues are the multipliers (the zero multipliers of the points that
+/// no delay reaches are left out): all of them (dense QR) for matrices up to 200, else the
+/// largest by Arnoldi (Spectra; at least 16, and every one of modulus above 1/2; each Ritz
+/// pair's residual checked, dense QR when one fails). The trivial multiplier (the one nearest 1, of
+/// the eigenvector x') must be 1: |mu_trivial - 1| is the accuracy check.
+///
+/// Special points along a branch: a fold (the parameter component of the unit tangent changes
+/// sign) is located by Illinois regula falsi in the arclength on that component (each trial
+/// orbit corrected); a period doubling (a real negative multiplier crosses the unit circle) and a
+/// torus bifurcation (a complex pair crosses it) likewise on |mu| - 1 of the multiplier that
+/// crosses (OrbitCrossing). The multipliers of each kind of two consecutive orbits are paired
+/// by distance, so every crossing of a step is found, also several in one long step; a change of
+/// the number of multipliers outside the circle without a crossing (two multipliers colliding on
+/// the real axis) is not reported.
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/core/execution.hpp"
+#include "ddemap/core/status.hpp"
+#include "ddemap/core/types.hpp"
+#include "ddemap/discretize/periodic_mesh.hpp"
+#include "ddemap/problem/nonlinear_dde.hpp"
+
+namespace ddemap {
+
+struct PeriodicOrbitOptions {
+    std::string parameter;   ///< the free parameter (a name of the system)
+    double from = 0.0;       ///< the parameter range [min(from, to), max(from, to)]: the branch
+    double to = 1.0;         ///< ends on its faces (located exactly)
+    int degree = 4;          ///< d, the degree of the piecewise polynomials (1..20)
+    int intervals = 40;      ///< L, the number of mesh intervals (>= 2)
+    int max_points = 100;    ///< orbits on the branch, the first included (>= 2)
+    double initial_step = 0.02;  ///< h in the weighted norm (also the first orbit's amplitude measure)
+    /// the largest step h in the weighted norm |u| of the continuation (below): h grows by 1.5
+    /// after an easy corrector up to it, and is halved after a failed one. The norm counts the
+    /// root mean square of the profile's values, T / sT and p / |to - from|, so its size follows
+    /// the orbits' amplitude: a branch whose orbits grow to an amplitude A needs about A / max_step
+    /// orbits at least
+    double max_step = 0.1;
+    double min_step = 1e-6;  ///< the branch ends when the step falls below it
+    int max_iterations = 10;      ///< Newton iterations per corrector
+    double tolerance = 1e-10;     ///< Newton stops when max |du| <= tolerance * max(1, max |u|)
+    double residual_tolerance = 1e-8;  ///< an orbit is accepted when max |F| <= this
+    /// the branch ends when the period exceeds this multiple of the first period (a homoclinic orbit)
+    double max_period_factor = 50.0;
+    bool floquet = true;     ///< compute the multipliers (stability, period doublings, tori)
+    /// move the mesh after every orbit so that it equidistributes |x^(d+1)|^(1/(d+1)) of that
+    /// orbit (L and d kept; false: the uniform mesh throughout). Off by default: on Wright's
+    /// equation at alpha = 2.9 (L = 40) it makes the period 3 times more accurate but the trivial
+    /// multiplier 100 times less (6.8e-4 against 5.4e-6), and the history segment of the
+    /// monodromy matrix (so its size) can grow where the mesh is fine near s = 1.
+    bool adapt = false;
+    /// After every orbit added to the branch, the first included: (orbits so far, max_points, p).
+    /// It may throw to stop the branch; the exception reaches the caller (no partial branch).
+    BranchProgress progress;
+    bool is_valid(std::string* why = nullptr) const;
+};
+
+/// The accuracy check of an orbit's multipliers: |mu_trivial - 1| above this leaves its
+/// stability undecided (accurate orbits have 1e-15 to 1e-5; near a homoclinic end it reaches 1).
+inline constexpr double orbit_accuracy_limit = 1e-2;
+
+/// One orbit: mesh values, period, parameter and what is derived from them.
+struct PeriodicOrbit {
+    double par = 0.0;
+    double period = 0.0;
+    Eigen::MatrixXd profile;  ///< L d x n: row i is x at mesh point i (x(1) = row 0)
+    std::vector<double> breakpoints;  ///< the mesh t_0 = 0 < ... < t_L = 1 of the profile
+    Eigen::VectorXd min, max;  ///< of every variable over the orbit (sampled at 8 d points per interval)
+    /// by decreasing modulus, the trivial one included (for monodromy matrices above 200: the
+    /// largest ones, at least 16 and all of modulus above 1/2)
+    std::vector<cplx> multipliers;
+    double trivial_distance = std::numeric_limits<double>::quiet_NaN();  ///< |mu_trivial - 1|
+    double max_nontrivial = std::numeric_limits<double>::quiet_NaN();   ///< max |mu| over the others
+    bool stable = false;      ///< every nontrivial |mu| < 1 (false without multipliers or when undecided)
+    /// non-empty: the orbit failed its accuracy check (trivial_distance > orbit_accuracy_limit):
+    /// no stability verdict (`stable` false, JSON null) and no special points next to it; the reason
+    std::string undecided;
+    double residual = std::numeric_limits<double>::infinity();  ///< max |F| (collocation and phase)
+    int iterations = 0;       ///< Newton iterations of its corrector
+};
+
+struct OrbitFold {
+    double par = 0.0, period = 0.0;
+    PeriodicOrbit orbit;
+    bool located = false;  ///< the regula falsi reached its tolerance
+    int after = 0;         ///< index of the branch orbit before it
+};
+
+/// A period doubling or a torus bifurcation between orbits after and after + 1: the zero of
+///     g(s) = |mu(s)| - 1
+/// along the branch (s the arclength from orbit `after`, each trial orbit corrected and its
+/// multipliers computed), mu the crossing real negative multiplier (period doubling) or complex
+/// one (torus), followed from the two orbits' by continuity, by Illinois regula falsi from the
+/// bracket of the two orbits until |g| <= 1e-9 (or the bracket is 1e-12 of the step); then an
+/// orbit just beyond the zero is computed and must have g of the other sign: par_bracket is the
+/// width of that verified bracket (a few 1e-8 of the step in the arclength, usually).
+struct OrbitCrossing {
+    double par = 0.0, period = 0.0;  ///< of the located orbit (not located: interpolated linearly in g)
+    cplx multiplier;                  ///< the crossing multiplier there (torus: the one with Im >= 0)
+    bool located = false;             ///< the regula falsi reached its tolerance
+    /// | |mu| - 1 | of the crossing multiplier at the located orbit (NaN when not located)
+    double accuracy = std::numeric_limits<double>::quiet_NaN();
+    /// the width in p of the last bracket of the zero (NaN when not located)
+    double par_bracket = std::numeric_limits<double>::quiet_NaN();
+    PeriodicOrbit orbit;              ///< the located orbit (empty when not located)
+    int after = 0;
+};
+
+struct OrbitBranch {
+    std::string parameter;
+    int degree = 0, intervals = 0;
+    std::vector<PeriodicOrbit> points;
+    std::vector<OrbitFold> folds;
+    std::vector<OrbitCrossing> period_doublings, tori;
+    /// Converged when the branch ended regularly (a face of the range, max_points, a period
+    /// above max_period_factor, an equilibrium) with every orbit and fold located; MaxIterations /
+    /// NumericalIssue when the first orbit failed or the step fell below min_step.
+    Status status = Status::Converged;
+    std::string message;
+    /// why it ended: "bound" (a face of the range), "max_points", "period" (above
+    /// max_period_factor), "hopf" (the amplitude fell below half the first orbit's: an
+    /// equilibrium, usually another Hopf point), "step_below_minimum", "first_orbit_failed"
+    std::string stop;
+    std::string method;   ///< the discretisation and solver used
+    double max_residual = 0.0;          ///< certificate: max over orbits of max |F|
+    double max_trivial_distance = 0.0;  ///< certificate: max over orbits of |mu_trivial - 1|
+    int newton_iterations = 0;
+    /// Jacobians evaluated and factorised by the correctors (condensed linearisations, or
+    /// sparse LU factorisations where the history window is too large for the condensed form)
+    int jacobians = 0;
+};
+
+/// A starting orbit (e.g. sampled from a simulation): values on the mesh of `mesh`, period, parameter.
+struct OrbitGuess {
+    double par = 0.0, period = 0.0;
+    Eigen::MatrixXd profile;  ///< points() x n
+};
+
+/// The guess from samples of one period: times t_0 < ... (covering [t_0, t_0 + period]) and
+/// states (one row per time), linearly interpolated at the mesh points t_0 + s period.
+/// std::invalid_argument when the samples do not cover a period or sizes do not fit.
+OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<double>& times, const Eigen::MatrixXd& states,
+                                    double period, double par);
+
+/// The branch from a Hopf point of an equilibrium branch (hopf.x, hopf.par, hopf.omega, hopf.q).
+/// std::invalid_argument for invalid options, an unknown parameter, a system without delay
+/// derivatives, or a Hopf point with omega <= 0 or q of the wrong size; non-convergence is a status.
+OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options);
+
+/// The branch through the orbit corrected from `guess` (the parameter fixed at guess.par for
+/// that correction), followed in the direction of increasing p when to > from, else decreasing.
+OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options);
+
+/// The Floquet multipliers (as in the branch, by decreasing modulus, the trivial one included)
+/// of a given orbit of `system`: its values on `mesh` (points() x n), period and the value `par`
+/// of `parameter` (the other parameters as held). Empty when they could not be computed (a
+/// singular collocation matrix, a non-finite value, or a history segment above 4000 values).
+/// std::invalid_argument for sizes that do not fit, a period <= 0 or an unknown parameter.
+std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
+                                    const Eigen::MatrixXd& profile, double period, double par);
+
+/// x(s) of an orbit on `mesh` at s (any real: taken mod 1), all n components (for an orbit of a
+/// branch: PeriodicMesh(branch.degree, orbit.breakpoints)).
+Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s);
+
+}  // namespace ddemap

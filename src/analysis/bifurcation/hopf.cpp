@@ -1,0 +1,591 @@
+#include "ddemap/analysis/bifurcation/hopf.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "core/internal/text.hpp"
+
+namespace ddemap {
+
+namespace {
+
+using D1 = Dual<double>;
+using D2 = NonlinearDDE::Dual2;
+using D3 = NonlinearDDE::Dual3;
+const cplx I1(0.0, 1.0);
+
+double entry(const Eigen::VectorXd& v, Eigen::Index i) { return v.size() == 0 ? 0.0 : v[i]; }
+
+/// D^2 f(u; p)[(a, 0), (b, bp)] (bp: a direction of the parameters, empty = 0), one evaluation
+/// in Dual<Dual<double>> seeded u + a e1 + b e2, p + bp e2.
+Eigen::VectorXd d2(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const Eigen::VectorXd& a,
+                   const Eigen::VectorXd& b, const Eigen::VectorXd& bp = {}) {
+    const int n = s.dimension();
+    std::vector<D2> U(static_cast<std::size_t>(u.size())), P(p.size()), out(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < u.size(); ++i) U[static_cast<std::size_t>(i)] = D2(D1(u[i], a[i]), D1(b[i], 0.0));
+    for (std::size_t i = 0; i < p.size(); ++i) P[i] = D2(D1(p[i], 0.0), D1(entry(bp, static_cast<Eigen::Index>(i)), 0.0));
+    s.evaluate(U.data(), P.data(), out.data());
+    Eigen::VectorXd r(n);
+    for (int i = 0; i < n; ++i) r[i] = out[static_cast<std::size_t>(i)].deriv.deriv;
+    return r;
+}
+
+/// D^3 f(u; p)[a, b, c]: u + a e1 + b e2 + c e3 in three nested levels.
+Eigen::VectorXd d3(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const Eigen::VectorXd& a,
+                   const Eigen::VectorXd& b, const Eigen::VectorXd& c) {
+    const int n = s.dimension();
+    std::vector<D3> U(static_cast<std::size_t>(u.size())), P(p.size()), out(static_cast<std::size_t>(n));
+    for (Eigen::Index i = 0; i < u.size(); ++i)
+        U[static_cast<std::size_t>(i)] = D3(D2(D1(u[i], a[i]), D1(b[i], 0.0)), D2(D1(c[i], 0.0), D1(0.0, 0.0)));
+    for (std::size_t i = 0; i < p.size(); ++i) P[i] = D3(p[i]);
+    s.evaluate(U.data(), P.data(), out.data());
+    Eigen::VectorXd r(n);
+    for (int i = 0; i < n; ++i) r[i] = out[static_cast<std::size_t>(i)].deriv.deriv.deriv;
+    return r;
+}
+
+/// B(a, b) for complex stacked directions (bilinear, not sesquilinear).
+VectorXc b_complex(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const VectorXc& a, const VectorXc& b) {
+    const Eigen::VectorXd ar = a.real(), ai = a.imag(), br = b.real(), bi = b.imag();
+    return (d2(s, u, p, ar, br) - d2(s, u, p, ai, bi)).cast<cplx>() + I1 * (d2(s, u, p, ar, bi) + d2(s, u, p, ai, br)).cast<cplx>();
+}
+
+/// C(a, b, c) for complex directions: the 8 real terms of the trilinear expansion.
+VectorXc c_complex(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const VectorXc& a, const VectorXc& b,
+                   const VectorXc& c) {
+    VectorXc r = VectorXc::Zero(s.dimension());
+    const Eigen::VectorXd parts[3][2] = {{a.real(), a.imag()}, {b.real(), b.imag()}, {c.real(), c.imag()}};
+    for (int mask = 0; mask < 8; ++mask) {
+        const int ia = mask & 1, ib = (mask >> 1) & 1, ic = (mask >> 2) & 1;
+        const Eigen::VectorXd& va = parts[0][ia];
+        const Eigen::VectorXd& vb = parts[1][ib];
+        const Eigen::VectorXd& vc = parts[2][ic];
+        if (va.isZero(0.0) || vb.isZero(0.0) || vc.isZero(0.0)) continue;
+        cplx factor(1.0, 0.0);
+        for (int k = 0; k < ia + ib + ic; ++k) factor *= I1;
+        r += factor * d3(s, u, p, va, vb, vc).cast<cplx>();
+    }
+    return r;
+}
+
+/// (v e^{-lambda tau_k})_k, tau_0 = 0.
+VectorXc stack(const VectorXc& v, cplx lambda, const std::vector<double>& tau) {
+    const Eigen::Index n = v.size();
+    VectorXc r(n * static_cast<Eigen::Index>(tau.size()));
+    for (std::size_t k = 0; k < tau.size(); ++k) r.segment(static_cast<Eigen::Index>(k) * n, n) = v * std::exp(-lambda * tau[k]);
+    return r;
+}
+
+/// Delta(lambda) = lambda I - sum_k A_k e^{-lambda tau_k}, or with derivative = true
+/// Delta'(lambda) = I + sum_k tau_k A_k e^{-lambda tau_k}.
+MatrixXc delta(const std::vector<Eigen::MatrixXd>& a, const std::vector<double>& tau, cplx lambda, bool derivative = false) {
+    const Eigen::Index n = a[0].rows();
+    MatrixXc m = MatrixXc::Identity(n, n) * (derivative ? cplx(1.0, 0.0) : lambda);
+    for (std::size_t k = 0; k < a.size(); ++k) {
+        const cplx e = std::exp(-lambda * tau[k]);
+        m += (derivative ? tau[k] * e : -e) * a[k].cast<cplx>();
+    }
+    return m;
+}
+
+void check_system(const NonlinearDDE& s, int j, const char* what) {
+    if (!s.has_higher_derivatives() || !s.has_delay_derivatives())
+        throw std::invalid_argument(std::string(what) +
+                                    ": the system gives no higher derivatives or no derivatives of its delays: expected an expression system or a built-in model (NonlinearDDEOf)");
+    if (j < 0 || j >= static_cast<int>(s.parameter_names().size()))
+        throw std::invalid_argument(std::string(what) + ": parameter index " + std::to_string(j) + ": expected 0.." +
+                                    std::to_string(static_cast<int>(s.parameter_names().size()) - 1));
+}
+
+/// The Hopf curve in u = (x, p1, Re q, Im q, omega, p2).
+class HopfCurveProblem final : public ContinuationProblem {
+public:
+    HopfCurveProblem(const NonlinearDDE& s, int j1, int j2, VectorXc q0) : m_s(s), m_j1(j1), m_j2(j2), m_q0(std::move(q0)), m_n(s.dimension()) {}
+    int equations() const override { return 3 * m_n + 2; }
+    std::vector<double> values(const Eigen::VectorXd& u) const {
+        std::vector<double> p = m_s.parameter_values();
+        p[static_cast<std::size_t>(m_j1)] = u[m_n];
+        p[static_cast<std::size_t>(m_j2)] = u[3 * m_n + 2];
+        return p;
+    }
+    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
+        return hopf_system(m_s, m_j1, m_q0, u.head(3 * m_n + 2), f, nullptr, values(u));
+    }
+    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override {
+        Eigen::VectorXd f1, f2;
+        Eigen::MatrixXd j1, j2;
+        const std::vector<double> p = values(u);
+        Eigen::VectorXd z = u.head(3 * m_n + 2);
+        if (!hopf_system(m_s, m_j1, m_q0, z, f1, &j1, p)) return false;
+        z[m_n] = u[3 * m_n + 2];
+        if (!hopf_system(m_s, m_j2, m_q0, z, f2, &j2, p)) return false;
+        j.resize(3 * m_n + 2, 3 * m_n + 3);
+        j.leftCols(3 * m_n + 2) = j1;
+        j.col(3 * m_n + 2) = j2.col(m_n);
+        return true;
+    }
+    bool in_domain(const Eigen::VectorXd& u) const override {
+        if (!(u[3 * m_n + 1] > 0.0)) return false;
+        try {
+            const std::vector<double> d = m_s.delays(values(u));
+            return std::all_of(d.begin(), d.end(), [](double t) { return std::isfinite(t) && t >= 0.0; });
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+    }
+    const VectorXc& q0() const { return m_q0; }
+
+private:
+    const NonlinearDDE& m_s;
+    int m_j1, m_j2;
+    VectorXc m_q0;
+    int m_n;
+};
+
+VectorXc q_of(const Eigen::VectorXd& u, int n) {
+    return u.segment(n + 1, n).cast<cplx>() + I1 * u.segment(2 * n + 1, n).cast<cplx>();
+}
+
+}  // namespace
+
+std::string to_string(Criticality c) {
+    switch (c) {
+        case Criticality::Supercritical: return "supercritical";
+        case Criticality::Subcritical: return "subcritical";
+        case Criticality::Degenerate: return "degenerate";
+    }
+    return "degenerate";
+}
+
+bool HopfCoefficientOptions::is_valid(std::string* why) const {
+    std::string m;
+    if (!(std::isfinite(degenerate_tolerance) && degenerate_tolerance >= 0.0 && degenerate_tolerance < 1.0))
+        m = "degenerate_tolerance: expected a value in [0, 1)";
+    else if (!(std::isfinite(transversal_tolerance) && transversal_tolerance >= 0.0 && transversal_tolerance < 1.0))
+        m = "transversal_tolerance: expected a value in [0, 1)";
+    if (!m.empty() && why) *why = m;
+    return m.empty();
+}
+
+HopfCoefficients hopf_coefficients(const NonlinearDDE& s, int j, const std::vector<double>& values, const Eigen::VectorXd& x, double omega,
+                                   const HopfCoefficientOptions& options) {
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("Hopf coefficient options: " + why);
+    check_system(s, j, "Hopf coefficients");
+    if (values.size() != s.parameter_values().size())
+        throw std::invalid_argument("Hopf coefficients: " + std::to_string(values.size()) + " parameter values: expected " +
+                                    std::to_string(s.parameter_values().size()));
+    if (!(std::isfinite(omega) && omega > 0.0))
+        throw std::invalid_argument("Hopf coefficients: omega = " + detail::format_number(omega) + ": expected a value > 0");
+    const int n = s.dimension();
+    HopfCoefficients r;
+    r.par = values[static_cast<std::size_t>(j)];
+    r.x = x;
+    r.omega = omega;
+    const Eigen::VectorXd u = s.stack_constant(x);  // checks the size and finiteness of x
+    std::vector<Eigen::MatrixXd> a;
+    std::vector<double> tau, dtau;
+    try {
+        a = s.jacobians(u, values);
+        tau = s.delays(values);
+        dtau = s.delay_derivatives(values, j);
+    } catch (const std::invalid_argument& e) {
+        r.message = std::string("the system cannot be evaluated at the Hopf point: ") + e.what();
+        return r;
+    }
+    tau.insert(tau.begin(), 0.0);
+    dtau.insert(dtau.begin(), 0.0);
+    const cplx lambda(0.0, omega);
+
+    // null vectors
+    const MatrixXc dl = delta(a, tau, lambda);
+    const Eigen::JacobiSVD<MatrixXc> svd(dl, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    VectorXc q = svd.matrixV().col(n - 1);
+    Eigen::Index big = 0;
+    q.cwiseAbs().maxCoeff(&big);
+    q *= std::conj(q[big]) / std::abs(q[big]);
+    Eigen::RowVectorXcd p = svd.matrixU().col(n - 1).adjoint();
+    const double size = std::max(1.0, svd.singularValues()[0]);
+    r.null_residual = std::max((dl * q).norm(), (p * dl).norm() / p.norm()) / size;
+    if (n > 1 && svd.singularValues()[n - 2] <= 1e-8 * size) {
+        r.message = "Delta(i omega) has a null space of dimension > 1 (a double Hopf eigenvalue): the normal form of a simple Hopf point does not apply";
+        return r;
+    }
+    const cplx scale = (p * delta(a, tau, lambda, true) * q)(0, 0);
+    if (!(std::abs(scale) > 1e-12 * delta(a, tau, lambda, true).norm())) {
+        r.message = "p Delta'(i omega) q = 0: the eigenvalue i omega is not simple";
+        return r;
+    }
+    p /= scale;
+    r.q = q;
+    r.p = p;
+
+    const Eigen::PartialPivLU<MatrixXc> lu2(delta(a, tau, 2.0 * lambda));
+    const Eigen::PartialPivLU<MatrixXc> lu0(delta(a, tau, cplx(0.0, 0.0)));
+    if (!(lu2.rcond() > 1e-13)) {
+        r.message = "Delta(2 i omega) is singular (a 1:2 resonance): the normal form needs higher order";
+        return r;
+    }
+    if (!(lu0.rcond() > 1e-13)) {
+        r.message = "Delta(0) is singular (a zero-Hopf point): the normal form needs higher order";
+        return r;
+    }
+    const VectorXc phi = stack(q, lambda, tau), phibar = phi.conjugate();
+    const VectorXc h20 = lu2.solve(b_complex(s, u, values, phi, phi));
+    const VectorXc h11 = lu0.solve(b_complex(s, u, values, phi, phibar));
+    const VectorXc H20 = stack(h20, 2.0 * lambda, tau), H11 = stack(h11, cplx(0.0, 0.0), tau);
+    const cplx t1 = (p * c_complex(s, u, values, phi, phi, phibar))(0, 0);
+    const cplx t2 = (p * b_complex(s, u, values, phibar, H20))(0, 0);
+    const cplx t3 = (p * b_complex(s, u, values, phi, H11))(0, 0);
+    r.c1 = 0.5 * (t1 + t2 + 2.0 * t3);
+    r.l1 = r.c1.real() / omega;
+    r.l1_scale = (std::abs(t1) + std::abs(t2) + 2.0 * std::abs(t3)) / (2.0 * omega);
+    const bool degenerate = !(std::abs(r.l1) > options.degenerate_tolerance * r.l1_scale);
+    r.criticality = degenerate ? Criticality::Degenerate : r.l1 < 0.0 ? Criticality::Supercritical : Criticality::Subcritical;
+
+    // transversality: dDelta/dp q = -D^2 f[Phi, (S x', e_j)] + lambda sum_k tau_k' A_k Phi_k
+    const Eigen::VectorXd fp = s.parameter_derivative(u, j, values);
+    const VectorXc xp = lu0.solve(fp.cast<cplx>());
+    const Eigen::VectorXd sx = s.stack_constant(xp.real());
+    Eigen::VectorXd ej = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(values.size()));
+    ej[j] = 1.0;
+    VectorXc dq = -(d2(s, u, values, phi.real(), sx, ej).cast<cplx>() + I1 * d2(s, u, values, phi.imag(), sx, ej).cast<cplx>());
+    for (std::size_t k = 0; k < a.size(); ++k)
+        if (dtau[k] != 0.0) dq += lambda * dtau[k] * (a[k].cast<cplx>() * phi.segment(static_cast<Eigen::Index>(k) * n, n));
+    r.dlambda = -(p * dq)(0, 0);
+    r.dre_dpar = r.dlambda.real();
+    const bool transversal = std::abs(r.dre_dpar) > options.transversal_tolerance * std::abs(r.dlambda);
+    if (!degenerate && transversal) {
+        r.side = (-r.dre_dpar / r.c1.real()) > 0.0 ? 1 : -1;
+        r.amplitude_coefficient = 4.0 * q.cwiseAbs() * std::sqrt(std::abs(r.dre_dpar / r.c1.real()));
+    }
+    const Eigen::VectorXd fx = s.f(u, values);
+    r.residual = std::max(fx.cwiseAbs().maxCoeff(), (dl * q).cwiseAbs().maxCoeff());
+    const bool finite = std::isfinite(r.l1) && std::isfinite(r.l1_scale) && std::isfinite(r.dre_dpar) && r.amplitude_coefficient.allFinite();
+    r.status = finite ? Status::Converged : Status::NumericalIssue;
+    r.message = !finite ? "a coefficient is not finite"
+                : degenerate ? "L1 = " + detail::format_number(r.l1) + " is within the tolerance of 0: degenerate (a generalised Hopf point)"
+                : !transversal ? "the root crosses the imaginary axis with zero speed: no side and no amplitude"
+                               : "";
+    return r;
+}
+
+HopfCoefficients hopf_coefficients(const NonlinearDDE& s, int j, const HopfPoint& h, const HopfCoefficientOptions& options) {
+    check_system(s, j, "Hopf coefficients");
+    if (!converged(h.status) || !(h.omega > 0.0) || h.x.size() != s.dimension() || !h.x.allFinite()) {
+        HopfCoefficients r;
+        r.status = converged(h.status) ? Status::NumericalIssue : h.status;
+        r.par = h.par;
+        r.x = h.x;
+        r.omega = h.omega;
+        r.residual = h.residual;
+        r.message = "the Hopf point was not located (" + to_string(h.status) + ", residual " + detail::format_number(h.residual) + ")";
+        return r;
+    }
+    std::vector<double> p = s.parameter_values();
+    p[static_cast<std::size_t>(j)] = h.par;
+    HopfCoefficients r = hopf_coefficients(s, j, p, h.x, h.omega, options);
+    r.residual = h.residual;
+    return r;
+}
+
+HopfAnalysis hopf_points(const NonlinearDDE& s, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& branch,
+                         const HopfCoefficientOptions& options) {
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("Hopf coefficient options: " + why);
+    HopfAnalysis r;
+    r.branch = equilibrium_branch(s, guess, branch);
+    const int j = s.parameter_index(branch.parameter);
+    int failed = 0;
+    for (const HopfPoint& h : r.branch.hopf) {
+        r.points.push_back(hopf_coefficients(s, j, h, options));
+        if (!converged(r.points.back().status)) {
+            ++failed;
+            if (converged(r.status)) r.status = r.points.back().status;
+        }
+    }
+    if (!converged(r.branch.status)) r.status = r.branch.status;
+    r.message = r.branch.message;
+    if (failed > 0) r.message += "; " + std::to_string(failed) + " Hopf point(s) without coefficients";
+    return r;
+}
+
+bool HopfCurveOptions::is_valid(std::string* why) const {
+    std::string m;
+    if (!branch.is_valid(&m)) m = "branch." + m;
+    else if (parameter2.empty()) m = "parameter2: expected the name of the second parameter";
+    else if (parameter2 == branch.parameter) m = "parameter2 = '" + parameter2 + "': expected a parameter other than the first";
+    else if (!std::isfinite(from2) || !std::isfinite(to2) || from2 == to2) m = "from2/to2: expected finite, distinct values";
+    else if (segment < 2) m = "segment: expected at least 2 points";
+    else if (!coefficients.is_valid(&m)) m = "coefficients." + m;
+    else if (continuation.initial_step < 0.0 || continuation.max_step < 0.0) m = "continuation steps: expected values >= 0 (0 = automatic)";
+    if (!m.empty() && why) *why = m;
+    return m.empty();
+}
+
+namespace {
+
+struct CurveSample {
+    Eigen::VectorXd u;
+    std::shared_ptr<HopfCurveProblem> problem;  // the normalisation it was computed with
+};
+
+/// L1 at a point u of the curve.
+HopfCoefficients coefficients_at(const NonlinearDDE& s, int j1, const HopfCurveProblem& pr, const Eigen::VectorXd& u,
+                                 const HopfCoefficientOptions& o) {
+    const int n = s.dimension();
+    HopfCoefficients c = hopf_coefficients(s, j1, pr.values(u), u.head(n), u[3 * n + 1], o);
+    Eigen::VectorXd f;
+    if (pr.residual(u, f)) c.residual = f.cwiseAbs().maxCoeff();
+    return c;
+}
+
+/// Illinois regula falsi on L1 along the chord from ua to ub (each trial corrected onto the curve).
+GeneralisedHopfPoint locate_generalised(const NonlinearDDE& s, int j1, const HopfCurveProblem& pr, const Eigen::VectorXd& ua,
+                                        const Eigen::VectorXd& ub, double fa, double fb, const HopfCurveOptions& o) {
+    const int n = s.dimension();
+    GeneralisedHopfPoint g;
+    const Eigen::VectorXd d = ub - ua;
+    const Eigen::VectorXd dir = d / d.norm();
+    double slo = 0.0, shi = 1.0, flo = fa, fhi = fb;
+    int last = 0;
+    Eigen::VectorXd best = ua;
+    for (int it = 0; it < 80; ++it) {
+        const double sm = (slo * fhi - shi * flo) / (fhi - flo);
+        const Eigen::VectorXd v = ua + sm * d;
+        Eigen::VectorXd u = v;
+        const CorrectorResult cr = correct(pr, u, dir, dir.dot(v), o.continuation.newton);
+        if (!converged(cr.status)) {
+            g.status = cr.status;
+            break;
+        }
+        const HopfCoefficients c = coefficients_at(s, j1, pr, u, o.coefficients);
+        if (!converged(c.status)) {
+            g.status = c.status;
+            break;
+        }
+        best = u;
+        g.l1 = c.l1;
+        g.residual = c.residual;
+        // to rounding: L1 at the rounding level of its terms, or the chord interval at rounding
+        if (std::abs(c.l1) <= 1e-13 * c.l1_scale || shi - slo <= 1e-14) {
+            g.status = Status::Converged;
+            break;
+        }
+        if ((c.l1 < 0.0) == (flo < 0.0)) {
+            slo = sm, flo = c.l1;
+            if (last == -1) fhi *= 0.5;
+            last = -1;
+        } else {
+            shi = sm, fhi = c.l1;
+            if (last == 1) flo *= 0.5;
+            last = 1;
+        }
+    }
+    g.x = best.head(n);
+    g.par = best[n];
+    g.omega = best[3 * n + 1];
+    g.par2 = best[3 * n + 2];
+    return g;
+}
+
+}  // namespace
+
+HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCurveOptions& o) {
+    std::string why;
+    if (!o.is_valid(&why)) throw std::invalid_argument("Hopf curve options: " + why);
+    const int j1 = s.parameter_index(o.branch.parameter), j2 = s.parameter_index(o.parameter2);
+    check_system(s, j1, "Hopf curve");
+    const int n = s.dimension();
+    HopfCurve curve;
+    if (!converged(start.status) || start.q.size() != n) {
+        curve.status = converged(start.status) ? Status::NumericalIssue : start.status;
+        curve.message = "the starting Hopf point was not located";
+        return curve;
+    }
+    const double held2 = s.parameter_values()[static_cast<std::size_t>(j2)];
+    const double lo1 = std::min(o.branch.from, o.branch.to), hi1 = std::max(o.branch.from, o.branch.to);
+    const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
+    if (!(held2 >= lo2 && held2 <= hi2))
+        throw std::invalid_argument(o.parameter2 + " = " + detail::format_number(held2) + " (its value in the system): expected a value in [" +
+                                    detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
+
+    ContinuationOptions co = o.continuation;
+    const int N = 3 * n + 3;
+    co.scale = Eigen::VectorXd::Ones(N);
+    co.scale[n] = hi1 - lo1;
+    co.scale[3 * n + 2] = hi2 - lo2;
+    if (co.initial_step == 0.0) co.initial_step = 0.01;
+    if (co.max_step == 0.0) co.max_step = 0.05;
+    co.initial_step = std::min(co.initial_step, co.max_step);
+    co.min_step = std::min(co.min_step, co.initial_step);
+    co.lower = Eigen::VectorXd::Constant(N, -std::numeric_limits<double>::infinity());
+    co.upper = Eigen::VectorXd::Constant(N, std::numeric_limits<double>::infinity());
+    co.lower[n] = lo1, co.upper[n] = hi1, co.lower[3 * n + 2] = lo2, co.upper[3 * n + 2] = hi2;
+    const int budget = o.continuation.max_points;
+
+    VectorXc q = start.q / start.q.norm();
+    Eigen::VectorXd u0(N);
+    u0 << start.x, start.par, q.real(), q.imag(), start.omega, held2;
+
+    long traced = 1;  // the start
+    if (o.progress)
+        co.on_point = [&](const Eigen::VectorXd& u) { o.progress(++traced, 2L * budget - 1, u[n]); };
+    std::vector<CurveSample> samples[2];
+    ContinuationStop stops[2] = {ContinuationStop::MaxPoints, ContinuationStop::MaxPoints};
+    Status dir_status[2] = {Status::Converged, Status::Converged};
+    std::string messages[2];
+    for (int d = 0; d < 2; ++d) {
+        if (d == 1 && stops[0] == ContinuationStop::ClosedLoop) break;  // the forward pass went round
+        auto pr = std::make_shared<HopfCurveProblem>(s, j1, j2, q);
+        Eigen::VectorXd t;
+        if (!tangent(*pr, u0, Eigen::VectorXd(), t)) {
+            stops[d] = ContinuationStop::TangentFailed;
+            dir_status[d] = Status::NumericalIssue;
+            messages[d] = "no tangent at the starting Hopf point (the Hopf system is singular there)";
+            samples[d].push_back({u0, pr});
+            continue;
+        }
+        Eigen::VectorXd direction = d == 0 ? t : Eigen::VectorXd(-t);
+        Eigen::VectorXd u = u0;
+        int left = budget - 1;
+        samples[d].push_back({u0, pr});
+        while (true) {
+            ContinuationOptions seg = co;
+            seg.max_points = std::min(o.segment, left) + 1;
+            const ContinuationResult c = continue_branch(*pr, u, direction, seg);
+            for (std::size_t k = 1; k < c.points.size(); ++k) samples[d].push_back({c.points[k], pr});
+            left -= static_cast<int>(c.points.size()) - 1;
+            stops[d] = c.stop;
+            dir_status[d] = c.status;
+            messages[d] = c.message;
+            if (c.stop != ContinuationStop::MaxPoints || left <= 0 || c.points.size() < 2) break;
+            // renew the normalisation: q / |q| becomes both q and q0
+            u = c.points.back();
+            Eigen::VectorXd tl = c.tangents.back();
+            const VectorXc ql = q_of(u, n);
+            const double len = ql.norm();
+            u.segment(n + 1, 2 * n) /= len;
+            tl.segment(n + 1, 2 * n) /= len;
+            direction = tl;
+            pr = std::make_shared<HopfCurveProblem>(s, j1, j2, q_of(u, n));
+            samples[d].back() = {u, pr};
+        }
+    }
+    curve.stop_forward = stops[0];
+    curve.stop_backward = stops[1];
+
+    std::vector<CurveSample> all(samples[1].rbegin(), samples[1].rend());
+    if (!all.empty()) all.pop_back();  // the start again
+    all.insert(all.end(), samples[0].begin(), samples[0].end());
+
+    bool coefficients_ok = true;
+    for (const CurveSample& sm : all) {
+        HopfCurvePoint pt;
+        pt.par = sm.u[n];
+        pt.par2 = sm.u[3 * n + 2];
+        pt.omega = sm.u[3 * n + 1];
+        pt.x = sm.u.head(n);
+        pt.coefficients = coefficients_at(s, j1, *sm.problem, sm.u, o.coefficients);
+        coefficients_ok = coefficients_ok && converged(pt.coefficients.status);
+        curve.points.push_back(std::move(pt));
+    }
+    bool genh_ok = true;
+    for (std::size_t k = 0; k + 1 < all.size(); ++k) {
+        const HopfCoefficients& a = curve.points[k].coefficients;
+        const HopfCoefficients& b = curve.points[k + 1].coefficients;
+        if (!converged(a.status) || !converged(b.status) || a.criticality == Criticality::Degenerate || b.criticality == Criticality::Degenerate ||
+            (a.l1 < 0.0) == (b.l1 < 0.0))
+            continue;
+        // both samples satisfy the later sample's normalisation up to a scale of q: use the later one's
+        const HopfCurveProblem& pr = *all[k + 1].problem;
+        Eigen::VectorXd ua = all[k].u;
+        const VectorXc qa = q_of(ua, n);
+        const cplx sc = pr.q0().dot(qa);
+        const VectorXc qn = qa / sc;
+        ua.segment(n + 1, n) = qn.real();
+        ua.segment(2 * n + 1, n) = qn.imag();
+        GeneralisedHopfPoint g = locate_generalised(s, j1, pr, ua, all[k + 1].u, a.l1, b.l1, o);
+        g.after = static_cast<int>(k);
+        genh_ok = genh_ok && converged(g.status);
+        curve.generalised.push_back(std::move(g));
+    }
+    // a degenerate sample is itself a generalised Hopf point (to the tolerance)
+    for (std::size_t k = 0; k < curve.points.size(); ++k) {
+        const HopfCurvePoint& p = curve.points[k];
+        if (!converged(p.coefficients.status) || p.coefficients.criticality != Criticality::Degenerate || p.coefficients.l1_scale == 0.0) continue;
+        GeneralisedHopfPoint g;
+        g.par = p.par, g.par2 = p.par2, g.omega = p.omega, g.x = p.x, g.status = Status::Converged;
+        g.l1 = p.coefficients.l1, g.residual = p.coefficients.residual, g.after = static_cast<int>(k);
+        curve.generalised.push_back(std::move(g));
+    }
+    std::sort(curve.generalised.begin(), curve.generalised.end(),
+              [](const GeneralisedHopfPoint& a, const GeneralisedHopfPoint& b) { return a.after < b.after; });
+
+    auto ended_well = [](ContinuationStop st) {
+        return st == ContinuationStop::Bound || st == ContinuationStop::ClosedLoop || st == ContinuationStop::LeftDomain;
+    };
+    const bool closed = stops[0] == ContinuationStop::ClosedLoop;
+    const bool ends_ok = ended_well(stops[0]) && (closed || ended_well(stops[1]));
+    if (!ends_ok) {
+        const int bad = ended_well(stops[0]) ? 1 : 0;
+        curve.status = stops[bad] == ContinuationStop::MaxPoints ? Status::BudgetExhausted : converged(dir_status[bad]) ? Status::NumericalIssue : dir_status[bad];
+    } else if (!coefficients_ok) {
+        curve.status = Status::NumericalIssue;
+    } else if (!genh_ok) {
+        curve.status = Status::MaxIterations;
+    }
+    curve.message = std::to_string(curve.points.size()) + " points, " + std::to_string(curve.generalised.size()) +
+                    " generalised Hopf points; ended: " + to_string(stops[0]) + (closed ? "" : " and " + to_string(stops[1]));
+    for (int d = 0; d < 2; ++d)
+        if (!ended_well(stops[d]) && !(d == 1 && closed) && !messages[d].empty()) curve.message += " (" + messages[d] + ")";
+    if (!coefficients_ok) curve.message += "; L1 not computed at some points";
+    if (!genh_ok) curve.message += "; a generalised Hopf point was not located";
+    return curve;
+}
+
+HopfCurves hopf_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
+    std::string why;
+    if (!o.is_valid(&why)) throw std::invalid_argument("Hopf curve options: " + why);
+    const int j2 = s.parameter_index(o.parameter2);
+    const double held2 = s.parameter_values()[static_cast<std::size_t>(j2)];
+    const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
+    if (!(held2 >= lo2 && held2 <= hi2))
+        throw std::invalid_argument(o.parameter2 + " = " + detail::format_number(held2) + " (its value in the system): expected a value in [" +
+                                    detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
+    HopfCurves r;
+    r.start = hopf_points(s, guess, o.branch, o.coefficients);
+    r.status = r.start.branch.status;
+    const double w1 = std::abs(o.branch.to - o.branch.from), w2 = hi2 - lo2;
+    for (std::size_t i = 0; i < r.start.branch.hopf.size(); ++i) {
+        const HopfPoint& h = r.start.branch.hopf[i];
+        if (!converged(h.status)) continue;
+        // skip a start that lies on a curve already traced (distance to its polyline in the scaled box)
+        bool seen = false;
+        for (const HopfCurve& c : r.curves) {
+            for (std::size_t k = 0; k + 1 < c.points.size() && !seen; ++k) {
+                const HopfCurvePoint &a = c.points[k], &b = c.points[k + 1];
+                const Eigen::Vector3d pa(a.par / w1, a.par2 / w2, a.omega), pb(b.par / w1, b.par2 / w2, b.omega), ph(h.par / w1, held2 / w2, h.omega);
+                const Eigen::Vector3d ab = pb - pa;
+                const double t = ab.squaredNorm() > 0.0 ? std::clamp((ph - pa).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+                seen = (pa + t * ab - ph).norm() <= 1e-3;
+            }
+            if (seen) break;
+        }
+        if (seen) continue;
+        HopfCurve c = hopf_curve(s, h, o);
+        c.start = static_cast<int>(i);
+        if (converged(r.status) && !converged(c.status)) r.status = c.status;
+        r.curves.push_back(std::move(c));
+    }
+    r.message = r.start.branch.message + "; " + std::to_string(r.curves.size()) + " Hopf curve(s)";
+    for (const HopfCurve& c : r.curves)
+        if (!converged(c.status)) r.message += "; a curve: " + c.message;
+    return r;
+}
+
+}  // namespace ddemap

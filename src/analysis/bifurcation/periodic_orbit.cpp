@@ -1,0 +1,1093 @@
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+// GCC 12 reports a false -Wuse-after-free inside Spectra's Hessenberg eigenvector code
+// (as in wave_stability.cpp: clang has no such warning and warns of its name)
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#endif
+#include <Spectra/GenEigsSolver.h>
+#include <Spectra/MatOp/DenseGenMatProd.h>
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+#include "analysis/bifurcation/internal/orbit_continuation.hpp"
+#include "analysis/bifurcation/internal/orbit_mesh.hpp"
+#include "core/internal/eigen_threads.hpp"
+
+namespace ddemap {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+using Triplet = Eigen::Triplet<double>;
+using SpD = Eigen::SparseMatrix<double>;
+
+/// The problem on a mesh: system, parameter index, weights of the continuation norm.
+struct Setup {
+    Setup(const NonlinearDDE& s, const PeriodicMesh& me) : sys(s), mesh(me) {}
+    const NonlinearDDE& sys;
+    const PeriodicMesh& mesh;
+    int n = 0, m = 0, j = 0, d = 0, L = 0, P = 0;  // dimension, delays, parameter, degree, intervals, points
+    std::vector<double> base;                       // parameter values (p_j replaced)
+    Eigen::VectorXd w;                              // weights of the norm (size N + 2)
+    int N() const { return P * n; }
+    std::vector<double> params(double p) const {
+        std::vector<double> v = base;
+        v[static_cast<std::size_t>(j)] = p;
+        return v;
+    }
+    double norm(const Eigen::VectorXd& v) const { return std::sqrt((w.array() * v.array().square()).sum()); }
+};
+
+/// What is evaluated at one collocation point.
+struct PointData {
+    double s = 0.0;
+    int interval = 0;
+    std::vector<double> l, dl;        // basis at s
+    std::vector<double> sk;           // unwrapped delayed positions s - tau_k / T
+    std::vector<int> lk;              // their intervals (of the wrapped position)
+    std::vector<std::vector<double>> lkv, lkd;  // basis at the wrapped positions
+    Eigen::VectorXd x, dx, stacked, f, fp;
+    std::vector<Eigen::VectorXd> dxk;  // x'(s_k)
+    std::vector<Eigen::MatrixXd> A;
+};
+
+Eigen::VectorXd combine(const Setup& c, const Eigen::VectorXd& u, int interval, const std::vector<double>& coef) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(c.n);
+    for (int jj = 0; jj <= c.d; ++jj) {
+        const int pt = (interval * c.d + jj) % c.P;
+        v += coef[static_cast<std::size_t>(jj)] * u.segment(static_cast<Eigen::Index>(pt) * c.n, c.n);
+    }
+    return v;
+}
+
+/// Evaluates the collocation point (interval, g) of the orbit u = (X, T, p); false when f is not
+/// finite there. With `derivatives` the Jacobian blocks and df/dp too.
+bool evaluate_point(const Setup& c, const Eigen::VectorXd& u, const std::vector<double>& tau, int interval, int g, bool derivatives,
+                    PointData& pd) {
+    const double T = u(c.N()), p = u(c.N() + 1);
+    const std::vector<double> pv = c.params(p);
+    pd.interval = interval;
+    pd.s = c.mesh.collocation_point(interval, g);
+    pd.l.assign(static_cast<std::size_t>(c.d) + 1, 0.0);
+    pd.dl.assign(static_cast<std::size_t>(c.d) + 1, 0.0);
+    c.mesh.basis(interval, pd.s, pd.l.data(), pd.dl.data());
+    pd.x = combine(c, u, interval, pd.l);
+    pd.dx = combine(c, u, interval, pd.dl);
+    pd.stacked.resize(static_cast<Eigen::Index>(c.n) * (c.m + 1));
+    pd.stacked.head(c.n) = pd.x;
+    pd.sk.resize(static_cast<std::size_t>(c.m));
+    pd.lk.resize(static_cast<std::size_t>(c.m));
+    pd.lkv.assign(static_cast<std::size_t>(c.m), std::vector<double>(static_cast<std::size_t>(c.d) + 1));
+    pd.lkd.assign(static_cast<std::size_t>(c.m), std::vector<double>(static_cast<std::size_t>(c.d) + 1));
+    pd.dxk.resize(static_cast<std::size_t>(c.m));
+    for (int k = 0; k < c.m; ++k) {
+        const auto uk = static_cast<std::size_t>(k);
+        const double sk = pd.s - tau[uk] / T;
+        double wrapped = sk - std::floor(sk);
+        if (wrapped >= 1.0) wrapped = 0.0;
+        pd.sk[uk] = sk;
+        pd.lk[uk] = c.mesh.interval_of(wrapped);
+        c.mesh.basis(pd.lk[uk], wrapped, pd.lkv[uk].data(), pd.lkd[uk].data());
+        pd.stacked.segment(static_cast<Eigen::Index>(k + 1) * c.n, c.n) = combine(c, u, pd.lk[uk], pd.lkv[uk]);
+        pd.dxk[uk] = combine(c, u, pd.lk[uk], pd.lkd[uk]);
+    }
+    pd.f = c.sys.f(pd.stacked, pv);
+    if (!pd.f.allFinite()) return false;
+    if (derivatives) {
+        pd.A = c.sys.jacobians(pd.stacked, pv);
+        pd.fp = c.sys.parameter_derivative(pd.stacked, c.j, pv);
+        for (const auto& a : pd.A)
+            if (!a.allFinite()) return false;
+        if (!pd.fp.allFinite()) return false;
+    }
+    return true;
+}
+
+void add_block(std::vector<Triplet>& t, int row, int col, const Eigen::MatrixXd& b, double factor) {
+    for (Eigen::Index cc = 0; cc < b.cols(); ++cc)
+        for (Eigen::Index r = 0; r < b.rows(); ++r)
+            if (b(r, cc) != 0.0) t.emplace_back(row + static_cast<int>(r), col + static_cast<int>(cc), factor * b(r, cc));
+}
+
+/// x' of the orbit u at every collocation point (row l d + g), for the phase condition.
+Eigen::MatrixXd derivative_at_collocation(const Setup& c, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd r(c.P, c.n);
+    std::vector<double> l(static_cast<std::size_t>(c.d) + 1), dl(static_cast<std::size_t>(c.d) + 1);
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < c.d; ++g) {
+            c.mesh.basis(i, c.mesh.collocation_point(i, g), l.data(), dl.data());
+            r.row(i * c.d + g) = combine(c, u, i, dl).transpose();
+        }
+    return r;
+}
+
+/// F(u) (N + 1: collocation and phase) and, with J, the bordered Jacobian [dF/du; a^T] and its
+/// last residual a . u - b appended (N + 2 rows).
+bool assemble(const Setup& c, const Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd* a, double b,
+              Eigen::VectorXd& F, SpD* J) {
+    const int N = c.N();
+    const double T = u(N), p = u(N + 1);
+    if (!(T > 0.0) || !std::isfinite(p)) return false;
+    const std::vector<double> pv = c.params(p);
+    std::vector<double> tau, dtau;
+    try {
+        tau = c.sys.delays(pv);
+        dtau = c.sys.delay_derivatives(pv, c.j);
+    } catch (const std::exception&) {
+        return false;
+    }
+    for (double t : tau)
+        if (!(t >= 0.0) || !std::isfinite(t)) return false;
+    F.setZero(N + (a ? 2 : 1));
+    std::vector<Triplet> trip;
+    if (J) trip.reserve(static_cast<std::size_t>(N) * static_cast<std::size_t>((c.d + 1) * (c.m + 1) * 4 + 4));
+    PointData pd;
+    for (int i = 0; i < c.L; ++i) {
+        const double h = c.mesh.width(i);
+        for (int g = 0; g < c.d; ++g) {
+            if (!evaluate_point(c, u, tau, i, g, J != nullptr, pd)) return false;
+            const int row = (i * c.d + g) * c.n;
+            F.segment(row, c.n) = pd.dx - T * pd.f;
+            const double wg = c.mesh.gauss_weights()[static_cast<std::size_t>(g)] * h;
+            const Eigen::VectorXd r = ref.row(i * c.d + g).transpose();
+            F(N) += wg * pd.x.dot(r);
+            if (!J) continue;
+            for (int jj = 0; jj <= c.d; ++jj) {
+                const int col = ((i * c.d + jj) % c.P) * c.n;
+                const double lj = pd.l[static_cast<std::size_t>(jj)], dlj = pd.dl[static_cast<std::size_t>(jj)];
+                for (int q = 0; q < c.n; ++q) trip.emplace_back(row + q, col + q, dlj);
+                add_block(trip, row, col, pd.A[0], -T * lj);
+                for (int q = 0; q < c.n; ++q)
+                    if (r(q) != 0.0) trip.emplace_back(N, col + q, wg * lj * r(q));
+            }
+            Eigen::VectorXd dT = -pd.f, dp = -T * pd.fp;
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                for (int jj = 0; jj <= c.d; ++jj) {
+                    const int col = ((pd.lk[uk] * c.d + jj) % c.P) * c.n;
+                    add_block(trip, row, col, pd.A[uk + 1], -T * pd.lkv[uk][static_cast<std::size_t>(jj)]);
+                }
+                const Eigen::VectorXd ad = pd.A[uk + 1] * pd.dxk[uk];
+                dT -= ad * (tau[uk] / T);
+                dp += ad * dtau[uk];
+            }
+            for (int q = 0; q < c.n; ++q) {
+                trip.emplace_back(row + q, N, dT(q));
+                trip.emplace_back(row + q, N + 1, dp(q));
+            }
+        }
+    }
+    if (a) {
+        F(N + 1) = a->dot(u) - b;
+        if (J)
+            for (int q = 0; q < N + 2; ++q)
+                if ((*a)(q) != 0.0) trip.emplace_back(N + 1, q, (*a)(q));
+    }
+    if (J) {
+        J->resize(N + 2, N + 2);
+        J->setFromTriplets(trip.begin(), trip.end());
+    }
+    return F.allFinite();
+}
+
+struct Linearization;
+
+struct Correction {
+    bool ok = false;
+    int iterations = 0;
+    int jacobians = 0;  // linearisations (condensed) or sparse LU factorisations
+    double residual = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd tangent;  // [J; a^T]^{-1} e_last at the result (not normalised)
+    std::shared_ptr<const Linearization> lin;  // at the result (condensed path only)
+};
+
+/// Newton on [F(u); a . u - b] = 0 with the phase reference `ref` (x' of the previous orbit),
+/// every step with a sparse LU of the whole bordered Jacobian: the path for windows too large
+/// for the condensed form (see Linearization).
+Correction correct_sparse(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b,
+                   const PeriodicOrbitOptions& o) {
+    Correction r;
+    Eigen::VectorXd F;
+    SpD J;
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    auto factorize = [&lu](SpD& m) {
+        m.makeCompressed();
+        lu.compute(m);
+        return lu.info() == Eigen::Success;
+    };
+    double last_step = std::numeric_limits<double>::infinity();
+    for (int it = 0; it <= o.max_iterations; ++it) {
+        if (it > 0 && last_step <= o.tolerance * std::max(1.0, u.lpNorm<Eigen::Infinity>())) {
+            // converged: the residual at u, the tangent from the last factorisation (one step
+            // earlier, an O(|du|) difference in a direction that is normalised anyway)
+            if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+            r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
+            r.ok = r.residual <= o.residual_tolerance;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(c.N() + 2);
+            e(c.N() + 1) = 1.0;
+            r.tangent = lu.solve(e);
+            if (!r.tangent.allFinite()) r.ok = false;
+            return r;
+        }
+        if (it == o.max_iterations) break;
+        if (!assemble(c, u, ref, &a, b, F, &J)) return r;
+        if (!factorize(J)) return r;
+        ++r.jacobians;
+        r.residual = F.head(c.N() + 1).lpNorm<Eigen::Infinity>();
+        const Eigen::VectorXd du = lu.solve(F);
+        if (!du.allFinite()) return r;
+        u -= du;
+        ++r.iterations;
+        last_step = du.lpNorm<Eigen::Infinity>();
+    }
+    return r;
+}
+
+/// Floquet multipliers of the orbit u (see the header), sorted by decreasing modulus.
+bool multipliers(const Setup& c, const Eigen::VectorXd& u, std::vector<cplx>& out) {
+    const int N = c.N(), n = c.n, d = c.d, P = c.P;
+    const double T = u(N);
+    const std::vector<double> pv = c.params(u(N + 1));
+    const std::vector<double> tau = c.sys.delays(pv);
+    double rmax = 0.0;
+    for (double t : tau) rmax = std::max(rmax, t / T);
+    long gmin = 0;
+    if (rmax > 0.0) {
+        const double smin = -rmax;
+        const double fl = std::floor(smin);
+        double w = smin - fl;
+        if (w >= 1.0) w = 0.0;
+        gmin = static_cast<long>(fl) * P + static_cast<long>(c.mesh.interval_of(w)) * d;
+    }
+    const long nh = 1 - gmin;  // history points gmin..0
+    if (nh * n > 4000) return false;  // the dense eigenvalue problem would be too large
+    std::vector<Triplet> t1, t0;
+    auto put = [&](long g, int row, const Eigen::MatrixXd& blk, double factor) {
+        if (g >= 1) add_block(t1, row, static_cast<int>((g - 1) * n), blk, factor);
+        else add_block(t0, row, static_cast<int>((g - gmin) * n), blk, factor);
+    };
+    const Eigen::MatrixXd eye = Eigen::MatrixXd::Identity(n, n);
+    PointData pd;
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < d; ++g) {
+            if (!evaluate_point(c, u, tau, i, g, true, pd)) return false;
+            const int row = (i * d + g) * n;
+            for (int jj = 0; jj <= d; ++jj) {
+                const long gl = i * d + jj;  // 0..P, not wrapped
+                put(gl, row, eye, pd.dl[static_cast<std::size_t>(jj)]);
+                put(gl, row, pd.A[0], -T * pd.l[static_cast<std::size_t>(jj)]);
+            }
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                const long per = static_cast<long>(std::floor(pd.sk[uk]));
+                for (int jj = 0; jj <= d; ++jj) {
+                    const long gl = per * P + static_cast<long>(pd.lk[uk]) * d + jj;
+                    put(gl, row, pd.A[uk + 1], -T * pd.lkv[uk][static_cast<std::size_t>(jj)]);
+                }
+            }
+        }
+    SpD m1(N, N), m0(N, static_cast<int>(nh * n));
+    m1.setFromTriplets(t1.begin(), t1.end());
+    m0.setFromTriplets(t0.begin(), t0.end());
+    // many right-hand sides: the supernodal LU solves them as a block
+    m1.makeCompressed();
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(m1);
+    if (lu.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd y = -lu.solve(Eigen::MatrixXd(m0));
+    if (!y.allFinite()) return false;
+    const auto H = static_cast<Eigen::Index>(nh * n);
+    Eigen::MatrixXd mono = Eigen::MatrixXd::Zero(H, H);
+    for (long h = 0; h < nh; ++h) {
+        const long g = gmin + h + P;
+        if (g <= 0) mono.block(h * n, (g - gmin) * n, n, n) = eye;
+        else mono.block(h * n, 0, n, H) = y.block((g - 1) * n, 0, n, H);
+    }
+    Eigen::EigenSolver<Eigen::MatrixXd> es(mono, false);
+    if (es.info() != Eigen::Success) return false;
+    out.clear();
+    for (Eigen::Index k = 0; k < H; ++k) out.push_back(es.eigenvalues()(k));
+    std::sort(out.begin(), out.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
+    return true;
+}
+
+using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using SpR = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// The collocation Jacobian at an orbit in the condensed form of the Floquet problem. Ordered as
+/// in multipliers(): the unknowns are the values at the points g = 1..P of the period (M1, whose
+/// column block g - 1 is the orbit's point g mod P) and at the history window g = gmin..0 (M0,
+/// H = (1 - gmin) n columns), so that dF/dX = M1 + M0 E with E picking the window's points from
+/// the orbit. M1 is block lower triangular by mesh intervals (a delayed point is never later
+/// than its collocation point): L diagonal blocks of d n x d n, factorised densely, and the
+/// entries left of them (`lower`). Its forward sweep gives
+///     Y = -M1^{-1} [M0, dF/dT, dF/dp]      (N x (H + 2)),
+/// and with it the Newton system J du = r of the whole bordered Jacobian reduces exactly (a Schur
+/// complement) to the dense (H + 2) x (H + 2) system K in the window values z and (dT, dp):
+///     Y_{b(h)} w - z_h = -x_{b(h)},  ph . Y w = r_ph - ph . x,  a . Y w + (a_T, a_p) . (dT, dp) = r_a - a . x,
+/// with x = M1^{-1} r_coll, w = (z, dT, dp), b(h) the M1 block of window point h, and
+/// du = x + Y w. The rows of Y at the points one period after the window are the monodromy
+/// matrix of the Floquet multipliers. Cost: one sweep with H + 2 right-hand sides per
+/// linearisation, one with one right-hand side per Newton step.
+struct Linearization {
+    long gmin = 0, nh = 0;
+    int H = 0;
+    std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> diag;
+    SpR lower;
+    RowMat Y;
+};
+
+/// The bordering of a linearisation for one corrector: phase row and arclength row (in M1 order) and K.
+struct Border {
+    Eigen::VectorXd ph, a;
+    Eigen::PartialPivLU<Eigen::MatrixXd> K;
+};
+
+/// failed: f or its derivatives not finite at u; too_large: see below; unstable: a singular
+/// diagonal block or Y not finite (the sparse LU of the whole Jacobian is used instead).
+enum class LinStatus { ok, too_large, failed, unstable };
+
+/// The largest window (H = n times its points) and Y (N (H + 2) doubles) of the condensed form;
+/// beyond them the sparse LU of the whole Jacobian is used (correct_sparse).
+constexpr int kMaxWindow = 4000;
+constexpr double kMaxCondensed = 1.6e7;
+
+/// The M1 block (0..P-1) of the orbit's point q (0..P-1): point P of M1 is point 0.
+inline int m1_block(int q, int P) { return q == 0 ? P - 1 : q - 1; }
+/// The orbit's point of window point g (any integer): g mod P.
+inline int wrap_point(long g, int P) { return static_cast<int>(((g % P) + P) % P); }
+
+/// x := M1^{-1} x (any number of columns), by the forward sweep over the intervals.
+void sweep(const Setup& c, const Linearization& lz, RowMat& x) {
+    const int dn = c.d * c.n;
+    for (int i = 0; i < c.L; ++i) {
+        const int r0 = i * dn;
+        for (int q = r0; q < r0 + dn; ++q)
+            for (SpR::InnerIterator it(lz.lower, q); it; ++it) x.row(q) -= it.value() * x.row(it.col());
+        const Eigen::MatrixXd blk = lz.diag[static_cast<std::size_t>(i)].solve(x.middleRows(r0, dn));
+        x.middleRows(r0, dn) = blk;
+    }
+}
+
+/// The linearisation at u (Linearization); too_large when the window or Y exceed the limits above.
+LinStatus linearize(const Setup& c, const Eigen::VectorXd& u, Linearization& lz) {
+    const int N = c.N(), n = c.n, d = c.d, P = c.P, dn = d * n;
+    const double T = u(N);
+    if (!(T > 0.0) || !std::isfinite(u(N + 1))) return LinStatus::failed;
+    const std::vector<double> pv = c.params(u(N + 1));
+    std::vector<double> tau, dtau;
+    try {
+        tau = c.sys.delays(pv);
+        dtau = c.sys.delay_derivatives(pv, c.j);
+    } catch (const std::exception&) {
+        return LinStatus::failed;
+    }
+    double rmax = 0.0;
+    for (double t : tau) {
+        if (!(t >= 0.0) || !std::isfinite(t)) return LinStatus::failed;
+        rmax = std::max(rmax, t / T);
+    }
+    long gmin = 0;
+    if (rmax > 0.0) {
+        const double fl = std::floor(-rmax);
+        double w = -rmax - fl;
+        if (w >= 1.0) w = 0.0;
+        gmin = static_cast<long>(fl) * P + static_cast<long>(c.mesh.interval_of(w)) * d;
+    }
+    const long nh = 1 - gmin;
+    if (nh * n > kMaxWindow || static_cast<double>(N) * static_cast<double>(nh * n + 2) > kMaxCondensed) return LinStatus::too_large;
+    lz.gmin = gmin;
+    lz.nh = nh;
+    lz.H = static_cast<int>(nh * n);
+    const int H = lz.H;
+    std::vector<Eigen::MatrixXd> D(static_cast<std::size_t>(c.L), Eigen::MatrixXd::Zero(dn, dn));
+    std::vector<Triplet> low;
+    low.reserve(static_cast<std::size_t>(N) * static_cast<std::size_t>((c.d + 1) * (c.m + 1) * 2));
+    RowMat B = RowMat::Zero(N, H + 2);  // -[M0, dF/dT, dF/dp]
+    bool structure = true;
+    auto put = [&](int i, long g, int row, const Eigen::MatrixXd* blk, double factor) {
+        if (factor == 0.0) return;
+        if (g >= 1) {
+            const long col = (g - 1) * n;
+            if (col >= static_cast<long>(i) * dn && col < static_cast<long>(i + 1) * dn) {
+                auto db = D[static_cast<std::size_t>(i)].block(row - i * dn, col - static_cast<long>(i) * dn, n, n);
+                if (blk) db += factor * *blk;
+                else db.diagonal().array() += factor;
+            } else if (col < static_cast<long>(i) * dn) {
+                for (int cc = 0; cc < n; ++cc)
+                    for (int r = 0; r < n; ++r) {
+                        const double v = blk ? (*blk)(r, cc) : (r == cc ? 1.0 : 0.0);
+                        if (v != 0.0) low.emplace_back(row + r, static_cast<int>(col) + cc, factor * v);
+                    }
+            } else {
+                structure = false;  // a point later than the interval: not block lower triangular
+            }
+        } else {
+            auto mb = B.block(row, (g - gmin) * n, n, n);
+            if (blk) mb -= factor * *blk;
+            else mb.diagonal().array() -= factor;
+        }
+    };
+    PointData pd;
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < d; ++g) {
+            if (!evaluate_point(c, u, tau, i, g, true, pd)) return LinStatus::failed;
+            const int row = (i * d + g) * n;
+            for (int jj = 0; jj <= d; ++jj) {
+                const long gl = static_cast<long>(i) * d + jj;
+                put(i, gl, row, nullptr, pd.dl[static_cast<std::size_t>(jj)]);
+                put(i, gl, row, &pd.A[0], -T * pd.l[static_cast<std::size_t>(jj)]);
+            }
+            Eigen::VectorXd dT = -pd.f, dp = -T * pd.fp;
+            for (int k = 0; k < c.m; ++k) {
+                const auto uk = static_cast<std::size_t>(k);
+                const long per = static_cast<long>(std::floor(pd.sk[uk]));
+                for (int jj = 0; jj <= d; ++jj)
+                    put(i, per * P + static_cast<long>(pd.lk[uk]) * d + jj, row, &pd.A[uk + 1], -T * pd.lkv[uk][static_cast<std::size_t>(jj)]);
+                const Eigen::VectorXd ad = pd.A[uk + 1] * pd.dxk[uk];
+                dT -= ad * (tau[uk] / T);
+                dp += ad * dtau[uk];
+            }
+            B.block(row, H, n, 1) = -dT;
+            B.block(row, H + 1, n, 1) = -dp;
+        }
+    if (!structure) return LinStatus::too_large;
+    lz.lower.resize(N, N);
+    lz.lower.setFromTriplets(low.begin(), low.end());
+    lz.lower.makeCompressed();
+    lz.diag.clear();
+    lz.diag.reserve(D.size());
+    for (const Eigen::MatrixXd& m : D) {
+        lz.diag.emplace_back(m);
+        if (!(std::abs(lz.diag.back().determinant()) > 0.0)) return LinStatus::unstable;
+    }
+    sweep(c, lz, B);
+    if (!B.allFinite()) return LinStatus::unstable;
+    lz.Y = std::move(B);
+    return LinStatus::ok;
+}
+
+/// The phase row d(phase)/dX (N, in the orbit's order) for the reference x' values `ref`.
+Eigen::VectorXd phase_row(const Setup& c, const Eigen::MatrixXd& ref) {
+    Eigen::VectorXd ph = Eigen::VectorXd::Zero(c.N());
+    std::vector<double> l(static_cast<std::size_t>(c.d) + 1), dl(static_cast<std::size_t>(c.d) + 1);
+    for (int i = 0; i < c.L; ++i)
+        for (int g = 0; g < c.d; ++g) {
+            c.mesh.basis(i, c.mesh.collocation_point(i, g), l.data(), dl.data());
+            const double wg = c.mesh.gauss_weights()[static_cast<std::size_t>(g)] * c.mesh.width(i);
+            for (int jj = 0; jj <= c.d; ++jj) {
+                const int col = ((i * c.d + jj) % c.P) * c.n;
+                ph.segment(col, c.n) += (wg * l[static_cast<std::size_t>(jj)]) * ref.row(i * c.d + g).transpose();
+            }
+        }
+    return ph;
+}
+
+/// K of the linearisation for the phase row ph (orbit order) and the arclength row a (N + 2).
+bool border(const Setup& c, const Linearization& lz, const Eigen::VectorXd& ph, const Eigen::VectorXd& a, Border& bd) {
+    const int N = c.N(), n = c.n, P = c.P, H = lz.H;
+    bd.ph.resize(N);
+    bd.a.resize(N);
+    for (int q = 0; q < P; ++q) {
+        const int b = m1_block(q, P);
+        bd.ph.segment(b * n, n) = ph.segment(q * n, n);
+        bd.a.segment(b * n, n) = a.segment(q * n, n);
+    }
+    Eigen::MatrixXd K(H + 2, H + 2);
+    for (long h = 0; h < lz.nh; ++h) {
+        const int b = m1_block(wrap_point(lz.gmin + h, P), P);
+        K.middleRows(h * n, n) = lz.Y.middleRows(static_cast<Eigen::Index>(b) * n, n);
+        K.block(h * n, h * n, n, n).diagonal().array() -= 1.0;
+    }
+    K.row(H) = bd.ph.transpose() * lz.Y;
+    K.row(H + 1) = bd.a.transpose() * lz.Y;
+    K(H + 1, H) += a(N);
+    K(H + 1, H + 1) += a(N + 1);
+    if (!K.allFinite()) return false;
+    bd.K.compute(K);
+    return std::abs(bd.K.determinant()) > 0.0;
+}
+
+/// du with J du = r (the bordered Jacobian of assemble(), N + 2 rows) from the condensed form.
+Eigen::VectorXd condensed_solve(const Setup& c, const Linearization& lz, const Border& bd, const Eigen::VectorXd& r) {
+    const int N = c.N(), n = c.n, P = c.P, H = lz.H;
+    RowMat x = r.head(N);
+    sweep(c, lz, x);
+    const Eigen::Map<const Eigen::VectorXd> xv(x.data(), N);
+    Eigen::VectorXd rk(H + 2);
+    for (long h = 0; h < lz.nh; ++h) {
+        const int b = m1_block(wrap_point(lz.gmin + h, P), P);
+        rk.segment(h * n, n) = -xv.segment(static_cast<Eigen::Index>(b) * n, n);
+    }
+    rk(H) = r(N) - bd.ph.dot(xv);
+    rk(H + 1) = r(N + 1) - bd.a.dot(xv);
+    const Eigen::VectorXd w = bd.K.solve(rk);
+    const Eigen::VectorXd dx = xv + lz.Y * w;
+    Eigen::VectorXd du(N + 2);
+    for (int q = 0; q < P; ++q) du.segment(q * n, n) = dx.segment(static_cast<Eigen::Index>(m1_block(q, P)) * n, n);
+    du(N) = w(H);
+    du(N + 1) = w(H + 1);
+    return du;
+}
+
+/// Newton on [F(u); a . u - b] = 0 (see correct_sparse) in the condensed form: chord steps with
+/// the linearisation `start` (e.g. at the previous orbit of the branch), a new linearisation at
+/// the current iterate when a step contracts by less than kChordContraction, and one at the
+/// result (for the tangent, the multipliers and the next corrector).
+constexpr double kChordContraction = 0.3;
+/// The chord steps go on to this fraction of the Newton tolerance while they contract (the
+/// linearisation for the multipliers is taken there, and |mu_trivial - 1| follows its distance
+/// from the orbit); a step within the tolerance that no longer contracts is at the rounding
+/// floor of the condensed solve and ends them.
+constexpr double kChordTolerance = 1e-2;
+
+Correction correct(const Setup& c, Eigen::VectorXd& u, const Eigen::MatrixXd& ref, const Eigen::VectorXd& a, double b,
+                   const PeriodicOrbitOptions& o, std::shared_ptr<const Linearization> start) {
+    Correction r;
+    const int N = c.N();
+    auto fresh = [&](std::shared_ptr<const Linearization>& lz) {
+        auto next = std::make_shared<Linearization>();
+        const LinStatus st = linearize(c, u, *next);
+        ++r.jacobians;
+        if (st != LinStatus::ok) return st;
+        lz = std::move(next);
+        return st;
+    };
+    std::shared_ptr<const Linearization> lz = std::move(start);
+    if (!lz) {
+        const LinStatus st = fresh(lz);
+        if (st == LinStatus::too_large || st == LinStatus::unstable) return correct_sparse(c, u, ref, a, b, o);
+        if (st != LinStatus::ok) return r;
+    }
+    const Eigen::VectorXd ph = phase_row(c, ref);
+    Border bd;
+    if (!border(c, *lz, ph, a, bd)) return correct_sparse(c, u, ref, a, b, o);
+    Eigen::VectorXd F;
+    double previous = std::numeric_limits<double>::infinity();
+    int refreshes = 0;
+    bool converged = false;
+    for (int step = 0; step < 3 * o.max_iterations; ++step) {
+        if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+        r.residual = F.head(N + 1).lpNorm<Eigen::Infinity>();
+        Eigen::VectorXd du = condensed_solve(c, *lz, bd, F);
+        if (!du.allFinite()) return r;
+        double size = du.lpNorm<Eigen::Infinity>();
+        const double target = o.tolerance * std::max(1.0, u.lpNorm<Eigen::Infinity>());
+        const bool slow = step > 0 && size > kChordContraction * previous;
+        if (slow && size <= target) {  // within the tolerance and at the rounding floor of the condensed solve
+            converged = true;
+            break;
+        }
+        if (slow) {
+            if (r.jacobians >= o.max_iterations) return r;
+            ++refreshes;
+            if (fresh(lz) != LinStatus::ok || !border(c, *lz, ph, a, bd)) return r;
+            du = condensed_solve(c, *lz, bd, F);
+            if (!du.allFinite()) return r;
+            size = du.lpNorm<Eigen::Infinity>();
+        }
+        u -= du;
+        ++r.iterations;
+        previous = size;
+        if (size <= kChordTolerance * target) {
+            converged = true;
+            break;
+        }
+    }
+    if (!converged || !assemble(c, u, ref, &a, b, F, nullptr)) return r;
+    // the linearisation at the result (for the tangent [J; a^T]^{-1} e_last, the multipliers and
+    // the next chord), first used for one Newton step: the chord steps converge linearly, so the
+    // result of their last step is only about kChordContraction * tolerance accurate
+    if (fresh(lz) != LinStatus::ok || !border(c, *lz, ph, a, bd)) return r;
+    const Eigen::VectorXd du = condensed_solve(c, *lz, bd, F);
+    if (!du.allFinite()) return r;
+    u -= du;
+    ++r.iterations;
+    if (!assemble(c, u, ref, &a, b, F, nullptr)) return r;
+    r.residual = F.head(N + 1).lpNorm<Eigen::Infinity>();
+    if (!(r.residual <= o.residual_tolerance)) return r;
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
+    e(N + 1) = 1.0;
+    r.tangent = condensed_solve(c, *lz, bd, e);
+    if (!r.tangent.allFinite()) return r;
+    r.lin = lz;
+    r.ok = true;
+    return r;
+}
+
+/// The eigenvalues of the monodromy matrix: all of them (dense QR) up to kDenseMultipliers, else
+/// the largest in modulus by Arnoldi (Spectra), at least kArnoldiMultipliers and, doubling
+/// their number, until the smallest one found is below kArnoldiFloor in modulus (so every
+/// multiplier outside the disc of that radius is listed); dense QR when Arnoldi fails.
+constexpr int kDenseMultipliers = 200;
+constexpr int kArnoldiMultipliers = 16;
+constexpr double kArnoldiFloor = 0.5;
+
+bool monodromy_eigenvalues(const Eigen::MatrixXd& mono, std::vector<cplx>& out) {
+    const auto H = mono.rows();
+    out.clear();
+    if (H > kDenseMultipliers) {
+        Spectra::DenseGenMatProd<double> op(mono);
+        const double scale = mono.lpNorm<Eigen::Infinity>();
+        for (Eigen::Index nev = kArnoldiMultipliers; 2 * nev + 20 <= H / 2; nev *= 2) {
+            Spectra::GenEigsSolver<Spectra::DenseGenMatProd<double>> es(op, nev, 2 * nev + 20);
+            es.init();
+            es.compute(Spectra::SortRule::LargestMagn, 1000, 1e-13);
+            if (es.info() != Spectra::CompInfo::Successful) break;
+            const Eigen::VectorXcd ev = es.eigenvalues();
+            const Eigen::MatrixXcd vec = es.eigenvectors();
+            if (ev.size() == 0) break;
+            // every Ritz pair checked: |M v - mu v| <= 1e-9 |M| |v|
+            bool good = true;
+            for (Eigen::Index k = 0; k < ev.size() && good; ++k)
+                good = (mono * vec.col(k) - ev(k) * vec.col(k)).norm() <= 1e-9 * scale * vec.col(k).norm();
+            if (!good) break;
+            if (std::abs(ev(ev.size() - 1)) < kArnoldiFloor) {
+                for (Eigen::Index k = 0; k < ev.size(); ++k) out.push_back(ev(k));
+                break;
+            }
+        }
+    }
+    if (out.empty()) {
+        Eigen::EigenSolver<Eigen::MatrixXd> es(mono, false);
+        if (es.info() != Eigen::Success) return false;
+        for (Eigen::Index k = 0; k < H; ++k) out.push_back(es.eigenvalues()(k));
+    }
+    std::sort(out.begin(), out.end(), [](cplx a, cplx b) { return std::abs(a) > std::abs(b); });
+    return true;
+}
+
+/// Floquet multipliers from the linearisation at the orbit: the monodromy matrix maps the window
+/// values to the values one period later (rows of Y, or of the identity for window points that
+/// are still in the window one period later).
+bool condensed_multipliers(const Setup& c, const Linearization& lz, std::vector<cplx>& out) {
+    const int n = c.n, P = c.P, H = lz.H;
+    Eigen::MatrixXd mono = Eigen::MatrixXd::Zero(H, H);
+    for (long h = 0; h < lz.nh; ++h) {
+        const long g = lz.gmin + h + P;
+        if (g <= 0) mono.block(h * n, (g - lz.gmin) * n, n, n).setIdentity();
+        else mono.middleRows(h * n, n) = lz.Y.block((g - 1) * n, 0, n, H);
+    }
+    return monodromy_eigenvalues(mono, out);
+}
+
+PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correction& r, bool floquet) {
+    PeriodicOrbit o;
+    o.period = u(c.N());
+    o.par = u(c.N() + 1);
+    o.profile.resize(c.P, c.n);
+    for (int i = 0; i < c.P; ++i) o.profile.row(i) = u.segment(static_cast<Eigen::Index>(i) * c.n, c.n).transpose();
+    o.min = o.profile.colwise().minCoeff().transpose();
+    o.max = o.profile.colwise().maxCoeff().transpose();
+    // the extremes sampled at 8 d points per interval (besides the mesh points): the sampling
+    // error is at most (h T / (8 d))^2 |x''| / 8
+    const int per = 8 * c.d;
+    for (int i = 0; i < c.L; ++i)
+        for (int k = 1; k < per; ++k) {
+            const Eigen::VectorXd x = orbit_value(c.mesh, o.profile, c.mesh.breakpoints()[static_cast<std::size_t>(i)] + c.mesh.width(i) * k / per);
+            o.min = o.min.cwiseMin(x);
+            o.max = o.max.cwiseMax(x);
+        }
+    o.breakpoints = c.mesh.breakpoints();
+    o.residual = r.residual;
+    o.iterations = r.iterations;
+    const bool have = floquet && (r.lin ? condensed_multipliers(c, *r.lin, o.multipliers) : multipliers(c, u, o.multipliers));
+    if (have && !o.multipliers.empty()) {
+        std::size_t k1 = 0;
+        for (std::size_t k = 1; k < o.multipliers.size(); ++k)
+            if (std::abs(o.multipliers[k] - 1.0) < std::abs(o.multipliers[k1] - 1.0)) k1 = k;
+        o.trivial_distance = std::abs(o.multipliers[k1] - 1.0);
+        o.max_nontrivial = 0.0;
+        for (std::size_t k = 0; k < o.multipliers.size(); ++k)
+            if (k != k1) o.max_nontrivial = std::max(o.max_nontrivial, std::abs(o.multipliers[k]));
+        o.stable = o.max_nontrivial < 1.0;
+        orbit_continuation::check_accuracy(o);
+    }
+    return o;
+}
+
+/// max over the variables of max - min: 0 for an equilibrium.
+double amplitude(const PeriodicOrbit& o) { return (o.max - o.min).maxCoeff(); }
+
+Setup make_setup(const NonlinearDDE& system, const PeriodicMesh& mesh, const PeriodicOrbitOptions& o, double period_scale) {
+    std::string why;
+    if (!o.is_valid(&why)) throw std::invalid_argument("periodic orbit options: " + why);
+    if (!system.has_delay_derivatives())
+        throw std::invalid_argument("periodic orbits: the system must give exact delay derivatives (has_delay_derivatives())");
+    Setup c(system, mesh);
+    c.n = system.dimension();
+    c.m = system.delay_count();
+    c.j = system.parameter_index(o.parameter);
+    c.d = mesh.degree();
+    c.L = mesh.intervals();
+    c.P = mesh.points();
+    c.base = system.parameter_values();
+    const int N = c.N();
+    c.w.resize(N + 2);
+    c.w.head(N).setConstant(1.0 / c.P);
+    c.w(N) = 1.0 / (period_scale * period_scale);
+    const double sp = std::abs(o.to - o.from);
+    c.w(N + 1) = 1.0 / (sp * sp);
+    return c;
+}
+
+/// The mesh that equidistributes |x^(d+1)|^(1/(d+1)) of the orbit u (analysis/bifurcation/internal/orbit_mesh.hpp).
+std::vector<double> adapted_breakpoints(const Setup& c, const Eigen::VectorXd& u) {
+    return orbit_mesh::equidistributed_breakpoints(c.mesh, c.n, u);
+}
+
+/// The same problem on another mesh of the same degree and number of intervals.
+Setup with_mesh(const Setup& c, const PeriodicMesh& mesh) {
+    Setup s(c.sys, mesh);
+    s.n = c.n;
+    s.m = c.m;
+    s.j = c.j;
+    s.d = c.d;
+    s.L = c.L;
+    s.P = c.P;
+    s.base = c.base;
+    s.w = c.w;
+    return s;
+}
+
+/// u (or a tangent) on the mesh of `from` re-represented on the mesh of `to`: the X part
+/// interpolated at the new points, T and p kept.
+Eigen::VectorXd resample(const Setup& from, const Setup& to, const Eigen::VectorXd& u) {
+    Eigen::MatrixXd profile(from.P, from.n);
+    for (int i = 0; i < from.P; ++i) profile.row(i) = u.segment(static_cast<Eigen::Index>(i) * from.n, from.n).transpose();
+    Eigen::VectorXd v(to.N() + 2);
+    for (int i = 0; i < to.P; ++i) v.segment(static_cast<Eigen::Index>(i) * to.n, to.n) = orbit_value(from.mesh, profile, to.mesh.point(i));
+    v(to.N()) = u(from.N());
+    v(to.N() + 1) = u(from.N() + 1);
+    return v;
+}
+
+/// Follows the branch from the corrected first orbit u with unit tangent t.
+void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const PeriodicOrbitOptions& o,
+            OrbitBranch& b) {
+    // the mesh of the next orbit (adapted to the last one when o.adapt); Setup refers to it
+    std::unique_ptr<PeriodicMesh> mesh;
+    std::unique_ptr<Setup> cp = std::make_unique<Setup>(c0);
+    const int N = c0.N();
+    const double lo = std::min(o.from, o.to), hi = std::max(o.from, o.to);
+    const double T0 = u(N);
+    const Setup* cur = cp.get();
+    std::shared_ptr<const Linearization> lin_u = first.lin;  // at u: the chord matrix of the next corrector
+    auto adapt = [&]() {
+        if (!o.adapt) return;
+        auto next_mesh = std::make_unique<PeriodicMesh>(c0.mesh.degree(), adapted_breakpoints(*cur, u));
+        auto next = std::make_unique<Setup>(with_mesh(*cur, *next_mesh));
+        u = resample(*cur, *next, u);
+        t = resample(*cur, *next, t);
+        t /= next->norm(t);
+        mesh = std::move(next_mesh);
+        cp = std::move(next);
+        cur = cp.get();
+        lin_u.reset();  // the next corrector starts with a linearisation on the new mesh
+    };
+    auto report = [&] {
+        if (o.progress) o.progress(static_cast<long>(b.points.size()), o.max_points, b.points.back().par);
+    };
+    b.points.push_back(make_orbit(*cur, u, first, o.floquet));
+    report();
+    const double amp0 = amplitude(b.points.front());
+    b.newton_iterations += first.iterations;
+    b.jacobians += first.jacobians;
+    StepControl step(orbit_continuation::step_control_options(o));
+    b.stop = "max_points";
+    adapt();
+    while (static_cast<int>(b.points.size()) < o.max_points) {
+        const Setup& c = *cur;
+        const double h = step.h();
+        const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+        Eigen::VectorXd v = u + h * t;
+        const Eigen::VectorXd a = c.w.cwiseProduct(t);
+        Correction r = correct(c, v, ref, a, a.dot(u + h * t), o, lin_u);
+        b.newton_iterations += r.iterations;
+        b.jacobians += r.jacobians;
+        const bool jump = r.ok && step.jumped(c.norm(v - u));
+        if (!r.ok || jump) {
+            if (!step.reject()) {
+                b.stop = "step_below_minimum";
+                b.status = jump ? Status::NumericalIssue : Status::MaxIterations;
+                std::ostringstream s;
+                s << "the corrector failed at " << b.parameter << " = " << v(N + 1) << " with the step below " << o.min_step;
+                b.message = s.str();
+                return;
+            }
+            continue;
+        }
+        Eigen::VectorXd tn = r.tangent / c.norm(r.tangent);
+        if (tn.dot(c.w.cwiseProduct(t)) < 0.0) tn = -tn;
+        // the end of the parameter range: the orbit on the face
+        const double p = v(N + 1);
+        if (p < lo || p > hi) {
+            const double bound = p < lo ? lo : hi;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
+            e(N + 1) = 1.0;
+            Eigen::VectorXd w = v;
+            const Correction rb = correct(c, w, ref, e, bound, o, r.lin);
+            b.newton_iterations += rb.iterations;
+            b.jacobians += rb.jacobians;
+            if (rb.ok) {
+                b.points.push_back(make_orbit(c, w, rb, o.floquet));
+                report();
+            } else {
+                b.status = Status::MaxIterations;
+                b.message = "the orbit on the end of the parameter range did not converge";
+            }
+            b.stop = "bound";
+            return;
+        }
+        PeriodicOrbit orbit = make_orbit(c, v, r, o.floquet);
+        const int after = static_cast<int>(b.points.size()) - 1;
+        // folds, period doublings and tori of this step (analysis/bifurcation/internal/orbit_continuation.hpp)
+        {
+            const Eigen::VectorXd ak = c.w.cwiseProduct(t);
+            Eigen::VectorXd best = v;
+            Correction bestc = r;
+            orbit_continuation::Probe probe;
+            probe.fold_trial = [&](double s, double& g) {
+                Eigen::VectorXd w = u + s * t;
+                const Correction rc = correct(c, w, ref, ak, ak.dot(u + s * t), o, lin_u);
+                b.newton_iterations += rc.iterations;
+                b.jacobians += rc.jacobians;
+                if (!rc.ok) return false;
+                g = (rc.tangent / c.norm(rc.tangent))(N + 1) * (rc.tangent.dot(ak) < 0.0 ? -1.0 : 1.0);
+                best = w;
+                bestc = rc;
+                return true;
+            };
+            probe.fold_orbit = [&] { return make_orbit(c, best, bestc, o.floquet); };
+            probe.orbit_at = [&](double s, PeriodicOrbit& out) {
+                Eigen::VectorXd w = u + s * t;
+                const Correction rc = correct(c, w, ref, ak, ak.dot(u + s * t), o, lin_u);
+                b.newton_iterations += rc.iterations;
+                b.jacobians += rc.jacobians;
+                if (!rc.ok) return false;
+                out = make_orbit(c, w, rc, true);
+                return true;
+            };
+            orbit_continuation::Step st;
+            st.after = after;
+            st.length = ak.dot(v - u);
+            st.h = h;
+            st.t_par = t(N + 1);
+            st.tn_par = tn(N + 1);
+            st.par_scale = std::abs(o.to - o.from);
+            orbit_continuation::special_points(st, b.points.back(), orbit, o.floquet, "periodic orbits", probe, b);
+        }
+        const bool collapsed = amplitude(orbit) < 0.5 * amp0;
+        b.points.push_back(std::move(orbit));
+        report();
+        if (collapsed) {  // the amplitude fell back towards 0: the branch ends at an equilibrium (a Hopf point)
+            b.stop = "hopf";
+            return;
+        }
+        u = v;
+        t = tn;
+        lin_u = r.lin;
+        // an easy step: the chord iterations converged with at most one new Jacobian besides the
+        // one at the result (sparse path: at most 3 Newton steps)
+        step.accept(r.lin ? r.jacobians <= 2 : r.iterations <= 3);
+        if (u(N) > o.max_period_factor * T0) {
+            b.stop = "period";
+            return;
+        }
+        adapt();
+    }
+}
+
+void finish(OrbitBranch& b) {
+    for (const PeriodicOrbit& p : b.points) {
+        b.max_residual = std::max(b.max_residual, p.residual);
+        if (std::isfinite(p.trivial_distance)) b.max_trivial_distance = std::max(b.max_trivial_distance, p.trivial_distance);
+    }
+    if (b.message.empty()) {
+        std::ostringstream s;
+        s << b.points.size() << " orbits, ended: " << b.stop;
+        b.message = s.str();
+    }
+}
+
+std::string method_text(const PeriodicMesh& mesh) {
+    std::ostringstream s;
+    s << "piecewise polynomial collocation, degree " << mesh.degree() << " on " << mesh.intervals()
+      << " intervals at Gauss-Legendre points; Newton (chord steps) on the system condensed to the history window by a forward sweep over the intervals; pseudo-arclength; Floquet multipliers of the collocated monodromy matrix";
+    return s.str();
+}
+
+}  // namespace
+
+bool PeriodicOrbitOptions::is_valid(std::string* why) const {
+    const char* w = nullptr;
+    if (parameter.empty()) w = "parameter: expected a name";
+    else if (!std::isfinite(from) || !std::isfinite(to) || from == to) w = "from, to: expected two different finite values";
+    else if (degree < 1 || degree > 20) w = "degree: expected an integer between 1 and 20";
+    else if (intervals < 2 || intervals > 100000) w = "intervals: expected an integer between 2 and 100000";
+    else if (max_points < 2) w = "max_points: expected an integer >= 2";
+    else if (!(min_step > 0.0 && initial_step >= min_step && max_step >= initial_step && std::isfinite(max_step)))
+        w = "steps: expected 0 < min_step <= initial_step <= max_step";
+    else if (max_iterations < 1) w = "max_iterations: expected an integer >= 1";
+    else if (!(tolerance > 0.0) || !(residual_tolerance > 0.0)) w = "tolerance, residual_tolerance: expected values > 0";
+    else if (!(max_period_factor > 1.0)) w = "max_period_factor: expected a value > 1";
+    if (w && why) *why = w;
+    return w == nullptr;
+}
+
+Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s) {
+    double w = s - std::floor(s);
+    if (w >= 1.0) w = 0.0;
+    const int l = mesh.interval_of(w), d = mesh.degree();
+    std::vector<double> v(static_cast<std::size_t>(d) + 1), dv(static_cast<std::size_t>(d) + 1);
+    mesh.basis(l, w, v.data(), dv.data());
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(profile.cols());
+    for (int j = 0; j <= d; ++j) x += v[static_cast<std::size_t>(j)] * profile.row((l * d + j) % mesh.points()).transpose();
+    return x;
+}
+
+OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<double>& times, const Eigen::MatrixXd& states,
+                                    double period, double par) {
+    if (times.size() < 2 || static_cast<Eigen::Index>(times.size()) != states.rows())
+        throw std::invalid_argument("orbit guess: expected at least two samples, one state row per time");
+    if (!(period > 0.0) || times.back() - times.front() < period * (1.0 - 1e-12))
+        throw std::invalid_argument("orbit guess: the samples must cover one period");
+    for (std::size_t i = 1; i < times.size(); ++i)
+        if (!(times[i] > times[i - 1])) throw std::invalid_argument("orbit guess: expected increasing times");
+    OrbitGuess g;
+    g.par = par;
+    g.period = period;
+    g.profile.resize(mesh.points(), states.cols());
+    std::size_t k = 0;
+    for (int i = 0; i < mesh.points(); ++i) {
+        const double t = times.front() + mesh.point(i) * period;
+        while (k + 2 < times.size() && times[k + 1] < t) ++k;
+        const double th = std::clamp((t - times[k]) / (times[k + 1] - times[k]), 0.0, 1.0);
+        g.profile.row(i) = (1.0 - th) * states.row(static_cast<Eigen::Index>(k)) + th * states.row(static_cast<Eigen::Index>(k + 1));
+    }
+    return g;
+}
+
+std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
+                                    const Eigen::MatrixXd& profile, double period, double par) {
+    if (profile.rows() != mesh.points() || profile.cols() != system.dimension())
+        throw std::invalid_argument("orbit multipliers: expected a profile of (degree x intervals) rows and one column per variable");
+    if (!(period > 0.0) || !std::isfinite(period)) throw std::invalid_argument("orbit multipliers: expected a period > 0");
+    Setup c(system, mesh);
+    c.n = system.dimension();
+    c.m = system.delay_count();
+    c.j = system.parameter_index(parameter);
+    c.d = mesh.degree();
+    c.L = mesh.intervals();
+    c.P = mesh.points();
+    c.base = system.parameter_values();
+    Eigen::VectorXd u(c.N() + 2);
+    for (int i = 0; i < c.P; ++i) u.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = profile.row(i).transpose();
+    u(c.N()) = period;
+    u(c.N() + 1) = par;
+    std::vector<cplx> out;
+    if (!multipliers(c, u, out)) out.clear();
+    return out;
+}
+
+OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& hopf, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
+    if (!(hopf.omega > 0.0) || !std::isfinite(hopf.omega)) throw std::invalid_argument("orbits from a Hopf point: expected omega > 0");
+    if (hopf.q.size() != system.dimension() || hopf.x.size() != system.dimension())
+        throw std::invalid_argument("orbits from a Hopf point: x and q must have the system's dimension");
+    const PeriodicMesh mesh(options.degree, options.intervals);
+    const double T0 = 2.0 * kPi / hopf.omega;
+    const Setup c = make_setup(system, mesh, options, T0);
+    const int N = c.N();
+    OrbitBranch b;
+    b.parameter = options.parameter;
+    b.degree = options.degree;
+    b.intervals = options.intervals;
+    b.method = method_text(mesh);
+    const VectorXc q = hopf.q / hopf.q.norm();
+    Eigen::VectorXd uh(N + 2), t0(N + 2);
+    for (int i = 0; i < c.P; ++i) {
+        const cplx e = std::exp(cplx(0.0, 2.0 * kPi * mesh.point(i)));
+        uh.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = hopf.x;
+        t0.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = (q * e).real();
+    }
+    uh(N) = T0;
+    uh(N + 1) = hopf.par;
+    t0(N) = t0(N + 1) = 0.0;
+    t0 /= c.norm(t0);
+    Eigen::VectorXd u = uh + options.initial_step * t0;
+    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+    const Eigen::VectorXd a = c.w.cwiseProduct(t0);
+    const Correction r = correct(c, u, ref, a, a.dot(u), options, nullptr);
+    if (!r.ok) {
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = "the first orbit from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
+        b.newton_iterations = r.iterations;
+        b.jacobians = r.jacobians;
+        return b;
+    }
+    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
+    follow(c, u, t, r, options, b);
+    finish(b);
+    return b;
+}
+
+OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
+    const PeriodicMesh mesh(options.degree, options.intervals);
+    if (guess.profile.rows() != mesh.points() || guess.profile.cols() != system.dimension())
+        throw std::invalid_argument("orbit guess: expected a profile of (degree x intervals) rows and one column per variable");
+    if (!(guess.period > 0.0)) throw std::invalid_argument("orbit guess: expected a period > 0");
+    const Setup c = make_setup(system, mesh, options, guess.period);
+    const int N = c.N();
+    OrbitBranch b;
+    b.parameter = options.parameter;
+    b.degree = options.degree;
+    b.intervals = options.intervals;
+    b.method = method_text(mesh);
+    Eigen::VectorXd u(N + 2);
+    for (int i = 0; i < c.P; ++i) u.segment(static_cast<Eigen::Index>(i) * c.n, c.n) = guess.profile.row(i).transpose();
+    u(N) = guess.period;
+    u(N + 1) = guess.par;
+    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 2);
+    e(N + 1) = 1.0;
+    const Correction r = correct(c, u, ref, e, guess.par, options, nullptr);
+    if (!r.ok) {
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = "the orbit did not converge from the guess";
+        b.newton_iterations = r.iterations;
+        return b;
+    }
+    {
+        const PeriodicOrbit first = make_orbit(c, u, r, false);
+        if (!(amplitude(first) > 1e-6 * std::max(1.0, first.max.cwiseAbs().maxCoeff()))) {
+            b.status = Status::NumericalIssue;
+            b.stop = "first_orbit_failed";
+            b.message = "the guess converged to an equilibrium, not a periodic orbit";
+            b.newton_iterations = r.iterations;
+            return b;
+        }
+    }
+    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
+    if ((t(N + 1) < 0.0) != (options.to < options.from)) t = -t;
+    follow(c, u, t, r, options, b);
+    finish(b);
+    return b;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,893 @@
+#include "ddemap/analysis/calibration/calibrate.hpp"
+
+#include "ddemap/core/execution.hpp"
+
+#include <exception>
+
+#include <algorithm>
+#include <atomic>
+#include <limits>
+#include <mutex>
+#include <numeric>
+#include <random>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/internal/text.hpp"
+
+namespace ddemap {
+
+namespace {
+
+/// linear interpolation of samples (constant outside)
+double interp(const std::vector<double>& t, const std::vector<double>& y, double x) {
+    if (x <= t.front()) return y.front();
+    if (x >= t.back()) return y.back();
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin()) - 1;
+    const double s = (x - t[k]) / (t[k + 1] - t[k]);
+    return y[k] + s * (y[k + 1] - y[k]);
+}
+
+const char* names[5] = {"k1", "k2", "th", "tau", "eta"};
+
+}  // namespace
+
+Trace read_trace_csv(const std::string& text, const std::string& source) {
+    detail::CsvReader csv(text, source, "time_s, lead_speed_mps, follower_speed_mps, gap_m");
+    const char* cols[4] = {"time_s", "lead_speed_mps", "follower_speed_mps", "gap_m"};
+    int idx[4];
+    for (int c = 0; c < 4; ++c) idx[c] = csv.column(cols[c]);
+    Trace tr;
+    tr.source = source;
+    std::vector<double>* dest[4] = {&tr.t, &tr.lead, &tr.speed, &tr.gap};
+    while (csv.next()) {
+        for (int c = 0; c < 4; ++c) dest[c]->push_back(csv.number(idx[c], cols[c]));
+        const std::size_t n = tr.t.size();
+        if (n > 1 && !(tr.t[n - 1] > tr.t[n - 2])) {
+            csv.fail("time_s = " + detail::format_number(tr.t[n - 1]) + " after " + detail::format_number(tr.t[n - 2]) +
+                     ": expected increasing times");
+        }
+    }
+    if (tr.t.size() < 100 || tr.t.back() - tr.t.front() < 20.0) {
+        throw std::invalid_argument(source + ": " + std::to_string(tr.t.size()) + " rows over " +
+                                    detail::format_number(tr.t.empty() ? 0.0 : tr.t.back() - tr.t.front()) +
+                                    " s: expected at least 100 rows and 20 s");
+    }
+    return tr;
+}
+
+const std::vector<std::string>& calibration_parameter_names() {
+    static const std::vector<std::string> n = {"k1", "k2", "th", "tau", "eta"};
+    return n;
+}
+
+ParameterBounds paper_calibration_bounds() {
+    return {{"k1", 0.0, 1.0}, {"k2", 0.0, 1.0}, {"th", 0.0, 3.0}, {"tau", 0.0, 1.0}, {"eta", 5.0, 15.0}};
+}
+
+BoundedParameter CalibrationOptions::bound(const std::string& name) const {
+    const ParameterBounds paper = paper_calibration_bounds();
+    const BoundedParameter* fallback = find_bound(paper, name);
+    if (!fallback) throw std::invalid_argument("bounds for '" + name + "': unknown parameter, expected one of k1, k2, th, tau, eta");
+    const BoundedParameter* b = find_bound(bounds, name);
+    return b ? *b : *fallback;
+}
+
+void CalibrationOptions::set_bounds(const std::string& name, double lower, double upper) {
+    if (BoundedParameter* b = find_bound(bounds, name)) {
+        b->lower = lower;
+        b->upper = upper;
+    } else {
+        bounds.push_back({name, lower, upper});
+    }
+}
+
+void CalibrationOptions::validate() const {
+    validate_bounds(bounds, calibration_parameter_names());
+    for (const auto& b : bounds)
+        if (b.lower < 0.0)
+            throw std::invalid_argument("bounds for '" + b.name + "' = " + detail::format_number(b.lower) + ":" + detail::format_number(b.upper) +
+                                        ": expected lower >= 0");
+    const double tau_max = bound("tau").upper;
+    if (tau_max > 5.0) throw std::invalid_argument("bounds for 'tau': upper = " + detail::format_number(tau_max) + ": expected at most 5 s");
+    if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected >= 0");
+    if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 0.5 s");
+    if (design_points < 1) throw std::invalid_argument("design points = " + std::to_string(design_points) + ": expected at least 1");
+    if (starts < 1 || starts > design_points)
+        throw std::invalid_argument("starts = " + std::to_string(starts) + ": expected 1 to design points (" + std::to_string(design_points) + ")");
+    if (max_iterations < 1) throw std::invalid_argument("max iterations = " + std::to_string(max_iterations) + ": expected at least 1");
+    for (double tol : {gradient_tolerance, function_tolerance, step_tolerance})
+        if (!(tol >= 0.0 && std::isfinite(tol))) throw std::invalid_argument("tolerance = " + detail::format_number(tol) + ": expected a finite value >= 0");
+    for (std::size_t i = 0; i < profile.size(); ++i) {
+        const auto& n = calibration_parameter_names();
+        if (std::find(n.begin(), n.end(), profile[i]) == n.end())
+            throw std::invalid_argument("profile '" + profile[i] + "': unknown parameter, expected one of k1, k2, th, tau, eta");
+        if (std::find(profile.begin(), profile.begin() + static_cast<std::ptrdiff_t>(i), profile[i]) != profile.begin() + static_cast<std::ptrdiff_t>(i))
+            throw std::invalid_argument("profile '" + profile[i] + "' is requested twice");
+        const BoundedParameter b = bound(profile[i]);
+        if (!(b.upper > b.lower)) throw std::invalid_argument("profile '" + profile[i] + "': the parameter is fixed by its bounds");
+    }
+    if (!profile.empty() && profile_points < 3)
+        throw std::invalid_argument("profile points = " + std::to_string(profile_points) + ": expected at least 3");
+}
+
+bool CalibrationOptions::is_valid() const {
+    try {
+        validate();
+        return true;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+void simulate_follower(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double step, std::vector<double>& speed,
+                       std::vector<double>& gap) {
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    FollowerTrajectory f = simulate_follower(tr, theta, t_a, t_b, step, false);
+    speed = std::move(f.speed);
+    gap = std::move(f.gap);
+}
+
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// One run of a (joint) least-squares problem: residuals (speeds, then sqrt(w) gaps) at the
+/// samples t_j >= t_from of the window [a, b] of its trace.
+struct Segment {
+    const Trace* tr = nullptr;
+    double a = 0.0, b = 0.0, t_from = 0.0;
+    std::size_t first = 0;             // data index of the trajectory's first row
+    std::vector<std::size_t> rows;     // trajectory rows of the residual samples
+    int samples() const { return static_cast<int>(rows.size()); }
+};
+
+/// The least-squares problem on the training windows of one or more runs: the residual vector
+/// is the runs' blocks one after the other, each block (speeds, then sqrt(w) gaps) of its run.
+struct LsqProblem {
+    std::vector<Segment> seg;
+    double step = 0.05, wg = 0.0;
+    CalibrationVector lo, hi;
+    mutable std::atomic<int> evaluations{0}, jacobians{0};
+
+    int samples() const {
+        int n = 0;
+        for (const auto& s : seg) n += s.samples();
+        return n;
+    }
+    int per_sample() const { return wg > 0.0 ? 2 : 1; }
+    int residuals() const { return samples() * per_sample(); }
+
+    /// r (and J if asked); false when a simulation is not finite
+    bool eval(const CalibrationVector& th, Eigen::VectorXd& r, Eigen::MatrixXd* J) const {
+        r.resize(residuals());
+        if (J) J->resize(residuals(), 5);
+        Eigen::Index off = 0;
+        for (const Segment& sg : seg) {
+            const Trace& tr = *sg.tr;
+            const FollowerTrajectory f = simulate_follower(tr, th, sg.a, sg.b, step, J != nullptr, sg.t_from);
+            ++evaluations;
+            if (J) ++jacobians;
+            const int n = sg.samples();
+            for (int j = 0; j < n; ++j) {
+                const std::size_t k = sg.rows[static_cast<std::size_t>(j)], d = sg.first + k;
+                r[off + j] = f.speed[k] - tr.speed[d];
+                if (J) J->row(off + j) = f.dspeed.row(static_cast<Eigen::Index>(k));
+                if (wg > 0.0) {
+                    r[off + n + j] = wg * (f.gap[k] - tr.gap[d]);
+                    if (J) J->row(off + n + j) = wg * f.dgap.row(static_cast<Eigen::Index>(k));
+                }
+            }
+            off += static_cast<Eigen::Index>(n) * per_sample();
+        }
+        return r.allFinite() && (!J || J->allFinite());
+    }
+    double ssr(const CalibrationVector& th) const {
+        Eigen::VectorXd r;
+        return eval(th, r, nullptr) ? r.squaredNorm() : kInf;
+    }
+};
+
+struct LmResult {
+    CalibrationVector theta;
+    double ssr = kInf;
+    Status status = Status::NumericalIssue;
+    std::string message;
+    int iterations = 0;
+};
+
+/// Levenberg-Marquardt with bounds on the free parameters `free` (the others stay at theta0):
+/// z = (theta - lo) / (hi - lo) in [0, 1]; a parameter on a bound whose gradient points
+/// outwards is held (active set); steps are projected onto the box; Nielsen's damping update.
+LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& theta0, const std::vector<int>& free,
+                             const CalibrationOptions& o) {
+    const int p = static_cast<int>(free.size());
+    LmResult res;
+    res.theta = theta0;
+    Eigen::VectorXd w(p), z(p);
+    for (int i = 0; i < p; ++i) {
+        const int k = free[static_cast<std::size_t>(i)];
+        w[i] = pb.hi[k] - pb.lo[k];
+        z[i] = std::clamp((theta0[k] - pb.lo[k]) / w[i], 0.0, 1.0);
+    }
+    auto theta_of = [&](const Eigen::VectorXd& zz) {
+        CalibrationVector th = theta0;
+        for (int i = 0; i < p; ++i) {
+            const int k = free[static_cast<std::size_t>(i)];
+            th[k] = std::clamp(pb.lo[k] + zz[i] * w[i], pb.lo[k], pb.hi[k]);
+        }
+        return th;
+    };
+    Eigen::VectorXd r, r_new;
+    Eigen::MatrixXd Jf, Jf_new;
+    auto scaled = [&](const Eigen::MatrixXd& J) {
+        Eigen::MatrixXd S(J.rows(), p);
+        for (int i = 0; i < p; ++i) S.col(i) = J.col(free[static_cast<std::size_t>(i)]) * w[i];
+        return S;
+    };
+    res.theta = theta_of(z);
+    if (!pb.eval(res.theta, r, &Jf)) {
+        res.message = "the simulation is not finite at the start";
+        return res;
+    }
+    Eigen::MatrixXd J = scaled(Jf);
+    double cost = r.squaredNorm();
+    res.ssr = cost;
+    if (p == 0) {
+        res.status = Status::Converged;
+        res.message = "no free parameter";
+        return res;
+    }
+    Eigen::MatrixXd A = J.transpose() * J;
+    Eigen::VectorXd g = J.transpose() * r;
+    double mu = 1e-3 * std::max(A.diagonal().maxCoeff(), 1e-300), nu = 2.0;
+    res.status = Status::MaxIterations;
+    res.message = "the iteration limit (" + std::to_string(o.max_iterations) + ") was reached";
+    for (int it = 0; it < o.max_iterations; ++it) {
+        res.iterations = it + 1;
+        // first-order optimality on the box
+        double pg = 0.0;
+        for (int i = 0; i < p; ++i) pg = std::max(pg, std::abs(std::clamp(z[i] - g[i], 0.0, 1.0) - z[i]));
+        if (pg <= o.gradient_tolerance * (1.0 + cost)) {
+            res.status = Status::Converged;
+            res.message = "projected gradient below tolerance";
+            break;
+        }
+        std::vector<int> act;  // free in this iteration
+        for (int i = 0; i < p; ++i)
+            if (!((z[i] <= 0.0 && g[i] > 0.0) || (z[i] >= 1.0 && g[i] < 0.0))) act.push_back(i);
+        const int q = static_cast<int>(act.size());
+        if (q == 0) {
+            res.status = Status::Converged;
+            res.message = "every parameter held at a bound";
+            break;
+        }
+        Eigen::MatrixXd Aq(q, q);
+        Eigen::VectorXd gq(q), dg(q);
+        const double dmax = A.diagonal().maxCoeff();
+        for (int i = 0; i < q; ++i) {
+            gq[i] = g[act[static_cast<std::size_t>(i)]];
+            for (int j = 0; j < q; ++j) Aq(i, j) = A(act[static_cast<std::size_t>(i)], act[static_cast<std::size_t>(j)]);
+            dg[i] = std::max(Aq(i, i), 1e-9 * dmax + 1e-300);
+        }
+        bool accepted = false, stop = false;
+        while (!accepted) {
+            Eigen::MatrixXd M = Aq;
+            M.diagonal() += mu * dg;
+            const Eigen::VectorXd dq = M.ldlt().solve(-gq);
+            Eigen::VectorXd d = Eigen::VectorXd::Zero(p);
+            for (int i = 0; i < q; ++i) d[act[static_cast<std::size_t>(i)]] = dq[i];
+            Eigen::VectorXd z_new = (z + d).cwiseMax(0.0).cwiseMin(1.0);
+            d = z_new - z;
+            if (!d.allFinite() || d.lpNorm<Eigen::Infinity>() <= o.step_tolerance) {
+                res.status = Status::Converged;
+                res.message = "step below tolerance";
+                stop = true;
+                break;
+            }
+            const double pred = -(g.dot(d) + 0.5 * d.dot(A * d));
+            const CalibrationVector th_new = theta_of(z_new);
+            const bool ok = pb.eval(th_new, r_new, &Jf_new);
+            const double cost_new = ok ? r_new.squaredNorm() : kInf;
+            const double rho = pred > 0.0 ? (cost - cost_new) / pred : -1.0;
+            if (ok && cost_new < cost && rho > 1e-4) {
+                const double decrease = cost - cost_new;
+                z = z_new;
+                r.swap(r_new);
+                J = scaled(Jf_new);
+                A = J.transpose() * J;
+                g = J.transpose() * r;
+                cost = cost_new;
+                res.theta = th_new;
+                res.ssr = cost;
+                mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+                nu = 2.0;
+                accepted = true;
+                if (decrease <= o.function_tolerance * cost) {
+                    res.status = Status::Converged;
+                    res.message = "relative decrease of the objective below tolerance";
+                    stop = true;
+                }
+            } else {
+                mu *= nu;
+                nu *= 2.0;
+                if (!(mu < 1e30)) {
+                    res.status = Status::Converged;
+                    res.message = "no descent step left (damping at its limit)";
+                    stop = true;
+                    break;
+                }
+            }
+        }
+        if (stop) break;
+    }
+    return res;
+}
+
+/// Latin hypercube in [0, 1]^p: n points, one in each of the n slices of every axis (fixed seed;
+/// a portable generator and no std distribution, so the design is the same on every platform).
+std::vector<Eigen::VectorXd> latin_hypercube(int n, int p, unsigned seed) {
+    std::mt19937 rng(seed);
+    auto uniform = [&] { return (static_cast<double>(rng()) + 0.5) / 4294967296.0; };
+    std::vector<Eigen::VectorXd> pts(static_cast<std::size_t>(n), Eigen::VectorXd(p));
+    std::vector<int> perm(static_cast<std::size_t>(n));
+    for (int j = 0; j < p; ++j) {
+        std::iota(perm.begin(), perm.end(), 0);
+        for (int i = n - 1; i > 0; --i) std::swap(perm[static_cast<std::size_t>(i)], perm[static_cast<std::size_t>(rng() % static_cast<unsigned>(i + 1))]);
+        for (int i = 0; i < n; ++i) pts[static_cast<std::size_t>(i)][j] = (perm[static_cast<std::size_t>(i)] + uniform()) / n;
+    }
+    return pts;
+}
+
+/// Errors over the samples of [t_a, t_b] at or after t_from.
+/// The simulation starts at max(t_start, t_a + tau).
+FitErrors errors_over(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double t_from, double step,
+                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr, double t_start = -1e300) {
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    FollowerTrajectory f = simulate_follower(tr, theta, t_a, t_b, step, false, t_start);
+    const std::vector<double>& v = f.speed;
+    const std::vector<double>& s = f.gap;
+    FitErrors e;
+    double sv = 0.0, sg = 0.0;
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < tr.t.size(); ++k) {
+        const double t = tr.t[k];
+        if (t < t_a || t > t_b) continue;
+        if (t >= t_from) {
+            const double dv = v[j] - tr.speed[k], dg = s[j] - tr.gap[k];
+            sv += dv * dv;
+            sg += dg * dg;
+            ++e.samples;
+        }
+        ++j;
+    }
+    if (e.samples > 0) {
+        e.rmse_speed = std::sqrt(sv / e.samples);
+        e.rmse_gap = std::sqrt(sg / e.samples);
+    }
+    if (sim_speed) *sim_speed = v;
+    if (sim_gap) *sim_gap = s;
+    return e;
+}
+
+/// autocorrelation of x at lags 0..max_lag (normalised by the lag-0 sum)
+std::vector<double> autocorrelation(const Eigen::VectorXd& x, int max_lag) {
+    const Eigen::Index n = x.size();
+    const Eigen::VectorXd c = x.array() - x.mean();
+    const double c0 = c.squaredNorm();
+    std::vector<double> rho(static_cast<std::size_t>(max_lag + 1), 0.0);
+    rho[0] = 1.0;
+    if (!(c0 > 0.0)) return rho;
+    for (int l = 1; l <= max_lag && l < n; ++l) rho[static_cast<std::size_t>(l)] = c.head(n - l).dot(c.tail(n - l)) / c0;
+    return rho;
+}
+
+/// first lag at which the autocorrelation falls below 0.05 (computed lag by lag up to cap)
+int decorrelation_lag(const Eigen::VectorXd& x, int cap) {
+    const Eigen::Index n = x.size();
+    const Eigen::VectorXd c = x.array() - x.mean();
+    const double c0 = c.squaredNorm();
+    if (!(c0 > 0.0)) return 1;
+    for (int l = 1; l <= cap && l < n; ++l)
+        if (c.head(n - l).dot(c.tail(n - l)) / c0 < 0.05) return l;
+    return cap;
+}
+
+std::string fmt(double x) { return detail::format_number(x); }
+
+std::string fmt3(double x) {
+    std::ostringstream s;
+    s.precision(3);
+    s << x;
+    return s.str();
+}
+
+}  // namespace
+
+namespace {
+
+/// The problem of `calibrate` (one run) or `calibrate_joint` (several): bounds, each run's
+/// training window and residual samples (t >= t_a + tau_max).
+void set_up(LsqProblem& pb, const std::vector<const Trace*>& traces, const CalibrationOptions& o) {
+    for (int i = 0; i < 5; ++i) {
+        const BoundedParameter bd = o.bound(names[i]);
+        pb.lo[i] = bd.lower;
+        pb.hi[i] = bd.upper;
+    }
+    pb.step = o.step;
+    pb.wg = std::sqrt(o.gap_weight);
+    for (const Trace* trp : traces) {
+        const Trace& tr = *trp;
+        const double first = tr.t.front(), last = tr.t.back();
+        const double a = o.train_start < 0.0 ? first : o.train_start;
+        const double b = o.train_end < 0.0 ? last : o.train_end;
+        if (!(a >= first && b <= last && b - a >= 20.0)) {
+            throw std::invalid_argument((traces.size() > 1 ? tr.source + ": " : std::string()) + "training window " + detail::format_number(a) + ":" +
+                                        detail::format_number(b) + " s: expected at least 20 s within the file's " + detail::format_number(first) +
+                                        ":" + detail::format_number(last) + " s");
+        }
+        // every candidate is scored on the same samples: those after the longest admissible delay
+        Segment sg;
+        sg.tr = trp;
+        sg.a = a;
+        sg.b = b;
+        sg.t_from = a + pb.hi[3];
+        sg.first = static_cast<std::size_t>(std::lower_bound(tr.t.begin(), tr.t.end(), a) - tr.t.begin());
+        for (std::size_t k = sg.first; k < tr.t.size() && tr.t[k] <= b; ++k)
+            if (tr.t[k] >= sg.t_from) sg.rows.push_back(k - sg.first);
+        pb.seg.push_back(std::move(sg));
+    }
+}
+
+/// The naive predictor v(t) = v_lead(t - d) at the samples t >= t_from, the best constant d in
+/// [0, 5] s: the RMSE per d on the 0.1 s grid (sum of squares and count, for pooling runs)
+void naive_sums(const Trace& tr, double t_from, std::vector<double>& sum, std::vector<int>& count) {
+    sum.assign(51, 0.0);
+    count.assign(51, 0);
+    for (int id = 0; id <= 50; ++id) {
+        const double d = 0.1 * id;
+        for (std::size_t k = 0; k < tr.t.size(); ++k) {
+            if (tr.t[k] < t_from) continue;
+            const double e = interp(tr.t, tr.lead, tr.t[k] - d) - tr.speed[k];
+            sum[static_cast<std::size_t>(id)] += e * e;
+            ++count[static_cast<std::size_t>(id)];
+        }
+    }
+}
+
+/// the fit of a problem: design, Levenberg-Marquardt starts, the uncertainty at the optimum,
+/// profiles and the warnings that do not depend on the whole-file errors
+CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o) {
+    const int n = pb.samples();
+    std::vector<int> free;
+    for (int i = 0; i < 5; ++i)
+        if (pb.hi[i] > pb.lo[i]) free.push_back(i);
+    const int p = static_cast<int>(free.size());
+    CalibrationResult res;
+    // 1. the design: Latin hypercube (plus the centre of the box), scored by the objective
+    CalibrationVector centre = 0.5 * (pb.lo + pb.hi);
+    std::vector<CalibrationVector> design(1, centre);
+    for (const auto& u : latin_hypercube(o.design_points - 1, p, o.seed)) {
+        CalibrationVector th = centre;
+        for (int i = 0; i < p; ++i) {
+            const int k = free[static_cast<std::size_t>(i)];
+            th[k] = pb.lo[k] + u[i] * (pb.hi[k] - pb.lo[k]);
+        }
+        design.push_back(th);
+    }
+    std::vector<double> score(design.size());
+    parallel_for(static_cast<long>(design.size()), [&](long i) { score[i] = pb.ssr(design[i]); });
+    std::vector<std::size_t> order(design.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return score[x] < score[y]; });
+    // 2. Levenberg-Marquardt from the best design points; keep the best end point
+    const int n_starts = std::min<int>(o.starts, static_cast<int>(design.size()));
+    std::vector<LmResult> fits(static_cast<std::size_t>(n_starts));
+    parallel_for(n_starts, [&](long s) { fits[s] = levenberg_marquardt(pb, design[order[s]], free, o); });
+    std::size_t best = 0;
+    for (std::size_t s = 1; s < fits.size(); ++s)
+        if (fits[s].ssr < fits[best].ssr) best = s;
+    LmResult fit = fits[best];
+    res.starts = n_starts;
+    if (!std::isfinite(fit.ssr)) {
+        // no start could be simulated: report the best design point
+        fit.theta = design[order[0]];
+        fit.ssr = score[order[0]];
+    }
+    res.status_code = fit.status;
+    res.status = to_string(fit.status);
+    res.message = fit.message;
+    const CalibrationVector theta = fit.theta;
+    res.objective = fit.ssr / std::max(n, 1);
+    for (int i = 0; i < 5; ++i) res.parameters[names[i]] = theta[i];
+    res.k1 = theta[0];
+    res.k2 = theta[1];
+    res.th = theta[2];
+    res.tau = theta[3];
+    res.eta = theta[4];
+
+    // 3. uncertainty at the optimum
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    const bool finite = pb.eval(theta, r, &J);
+    CalibrationMatrix cov = CalibrationMatrix::Zero(), cov_iid = CalibrationMatrix::Zero();
+    std::vector<bool> undetermined(5, false);
+    double sigma2 = 0.0;
+    if (finite && p > 0 && n > p) {
+        const int m = static_cast<int>(r.size());
+        Eigen::MatrixXd JF(m, p);
+        for (int i = 0; i < p; ++i) JF.col(i) = J.col(free[static_cast<std::size_t>(i)]);
+        const Eigen::MatrixXd H = JF.transpose() * JF;
+        Eigen::VectorXd D = H.diagonal().cwiseSqrt();
+        for (int i = 0; i < p; ++i)
+            if (!(D[i] > 0.0)) D[i] = 1.0;
+        const Eigen::MatrixXd Hs = D.asDiagonal().inverse() * H * D.asDiagonal().inverse();
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hs);
+        const Eigen::VectorXd lam = es.eigenvalues();
+        const double lmax = lam.maxCoeff();
+        res.condition_number = lam.minCoeff() > 0.0 ? lmax / lam.minCoeff() : kInf;
+        // pseudo-inverse: directions below 1e-12 lmax are not determined
+        Eigen::MatrixXd Hinv_s = Eigen::MatrixXd::Zero(p, p);
+        for (int k = 0; k < p; ++k) {
+            if (lam[k] > 1e-12 * lmax) {
+                Hinv_s += es.eigenvectors().col(k) * es.eigenvectors().col(k).transpose() / lam[k];
+            } else {
+                for (int i = 0; i < p; ++i)
+                    if (std::abs(es.eigenvectors()(i, k)) >= 0.3) undetermined[static_cast<std::size_t>(free[static_cast<std::size_t>(i)])] = true;
+            }
+        }
+        const Eigen::MatrixXd Hinv = D.asDiagonal().inverse() * Hinv_s * D.asDiagonal().inverse();
+        sigma2 = r.squaredNorm() / (m - p);
+        // per run: scores per sample time (speed and gap residual of the same time together),
+        // the bandwidth from the run's residual autocorrelation and its Newey-West sum; runs are
+        // independent, so Omega is the sum over runs (no cross-run lags)
+        Eigen::MatrixXd Omega = Eigen::MatrixXd::Zero(p, p);
+        double b_max = 0.0, eff = 0.0;
+        Eigen::Index off = 0;
+        for (const Segment& sg : pb.seg) {
+            const int ns = sg.samples();
+            const Eigen::Index ms = static_cast<Eigen::Index>(ns) * pb.per_sample();
+            if (ns < 2) {
+                off += ms;
+                continue;
+            }
+            const Eigen::VectorXd rv = r.segment(off, ns);
+            Eigen::MatrixXd G(ns, p);
+            for (int t = 0; t < ns; ++t) {
+                G.row(t) = JF.row(off + t) * r[off + t];
+                if (pb.wg > 0.0) G.row(t) += JF.row(off + ns + t) * r[off + ns + t];
+            }
+            // bandwidth: five times the lag at which the residuals decorrelate (the slower stream)
+            const int cap = std::max(1, ns / 4);
+            int lag = decorrelation_lag(rv, cap);
+            if (pb.wg > 0.0) lag = std::max(lag, decorrelation_lag(r.segment(off + ns, ns), cap));
+            const int L = std::min(5 * lag, cap);
+            res.bandwidth = std::max(res.bandwidth, L);
+            b_max = std::max(b_max, static_cast<double>(L) / ns);
+            Omega += G.transpose() * G;
+            for (int l = 1; l <= L; ++l) {
+                const double wl = 1.0 - static_cast<double>(l) / (L + 1);
+                const Eigen::MatrixXd Gl = G.bottomRows(ns - l).transpose() * G.topRows(ns - l);
+                Omega += wl * (Gl + Gl.transpose());
+            }
+            const std::vector<double> rho = autocorrelation(rv, L);
+            double f = 1.0;
+            for (int l = 1; l <= L; ++l) f += 2.0 * (1.0 - static_cast<double>(l) / (L + 1)) * rho[static_cast<std::size_t>(l)];
+            eff += ns / std::max(f, 1.0);
+            off += ms;
+        }
+        res.effective_samples = eff;
+        // fixed-b critical value of the Bartlett HAC t-statistic (Kiefer & Vogelsang 2005, the
+        // 97.5 % quantile as a cubic in b = L / n; the largest b over the runs): wider than 1.96
+        // when the bandwidth is a sizeable part of the trace, as it is for 10 Hz residuals
+        const double bb = b_max;
+        res.critical_value = 1.96 + 2.9694 * bb + 0.4160 * bb * bb - 0.5324 * bb * bb * bb;
+        // symmetric by construction; symmetrised so that rounding does not make C(i, j) != C(j, i)
+        const Eigen::MatrixXd C0 = Hinv * Omega * Hinv;
+        const Eigen::MatrixXd C = 0.5 * (C0 + C0.transpose());
+        const Eigen::MatrixXd Ci = 0.5 * sigma2 * (Hinv + Hinv.transpose());
+        for (int i = 0; i < p; ++i)
+            for (int j = 0; j < p; ++j) {
+                cov(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = C(i, j);
+                cov_iid(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = Ci(i, j);
+            }
+    }
+    res.covariance = cov;
+    res.covariance_independent = cov_iid;
+    for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 5; ++j) {
+            const double d = std::sqrt(cov(i, i) * cov(j, j));
+            res.correlation(i, j) = i == j ? 1.0 : (d > 0.0 ? cov(i, j) / d : 0.0);
+        }
+    for (int i = 0; i < 5; ++i) {
+        ParameterEstimate& e = res.estimates[static_cast<std::size_t>(i)];
+        e.name = names[i];
+        e.value = theta[i];
+        e.fixed = !(pb.hi[i] > pb.lo[i]);
+        const double width = pb.hi[i] - pb.lo[i];
+        e.at_bound = !e.fixed && (theta[i] - pb.lo[i] <= 1e-6 * width || pb.hi[i] - theta[i] <= 1e-6 * width);
+        e.standard_error = e.fixed ? 0.0 : (undetermined[static_cast<std::size_t>(i)] || !finite ? kInf : std::sqrt(std::max(cov(i, i), 0.0)));
+        e.lower95 = e.value - res.critical_value * e.standard_error;
+        e.upper95 = e.value + res.critical_value * e.standard_error;
+    }
+
+    // 5. profile likelihoods on request
+    for (const std::string& name : o.profile) {
+        const int k = static_cast<int>(std::find(names, names + 5, name) - names);
+        ProfileLikelihood pl;
+        pl.parameter = name;
+        const double se = res.estimates[static_cast<std::size_t>(k)].standard_error;
+        double lo = pb.lo[k], hi = pb.hi[k];
+        if (std::isfinite(se) && se > 0.0) {
+            lo = std::max(lo, theta[k] - 4.0 * se);
+            hi = std::min(hi, theta[k] + 4.0 * se);
+        }
+        const int K = o.profile_points;
+        pl.values.resize(static_cast<std::size_t>(K));
+        pl.objective.assign(static_cast<std::size_t>(K), kInf);
+        for (int j = 0; j < K; ++j) pl.values[static_cast<std::size_t>(j)] = lo + (hi - lo) * j / (K - 1);
+        std::vector<int> others;
+        for (int i : free)
+            if (i != k) others.push_back(i);
+        // walk outwards from the optimum, each point started from its neighbour's solution
+        const int j0 = static_cast<int>(std::lower_bound(pl.values.begin(), pl.values.end(), theta[k]) - pl.values.begin());
+        for (int dir : {-1, 1}) {
+            CalibrationVector start = theta;
+            for (int j = dir < 0 ? j0 - 1 : j0; j >= 0 && j < K; j += dir) {
+                start[k] = pl.values[static_cast<std::size_t>(j)];
+                const LmResult lm = levenberg_marquardt(pb, start, others, o);
+                if (std::isfinite(lm.ssr)) start = lm.theta;
+                pl.objective[static_cast<std::size_t>(j)] = lm.ssr / std::max(n, 1);
+            }
+        }
+        const double var_ratio = cov_iid(k, k) > 0.0 ? std::max(cov(k, k) / cov_iid(k, k), 1.0) : 1.0;
+        const double threshold = res.critical_value * res.critical_value * sigma2 * var_ratio / std::max(n, 1);
+        const double omin = std::min(res.objective, *std::min_element(pl.objective.begin(), pl.objective.end()));
+        if (omin < res.objective * (1.0 - 1e-9))
+            res.warnings.push_back("the profile of " + name + " found a lower objective (" + fmt3(omin) + " < " + fmt3(res.objective) +
+                                   "): the fit is not the global minimum");
+        int jm = static_cast<int>(std::min_element(pl.objective.begin(), pl.objective.end()) - pl.objective.begin());
+        auto crossing = [&](int dir, double& out, bool& open) {
+            int j = jm;
+            while (j + dir >= 0 && j + dir < K && pl.objective[static_cast<std::size_t>(j + dir)] - omin <= threshold) j += dir;
+            if (j + dir < 0 || j + dir >= K) {
+                out = pl.values[static_cast<std::size_t>(j)];
+                open = true;
+                return;
+            }
+            const double f0 = pl.objective[static_cast<std::size_t>(j)] - omin, f1 = pl.objective[static_cast<std::size_t>(j + dir)] - omin;
+            const double s = std::isfinite(f1) && f1 > f0 ? (threshold - f0) / (f1 - f0) : 0.0;
+            out = pl.values[static_cast<std::size_t>(j)] + s * (pl.values[static_cast<std::size_t>(j + dir)] - pl.values[static_cast<std::size_t>(j)]);
+        };
+        crossing(-1, pl.lower95, pl.lower_open);
+        crossing(1, pl.upper95, pl.upper_open);
+        res.profiles.push_back(pl);
+    }
+
+    // 6. warnings
+    if (!converged(res.status_code)) res.warnings.push_back("the fit did not converge (" + res.status + "): " + res.message);
+    if (!finite) res.warnings.push_back("the simulation at the fitted parameters is not finite: no uncertainty");
+    for (const auto& e : res.estimates) {
+        const int i = static_cast<int>(&e - res.estimates.data());
+        if (e.at_bound) {
+            const bool upper = pb.hi[i] - e.value <= e.value - pb.lo[i];
+            res.warnings.push_back(e.name + " = " + fmt3(e.value) + " is at its " + (upper ? "upper" : "lower") + " bound (" +
+                                   fmt(upper ? pb.hi[i] : pb.lo[i]) + "): the best fit may lie outside the bounds; its interval is not reliable");
+        }
+        if (!e.fixed && finite && !(e.upper95 - e.lower95 <= pb.hi[i] - pb.lo[i]))
+            res.warnings.push_back(e.name + " is not determined by this trace: its 95 % interval [" + fmt3(e.lower95) + ", " + fmt3(e.upper95) +
+                                   "] is wider than its bounds [" + fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) + "]");
+    }
+    if (res.condition_number > 1e8) {
+        std::string which;
+        for (int i = 0; i < 5; ++i)
+            if (undetermined[static_cast<std::size_t>(i)]) which += (which.empty() ? "" : ", ") + std::string(names[i]);
+        res.warnings.push_back("J^T J is nearly singular (condition number " + fmt3(res.condition_number) + ")" +
+                               (which.empty() ? std::string(": the parameters are strongly correlated") : ": " + which + " not determined by this trace"));
+    }
+    res.evaluations = pb.evaluations;
+    res.jacobian_evaluations = pb.jacobians;
+    return res;
+}
+
+/// the naive predictor's warning (appended once the whole-file errors are known)
+void warn_naive(CalibrationResult& res) {
+    if (!(res.all.rmse_speed < res.naive.rmse_speed))
+        res.warnings.push_back("the model (speed RMSE " + fmt3(res.all.rmse_speed) + " m/s) is no better than the naive predictor v(t) = v_lead(t - " +
+                               fmt3(res.naive_delay) + " s) (" + fmt3(res.naive.rmse_speed) + " m/s)");
+}
+
+}  // namespace
+
+double calibration_objective(const Trace& tr, const ParameterMap& p, const CalibrationOptions& o) {
+    o.validate();
+    LsqProblem pb;
+    set_up(pb, {&tr}, o);
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    return pb.ssr(theta) / std::max(pb.samples(), 1);
+}
+
+double calibration_objective(const std::vector<Trace>& runs, const ParameterMap& p, const CalibrationOptions& o) {
+    o.validate();
+    if (runs.empty()) throw std::invalid_argument("joint objective: expected at least one run");
+    LsqProblem pb;
+    std::vector<const Trace*> ptr;
+    for (const auto& t : runs) ptr.push_back(&t);
+    set_up(pb, ptr, o);
+    CalibrationVector theta;
+    for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
+    return pb.ssr(theta) / std::max(pb.samples(), 1);
+}
+
+FitEvaluation evaluate_fit(const Trace& tr, const ParameterMap& p, double step) {
+    FitEvaluation ev;
+    const double first = tr.t.front(), last = tr.t.back(), t_from = first + p.at("tau");
+    ev.errors = errors_over(tr, p, first, last, t_from, step, &ev.sim_speed, &ev.sim_gap);
+    std::vector<double> sum;
+    std::vector<int> count;
+    naive_sums(tr, t_from, sum, count);
+    double best = kInf;
+    for (std::size_t id = 0; id < sum.size(); ++id) {
+        const double rmse = std::sqrt(sum[id] / std::max(count[id], 1));
+        if (rmse < best) {
+            best = rmse;
+            ev.naive_delay = 0.1 * static_cast<double>(id);
+        }
+    }
+    ev.naive.rmse_speed = best;
+    ev.naive.samples = ev.errors.samples;
+    return ev;
+}
+
+CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
+    o.validate();
+    const auto t_start = std::chrono::steady_clock::now();
+    const double first = tr.t.front(), last = tr.t.back();
+    LsqProblem pb;
+    set_up(pb, {&tr}, o);
+    const double a = pb.seg[0].a, b = pb.seg[0].b;
+    CalibrationResult res = fit_problem(pb, o);
+    // 4. errors and the naive predictor
+    res.train = errors_over(tr, res.parameters, a, b, pb.seg[0].t_from, o.step, nullptr, nullptr, pb.seg[0].t_from);  // as the objective
+    res.all = errors_over(tr, res.parameters, first, last, first + res.parameters.at("tau"), o.step, &res.sim_speed, &res.sim_gap);
+    // the test part: the file outside the training window, each piece simulated from its own start
+    FitErrors test;
+    double sv = 0.0, sg = 0.0;
+    for (auto [ta, tb] : {std::pair{first, a}, std::pair{b, last}}) {
+        if (tb - ta < 5.0) continue;
+        const FitErrors e = errors_over(tr, res.parameters, ta, tb, ta + res.parameters.at("tau"), o.step);
+        sv += e.rmse_speed * e.rmse_speed * e.samples;
+        sg += e.rmse_gap * e.rmse_gap * e.samples;
+        test.samples += e.samples;
+    }
+    if (test.samples > 0) {
+        test.rmse_speed = std::sqrt(sv / test.samples);
+        test.rmse_gap = std::sqrt(sg / test.samples);
+    }
+    res.test = test;
+    // the naive predictor v(t) = v_lead(t - d), best constant d in [0, 5] s, same samples as `all`
+    const FitEvaluation naive = evaluate_fit(tr, res.parameters, o.step);
+    res.naive = naive.naive;
+    res.naive_delay = naive.naive_delay;
+    res.rmse_speed = res.all.rmse_speed;
+    res.rmse_gap = res.all.rmse_gap;
+    res.naive_rmse_speed = res.naive.rmse_speed;
+    res.runs.push_back({res.all, res.naive, res.naive_delay, res.sim_speed, res.sim_gap});
+    warn_naive(res);
+    res.evaluations = pb.evaluations;
+    res.jacobian_evaluations = pb.jacobians;
+    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    return res;
+}
+
+CalibrationResult calibrate_joint(const std::vector<Trace>& runs, const CalibrationOptions& o) {
+    o.validate();
+    if (runs.empty()) throw std::invalid_argument("joint calibration: expected at least one run");
+    const auto t_start = std::chrono::steady_clock::now();
+    LsqProblem pb;
+    std::vector<const Trace*> ptr;
+    for (const auto& t : runs) ptr.push_back(&t);
+    set_up(pb, ptr, o);
+    CalibrationResult res = fit_problem(pb, o);
+    // pooled errors: train as the objective (each run's window), all and naive over whole files
+    double tv = 0.0, tg = 0.0, av = 0.0, ag = 0.0, nv = 0.0;
+    for (const Segment& sg : pb.seg) {
+        const FitErrors e = errors_over(*sg.tr, res.parameters, sg.a, sg.b, sg.t_from, o.step, nullptr, nullptr, sg.t_from);
+        tv += e.rmse_speed * e.rmse_speed * e.samples;
+        tg += e.rmse_gap * e.rmse_gap * e.samples;
+        res.train.samples += e.samples;
+        const FitEvaluation ev = evaluate_fit(*sg.tr, res.parameters, o.step);
+        av += ev.errors.rmse_speed * ev.errors.rmse_speed * ev.errors.samples;
+        ag += ev.errors.rmse_gap * ev.errors.rmse_gap * ev.errors.samples;
+        res.all.samples += ev.errors.samples;
+        res.runs.push_back(ev);
+    }
+    // the naive predictor pooled over the runs: one delay d for all of them
+    std::vector<double> total(51, 0.0);
+    std::vector<int> cnt(51, 0);
+    for (const Trace& tr : runs) {
+        std::vector<double> sum;
+        std::vector<int> count;
+        naive_sums(tr, tr.t.front() + res.tau, sum, count);
+        for (std::size_t id = 0; id < sum.size(); ++id) {
+            total[id] += sum[id];
+            cnt[id] += count[id];
+        }
+    }
+    nv = kInf;
+    for (std::size_t id = 0; id < total.size(); ++id) {
+        const double rmse = std::sqrt(total[id] / std::max(cnt[id], 1));
+        if (rmse < nv) {
+            nv = rmse;
+            res.naive_delay = 0.1 * static_cast<double>(id);
+        }
+    }
+    if (res.train.samples > 0) {
+        res.train.rmse_speed = std::sqrt(tv / res.train.samples);
+        res.train.rmse_gap = std::sqrt(tg / res.train.samples);
+    }
+    if (res.all.samples > 0) {
+        res.all.rmse_speed = std::sqrt(av / res.all.samples);
+        res.all.rmse_gap = std::sqrt(ag / res.all.samples);
+    }
+    res.naive.rmse_speed = nv;
+    res.naive.samples = res.all.samples;
+    res.rmse_speed = res.all.rmse_speed;
+    res.rmse_gap = res.all.rmse_gap;
+    res.naive_rmse_speed = nv;
+    warn_naive(res);
+    res.evaluations = pb.evaluations;
+    res.jacobian_evaluations = pb.jacobians;
+    res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    return res;
+}
+
+std::vector<CalibrationResult> calibrate_many(const std::vector<Trace>& traces, const CalibrationOptions& options,
+                                             const ExecutionPolicy& policy) {
+    options.validate();
+    std::vector<CalibrationResult> fits(traces.size());
+    // an error in any trace is rethrown here (the lowest index first), never inside the loop
+    parallel_for(static_cast<long>(traces.size()), [&](long i) { fits[i] = calibrate(traces[i], options); }, policy);
+    return fits;
+}
+
+std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, const CalibrationOptions& options,
+                                           const ExecutionPolicy& policy, const CarFinished& finished) {
+    options.validate();
+    for (const CarRuns& c : cars) {
+        if (c.train.empty()) throw std::invalid_argument("car " + detail::quoted(c.car) + ": expected at least one training run");
+        if (c.test_types.size() != c.test.size())
+            throw std::invalid_argument("car " + detail::quoted(c.car) + ": " + std::to_string(c.test_types.size()) + " test types for " +
+                                        std::to_string(c.test.size()) + " test runs: expected one per test run");
+    }
+    std::vector<CarCalibration> out(cars.size());
+    std::mutex lock;
+    long done = 0;
+    parallel_for(
+        static_cast<long>(cars.size()),
+        [&](long i) {
+            const CarRuns& c = cars[static_cast<std::size_t>(i)];
+            CarCalibration& r = out[static_cast<std::size_t>(i)];
+            r.car = c.car;
+            for (const Trace& t : c.train) r.train_sources.push_back(t.source);
+            r.fit = c.train.size() == 1 ? calibrate(c.train[0], options) : calibrate_joint(c.train, options);
+            for (std::size_t k = 0; k < c.test.size(); ++k)
+                r.tests.push_back({c.test[k].source, c.test_types[k], evaluate_fit(c.test[k], r.fit.parameters, options.step)});
+            if (finished) {
+                std::lock_guard<std::mutex> guard(lock);
+                finished(r, ++done, static_cast<long>(cars.size()));
+            }
+        },
+        policy);
+    return out;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,472 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "../numeric_helpers.hpp"
+#include "../tolerances.hpp"
+#include "ddemap/analysis/bifurcation/hopf.hpp"
+#include "ddemap/io/hopf_output.hpp"
+#include "ddemap/problem/expression_system.hpp"
+#include "ddemap/solve/integrate.hpp"
+#include "ddemap/traffic/ov_ring.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+
+using test::bisect;
+using test::pi;
+
+/// max - min of y' = -alpha y(t - 1) (1 + y) on its attracting orbit: RK4 with Hermite history
+/// (solve/integrate.hpp, order 4) from y = a0 cos(pi t / 2) on [-1, 0], until t_end; the extrema
+/// over the last 40 time units, each refined by a parabola through the step values around it.
+double wright_range(double alpha, double a0, double t_end, double h) {
+    DdeSolver solver(
+        1, 0.0, [&](double t, double* y) { y[0] = a0 * std::cos(pi * t / 2.0); },
+        [&](double t, const double* y, const DdeSolver& s, double* dy) { dy[0] = -alpha * s.value(0, t - 1.0) * (1.0 + y[0]); });
+    std::vector<double> ys, ts;
+    solver.integrate(t_end, h, {}, [&](const DdeSolver& s) {
+        if (s.time() >= t_end - 40.0 - 2 * h) {
+            ys.push_back(s.state()[0]);
+            ts.push_back(s.time());
+        }
+        return true;
+    });
+    double hi = -1e300, lo = 1e300;
+    for (std::size_t k = 1; k + 1 < ys.size(); ++k) {
+        const double a = ys[k - 1], b = ys[k], c = ys[k + 1];
+        const bool peak = b >= a && b >= c, trough = b <= a && b <= c;
+        if (!peak && !trough) continue;
+        const double den = a - 2 * b + c;
+        const double ext = den != 0.0 ? b - (c - a) * (c - a) / (8.0 * den) : b;  // the parabola's extremum
+        if (peak) hi = std::max(hi, ext);
+        if (trough) lo = std::min(lo, ext);
+    }
+    return hi - lo;
+}
+
+ExpressionSystem neuron_system() {
+    return ExpressionSystem({"x1", "x2"}, {"kappa", "beta", "a12", "a21", "tau1", "tau2", "taus"}, {0.5, -1, 1, 0.5, 0.2, 0.2, 1.5},
+                            {"-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
+                             "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"});
+}
+
+}  // namespace
+
+TEST_CASE("Wright's equation: L1, the crossing speed and the amplitude law in closed form") {
+    // y'(t) = -alpha y(t - 1) (1 + y(t)) at y = 0: Delta(lambda) = lambda + alpha e^{-lambda}, Hopf at
+    // alpha = omega = pi/2. With q = 1, Phi = (1, -i), B(a, b) = -alpha (a_0 b_1 + a_1 b_0), C = 0:
+    // B(Phi, Phi) = i pi, h20 = i pi / (i pi - pi/2), B(Phi, conj Phi) = 0 (h11 = 0),
+    // p = 1 / Delta'(i pi/2) = 1 / (1 + i pi/2), and
+    //     c1 = p B(conj Phi, H20) / 2,  Re c1 = -pi (3 pi - 2) / (5 (4 + pi^2)),
+    //     lambda'(alpha) = -p e^{-i pi/2} = i / (1 + i pi/2),  Re lambda' = 2 pi / (4 + pi^2),
+    // so r^2 = -mu Re lambda' / Re c1 = 10 mu / (3 pi - 2) and y ~ 2 r cos(pi t/2): the range
+    // max - min = 4 r, i.e. half-amplitude^2 = 40 mu / (3 pi - 2), the classical law of Chow and
+    // Mallet-Paret (1977; also Hassard, Kazarinoff and Wan, 1981): alpha = pi/2 + (3 pi - 2) eps^2 / 40.
+    ExpressionSystem wright({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)*(1 + y)"});
+    const HopfPoint h = correct_hopf(wright, 0, Eigen::VectorXd::Zero(1), 1.5, 1.5);
+    REQUIRE(h.status == Status::Converged);
+    CHECK(std::abs(h.par - pi / 2) < tol::special_point);
+    CHECK(std::abs(h.omega - pi / 2) < tol::special_point);
+    const HopfCoefficients c = hopf_coefficients(wright, 0, h);
+    REQUIRE(c.status == Status::Converged);
+    const double re_c1 = -pi * (3 * pi - 2) / (5 * (4 + pi * pi));
+    CHECK(std::abs(c.c1.real() - re_c1) < tol::normal_form);
+    CHECK(std::abs(c.l1 - re_c1 / (pi / 2)) < tol::normal_form);
+    CHECK(c.criticality == Criticality::Supercritical);
+    CHECK(std::abs(c.dre_dpar - 2 * pi / (4 + pi * pi)) < tol::normal_form);
+    CHECK(std::abs(c.dlambda - cplx(0, 1) / cplx(1, pi / 2)) < tol::normal_form);
+    CHECK(c.side == 1);
+    REQUIRE(c.amplitude_coefficient.size() == 1);
+    CHECK(std::abs(c.amplitude_coefficient[0] - 4 * std::sqrt(10 / (3 * pi - 2))) < tol::normal_form);
+    CHECK(std::abs(c.q.norm() - 1) < 1e-14);
+    CHECK(c.null_residual < tol::normal_form);
+}
+
+TEST_CASE("the crossing speed through a moving equilibrium and through a delay, in closed form") {
+    // x' = p - x(t - 1)^2: x* = sqrt(p), Delta = lambda + 2 sqrt(p) e^{-lambda}, Hopf at p = pi^2/16,
+    // omega = pi/2; the total dDelta/dp = e^{-lambda} / sqrt(p) (through x*(p)) gives
+    // lambda' = (4 i / pi) / (1 + i pi/2), Re lambda' = 8 / (4 + pi^2).
+    ExpressionSystem fold({"x"}, {"p"}, {0.6}, {"p - x(t - 1)^2"});
+    const HopfPoint h1 = correct_hopf(fold, 0, Eigen::VectorXd::Constant(1, 0.78), 0.6, 1.5);
+    REQUIRE(h1.status == Status::Converged);
+    CHECK(std::abs(h1.par - pi * pi / 16) < tol::special_point);
+    const HopfCoefficients c1 = hopf_coefficients(fold, 0, h1);
+    REQUIRE(c1.status == Status::Converged);
+    CHECK(std::abs(c1.dlambda - cplx(0, 4 / pi) / cplx(1, pi / 2)) < tol::normal_form);
+    CHECK(std::abs(c1.dre_dpar - 8 / (4 + pi * pi)) < tol::normal_form);
+    // x' = -x(t - tau) + x x(t - tau) in tau: Hopf at tau = pi/2, omega = 1; dDelta/dtau = -lambda e^{-lambda tau}
+    // = -1, Delta' = 1 + i pi/2, so lambda' = 1 / (1 + i pi/2), Re lambda' = 4 / (4 + pi^2)
+    ExpressionSystem delay({"x"}, {"tau"}, {1.5}, {"-x(t - tau) + x*x(t - tau)"});
+    const HopfPoint h2 = correct_hopf(delay, 0, Eigen::VectorXd::Zero(1), 1.5, 1.0);
+    REQUIRE(h2.status == Status::Converged);
+    CHECK(std::abs(h2.par - pi / 2) < tol::special_point);
+    const HopfCoefficients c2 = hopf_coefficients(delay, 0, h2);
+    REQUIRE(c2.status == Status::Converged);
+    CHECK(std::abs(c2.dlambda - 1.0 / cplx(1, pi / 2)) < tol::normal_form);
+    CHECK(std::abs(c2.dre_dpar - 4 / (4 + pi * pi)) < tol::normal_form);
+}
+
+TEST_CASE("hopf output: a Hopf point that was not located is undecided, with null coefficients") {
+    ExpressionSystem wright({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)*(1 + y)"});
+    HopfAnalysis a;
+    a.branch.parameter = "alpha";
+    HopfPoint bad;
+    bad.x = Eigen::VectorXd::Zero(1);
+    bad.par = 1.5;
+    bad.omega = 1.5;
+    a.points.push_back(hopf_coefficients(wright, 0, bad));
+    a.points.push_back(hopf_coefficients(wright, 0, correct_hopf(wright, 0, Eigen::VectorXd::Zero(1), 1.5, 1.5)));
+    const std::string j = hopf_points_json(a, {"y"});
+    CHECK(j.find("\"criticality\":\"undecided\"") != std::string::npos);
+    CHECK(j.find("\"l1\":null") != std::string::npos);
+    CHECK(j.find("\"criticality\":\"supercritical\"") != std::string::npos);
+    const std::string csv = hopf_points_csv(a, {"y"});
+    CHECK(csv.find(",undecided,") != std::string::npos);
+    CHECK(csv.find("nan") == std::string::npos);
+    CHECK(csv.find("inf") == std::string::npos);
+}
+
+TEST_CASE("Wright's equation: the predicted amplitude against a long simulation, error O(mu)") {
+    ExpressionSystem wright({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)*(1 + y)"});
+    const HopfPoint h = correct_hopf(wright, 0, Eigen::VectorXd::Zero(1), 1.5, 1.5);
+    const HopfCoefficients c = hopf_coefficients(wright, 0, h);
+    REQUIRE(c.status == Status::Converged);
+    REQUIRE(c.side == 1);
+    double err[2];
+    const double mus[2] = {0.02, 0.01};
+    for (int i = 0; i < 2; ++i) {
+        const double mu = mus[i];
+        const double predicted = c.amplitude_coefficient[0] * std::sqrt(mu);
+        // from the predicted orbit: the distance to the attracting orbit decays like
+        // exp(-2 mu Re lambda' t) (the orbit's nontrivial exponent), e^-10 by t = 5 / (mu Re lambda')
+        const double t_end = 5.0 / (mu * c.dre_dpar) + 100.0;
+        const double simulated = wright_range(h.par + mu, predicted / 2, t_end, 1.0 / 64);
+        err[i] = std::abs(simulated / predicted - 1);
+        MESSAGE("mu = " << mu << ": simulated range " << simulated << ", predicted " << predicted << ", relative error " << err[i]);
+        CHECK(err[i] < tol::amplitude_law_per_mu * mu);
+    }
+    // the error is O(mu): it halves with mu (ratio 2 up to the O(mu^2) terms)
+    CHECK(err[1] < err[0]);
+    CHECK(std::abs(err[0] / err[1] - 2.0) < tol::order_ratio_band);
+}
+
+TEST_CASE("neuron demo: the predicted range of each variable against a long simulation, error O(mu)") {
+    // a vector system: the range of x_j is predicted as amplitude_coefficient_j sqrt(mu), through
+    // |q_j| (the direction of the eigenvector matters, its normalisation does not)
+    ExpressionSystem neuron = neuron_system();
+    const int j = neuron.parameter_index("a21");
+    const HopfPoint h = correct_hopf(neuron, j, Eigen::VectorXd::Zero(2), 0.8, 0.78);
+    const HopfCoefficients c = hopf_coefficients(neuron, j, h);
+    REQUIRE(c.status == Status::Converged);
+    REQUIRE(c.criticality == Criticality::Supercritical);
+    REQUIRE(c.side == 1);
+    double err[2][2];
+    const double mus[2] = {0.02, 0.01};
+    for (int i = 0; i < 2; ++i) {
+        const double mu = mus[i];
+        neuron.set_parameter("a21", h.par + mu);
+        const std::vector<double> tau = neuron.delays();
+        const double r = std::sqrt(-mu * c.dre_dpar / c.c1.real());
+        // from the predicted orbit x ~ 2 r Re(q e^{i omega t})
+        DdeSolver solver(
+            2, 0.0,
+            [&](double t, double* y) {
+                for (int k = 0; k < 2; ++k) y[k] = 2 * r * std::real(c.q[k] * std::exp(cplx(0, c.omega * t)));
+            },
+            [&](double t, const double* y, const DdeSolver& s, double* dy) {
+                Eigen::VectorXd u(2 * (tau.size() + 1));
+                u << y[0], y[1], Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(tau.size()));
+                for (std::size_t k = 0; k < tau.size(); ++k)
+                    for (int m = 0; m < 2; ++m) u[2 * static_cast<Eigen::Index>(k + 1) + m] = s.value(m, t - tau[k]);
+                const Eigen::VectorXd f = neuron.f(u);
+                dy[0] = f[0];
+                dy[1] = f[1];
+            });
+        const double t_end = 5.0 / (mu * c.dre_dpar) + 100.0;
+        double hi[2] = {-1e300, -1e300}, lo[2] = {1e300, 1e300};
+        std::vector<double> prev[2];
+        solver.integrate(t_end, 1.0 / 32, {}, [&](const DdeSolver& s) {
+            if (s.time() < t_end - 60.0) return true;
+            for (int m = 0; m < 2; ++m) {
+                prev[m].push_back(s.state()[m]);
+                const std::size_t n = prev[m].size();
+                if (n < 3) continue;
+                const double a = prev[m][n - 3], b = prev[m][n - 2], cc = prev[m][n - 1], den = a - 2 * b + cc;
+                if ((b >= a && b >= cc) || (b <= a && b <= cc)) {
+                    const double ext = den != 0.0 ? b - (cc - a) * (cc - a) / (8.0 * den) : b;
+                    hi[m] = std::max(hi[m], ext);
+                    lo[m] = std::min(lo[m], ext);
+                }
+            }
+            return true;
+        });
+        for (int m = 0; m < 2; ++m) {
+            const double predicted = c.amplitude_coefficient[m] * std::sqrt(mu);
+            err[i][m] = std::abs((hi[m] - lo[m]) / predicted - 1);
+            MESSAGE("neuron, mu = " << mu << ", x" << m + 1 << ": simulated range " << hi[m] - lo[m] << ", predicted " << predicted
+                                    << ", relative error " << err[i][m]);
+            CHECK(err[i][m] < tol::amplitude_law_per_mu * mu);
+        }
+    }
+    for (int m = 0; m < 2; ++m) CHECK(std::abs(err[0][m] / err[1][m] - 2.0) < tol::order_ratio_band);
+}
+
+TEST_CASE("a cubic term flips the criticality: x' = -a x(t - 1) + b x x(t - 1) + c x^3") {
+    // At x = 0 the linearisation is Wright's (alpha = a): Hopf at a = omega = pi/2 for every b, c.
+    // The quadratic term contributes b^2 times Wright's Re c1 / alpha^2 (Wright: b = -alpha), the
+    // cubic one C(Phi, Phi, conj Phi) = 6 c |q|^2 q, so c1 = 3 c p, Re p = 4 / (4 + pi^2):
+    //     Re c1 = -4 b^2 (3 pi - 2) / (5 pi (4 + pi^2)) + 12 c / (4 + pi^2),
+    // zero at c* = b^2 (3 pi - 2) / (15 pi) (a generalised Hopf point).
+    const double b = 1.0;
+    const double cstar = b * b * (3 * pi - 2) / (15 * pi);
+    for (const double cc : {0.0, 0.1, 0.2, 0.5}) {
+        ExpressionSystem sys({"x"}, {"a", "b", "c"}, {1.5, b, cc}, {"-a*x(t - 1) + b*x*x(t - 1) + c*x^3"});
+        const HopfPoint h = correct_hopf(sys, 0, Eigen::VectorXd::Zero(1), 1.5, 1.5);
+        const HopfCoefficients k = hopf_coefficients(sys, 0, h);
+        REQUIRE(k.status == Status::Converged);
+        const double re_c1 = -4 * b * b * (3 * pi - 2) / (5 * pi * (4 + pi * pi)) + 12 * cc / (4 + pi * pi);
+        CHECK(std::abs(k.c1.real() - re_c1) < tol::normal_form);
+        CHECK(k.criticality == (cc < cstar ? Criticality::Supercritical : Criticality::Subcritical));
+        CHECK(k.side == (cc < cstar ? 1 : -1));  // Re lambda' > 0: supercritical orbits for a > pi/2
+    }
+    // the Hopf curve in (a, c): the line a = pi/2, with the generalised Hopf point at c*
+    ExpressionSystem sys({"x"}, {"a", "b", "c"}, {1.2, b, 0.0}, {"-a*x(t - 1) + b*x*x(t - 1) + c*x^3"});
+    HopfCurveOptions o;
+    o.branch.parameter = "a";
+    o.branch.from = 1.2;
+    o.branch.to = 2.0;
+    o.parameter2 = "c";
+    o.from2 = -0.5;
+    o.to2 = 0.5;
+    const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(1), o);
+    CHECK(hc.status == Status::Converged);
+    REQUIRE(hc.curves.size() == 1);
+    const HopfCurve& curve = hc.curves[0];
+    CHECK(curve.stop_forward == ContinuationStop::Bound);
+    CHECK(curve.stop_backward == ContinuationStop::Bound);
+    double c_lo = 1e300, c_hi = -1e300;
+    for (const HopfCurvePoint& p : curve.points) {
+        CHECK(std::abs(p.par - pi / 2) < tol::special_point);
+        CHECK(std::abs(p.omega - pi / 2) < tol::special_point);
+        c_lo = std::min(c_lo, p.par2);
+        c_hi = std::max(c_hi, p.par2);
+    }
+    CHECK(c_lo == doctest::Approx(-0.5).epsilon(1e-12));
+    CHECK(c_hi == doctest::Approx(0.5).epsilon(1e-12));
+    REQUIRE(curve.generalised.size() == 1);
+    CHECK(curve.generalised[0].status == Status::Converged);
+    CHECK(std::abs(curve.generalised[0].par2 - cstar) < tol::special_point);
+    CHECK(std::abs(curve.generalised[0].par - pi / 2) < tol::special_point);
+}
+
+TEST_CASE("the Hopf curve of x' = -a x(t - tau) + x x(t - tau) - x^3 in (a, tau) is a tau = pi/2, omega = a") {
+    ExpressionSystem sys({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*x(t - tau) + x*x(t - tau) - x^3"});
+    HopfCurveOptions o;
+    o.branch.parameter = "a";
+    o.branch.from = 1.0;
+    o.branch.to = 2.5;
+    o.parameter2 = "tau";
+    o.from2 = 0.7;
+    o.to2 = 2.0;
+    const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(1), o);
+    CHECK(hc.status == Status::Converged);
+    REQUIRE(hc.curves.size() == 1);
+    const HopfCurve& c = hc.curves[0];
+    CHECK(c.points.size() > 10);
+    for (const HopfCurvePoint& p : c.points) {
+        CHECK(std::abs(p.par * p.par2 - pi / 2) < tol::special_point);
+        CHECK(std::abs(p.omega - p.par) < tol::special_point);
+        CHECK(p.coefficients.status == Status::Converged);
+        CHECK(p.coefficients.criticality == Criticality::Supercritical);
+    }
+    // it leaves the box through tau = 0.7 (a = pi / 1.4 < 2.5) and a = 1 (tau = pi/2 < 2)
+    const HopfCurvePoint& first = c.points.front();
+    const HopfCurvePoint& last = c.points.back();
+    const double lo_tau = std::min(first.par2, last.par2), hi_tau = std::max(first.par2, last.par2);
+    CHECK(lo_tau == doctest::Approx(0.7).epsilon(1e-12));
+    CHECK(hi_tau == doctest::Approx(pi / 2).epsilon(tol::special_point));
+    CHECK(c.generalised.empty());
+}
+
+TEST_CASE("normalisation independence: rescaled variables keep the criticality, the crossing speed and the amplitudes") {
+    // the neuron system in x and in (x1, z2) with x2 = s z2: ||q|| = 1 is another normalisation in
+    // the new coordinates, so L1 changes, but not its sign, lambda', omega, nor the amplitudes
+    // (of z2 = x2 / s)
+    ExpressionSystem a = neuron_system();
+    const double s = 7.0;
+    ExpressionSystem b({"x1", "z2"}, {"kappa", "beta", "a12", "a21", "tau1", "tau2", "taus"}, {0.5, -1, 1, 0.5, 0.2, 0.2, 1.5},
+                       {"-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(7*z2(t - tau2))",
+                        "(-kappa*7*z2 + beta*tanh(7*z2(t - taus)) + a21*tanh(x1(t - tau1)))/7"});
+    const int j = a.parameter_index("a21");
+    const HopfPoint ha = correct_hopf(a, j, Eigen::VectorXd::Zero(2), 0.8, 0.78);
+    const HopfPoint hb = correct_hopf(b, j, Eigen::VectorXd::Zero(2), 0.8, 0.78);
+    REQUIRE(ha.status == Status::Converged);
+    REQUIRE(hb.status == Status::Converged);
+    const HopfCoefficients ca = hopf_coefficients(a, j, ha), cb = hopf_coefficients(b, j, hb);
+    REQUIRE(ca.status == Status::Converged);
+    REQUIRE(cb.status == Status::Converged);
+    CHECK(std::abs(ca.l1 - cb.l1) > 1e-3 * std::abs(ca.l1));  // the normalisation does change L1
+    CHECK(ca.criticality == cb.criticality);
+    CHECK(ca.side == cb.side);
+    CHECK(std::abs(ca.dlambda - cb.dlambda) < tol::normal_form);
+    CHECK(std::abs(ca.omega - cb.omega) < tol::special_point);
+    REQUIRE(ca.amplitude_coefficient.size() == 2);
+    REQUIRE(cb.amplitude_coefficient.size() == 2);
+    CHECK(std::abs(ca.amplitude_coefficient[0] / cb.amplitude_coefficient[0] - 1) < tol::normal_form);
+    CHECK(std::abs(ca.amplitude_coefficient[1] / (s * cb.amplitude_coefficient[1]) - 1) < tol::normal_form);
+}
+
+TEST_CASE("ov ring: Hopf points at the ring modes' closed form, L1 the same from the expression form of the ring") {
+    // the closed form (Orosz, Wilson, Stepan, Phys. Rev. E 70, 026207 (2004)): a Fourier mode
+    // z = exp(i theta_k) of the linearisation at the uniform flow has
+    //     lambda^2 + alpha lambda + alpha f (1 - z) e^{-lambda tau} = 0,   f = V'(h*),
+    // so at lambda = i omega: omega sqrt(omega^2 + alpha^2) = 2 alpha f sin(theta_k / 2) and
+    // omega tau = theta_k / 2 - pi/2 + arctan(alpha / omega).
+    const int N = 3;
+    const double alpha = 1.0, tau = 1.0;
+    OvRing ring(N, alpha, tau, 1.0, 1.0, 1.2);
+    EquilibriumBranchOptions o;
+    o.parameter = "headway";
+    o.from = 1.2;
+    o.to = 3.0;
+    const HopfAnalysis ha = hopf_points(ring, ring.uniform_flow(), o);
+    CHECK(ha.status == Status::Converged);
+    REQUIRE(ha.points.size() == 2);
+    // the same ring written as expressions (a second implementation of f and its derivatives)
+    const std::string V = "(H - 1)^3/(1 + (H - 1)^3)";
+    auto v_of = [&](const std::string& h) {
+        std::string s = V;
+        for (std::size_t at; (at = s.find('H')) != std::string::npos;) s.replace(at, 1, h);
+        return s;
+    };
+    ExpressionSystem expr({"h0", "h1", "v0", "v1", "v2"}, {"alpha", "tau", "hm"}, {alpha, tau, 1.2},
+                          {"v1 - v0", "v2 - v1", "alpha*(" + v_of("h0(t - tau)") + " - v0)", "alpha*(" + v_of("h1(t - tau)") + " - v1)",
+                           "alpha*(" + v_of("(3*hm - h0(t - tau) - h1(t - tau))") + " - v2)"});
+    for (const HopfCoefficients& c : ha.points) {
+        REQUIRE(c.status == Status::Converged);
+        const double f = ring.optimal_velocity_slope(c.par);
+        const double th = 2 * pi / N;  // modes 1 and 2 are conjugate: one family of crossings with omega > 0
+        const double w = bisect([&](double ww) { return ww * tau - th / 2 + pi / 2 - std::atan(alpha / ww); }, 1e-9, 10.0);
+        CHECK(std::abs(c.omega - w) < tol::special_point);
+        CHECK(std::abs(f - w * std::sqrt(w * w + alpha * alpha) / (2 * alpha * std::sin(th / 2))) < tol::special_point);
+        std::vector<double> pe{alpha, tau, c.par};
+        const HopfCoefficients ce = hopf_coefficients(expr, 2, pe, c.x, c.omega);
+        REQUIRE(ce.status == Status::Converged);
+        CHECK(std::abs(ce.l1 - c.l1) < tol::normal_form * std::max(1.0, std::abs(c.l1)));
+        CHECK(std::abs(ce.dre_dpar - c.dre_dpar) < tol::normal_form);
+        CHECK(ce.criticality == c.criticality);
+        // Orosz and Stepan, Proc. R. Soc. A 462, 2643 (2006), "Subcritical Hopf bifurcations in a
+        // car-following model with reaction-time delay": where the uniform flow of this OV ring loses
+        // stability (the first mode, the only one for N = 3) "the subcritical Hopf bifurcation occurs
+        // robustly"
+        CHECK(c.criticality == Criticality::Subcritical);
+        MESSAGE("ov ring N = 3: Hopf at headway " << c.par << ", omega " << c.omega << ", L1 " << c.l1 << " (" << to_string(c.criticality)
+                                                 << "), dRe/dpar " << c.dre_dpar);
+    }
+}
+
+TEST_CASE("DDE-BIFTOOL demo 1 (neuron): the Hopf curve in (a21, taus) is supercritical" * doctest::test_suite("reference")) {
+    // DDE-Biftool, demos/neuron/html/demo1_normalforms.html (published output of
+    // demo1_normalforms.m): along the Hopf curves in (a21, taus) of demo1_hopf.m "the Lyapunov
+    // coefficient is negative such that the Hopf bifurcation is supercritical" (except at a21 = 0,
+    // a non-semisimple eigenvalue, outside the box here). The curve starts at the published Hopf
+    // point a21 = 0.80712 (taus = 1.5) and is followed in demo1_hopf.m's box taus <= 10, a21 <= 4.
+    // (The printed "L1: -0.0127" at the double Hopf point comes from the 2014 double-Hopf normal
+    // form, Re g2100 / omega1 in that version's scaling: not the Hopf normalisation used here.)
+    ExpressionSystem neuron = neuron_system();
+    HopfCurveOptions o;
+    o.branch.parameter = "a21";
+    o.branch.from = 0.3;
+    o.branch.to = 2.0;
+    o.parameter2 = "taus";
+    o.from2 = 0.0;
+    o.to2 = 10.0;
+    const HopfCurves hc = hopf_curves(neuron, Eigen::VectorXd::Zero(2), o);
+    REQUIRE(hc.curves.size() == 1);
+    const HopfCurve& c = hc.curves[0];
+    CHECK(c.status == Status::Converged);
+    CHECK(c.points.size() > 20);
+    for (const HopfCurvePoint& p : c.points) {
+        REQUIRE(p.coefficients.status == Status::Converged);
+        CHECK(p.coefficients.criticality == Criticality::Supercritical);
+    }
+    CHECK(c.generalised.empty());
+    MESSAGE("neuron Hopf curve: " << c.message << "; L1 at the start " << hc.start.points[0].l1);
+}
+
+TEST_CASE("DDE-BIFTOOL minimal demo (delayed Duffing oscillator): published L1 values and the generalised Hopf point" *
+          doctest::test_suite("reference")) {
+    // DDE-Biftool, demos/minimal_demo/html/minimal_demo.html (published output of minimal_demo.m,
+    // DDE-BIFTOOL's current normal form code): x'' + d x' + a x + x^3 + b (x - x(t - tau)) = 0 with
+    // a = 0.5, b = 0.6, d = 0.05, continued in tau from 0: LocateSpecialPoints prints the Hopf points
+    // with "L1: 0.12631", "L1: 0.13109", "L1: -0.48039"; along the Hopf curve in (b, tau) from the
+    // second one (b <= 0.6, tau <= 20) BranchFromCodimension2 prints "from genh at par(3)=0.036906,
+    // par(1)=14.8348" (par(3) = b, par(1) = tau).
+    ExpressionSystem duffing({"x1", "x2"}, {"a", "b", "d", "tau"}, {0.5, 0.6, 0.05, 0.0},
+                             {"x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"});
+    EquilibriumBranchOptions o;
+    o.parameter = "tau";
+    o.from = 0.0;
+    o.to = 10.0;
+    const HopfAnalysis ha = hopf_points(duffing, Eigen::VectorXd::Zero(2), o);
+    CHECK(ha.status == Status::Converged);
+    REQUIRE(ha.points.size() == 3);
+    const double published[3] = {0.12631, 0.13109, -0.48039};
+    for (int i = 0; i < 3; ++i) {
+        REQUIRE(ha.points[static_cast<std::size_t>(i)].status == Status::Converged);
+        CHECK(std::abs(ha.points[static_cast<std::size_t>(i)].l1 / published[i] - 1) < tol::published_5_digits_rel);
+    }
+    HopfCurveOptions co;
+    co.branch = o;
+    co.branch.to = 20.0;
+    co.parameter2 = "b";
+    co.from2 = 0.0;
+    co.to2 = 0.6;
+    const HopfCurve c = hopf_curve(duffing, ha.branch.hopf[1], co);
+    CHECK(c.status == Status::Converged);
+    REQUIRE(c.generalised.size() == 1);
+    const GeneralisedHopfPoint& g = c.generalised[0];
+    CHECK(g.status == Status::Converged);
+    CHECK(std::abs(g.par / 14.8348 - 1) < tol::published_5_digits_rel);
+    CHECK(std::abs(g.par2 / 0.036906 - 1) < tol::published_5_digits_rel);
+    MESSAGE("generalised Hopf point at tau = " << g.par << ", b = " << g.par2 << ", omega = " << g.omega << "; curve: " << c.message);
+}
+
+TEST_CASE("Hopf coefficients: inputs and failures") {
+    ExpressionSystem wright({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)*(1 + y)"});
+    HopfPoint bad;  // not located
+    const HopfCoefficients c = hopf_coefficients(wright, 0, bad);
+    CHECK(c.status != Status::Converged);
+    CHECK(!c.message.empty());
+    CHECK_THROWS_AS(hopf_coefficients(wright, 3, bad), std::invalid_argument);
+    CHECK_THROWS_AS(hopf_coefficients(wright, 0, {1.5}, Eigen::VectorXd::Zero(1), -1.0), std::invalid_argument);
+    CHECK_THROWS_AS(hopf_coefficients(wright, 0, {1.5, 2.0}, Eigen::VectorXd::Zero(1), 1.0), std::invalid_argument);
+    HopfCoefficientOptions o;
+    o.degenerate_tolerance = -1;
+    CHECK_THROWS_AS(hopf_coefficients(wright, 0, {1.5}, Eigen::VectorXd::Zero(1), 1.0, o), std::invalid_argument);
+    // a linear system: L1 = 0 exactly, degenerate, no amplitude
+    ExpressionSystem lin({"y"}, {"alpha"}, {1.5}, {"-alpha*y(t - 1)"});
+    const HopfCoefficients cl = hopf_coefficients(lin, 0, correct_hopf(lin, 0, Eigen::VectorXd::Zero(1), 1.5, 1.5));
+    CHECK(cl.status == Status::Converged);
+    CHECK(cl.criticality == Criticality::Degenerate);
+    CHECK(cl.side == 0);
+    CHECK(cl.amplitude_coefficient.size() == 0);
+    // curve options
+    HopfCurveOptions ho;
+    ho.branch.parameter = "alpha";
+    ho.branch.from = 1.0;
+    ho.branch.to = 2.0;
+    ho.parameter2 = "alpha";
+    CHECK_FALSE(ho.is_valid());
+    ExpressionSystem two({"y"}, {"alpha", "beta"}, {1.5, 3.0}, {"-alpha*y(t - 1)*(1 + beta*y)"});
+    ho.parameter2 = "beta";
+    ho.from2 = 0.0;
+    ho.to2 = 1.0;  // the held beta = 3 is outside
+    CHECK_THROWS_AS(hopf_curves(two, Eigen::VectorXd::Zero(1), ho), std::invalid_argument);
+}

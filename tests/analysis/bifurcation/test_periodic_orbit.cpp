@@ -1,0 +1,377 @@
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "../tolerances.hpp"
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
+#include "ddemap/problem/expression_system.hpp"
+#include "ddemap/solve/integrate.hpp"
+#include "ddemap/traffic/ov_ring.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+
+const double pi = 3.14159265358979323846;
+
+/// The Hopf point of y' = -a y(t - 1) (g(y) y(t - 1) terms alike) at y = 0: a = omega = pi/2, q = 1.
+HopfPoint scalar_hopf() {
+    HopfPoint h;
+    h.par = pi / 2;
+    h.omega = pi / 2;
+    h.x = Eigen::VectorXd::Zero(1);
+    h.q = VectorXc::Constant(1, cplx(1.0, 0.0));
+    h.status = Status::Converged;
+    return h;
+}
+
+ExpressionSystem wright(double alpha = 1.6) { return ExpressionSystem({"y"}, {"alpha"}, {alpha}, {"-alpha*y(t - 1)*(1 + y)"}); }
+
+PeriodicOrbitOptions options(const std::string& par, double from, double to, int points, int intervals = 40) {
+    PeriodicOrbitOptions o;
+    o.parameter = par;
+    o.from = from;
+    o.to = to;
+    o.max_points = points;
+    o.intervals = intervals;
+    return o;
+}
+
+/// Integrates the system with the project's DDE integrator (RK4 with Hermite history) from the
+/// history `history` on [-tau_max, 0] to t_end with step h.
+DdeSolver simulate(const NonlinearDDE& sys, const std::function<void(double, double*)>& history, double t_end, double h) {
+    const int n = sys.dimension(), m = sys.delay_count();
+    const std::vector<double> tau = sys.delays();
+    DdeSolver s(n, 0.0, history, [&sys, n, m, tau](double t, const double* y, const DdeSolver& sol, double* dy) {
+        Eigen::VectorXd u(static_cast<Eigen::Index>(n) * (m + 1));
+        for (int i = 0; i < n; ++i) u(i) = y[i];
+        for (int k = 0; k < m; ++k)
+            for (int i = 0; i < n; ++i) u((k + 1) * n + i) = sol.value(i, t - tau[static_cast<std::size_t>(k)]);
+        const Eigen::VectorXd f = sys.f(u);
+        for (int i = 0; i < n; ++i) dy[i] = f(i);
+    });
+    s.integrate(t_end, h, {});
+    return s;
+}
+
+/// Upward crossings of component j through `level` in [t0, t1], located by bisection on the
+/// integrator's continuous extension.
+std::vector<double> crossings(const DdeSolver& s, int j, double level, double t0, double t1, double dt) {
+    std::vector<double> out;
+    for (double t = t0; t + dt <= t1; t += dt) {
+        double a = t, b = t + dt;
+        if (!(s.value(j, a) < level && s.value(j, b) >= level)) continue;
+        for (int i = 0; i < 60; ++i) {
+            const double mid = 0.5 * (a + b);
+            (s.value(j, mid) < level ? a : b) = mid;
+        }
+        out.push_back(0.5 * (a + b));
+    }
+    return out;
+}
+
+/// max - min of component j on [t0, t1] sampled at dt (refined around the extremes by the
+/// integrator's Hermite extension: sampling error O(dt^2 |y''|)).
+double range(const DdeSolver& s, int j, double t0, double t1, double dt) {
+    double lo = 1e300, hi = -1e300;
+    for (double t = t0; t <= t1; t += dt) {
+        lo = std::min(lo, s.value(j, t));
+        hi = std::max(hi, s.value(j, t));
+    }
+    return hi - lo;
+}
+
+/// The subcritical Hopf point of the ov ring (N = 5, alpha = tau = v0 = h_st = 1) at the upper end of
+/// the unstable headways, mode k = 1 (Orosz, Wilson, Stepan 2004: the ring mode formula of
+/// test_equilibrium_branch.cpp), corrected by Newton from a rough guess.
+HopfPoint ov_hopf(OvRing& ring) {
+    ring.set_parameter("headway", 2.6);
+    const HopfPoint h = correct_hopf(ring, ring.parameter_index("headway"), ring.uniform_flow(), 2.6, 0.32);
+    REQUIRE(h.status == Status::Converged);
+    ring.set_parameter("headway", h.par);
+    return h;
+}
+
+}  // namespace
+
+TEST_CASE("y' = -(pi/2) y(t - 1): the orbits at the Hopf point are sin(pi t / 2) with period 4 at every amplitude") {
+    // the linear equation has the solutions A sin(pi t / 2) exactly at a = pi/2: the branch is vertical
+    ExpressionSystem sys({"y"}, {"a"}, {pi / 2}, {"-a*y(t - 1)"});
+    const OrbitBranch b = orbit_branch_from_hopf(sys, scalar_hopf(), options("a", 1.0, 2.0, 6));
+    REQUIRE(b.points.size() == 6);
+    for (const PeriodicOrbit& p : b.points) {
+        CHECK(std::abs(p.period - 4.0) < tol::orbit_closed_form);
+        CHECK(std::abs(p.par - pi / 2) < tol::orbit_closed_form);
+        // the profile is a sine: max = -min
+        CHECK(std::abs(p.max[0] + p.min[0]) < tol::orbit_closed_form);
+        CHECK(p.trivial_distance < tol::orbit_closed_form);
+    }
+    CHECK(b.points.back().max[0] > 10.0 * b.points.front().max[0]);  // the amplitude did grow
+}
+
+TEST_CASE("Wright's equation near its Hopf point: amplitude law and period 4 (Chow and Mallet-Paret)") {
+    // y' = -alpha y(t - 1)(1 + y): Hopf at alpha = pi/2, omega = pi/2 (period 4), supercritical, with
+    // y(t) ~ K sqrt(alpha - pi/2) sin(pi t / 2), K^2 = 40 / (3 pi - 2) (the classical Hopf
+    // expansion of Wright's equation, e.g. Hale and Verduyn Lunel, Introduction to FDEs, sec. 11.4)
+    const ExpressionSystem sys = wright();
+    const OrbitBranch b = orbit_branch_from_hopf(sys, scalar_hopf(), options("alpha", 1.5, 2.0, 5));
+    REQUIRE(b.points.size() == 5);
+    CHECK(b.status == Status::Converged);
+    const double K = std::sqrt(40.0 / (3.0 * pi - 2.0));
+    double previous_error = 1e300;
+    for (int k = 2; k >= 0; --k) {  // towards the Hopf point the law holds ever better
+        const PeriodicOrbit& p = b.points[static_cast<std::size_t>(k)];
+        const double e = p.par - pi / 2;
+        REQUIRE(e > 0.0);  // supercritical: the orbits exist for alpha > pi/2
+        CHECK(p.stable);
+        const double error = std::abs(0.5 * (p.max[0] - p.min[0]) / std::sqrt(e) / K - 1.0);
+        CHECK(error < previous_error);
+        previous_error = error;
+    }
+    CHECK(previous_error < tol::hopf_amplitude_law);
+    // the period tends to 4 linearly in alpha - pi/2: (T - 4) / (alpha - pi/2) settles
+    const double s0 = (b.points[0].period - 4.0) / (b.points[0].par - pi / 2), s1 = (b.points[1].period - 4.0) / (b.points[1].par - pi / 2);
+    CHECK(std::abs(b.points[0].period - 4.0) < 1e-3);
+    CHECK(std::abs(s0 - s1) < tol::hopf_period_slope * std::abs(s0));
+}
+
+TEST_CASE("Wright's equation at alpha = 2: the stable orbit's period and amplitude against a long simulation") {
+    const OrbitBranch b = orbit_branch_from_hopf(wright(), scalar_hopf(), options("alpha", 1.5, 2.0, 60));
+    REQUIRE(b.stop == "bound");
+    const PeriodicOrbit& p = b.points.back();
+    REQUIRE(std::abs(p.par - 2.0) < 1e-12);
+    CHECK(p.stable);
+    CHECK(p.trivial_distance < tol::orbit_trivial_multiplier);
+    const ExpressionSystem sys = wright(2.0);
+    const DdeSolver s = simulate(sys, [](double, double* y) { y[0] = 0.5; }, 400.0, 0.01);
+    const std::vector<double> up = crossings(s, 0, 0.0, 300.0, 400.0, 0.05);
+    REQUIRE(up.size() >= 3);
+    const double period = (up.back() - up.front()) / static_cast<double>(up.size() - 1);
+    CHECK(std::abs(period - p.period) < tol::orbit_vs_simulation * p.period);
+    const double amp = range(s, 0, up.front(), up.back(), 0.001);
+    CHECK(std::abs(amp - (p.max[0] - p.min[0])) < tol::orbit_vs_simulation * amp);
+}
+
+TEST_CASE("Wright's equation at alpha = 2: a branch started from an orbit sampled from a simulation") {
+    const ExpressionSystem sys = wright(2.0);
+    const DdeSolver s = simulate(sys, [](double, double* y) { y[0] = 0.5; }, 300.0, 0.01);
+    const std::vector<double> up = crossings(s, 0, 0.0, 250.0, 300.0, 0.05);
+    REQUIRE(up.size() >= 2);
+    // one period of samples every 0.05 from an upward crossing, the period from two crossings
+    std::vector<double> times;
+    for (double t = up[0]; t <= up[1] + 1e-9; t += 0.05) times.push_back(t);
+    times.push_back(up[1]);
+    Eigen::MatrixXd states(static_cast<Eigen::Index>(times.size()), 1);
+    for (std::size_t i = 0; i < times.size(); ++i) states(static_cast<Eigen::Index>(i), 0) = s.value(0, times[i]);
+    const PeriodicMesh mesh(4, 40);
+    const OrbitGuess g = orbit_guess_from_samples(mesh, times, states, up[1] - up[0], 2.0);
+    const OrbitBranch b = orbit_branch_from_guess(sys, g, options("alpha", 2.0, 2.2, 4));
+    REQUIRE(b.points.size() == 4);
+    CHECK(b.status == Status::Converged);
+    CHECK(std::abs(b.points[0].par - 2.0) < 1e-12);
+    CHECK(b.points[1].par > 2.0);  // followed towards --to
+    // the same orbit as the branch from the Hopf point reaches at alpha = 2
+    const OrbitBranch h = orbit_branch_from_hopf(wright(), scalar_hopf(), options("alpha", 1.5, 2.0, 60));
+    REQUIRE(h.stop == "bound");
+    CHECK(std::abs(b.points[0].period - h.points.back().period) < tol::orbit_closed_form * h.points.back().period);
+    CHECK(std::abs(b.points[0].max[0] - h.points.back().max[0]) < tol::orbit_extremes);
+    CHECK(std::abs(b.points[0].min[0] - h.points.back().min[0]) < tol::orbit_extremes);
+}
+
+TEST_CASE("Wright's equation: the trivial multiplier tends to 1 and the period converges as the mesh is refined") {
+    std::vector<double> trivial, period;
+    for (int L : {8, 16, 32, 64}) {
+        const OrbitBranch b = orbit_branch_from_hopf(wright(), scalar_hopf(), options("alpha", 1.5, 2.6, 80, L));
+        REQUIRE(b.stop == "bound");
+        REQUIRE(std::abs(b.points.back().par - 2.6) < 1e-12);
+        trivial.push_back(b.points.back().trivial_distance);
+        period.push_back(b.points.back().period);
+    }
+    for (std::size_t i = 1; i < trivial.size(); ++i) CHECK(trivial[i] < trivial[i - 1]);
+    // the period error against the finest mesh falls (at least by 2^d / 2 per halving)
+    const double e0 = std::abs(period[0] - period[3]), e1 = std::abs(period[1] - period[3]), e2 = std::abs(period[2] - period[3]);
+    CHECK(e1 < e0 / 8.0);
+    CHECK(e2 < e1 / 8.0);
+}
+
+TEST_CASE("ov ring (N = 5): subcritical Hopf, fold of orbits and bistability, checked by simulation" * doctest::test_suite("slow")) {
+    OvRing ring(5, 1.0, 1.0, 1.0, 1.0, 2.6);
+    const HopfPoint h = ov_hopf(ring);
+    const OrbitBranch b = orbit_branch_from_hopf(ring, h, options("headway", 2.0, 3.5, 45, 40));
+    REQUIRE(b.folds.size() == 1);
+    CHECK(b.folds[0].located);
+    const double fold = b.folds[0].par;
+    CHECK(fold > h.par);  // subcritical: the orbits bend back past the Hopf point
+    // the orbits before the fold are unstable, after it stable (the fold exchanges one multiplier)
+    const auto after = static_cast<std::size_t>(b.folds[0].after);
+    for (std::size_t i = 0; i <= after; ++i) CHECK(!b.points[i].stable);
+    for (std::size_t i = after + 2; i < b.points.size(); ++i) CHECK(b.points[i].stable);
+    // pick the unstable and the stable orbit at one headway inside the window: the branch crosses
+    // h = hm once on each side of the fold
+    const double hm = 0.5 * (h.par + fold);
+    std::size_t iu = 0, is = 0;
+    for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
+        const double a = b.points[i].par - hm, c = b.points[i + 1].par - hm;
+        if (a * c <= 0.0) (i < after ? iu : is) = i;
+    }
+    REQUIRE(iu > 0);
+    REQUIRE(is > after);
+    ring.set_parameter("headway", hm);
+    // the stable large orbit, corrected at h = hm, against a long simulation
+    OrbitGuess g{hm, b.points[is].period, Eigen::MatrixXd()};
+    {
+        const PeriodicMesh from(b.degree, b.points[is].breakpoints), to(4, 40);
+        g.profile.resize(to.points(), ring.dimension());
+        for (int i = 0; i < to.points(); ++i) g.profile.row(i) = orbit_value(from, b.points[is].profile, to.point(i)).transpose();
+    }
+    const OrbitBranch stable = orbit_branch_from_guess(ring, g, options("headway", hm, hm + 0.1, 2, 40));
+    REQUIRE(!stable.points.empty());
+    const PeriodicOrbit& ps = stable.points.front();
+    CHECK(std::abs(ps.par - hm) < 1e-12);
+    CHECK(ps.stable);
+    // start the simulation on a profile that is the unstable orbit grown by 20 % around the uniform flow
+    const PeriodicOrbit& pu = b.points[iu];
+    const PeriodicMesh mesh(b.degree, pu.breakpoints);
+    const Eigen::VectorXd xs = ring.uniform_flow();
+    auto from_orbit = [&](double factor) {
+        return [&, factor](double t, double* y) {
+            const Eigen::VectorXd x = xs + factor * (orbit_value(mesh, pu.profile, t / pu.period) - xs);
+            for (Eigen::Index i = 0; i < x.size(); ++i) y[i] = x(i);
+        };
+    };
+    const DdeSolver big = simulate(ring, from_orbit(1.2), 1500.0, 0.02);
+    const std::vector<double> up = crossings(big, 0, hm, 1200.0, 1500.0, 0.1);
+    REQUIRE(up.size() >= 3);
+    const double period = (up.back() - up.front()) / static_cast<double>(up.size() - 1);
+    CHECK(std::abs(period - ps.period) < tol::orbit_vs_simulation * ps.period);
+    const double amp = range(big, 0, up.front(), up.back(), 0.005);
+    CHECK(std::abs(amp - (ps.max[0] - ps.min[0])) < tol::orbit_vs_simulation * amp);
+    // the unstable orbit shrunk by 20 %: the disturbance dies out (the uniform flow is stable here),
+    // so the unstable orbit is not reached by simulation, it separates the two attractors
+    const DdeSolver small = simulate(ring, from_orbit(0.8), 1500.0, 0.02);
+    CHECK(range(small, 0, 1200.0, 1500.0, 0.1) < 1e-3 * (pu.max[0] - pu.min[0]));
+}
+
+TEST_CASE("ov ring (N = 5): the fold of orbits converges as the mesh is refined" * doctest::test_suite("slow")) {
+    std::vector<double> fold, period;
+    // from 20 intervals: on 10 the orbits near the fold fail the accuracy check (|mu_trivial - 1| up
+    // to 0.04 > orbit_accuracy_limit), so that branch is undecided and reports no special points
+    for (int L : {20, 40, 80, 160}) {
+        OvRing ring(5, 1.0, 1.0, 1.0, 1.0, 2.6);
+        const HopfPoint h = ov_hopf(ring);
+        const OrbitBranch b = orbit_branch_from_hopf(ring, h, options("headway", 2.0, 3.5, 30, L));
+        REQUIRE(b.folds.size() == 1);
+        REQUIRE(b.folds[0].located);
+        fold.push_back(b.folds[0].par);
+        period.push_back(b.folds[0].period);
+    }
+    const double e0 = std::abs(fold[0] - fold[3]), e1 = std::abs(fold[1] - fold[3]), e2 = std::abs(fold[2] - fold[3]);
+    CHECK(e1 < e0);
+    CHECK(e2 < e1);
+    CHECK(std::abs(period[2] - period[3]) < std::abs(period[0] - period[3]));
+}
+
+TEST_CASE("orbit options and starts: bad input is std::invalid_argument, a failed start is a status") {
+    const ExpressionSystem sys = wright();
+    PeriodicOrbitOptions o = options("alpha", 1.5, 2.0, 5);
+    o.degree = 0;
+    CHECK_THROWS_AS(orbit_branch_from_hopf(sys, scalar_hopf(), o), std::invalid_argument);
+    CHECK_THROWS_AS(orbit_branch_from_hopf(sys, scalar_hopf(), options("beta", 1.5, 2.0, 5)), std::invalid_argument);
+    HopfPoint h = scalar_hopf();
+    h.omega = 0.0;
+    CHECK_THROWS_AS(orbit_branch_from_hopf(sys, h, options("alpha", 1.5, 2.0, 5)), std::invalid_argument);
+    // a constant guess (an equilibrium solves the collocation equations with any period): a status
+    OrbitGuess g{1.6, 4.0, Eigen::MatrixXd::Constant(160, 1, 0.01)};
+    const OrbitBranch b = orbit_branch_from_guess(sys, g, options("alpha", 1.5, 2.0, 5));
+    CHECK(b.status != Status::Converged);
+    CHECK(b.stop == "first_orbit_failed");
+    // a guess far from any orbit: no crash, a status (from 50 sin + 60 the condensed corrector
+    // reaches the orbit of period 4.02 itself, so the guess is ten times further up)
+    const PeriodicMesh mesh(4, 40);
+    for (int i = 0; i < mesh.points(); ++i) g.profile(i, 0) = 50.0 * std::sin(2 * pi * mesh.point(i)) + 600.0;
+    const OrbitBranch far = orbit_branch_from_guess(sys, g, options("alpha", 1.5, 2.0, 5));
+    CHECK(far.status != Status::Converged);
+    CHECK(far.stop == "first_orbit_failed");
+}
+
+TEST_CASE("Wright's equation at alpha = 2.9: the adapted mesh gives a more accurate period than the uniform one") {
+    // the orbit has a fast pulse and a slow phase near y = -1; the reference is a uniform mesh of 200 intervals
+    std::vector<double> period;
+    for (int k = 0; k < 3; ++k) {
+        PeriodicOrbitOptions o = options("alpha", 1.5, 2.9, 200, k == 2 ? 200 : 40);
+        o.adapt = k == 1;
+        const OrbitBranch b = orbit_branch_from_hopf(wright(), scalar_hopf(), o);
+        REQUIRE(b.stop == "bound");
+        period.push_back(b.points.back().period);
+        if (k == 1) {  // the mesh moved: its intervals differ by more than a factor 2
+            const std::vector<double>& t = b.points.back().breakpoints;
+            double hmin = 1.0, hmax = 0.0;
+            for (std::size_t i = 1; i < t.size(); ++i) hmin = std::min(hmin, t[i] - t[i - 1]), hmax = std::max(hmax, t[i] - t[i - 1]);
+            CHECK(hmax > 2.0 * hmin);
+        }
+    }
+    CHECK(std::abs(period[1] - period[2]) < 0.5 * std::abs(period[0] - period[2]));
+}
+
+TEST_CASE("Mackey-Glass (beta = 2, gamma = 1, n = 9.65): the first period doubling in tau, located, and period T / 2T by simulation on either side") {
+    // x' = beta x(t - tau) / (1 + x(t - tau)^n) - gamma x: equilibrium x = 1, a supercritical Hopf
+    // point in tau, then the period doubling cascade of the stable orbit (Mackey and Glass 1977)
+    ExpressionSystem mg({"x"}, {"beta", "gamma", "n", "tau"}, {2.0, 1.0, 9.65, 0.3}, {"beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"});
+    EquilibriumBranchOptions eo;
+    eo.parameter = "tau";
+    eo.from = 0.3;
+    eo.to = 2.0;
+    eo.roots.count = 2;
+    const EquilibriumBranch eq = equilibrium_branch(mg, Eigen::VectorXd::Constant(1, 1.0), eo);
+    REQUIRE(!eq.hopf.empty());
+    const OrbitBranch b = orbit_branch_from_hopf(mg, eq.hopf.front(), options("tau", 0.3, 2.0, 200));
+    REQUIRE(!b.period_doublings.empty());
+    const OrbitCrossing& pd = b.period_doublings.front();
+    REQUIRE(pd.located);
+    CHECK(pd.accuracy <= 1e-9);
+    CHECK(std::abs(pd.multiplier + 1.0) <= 1e-8);  // a real multiplier at -1
+    CHECK(pd.par_bracket < 1e-6);
+    CHECK(pd.orbit.trivial_distance < tol::orbit_trivial_multiplier);
+    // the orbits before it are stable, the ones just after it not (the multiplier left through -1)
+    const auto k = static_cast<std::size_t>(pd.after);
+    CHECK(b.points[k].stable);
+    CHECK(!b.points[k + 1].stable);
+    // independent check by simulation, 0.02 below and above the located tau: successive maxima
+    // of x are equal below (period T) and alternate above (period 2T)
+    auto maxima = [&](double tau) {
+        mg.set_parameter("tau", tau);
+        const DdeSolver s = simulate(mg, [](double, double* y) { y[0] = 0.5; }, 3000.0, 0.005);
+        std::vector<double> m, when;
+        double prev2 = s.value(0, 2500.0 - 0.01), prev = s.value(0, 2500.0);
+        for (double t = 2500.0 + 0.01; t <= 3000.0; t += 0.01) {
+            const double x = s.value(0, t);
+            if (prev > prev2 && prev >= x) {
+                m.push_back(prev);
+                when.push_back(t - 0.01);
+            }
+            prev2 = prev;
+            prev = x;
+        }
+        return std::make_pair(m, when);
+    };
+    const auto below = maxima(pd.par - 0.02), above = maxima(pd.par + 0.02);
+    REQUIRE(below.first.size() > 20);
+    REQUIRE(above.first.size() > 20);
+    double spread_below = 0.0, alternation_above = 1e300, spread_above_2 = 0.0;
+    for (std::size_t i = 1; i < below.first.size(); ++i) spread_below = std::max(spread_below, std::abs(below.first[i] - below.first[i - 1]));
+    for (std::size_t i = 1; i < above.first.size(); ++i) alternation_above = std::min(alternation_above, std::abs(above.first[i] - above.first[i - 1]));
+    for (std::size_t i = 2; i < above.first.size(); ++i) spread_above_2 = std::max(spread_above_2, std::abs(above.first[i] - above.first[i - 2]));
+    CHECK(spread_below < 1e-3);        // one maximum per period: period T
+    CHECK(alternation_above > 1e-2);   // two different maxima ...
+    CHECK(spread_above_2 < 1e-3);      // ... repeating every second one: period 2T
+    // and the period of the simulated orbit below is the located orbit's (to the slope of T over 0.02 in tau)
+    const double T_below = (below.second.back() - below.second.front()) / static_cast<double>(below.second.size() - 1);
+    CHECK(std::abs(T_below - pd.period) < 0.05 * pd.period);
+}
