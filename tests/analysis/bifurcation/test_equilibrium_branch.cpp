@@ -5,8 +5,8 @@
 #include <random>
 #include <string>
 
-#include "../numeric_helpers.hpp"
-#include "../tolerances.hpp"
+#include "numeric_helpers.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/equilibrium.hpp"
@@ -94,7 +94,7 @@ TEST_CASE("Mackey-Glass continued in the exponent n: the Hopf point of its linea
     for (const EquilibriumPoint& p : br.points) CHECK(std::abs(p.x[0] - std::pow(2.0, 1.0 / p.par)) < 1e-10);
 }
 
-TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy the ring modes' closed form") {
+TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy the ring modes' closed form" * doctest::test_suite("slow")) {
     // Linearising the ring at the uniform flow with f = V'(h*) and a Fourier mode v_i ~ z^i e^{lambda t},
     // z = exp(i theta_k), theta_k = 2 pi k / N, gives h_i = (z - 1) v_i / lambda and
     //     lambda^2 + alpha lambda + alpha f (1 - z) e^{-lambda tau} = 0

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "../numeric_helpers.hpp"
-#include "../tolerances.hpp"
+#include "numeric_helpers.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/io/hopf_output.hpp"
 #include "ddemap/problem/expression_system.hpp"
@@ -322,7 +322,7 @@ TEST_CASE("normalisation independence: rescaled variables keep the criticality, 
     CHECK(std::abs(ca.amplitude_coefficient[1] / (s * cb.amplitude_coefficient[1]) - 1) < tol::normal_form);
 }
 
-TEST_CASE("ov ring: Hopf points at the ring modes' closed form, L1 the same from the expression form of the ring") {
+TEST_CASE("ov ring: Hopf points at the ring modes' closed form, L1 the same from the expression form of the ring" * doctest::test_suite("slow")) {
     // the closed form (Orosz, Wilson, Stepan, Phys. Rev. E 70, 026207 (2004)): a Fourier mode
     // z = exp(i theta_k) of the linearisation at the uniform flow has
     //     lambda^2 + alpha lambda + alpha f (1 - z) e^{-lambda tau} = 0,   f = V'(h*),

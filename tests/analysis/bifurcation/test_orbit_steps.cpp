@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "../tolerances.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/analysis/bifurcation/travelling_wave.hpp"
@@ -205,7 +205,7 @@ OrbitBranch full_ring_branch(const std::string& model, const ParameterMap& param
 
 }  // namespace
 
-TEST_CASE("travelling waves (ov, 5 cars): long steps find the same fold of the wave branch, at the full ring's fold and above every wave") {
+TEST_CASE("travelling waves (ov, 5 cars): long steps find the same fold of the wave branch, at the full ring's fold and above every wave" * doctest::test_suite("slow")) {
     // the subcritical wave branch from the Hopf point at headway 2.62 folds at headway 3.1078
     // (README) and comes back to headway 2: the fold is the largest headway of the branch
     const OrbitBranch full = full_ring_branch("ov", {}, "headway", 3.5, 2.0, 0.1, false);
@@ -250,7 +250,7 @@ TEST_CASE("travelling waves (ov, 5 cars): long steps find the same fold of the w
     }
 }
 
-TEST_CASE("travelling waves (IDM, 5 cars): long steps give the same branch, period doubling and torus, both at the full ring's") {
+TEST_CASE("travelling waves (IDM, 5 cars): long steps give the same branch, period doubling and torus, both at the full ring's" * doctest::test_suite("slow")) {
     // the wave branch of `orbits --model idm --ring 5 --th 1.2 --tau 0.6 --wave 1` from its Hopf
     // point at gap 8.048 to gap 22, with the full ring's multipliers along the wave: a torus
     // bifurcation near gap 20.4575 and a period doubling near 21.0402, as on the full ring's own

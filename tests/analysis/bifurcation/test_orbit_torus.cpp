@@ -4,7 +4,7 @@
 #include <complex>
 #include <vector>
 
-#include "../tolerances.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/problem/expression_system.hpp"

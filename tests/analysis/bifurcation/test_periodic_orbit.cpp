@@ -5,7 +5,7 @@
 #include <functional>
 #include <vector>
 
-#include "../tolerances.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/problem/expression_system.hpp"
@@ -301,7 +301,7 @@ TEST_CASE("orbit options and starts: bad input is std::invalid_argument, a faile
     CHECK(far.stop == "first_orbit_failed");
 }
 
-TEST_CASE("Wright's equation at alpha = 2.9: the adapted mesh gives a more accurate period than the uniform one") {
+TEST_CASE("Wright's equation at alpha = 2.9: the adapted mesh gives a more accurate period than the uniform one" * doctest::test_suite("slow")) {
     // the orbit has a fast pulse and a slow phase near y = -1; the reference is a uniform mesh of 200 intervals
     std::vector<double> period;
     for (int k = 0; k < 3; ++k) {
@@ -320,7 +320,7 @@ TEST_CASE("Wright's equation at alpha = 2.9: the adapted mesh gives a more accur
     CHECK(std::abs(period[1] - period[2]) < 0.5 * std::abs(period[0] - period[2]));
 }
 
-TEST_CASE("Mackey-Glass (beta = 2, gamma = 1, n = 9.65): the first period doubling in tau, located, and period T / 2T by simulation on either side") {
+TEST_CASE("Mackey-Glass (beta = 2, gamma = 1, n = 9.65): the first period doubling in tau, located, and period T / 2T by simulation on either side" * doctest::test_suite("slow")) {
     // x' = beta x(t - tau) / (1 + x(t - tau)^n) - gamma x: equilibrium x = 1, a supercritical Hopf
     // point in tau, then the period doubling cascade of the stable orbit (Mackey and Glass 1977)
     ExpressionSystem mg({"x"}, {"beta", "gamma", "n", "tau"}, {2.0, 1.0, 9.65, 0.3}, {"beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"});

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "../tolerances.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/analysis/bifurcation/travelling_wave.hpp"
@@ -62,7 +62,7 @@ void check_agrees(double reduced, double reduced20, double full, double floor, c
 
 }  // namespace
 
-TEST_CASE("travelling waves: the reduced form against the full ring (N = 3, 5): Hopf point, fold, end orbit") {
+TEST_CASE("travelling waves: the reduced form against the full ring (N = 3, 5): Hopf point, fold, end orbit" * doctest::test_suite("slow")) {
     for (int cars : {3, 5}) {
         CAPTURE(cars);
         const FullRing full = full_ring(cars, 80);
@@ -112,7 +112,7 @@ TEST_CASE("travelling waves: the reduced form against the full ring (N = 3, 5): 
     }
 }
 
-TEST_CASE("travelling waves: the full ring's multipliers along the reduced wave equal those of the full ring's orbit (N = 3)") {
+TEST_CASE("travelling waves: the full ring's multipliers along the reduced wave equal those of the full ring's orbit (N = 3)" * doctest::test_suite("slow")) {
     const int cars = 3;
     const FullRing full = full_ring(cars, 40);
     REQUIRE(full.branch.stop == "bound");
@@ -160,7 +160,7 @@ TEST_CASE("travelling waves: 1000 cars, 100 per wave, the ring length held by ev
     }
 }
 
-TEST_CASE("travelling waves: the 6-car IDM ring, reduced against full (supercritical Hopf point, the end orbit and its stability)") {
+TEST_CASE("travelling waves: the 6-car IDM ring, reduced against full (supercritical Hopf point, the end orbit and its stability)" * doctest::test_suite("slow")) {
     // th = 1.2 s, tau = 0.6 s: the uniform flow loses stability below gap ~10.917 m (ring modes
     // 1 and 5); the waves born there are stable and exist for smaller gaps
     const int cars = 6;

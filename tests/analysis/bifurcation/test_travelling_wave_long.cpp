@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "../tolerances.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 #include "ddemap/solve/integrate.hpp"
 #include "ddemap/traffic/nonlinear_ring.hpp"

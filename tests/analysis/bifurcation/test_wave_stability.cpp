@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "../tolerances.hpp"
+#include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 #include "ddemap/analysis/bifurcation/wave_stability.hpp"
 #include "ddemap/solve/integrate.hpp"
@@ -148,7 +148,7 @@ std::pair<double, double> simulate_from_wave(const std::string& model, const Par
 
 }  // namespace
 
-TEST_CASE("wave stability: the matrix-free multipliers equal the dense path's (ov, N = 5 and 10)") {
+TEST_CASE("wave stability: the matrix-free multipliers equal the dense path's (ov, N = 5 and 10)" * doctest::test_suite("slow")) {
     check_against_dense("ov", {}, 5, 3.5, 2.0);
     check_against_dense("ov", {}, 10, 3.5, 2.0);
 }
@@ -206,7 +206,7 @@ TEST_CASE("wave stability: verdicts against simulation of the full ring (N = 20:
     }
 }
 
-TEST_CASE("wave stability: the branch of a 100-car ring (K = 10) through the library option, undecided never called stable") {
+TEST_CASE("wave stability: the branch of a 100-car ring (K = 10) through the library option, undecided never called stable" * doctest::test_suite("slow")) {
     TravellingWaveOptions o = options("ov", 100, 10, 3.5, 2.0, 40, 6, true);
     o.sparse_floquet = true;
     long progress = 0;

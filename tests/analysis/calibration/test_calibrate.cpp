@@ -64,7 +64,7 @@ TEST_CASE("calibration recovers known parameters from noisy synthetic data" * do
     }
 }
 
-TEST_CASE("calibrate_many gives each trace the fit of calibrate alone, in order, and rethrows errors") {
+TEST_CASE("calibrate_many gives each trace the fit of calibrate alone, in order, and rethrows errors" * doctest::test_suite("slow")) {
     CalibrationOptions o;
     const std::vector<Trace> traces = {synthetic({{"k1", 0.05}, {"k2", 0.3}, {"th", 1.2}, {"tau", 0.4}, {"eta", 8}}, 1),
                                        synthetic({{"k1", 0.1}, {"k2", 0.2}, {"th", 1.8}, {"tau", 0.9}, {"eta", 6}}, 2)};

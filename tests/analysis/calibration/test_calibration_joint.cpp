@@ -27,7 +27,7 @@ std::vector<Trace> two_runs() {
 
 }  // namespace
 
-TEST_CASE("joint calibration of two runs recovers the truth with narrower intervals than either run") {
+TEST_CASE("joint calibration of two runs recovers the truth with narrower intervals than either run" * doctest::test_suite("slow")) {
     const std::vector<Trace> runs = two_runs();
     const CalibrationOptions o;
     const CalibrationResult joint = calibrate_joint(runs, o);

@@ -105,7 +105,7 @@ TEST_CASE("calibration: other design seeds find the same minimum" * doctest::tes
     }
 }
 
-TEST_CASE("calibration warns: a parameter on a bound, an undetermined parameter, a model worse than the naive predictor") {
+TEST_CASE("calibration warns: a parameter on a bound, an undetermined parameter, a model worse than the naive predictor" * doctest::test_suite("slow")) {
     const double truth[5] = {0.05, 0.3, 1.2, 0.43, 8};
     const Trace tr = calib_test::noisy(calib_test::clean_trace(calib_test::ovrv(truth), calib_test::three_sines(100), 100), 4);
     {

@@ -68,7 +68,7 @@ TEST_CASE("verdicts under a tiny covariance are the nominal verdicts (p = 0 or 1
     }
 }
 
-TEST_CASE("p follows the normal CDF where the verdict is the sign of c2, linear in k2") {
+TEST_CASE("p follows the normal CDF where the verdict is the sign of c2, linear in k2" * doctest::test_suite("slow")) {
     // OVRV: c2 = 2 k1 [k1 th^2/2 - 1 - tau k1 th + k2 (th - tau)], linear in k2. At k1 = 0.2,
     // th = 1.5, tau = 0.3 the string boundary near k2 = 0.72 is the low-frequency one (c2 = 0),
     // so with only k2 uncertain, P(string unstable) = P(c2 < 0) = Phi(-mean(c2) / sd(c2)).
@@ -105,7 +105,7 @@ TEST_CASE("p follows the normal CDF where the verdict is the sign of c2, linear 
     CHECK(u.ring_unstable.trials == 0);
 }
 
-TEST_CASE("the Wilson interval covers the exact p at its nominal rate over seeds") {
+TEST_CASE("the Wilson interval covers the exact p at its nominal rate over seeds" * doctest::test_suite("slow")) {
     const double k1 = 0.2, th = 1.5, tau = 0.3, k2 = 0.73, sd = 0.02;
     Cov C = Cov::Zero();
     C(1, 1) = sd * sd;

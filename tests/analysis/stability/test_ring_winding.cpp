@@ -207,7 +207,7 @@ TEST_CASE("the winding sweep equals the per-mode sweep and does not depend on th
     CHECK_THROWS_AS(run_sweep(unknown), std::invalid_argument);
 }
 
-TEST_CASE("few modes: roots accounted for right of the axis (one table) give the per-mode abscissa, count and verdict") {
+TEST_CASE("few modes: roots accounted for right of the axis (one table) give the per-mode abscissa, count and verdict" * doctest::test_suite("slow")) {
     // rows continued as a sweep continues them (each point from the previous point's result), at
     // random rows and across the ring's boundaries; every point against the per-mode ring analysis
     std::mt19937 rng(4242);
