@@ -117,7 +117,7 @@ bool tangent(const ContinuationProblem& problem, const Eigen::VectorXd& u, const
         if (!lu.isInvertible()) return false;
         t = lu.solve(Eigen::VectorXd::Unit(m, n));
     } else {
-        const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(j.transpose());
+        const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Eigen::MatrixXd(j.transpose()));
         if (qr.rank() < n) return false;
         t = qr.householderQ() * Eigen::VectorXd::Unit(m, n);
         bordered.row(n) = t.transpose();

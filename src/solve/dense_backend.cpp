@@ -239,7 +239,7 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         if (dde.is_real()) {
             // real arithmetic: exact conjugate pairs and real eigenvalues with zero imaginary part
             // (refine_all skips Im < 0, so a real eigenvalue computed as x - 1e-18 i would be lost)
-            Eigen::EigenSolver<Eigen::MatrixXd> es(a.real(), false);
+            Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(a.real()), false);
             ev.assign(es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size());
         } else {
             Eigen::ComplexEigenSolver<MatrixXc> es(a, false);
@@ -274,7 +274,7 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         MatrixXc vectors;
         bool ok = true;
         if (dde.is_real()) {
-            Eigen::EigenSolver<Eigen::MatrixXd> es(limit.real(), try_discs);
+            Eigen::EigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(limit.real()), try_discs);
             ok = es.info() == Eigen::Success;
             if (ok) {
                 mu = es.eigenvalues();

@@ -368,7 +368,7 @@ private:
         out.theta.clear();
         out.converged = 0;
         out.rank = m_r;
-        Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(m_h.topLeftCorner(k, k));
+        Eigen::ComplexEigenSolver<Eigen::MatrixXcd> es(Eigen::MatrixXcd(m_h.topLeftCorner(k, k)));
         if (es.info() != Eigen::Success) return;
         const Eigen::VectorXcd ev = es.eigenvalues();
         std::vector<int> order(static_cast<std::size_t>(k));
@@ -391,7 +391,7 @@ private:
     /// Krylov-Schur truncation to the `keep` Ritz values of largest |theta| (see the class).
     void restart(int keep, double tol) {
         const int k = m_k;
-        Eigen::ComplexSchur<Eigen::MatrixXcd> cs(m_h.topLeftCorner(k, k));
+        Eigen::ComplexSchur<Eigen::MatrixXcd> cs(Eigen::MatrixXcd(m_h.topLeftCorner(k, k)));
         Eigen::MatrixXcd s = cs.matrixT();
         Eigen::MatrixXcd u = cs.matrixU();
         for (int t = 0; t < keep; ++t) {
@@ -431,7 +431,10 @@ private:
         const int nvec = m_k + 1;
         Eigen::MatrixXcd c(static_cast<Eigen::Index>(nvec) * m_rows, m_r);
         for (int i = 0; i < nvec; ++i) c.middleRows(static_cast<Eigen::Index>(i) * m_rows, m_rows) = Eigen::Map<const Eigen::MatrixXcd>(m_v.col(i).data(), m_rows, m_r);
-        Eigen::BDCSVD<Eigen::MatrixXcd> svd(c, Eigen::ComputeThinV);
+        // JacobiSVD (compiled once, core/internal/eigen_instances.hpp): c is tall and thin, and
+        // JacobiSVD reduces it by a QR to its r x r factor first (r <= basis + 2), so that QR, like
+        // BDCSVD's bidiagonalisation, is most of the work
+        Eigen::JacobiSVD<Eigen::MatrixXcd> svd(c, Eigen::ComputeThinV);
         const Eigen::VectorXd& sv = svd.singularValues();
         int r2 = 0;
         while (r2 < sv.size() && sv(r2) > 1e-14 * sv(0)) ++r2;
@@ -802,7 +805,7 @@ private:
             t(k, k) = orthogonalise_twice(basis.middleCols(from, k + 1 - from), w)(k - from).real();
             const double beta = w.norm();
             t(k + 1, k) = t(k, k + 1) = beta;
-            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(k + 1, k + 1), Eigen::EigenvaluesOnly);
+            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(t.topLeftCorner(k + 1, k + 1)), Eigen::EigenvaluesOnly);
             const double next = es.eigenvalues().maxCoeff();
             const bool settled = k > 4 && std::abs(next - estimate) <= 1e-4 * next;
             estimate = next;
@@ -811,7 +814,7 @@ private:
             basis.col(k + 1) = w / beta;
         }
         if (!(estimate > 0.0) || !std::isfinite(estimate)) return 0.0;
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(t.topLeftCorner(used, used));
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(t.topLeftCorner(used, used)));
         Eigen::Index top;
         es.eigenvalues().maxCoeff(&top);
         previous = basis.leftCols(used) * es.eigenvectors().col(top).cast<cplx>();

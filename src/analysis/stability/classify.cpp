@@ -130,7 +130,7 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
     }
     (void)make_model("ovrv", ovrv);  // the centre itself must be a valid setting
     // C = V Lambda V^T; theta = mean + V sqrt(Lambda) z
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> es(0.5 * (covariance + covariance.transpose()));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> es(Eigen::Matrix<double, 5, 5>(0.5 * (covariance + covariance.transpose())));
     Eigen::Matrix<double, 5, 1> lam = es.eigenvalues();
     const double lmax = lam.cwiseAbs().maxCoeff();
     for (int i = 0; i < 5; ++i) {
