@@ -24,11 +24,11 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct AtlasArgs {
     std::string spec;
     OutArg out;
     bool resume = false;
-} args;
+} atlas_args;
 
 /// The chunks of one run: those still to compute, handed out in order; the results appended
 /// to the chunk store as they arrive (rank 0 keeps no values in memory). Thread-safe.
@@ -256,11 +256,11 @@ bool under_mpirun() {
 }  // namespace
 
 void add_atlas_flags(CLI::App& app) {
-    app.add_option("spec", args.spec, "the atlas spec (TOML, see maps/atlas-example.toml)")->required();
-    app.add_option("--out", args.out.text, "the folder of DIR/atlas.h5, DIR/atlas.svg (and DIR/atlas.chunks while it runs)")
+    app.add_option("spec", atlas_args.spec, "the atlas spec (TOML, see maps/atlas-example.toml)")->required();
+    app.add_option("--out", atlas_args.out.text, "the folder of DIR/atlas.h5, DIR/atlas.svg (and DIR/atlas.chunks while it runs)")
         ->required()
         ->type_name("DIR");
-    app.add_flag("--resume", args.resume, "continue an interrupted run from the chunks finished in DIR/atlas.chunks");
+    app.add_flag("--resume", atlas_args.resume, "continue an interrupted run from the chunks finished in DIR/atlas.chunks");
     run_flags().add_to(app, true);
 }
 
@@ -294,7 +294,7 @@ int run_atlas() {
     std::exception_ptr read_error;
     if (rank == 0) {
         try {
-            text = read_input_file("spec", args.spec);
+            text = read_input_file("spec", atlas_args.spec);
         } catch (...) {
             read_error = std::current_exception();
         }
@@ -318,7 +318,7 @@ int run_atlas() {
     // every rank parses the same text: a bad spec ends every rank alike (rank 0 reports)
     AtlasFile file;
     try {
-        file = parse_atlas_spec(text, args.spec);
+        file = parse_atlas_spec(text, atlas_args.spec);
     } catch (const std::invalid_argument&) {
         if (rank == 0) throw;
         return exit_bad_input;
@@ -336,18 +336,18 @@ int run_atlas() {
         try {
             check_atlas_size(spec, threads * ranks);
             OutArg dir;
-            dir.text = args.out.text.empty() || args.out.text.back() == '/' ? args.out.text : args.out.text + "/";
+            dir.text = atlas_args.out.text.empty() || atlas_args.out.text.back() == '/' ? atlas_args.out.text : atlas_args.out.text + "/";
             prefix = dir.prepare("atlas", {".h5", ".svg", ".chunks"});
             // --resume of a run that had finished: nothing to do (the store went with the result)
             struct stat st {};
             const bool store_exists = ::stat((prefix + ".chunks").c_str(), &st) == 0;
-            if (args.resume && !store_exists && atlas_hdf5_matches(prefix + ".h5", text)) {
+            if (atlas_args.resume && !store_exists && atlas_hdf5_matches(prefix + ".h5", text)) {
                 complete = true;
             } else {
-                if (!args.resume && store_exists && !run_flags().quiet)
+                if (!atlas_args.resume && store_exists && !run_flags().quiet)
                     std::cerr << "ddemap: atlas: note: the chunks of an earlier run in " << prefix
                               << ".chunks are discarded (--resume continues that run)\n";
-                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), args.resume, done);
+                store = std::make_unique<AtlasStore>(prefix + ".chunks", spec, atlas_fingerprint(text), atlas_args.resume, done);
             }
         } catch (...) {
             setup_error = std::current_exception();
@@ -379,7 +379,7 @@ int run_atlas() {
     }
 #endif
     const long loaded = store->loaded();
-    if (args.resume && !run_flags().quiet) {
+    if (atlas_args.resume && !run_flags().quiet) {
         std::cerr << "ddemap: atlas: resumed " << loaded << " of " << spec.chunks() << " chunks from " << prefix << ".chunks";
         if (store->dropped_bytes() > 0) std::cerr << " (a torn last record of " << store->dropped_bytes() << " bytes dropped)";
         std::cerr << "\n";

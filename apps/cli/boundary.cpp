@@ -13,37 +13,37 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct BoundaryArgs {
     ModelArgs model;
     RingArg ring;
     std::string grid = "41";
     std::string ring_curves = "auto";
     FormatArg format;
     OutArg out;
-} args;
+} boundary_args;
 }  // namespace
 
 void add_boundary_flags(CLI::App& app) {
-    args.model.add_to(app);
-    args.ring.add_to(app, "22", "ring size N >= 2 (at most 10^9; 10^6 with --ring-curves all), or inf");
-    args.out.add_to(app, "PREFIX.csv (one row per curve point) and PREFIX.json", true);
-    app.add_option("--ring-curves", args.ring_curves,
+    boundary_args.model.add_to(app);
+    boundary_args.ring.add_to(app, "22", "ring size N >= 2 (at most 10^9; 10^6 with --ring-curves all), or inf");
+    boundary_args.out.add_to(app, "PREFIX.csv (one row per curve point) and PREFIX.json", true);
+    app.add_option("--ring-curves", boundary_args.ring_curves,
                    "ring Hopf curves: all (every mode's), envelope (only the boundary of the ring-stable region, any N), auto (all up to 64 cars)")
         ->type_name("all|envelope|auto")
         ->capture_default_str();
-    app.add_option("--seed-grid", args.grid, "grid points per axis used to seed the branches")->capture_default_str();
-    args.format.add_to(app);
+    app.add_option("--seed-grid", boundary_args.grid, "grid points per axis used to seed the branches")->capture_default_str();
+    boundary_args.format.add_to(app);
     run_flags().add_to(app, true);
 }
 
 int run_boundary() {
-    const Format format = args.format.parse();
-    const int grid = static_cast<int>(parse_integer("--seed-grid", args.grid, 5, 2001, "an integer between 5 and 2001"));
-    SweepSpec spec = sweep_spec(args.model, args.ring, "", false, grid);
-    const RingCurves ring_curves = parse_ring_curves_flag(args.ring_curves, spec);
+    const Format format = boundary_args.format.parse();
+    const int grid = static_cast<int>(parse_integer("--seed-grid", boundary_args.grid, 5, 2001, "an integer between 5 and 2001"));
+    SweepSpec spec = sweep_spec(boundary_args.model, boundary_args.ring, "", false, grid);
+    const RingCurves ring_curves = parse_ring_curves_flag(boundary_args.ring_curves, spec);
     if (ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";  // every mode's curve needs every mode's root
     check_sweep_size(spec, "boundary", false);
-    const std::string prefix = args.out.prepare("boundary", {".csv", ".json"});
+    const std::string prefix = boundary_args.out.prepare("boundary", {".csv", ".json"});
     ExecutionPolicy policy;
     policy.progress = progress_printer("boundary", "seed-grid rows");
     const SweepResult sw = run_sweep(spec, policy);

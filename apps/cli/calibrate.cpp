@@ -20,13 +20,13 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct CalibrateArgs {
     std::vector<std::string> files;
     std::string train, model = "ovrv", bounds, gap_weight = "0.02", runs, report, car = "joint", data_dir;
     bool joint = false;
     FormatArg format;
     OutArg out;
-} args;
+} calibrate_args;
 
 std::string base_name(const std::string& path) {
     std::string b = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
@@ -35,18 +35,18 @@ std::string base_name(const std::string& path) {
 }
 
 CalibrationOptions options() {
-    if (args.model != "ovrv") throw BadInput("--model = '" + args.model + "': calibration supports ovrv");
+    if (calibrate_args.model != "ovrv") throw BadInput("--model = '" + calibrate_args.model + "': calibration supports ovrv");
     CalibrationOptions o;
-    o.gap_weight = parse_number("--gap-weight", args.gap_weight);
-    if (!args.train.empty()) {
-        const auto colon = args.train.find(':');
-        if (colon == std::string::npos) throw BadInput("--train = '" + args.train + "': expected T0:T1 in seconds");
-        o.train_start = parse_number("--train", args.train.substr(0, colon));
-        o.train_end = parse_number("--train", args.train.substr(colon + 1));
-        if (!(o.train_start >= 0 && o.train_end > o.train_start)) throw BadInput("--train = '" + args.train + "': expected 0 <= T0 < T1");
+    o.gap_weight = parse_number("--gap-weight", calibrate_args.gap_weight);
+    if (!calibrate_args.train.empty()) {
+        const auto colon = calibrate_args.train.find(':');
+        if (colon == std::string::npos) throw BadInput("--train = '" + calibrate_args.train + "': expected T0:T1 in seconds");
+        o.train_start = parse_number("--train", calibrate_args.train.substr(0, colon));
+        o.train_end = parse_number("--train", calibrate_args.train.substr(colon + 1));
+        if (!(o.train_start >= 0 && o.train_end > o.train_start)) throw BadInput("--train = '" + calibrate_args.train + "': expected 0 <= T0 < T1");
     }
-    if (!args.bounds.empty()) {
-        std::stringstream ss(args.bounds);
+    if (!calibrate_args.bounds.empty()) {
+        std::stringstream ss(calibrate_args.bounds);
         std::string item;
         const char* names[5] = {"k1", "k2", "th", "tau", "eta"};
         while (std::getline(ss, item, ',')) {
@@ -66,20 +66,20 @@ CalibrationOptions options() {
 }  // namespace
 
 void add_calibrate_flags(CLI::App& app) {
-    app.add_option("DATA.csv", args.files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one fit per file)");
-    app.add_flag("--joint", args.joint, "fit one parameter set to all DATA files (runs of the same car)");
-    app.add_option("--car", args.car, "the car's name for --joint")->capture_default_str();
-    app.add_option("--runs", args.runs,
+    app.add_option("DATA.csv", calibrate_args.files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one fit per file)");
+    app.add_flag("--joint", calibrate_args.joint, "fit one parameter set to all DATA files (runs of the same car)");
+    app.add_option("--car", calibrate_args.car, "the car's name for --joint")->capture_default_str();
+    app.add_option("--runs", calibrate_args.runs,
                    "RUNS.csv with columns car,file,role[,type]: each car fitted jointly on its role=train files, "
                    "tested on its role=test files (errors per type; files relative to the current folder)");
-    app.add_option("--data-dir", args.data_dir, "folder the relative file names of RUNS.csv are read from (default: the current folder)");
-    app.add_option("--report", args.report, "folder: table.csv, table.json, table.md (parameters, train and test errors) and fit_FILE.svg per run");
-    app.add_option("--train", args.train, "training window T0:T1 [s] (default: the whole file; the rest is the test part)");
-    app.add_option("--model", args.model, "the model to fit (ovrv)")->capture_default_str();
-    app.add_option("--bounds", args.bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
-    app.add_option("--gap-weight", args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
-    args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
-    args.format.add_to(app);
+    app.add_option("--data-dir", calibrate_args.data_dir, "folder the relative file names of RUNS.csv are read from (default: the current folder)");
+    app.add_option("--report", calibrate_args.report, "folder: table.csv, table.json, table.md (parameters, train and test errors) and fit_FILE.svg per run");
+    app.add_option("--train", calibrate_args.train, "training window T0:T1 [s] (default: the whole file; the rest is the test part)");
+    app.add_option("--model", calibrate_args.model, "the model to fit (ovrv)")->capture_default_str();
+    app.add_option("--bounds", calibrate_args.bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
+    app.add_option("--gap-weight", calibrate_args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
+    calibrate_args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
+    calibrate_args.format.add_to(app);
     run_flags().add_to(app, false);
 }
 
@@ -88,7 +88,7 @@ namespace {
 /// the cars of --runs RUNS.csv (car,file,role[,type]), in order of first appearance
 std::vector<CarRuns> read_runs(const std::string& path) {
     auto read = [&](const std::string& name) {
-        const std::string file = args.data_dir.empty() || name.front() == '/' ? name : (std::filesystem::path(args.data_dir) / name).string();
+        const std::string file = calibrate_args.data_dir.empty() || name.front() == '/' ? name : (std::filesystem::path(calibrate_args.data_dir) / name).string();
         return read_trace_csv(read_input_file("--runs " + path + ": file", file), file);
     };
     return cars_from_run_list(read_run_list_csv(read_input_file("--runs", path), path), read, "--runs " + path);
@@ -109,23 +109,23 @@ std::string prepare_report_dir(const std::string& dir) {
 }  // namespace
 
 int run_calibrate() {
-    const Format format = args.format.parse();
+    const Format format = calibrate_args.format.parse();
     const CalibrationOptions o = options();
-    const int modes = (args.joint ? 1 : 0) + (!args.runs.empty() ? 1 : 0);
-    if (!args.runs.empty() && !args.files.empty()) throw BadInput("--runs " + args.runs + ": give the files in RUNS.csv, not also as DATA.csv");
-    if (args.runs.empty() && args.files.empty()) throw BadInput("DATA.csv: expected at least one trace (or --runs RUNS.csv)");
-    if (!args.data_dir.empty() && args.runs.empty()) throw BadInput("--data-dir " + args.data_dir + ": only with --runs RUNS.csv");
+    const int modes = (calibrate_args.joint ? 1 : 0) + (!calibrate_args.runs.empty() ? 1 : 0);
+    if (!calibrate_args.runs.empty() && !calibrate_args.files.empty()) throw BadInput("--runs " + calibrate_args.runs + ": give the files in RUNS.csv, not also as DATA.csv");
+    if (calibrate_args.runs.empty() && calibrate_args.files.empty()) throw BadInput("DATA.csv: expected at least one trace (or --runs RUNS.csv)");
+    if (!calibrate_args.data_dir.empty() && calibrate_args.runs.empty()) throw BadInput("--data-dir " + calibrate_args.data_dir + ": only with --runs RUNS.csv");
     if (modes > 1) throw BadInput("--joint: not with --runs (RUNS.csv groups the runs into cars)");
-    const std::string prefix = args.out.given() ? args.out.prepare("calibrate") : std::string();
-    const std::string report_dir = args.report.empty() ? std::string() : prepare_report_dir(args.report);
+    const std::string prefix = calibrate_args.out.given() ? calibrate_args.out.prepare("calibrate") : std::string();
+    const std::string report_dir = calibrate_args.report.empty() ? std::string() : prepare_report_dir(calibrate_args.report);
     std::vector<CarRuns> cars;
-    if (!args.runs.empty()) {
-        cars = read_runs(args.runs);
-    } else if (args.joint) {
-        cars.push_back(CarRuns{args.car, {}, {}, {}});
-        for (const auto& f : args.files) cars[0].train.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
+    if (!calibrate_args.runs.empty()) {
+        cars = read_runs(calibrate_args.runs);
+    } else if (calibrate_args.joint) {
+        cars.push_back(CarRuns{calibrate_args.car, {}, {}, {}});
+        for (const auto& f : calibrate_args.files) cars[0].train.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
     } else {
-        for (const auto& f : args.files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_input_file("DATA.csv", f), f)}, {}, {}});
+        for (const auto& f : calibrate_args.files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_input_file("DATA.csv", f), f)}, {}, {}});
     }
     // one progress line per finished fit: ddemap: calibrate: fits 3/12 done, NAME in 0.41 s (4.2 s, about 12 s left)
     CarFinished finished;
@@ -151,9 +151,9 @@ int run_calibrate() {
     for (const auto& c : cars)
         for (const auto& t : c.train) files.push_back(json_string(t.source));
     JsonObject in;
-    in.json("traces", json_array(files)).string("model", args.model).number("gap_weight", o.gap_weight);
-    if (!args.runs.empty()) in.string("runs", args.runs);
-    if (args.joint) in.string("joint", args.car);
+    in.json("traces", json_array(files)).string("model", calibrate_args.model).number("gap_weight", o.gap_weight);
+    if (!calibrate_args.runs.empty()) in.string("runs", calibrate_args.runs);
+    if (calibrate_args.joint) in.string("joint", calibrate_args.car);
     if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
     e.inputs = in.str();
     e.result = calibration_json(names, fits, o, &results);
@@ -171,7 +171,7 @@ int run_calibrate() {
     if (!prefix.empty())
         outputs = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", calibration_svg(names, traces, fits)}};
     if (!report_dir.empty())
-        for (auto& [name, text] : calibration_report_files(results, cars, o, args.runs.empty() && !args.joint))
+        for (auto& [name, text] : calibration_report_files(results, cars, o, calibrate_args.runs.empty() && !calibrate_args.joint))
             outputs.push_back({report_dir + name, std::move(text)});
     if (!outputs.empty()) write_files_atomic(outputs);
     print_output(format, e, csv, [&] {

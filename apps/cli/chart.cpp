@@ -11,24 +11,24 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct ChartArgs {
     std::string spec;
     FormatArg format;
     OutArg out;
-} args;
+} chart_args;
 }  // namespace
 
 void add_chart_flags(CLI::App& app) {
-    app.add_option("SPEC", args.spec, "chart specification (TOML)")->required();
-    args.out.add_to(app, "PREFIX.svg", true);
-    args.format.add_to(app, {Format::Table, Format::Json});
+    app.add_option("SPEC", chart_args.spec, "chart specification (TOML)")->required();
+    chart_args.out.add_to(app, "PREFIX.svg", true);
+    chart_args.format.add_to(app, {Format::Table, Format::Json});
     run_flags().add_to(app, true);
 }
 
 int run_chart() {
-    const Format format = args.format.parse();
-    const std::string prefix = args.out.prepare("chart", {".svg"});
-    const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", args.spec), args.spec);
+    const Format format = chart_args.format.parse();
+    const std::string prefix = chart_args.out.prepare("chart", {".svg"});
+    const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", chart_args.spec), chart_args.spec);
     if (!spec.panels.empty()) check_sweep_size(panel_sweep(spec, 0), "chart", false, spec.panels.size());  // panels share the window and ring
     ExecutionPolicy policy;
     policy.progress = progress_printer("chart", "panels");
@@ -37,7 +37,7 @@ int run_chart() {
     if (format == Format::Json) {
         JsonEnvelope e;
         e.command = "chart";
-        e.inputs = JsonObject().string("spec", args.spec).string("out", prefix).str();
+        e.inputs = JsonObject().string("spec", chart_args.spec).string("out", prefix).str();
         e.result = JsonObject()
                        .integer("panels", static_cast<long long>(spec.panels.size()))
                        .number("seconds", r.seconds)

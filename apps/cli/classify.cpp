@@ -19,60 +19,60 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct ClassifyArgs {
     std::string file, svg, samples = "4000", ring_samples = "200", seed = "1";
     RingArg ring;
     FormatArg format;
     OutArg out;
-} args;
+} classify_args;
 }  // namespace
 
 void add_classify_flags(CLI::App& app) {
-    app.add_option("VEHICLES", args.file,
+    app.add_option("VEHICLES", classify_args.file,
                    "the vehicles: a CSV file with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m; other columns ignored, "
                    "so calibrate's output works), a fleet table of ovrv cars (as roots --fleet), or built-in names \"A_min,E_max\"; with the "
                    "covariance columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes the verdicts come with probabilities, from samples "
                    "of the parameters' normal distribution restricted to the fit's bounds of k1, k2, th, tau (columns lo_k1,hi_k1 .. that "
                    "`calibrate` writes; calibrate's default bounds when the file has none)")
         ->type_name("FILE|PATTERN");
-    app.add_option("--samples", args.samples, "parameter samples per vehicle with a covariance")->capture_default_str();
-    app.add_option("--ring-samples", args.ring_samples, "of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
+    app.add_option("--samples", classify_args.samples, "parameter samples per vehicle with a covariance")->capture_default_str();
+    app.add_option("--ring-samples", classify_args.ring_samples, "of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
         ->capture_default_str();
-    app.add_option("--seed", args.seed, "seed of the parameter samples")->capture_default_str();
-    args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
-    args.format.add_to(app);
-    args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
-    app.add_option("--svg", args.svg, "old spelling: write only the figure to this file")->group("");
+    app.add_option("--seed", classify_args.seed, "seed of the parameter samples")->capture_default_str();
+    classify_args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
+    classify_args.format.add_to(app);
+    classify_args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
+    app.add_option("--svg", classify_args.svg, "old spelling: write only the figure to this file")->group("");
     run_flags().add_to(app, true);
 }
 
 int run_classify() {
-    const int cars = args.ring.parse();
-    const Format format = args.format.parse();
-    if (args.out.given() && !args.svg.empty()) throw BadInput("--out and --svg: expected only --out (--svg is its old spelling)");
-    const std::string prefix = args.out.given() ? args.out.prepare("classify") : std::string();
+    const int cars = classify_args.ring.parse();
+    const Format format = classify_args.format.parse();
+    if (classify_args.out.given() && !classify_args.svg.empty()) throw BadInput("--out and --svg: expected only --out (--svg is its old spelling)");
+    const std::string prefix = classify_args.out.given() ? classify_args.out.prepare("classify") : std::string();
     // --svg FILE writes exactly FILE (through a link; into a device such as /dev/null directly)
-    const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);
+    const std::string svg_file = classify_args.svg.empty() ? std::string() : output_file("--svg", classify_args.svg);
     std::vector<CalibratedVehicle> vehicles;
     std::string source = "the paper's calibration table (built in)";
-    if (args.file.empty()) {
+    if (classify_args.file.empty()) {
         vehicles = paper_calibration_table();
     } else {
-        vehicles = vehicles_argument("VEHICLES", args.file);
-        source = args.file;
+        vehicles = vehicles_argument("VEHICLES", classify_args.file);
+        source = classify_args.file;
     }
     const bool figure = !prefix.empty() || !svg_file.empty();
     ChartSpec chart;
     if (figure) {
-        chart = classification_chart(parse_chart_spec(builtin_classification_toml, "maps/classification.toml"), vehicles, cars, args.file);
+        chart = classification_chart(parse_chart_spec(builtin_classification_toml, "maps/classification.toml"), vehicles, cars, classify_args.file);
         if (!chart.panels.empty()) check_sweep_size(panel_sweep(chart, 0), "classify", false, chart.panels.size());
     }
     UncertaintyOptions uo;
-    uo.samples = static_cast<int>(parse_integer("--samples", args.samples, 1, 1000000, "an integer 1..1000000"));
+    uo.samples = static_cast<int>(parse_integer("--samples", classify_args.samples, 1, 1000000, "an integer 1..1000000"));
     // calibrate's default search space, replaced per vehicle by the bounds its file carries (lo_NAME, hi_NAME)
     uo.domain = classification_domain();
-    uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", args.ring_samples, 0, 1000000, "an integer 0..1000000"));
-    uo.seed = static_cast<unsigned long long>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
+    uo.ring_samples = static_cast<int>(parse_integer("--ring-samples", classify_args.ring_samples, 0, 1000000, "an integer 0..1000000"));
+    uo.seed = static_cast<unsigned long long>(parse_integer("--seed", classify_args.seed, 0, 4294967295L, "an integer 0..4294967295"));
     const auto rows = classify(vehicles, cars, uo);
     JsonEnvelope e;
     e.command = "classify";

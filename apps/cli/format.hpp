@@ -17,6 +17,12 @@ std::string roots_table(const std::vector<Root>& roots);
 inline std::string counted(long long n, const std::string& singular, const std::string& plural = {}) {
     return std::to_string(n) + " " + (n == 1 ? singular : plural.empty() ? singular + "s" : plural);
 }
+/// A column of a human table: s followed by spaces to width w, or by one space when it is wider.
+inline std::string pad(std::string s, std::size_t w) {
+    if (s.size() < w) s.resize(w, ' ');
+    else s += ' ';
+    return s;
+}
 /// N, or "inf" for 0.
 inline std::string ring_name(int cars) { return cars == 0 ? "inf" : std::to_string(cars); }
 

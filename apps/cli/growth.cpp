@@ -15,28 +15,28 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct GrowthArgs {
     std::string followers = "15";
     LeadArgs lead;
     FormatArg format;
     OutArg out;
-} args;
+} growth_args;
 }  // namespace
 
 void add_growth_flags(CLI::App& app) {
-    app.add_option("--followers", args.followers, "longest platoon")->capture_default_str();
-    args.lead.add_to(app);
-    args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", false);
-    args.format.add_to(app);
+    app.add_option("--followers", growth_args.followers, "longest platoon")->capture_default_str();
+    growth_args.lead.add_to(app);
+    growth_args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", false);
+    growth_args.format.add_to(app);
     run_flags().add_to(app, true);
 }
 
 int run_growth() {
-    const int followers = static_cast<int>(parse_integer("--followers", args.followers, 1, 200, "an integer from 1 to 200"));
-    const Format format = args.format.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("growth") : std::string();
+    const int followers = static_cast<int>(parse_integer("--followers", growth_args.followers, 1, 200, "an integer from 1 to 200"));
+    const Format format = growth_args.format.parse();
+    const std::string prefix = growth_args.out.given() ? growth_args.out.prepare("growth") : std::string();
     std::string label;
-    const LeadProfile lead = args.lead.parse(label);
+    const LeadProfile lead = growth_args.lead.parse(label);
     const std::vector<CalibratedVehicle> vehicles = paper_calibration_table();
     // sized before the work as simulate is: the platoons run in parallel (memory: the largest
     // ones at once), about 2 us per car and step in all (simulate's measured rate)

@@ -19,66 +19,61 @@ namespace ddemap::cli {
 
 namespace {
 
-struct Args {
+struct HopfArgs {
     NonlinearProblemArgs problem;
     std::string par2, from2, to2, points = "400";
     FormatArg format;
     OutArg out;
-} args;
+} hopf_args;
 
-std::string pad(std::string s, std::size_t w) {
-    if (s.size() < w) s.resize(w, ' ');
-    else s += ' ';
-    return s;
-}
 
 std::string side_word(int side) { return side > 0 ? "above" : side < 0 ? "below" : "-"; }
 
 }  // namespace
 
 void add_hopf_flags(CLI::App& app) {
-    args.problem.add_to(app);
-    app.add_option("--par2", args.par2, "a second parameter: continue the Hopf curves in (--par, --par2)")->type_name("NAME");
-    app.add_option("--from2", args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
-    app.add_option("--to2", args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
-    app.add_option("--max-points", args.points, "the most points of the branch, and of a Hopf curve in each direction")->capture_default_str();
-    args.format.add_to(app);
-    args.out.add_to(app, "PREFIX.csv (one row per Hopf point, or per curve point with --par2) and PREFIX.json", false);
+    hopf_args.problem.add_to(app);
+    app.add_option("--par2", hopf_args.par2, "a second parameter: continue the Hopf curves in (--par, --par2)")->type_name("NAME");
+    app.add_option("--from2", hopf_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
+    app.add_option("--to2", hopf_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
+    app.add_option("--max-points", hopf_args.points, "the most points of the branch, and of a Hopf curve in each direction")->capture_default_str();
+    hopf_args.format.add_to(app);
+    hopf_args.out.add_to(app, "PREFIX.csv (one row per Hopf point, or per curve point with --par2) and PREFIX.json", false);
     run_flags().add_to(app, false);
 }
 
 int run_hopf() {
-    const Format format = args.format.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("hopf", {".csv", ".json"}) : std::string();
-    NonlinearProblemArgs::Problem pb = args.problem.load();
-    if (!(pb.from < pb.to)) throw BadInput("--from = '" + args.problem.from + "', --to = '" + args.problem.to + "': expected --from < --to");
-    const bool two = !args.par2.empty();
-    if (!two && (!args.from2.empty() || !args.to2.empty())) throw BadInput("--from2/--to2 without --par2: expected --par2 NAME with them");
+    const Format format = hopf_args.format.parse();
+    const std::string prefix = hopf_args.out.given() ? hopf_args.out.prepare("hopf", {".csv", ".json"}) : std::string();
+    NonlinearProblemArgs::Problem pb = hopf_args.problem.load();
+    if (!(pb.from < pb.to)) throw BadInput("--from = '" + hopf_args.problem.from + "', --to = '" + hopf_args.problem.to + "': expected --from < --to");
+    const bool two = !hopf_args.par2.empty();
+    if (!two && (!hopf_args.from2.empty() || !hopf_args.to2.empty())) throw BadInput("--from2/--to2 without --par2: expected --par2 NAME with them");
     EquilibriumBranchOptions o;
-    o.parameter = args.problem.par;
+    o.parameter = hopf_args.problem.par;
     o.from = pb.from;
     o.to = pb.to;
-    const int max_points = static_cast<int>(parse_integer("--max-points", args.points, 2, 100000, "an integer between 2 and 100000"));
+    const int max_points = static_cast<int>(parse_integer("--max-points", hopf_args.points, 2, 100000, "an integer between 2 and 100000"));
     o.continuation.max_points = max_points;
     const NonlinearDDE& system = *pb.system;
     JsonObject& inputs = pb.inputs;
-    inputs.string("par", args.problem.par).number("from", o.from).number("to", o.to);
+    inputs.string("par", hopf_args.problem.par).number("from", o.from).number("to", o.to);
 
     HopfCurveOptions co;
     if (two) {
-        if (args.from2.empty() || args.to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + args.par2);
-        if (args.par2 == args.problem.par) throw BadInput("--par2 = '" + args.par2 + "': expected a parameter other than --par");
-        const int j2 = system.parameter_index(args.par2);  // unknown: bad input naming the known ones
+        if (hopf_args.from2.empty() || hopf_args.to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + hopf_args.par2);
+        if (hopf_args.par2 == hopf_args.problem.par) throw BadInput("--par2 = '" + hopf_args.par2 + "': expected a parameter other than --par");
+        const int j2 = system.parameter_index(hopf_args.par2);  // unknown: bad input naming the known ones
         co.branch = o;
-        co.parameter2 = args.par2;
-        co.from2 = parse_number("--from2", args.from2);
-        co.to2 = parse_number("--to2", args.to2);
-        if (!(co.from2 < co.to2)) throw BadInput("--from2 = '" + args.from2 + "', --to2 = '" + args.to2 + "': expected --from2 < --to2");
+        co.parameter2 = hopf_args.par2;
+        co.from2 = parse_number("--from2", hopf_args.from2);
+        co.to2 = parse_number("--to2", hopf_args.to2);
+        if (!(co.from2 < co.to2)) throw BadInput("--from2 = '" + hopf_args.from2 + "', --to2 = '" + hopf_args.to2 + "': expected --from2 < --to2");
         const double held = system.parameter_values()[static_cast<std::size_t>(j2)];
         if (!(held >= co.from2 && held <= co.to2))
-            throw BadInput("--par2 " + args.par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
+            throw BadInput("--par2 " + hopf_args.par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
         co.continuation.max_points = max_points;
-        inputs.string("par2", args.par2).number("from2", co.from2).number("to2", co.to2);
+        inputs.string("par2", hopf_args.par2).number("from2", co.from2).number("to2", co.to2);
     }
 
     JsonEnvelope e;
@@ -93,17 +88,17 @@ int run_hopf() {
     HopfCurves curves;
     HopfAnalysis points;
     if (two) {
-        co.branch.progress = branch_progress_printer("hopf", "equilibria", args.problem.par, true);
-        co.progress = branch_progress_printer("hopf", "curve points", args.problem.par, false);
+        co.branch.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true);
+        co.progress = branch_progress_printer("hopf", "curve points", hopf_args.problem.par, false);
         curves = hopf_curves(system, pb.guess, co);
         co.branch.progress = nullptr;  // ends an open progress line before the output
         co.progress = nullptr;
         status = curves.status;
         message = curves.message;
-        e.result = hopf_curves_json(curves, args.par2, pb.variables);
+        e.result = hopf_curves_json(curves, hopf_args.par2, pb.variables);
         csv = hopf_curves_csv(curves);
     } else {
-        o.progress = branch_progress_printer("hopf", "equilibria", args.problem.par, true);
+        o.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true);
         points = hopf_points(system, pb.guess, o);
         o.progress = nullptr;
         status = points.status;
@@ -117,7 +112,7 @@ int run_hopf() {
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
     print_output(format, e, csv, [&] {
         std::ostringstream out;
-        const std::string& par = args.problem.par;
+        const std::string& par = hopf_args.problem.par;
         out << "branch     " << start.branch.points.size() << " equilibria in " << par << " from " << rounded(o.from) << " to " << rounded(o.to)
             << ", " << start.points.size() << " Hopf points\n";
         out << "  " << pad(par, 14) << pad("omega", 12) << pad("L1", 13) << pad("criticality", 15) << pad("dRe/d" + par, 13) << pad("orbit side", 12) << "max range/sqrt|mu|\n";
@@ -130,9 +125,9 @@ int run_hopf() {
         if (two)
             for (std::size_t k = 0; k < curves.curves.size(); ++k) {
                 const HopfCurve& c = curves.curves[k];
-                out << "curve " << k << "    from Hopf point " << c.start << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << args.par2
+                out << "curve " << k << "    from Hopf point " << c.start << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << hopf_args.par2
                     << "), " << to_string(c.status) << "\n";
-                out << "  " << pad(par, 14) << pad(args.par2, 14) << pad("omega", 12) << pad("L1", 13) << "criticality\n";
+                out << "  " << pad(par, 14) << pad(hopf_args.par2, 14) << pad("omega", 12) << pad("L1", 13) << "criticality\n";
                 const std::size_t step = std::max<std::size_t>(1, c.points.size() / 20);
                 for (std::size_t i = 0; i < c.points.size(); i += step) {
                     const HopfCurvePoint& p = c.points[i];
@@ -141,7 +136,7 @@ int run_hopf() {
                         << pad(ok ? rounded(p.coefficients.l1, 4) : "-", 13) << criticality_word(p.coefficients) << "\n";
                 }
                 for (const GeneralisedHopfPoint& g : c.generalised)
-                    out << "  generalised Hopf (L1 = 0): " << par << " = " << rounded(g.par, 10) << ", " << args.par2 << " = " << rounded(g.par2, 10)
+                    out << "  generalised Hopf (L1 = 0): " << par << " = " << rounded(g.par, 10) << ", " << hopf_args.par2 << " = " << rounded(g.par2, 10)
                         << ", omega = " << rounded(g.omega, 8) << " (" << to_string(g.status) << ")\n";
             }
         if (status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(status) << "): " << message << "\n";

@@ -16,27 +16,27 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct MixArgs {
     std::string x, y, cars, p = "0:1:11", draws = "0", seed = "1", speed, length, solver = "auto";
     RingArg ring;
     FormatArg format;
     OutArg out;
-} args;
+} mix_args;
 }  // namespace
 
 void add_mix_flags(CLI::App& app) {
-    app.add_option("--x", args.x, "type X: a calibrated vehicle (e.g. E_min), MODEL:NAME=VALUE,..., a CSV file of one kind of car (e.g. calibrate's output) or FILE.csv:NAME (the car NAME of the file)")->required();
-    app.add_option("--y", args.y, "type Y: as --x")->required();
-    args.ring.add_to(app, "40", "ring size N >= 2 (finite)");
-    app.add_option("--cars", args.cars, "old spelling of --ring")->group("");
-    app.add_option("--p", args.p, "fractions of X as LO:HI:COUNT in [0, 1]")->capture_default_str();
-    app.add_option("--draws", args.draws, "random arrangements per p besides the evenly spread one (order matters only for CCC)")->capture_default_str();
-    app.add_option("--seed", args.seed, "seed of the random arrangements")->capture_default_str();
-    app.add_option("--speed", args.speed, "common equilibrium speed [m/s] (default 20)");
-    app.add_option("--length", args.length, "ring length [m]; the speed follows for each mix");
-    app.add_option("--solver", args.solver, "auto, product, dense or sparse (as roots --fleet)")->capture_default_str();
-    args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", true);
-    args.format.add_to(app);
+    app.add_option("--x", mix_args.x, "type X: a calibrated vehicle (e.g. E_min), MODEL:NAME=VALUE,..., a CSV file of one kind of car (e.g. calibrate's output) or FILE.csv:NAME (the car NAME of the file)")->required();
+    app.add_option("--y", mix_args.y, "type Y: as --x")->required();
+    mix_args.ring.add_to(app, "40", "ring size N >= 2 (finite)");
+    app.add_option("--cars", mix_args.cars, "old spelling of --ring")->group("");
+    app.add_option("--p", mix_args.p, "fractions of X as LO:HI:COUNT in [0, 1]")->capture_default_str();
+    app.add_option("--draws", mix_args.draws, "random arrangements per p besides the evenly spread one (order matters only for CCC)")->capture_default_str();
+    app.add_option("--seed", mix_args.seed, "seed of the random arrangements")->capture_default_str();
+    app.add_option("--speed", mix_args.speed, "common equilibrium speed [m/s] (default 20)");
+    app.add_option("--length", mix_args.length, "ring length [m]; the speed follows for each mix");
+    app.add_option("--solver", mix_args.solver, "auto, product, dense or sparse (as roots --fleet)")->capture_default_str();
+    mix_args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", true);
+    mix_args.format.add_to(app);
     run_flags().add_to(app, true);
 }
 
@@ -78,23 +78,23 @@ void size_mix(const MixOptions& o) {
 }  // namespace
 
 int run_mix() {
-    const Format format = args.format.parse();
-    const FleetCar x = car_argument("--x", args.x), y = car_argument("--y", args.y);
-    if (args.ring.given() && !args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
-    RingArg ring = args.ring;
-    if (!args.cars.empty()) ring.text = args.cars;
+    const Format format = mix_args.format.parse();
+    const FleetCar x = car_argument("--x", mix_args.x), y = car_argument("--y", mix_args.y);
+    if (mix_args.ring.given() && !mix_args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
+    RingArg ring = mix_args.ring;
+    if (!mix_args.cars.empty()) ring.text = mix_args.cars;
     MixOptions o;
     o.cars = ring.parse(false);
-    const Axis axis = parse_axis("p", args.p);
+    const Axis axis = parse_axis("p", mix_args.p);
     for (int i = 0; i < axis.count; ++i) o.fractions.push_back(axis.value(i));
-    o.draws = static_cast<int>(parse_integer("--draws", args.draws, 0, 10000, "an integer 0..10000"));
-    o.seed = static_cast<unsigned>(parse_integer("--seed", args.seed, 0, 4294967295L, "an integer 0..4294967295"));
-    set_equilibrium(o.ring, args.speed, args.length);
-    o.ring.roots.method = root_method(args.solver);
+    o.draws = static_cast<int>(parse_integer("--draws", mix_args.draws, 0, 10000, "an integer 0..10000"));
+    o.seed = static_cast<unsigned>(parse_integer("--seed", mix_args.seed, 0, 4294967295L, "an integer 0..4294967295"));
+    set_equilibrium(o.ring, mix_args.speed, mix_args.length);
+    o.ring.roots.method = root_method(mix_args.solver);
     o.ring.roots.count = 4;
     o.validate();
     size_mix(o);
-    const std::string prefix = args.out.prepare("mix");
+    const std::string prefix = mix_args.out.prepare("mix");
     // one line per arrangement solved: ddemap: mix: arrangements 3/11, p = 0.2 (1.2 s, about 3 s left)
     o.progress = branch_progress_printer("mix", "arrangements", "p", true);
     const std::vector<MixPoint> pts = penetration_study(x, y, o);
@@ -108,7 +108,7 @@ int run_mix() {
     JsonEnvelope e;
     e.command = "mix";
     JsonObject in;
-    in.string("x", args.x).string("y", args.y).integer("ring", o.cars).json("p", json_array([&] {
+    in.string("x", mix_args.x).string("y", mix_args.y).integer("ring", o.cars).json("p", json_array([&] {
         std::vector<std::string> v;
         for (double f : o.fractions) v.push_back(json_number(f));
         return v;

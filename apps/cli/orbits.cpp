@@ -20,7 +20,7 @@ namespace ddemap::cli {
 
 namespace {
 
-struct Args {
+struct OrbitsArgs {
     NonlinearProblemArgs problem;
     std::string hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
     std::string wave, initial_step, max_step;
@@ -30,91 +30,86 @@ struct Args {
     bool stability = false;
     FormatArg format;
     OutArg out;
-} args;
+} orbits_args;
 
-std::string pad(std::string s, std::size_t w) {
-    if (s.size() < w) s.resize(w, ' ');
-    else s += ' ';
-    return s;
-}
 
 }  // namespace
 
 void add_orbits_flags(CLI::App& app) {
-    args.problem.add_to(app);  // --system | --model ov|idm ..., --par, --from (the equilibrium branch, whose Hopf points start the orbits), --to
-    args.hopf_option = app.add_option("--hopf", args.hopf, "the index (from 0, in the order met along the equilibrium branch) of the Hopf point to start from")
+    orbits_args.problem.add_to(app);  // --system | --model ov|idm ..., --par, --from (the equilibrium branch, whose Hopf points start the orbits), --to
+    orbits_args.hopf_option = app.add_option("--hopf", orbits_args.hopf, "the index (from 0, in the order met along the equilibrium branch) of the Hopf point to start from")
         ->capture_default_str()->type_name("INTEGER");
-    app.add_option("--degree", args.degree, "degree d of the piecewise polynomials (1..20)")->capture_default_str()->type_name("INTEGER");
-    app.add_option("--intervals", args.intervals, "number L of mesh intervals over one period (2..10000)")->capture_default_str()->type_name("INTEGER");
-    app.add_option("--points", args.points, "the most orbits on the branch")->capture_default_str()->type_name("INTEGER");
-    app.add_flag("--adapt", args.adapt,
+    app.add_option("--degree", orbits_args.degree, "degree d of the piecewise polynomials (1..20)")->capture_default_str()->type_name("INTEGER");
+    app.add_option("--intervals", orbits_args.intervals, "number L of mesh intervals over one period (2..10000)")->capture_default_str()->type_name("INTEGER");
+    app.add_option("--points", orbits_args.points, "the most orbits on the branch")->capture_default_str()->type_name("INTEGER");
+    app.add_flag("--adapt", orbits_args.adapt,
                  "move the mesh after every orbit to equidistribute |x^(d+1)|^(1/(d+1)) (more accurate orbits, less accurate multipliers; see README)");
-    app.add_option("--variable", args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
-    app.add_option("--svg", args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
-    args.format.add_to(app);
-    args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json", false);
+    app.add_option("--variable", orbits_args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
+    app.add_option("--svg", orbits_args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
+    orbits_args.format.add_to(app);
+    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json", false);
     run_flags().add_to(app, false);
 
-    app.add_option("--wave", args.wave,
+    app.add_option("--wave", orbits_args.wave,
                    "--model ov|idm --ring N: the travelling waves of wave number K (1..N-1; car i + 1 repeats car i shifted by K T / N) in "
                    "the reduced form, one car whatever N (see README)")
         ->type_name("K");
-    app.add_option("--initial-step", args.initial_step, "--wave: the first step along the branch in its weighted norm (default 0.02; long waves need smaller)")
+    app.add_option("--initial-step", orbits_args.initial_step, "--wave: the first step along the branch in its weighted norm (default 0.02; long waves need smaller)")
         ->type_name("H");
-    app.add_flag("--no-stability", args.no_stability,
+    app.add_flag("--no-stability", orbits_args.no_stability,
                  "--wave on more than 10 cars: skip the full ring's Floquet multipliers (matrix-free Arnoldi; on long rings far costlier than the branch)");
-    app.add_flag("--stability", args.stability,
+    app.add_flag("--stability", orbits_args.stability,
                  "--wave on more than 200 cars: compute the full ring's Floquet multipliers anyway (minutes per wave on 1000 cars; "
                  "by default not computed above 200 cars)");
-    app.add_option("--max-step", args.max_step,
+    app.add_option("--max-step", orbits_args.max_step,
                    "the largest step along the branch in its weighted norm (default 0.1; larger steps: fewer orbits for the same stretch, "
                    "see README)")
         ->type_name("S");
 }
 
 int run_orbits() {
-    if (!args.wave.empty())
-        return run_orbits_wave({args.problem, args.wave, args.degree, args.intervals, args.points, args.initial_step, args.svg, args.variable, args.adapt,
-                                args.hopf_option && args.hopf_option->count() > 0, args.format, args.out, args.max_step, args.no_stability, args.stability});
-    if (!args.initial_step.empty()) throw BadInput("--initial-step: only with --wave (expected --wave K)");
-    if (args.no_stability) throw BadInput("--no-stability: only with --wave (expected --wave K)");
-    if (args.stability) throw BadInput("--stability: only with --wave (expected --wave K)");
-    const Format format = args.format.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("orbits", {".csv", ".json"}) : std::string();
-    const std::string svg_file = args.svg.empty() ? std::string() : output_file("--svg", args.svg);
+    if (!orbits_args.wave.empty())
+        return run_orbits_wave({orbits_args.problem, orbits_args.wave, orbits_args.degree, orbits_args.intervals, orbits_args.points, orbits_args.initial_step, orbits_args.svg, orbits_args.variable, orbits_args.adapt,
+                                orbits_args.hopf_option && orbits_args.hopf_option->count() > 0, orbits_args.format, orbits_args.out, orbits_args.max_step, orbits_args.no_stability, orbits_args.stability});
+    if (!orbits_args.initial_step.empty()) throw BadInput("--initial-step: only with --wave (expected --wave K)");
+    if (orbits_args.no_stability) throw BadInput("--no-stability: only with --wave (expected --wave K)");
+    if (orbits_args.stability) throw BadInput("--stability: only with --wave (expected --wave K)");
+    const Format format = orbits_args.format.parse();
+    const std::string prefix = orbits_args.out.given() ? orbits_args.out.prepare("orbits", {".csv", ".json"}) : std::string();
+    const std::string svg_file = orbits_args.svg.empty() ? std::string() : output_file("--svg", orbits_args.svg);
     PeriodicOrbitOptions o;
-    const std::string& par = args.problem.par;
+    const std::string& par = orbits_args.problem.par;
     o.parameter = par;
-    const int hopf_index = static_cast<int>(parse_integer("--hopf", args.hopf, 0, 1000000, "an integer >= 0"));
-    o.degree = static_cast<int>(parse_integer("--degree", args.degree, 1, 20, "an integer between 1 and 20"));
-    o.intervals = static_cast<int>(parse_integer("--intervals", args.intervals, 2, 10000, "an integer between 2 and 10000"));
-    o.max_points = static_cast<int>(parse_integer("--points", args.points, 2, 100000, "an integer between 2 and 100000"));
-    o.adapt = args.adapt;
-    if (!args.max_step.empty()) {
-        o.max_step = parse_number("--max-step", args.max_step);
+    const int hopf_index = static_cast<int>(parse_integer("--hopf", orbits_args.hopf, 0, 1000000, "an integer >= 0"));
+    o.degree = static_cast<int>(parse_integer("--degree", orbits_args.degree, 1, 20, "an integer between 1 and 20"));
+    o.intervals = static_cast<int>(parse_integer("--intervals", orbits_args.intervals, 2, 10000, "an integer between 2 and 10000"));
+    o.max_points = static_cast<int>(parse_integer("--points", orbits_args.points, 2, 100000, "an integer between 2 and 100000"));
+    o.adapt = orbits_args.adapt;
+    if (!orbits_args.max_step.empty()) {
+        o.max_step = parse_number("--max-step", orbits_args.max_step);
         if (!(o.max_step >= o.initial_step && o.max_step <= 1e6))
-            throw BadInput("--max-step = '" + args.max_step + "': expected a value from " + rounded(o.initial_step, 6) +
+            throw BadInput("--max-step = '" + orbits_args.max_step + "': expected a value from " + rounded(o.initial_step, 6) +
                            " (the first step) to 1e6");
     }
 
-    NonlinearProblemArgs::Problem built = args.problem.load();  // --from != --to checked there
+    NonlinearProblemArgs::Problem built = orbits_args.problem.load();  // --from != --to checked there
     o.from = built.from;
     o.to = built.to;
     const std::vector<std::string>& variables = built.variables;
     int variable = 0;
-    if (!args.variable.empty()) {
-        const auto it = std::find(variables.begin(), variables.end(), args.variable);
+    if (!orbits_args.variable.empty()) {
+        const auto it = std::find(variables.begin(), variables.end(), orbits_args.variable);
         if (it == variables.end()) {
             std::string known;
             for (const auto& v : variables) known += (known.empty() ? "" : ", ") + v;
-            throw BadInput("--variable = '" + args.variable + "': expected one of " + known);
+            throw BadInput("--variable = '" + orbits_args.variable + "': expected one of " + known);
         }
         variable = static_cast<int>(it - variables.begin());
     }
     JsonObject& inputs = built.inputs;
     inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf_index).integer("degree", o.degree)
         .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
-    if (!args.max_step.empty()) inputs.number("max_step", o.max_step);  // only when given: the Python binding's envelope has no step option yet
+    if (!orbits_args.max_step.empty()) inputs.number("max_step", o.max_step);  // only when given: the Python binding's envelope has no step option yet
 
     EquilibriumBranchOptions eo;
     eo.parameter = par;
@@ -125,10 +120,10 @@ int run_orbits() {
     const EquilibriumBranch eq = equilibrium_branch(*built.system, built.guess, eo);
     eo.progress = nullptr;  // ends an open progress line
     if (eq.hopf.empty())
-        throw BadInput("no Hopf point on the equilibrium branch in " + par + " from " + args.problem.from + " to " + args.problem.to +
+        throw BadInput("no Hopf point on the equilibrium branch in " + par + " from " + orbits_args.problem.from + " to " + orbits_args.problem.to +
                        " (ended: " + to_string(eq.stop) + "): expected at least one to start the periodic orbits from");
     if (hopf_index >= static_cast<int>(eq.hopf.size()))
-        throw BadInput("--hopf = '" + args.hopf + "': expected an index from 0 to " + std::to_string(eq.hopf.size() - 1) + " (the branch has " +
+        throw BadInput("--hopf = '" + orbits_args.hopf + "': expected an index from 0 to " + std::to_string(eq.hopf.size() - 1) + " (the branch has " +
                        std::to_string(eq.hopf.size()) + " Hopf point" + (eq.hopf.size() == 1 ? "" : "s") + ")");
     const HopfPoint& h = eq.hopf[static_cast<std::size_t>(hopf_index)];
     o.progress = branch_progress_printer("orbits", "orbits", par, false);
@@ -160,7 +155,7 @@ int run_orbits() {
         const std::string vunit = built.units.count(variables[static_cast<std::size_t>(variable)]) ? built.units.at(variables[static_cast<std::size_t>(variable)]) : std::string();
         std::ostringstream title;
         title << "Periodic orbits from the Hopf point at " << par << " = " << rounded(h.par, 6);
-        if (!args.problem.model.empty()) title << ", " << args.problem.model << " ring of " << args.problem.ring << " cars";
+        if (!orbits_args.problem.model.empty()) title << ", " << orbits_args.problem.model << " ring of " << orbits_args.problem.ring << " cars";
         files.push_back({svg_file, bifurcation_svg(&eq, b, variable, variables[static_cast<std::size_t>(variable)], vunit, punit, title.str())});
     }
     if (!files.empty()) write_files_atomic(files);

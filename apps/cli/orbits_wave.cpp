@@ -15,14 +15,6 @@
 
 namespace ddemap::cli {
 
-namespace {
-std::string pad(std::string s, std::size_t w) {
-    if (s.size() < w) s.resize(w, ' ');
-    else s += ' ';
-    return s;
-}
-}  // namespace
-
 std::string crossing_lines(const OrbitBranch& b) {
     std::ostringstream out;
     const std::string& par = b.parameter;

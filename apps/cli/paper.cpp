@@ -14,24 +14,24 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct PaperArgs {
     FormatArg format;
     OutArg out;
-} args;
+} paper_args;
 }  // namespace
 
 void add_paper_flags(CLI::App& app) {
-    args.out.add_to(app,
+    paper_args.out.add_to(app,
                     "PREFIX.svg (the diagrams), PREFIX.json, PREFIX-classification.csv/.json/.svg, PREFIX-panelK.csv, "
                     "PREFIX-panelK-boundaries.csv, PREFIX-growth.csv/.svg (a folder DIR: DIR/paper...)",
                     true);
-    args.format.add_to(app, {Format::Table, Format::Json});
+    paper_args.format.add_to(app, {Format::Table, Format::Json});
     run_flags().add_to(app, false);
 }
 
 int run_paper() {
-    const Format format = args.format.parse();
-    const std::string prefix = args.out.prepare("paper", {".svg", ".json", "-classification.csv", "-classification.json", "-classification.svg", "-growth.csv", "-growth.svg"});
+    const Format format = paper_args.format.parse();
+    const std::string prefix = paper_args.out.prepare("paper", {".svg", ".json", "-classification.csv", "-classification.json", "-classification.svg", "-growth.csv", "-growth.svg"});
     const PaperJob job = run_paper_job(builtin_paper_toml, "maps/paper.toml", builtin_classification_toml, "maps/classification.toml", {},
                                        progress_printer("paper", "steps"));
     JsonEnvelope e;

@@ -23,18 +23,18 @@ namespace ddemap::cli {
 
 namespace {
 
-struct Args {
+struct RootsArgs {
     ModelArgs model;
     RingArg ring;
     std::string count = "6", system, fleet, pattern, cars, length, solver = "auto", degree = "0", ring_method = "auto";
     FormatArg format;
     OutArg out;
-} args;
+} roots_args;
 
-int parse_count() { return static_cast<int>(parse_integer("--count", args.count, 1, 10000, "an integer between 1 and 10000")); }
+int parse_count() { return static_cast<int>(parse_integer("--count", roots_args.count, 1, 10000, "an integer between 1 and 10000")); }
 
 int parse_degree() {
-    const int d = static_cast<int>(parse_integer("--degree", args.degree, 0, 200, "0 (automatic) or an integer 2..200"));
+    const int d = static_cast<int>(parse_integer("--degree", roots_args.degree, 0, 200, "0 (automatic) or an integer 2..200"));
     if (d == 1) throw BadInput("--degree = '1': expected 0 (automatic) or an integer 2..200");
     return d;
 }
@@ -53,21 +53,21 @@ void emit(const JsonEnvelope& e, const std::string& csv, const std::string& tabl
 }
 
 int run_system(Format format, const std::string& prefix) {
-    if (args.model.given() || args.ring.given())
+    if (roots_args.model.given() || roots_args.ring.given())
         throw BadInput("--system takes the whole problem from the file: expected no model parameters, --model or --ring");
     RootOptions o;
     o.count = parse_count();
     o.degree = parse_degree();
-    o.method = root_method(args.solver);
+    o.method = root_method(roots_args.solver);
     if (o.method == "contour") throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
-    const std::string text = read_input_file("--system", args.system);
+    const std::string text = read_input_file("--system", roots_args.system);
     std::string equilibrium_json, equilibrium_line;
     Status eq_status = Status::Converged;
     const std::optional<LinearDDE> lin = [&] {
         if (!is_nonlinear_system_json(text)) {
             // every matrix is held dense (16 n^2 bytes each) and its norm taken by a full SVD
             // (about 64 n^2 bytes and 2e-9 n^3 s each, measured)
-            const LinearDdeShape shape = peek_linear_dde_json(text, args.system);
+            const LinearDdeShape shape = peek_linear_dde_json(text, roots_args.system);
             const double n = static_cast<double>(std::max(shape.dimension, 0L)), terms = static_cast<double>(shape.delays) + 1.0;
             const std::string what = "a " + std::to_string(shape.dimension) + "-state system with " + std::to_string(shape.delays) + (shape.delays == 1 ? " delay" : " delays");
             if (shape.sparse) {
@@ -78,10 +78,10 @@ int run_system(Format format, const std::string& prefix) {
                 check_size("roots", what, "memory", n * n * (16.0 * terms + 64.0));
                 check_size("roots", what, "time", 2e-9 * n * n * n * terms);
             }
-            return std::optional<LinearDDE>(read_linear_dde_json(text, args.system));
+            return std::optional<LinearDDE>(read_linear_dde_json(text, roots_args.system));
         }
         // a nonlinear file: its equilibrium by Newton from the file's guess, then the linearisation there
-        const NonlinearSystemFile file = read_nonlinear_system_json(text, args.system);
+        const NonlinearSystemFile file = read_nonlinear_system_json(text, roots_args.system);
         const EquilibriumResult eq = find_equilibrium(*file.system, file.equilibrium);
         eq_status = eq.status;
         equilibrium_json = equilibrium_result_json(eq);
@@ -96,12 +96,12 @@ int run_system(Format format, const std::string& prefix) {
         // no equilibrium: undecided, the Newton result printed
         JsonEnvelope e;
         e.command = "roots";
-        e.inputs = JsonObject().string("system", args.system).integer("count", o.count).integer("degree", o.degree).str();
+        e.inputs = JsonObject().string("system", roots_args.system).integer("count", o.count).integer("degree", o.degree).str();
         e.status = to_string(eq_status);
         e.message = "no equilibrium found from the guess";
         e.result = JsonObject().json("equilibrium", equilibrium_json).str();
         emit(e, roots_csv({}), equilibrium_line + "verdict    UNDECIDED (no equilibrium: " + to_string(eq_status) + ")\n", format, prefix);
-        std::cerr << "ddemap: undecided: " << args.system << ": Newton found no equilibrium from the guess (" << to_string(eq_status)
+        std::cerr << "ddemap: undecided: " << roots_args.system << ": Newton found no equilibrium from the guess (" << to_string(eq_status)
                   << "); give a better \"equilibrium\" guess in the file\n";
         return exit_not_converged;
     }
@@ -111,7 +111,7 @@ int run_system(Format format, const std::string& prefix) {
     const RootResult& r = s.roots;
     JsonEnvelope e;
     e.command = "roots";
-    e.inputs = JsonObject().string("system", args.system).integer("count", o.count).integer("degree", o.degree).str();
+    e.inputs = JsonObject().string("system", roots_args.system).integer("count", o.count).integer("degree", o.degree).str();
     e.has_solver = true;
     e.solver_given = solver_name(r.method_given);
     e.solver_used = solver_name(r.method_used);
@@ -120,7 +120,7 @@ int run_system(Format format, const std::string& prefix) {
     e.result = system_roots_json(dde, s);
     if (!equilibrium_json.empty()) e.result = JsonObject().json("equilibrium", equilibrium_json).json("linearisation", e.result).str();
     std::ostringstream out;
-    out << "system     " << args.system << " (dimension " << dde.dimension() << ", " << dde.delays().size() << " delays)\n";
+    out << "system     " << roots_args.system << " (dimension " << dde.dimension() << ", " << dde.delays().size() << " delays)\n";
     out << equilibrium_line;
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << (r.status == Status::Converged ? "trusted    " : "why not    ") << r.message << "\n";
@@ -136,25 +136,25 @@ int run_system(Format format, const std::string& prefix) {
 }
 
 int run_fleet(Format format, const std::string& prefix) {
-    auto raw = args.model.raw;
+    auto raw = roots_args.model.raw;
     const std::string speed = raw.count("speed") ? raw.at("speed") : "";
     raw.erase("speed");
-    if (!args.fleet.empty() && !args.pattern.empty()) throw BadInput("--fleet and --fleet-pattern: expected only one of them");
-    if (!args.system.empty() || !raw.empty() || args.model.model != "ovrv")
+    if (!roots_args.fleet.empty() && !roots_args.pattern.empty()) throw BadInput("--fleet and --fleet-pattern: expected only one of them");
+    if (!roots_args.system.empty() || !raw.empty() || roots_args.model.model != "ovrv")
         throw BadInput("--fleet/--fleet-pattern define the ring: expected no --system, --model or model parameters "
                        "(--speed or --length set the equilibrium, --ring the size of a pattern ring)");
-    if (args.ring.given() && !args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
-    const std::string ring_text = args.ring.given() ? args.ring.text : args.cars;
+    if (roots_args.ring.given() && !roots_args.cars.empty()) throw BadInput("--ring and --cars: expected only --ring (--cars is its old spelling)");
+    const std::string ring_text = roots_args.ring.given() ? roots_args.ring.text : roots_args.cars;
     // a file or a pattern, the same way in --fleet and --fleet-pattern (its old spelling);
     // --ring N repeats the cars to N
-    const std::string flag = args.fleet.empty() ? "--fleet-pattern" : "--fleet";
-    const std::string spec = args.fleet.empty() ? args.pattern : args.fleet;
+    const std::string flag = roots_args.fleet.empty() ? "--fleet-pattern" : "--fleet";
+    const std::string spec = roots_args.fleet.empty() ? roots_args.pattern : roots_args.fleet;
     RingArg n;
     n.text = ring_text;
     const Fleet fleet = fleet_argument(flag, spec, ring_text.empty() ? 0 : n.parse(false));
     MixedRingOptions o;
-    set_equilibrium(o, speed, args.length);
-    o.roots.method = root_method(args.solver);
+    set_equilibrium(o, speed, roots_args.length);
+    o.roots.method = root_method(roots_args.solver);
     o.roots.count = parse_count();
     o.roots.degree = parse_degree();
     o.roots.progress = root_progress();
@@ -163,7 +163,7 @@ int run_fleet(Format format, const std::string& prefix) {
     JsonEnvelope e;
     e.command = "roots";
     JsonObject in;
-    in.string(args.fleet.empty() ? "fleet_pattern" : "fleet", spec)
+    in.string(roots_args.fleet.empty() ? "fleet_pattern" : "fleet", spec)
         .integer("ring", static_cast<long long>(fleet.size()));
     equilibrium_inputs(in, o);
     in.integer("count", o.roots.count).integer("degree", o.roots.degree);
@@ -201,14 +201,14 @@ int run_fleet(Format format, const std::string& prefix) {
 }
 
 int run_ring(Format format, const std::string& prefix) {
-    if (args.solver != "auto" || args.degree != "0" || !args.length.empty() || !args.cars.empty())
+    if (roots_args.solver != "auto" || roots_args.degree != "0" || !roots_args.length.empty() || !roots_args.cars.empty())
         throw BadInput("--solver, --degree, --length and --cars go with --fleet, --fleet-pattern or --system; a ring of identical cars "
                        "takes --ring-method");
-    const auto model = args.model.build();
-    const std::string given = parse_ring_method(args.ring_method);
+    const auto model = roots_args.model.build();
+    const std::string given = parse_ring_method(roots_args.ring_method);
     const Linearisation lin = model->linearise();
     const std::string method = resolve_ring_method(given, lin);
-    const int cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
+    const int cars = roots_args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
     const int count = parse_count();
     // N = inf: the wave numbers of the scan, then the steps of the search for --count roots at the abscissa's
     const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", cars == 0 ? "wave numbers" : "modes"),
@@ -269,43 +269,43 @@ int run_ring(Format format, const std::string& prefix) {
 }  // namespace
 
 void add_roots_flags(CLI::App& app) {
-    args.model.add_to(app);
-    args.ring.add_to(app, "22",
+    roots_args.model.add_to(app);
+    roots_args.ring.add_to(app, "22",
                      "ring size N >= 2 (at most 10^9 when the car reacts only to the car ahead: one winding pass, milliseconds; "
                      "the per-mode path, at most 10^6, takes about 0.3 ms per mode), or inf for all wave numbers; "
                      "with --fleet: the number of cars, the fleet repeated (default: the fleet once)");
-    app.add_option("--count", args.count, "how many rightmost roots to list")->capture_default_str();
-    app.add_option("--system", args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
-    app.add_option("--fleet", args.fleet,
+    app.add_option("--count", roots_args.count, "how many rightmost roots to list")->capture_default_str();
+    app.add_option("--system", roots_args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
+    app.add_option("--fleet", roots_args.fleet,
                    "a mixed ring: a CSV file (a fleet table: vehicle and/or model, parameters, optional count; or a vehicle table "
                    "name,k1,k2,th,tau[,eta] as calibrate writes; see README) or built-in names \"A_min,C_max*3,E_min\"; repeated to --ring cars");
-    app.add_option("--fleet-pattern", args.pattern, "the same as --fleet (kept for old scripts)");
-    app.add_option("--cars", args.cars, "old spelling of --ring for --fleet-pattern")->group("");
-    app.add_option("--length", args.length, "fleet: ring length [m] (sum of the gaps); the speed follows");
-    app.add_option("--solver", args.solver,
+    app.add_option("--fleet-pattern", roots_args.pattern, "the same as --fleet (kept for old scripts)");
+    app.add_option("--cars", roots_args.cars, "old spelling of --ring for --fleet-pattern")->group("");
+    app.add_option("--length", roots_args.length, "fleet: ring length [m] (sum of the gaps); the speed follows");
+    app.add_option("--solver", roots_args.solver,
                    "--fleet: auto (product: the argument principle on det Delta, for cars that react to the car ahead and "
                    "connected cruise control cars that react to the car two ahead too), product, dense or sparse; "
                    "--system: auto (dense up to 16 states), dense or sparse")
         ->capture_default_str();
-    app.add_option("--ring-method", args.ring_method,
+    app.add_option("--ring-method", roots_args.ring_method,
                    "a ring of identical cars: auto (winding when the car reacts only to the car ahead, else modes), winding "
                    "(verdict, counts and abscissa from one certified winding pass whatever N) or modes (every mode on its own)")
         ->capture_default_str()
         ->type_name("auto|winding|modes");
-    app.add_option("--degree", args.degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")
+    app.add_option("--degree", roots_args.degree, "--fleet (dense and sparse paths) and --system (sparse path): collocation degree M (0 = automatic)")
         ->capture_default_str();
-    args.format.add_to(app);
+    roots_args.format.add_to(app);
     run_flags().add_to(app, true);
-    args.out.add_to(app, "PREFIX.csv (the roots) and PREFIX.json", false);
+    roots_args.out.add_to(app, "PREFIX.csv (the roots) and PREFIX.json", false);
 }
 
 int run_roots() {
-    const Format format = args.format.parse();
-    const std::string prefix = args.out.given() ? args.out.prepare("roots", {".csv", ".json"}) : std::string();
-    if ((!args.fleet.empty() || !args.pattern.empty() || !args.system.empty()) && args.ring_method != "auto")
-        throw BadInput("--ring-method = '" + args.ring_method + "' goes with a ring of identical cars; --fleet and --system take --solver");
-    if (!args.fleet.empty() || !args.pattern.empty()) return run_fleet(format, prefix);
-    if (!args.system.empty()) return run_system(format, prefix);
+    const Format format = roots_args.format.parse();
+    const std::string prefix = roots_args.out.given() ? roots_args.out.prepare("roots", {".csv", ".json"}) : std::string();
+    if ((!roots_args.fleet.empty() || !roots_args.pattern.empty() || !roots_args.system.empty()) && roots_args.ring_method != "auto")
+        throw BadInput("--ring-method = '" + roots_args.ring_method + "' goes with a ring of identical cars; --fleet and --system take --solver");
+    if (!roots_args.fleet.empty() || !roots_args.pattern.empty()) return run_fleet(format, prefix);
+    if (!roots_args.system.empty()) return run_system(format, prefix);
     return run_ring(format, prefix);
 }
 

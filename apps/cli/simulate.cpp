@@ -15,42 +15,42 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct SimulateArgs {
     std::string fleet, on_event = "continue", t_end = "0", step = "0.05", output_dt = "0.1";
     LeadArgs lead;
     FormatArg format;
     OutArg out;
-} args;
+} simulate_args;
 }  // namespace
 
 void add_simulate_flags(CLI::App& app) {
-    app.add_option("--fleet", args.fleet,
+    app.add_option("--fleet", simulate_args.fleet,
                    "followers in platoon order: built-in names with repeats (A_min*7,C_max) or a CSV file: a vehicle table "
                    "name,k1,k2,th,tau[,eta][,min_acc_speed] (as calibrate writes) or a fleet table of ovrv cars (as roots --fleet)");
-    args.lead.add_to(app);
-    args.out.add_to(app, "PREFIX.csv (time series), PREFIX.json, PREFIX.svg (speeds)", true);
-    app.add_option("--on-event", args.on_event, "stop or continue at the first disengagement or collision")->capture_default_str();
-    app.add_option("--t-end", args.t_end, "end time [s] (0: the profile's last breakpoint + 30 s)")->capture_default_str();
-    app.add_option("--step", args.step, "largest integration step [s]")->capture_default_str();
-    app.add_option("--output-dt", args.output_dt, "output sampling [s]")->capture_default_str();
-    args.format.add_to(app);
+    simulate_args.lead.add_to(app);
+    simulate_args.out.add_to(app, "PREFIX.csv (time series), PREFIX.json, PREFIX.svg (speeds)", true);
+    app.add_option("--on-event", simulate_args.on_event, "stop or continue at the first disengagement or collision")->capture_default_str();
+    app.add_option("--t-end", simulate_args.t_end, "end time [s] (0: the profile's last breakpoint + 30 s)")->capture_default_str();
+    app.add_option("--step", simulate_args.step, "largest integration step [s]")->capture_default_str();
+    app.add_option("--output-dt", simulate_args.output_dt, "output sampling [s]")->capture_default_str();
+    simulate_args.format.add_to(app);
     run_flags().add_to(app, true);
 }
 
 int run_simulate() {
-    if (args.fleet.empty()) throw BadInput("--fleet is required (e.g. --fleet A_min*7 or --fleet cars.csv)");
-    const Format format = args.format.parse();
+    if (simulate_args.fleet.empty()) throw BadInput("--fleet is required (e.g. --fleet A_min*7 or --fleet cars.csv)");
+    const Format format = simulate_args.format.parse();
     SimOptions o;
-    o.step = parse_number("--step", args.step);
-    o.t_end = parse_number("--t-end", args.t_end);
-    o.output_dt = parse_number("--output-dt", args.output_dt);
-    if (args.on_event == "stop") o.on_event = OnEvent::Stop;
-    else if (args.on_event != "continue") throw BadInput("--on-event = '" + args.on_event + "': expected stop or continue");
+    o.step = parse_number("--step", simulate_args.step);
+    o.t_end = parse_number("--t-end", simulate_args.t_end);
+    o.output_dt = parse_number("--output-dt", simulate_args.output_dt);
+    if (simulate_args.on_event == "stop") o.on_event = OnEvent::Stop;
+    else if (simulate_args.on_event != "continue") throw BadInput("--on-event = '" + simulate_args.on_event + "': expected stop or continue");
     o.validate();
-    const std::string prefix = args.out.prepare("simulate");
+    const std::string prefix = simulate_args.out.prepare("simulate");
     std::string label;
-    const LeadProfile lead = args.lead.parse(label);
-    const std::vector<SimCar> cars = platoon_from(vehicles_argument("--fleet", args.fleet));
+    const LeadProfile lead = simulate_args.lead.parse(label);
+    const std::vector<SimCar> cars = platoon_from(vehicles_argument("--fleet", simulate_args.fleet));
     const SimEstimate size = estimate_simulation(lead, cars, o);
     const std::string what = std::to_string(cars.size()) + " followers over " + rounded(size.t_end, 6) + " s (" +
                              rounded(size.steps, 3) + " steps)";
@@ -62,9 +62,9 @@ int run_simulate() {
     JsonEnvelope e;
     e.command = "simulate";
     e.inputs = JsonObject()
-                   .string("fleet", args.fleet)
+                   .string("fleet", simulate_args.fleet)
                    .string("lead", label)
-                   .string("on_event", args.on_event)
+                   .string("on_event", simulate_args.on_event)
                    .number("t_end", o.t_end)
                    .number("step", o.step)
                    .number("output_dt", o.output_dt)

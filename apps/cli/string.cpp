@@ -18,40 +18,40 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct StringArgs {
     ModelArgs model;
     RingArg ring;
     std::string ring_method = "auto";
     FormatArg format;
     OutArg out;
-} args;
+} string_args;
 }  // namespace
 
 void add_string_flags(CLI::App& app) {
-    args.model.add_to(app);
-    args.ring.add_to(app, "", "also decide ring stability for N cars (N >= 2 or inf; at most 10^9 on the winding path, 10^6 on the per-mode path)");
-    app.add_option("--ring-method", args.ring_method,
+    string_args.model.add_to(app);
+    string_args.ring.add_to(app, "", "also decide ring stability for N cars (N >= 2 or inf; at most 10^9 on the winding path, 10^6 on the per-mode path)");
+    app.add_option("--ring-method", string_args.ring_method,
                    "with --ring: auto (winding when the car reacts only to the car ahead, else modes), winding or modes")
         ->capture_default_str()
         ->type_name("auto|winding|modes");
-    args.format.add_to(app);
-    args.out.add_to(app, "PREFIX.csv and PREFIX.json", false);
+    string_args.format.add_to(app);
+    string_args.out.add_to(app, "PREFIX.csv and PREFIX.json", false);
     run_flags().add_to(app, false);
 }
 
 int run_string() {
-    const auto model = args.model.build();
-    const Format format = args.format.parse();
+    const auto model = string_args.model.build();
+    const Format format = string_args.format.parse();
     const Linearisation lin = model->linearise();
-    const std::string given = parse_ring_method(args.ring_method);
-    if (args.ring.empty() && given != "auto") throw BadInput("--ring-method = '" + given + "' goes with --ring: expected --ring N|inf too");
+    const std::string given = parse_ring_method(string_args.ring_method);
+    if (string_args.ring.empty() && given != "auto") throw BadInput("--ring-method = '" + given + "' goes with --ring: expected --ring N|inf too");
     std::optional<int> cars;
     std::string method;
-    if (!args.ring.empty()) {
+    if (!string_args.ring.empty()) {
         method = resolve_ring_method(given, lin);
-        cars = args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
+        cars = string_args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
     }
-    const std::string prefix = args.out.given() ? args.out.prepare("string", {".csv", ".json"}) : std::string();
+    const std::string prefix = string_args.out.given() ? string_args.out.prepare("string", {".csv", ".json"}) : std::string();
     const StringResult s = analyse_string(lin);
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;

@@ -15,7 +15,7 @@
 namespace ddemap::cli {
 
 namespace {
-struct Args {
+struct SweepArgs {
     ModelArgs model;
     RingArg ring;
     std::string x;
@@ -23,39 +23,39 @@ struct Args {
     std::string ring_curves = "auto";
     FormatArg format;
     OutArg out;
-} args;
+} sweep_args;
 }  // namespace
 
 void add_sweep_flags(CLI::App& app) {
-    args.model.add_to(app);
-    args.ring.add_to(app, "22", "ring size N >= 2 (at most 10^9; 10^6 with --ring-curves all), or inf");
-    args.out.add_to(app, "PREFIX.csv, PREFIX.json, PREFIX.svg, PREFIX-boundaries.csv", true);
-    app.add_option("--x", args.x, "which swept parameter is the horizontal axis (default: alphabetical)");
-    app.add_flag("--no-boundaries", args.no_boundaries, "skip the boundary continuation");
-    app.add_option("--ring-curves", args.ring_curves,
+    sweep_args.model.add_to(app);
+    sweep_args.ring.add_to(app, "22", "ring size N >= 2 (at most 10^9; 10^6 with --ring-curves all), or inf");
+    sweep_args.out.add_to(app, "PREFIX.csv, PREFIX.json, PREFIX.svg, PREFIX-boundaries.csv", true);
+    app.add_option("--x", sweep_args.x, "which swept parameter is the horizontal axis (default: alphabetical)");
+    app.add_flag("--no-boundaries", sweep_args.no_boundaries, "skip the boundary continuation");
+    app.add_option("--ring-curves", sweep_args.ring_curves,
                    "ring Hopf curves: all (every mode's), envelope (only the boundary of the ring-stable region, any N), auto (all up to 64 cars)")
         ->type_name("all|envelope|auto")
         ->capture_default_str();
-    args.format.add_to(app);
+    sweep_args.format.add_to(app);
     run_flags().add_to(app, true);
 }
 
 int run_sweep() {
-    const Format format = args.format.parse();
-    SweepSpec spec = sweep_spec(args.model, args.ring, args.x, true, 0);
-    const RingCurves ring_curves = parse_ring_curves_flag(args.ring_curves, spec);
+    const Format format = sweep_args.format.parse();
+    SweepSpec spec = sweep_spec(sweep_args.model, sweep_args.ring, sweep_args.x, true, 0);
+    const RingCurves ring_curves = parse_ring_curves_flag(sweep_args.ring_curves, spec);
     // every mode's curve needs every mode's root; the envelope is seeded from the winding sweep
-    if (!args.no_boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
+    if (!sweep_args.no_boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
     check_sweep_size(spec, "sweep", true);
-    const std::string prefix = args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
+    const std::string prefix = sweep_args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
     policy.progress = progress_printer("sweep", "rows");
     const SweepResult sw = run_sweep(spec, policy);
     BoundarySet b;
     BoundaryOptions bo;
     bo.ring_curves = ring_curves;
-    if (!args.no_boundaries) b = trace_boundaries(sw, bo);
-    const BoundarySet* bp = args.no_boundaries ? nullptr : &b;
+    if (!sweep_args.no_boundaries) b = trace_boundaries(sw, bo);
+    const BoundarySet* bp = sweep_args.no_boundaries ? nullptr : &b;
     ChartOptions co;
     co.title = "Stability chart: " + fixed_title(spec);
     co.columns = 1;
@@ -67,7 +67,7 @@ int run_sweep() {
     panel.boundaries = bp;
     JsonEnvelope e;
     e.command = "sweep";
-    e.inputs = sweep_inputs(spec).boolean("boundaries", !args.no_boundaries).string("ring_curves", ring_curves_name(ring_curves)).str();
+    e.inputs = sweep_inputs(spec).boolean("boundaries", !sweep_args.no_boundaries).string("ring_curves", ring_curves_name(ring_curves)).str();
     e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;
