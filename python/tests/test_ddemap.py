@@ -234,6 +234,7 @@ def test_mixed_ring():
     same_envelope(r, cli_json("roots", "--fleet", "A_min,E_max", "--ring", 6, "--length", 200, "--solver", "dense"))
 
 
+@pytest.mark.slow
 def test_equilibria(tmp_path):
     # x' = p - x(t - 1)^2: a fold at p = 0 and a Hopf point at p = (pi/4)^2
     system = tmp_path / "fold.json"
@@ -251,6 +252,7 @@ def test_equilibria(tmp_path):
     same_envelope(r, cli_json("equilibria", "--model", "idm", "--ring", 5, "--th", 1.2, "--tau", 0.6, "--par", "gap", "--from", 6, "--to", 40))
 
 
+@pytest.mark.slow
 def test_hopf(tmp_path):
     # Wright's equation: one supercritical Hopf point at alpha = pi/2 (closed forms: tests/cli/test_cli.sh)
     system = tmp_path / "wright.json"
@@ -267,6 +269,7 @@ def test_hopf(tmp_path):
         ddemap.hopf("alpha", 2, 1, system=system)
 
 
+@pytest.mark.slow
 def test_orbits():
     r = ddemap.orbits("headway", 2, 3.5, model="ov", ring=3, points=12)
     same_envelope(r, cli_json("orbits", "--model", "ov", "--ring", 3, "--par", "headway", "--from", 2, "--to", 3.5, "--points", 12))
@@ -285,6 +288,7 @@ def _tolerance(name):
     raise KeyError(name)
 
 
+@pytest.mark.slow
 def test_orbits_max_step():
     # max_step is the command's --max-step: the same envelope (inputs include it) ...
     ring = dict(model="ov", ring=3)
@@ -393,6 +397,7 @@ def test_ctrl_c_stops_a_long_sweep():
     assert stopped < 5, stopped  # the full sweep takes minutes
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_orbits_and_a_later_call_works():
     # SIGINT while the orbits are computed: the 10-car IDM ring's branch of 100 orbits, measured
     # uninterrupted first (CPU time of the main thread, where the library computes), is
@@ -415,6 +420,7 @@ def test_ctrl_c_stops_orbits_and_a_later_call_works():
     assert list(again["points"]["par"]) == list(branch["points"]["par"])
 
 
+@pytest.mark.slow
 def test_stability_chart_example(tmp_path):
     png = tmp_path / "chart.png"
     subprocess.run([sys.executable, os.path.join(SOURCE, "examples", "stability_chart.py"), str(png), "--count", "15"],
@@ -470,6 +476,7 @@ def _interrupted_after(call, fraction):
     return (full, *_interrupted_at(call, fraction * full))
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_a_long_mixed_ring():
     # a 300,000-car ring on the product path (contour counts of a few tenths of a second each),
     # interrupted a quarter into its work
@@ -484,6 +491,7 @@ def test_ctrl_c_stops_a_long_mixed_ring():
     assert ddemap.mixed_ring("A_min,C_max", ring=20, count=4)["ring_stable"] in (True, False)
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_a_long_system_roots(tmp_path):
     # a sparse circulant system x_i' = -x_i + 0.95 x_{i-1}(t - 1) of 6000 states, 200 roots (a
     # dense band of them, about 2.5 s): the sparse path's Arnoldi shifts, interrupted between shifts
@@ -500,6 +508,7 @@ def test_ctrl_c_stops_a_long_system_roots(tmp_path):
     assert took < 0.6 * full, (took, at, full)
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_dense_step_of_an_infinite_ring():
     # N = inf near the edge of the computable range: after a short scan of wave numbers, the search
     # for the 5 roots at the abscissa's wave number climbs from M = 22 to M = 400 in one dense degree (a

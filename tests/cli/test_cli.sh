@@ -22,6 +22,50 @@ PY
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
+# The tests come in parts (CLI_PARTS="basics files ...": only those; unset: all), so that ctest
+# runs them as separate tests (cli_<part>, tests/CMakeLists.txt), in parallel, fast or slow.
+part() { [ -z "${CLI_PARTS:-}" ] || [[ " $CLI_PARTS " == *" $1 "* ]]; }
+expect_error() {  # expect_error PATTERN args...
+    local pattern="$1"; shift
+    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
+    local rc=$?
+    if [ $rc -ne 2 ]; then bad "exit $rc (expected 2) for: $*"; return; fi
+    if [ -s "$tmp/o.txt" ]; then bad "stdout not empty for: $*"; return; fi
+    if [ "$(wc -l <"$tmp/e.txt")" -ne 1 ]; then bad "stderr not one line for: $*"; cat "$tmp/e.txt"; return; fi
+    if ! grep -q -- "$pattern" "$tmp/e.txt"; then bad "stderr lacks '$pattern' for: $*: $(cat "$tmp/e.txt")"; return; fi
+    ok
+}
+expect_code() {  # expect_code CODE args...
+    local code="$1"; shift
+    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
+    local rc=$?
+    [ $rc -eq "$code" ] && ok || bad "exit $rc (expected $code) for: $*: $(cat "$tmp/e.txt")"
+}
+rows() { awk '/^  #/{t=1; next} t && NF' "$1" | wc -l; }
+crlf() { python3 -c "import sys; t=sys.stdin.read().replace('\n','\r\n'); sys.stdout.buffer.write(b'\xef\xbb\xbf'+t.encode())" >"$1"; }
+ms_now() { echo $(( $(date +%s%N) / 1000000 )); }
+pgcount() {  # pgcount FILE REGEX: the number of lines of FILE matching REGEX
+    grep -c -E "$2" "$1"
+}
+# files that several parts read (made here, so that any part runs alone)
+excerpt="$(dirname "$0")/../data/openacc_excerpt_rav4_to_etron.csv"
+fio="$tmp/fio"
+mkdir -p "$fio"
+orb="$tmp/orbits"; mkdir -p "$orb"
+echo '{"variables": ["y"], "parameters": {"alpha": 1}, "equations": ["-alpha*y(t - 1)*(1 + y)"], "equilibrium": [0]}' >"$orb/wright.json"
+echo '{"variables": ["x"], "parameters": {"p": 1}, "equations": ["p - x(t - 1)^2"], "equilibrium": [1]}' >"$tmp/fold.json"
+echo '{"variables": ["y"], "parameters": {"alpha": 1, "b": 1}, "equations": ["-alpha*y(t - 1)*(1 + b*y)"]}' >"$tmp/wright.json"
+# a real 20-dimensional cyclic system
+python3 - >"$tmp/cyc.json" <<'PY'
+import json
+n = 20
+print(json.dumps({"dimension": n, "delays": [1.0, 0.4], "A0": {"triplets": [[i, i, -1.0] for i in range(n)]},
+                  "A": [{"triplets": [[i, (i - 1) % n, 0.9] for i in range(n)]}, {"triplets": [[i, (i + 1) % n, 0.3] for i in range(n)]}]}))
+PY
+# the calibration of the excerpt, for the parts that read what calibrate writes
+fixture_cal() { [ -s "$tmp/cal.csv" ] || "$bin" calibrate "$excerpt" --quiet --format json --out "$tmp/cal" >/dev/null 2>&1; }
+
+if part basics; then
 # roots --format json
 if "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring 22 --format json >"$tmp/r.json"; then
     json_has "$tmp/r.json" roots spectral_abscissa ring_stable degree && ok || bad "roots json keys"
@@ -71,16 +115,6 @@ for args in "roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1" \
 done
 
 # bad input: exit 2, one line on stderr naming the value, nothing on stdout
-expect_error() {  # expect_error PATTERN args...
-    local pattern="$1"; shift
-    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
-    local rc=$?
-    if [ $rc -ne 2 ]; then bad "exit $rc (expected 2) for: $*"; return; fi
-    if [ -s "$tmp/o.txt" ]; then bad "stdout not empty for: $*"; return; fi
-    if [ "$(wc -l <"$tmp/e.txt")" -ne 1 ]; then bad "stderr not one line for: $*"; cat "$tmp/e.txt"; return; fi
-    if ! grep -q -- "$pattern" "$tmp/e.txt"; then bad "stderr lacks '$pattern' for: $*: $(cat "$tmp/e.txt")"; return; fi
-    ok
-}
 expect_error "k1 = -0.5" roots --k1 -0.5 --k2 0.2 --th 1.5 --tau 0.1
 expect_error "tau = -1" roots --k1 0.5 --k2 0.2 --th 1.5 --tau -1
 expect_error "'abc'" roots --k1 abc --k2 0.2 --th 1.5 --tau 0.1
@@ -125,6 +159,9 @@ else
 fi
 expect_error "LO:HI" boundary --th 1.5 --tau 0.5 --k1 0.01:1:5 --k2 0.01:1 --out "$tmp/b2.csv"
 
+fi  # part basics
+
+if part classify; then
 # classify: built in, from a file, errors naming line and column
 "$bin" classify --format csv >"$tmp/c.csv" && [ "$(grep -c ',false,false,false,' "$tmp/c.csv")" -eq 0 ] && ok || bad "classify csv"
 [ "$(tail -n +2 "$tmp/c.csv" | wc -l)" -eq 14 ] && ok || bad "classify rows"
@@ -200,8 +237,10 @@ expect_error "badlead.csv:3: time_s = 0" simulate --fleet A_min --lead "$tmp/bad
 # growth
 "$bin" growth --format csv >"$tmp/g.csv" && head -1 "$tmp/g.csv" | grep -q '^name,position,speed_drop,amplification,min_gap,failure$' && ok || bad "growth csv"
 
+fi  # part classify
+
+if part calibrate; then
 # calibrate: an excerpt of real data (tests/data), JSON keys, the table goes into classify
-excerpt="$(dirname "$0")/../data/openacc_excerpt_rav4_to_etron.csv"
 if "$bin" calibrate "$excerpt" --format json --out "$tmp/cal" >"$tmp/cal.json"; then
     python3 -c "import json,sys; f=json.load(open('$tmp/cal.json'))['result']['fits'][0]; missing=[k for k in 'k1 k2 th tau eta rmse_speed rmse_gap status'.split() if k not in f]; sys.exit(1 if missing else 0)" && ok || bad "calibrate JSON keys"
     # the uncertainty keys scripts rely on: ci95 per parameter (lo <= value <= hi where given),
@@ -287,6 +326,9 @@ expect_error "expected at least one trace" calibrate
 touch "$tmp/notadir"
 expect_error "--report = '$tmp/notadir': the folder does not exist and cannot be created" calibrate "$excerpt" --report "$tmp/notadir"
 
+fi  # part calibrate
+
+if part system; then
 # roots --system: any linear DDE from JSON
 cat >"$tmp/sys.json" <<'JSON'
 {"dimension": 2, "delays": [1.0, 0.3], "A0": [[0, 0], [0, 0]],
@@ -301,12 +343,6 @@ expect_error "solver product goes with --fleet rings" roots --system "$tmp/sys.j
 printf '{"dimension": 1, "delays": [1], "A0": [[1e400]], "A": [[[0.5]]]}' >"$tmp/huge.json"
 expect_error "a number outside the range of doubles" roots --system "$tmp/huge.json"
 # a real 20-dimensional cyclic system: auto takes the sparse path; the dense path agrees
-python3 - >"$tmp/cyc.json" <<'PY'
-import json
-n = 20
-print(json.dumps({"dimension": n, "delays": [1.0, 0.4], "A0": {"triplets": [[i, i, -1.0] for i in range(n)]},
-                  "A": [{"triplets": [[i, (i - 1) % n, 0.9] for i in range(n)]}, {"triplets": [[i, (i + 1) % n, 0.3] for i in range(n)]}]}))
-PY
 "$bin" roots --system "$tmp/cyc.json" --count 6 --format json >"$tmp/cyc_s.json" &&
     "$bin" roots --system "$tmp/cyc.json" --count 6 --solver dense --format json >"$tmp/cyc_d.json" &&
     python3 - "$tmp/cyc_s.json" "$tmp/cyc_d.json" <<'PY' && ok || bad "roots --system: sparse (auto) against dense"
@@ -354,6 +390,9 @@ assert len(zs) >= 6, zs
 assert all(min(abs(z - w) for w in ref) < 1e-8 for z in zs), (zs, sorted(ref, key=lambda z: -z.real)[:8])
 PY
 
+fi  # part system
+
+if part fleet; then
 # mixed fleets: roots --fleet-pattern / --fleet, bad fleet files, mix
 "$bin" roots --fleet-pattern "A_min,E_min*2" --ring 12 --count 4 --format json >"$tmp/fleet.json" &&
     json_has "$tmp/fleet.json" roots spectral_abscissa ring_stable trivial_root_found product_residual strip_floor status degree_reason && ok || bad "roots --fleet-pattern json"
@@ -405,13 +444,10 @@ else bad "mix"; fi
 expect_error "p = 1.5" mix --x E_min --y A_min --ring 10 --p 0:1.5:3 --out "$tmp/mix2"
 [ ! -e "$tmp/mix2.csv" ] && ok || bad "mix wrote output after an error"
 
+fi  # part fleet
+
+if part exits; then
 # exit codes (README "Exit codes"): 0 success, 2 bad input, 3 internal error, 4 not converged, 5 write failed
-expect_code() {  # expect_code CODE args...
-    local code="$1"; shift
-    "$bin" "$@" >"$tmp/o.txt" 2>"$tmp/e.txt"
-    local rc=$?
-    [ $rc -eq "$code" ] && ok || bad "exit $rc (expected $code) for: $*: $(cat "$tmp/e.txt")"
-}
 expect_code 0 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1
 expect_code 2 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --format xml
 DDEMAP_TEST_FAULT=internal expect_code 3 string --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1
@@ -458,7 +494,6 @@ expect_error "--ring = 'inf'" mix --x E_min --y A_min --ring inf --out "$tmp/mix
 
 # verdicts (issue 15): the low-frequency boundary, tiny delays, the computable range, MARGINAL,
 # --count on every path, UNDECIDED with its reason on stderr and exit 4
-rows() { awk '/^  #/{t=1; next} t && NF' "$1" | wc -l; }
 "$bin" string --k1 0.2 --k2 0.6423077 --th 1.5 --tau 0.2 --ring inf --format json >"$tmp/v1.json" && python3 - "$tmp/v1.json" <<'PY' && ok || bad "string at c2 = +4e-9: stable, positive margin"
 import json, sys
 r = json.load(open(sys.argv[1]))["result"]
@@ -511,6 +546,7 @@ printf '{"dimension": 1, "delays": [1.0], "A0": [[0.0]], "A": [[[-1.570796326794
     ok || bad "roots --fleet-pattern --count 2"
 
 # classify with the covariance calibrate writes: verdicts with probabilities, margins' intervals
+fixture_cal
 if [ -s "$tmp/cal.csv" ] || { bad "calibrate wrote no cal.csv"; false; }; then
     head -1 "$tmp/cal.csv" | grep -q ',cov_k1_k1,cov_k1_k2,' && ok || bad "calibrate csv covariance columns"
     "$bin" classify "$tmp/cal.csv" --samples 400 --ring-samples 20 >"$tmp/cu.txt" && grep -Eq 'string (UNSTABLE|stable) \(p [<>=] ' "$tmp/cu.txt" && ok || bad "classify with covariance: table verdict with p"
@@ -538,9 +574,10 @@ for c in roots string sweep boundary; do
 done
 "$bin" --help >/dev/null && ok || bad "--help"
 
+fi  # part exits
+
+if part files; then
 # ---- files in and out (issue 15) ---------------------------------------------------------------
-fio="$tmp/fio"
-mkdir -p "$fio"
 rootsargs="--k1 0.2 --k2 0.4 --th 1.5 --tau 0.3"
 # a full stdout is a write error with the system's reason (exit 5), in every format
 for fmt in table json csv; do
@@ -610,7 +647,6 @@ expect_error "VEHICLES = '$fio' is a folder, expected a file" classify "$fio"
 expect_error "is a folder, expected a file" roots --system "$fio"
 expect_error "is a folder, expected a file" chart "$fio" --out "$fio/c"
 expect_error "is a folder, expected a file" calibrate "$fio"
-crlf() { python3 -c "import sys; t=sys.stdin.read().replace('\n','\r\n'); sys.stdout.buffer.write(b'\xef\xbb\xbf'+t.encode())" >"$1"; }
 printf 'name,k1,k2,th,tau,eta\nmine,0.2,0.4,1.5,0.3,10\n' | crlf "$fio/v.csv"
 "$bin" classify "$fio/v.csv" --format csv | grep -q '^mine,0.2' && ok || bad "classify: BOM + CRLF"
 "$bin" simulate --fleet "$fio/v.csv" --out "$fio/sim" >/dev/null && ok || bad "simulate: BOM + CRLF"
@@ -653,6 +689,9 @@ fi
 printf 'vehicle,model,k1,k2,th,tau,k3,tau2\n,ccc,0.1,0.3,1.2,0.4,0.2,0.1\n' >"$fio/ccc.csv"
 expect_error "has model 'ccc': expected ovrv cars" classify "$fio/ccc.csv"
 
+fi  # part files
+
+if part nonlinear; then
 # ---- one consistent command line: help and errors -----------------------------------------------
 for c in roots string classify sweep boundary chart paper simulate growth calibrate mix equilibria; do
     "$bin" $c --help >"$fio/h.txt" 2>&1
@@ -711,7 +750,6 @@ expect_error "character 4: unknown name 'y'" equilibria --system "$tmp/bad2.json
 echo '{"variables": ["x"], "parameters": {"a": 1}, "equations": ["-a*(x + 1"]}' >"$tmp/bad3.json"
 expect_error "character 10: the expression ends early: expected ')'" equilibria --system "$tmp/bad3.json" --par a --from 0 --to 1 --out "$tmp/eqbad"
 [ ! -e "$tmp/eqbad.csv" ] && [ ! -e "$tmp/eqbad.json" ] && ok || bad "equilibria bad input wrote files"
-echo '{"variables": ["x"], "parameters": {"p": 1}, "equations": ["p - x(t - 1)^2"], "equilibrium": [1]}' >"$tmp/fold.json"
 expect_error "parameter 'q' is not a parameter of this system: expected one of p" equilibria --system "$tmp/fold.json" --par q --from 0 --to 1
 expect_error "expected one of --system FILE or --model ov" equilibria --system "$tmp/fold.json" --model ov --par p --from 0 --to 1
 expect_error "--model = 'ccc'" equilibria --model ccc --ring 5 --par v0 --from 0 --to 1
@@ -807,6 +845,7 @@ DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:6 --k
 [ ! -s "$tmp/e.txt" ] && ok || bad "--quiet still printed: $(cat "$tmp/e.txt")"
 
 # calibrate's CSV carries the bounds the fit used; classify samples within them (not calibrate's defaults)
+fixture_cal
 if "$bin" calibrate "$excerpt" --bounds k1=0:2,tau=0.1:0.9 --out "$tmp/calb" >/dev/null 2>&1 || [ $? -eq 4 ]; then
     head -1 "$tmp/calb.csv" | grep -q ',cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta$' && ok || bad "calibrate csv bounds columns"
     sed -n 2p "$tmp/calb.csv" | grep -q ',0,2,0,1,0,3,0.10000000000000001,0.90000000000000002,5,15$' && ok || bad "calibrate csv bounds values"
@@ -847,12 +886,14 @@ printf 'name,k1,k2,th,tau\nedge,19.5,0.2,1.5,0.2\n' >"$crd/edge.csv"
 rm -rf "$crd/edge" "$crd/edge.csv"
 [ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
 
+fi  # part nonlinear
+
+if part hopf; then
 # ---- hopf: Hopf points with their criticality, and Hopf curves in two parameters ----------------
 "$bin" hopf --help >"$tmp/hh.txt" 2>&1
 grep -q ' TEXT' "$tmp/hh.txt" && bad "hopf --help has an option without its kind: $(grep ' TEXT' "$tmp/hh.txt" | head -1)" || ok
 # Wright's equation y' = -alpha y(t - 1) (1 + y): Hopf at alpha = omega = pi/2, supercritical,
 # L1 = -2 (3 pi - 2) / (5 (4 + pi^2)), max - min ~ 4 sqrt(10 (alpha - pi/2) / (3 pi - 2)) (Chow and Mallet-Paret)
-echo '{"variables": ["y"], "parameters": {"alpha": 1, "b": 1}, "equations": ["-alpha*y(t - 1)*(1 + b*y)"]}' >"$tmp/wright.json"
 if "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --format json --out "$tmp/hw" >"$tmp/hw.out"; then
     json_has "$tmp/hw.out" parameter hopf && ok || bad "hopf json keys"
     python3 - "$tmp/hw.out" "$tmp/hw.csv" <<'PY' && ok || bad "hopf: Wright's equation against the closed forms"
@@ -951,10 +992,11 @@ wnd="$tmp/winding"; mkdir -p "$wnd"
     ok || bad "sweep with boundaries: per-mode roots"
 rm -rf "$wnd"
 
+fi  # part hopf
+
+if part orbits; then
 # ---- orbits: periodic orbits from a Hopf point (Wright's equation y' = -alpha y(t-1)(1 + y): Hopf at
 # alpha = pi/2 with period 4; the orbits exist for alpha > pi/2 and are stable)
-orb="$tmp/orbits"; mkdir -p "$orb"
-echo '{"variables": ["y"], "parameters": {"alpha": 1}, "equations": ["-alpha*y(t - 1)*(1 + y)"], "equilibrium": [0]}' >"$orb/wright.json"
 if "$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --points 8 --format json --out "$orb/w" --svg "$orb/w.svg" >"$orb/w.out"; then
     json_has "$orb/w.out" points folds period_doublings tori && ok || bad "orbits json keys"
     python3 - "$orb/w.out" "$orb/w.csv" <<'PY' && ok || bad "orbits: Wright's branch (period -> 4, stable, alpha > pi/2)"
@@ -983,9 +1025,11 @@ expect_error "--intervals" orbits --system "$orb/wright.json" --par alpha --from
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits bad input wrote files: $(ls "$orb")"
 "$bin" orbits --help >"$orb/h.txt" 2>&1 && ! grep -q ' TEXT' "$orb/h.txt" && ok || bad "orbits --help has an option without its kind"
 
+fi  # part orbits
+
+if part rings; then
 # roots/string --ring: verdict, counts and abscissa from the winding pass (cost independent of N)
 rwd="$tmp/ringwind"; mkdir -p "$rwd"
-ms_now() { echo $(( $(date +%s%N) / 1000000 )); }
 for n in 1000000 1000000000; do
     t0=$(ms_now)
     "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring "$n" --format json >"$rwd/r$n.json" 2>/dev/null &&
@@ -1097,12 +1141,12 @@ OMP_NUM_THREADS=1 "$bin" roots --fleet "$ccwd/ccc.csv" --count 8 --format json >
     cmp -s "$ccwd/p1.json" "$ccwd/p2.json" && ok || bad "roots --fleet with ccc cars: output depends on the number of threads"
 rm -rf "$ccwd"
 
+fi  # part rings
+
+if part progress; then
 # ---- progress of equilibria, hopf and orbits on stderr (one line per finished point when stderr
 # is a file, none with --quiet), and SIGINT during orbits --out leaves the old set, nothing else
 pgd="$tmp/progress"; mkdir -p "$pgd"
-pgcount() {  # pgcount FILE REGEX: the number of lines of FILE matching REGEX
-    grep -c -E "$2" "$1"
-}
 DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 --format json >"$pgd/eq.json" 2>"$pgd/eq.err"
 n=$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['result']['points']))" "$pgd/eq.json" 2>/dev/null || echo none)
 [ "$(pgcount "$pgd/eq.err" "^ddemap: equilibria: points [0-9]+/$n, p = [-0-9.e]+ \(")" = "$n" ] && ! grep -q "ddemap:" "$pgd/eq.json" && ok ||
@@ -1144,6 +1188,9 @@ assert left == ["o.csv", "o.json", "o.svg"], left
 assert all(open(os.path.join(d, f)).read() == "old\n" for f in left)
 PY
 
+fi  # part progress
+
+if part waves; then
 # ---- orbits --wave: travelling waves of a ring in the reduced form (one car; the leader is the car
 # shifted by K T / N). The 3-car ov ring: the wave agrees with the full ring's branch from the same
 # Hopf point (fold headway, period), and the stability is the full ring's (N <= 10)
@@ -1179,6 +1226,9 @@ expect_error "--svg: not available with --wave" orbits --model ov --ring 5 --wav
 expect_error "--initial-step: only with --wave" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --initial-step 0.01
 [ -z "$(ls "$wav" | grep bad)" ] && ok || bad "orbits --wave bad input wrote files: $(ls "$wav")"
 
+fi  # part waves
+
+if part large; then
 # sweep and chart rings up to 10^9 cars on the winding tables; the per-mode path (--ring-curves all) stays at 10^6
 big="$tmp/bigring"; mkdir -p "$big"
 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000000000 --no-boundaries --out "$big/n" --format json >"$big/n.out" 2>/dev/null &&
@@ -1238,6 +1288,9 @@ PY
     bad "roots --system with complex triplets: not the dense path"
 rm -rf "$bsd"
 
+fi  # part large
+
+if part progress2; then
 # ---- progress of roots --fleet/--system (at most one line per contour count, shift or degree when
 # stderr is a file, at most one a second; none with --quiet), SIGINT during a long
 # roots --fleet --out leaves no output file and ends the process by the signal, and a branch's
@@ -1368,6 +1421,9 @@ PY
     bad "sweep with one uncertified point: $(cat "$spd/s1.err")"
 rm -rf "$spd"
 
+fi  # part progress2
+
+if part waves2; then
 # ---- orbits --wave: the resolution of the waves (defect between collocation points) ----
 wrs="$(mktemp -d)"
 # 100 cars per wave on 20 uniform intervals: the branch stops as unresolved, exit 4, every
@@ -1432,6 +1488,9 @@ expect_error "--initial-step = '0.5': expected a value from 1e-6 to 0.1 (the lar
 [ $? -ne 2 ] && ok || bad "orbits --wave --initial-step 0.5 --max-step 1: refused"
 rm -rf "$wms"
 
+fi  # part waves2
+
+if part mix; then
 # ---- mix: sized before any work (time, memory, output); refused in one line naming the rings and the limit
 mxd="$tmp/mixsize"; mkdir -p "$mxd"
 expect_error "101 arrangements of a 1000000-car ring (product path): estimated run time .* is above the limit 10 min (--allow-large runs it anyway)" \
@@ -1455,6 +1514,9 @@ assert len(steps) >= 2 and steps == sorted(set(steps)), steps
 assert "nan" not in open(sys.argv[1]).read().lower()
 PY
 
+fi  # part mix
+
+if part waves3; then
 # ---- orbits --wave on more than 10 cars: the full ring's multipliers by the matrix-free path (Arnoldi
 # on the monodromy applied by sparse sweeps); near the Hopf point of mode 10 the waves of 10 cars
 # are unstable on 100 cars; a verdict per wave, stable null when undecided; a progress line per wave
@@ -1480,6 +1542,9 @@ expect_error "--no-stability: only with --wave" orbits --system "$wms/wright.jso
 [ -z "$(ls "$wms" | grep bad)" ] && ok || bad "orbits --no-stability bad input wrote files"
 rm -rf "$wms"
 
+fi  # part waves3
+
+if part shortdelay; then
 # ---- large gains with a short delay: the certified short-delay path settles every mode (exit 0, M = 0, a verdict,
 # under 5 s); where a mode's listing still does not settle, the certified winding verdict is kept and the table is
 # marked UNSETTLED with exit 4 (never a bare verdict next to a non-converged status)
@@ -1526,6 +1591,9 @@ PY
 "$bin" orbits --help | grep -q -- "--ring N " && ! "$bin" orbits --help | grep -q "N|inf" && ok || bad "orbits --help: --ring offers inf, which it refuses"
 rm -rf "$r12"
 
+fi  # part shortdelay
+
+if part curves; then
 # ---- orbits --wave above 200 cars: the matrix-free multipliers only with --stability (minutes per wave)
 "$bin" orbits --model ov --ring 1000 --wave 100 --par headway --from 3.5 --to 2 --points 3 --quiet >"$tmp/w1000.txt" &&
     grep -q "^stability  not computed (more than 200 cars" "$tmp/w1000.txt" && ok || bad "orbits --wave --ring 1000: multipliers computed by default: $(grep stability "$tmp/w1000.txt")"
@@ -1576,6 +1644,8 @@ expect_error "string verdict (the low-frequency string condition) needs a law th
 expect_error "uses only the car ahead; this one uses 2 cars ahead" boundary --model ccc --th 1.5 --tau 0.5 --k3 0.2 --tau2 0.5 --k1 0.1:1 --k2 0.1:1 --ring-curves all --out "$env/x"
 [ ! -e "$env/x.csv" ] && ok || bad "a refused --ring-curves wrote files"
 rm -rf "$env"
+
+fi  # part curves
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

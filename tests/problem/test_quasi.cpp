@@ -58,7 +58,7 @@ TEST_CASE("argument-principle counts equal the number of collocation roots right
     CHECK(checked > 400);
 }
 
-TEST_CASE("real quasi-polynomials (counted along the upper half line) equal the collocation roots right of the line") {
+TEST_CASE("real quasi-polynomials (counted along the upper half line) equal the collocation roots right of the line" * doctest::test_suite("slow")) {
     // the plant D and ring mode N/2 (zeta = -1) have real coefficients: zeros_right_of samples
     // only Im >= 0 and doubles the change of arg (conjugate symmetry); the collocation roots are
     // the independent count

@@ -198,7 +198,7 @@ TEST_CASE("restarted and unrestarted compact Krylov runs give the same roots") {
     }
 }
 
-TEST_CASE("root_free_radius: no root of a dense computation lies in the disc, and the radius is the formulas'") {
+TEST_CASE("root_free_radius: no root of a dense computation lies in the disc, and the radius is the formulas'" * doctest::test_suite("slow")) {
     // random sparse systems: every root right of the dense path's certified floor is known.
     // The radius must (1) hold no root, (2) be at most the larger of the two bounds with the
     // exact s = sigma_min(Delta(z)), ||Delta'(z)|| and a = ||Delta(z)^{-1} Delta'(z)||, and (3) at

@@ -101,7 +101,7 @@ void check_same_curves(const BoundarySet& a, const BoundarySet& b) {
 
 }  // namespace
 
-TEST_CASE("envelope arcs lie on their modes' Hopf curves, the ones RingCurves::All traces (N = 22, 100)") {
+TEST_CASE("envelope arcs lie on their modes' Hopf curves, the ones RingCurves::All traces (N = 22, 100)" * doctest::test_suite("slow")) {
     for (int cars : {22, 100}) {
         CAPTURE(cars);
         SweepSpec spec = ddemap::test::ovrv_chart(41, cars, 1.5, 0.5);
@@ -135,7 +135,7 @@ TEST_CASE("envelope arcs lie on their modes' Hopf curves, the ones RingCurves::A
     }
 }
 
-TEST_CASE("at envelope points the per-mode ring analysis puts the crossing pair on the axis and every other mode left of it") {
+TEST_CASE("at envelope points the per-mode ring analysis puts the crossing pair on the axis and every other mode left of it" * doctest::test_suite("slow")) {
     for (int cars : {22, 100}) {
         CAPTURE(cars);
         const SweepSpec spec = ddemap::test::ovrv_chart(41, cars, 1.5, 0.5);

@@ -191,7 +191,7 @@ TEST_CASE("growth: one progress call per platoon, and Cancelled gives Status::Ca
     }
 }
 
-TEST_CASE("orbits --wave: one progress call per wave of the branch, and a throwing callback's exception reaches the caller") {
+TEST_CASE("orbits --wave: one progress call per wave of the branch, and a throwing callback's exception reaches the caller" * doctest::test_suite("slow")) {
     TravellingWaveOptions o;
     o.model = "ov";
     o.cars = 3;

@@ -232,7 +232,7 @@ double brute_arg(const RingDeterminant& d, cplx a, cplx b, int n) {
 
 }  // namespace
 
-TEST_CASE("argument principle: counts far into the left half-plane equal a uniform fine sampling of arg D") {
+TEST_CASE("argument principle: counts far into the left half-plane equal a uniform fine sampling of arg D" * doctest::test_suite("slow")) {
     // a 2-car ring with tau = 1: arg Gamma turns about once per 2 pi along vertical edges, so a
     // first step of an eighth of a long edge can skip a whole turn unless the step is capped
     // by the local rates (the first cell is such a case: it has no roots)

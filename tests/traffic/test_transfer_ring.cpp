@@ -286,7 +286,7 @@ double brute_arg(const TransferRingDeterminant& d, cplx a, cplx b) {
 
 }  // namespace
 
-TEST_CASE("transfer ring determinant: counts on a long ring next to its band of roots equal a fine uniform sampling of arg D") {
+TEST_CASE("transfer ring determinant: counts on a long ring next to its band of roots equal a fine uniform sampling of arg D" * doctest::test_suite("slow")) {
     // 300 cars in a random order: the unstable band holds many roots close together; rectangles
     // whose left edge runs just below the top of the band, where a step could jump over it
     std::mt19937 rng(300);
