@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
-scripts/install-deps.sh
+scripts/install-deps.sh all
 packages=(clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do

@@ -1,13 +1,23 @@
 #!/usr/bin/env bash
-# Installs the Debian packages ddemap needs to build and test. Idempotent: installs only
-# what is missing, and runs apt-get update only then.
+# Installs the Debian packages ddemap needs. Idempotent: installs only what is missing, and runs
+# apt-get update only then.
+# Usage: scripts/install-deps.sh [build|all]
+#   build: what building the library and the program needs (scripts/demo.sh)
+#   all (default): also the Python module and what the tests and figures use (scripts/test.sh)
 set -euo pipefail
-packages=(g++ make cmake python3 pkg-config
-          libeigen3-dev libspectra-dev libsuitesparse-dev doctest-dev
-          libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
-          libxml2-utils librsvg2-bin
-          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
-          libhdf5-dev libopenmpi-dev openmpi-bin python3-h5py hdf5-tools)  # ddemap atlas (HDF5, MPI)
+what=${1:-all}
+build=(g++ make cmake ninja-build pkg-config
+       libeigen3-dev libspectra-dev libsuitesparse-dev
+       libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
+       libhdf5-dev libopenmpi-dev openmpi-bin)  # ddemap atlas (HDF5, MPI)
+rest=(python3 doctest-dev libxml2-utils librsvg2-bin
+      pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv
+      python3-h5py hdf5-tools)
+case "$what" in
+    build) packages=("${build[@]}") ;;
+    all) packages=("${build[@]}" "${rest[@]}") ;;
+    *) echo "install-deps.sh: '$what': expected build or all" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -9,7 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-all}
-scripts/install-deps.sh
+scripts/install-deps.sh all
 launcher=()
 if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 if [ "$what" = all ] || [ "$what" = asan ]; then
