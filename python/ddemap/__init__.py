@@ -44,10 +44,11 @@ import numpy as _np
 
 from . import _ddemap
 
-__all__ = ["Result", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
+__all__ = ["__version__", "Result", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
            "mixed_ring", "equilibria", "hopf", "orbits", "version"]
 
 version = _ddemap.version
+__version__ = _ddemap.version
 
 
 class Result(dict):
