@@ -11,6 +11,7 @@
 #include "tables.hpp"
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
+#include "ddemap/io/cars.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
@@ -29,12 +30,12 @@ struct ClassifyArgs {
 
 void add_classify_flags(CLI::App& app) {
     app.add_option("VEHICLES", classify_args.file,
-                   "the vehicles: a CSV file with columns name,k1,k2,th,tau[,eta] (OVRV; units 1/s^2, 1/s, s, s, m; other columns ignored, "
-                   "so calibrate's output works), a fleet table of ovrv cars (as roots --fleet), or built-in names \"A_min,E_max\"; with the "
-                   "covariance columns cov_k1_k1 .. cov_eta_eta that `calibrate` writes the verdicts come with probabilities, from samples "
-                   "of the parameters' normal distribution restricted to the fit's bounds of k1, k2, th, tau (columns lo_k1,hi_k1 .. that "
-                   "`calibrate` writes; calibrate's default bounds when the file has none)")
-        ->type_name("FILE|PATTERN");
+                   std::string("the cars to classify, each distinct car once (default: the paper's table): ") + cars_help() +
+                       ". Every car is of the ovrv law (units of k1, k2, th, tau, eta: 1/s^2, 1/s, s, s, m). With a fit's covariance (the "
+                       "cov_k1_k1 .. cov_eta_eta columns or the JSON that calibrate writes) the verdicts come with probabilities, from samples "
+                       "of the parameters' normal distribution restricted to the fit's bounds (lo_k1, hi_k1 .. as calibrate writes; "
+                       "calibrate's default bounds when there are none)")
+        ->type_name("CARS");
     app.add_option("--samples", classify_args.samples, "parameter samples per vehicle with a covariance")->capture_default_str();
     app.add_option("--ring-samples", classify_args.ring_samples, "of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
         ->capture_default_str();
@@ -58,7 +59,7 @@ int run_classify() {
     if (classify_args.file.empty()) {
         vehicles = paper_calibration_table();
     } else {
-        vehicles = vehicles_argument("VEHICLES", classify_args.file);
+        vehicles = distinct_cars(vehicles_argument("VEHICLES", classify_args.file));
         source = classify_args.file;
     }
     const bool figure = !prefix.empty() || !svg_file.empty();

@@ -8,7 +8,7 @@
 
 #include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/io/files.hpp"
-#include "ddemap/io/vehicle_files.hpp"
+#include "ddemap/io/cars.hpp"
 
 namespace ddemap::cli {
 
@@ -261,15 +261,17 @@ std::string output_file(const std::string& flag, const std::string& path) {
     return path;
 }
 
-Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars) {
-    Fleet unit;
+std::vector<CalibratedVehicle> cars_argument(const std::string& flag, const std::string& list) {
+    if (list.empty()) throw BadInput(flag + " = '': expected cars (A_min, FILE.csv, FILE.csv:NAME, MODEL:NAME=VALUE,...)");
     try {
-        unit = names_a_file(spec) ? read_fleet_table(read_input_file(flag, spec), spec) : fleet_from_pattern(spec, 0);
-    } catch (const BadInput&) {
-        throw;
+        return read_cars(list);
     } catch (const std::invalid_argument& e) {
         throw BadInput(flag + ": " + e.what());
     }
+}
+
+Fleet fleet_argument(const std::string& flag, const std::string& list, int cars) {
+    const Fleet unit = to_fleet(cars_argument(flag, list));
     if (cars <= 0) return unit;
     Fleet out;
     out.reserve(static_cast<std::size_t>(cars));
@@ -277,22 +279,24 @@ Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars)
     return out;
 }
 
-std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& spec) {
+std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& list) {
+    std::vector<CalibratedVehicle> cars = cars_argument(flag, list);
     try {
-        return names_a_file(spec) ? read_vehicle_table(read_input_file(flag, spec), spec) : vehicles_from_pattern(spec);
-    } catch (const BadInput&) {
-        throw;
+        require_ovrv(cars, flag);
     } catch (const std::invalid_argument& e) {
-        throw BadInput(flag + ": " + e.what());
+        throw BadInput(e.what());
     }
+    return cars;
 }
 
-FleetCar car_argument(const std::string& flag, const std::string& spec) {
-    try {
-        return fleet_car_from_argument(spec);
-    } catch (const std::invalid_argument& e) {
-        throw BadInput(flag + ": " + e.what());
+FleetCar car_argument(const std::string& flag, const std::string& list) {
+    const std::vector<CalibratedVehicle> cars = distinct_cars(cars_argument(flag, list));
+    if (cars.size() != 1) {
+        std::string names;
+        for (const auto& c : cars) names += (names.empty() ? "" : ", ") + c.name;
+        throw BadInput(flag + " = '" + list + "': " + std::to_string(cars.size()) + " different cars (" + names + "): expected one car (e.g. FILE.csv:NAME)");
     }
+    return to_fleet(cars).front();
 }
 
 void print_json(const JsonEnvelope& e) { std::cout << envelope_json(e); }

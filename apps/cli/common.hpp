@@ -135,14 +135,22 @@ struct OutArg {
 /// work (check_output_file): bad input naming the flag otherwise. Returns `path`.
 std::string output_file(const std::string& flag, const std::string& path);
 
-/// A command's cars, given the same way everywhere: a file (a vehicle or fleet CSV, e.g. what
-/// calibrate writes; io names_a_file) or a pattern of built-in names "A_min*3,C_max".
-/// `cars` > 0 repeats the cars to that many (the last repetition cut short).
-Fleet fleet_argument(const std::string& flag, const std::string& spec, int cars = 0);
-/// The same as OVRV vehicles (classify, simulate).
-std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& spec);
-/// One car (mix --x/--y): NAME, MODEL:NAME=VALUE,..., FILE.csv (one kind of car) or FILE.csv:NAME.
-FleetCar car_argument(const std::string& flag, const std::string& spec);
+/// A command's cars, given the same way everywhere (io/cars.hpp): built-in names (A_min), every
+/// car of a table or fit file (FILE.csv, FILE.json), one car of it (FILE.csv:NAME), inline cars
+/// (ovrv:k1=0.1,k2=0.3,th=1.5,tau=0.5), each with *K, joined by commas; in order, expanded.
+std::vector<CalibratedVehicle> cars_argument(const std::string& flag, const std::string& list);
+/// The car syntax in a flag's help: "CARS: ..." (the same words in every command).
+inline const char* cars_help() {
+    return "built-in names (A_min .. G_max), FILE.csv (every car of a car table: name/vehicle/model, count, parameters; or what calibrate "
+           "writes, CSV or JSON), FILE.csv:NAME (one car of it), MODEL:k1=..,k2=..,... (a car of a law: ovrv, idm, ccc; name=NAME names it), "
+           "each with *K to repeat, joined by commas";
+}
+/// The same as a fleet; `cars` > 0 repeats the cars to that many (the last repetition cut short).
+Fleet fleet_argument(const std::string& flag, const std::string& list, int cars = 0);
+/// The same, every car of the paper's law (ovrv): classify, simulate, growth.
+std::vector<CalibratedVehicle> vehicles_argument(const std::string& flag, const std::string& list);
+/// Exactly one distinct car (mix --x/--y).
+FleetCar car_argument(const std::string& flag, const std::string& list);
 
 /// Prints the envelope of a command's JSON output.
 void print_json(const JsonEnvelope& e);

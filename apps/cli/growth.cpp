@@ -1,4 +1,4 @@
-// growth: disturbance growth for every setting of the calibration table.
+// growth: disturbance growth for each car (the paper's table, or the cars of --fleet).
 #include <algorithm>
 #include <iostream>
 
@@ -7,6 +7,7 @@
 #include "lead_flags.hpp"
 #include "limits.hpp"
 #include "tables.hpp"
+#include "ddemap/io/cars.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
 #include "ddemap/io/svg.hpp"
@@ -16,7 +17,7 @@ namespace ddemap::cli {
 
 namespace {
 struct GrowthArgs {
-    std::string followers = "15";
+    std::string followers = "15", fleet;
     LeadArgs lead;
     FormatArg format;
     OutArg out;
@@ -24,6 +25,10 @@ struct GrowthArgs {
 }  // namespace
 
 void add_growth_flags(CLI::App& app) {
+    app.add_option("--fleet", growth_args.fleet,
+                   std::string("the cars, each distinct car in platoons of its own (default: the paper's table): ") + cars_help() +
+                       "; every car of the ovrv law")
+        ->type_name("CARS");
     app.add_option("--followers", growth_args.followers, "longest platoon")->capture_default_str();
     growth_args.lead.add_to(app);
     growth_args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg", false);
@@ -37,7 +42,9 @@ int run_growth() {
     const std::string prefix = growth_args.out.given() ? growth_args.out.prepare("growth") : std::string();
     std::string label;
     const LeadProfile lead = growth_args.lead.parse(label);
-    const std::vector<CalibratedVehicle> vehicles = paper_calibration_table();
+    const std::vector<CalibratedVehicle> vehicles =
+        growth_args.fleet.empty() ? paper_calibration_table() : distinct_cars(vehicles_argument("--fleet", growth_args.fleet));
+    const std::string source = growth_args.fleet.empty() ? "the paper's calibration table (built in)" : growth_args.fleet;
     // sized before the work as simulate is: the platoons run in parallel (memory: the largest
     // ones at once), about 2 us per car and step in all (simulate's measured rate)
     double largest = 0.0, car_steps = 0.0, steps = 0.0, t_end = 0.0;
@@ -58,7 +65,7 @@ int run_growth() {
     const auto g = disturbance_growth(vehicles, lead, followers, SimOptions{}, policy);
     JsonEnvelope e;
     e.command = "growth";
-    e.inputs = JsonObject().string("vehicles", "the paper's calibration table (built in)").string("lead", label).integer("followers", followers).str();
+    e.inputs = JsonObject().string("vehicles", source).string("lead", label).integer("followers", followers).str();
     for (const GrowthResult& r : g)  // the envelope's status: the first platoon that is undecided
         if (r.status != Status::Converged && e.status == "converged") {
             e.status = to_string(r.status);

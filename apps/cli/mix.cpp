@@ -25,8 +25,8 @@ struct MixArgs {
 }  // namespace
 
 void add_mix_flags(CLI::App& app) {
-    app.add_option("--x", mix_args.x, "type X: a calibrated vehicle (e.g. E_min), MODEL:NAME=VALUE,..., a CSV file of one kind of car (e.g. calibrate's output) or FILE.csv:NAME (the car NAME of the file)")->required();
-    app.add_option("--y", mix_args.y, "type Y: as --x")->required();
+    app.add_option("--x", mix_args.x, std::string("type X: one car, given as any car list that names one car: ") + cars_help())->required()->type_name("CAR");
+    app.add_option("--y", mix_args.y, "type Y: as --x")->required()->type_name("CAR");
     mix_args.ring.add_to(app, "40", "ring size N >= 2 (finite)");
     app.add_option("--cars", mix_args.cars, "old spelling of --ring")->group("");
     app.add_option("--p", mix_args.p, "fractions of X as LO:HI:COUNT in [0, 1]")->capture_default_str();

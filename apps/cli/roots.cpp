@@ -276,10 +276,9 @@ void add_roots_flags(CLI::App& app) {
                      "with --fleet: the number of cars, the fleet repeated (default: the fleet once)");
     app.add_option("--count", roots_args.count, "how many rightmost roots to list")->capture_default_str();
     app.add_option("--system", roots_args.system, "any linear DDE from a JSON file (dimension, delays, A0, A; see README) instead of a ring");
-    app.add_option("--fleet", roots_args.fleet,
-                   "a mixed ring: a CSV file (a fleet table: vehicle and/or model, parameters, optional count; or a vehicle table "
-                   "name,k1,k2,th,tau[,eta] as calibrate writes; see README) or built-in names \"A_min,C_max*3,E_min\"; repeated to --ring cars");
-    app.add_option("--fleet-pattern", roots_args.pattern, "the same as --fleet (kept for old scripts)");
+    app.add_option("--fleet", roots_args.fleet, std::string("a mixed ring of these cars in this order, repeated to --ring cars: ") + cars_help())
+        ->type_name("CARS");
+    app.add_option("--fleet-pattern", roots_args.pattern, "the same as --fleet (kept for old scripts)")->type_name("CARS");
     app.add_option("--cars", roots_args.cars, "old spelling of --ring for --fleet-pattern")->group("");
     app.add_option("--length", roots_args.length, "fleet: ring length [m] (sum of the gaps); the speed follows");
     app.add_option("--solver", roots_args.solver,

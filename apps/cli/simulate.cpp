@@ -24,9 +24,9 @@ struct SimulateArgs {
 }  // namespace
 
 void add_simulate_flags(CLI::App& app) {
-    app.add_option("--fleet", simulate_args.fleet,
-                   "followers in platoon order: built-in names with repeats (A_min*7,C_max) or a CSV file: a vehicle table "
-                   "name,k1,k2,th,tau[,eta][,min_acc_speed] (as calibrate writes) or a fleet table of ovrv cars (as roots --fleet)");
+    app.add_option("--fleet", simulate_args.fleet, std::string("the followers in platoon order (the first follows the lead): ") + cars_help() +
+                                                       "; every car of the ovrv law")
+        ->type_name("CARS");
     simulate_args.lead.add_to(app);
     simulate_args.out.add_to(app, "PREFIX.csv (time series), PREFIX.json, PREFIX.svg (speeds)", true);
     app.add_option("--on-event", simulate_args.on_event, "stop or continue at the first disengagement or collision")->capture_default_str();
@@ -38,7 +38,7 @@ void add_simulate_flags(CLI::App& app) {
 }
 
 int run_simulate() {
-    if (simulate_args.fleet.empty()) throw BadInput("--fleet is required (e.g. --fleet A_min*7 or --fleet cars.csv)");
+    if (simulate_args.fleet.empty()) throw BadInput("--fleet is required (e.g. --fleet A_min*7, --fleet mycars.csv or --fleet mycars.csv:Sedan*3)");
     const Format format = simulate_args.format.parse();
     SimOptions o;
     o.step = parse_number("--step", simulate_args.step);

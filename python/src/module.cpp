@@ -46,7 +46,7 @@
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
-#include "ddemap/io/vehicle_files.hpp"
+#include "ddemap/io/cars.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/equilibrium.hpp"
 #include "ddemap/study/boundary.hpp"
@@ -125,12 +125,12 @@ std::string root_method(const std::string& solver) {
     throw std::invalid_argument("solver = '" + solver + "': expected auto, dense, sparse or product");
 }
 
-/// A fleet or vehicles argument: an existing file (io names_a_file) or a pattern of built-in names.
-Fleet fleet_spec(const std::string& spec) {
-    return names_a_file(spec) ? read_fleet_table(read_text_file(spec), spec) : fleet_from_pattern(spec, 0);
-}
+/// A car list (io/cars.hpp: built-in names, FILE.csv, FILE.csv:NAME, MODEL:k1=..., each with *K).
+Fleet fleet_spec(const std::string& spec) { return to_fleet(read_cars(spec)); }
 std::vector<CalibratedVehicle> vehicles_spec(const std::string& spec) {
-    return names_a_file(spec) ? read_vehicle_table(read_text_file(spec), spec) : vehicles_from_pattern(spec);
+    std::vector<CalibratedVehicle> cars = read_cars(spec);
+    require_ovrv(cars, "the cars");
+    return cars;
 }
 
 // ------------------------------------------------------------------ commands

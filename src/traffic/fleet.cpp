@@ -115,62 +115,8 @@ Fleet fleet_from_pattern(const std::string& pattern, int cars) {
 }
 
 Fleet read_fleet_csv(const std::string& text, const std::string& source) {
-    detail::CsvReader csv(text, source, "vehicle and/or model, parameter columns, [count]");
-    std::set<std::string> params;
-    for (const auto& m : model_names())
-        for (const auto& s : model_parameters(m))
-            if (s.name != "speed") params.insert(s.name);
-    std::string known;
-    for (const auto& p : params) known += ", " + p;
-    for (const auto& h : csv.header()) {
-        if (h == "speed") throw std::invalid_argument(source + ": column 'speed': the equilibrium speed is set by the ring (give --speed or --length)");
-        if (h != "vehicle" && h != "model" && h != "count" && !params.count(h))
-            throw std::invalid_argument(source + ": column " + detail::quoted(h) + ": expected vehicle, model, count" + known);
-    }
-    const int c_vehicle = csv.column("vehicle", false), c_model = csv.column("model", false), c_count = csv.column("count", false);
-    if (c_vehicle < 0 && c_model < 0) throw std::invalid_argument(source + ": the header needs a 'vehicle' or a 'model' column");
-    std::vector<std::pair<std::string, int>> c_params;
-    for (const auto& p : params) {
-        const int c = csv.column(p, false);
-        if (c >= 0) c_params.emplace_back(p, c);
-    }
     Fleet out;
-    while (csv.next()) {
-        const auto& f = csv.fields();
-        auto field = [&](int c) { return c >= 0 && c < static_cast<int>(f.size()) ? f[c] : std::string(); };
-        FleetCar car;
-        const std::string vehicle = field(c_vehicle), model = field(c_model);
-        if (!vehicle.empty()) {
-            const CalibratedVehicle* v = find_vehicle(vehicle);
-            if (!v) csv.fail("column 'vehicle' = " + detail::quoted(vehicle) + ": expected a calibrated vehicle (" + vehicle_names() + ") or a blank with a model");
-            car.label = v->name;
-            car.model = model.empty() ? "ovrv" : model;
-            car.parameters = v->parameters;
-        } else if (!model.empty()) {
-            car.model = model;
-            car.label = model + "@" + csv.where();
-        } else {
-            csv.fail("expected a vehicle name or a model on this row");
-        }
-        for (const auto& [name, c] : c_params)
-            if (!field(c).empty()) car.parameters[name] = csv.number(c, name);
-        long count = 1;
-        if (!field(c_count).empty()) {
-            const double k = csv.number(c_count, "count");
-            if (!(k >= 1 && k <= 1000000 && k == std::floor(k))) csv.fail("column 'count' = " + detail::quoted(field(c_count)) + ": expected an integer 1..1000000");
-            count = static_cast<long>(k);
-        }
-        try {
-            ParameterMap p = car.parameters;
-            p["speed"] = 0.0;
-            (void)make_model(car.model, p);
-        } catch (const std::invalid_argument& e) {
-            csv.fail(e.what());
-        }
-        if (out.size() + static_cast<std::size_t>(count) > 1000000) csv.fail("more than 1000000 cars");
-        for (long r = 0; r < count; ++r) out.push_back(car);
-    }
-    if (out.empty()) throw std::invalid_argument(source + ": no cars after the header");
+    for (const CalibratedVehicle& v : read_car_table(text, source)) out.push_back({v.name, v.model, v.parameters});
     return out;
 }
 

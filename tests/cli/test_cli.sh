@@ -180,7 +180,7 @@ expect_error "bad.csv:3: column 'k2' = 'abc'" classify "$tmp/bad.csv"
 printf 'name,k1,k2,th
 A,0.1,0.2,1
 ' >"$tmp/bad2.csv"
-expect_error "bad2.csv:1: missing column 'tau'" classify "$tmp/bad2.csv"
+expect_error "bad2.csv:2: car 'A': model ovrv needs tau" classify "$tmp/bad2.csv"
 printf 'name,k1,k2,th,tau
 A,0.1,0.2,1
 ' >"$tmp/bad3.csv"
@@ -188,7 +188,7 @@ expect_error "bad3.csv:2: 4 fields, expected 5" classify "$tmp/bad3.csv"
 printf 'name,k1,k2,th,tau
 A,-0.1,0.2,1,0.3
 ' >"$tmp/bad4.csv"
-expect_error "bad4.csv:2: k1 = -0.1" classify "$tmp/bad4.csv"
+expect_error "bad4.csv:2: car 'A': k1 = -0.1" classify "$tmp/bad4.csv"
 expect_error "cannot open" classify "$tmp/none.csv"
 
 # chart spec errors
@@ -414,7 +414,7 @@ A_min,0.1
 B_mx,0.2
 ' >"$tmp/badfleet.csv"
 expect_error "badfleet.csv:3: column 'vehicle' = 'B_mx'" roots --fleet "$tmp/badfleet.csv"
-expect_error "fleet pattern entry 'Q'" roots --fleet-pattern "A_min,Q" --ring 4
+expect_error "car 'Q': expected a setting of the paper's table" roots --fleet-pattern "A_min,Q" --ring 4
 # the product path (automatic for cars of the car ahead) against the sparse path
 "$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --ring 40 --count 6 --format json >"$tmp/prod.json" &&
     "$bin" roots --fleet-pattern "A_min,C_max*2,E_min" --ring 40 --count 6 --solver sparse --format json >"$tmp/spar.json" &&

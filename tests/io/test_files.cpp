@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include "ddemap/io/files.hpp"
-#include "ddemap/io/vehicle_files.hpp"
 
 using namespace ddemap;
 namespace fs = std::filesystem;
@@ -146,32 +145,6 @@ TEST_CASE("write_files_atomic: a folder where a file is needed fails before anyt
     CHECK_THROWS_WITH_AS(write_files_atomic({{d / "s.csv", "new"}, {d / "s.json", "new"}}), doctest::Contains("Is a directory"), WriteError);
     CHECK(slurp(d / "s.csv") == "old");
     CHECK(entries(d.path) == 2);
-}
-
-TEST_CASE("vehicle and fleet tables: one family, read by both readers") {
-    // what calibrate writes: a vehicle table with extra columns
-    const std::string fits =
-        "name,k1,k2,th,tau,eta,rmse_speed,status\n"
-        "fit1,0.1,0.45,0.16,0.43,15,0.05,converged\n";
-    const Fleet f = read_fleet_table(fits, "fits.csv");
-    REQUIRE(f.size() == 1);
-    CHECK(f[0].label == "fit1");
-    CHECK(f[0].model == "ovrv");
-    CHECK(f[0].parameters.at("k2") == 0.45);
-    CHECK(f[0].parameters.at("eta") == 15);
-    const auto v = read_vehicle_table(fits, "fits.csv");
-    REQUIRE(v.size() == 1);
-    CHECK(v[0].parameters.at("tau") == 0.43);
-    // a fleet table as vehicles: counts expanded, a built-in keeps its minimum ACC speed
-    const std::string fleet = "vehicle,model,k1,k2,th,tau,count\nA_min,,,,,,2\n,ovrv,0.2,0.4,1.5,0.3,1\n";
-    const auto w = read_vehicle_table(fleet, "fleet.csv");
-    REQUIRE(w.size() == 3);
-    CHECK(w[0].name == "A_min");
-    CHECK(w[0].min_acc_speed == paper_calibration_table().front().min_acc_speed);
-    CHECK(w[2].parameters.at("k1") == 0.2);
-    CHECK(w[2].parameters.at("eta") == 10);  // the model's default
-    CHECK_THROWS_WITH_AS(read_vehicle_table("vehicle,model,k1,k2,th,tau,k3,tau2\n,ccc,0.1,0.3,1.2,0.4,0.2,0.1\n", "c.csv"),
-                         doctest::Contains("expected ovrv cars"), std::invalid_argument);
 }
 
 TEST_CASE("write_files_atomic: stale members of a set are removed with it, or kept when it fails") {

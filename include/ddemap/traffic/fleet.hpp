@@ -35,11 +35,8 @@ using Fleet = std::vector<FleetCar>;
 /// last repetition is cut short when cars is not a multiple of the pattern length).
 Fleet fleet_from_pattern(const std::string& pattern, int cars);
 
-/// CSV with a header. Each row is one car (or `count` cars): either `vehicle` names a
-/// built-in calibration (parameter columns on the row override its values), or `model` names a
-/// law and the parameter columns give its values (blank = the model's default). Columns:
-/// vehicle, model, count and the parameter names of the models. Errors name the source, the
-/// line and the column.
+/// The cars of a car table (traffic/vehicles.hpp read_car_table: name, vehicle, model, count,
+/// parameter columns), as a fleet: each car's name, law and parameters.
 Fleet read_fleet_csv(const std::string& text, const std::string& source);
 
 /// One car from text: a calibrated vehicle name ("E_min") or "MODEL:NAME=VALUE,..."

@@ -13,13 +13,16 @@
 
 namespace ddemap {
 
+/// A car with its law and parameters: a setting of the paper's table, a row of a user's table, a
+/// fit that `calibrate` wrote, or a car given inline (io/cars.hpp reads every kind).
 struct CalibratedVehicle {
     std::string name;       ///< e.g. "A_min"
+    std::string model = "ovrv";  ///< the car-following law (a built-in model: ovrv, idm, ccc)
     std::string vehicle;    ///< "A".."G"
     std::string setting;    ///< "min" or "max" following distance
     int make = 1;           ///< 1 (vehicles A-D) or 2 (E-G)
     double min_acc_speed = 0.0;  ///< m/s below which ACC disengages (make 1: 25 mph = 11.2 m/s; make 2: 0)
-    ParameterMap parameters;     ///< OVRV: k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]
+    ParameterMap parameters;     ///< the model's parameters without speed; OVRV: k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]
     /// Covariance of the calibrated (k1, k2, th, tau, eta), in that order (as `calibrate` writes
     /// it); meaningful only when has_covariance.
     Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
@@ -44,14 +47,28 @@ const std::vector<CalibratedVehicle>& paper_calibration_table();
 /// naming the name otherwise.
 const CalibratedVehicle& builtin_vehicle(const std::string& name);
 
-/// Reads vehicles from CSV text: a header with at least name, k1, k2, th, tau (eta optional,
-/// default 10; min_acc_speed [m/s] optional, default 0 = the ACC never disengages; the 15
-/// covariance columns cov_k1_k1 .. cov_eta_eta optional, all or none: a row with all of them
-/// filled carries a covariance (symmetric, finite, non-negative diagonal), a row with all empty
-/// none; the bounds columns lo_k1, hi_k1 .. lo_eta, hi_eta optional, for each parameter both or
-/// neither in the header, a row's pair both filled (finite, lower <= upper) or both empty, into
-/// `bounds`; other columns are ignored), one vehicle per line. Errors name `source`, the line
-/// and the column (std::invalid_argument).
+/// The one table of cars: a vehicle table and a fleet table are one format (CSV with a header,
+/// columns in any order; blank lines and lines starting with '#' skipped):
+///   name      the car's name (default: the vehicle's, else MODEL@SOURCE:LINE)
+///   vehicle   a setting of the paper's table (A_min .. G_max) whose parameters the row starts from
+///   model     the car-following law: ovrv, idm or ccc (default ovrv)
+///   count     how many cars the row stands for, 1 to 1000000 (default 1)
+///   the parameters of the models (k1, k2, th, tau, eta for ovrv; see model_parameters), blank =
+///   the vehicle's value or the model's default (a required parameter must be given);
+///   min_acc_speed [m/s] (ovrv: the ACC disengages below it; default 0 = never);
+///   the 15 covariance columns cov_k1_k1 .. cov_eta_eta (all or none; a row with all filled
+///   carries a covariance: symmetric, finite, non-negative diagonal) and the bounds lo_k1, hi_k1
+///   .. lo_eta, hi_eta (per parameter both or neither; a row's pair both filled, lower <= upper)
+///   of a fit; and the other columns `calibrate` writes (rmse_speed, rmse_gap, train_rmse_speed,
+///   train_rmse_gap, test_rmse_speed, test_rmse_gap, naive_rmse_speed, status), not read.
+/// Any other column is an error naming it; so is a name given to two rows with different
+/// values (the same name on rows of the same car is one car). The rows are returned in order,
+/// each repeated `count` times, at most 1000000 cars in all. Errors are std::invalid_argument
+/// naming `source`, the line and the column.
+std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std::string& source);
+
+/// The same table, every car of the paper's law (ovrv): a car of another model is an error
+/// naming it.
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source);
 
 }  // namespace ddemap

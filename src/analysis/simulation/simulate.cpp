@@ -140,12 +140,6 @@ std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers) {
     return platoon_from(std::vector<CalibratedVehicle>(static_cast<std::size_t>(std::max(followers, 0)), v));
 }
 
-std::vector<CalibratedVehicle> vehicles_from_pattern(const std::string& pattern) {
-    std::vector<CalibratedVehicle> out;
-    for (const FleetCar& car : fleet_from_pattern(pattern, 0)) out.push_back(builtin_vehicle(car.label));
-    if (out.empty()) throw std::invalid_argument("fleet pattern " + detail::quoted(pattern) + ": expected vehicle names such as A_min*7");
-    return out;
-}
 
 SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options) {
     options.validate();

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "ddemap/solve/integrate.hpp"
+#include "ddemap/io/cars.hpp"
 #include "ddemap/study/growth.hpp"
 #include "ddemap/analysis/stability/string_stability.hpp"
 
@@ -145,7 +146,7 @@ TEST_CASE("lead profiles: exact position, validation, CSV errors") {
 
 TEST_CASE("one minimum ACC speed rule for built-in and CSV vehicles (platoon_from)") {
     // built in: the record's value (make 1: 25 mph; make 2: none)
-    const auto a = platoon_from(vehicles_from_pattern("A_min*2,E_min"));
+    const auto a = platoon_from(read_cars("A_min*2,E_min"));
     REQUIRE(a.size() == 3);
     CHECK(a[0].min_speed == doctest::Approx(11.176));
     CHECK(a[1].min_speed == doctest::Approx(11.176));
@@ -159,7 +160,7 @@ TEST_CASE("one minimum ACC speed rule for built-in and CSV vehicles (platoon_fro
     CHECK(c[1].min_speed == 0.0);
     CHECK(platoon_from(read_vehicles_csv("name,k1,k2,th,tau\nx,0.1,0.2,1,0.3\n", "w.csv"))[0].min_speed == 0.0);
     CHECK_THROWS_WITH_AS(read_vehicles_csv("name,k1,k2,th,tau,min_acc_speed\nx,0.1,0.2,1,0.3,-1\n", "b.csv"),
-                         "b.csv:2: min_acc_speed = -1: expected >= 0 m/s", std::invalid_argument);
+                         "b.csv:2: min_acc_speed = -1: expected 0 to 100 m/s", std::invalid_argument);
     CHECK_THROWS_WITH_AS(builtin_vehicle("Z_min"), doctest::Contains("'Z_min'"), std::invalid_argument);
 }
 

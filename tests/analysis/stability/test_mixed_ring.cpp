@@ -249,14 +249,14 @@ TEST_CASE("fleet input: patterns and CSV files, errors name the line and the col
     };
     bad("vehicle\nA_min\nQ_max\n", "f.csv:3: column 'vehicle' = 'Q_max'");
     bad("model,k1,k2,th,tau\novrv,0.1,x,1,0.5\n", "f.csv:2: column 'k2' = 'x'");
-    bad("model,k1,k2,th,tau\novrv,0.1,-2,1,0.5\n", "f.csv:2: k2 = -2");
-    bad("model,k1,k2,th\novrv,0.1,0.2,1\n", "f.csv:2: model ovrv needs tau");
+    bad("model,k1,k2,th,tau\novrv,0.1,-2,1,0.5\n", "f.csv:2: car 'ovrv@f.csv:2': k2 = -2");
+    bad("model,k1,k2,th\novrv,0.1,0.2,1\n", "f.csv:2: car 'ovrv@f.csv:2': model ovrv needs tau");
     bad("vehicle,colour\nA_min,red\n", "column 'colour'");
     bad("vehicle,speed\nA_min,20\n", "column 'speed'");
-    bad("k1,k2\n0.1,0.2\n", "'vehicle' or a 'model' column");
-    bad("vehicle,model\n,\n", "f.csv:2: expected a vehicle name or a model");
+    bad("k1,k2\n0.1,0.2\n", "the header needs a 'name', 'vehicle' or 'model' column");
+    bad("vehicle,model\n,\n", "f.csv:2: car 'ovrv@f.csv:2': model ovrv needs k1");  // a blank row: the paper's law, whose gains are required
     bad("vehicle,count\nA_min,2.5\n", "f.csv:2: column 'count' = '2.5'");
-    bad("model,k1,k2,th,tau\nidm,0.1,0.2,1,0.5\n", "f.csv:2: parameter 'k1' does not belong to model idm");
+    bad("model,k1,k2,th,tau\nidm,0.1,0.2,1,0.5\n", "f.csv:2: car 'idm@f.csv:2': parameter 'k1' does not belong to model idm");
     bad("vehicle\n", "no cars");
     CHECK_THROWS_WITH_AS(parse_fleet_car("ccc:k1=0.1,k2"), doctest::Contains("'k2'"), std::invalid_argument);
     CHECK_THROWS_WITH_AS(analyse_mixed_ring(fleet_from_pattern("A_min", 1), at_speed(4, "auto")),

@@ -125,7 +125,4 @@ std::vector<SimCar> platoon_from(const std::vector<CalibratedVehicle>& vehicles)
 /// `followers` cars of one setting: platoon_from({v, v, ...}).
 std::vector<SimCar> platoon_of(const CalibratedVehicle& v, int followers);
 
-/// The settings of a pattern of built-in names, "A_min*3,C_max" (*k repeats), in order.
-std::vector<CalibratedVehicle> vehicles_from_pattern(const std::string& pattern);
-
 }  // namespace ddemap
