@@ -1,4 +1,5 @@
-// chart: render a chart spec (TOML) to PREFIX.svg.
+// chart: render a chart spec (TOML) to PREFIX.svg, with each panel's grid and boundaries as CSV.
+#include <filesystem>
 #include <iostream>
 
 #include "commands.hpp"
@@ -20,7 +21,7 @@ struct ChartArgs {
 
 void add_chart_flags(CLI::App& app) {
     app.add_option("SPEC", chart_args.spec, "chart specification (TOML)")->required();
-    chart_args.out.add_to(app, "PREFIX.svg", true);
+    chart_args.out.add_to(app, "PREFIX.svg, and for panel K its grid PREFIX-panelK.csv and boundaries PREFIX-panelK-boundaries.csv", true);
     chart_args.format.add_to(app, {Format::Table, Format::Json});
     run_flags().add_to(app, true);
 }
@@ -33,7 +34,24 @@ int run_chart() {
     ExecutionPolicy policy;
     policy.progress = progress_printer("chart", "panels");
     const RenderedChart r = render_chart(spec, policy);
-    write_files_atomic({{prefix + ".svg", r.svg}});
+    const auto files = chart_files(r, prefix);
+    // an earlier run's panels beyond this chart's are not left beside it: PREFIX-panelK*.csv, K > panels
+    std::vector<std::string> stale;
+    const std::filesystem::path base(prefix);
+    const std::string stem = base.filename().string() + "-panel";
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(base.parent_path().empty() ? "." : base.parent_path(), ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name.compare(0, stem.size(), stem) != 0) continue;
+        std::size_t k = stem.size(), n = 0;
+        while (k < name.size() && name[k] >= '0' && name[k] <= '9') n = 10 * n + static_cast<std::size_t>(name[k++] - '0');
+        const std::string tail = name.substr(k);
+        if (k > stem.size() && n > spec.panels.size() && (tail == ".csv" || tail == "-boundaries.csv"))
+            stale.push_back((base.parent_path() / name).string());
+    }
+    write_files_atomic(files, stale);
+    std::vector<std::string> names;
+    for (const auto& f : files) names.push_back(json_string(f.first));
     if (format == Format::Json) {
         JsonEnvelope e;
         e.command = "chart";
@@ -41,11 +59,12 @@ int run_chart() {
         e.result = JsonObject()
                        .integer("panels", static_cast<long long>(spec.panels.size()))
                        .number("seconds", r.seconds)
-                       .json("files", json_array({json_string(prefix + ".svg")}))
+                       .json("files", json_array(names))
                        .str();
         print_json(e);
     } else {
-        std::cout << "chart      " << spec.panels.size() << " panels in " << rounded(r.seconds, 3) << " s\nwrote      " << prefix << ".svg\n";
+        std::cout << "chart      " << counted(static_cast<long long>(spec.panels.size()), "panel") << " in " << rounded(r.seconds, 3) << " s\nwrote      " << prefix
+                  << ".svg, " << prefix << "-panel1.csv .. and their -boundaries.csv\n";
     }
     return exit_ok;
 }

@@ -8,6 +8,7 @@
 #include "common.hpp"
 #include "limits.hpp"
 #include "sweep_flags.hpp"
+#include "ddemap/io/cars.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/study/boundary.hpp"
@@ -18,12 +19,58 @@ namespace {
 struct SweepArgs {
     ModelArgs model;
     RingArg ring;
-    std::string x;
+    std::string x, mark;
     bool no_boundaries = false;
     std::string ring_curves = "auto";
     FormatArg format;
     OutArg out;
 } sweep_args;
+}  // namespace
+
+namespace {
+
+/// The cars of --mark at their values of the swept parameters (x, y), the (x, y) block of a fit's
+/// covariance as their ellipse; a car whose other parameters differ from the chart's fixed ones
+/// is named on stderr (its marker shows its values of x and y on a chart that is not its own).
+std::vector<ChartMarker> car_markers(const SweepSpec& spec) {
+    static const char* fitted[] = {"k1", "k2", "th", "tau", "eta"};
+    auto index = [](const std::string& name) {
+        for (int i = 0; i < 5; ++i)
+            if (name == fitted[i]) return i;
+        return -1;
+    };
+    std::vector<ChartMarker> out;
+    for (const CalibratedVehicle& car : distinct_cars(cars_argument("--mark", sweep_args.mark))) {
+        if (car.model != spec.model)
+            throw BadInput("--mark: car '" + car.name + "' has model " + car.model + ": expected cars of the chart's model " + spec.model);
+        for (const std::string& axis : {spec.x.name, spec.y.name})
+            if (!car.parameters.count(axis)) throw BadInput("--mark: car '" + car.name + "' has no value of " + axis);
+        ChartMarker m;
+        m.x = car.parameters.at(spec.x.name);
+        m.y = car.parameters.at(spec.y.name);
+        m.label = car.name;
+        const int ix = index(spec.x.name), iy = index(spec.y.name);
+        if (car.has_covariance && ix >= 0 && iy >= 0) {
+            m.has_ellipse = true;
+            m.cov_xx = car.covariance(ix, ix);
+            m.cov_xy = car.covariance(ix, iy);
+            m.cov_yy = car.covariance(iy, iy);
+        }
+        std::string differ;
+        for (const auto& [name, value] : spec.fixed) {
+            if (!car.parameters.count(name) || (spec.model == "ovrv" && name == "eta")) continue;  // eta moves no boundary of OVRV's chart
+            const double v = car.parameters.at(name);
+            if (std::abs(v - value) > 1e-9 * std::max(std::abs(v), std::abs(value)))
+                differ += (differ.empty() ? "" : ", ") + name + " = " + rounded(v, 6) + " (the chart's " + rounded(value, 6) + ")";
+        }
+        if (!differ.empty())
+            std::cerr << "ddemap: sweep: --mark: " << car.name << " has " << differ << ": its marker shows its " << spec.x.name << " and "
+                      << spec.y.name << " on a chart that is not its own\n";
+        out.push_back(m);
+    }
+    return out;
+}
+
 }  // namespace
 
 void add_sweep_flags(CLI::App& app) {
@@ -32,6 +79,11 @@ void add_sweep_flags(CLI::App& app) {
     sweep_args.out.add_to(app, "PREFIX.csv, PREFIX.json, PREFIX.svg, PREFIX-boundaries.csv", true);
     app.add_option("--x", sweep_args.x, "which swept parameter is the horizontal axis (default: alphabetical)");
     app.add_flag("--no-boundaries", sweep_args.no_boundaries, "skip the boundary continuation");
+    app.add_option("--mark", sweep_args.mark,
+                   std::string("cars drawn on the chart, each distinct car as a labelled marker at its values of the two swept parameters, "
+                               "with its 95 % confidence ellipse where it has a fit's covariance: ") +
+                       cars_help())
+        ->type_name("CARS");
     app.add_option("--ring-curves", sweep_args.ring_curves,
                    "ring Hopf curves: all (every mode's), envelope (only the boundary of the ring-stable region, any N), auto (all up to 64 cars)")
         ->type_name("all|envelope|auto")
@@ -47,6 +99,7 @@ int run_sweep() {
     // every mode's curve needs every mode's root; the envelope is seeded from the winding sweep
     if (!sweep_args.no_boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
     check_sweep_size(spec, "sweep", true);
+    const std::vector<ChartMarker> marks = sweep_args.mark.empty() ? std::vector<ChartMarker>{} : car_markers(spec);
     const std::string prefix = sweep_args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
     policy.progress = progress_printer("sweep", "rows");
@@ -65,9 +118,12 @@ int run_sweep() {
     panel.title = fixed_title(spec);
     panel.sweep = &sw;
     panel.boundaries = bp;
+    panel.markers = marks;
     JsonEnvelope e;
     e.command = "sweep";
-    e.inputs = sweep_inputs(spec).boolean("boundaries", !sweep_args.no_boundaries).string("ring_curves", ring_curves_name(ring_curves)).str();
+    JsonObject inputs = sweep_inputs(spec).boolean("boundaries", !sweep_args.no_boundaries).string("ring_curves", ring_curves_name(ring_curves));
+    if (!sweep_args.mark.empty()) inputs.string("mark", sweep_args.mark);
+    e.inputs = inputs.str();
     e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;

@@ -233,7 +233,7 @@ std::vector<CalibratedVehicle> read_calibration_json(const std::string& text, co
     return distinct_cars(out);
 }
 
-std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars) {
+std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars, const std::string& base_dir) {
     if (trim(list).empty()) throw std::invalid_argument("an empty car list: expected cars separated by commas (A_min, FILE.csv, FILE.csv:NAME, MODEL:NAME=VALUE,...)");
     std::vector<CalibratedVehicle> out;
     for (const Item& item : split_items(list)) {
@@ -251,6 +251,10 @@ std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t ma
                 }
             }
             if (names_a_file(file)) {
+                struct stat st {};
+                if (!base_dir.empty() && !file.empty() && file[0] != '/' && ::stat(file.c_str(), &st) != 0 &&
+                    ::stat((base_dir + "/" + file).c_str(), &st) == 0)
+                    file = base_dir + "/" + file;
                 std::vector<CalibratedVehicle> cars = read_file_cars(file);
                 if (!name.empty()) {
                     auto it = std::find_if(cars.begin(), cars.end(), [&](const CalibratedVehicle& c) { return c.name == name; });

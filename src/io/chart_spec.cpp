@@ -1,6 +1,10 @@
 #include "ddemap/io/chart_spec.hpp"
 
+#include <algorithm>
+
 #include "core/internal/text.hpp"
+#include "ddemap/io/cars.hpp"
+#include "ddemap/io/csv.hpp"
 #include "io/internal/toml_fields.hpp"
 
 #include <chrono>
@@ -64,25 +68,41 @@ SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel) {
 }
 
 std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehicles) {
+    // one panel per distinct (tau, th): the (k1, k2) chart of OVRV depends on nothing else
     std::vector<PanelSpec> panels;
+    std::vector<std::pair<double, double>> keys;
+    std::vector<std::vector<const CalibratedVehicle*>> members;
     for (const auto& v : vehicles) {
-        PanelSpec p;
-        const auto& q = v.parameters;
-        p.title = v.name + ": " + parameter_symbol("tau") + " = " + short_number(q.at("tau")) + " s, " + parameter_symbol("th") + " = " +
-                  short_number(q.at("th")) + " s";
-        for (const char* k : {"tau", "th", "eta"})
-            if (q.count(k)) p.parameters[k] = q.at(k);
-        ChartMarker m;
-        m.x = q.at("k1");
-        m.y = q.at("k2");
-        m.label = v.name;
-        if (v.has_covariance) {  // the (k1, k2) block of the calibration's covariance
-            m.has_ellipse = true;
-            m.cov_xx = v.covariance(0, 0);
-            m.cov_xy = v.covariance(0, 1);
-            m.cov_yy = v.covariance(1, 1);
+        const std::pair<double, double> key{v.parameters.at("tau"), v.parameters.at("th")};
+        const auto it = std::find(keys.begin(), keys.end(), key);
+        if (it == keys.end()) {
+            keys.push_back(key);
+            members.push_back({&v});
+        } else {
+            members[static_cast<std::size_t>(it - keys.begin())].push_back(&v);
         }
-        p.markers.push_back(m);
+    }
+    for (std::size_t g = 0; g < keys.size(); ++g) {
+        PanelSpec p;
+        const std::string where = parameter_symbol("tau") + " = " + short_number(keys[g].first) + " s, " + parameter_symbol("th") + " = " +
+                                  short_number(keys[g].second) + " s";
+        p.title = members[g].size() == 1 ? members[g].front()->name + ": " + where : where;
+        p.parameters["tau"] = keys[g].first;
+        p.parameters["th"] = keys[g].second;
+        if (members[g].front()->parameters.count("eta")) p.parameters["eta"] = members[g].front()->parameters.at("eta");  // no effect on the chart
+        for (const CalibratedVehicle* v : members[g]) {
+            ChartMarker m;
+            m.x = v->parameters.at("k1");
+            m.y = v->parameters.at("k2");
+            m.label = v->name;
+            if (v->has_covariance) {  // the (k1, k2) block of the calibration's covariance
+                m.has_ellipse = true;
+                m.cov_xx = v->covariance(0, 0);
+                m.cov_xy = v->covariance(0, 1);
+                m.cov_yy = v->covariance(1, 1);
+            }
+            p.markers.push_back(m);
+        }
         panels.push_back(p);
     }
     return panels;
@@ -147,10 +167,24 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
         spec.ring_curves = parse_ring_curves(*v);
     }
     if (const toml::node* v = root.get("vehicles")) {
-        if (v->value<std::string>() != std::optional<std::string>("paper")) {
-            throw std::invalid_argument(where(source, *v) + ": vehicles: expected \"paper\" (the built-in calibration table)");
+        // "paper" (the built-in table) or a car list (io/cars.hpp), files found beside the spec
+        const auto list = v->value<std::string>();
+        if (!list || list->empty())
+            throw std::invalid_argument(where(source, *v) + ": vehicles: expected \"paper\" (the built-in calibration table) or a car list "
+                                        "(\"mycars.csv\", \"fits.json\", \"A_min,mycars.csv:Sedan\", ...)");
+        std::vector<CalibratedVehicle> cars;
+        if (*list == "paper") {
+            cars = paper_calibration_table();
+        } else {
+            const auto slash = source.rfind('/');
+            try {
+                cars = distinct_cars(read_cars(*list, kMaxCars, slash == std::string::npos ? std::string() : source.substr(0, slash)));
+                require_ovrv(cars, "a chart of vehicles");
+            } catch (const std::invalid_argument& e) {
+                throw std::invalid_argument(where(source, *v) + ": vehicles: " + e.what());
+            }
         }
-        spec.panels = vehicle_panels(paper_calibration_table());
+        spec.panels = vehicle_panels(cars);
     }
     if (const toml::node* ps = root.get("panel")) {
         const toml::array* arr = ps->as_array();
@@ -240,6 +274,16 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
     out.svg = render_chart_svg(panels, co);
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
+}
+
+std::vector<std::pair<std::string, std::string>> chart_files(const RenderedChart& chart, const std::string& prefix) {
+    std::vector<std::pair<std::string, std::string>> files{{prefix + ".svg", chart.svg}};
+    for (std::size_t i = 0; i < chart.sweeps.size(); ++i) {
+        const std::string base = prefix + "-panel" + std::to_string(i + 1);
+        files.emplace_back(base + ".csv", sweep_csv(chart.sweeps[i]));
+        files.emplace_back(base + "-boundaries.csv", boundary_csv(chart.specs[i], chart.boundaries[i]));
+    }
+    return files;
 }
 
 }  // namespace ddemap

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -139,34 +140,45 @@ ChartSpec classification_chart(const ChartSpec& base, const std::vector<Calibrat
     const std::string ring = cars == 0 ? std::string("an infinite ring") : "a ring of " + std::to_string(cars) + " cars";
     if (!source.empty()) {
         spec.title = "Vehicles of " + source + " on their own stability charts, " + ring;
-        // the window: every vehicle's (k1, k2), and its 95 % ellipse's extent sqrt(5.991 C_ii)
-        // where that is at most half the vehicles' spread (or half the value, for one vehicle):
-        // a parameter the trace hardly determines would otherwise shrink every vehicle to a dot
-        // (its ellipse is clipped at the window); widened by 12 % of the span on each side and
-        // kept above 2 % of its upper end (k1, k2 > 0)
+        // the window: every car's (k1, k2) and its whole 95 % ellipse (extent sqrt(5.991 C_ii)),
+        // within the domain its fit searched (its bounds; k1, k2 >= 0 without them); and where
+        // the string-stable region's low-frequency edge c2 = 0 lies above a car at its k1 (for
+        // OVRV k2 = (1 + k1 th (tau - th / 2)) / (th - tau) when th > tau) within three spans, up
+        // to that edge, so that the verdict can be read off; widened by 12 % of the span on each
+        // side and kept above 2 % of its upper end (k1, k2 > 0)
         double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
         for (const auto& v : vehicles) {
-            x0 = std::min(x0, v.parameters.at("k1"));
-            x1 = std::max(x1, v.parameters.at("k1"));
-            y0 = std::min(y0, v.parameters.at("k2"));
-            y1 = std::max(y1, v.parameters.at("k2"));
-        }
-        const double sx = x1 - x0, sy = y1 - y0;
-        for (const auto& v : vehicles) {
-            if (!v.has_covariance) continue;
             const double k1 = v.parameters.at("k1"), k2 = v.parameters.at("k2");
+            x0 = std::min(x0, k1);
+            x1 = std::max(x1, k1);
+            y0 = std::min(y0, k2);
+            y1 = std::max(y1, k2);
+            if (!v.has_covariance) continue;
+            auto within = [&](const char* name, double lo, double hi) {
+                double a = 0.0, b = std::numeric_limits<double>::infinity();
+                if (const BoundedParameter* bp = find_bound(v.bounds, name)) {
+                    a = bp->lower;
+                    b = bp->upper;
+                }
+                return std::pair<double, double>{std::max(lo, a), std::min(hi, b)};
+            };
             const double ex = std::sqrt(5.991464547107979 * std::max(0.0, v.covariance(0, 0)));
             const double ey = std::sqrt(5.991464547107979 * std::max(0.0, v.covariance(1, 1)));
-            if (ex <= 0.5 * std::max(sx, std::abs(k1))) {
-                x0 = std::min(x0, k1 - ex);
-                x1 = std::max(x1, k1 + ex);
-            }
-            if (ey <= 0.5 * std::max(sy, std::abs(k2))) {
-                y0 = std::min(y0, k2 - ey);
-                y1 = std::max(y1, k2 + ey);
-            }
+            const auto [ex0, ex1] = within("k1", k1 - ex, k1 + ex);
+            const auto [ey0, ey1] = within("k2", k2 - ey, k2 + ey);
+            x0 = std::min(x0, ex0);
+            x1 = std::max(x1, ex1);
+            y0 = std::min(y0, ey0);
+            y1 = std::max(y1, ey1);
         }
-        // (but never above half the smallest vehicle's value, so every vehicle is inside)
+        const double span_y = std::max(y1 - y0, 0.05 * std::abs(y1));
+        for (const auto& v : vehicles) {
+            const double k1 = v.parameters.at("k1"), k2 = v.parameters.at("k2"), th = v.parameters.at("th"), tau = v.parameters.at("tau");
+            if (!(th > tau)) continue;
+            const double edge = (1.0 + k1 * th * (tau - 0.5 * th)) / (th - tau);
+            if (edge > k2 && edge > y1 && edge <= y1 + 3.0 * span_y) y1 = edge;
+        }
+        // (but never above half the smallest car's value, so every car is inside)
         auto widen = [](double& lo, double& hi, double smallest) {
             const double span = hi - lo > 0.0 ? hi - lo : std::max(0.5 * std::abs(hi), 0.01);
             lo -= 0.12 * span;

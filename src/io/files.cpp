@@ -257,10 +257,31 @@ std::string normalize_input_text(std::string text) {
     return out;
 }
 
+namespace {
+
+/// The regular files this process has read (device and inode): an output never replaces one
+/// (`classify mycars.csv --out mycars` would otherwise write its table over the cars).
+std::vector<std::pair<dev_t, ino_t>>& inputs_read() {
+    static std::vector<std::pair<dev_t, ino_t>> files;
+    return files;
+}
+
+/// std::invalid_argument when `path` is a file this process has read.
+void refuse_input(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+    for (const auto& f : inputs_read())
+        if (f.first == st.st_dev && f.second == st.st_ino)
+            throw std::invalid_argument("'" + path + "' is an input of this command: expected another output name (it would be overwritten)");
+}
+
+}  // namespace
+
 std::string read_text_file(const std::string& path) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
     if (S_ISDIR(st.st_mode)) throw std::invalid_argument("'" + path + "' is a folder, expected a file");
+    if (S_ISREG(st.st_mode)) inputs_read().emplace_back(st.st_dev, st.st_ino);
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
     std::string text;
@@ -333,6 +354,16 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         ts[i].remove = true;
         ts[i].given = remove[i - files.size()];
         ts[i].text = &nothing;
+    }
+    // 0. no file of the set is an input of this process (before anything is written)
+    for (const auto& f : files) {
+        std::string path;
+        try {
+            path = resolve_output_path(f.first);
+        } catch (const std::invalid_argument&) {
+            continue;  // a link loop: refused below with the others
+        }
+        refuse_input(path);
     }
     InterruptCleanup cleanup;
     // 1. resolve every path; write the special files; write the regular ones to temporary files

@@ -39,12 +39,7 @@ std::vector<std::pair<std::string, std::string>> paper_files(const PaperJob& job
     e.result = classification_json(s.classification, s.options.cars, table_source);
     files.emplace_back(prefix + "-classification.json", envelope_json(e));
     files.emplace_back(prefix + "-classification.svg", job.classification.svg);
-    files.emplace_back(prefix + ".svg", job.figure.svg);
-    for (std::size_t i = 0; i < job.figure.sweeps.size(); ++i) {
-        const std::string base = prefix + "-panel" + std::to_string(i + 1);
-        files.emplace_back(base + ".csv", sweep_csv(job.figure.sweeps[i]));
-        files.emplace_back(base + "-boundaries.csv", boundary_csv(job.figure.specs[i], job.figure.boundaries[i]));
-    }
+    for (auto& f : chart_files(job.figure, prefix)) files.push_back(std::move(f));
     files.emplace_back(prefix + "-growth.csv", growth_csv(s.growth));
     files.emplace_back(prefix + "-growth.svg", growth_svg(s.growth, s.options.lead));
     return files;

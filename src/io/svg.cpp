@@ -161,9 +161,10 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     const double f_tick = 13, f_label = 14, f_title = 14, f_legend = 14, f_head = 17;
     const double ml = 70, mr = 18, mt = 46, mb = 54;  // margins around each plot area (two title lines fit above)
     const double cw = o.panel_width + ml + mr, ch = o.panel_height + mt + mb;
-    const double width = cols * cw + 10;
-    const double head_size = fitted_size(o.title, f_head, width - 20, 10);
-    const double header = o.title.empty() ? 10 : 40;
+    // the figure is as wide as its panels, or wider where the title (at 12 px or more) or a legend
+    // item needs it: nothing is cut off, whatever the names
+    double width = cols * cw + 10;
+    width = std::max(width, text_width(o.title, 12) + 20);
 
     // what the figure shows: region classes (grid points), boundary kinds, markers, ellipses
     bool class_shown[4] = {false, false, false, false};
@@ -197,6 +198,53 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     if (any_marker) items.push_back({2, 0, "marked setting (k\u2081, k\u2082)"});
     if (any_ellipse) items.push_back({3, 0, "95 % confidence ellipse of (k\u2081, k\u2082)"});
     if (any_outside) items.push_back({4, 0, "outside the window (at its edge)"});
+    for (const auto& it : items) width = std::max(width, 36 + text_width(it.text, f_legend) + 20);
+    // marker labels: the names beside the markers where every panel's names fit (at most 45 % of
+    // the plot width each) and no two labels, or a label and another marker, overlap; otherwise
+    // numbers (one per distinct name in the figure), with a key under the legend
+    std::vector<std::string> names;  // distinct marker labels, in order
+    for (const auto& panel : panels)
+        for (const auto& m : panel.markers)
+            if (!m.label.empty() && std::find(names.begin(), names.end(), m.label) == names.end()) names.push_back(m.label);
+    auto label_box = [&](const ChartPanel& panel, const ChartMarker& m, const std::string& label) {
+        // as drawn below: right of the marker, or left of it at the right edge; above it, or below at the top
+        const Axis& ax = panel.sweep->spec.x;
+        const Axis& ay = panel.sweep->spec.y;
+        const double cx = std::min(std::max((m.x - ax.lo) / (ax.hi - ax.lo), 0.0), 1.0) * o.panel_width;
+        const double cy = (1.0 - std::min(std::max((m.y - ay.lo) / (ay.hi - ay.lo), 0.0), 1.0)) * o.panel_height;
+        const double lw = text_width(label, f_tick);
+        const bool right = cx + 8 + lw <= o.panel_width;
+        const double x0 = right ? cx + 8 : std::max(cx - 8, lw) - lw;
+        const double y1 = cy - 8 < f_tick ? cy + f_tick + 6 : cy - 8;
+        return std::array<double, 4>{x0, y1 - f_tick, x0 + lw, y1 + 2};
+    };
+    bool numbered = false;
+    for (const auto& panel : panels) {
+        const Axis& ax = panel.sweep->spec.x;
+        const Axis& ay = panel.sweep->spec.y;
+        std::vector<std::array<double, 4>> boxes;  // per marker: its label's box (empty label: none)
+        std::vector<std::pair<double, double>> dots;
+        for (const auto& m : panel.markers) {
+            if (text_width(m.label, f_tick) > 0.45 * o.panel_width) numbered = true;
+            boxes.push_back(m.label.empty() ? std::array<double, 4>{0, 0, 0, 0} : label_box(panel, m, m.label));
+            dots.emplace_back((m.x - ax.lo) / (ax.hi - ax.lo) * o.panel_width, (1.0 - (m.y - ay.lo) / (ay.hi - ay.lo)) * o.panel_height);
+        }
+        auto overlap = [](const std::array<double, 4>& p, const std::array<double, 4>& q) {
+            return p[0] < q[2] && q[0] < p[2] && p[1] < q[3] && q[1] < p[3];
+        };
+        for (std::size_t a = 0; a < boxes.size(); ++a) {
+            if (panel.markers[a].label.empty()) continue;
+            for (std::size_t b = 0; b < boxes.size(); ++b) {
+                if (a == b) continue;
+                const std::array<double, 4> dot{dots[b].first - 5, dots[b].second - 5, dots[b].first + 5, dots[b].second + 5};
+                if ((!panel.markers[b].label.empty() && overlap(boxes[a], boxes[b])) || overlap(boxes[a], dot)) numbered = true;
+            }
+        }
+    }
+    auto marker_text = [&](const ChartMarker& m) {
+        if (!numbered || m.label.empty()) return m.label;
+        return std::to_string(std::find(names.begin(), names.end(), m.label) - names.begin() + 1);
+    };
     std::vector<std::pair<double, double>> item_pos;
     double lx = 10, ly_rel = 0;
     for (const auto& it : items) {
@@ -208,7 +256,24 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         item_pos.emplace_back(lx, ly_rel);
         lx += w + 20;
     }
-    const double legend_h = items.empty() ? 10 : ly_rel + 24 + 16;
+    // the key of the numbered markers: "1 NAME" entries, wrapped to the figure width
+    std::vector<std::pair<double, double>> key_pos;
+    double kx = 10, ky = ly_rel + 24 + 6;
+    if (numbered) {
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            const double w = text_width(std::to_string(i + 1) + "  " + names[i], f_legend);
+            width = std::max(width, w + 20);
+            if (kx + w > width - 10 && kx > 10) {
+                kx = 10;
+                ky += 22;
+            }
+            key_pos.emplace_back(kx, ky);
+            kx += w + 24;
+        }
+    }
+    const double head_size = fitted_size(o.title, f_head, width - 20, 12);
+    const double header = o.title.empty() ? 10 : 40;
+    const double legend_h = (items.empty() ? 10 : ly_rel + 24 + 16) + (numbered ? ky - (ly_rel + 24) + 22 : 0.0);
     const double height = header + rows * ch + legend_h;
 
     std::ostringstream s;
@@ -416,9 +481,16 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         // markers: inside the window as a dot with its label; outside it on the nearest edge as
         // an open triangle pointing out of the window, the label saying so
         s << "<g id=\"" << id << "-markers\" font-size=\"" << num(f_tick) << "\">\n";
+        // the dots first (a label is drawn over them, never under one), then each label at the
+        // first of four places around its dot (upper right, upper left, lower right, lower left)
+        // that stays in the plot and clears every dot and every label placed before it
+        std::vector<std::array<double, 4>> taken;
+        std::vector<std::pair<double, double>> at;
         for (const auto& m : panel.markers) {
             const bool out = !(m.x >= ax.lo && m.x <= ax.hi && m.y >= ay.lo && m.y <= ay.hi);
             const double cx = std::min(std::max(X(m.x), ox), ox + pw), cy = std::min(std::max(Y(m.y), oy), oy + ph);
+            at.emplace_back(cx, cy);
+            taken.push_back({cx - 5.5, cy - 5.5, cx + 5.5, cy + 5.5});
             if (out) {
                 const double dx = X(m.x) - cx, dy = Y(m.y) - cy, n = std::hypot(dx, dy);
                 const double ux = n > 0 ? dx / n : 0.0, uy = n > 0 ? dy / n : -1.0;
@@ -428,14 +500,33 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
             } else {
                 s << "<circle cx=\"" << num(cx) << "\" cy=\"" << num(cy) << "\" r=\"4.5\" fill=\"#000\" stroke=\"#fff\" stroke-width=\"1.2\"/>\n";
             }
-            // a label wider than 45 % of the panel is left out (the panel title names the vehicle)
-            const std::string label = out ? m.label + " (outside)" : m.label;
+        }
+        for (std::size_t k = 0; k < panel.markers.size(); ++k) {
+            const ChartMarker& m = panel.markers[k];
+            const bool out = !(m.x >= ax.lo && m.x <= ax.hi && m.y >= ay.lo && m.y <= ay.hi);
+            // the name, or its number in the key (see above)
+            const std::string label = out && !numbered ? m.label + " (outside)" : marker_text(m);
+            if (label.empty()) continue;
             const double lw = text_width(label, f_tick);
-            if (label.empty() || lw > 0.45 * pw) continue;
-            const bool right = cx + 8 + lw <= ox + pw;
-            const double ty = cy - 8 < oy + f_tick ? cy + f_tick + 6 : cy - 8;
-            s << "<text x=\"" << num(right ? cx + 8 : std::max(cx - 8, ox + lw)) << "\" y=\"" << num(ty) << "\" text-anchor=\""
-              << (right ? "start" : "end") << "\" paint-order=\"stroke\" stroke=\"#fff\" stroke-width=\"3\">" << esc(label) << "</text>\n";
+            const auto [cx, cy] = at[k];
+            std::array<double, 4> box{};
+            bool placed = false;
+            for (int c = 0; c < 4 && !placed; ++c) {
+                const double x0 = c % 2 == 0 ? cx + 7 : cx - 7 - lw, baseline = c < 2 ? cy - 7 : cy + f_tick + 5;
+                box = {x0, baseline - f_tick + 2, x0 + lw, baseline + 2};
+                if (box[0] < ox || box[2] > ox + pw || box[1] < oy || box[3] > oy + ph) continue;
+                placed = true;
+                for (std::size_t q = 0; q < taken.size() && placed; ++q)
+                    if (q != k && box[0] < taken[q][2] && taken[q][0] < box[2] && box[1] < taken[q][3] && taken[q][1] < box[3]) placed = false;
+            }
+            if (!placed) {  // nowhere clear: the upper right (left at the right edge), as before
+                const double x0 = cx + 8 + lw <= ox + pw ? cx + 7 : std::max(cx - 7, ox + lw) - lw;
+                const double baseline = cy - 8 < oy + f_tick ? cy + f_tick + 5 : cy - 7;
+                box = {x0, baseline - f_tick + 2, x0 + lw, baseline + 2};
+            }
+            taken.push_back(box);
+            s << "<text x=\"" << num(box[0]) << "\" y=\"" << num(box[3] - 2) << "\" text-anchor=\"start\" paint-order=\"stroke\" stroke=\"#fff\" "
+              << "stroke-width=\"3\">" << esc(label) << "</text>\n";
         }
         s << "</g>\n";
         s << "</g>\n";
@@ -472,6 +563,9 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         }
         s << "<text x=\"" << num(x + 34) << "\" y=\"" << num(y + 12.5) << "\">" << esc(it.text) << "</text>\n";
     }
+    for (std::size_t i = 0; i < key_pos.size(); ++i)
+        s << "<text class=\"key\" x=\"" << num(key_pos[i].first) << "\" y=\"" << num(ly + key_pos[i].second + 12.5) << "\"><tspan font-weight=\"bold\">"
+          << (i + 1) << "</tspan>  " << esc(names[i]) << "</text>\n";
     s << "</g>\n</svg>\n";
     return s.str();
 }

@@ -159,9 +159,15 @@ TEST_CASE("classification figure: window fitted to the user's vehicles, their el
     CHECK(spec.y.lo <= 0.6 - ey);
     CHECK(spec.y.hi >= 0.6 + ey);
     CHECK(spec.x.lo > 0.0);
-    REQUIRE(spec.panels.size() == 2);
+    // one panel per distinct (tau, th): both cars in it
+    REQUIRE(spec.panels.size() == 1);
+    REQUIRE(spec.panels[0].markers.size() == 2);
     CHECK(spec.panels[0].markers[0].has_ellipse);
-    CHECK_FALSE(spec.panels[1].markers[0].has_ellipse);
+    CHECK_FALSE(spec.panels[0].markers[1].has_ellipse);
+    CalibratedVehicle c = b;
+    c.name = "third";
+    c.parameters["th"] = 2.0;
+    CHECK(classification_chart(base, {a, b, c}, 22, "fits.csv").panels.size() == 2);
     const std::string svg = render_chart(spec).svg;
     CHECK(svg.find("95 % confidence ellipse") != std::string::npos);
     CHECK(svg.find("(outside)") == std::string::npos);
@@ -173,6 +179,17 @@ TEST_CASE("classification figure: window fitted to the user's vehicles, their el
         for (const auto& p : sw.points) plant_unstable = plant_unstable || !p.plant_stable;
     CHECK((svg.find(">plant unstable<") != std::string::npos) == plant_unstable);
     CHECK(svg.find("k\u2081 [1/s\u00b2]") != std::string::npos);
+    // long names and a long title: the figure widens, the names go to a numbered key
+    CalibratedVehicle d = a, e = b;
+    d.name = std::string(60, 'D');
+    e.name = "E with a name that is long enough not to fit beside its marker in a panel of 260 px";
+    const ChartSpec long_spec = classification_chart(base, {d, e}, 22, std::string(150, 'f') + ".csv");
+    const std::string long_svg = render_chart(long_spec).svg;
+    const auto width_at = long_svg.find("width=\"");
+    REQUIRE(width_at != std::string::npos);
+    CHECK(std::stod(long_svg.substr(width_at + 7)) >= 0.62 * 12 * long_spec.title.size());  // the title at 12 px or more fits
+    CHECK(long_svg.find(">1</tspan>  " + d.name + "<") != std::string::npos);                   // the key
+    CHECK(long_svg.find(">2</tspan>  " + e.name + "<") != std::string::npos);
     // the paper's table (no source): the base window and title
     const ChartSpec paper = classification_chart(base, {b}, 22);
     CHECK(paper.x.lo == base.x.lo);

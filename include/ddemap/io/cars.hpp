@@ -28,10 +28,12 @@ namespace ddemap {
 /// The most cars a car list expands to.
 constexpr std::size_t kMaxCars = 1000000;
 
-/// Reads a car list (see the file comment); files are read from disk. std::invalid_argument
-/// naming the item (and the file, line and column) for anything it cannot read; a list that
-/// would expand to more than `max_cars` cars is refused before it is built.
-std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars = kMaxCars);
+/// Reads a car list (see the file comment); files are read from disk, a relative path found
+/// from the working folder or else from `base_dir` (e.g. the folder of the chart spec that names
+/// it). std::invalid_argument naming the item (and the file, line and column) for anything it
+/// cannot read; a list that would expand to more than `max_cars` cars is refused before it is
+/// built.
+std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars = kMaxCars, const std::string& base_dir = "");
 
 /// The cars of what `calibrate` writes as JSON (its envelope `{"command": "calibrate", ...}`):
 /// one per fit, with the fit's parameters, covariance and bounds. A fit that did not converge

@@ -3,10 +3,12 @@
 /// Chart specifications: a small TOML format (see maps/*.toml) naming the model, the ring, the
 /// two swept parameters, fixed parameters common to all panels, and one [[panel]] per panel
 /// with its own fixed parameters and optional [[panel.marker]] entries; or
-/// `vehicles = "paper"` for one panel per vehicle setting of the built-in calibration table,
-/// each at the vehicle's own tau and th with the vehicle marked.
+/// `vehicles = "paper"` (the built-in calibration table) or `vehicles = "CARS"` (a car list,
+/// io/cars.hpp: "mycars.csv", "fits.json", "A_min,mycars.csv:Sedan", ...; files found beside
+/// the spec) for one panel per distinct (tau, th), every car of it marked at its (k1, k2).
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ddemap/core/execution.hpp"
@@ -45,7 +47,8 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source);
 /// The sweep of one panel: the chart's model, window and ring with the panel's parameters.
 SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel);
 
-/// Panels for a list of vehicles: each at its own tau and th (and eta), marked at (k1, k2).
+/// Panels for a list of cars (of the ovrv law): one per distinct (tau, th), every car of that
+/// (tau, th) marked in it at its (k1, k2), with its 95 % ellipse where it has a covariance.
 std::vector<PanelSpec> vehicle_panels(const std::vector<CalibratedVehicle>& vehicles);
 
 /// The sweeps and boundaries of every panel, and the SVG.
@@ -60,5 +63,9 @@ struct RenderedChart {
 /// Panels run one after the other (each sweep in parallel under `policy`); the policy's
 /// progress counts finished panels.
 RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy = {});
+
+/// The files of a rendered chart: PREFIX.svg, and for panel K its grid PREFIX-panelK.csv (as
+/// `sweep` writes it) and its boundary curves PREFIX-panelK-boundaries.csv.
+std::vector<std::pair<std::string, std::string>> chart_files(const RenderedChart& chart, const std::string& prefix);
 
 }  // namespace ddemap

@@ -49,6 +49,8 @@ void write_file_atomic(const std::string& path, const std::string& text);
 /// - `remove`: files of an earlier run that are not part of this set (e.g. PREFIX-boundaries.csv
 ///   of a sweep now run without boundaries): removed together with the move, so that a folder
 ///   never holds old and new files of one command side by side (only regular files).
+/// - a file this process has read (read_text_file) is never written over: std::invalid_argument
+///   naming it, before anything is written (`classify mycars.csv --out mycars`).
 /// On a failure the old files stay as they were and no temporary file is left; WriteError
 /// names the path and the system's reason (e.g. "No space left on device").
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files, const std::vector<std::string>& remove = {});
