@@ -11,7 +11,7 @@ build=(g++ make cmake ninja-build pkg-config
        libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
        libhdf5-dev libopenmpi-dev openmpi-bin)  # ddemap atlas (HDF5, MPI)
 rest=(python3 doctest-dev libxml2-utils librsvg2-bin
-      pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv
+      pybind11-dev python3-dev python3-numpy python3-pandas python3-pytest python3-matplotlib python3-venv
       python3-h5py hdf5-tools)
 case "$what" in
     build) packages=("${build[@]}") ;;

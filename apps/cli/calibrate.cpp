@@ -3,6 +3,7 @@
 // list with test runs (--runs); --report DIR writes the Tables 1/2 report and fit figures.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -22,7 +23,7 @@ namespace ddemap::cli {
 namespace {
 struct CalibrateArgs {
     std::vector<std::string> files;
-    std::string train, model = "ovrv", bounds, gap_weight = "0.02", runs, report, car = "joint", data_dir;
+    std::string train, model = "ovrv", bounds, gap_weight = "0.02", runs, report, car = "joint", data_dir, follower;
     bool joint = false;
     FormatArg format;
     OutArg out;
@@ -66,7 +67,10 @@ CalibrationOptions options() {
 }  // namespace
 
 void add_calibrate_flags(CLI::App& app) {
-    app.add_option("DATA.csv", calibrate_args.files, "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one fit per file)");
+    app.add_option("DATA.csv", calibrate_args.files,
+                   "traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one fit per file), or the CSV that simulate "
+                   "writes (one fit per follower; FILE.csv:K fits follower K only)");
+    app.add_option("--follower", calibrate_args.follower, "in the CSVs that simulate writes, fit follower K only (1 = the first behind the lead)")->type_name("K");
     app.add_flag("--joint", calibrate_args.joint, "fit one parameter set to all DATA files (runs of the same car)");
     app.add_option("--car", calibrate_args.car, "the car's name for --joint")->capture_default_str();
     app.add_option("--runs", calibrate_args.runs,
@@ -92,6 +96,33 @@ std::vector<CarRuns> read_runs(const std::string& path) {
         return read_trace_csv(read_input_file("--runs " + path + ": file", file), file);
     };
     return cars_from_run_list(read_run_list_csv(read_input_file("--runs", path), path), read, "--runs " + path);
+}
+
+/// The traces of one DATA.csv argument with their car names: a trace file (named after the file),
+/// every follower of simulate's CSV (FILE-K), or one follower (FILE.csv:K or --follower K).
+bool append_traces(const std::string& arg, int follower, std::vector<std::pair<std::string, Trace>>& out) {
+    namespace fs = std::filesystem;
+    std::string file = arg;
+    std::error_code ec;
+    const auto colon = arg.rfind(':');
+    if (!fs::exists(arg, ec) && colon != std::string::npos && colon + 1 < arg.size() &&
+        arg.find_first_not_of("0123456789", colon + 1) == std::string::npos) {
+        file = arg.substr(0, colon);
+        const double k = parse_number("DATA.csv " + arg, arg.substr(colon + 1));
+        if (!(k >= 1 && k <= 1e6)) throw BadInput("DATA.csv = '" + arg + "': follower " + arg.substr(colon + 1) + ": expected 1, 2, ...");
+        if (follower != 0 && follower != static_cast<int>(k))
+            throw BadInput("DATA.csv = '" + arg + "': follower " + arg.substr(colon + 1) + " and --follower " + std::to_string(follower) + " disagree");
+        follower = static_cast<int>(k);
+    }
+    const std::string text = read_input_file("DATA.csv", file);
+    if (file != arg && !is_platoon_csv(text))
+        throw BadInput("DATA.csv = '" + arg + "': ':K' picks a follower of a platoon CSV (simulate's), and " + file + " is one trace");
+    const bool platoon = is_platoon_csv(text);
+    for (Trace& t : read_traces_csv(text, file, platoon ? follower : 0)) {
+        const std::string name = platoon ? base_name(file) + "-" + t.source.substr(t.source.rfind(':') + 1) : base_name(file);
+        out.emplace_back(name, std::move(t));
+    }
+    return platoon;
 }
 
 /// the --report folder, created as needed and writable (bad input otherwise, before any work)
@@ -121,11 +152,23 @@ int run_calibrate() {
     std::vector<CarRuns> cars;
     if (!calibrate_args.runs.empty()) {
         cars = read_runs(calibrate_args.runs);
-    } else if (calibrate_args.joint) {
-        cars.push_back(CarRuns{calibrate_args.car, {}, {}, {}});
-        for (const auto& f : calibrate_args.files) cars[0].train.push_back(read_trace_csv(read_input_file("DATA.csv", f), f));
     } else {
-        for (const auto& f : calibrate_args.files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_input_file("DATA.csv", f), f)}, {}, {}});
+        int follower = 0;
+        if (!calibrate_args.follower.empty()) {
+            const double k = parse_number("--follower", calibrate_args.follower);
+            if (!(k >= 1 && k <= 1e6 && k == std::floor(k))) throw BadInput("--follower = '" + calibrate_args.follower + "': expected a follower number 1, 2, ...");
+            follower = static_cast<int>(k);
+        }
+        std::vector<std::pair<std::string, Trace>> traces;  // (name, trace)
+        bool platoon = false;
+        for (const auto& f : calibrate_args.files) platoon = append_traces(f, follower, traces) || platoon;
+        if (follower != 0 && !platoon) throw BadInput("--follower " + calibrate_args.follower + ": none of the DATA files is a platoon CSV (the CSV that simulate writes)");
+        if (calibrate_args.joint) {
+            cars.push_back(CarRuns{calibrate_args.car, {}, {}, {}});
+            for (auto& [name, t] : traces) cars[0].train.push_back(std::move(t));
+        } else {
+            for (auto& [name, t] : traces) cars.push_back(CarRuns{name, {std::move(t)}, {}, {}});
+        }
     }
     // one progress line per finished fit: ddemap: calibrate: fits 3/12 done, NAME in 0.41 s (4.2 s, about 12 s left)
     CarFinished finished;

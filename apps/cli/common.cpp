@@ -1,3 +1,4 @@
+#include <cctype>
 #include "common.hpp"
 
 #include <cstdio>
@@ -169,7 +170,9 @@ void RingArg::add_to(CLI::App& app, const std::string& fallback, const std::stri
 }
 
 int RingArg::parse(bool allow_inf, int max_cars) const {
-    if (allow_inf && (text == "inf" || text == "infinity")) return 0;
+    std::string lower = text;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (allow_inf && (lower == "inf" || lower == "infinity")) return 0;
     const std::string most = "(at most " + std::to_string(max_cars) + ")";
     return static_cast<int>(parse_integer("--ring", text, 2, max_cars,
                                           allow_inf ? "an integer N >= 2 " + most + " or 'inf'"

@@ -16,7 +16,7 @@ namespace ddemap::cli {
 
 namespace {
 struct SimulateArgs {
-    std::string fleet, on_event = "continue", t_end = "0", step = "0.05", output_dt = "0.1";
+    std::string fleet, on_event = "continue", t_end = "0", step = "0.05", output_dt = "0.1", noise, seed = "1";
     LeadArgs lead;
     FormatArg format;
     OutArg out;
@@ -33,6 +33,11 @@ void add_simulate_flags(CLI::App& app) {
     app.add_option("--t-end", simulate_args.t_end, "end time [s] (0: the profile's last breakpoint + 30 s)")->capture_default_str();
     app.add_option("--step", simulate_args.step, "largest integration step [s]")->capture_default_str();
     app.add_option("--output-dt", simulate_args.output_dt, "output sampling [s]")->capture_default_str();
+    app.add_option("--noise", simulate_args.noise,
+                   "measurement noise written to the CSV: Gaussian errors of SD_SPEED [m/s] on every speed and SD_GAP [m] on every gap "
+                   "(the dynamics and the JSON summary are exact), e.g. 0.05:0.1")
+        ->type_name("SD_SPEED:SD_GAP");
+    app.add_option("--seed", simulate_args.seed, "seed of the noise")->capture_default_str();
     simulate_args.format.add_to(app);
     run_flags().add_to(app, true);
 }
@@ -58,7 +63,20 @@ int run_simulate() {
     check_size("simulate", what, "output", size.output_bytes);
     check_size("simulate", what, "time", size.car_steps * 2e-6);  // about 2 us per car and step (measured)
     o.progress = progress_printer("simulate", "ms simulated");
-    const SimResult r = simulate_platoon(lead, cars, o);
+    double speed_sd = 0.0, gap_sd = 0.0;
+    if (!simulate_args.noise.empty()) {
+        const auto colon = simulate_args.noise.find(':');
+        if (colon == std::string::npos) throw BadInput("--noise = '" + simulate_args.noise + "': expected SD_SPEED:SD_GAP, e.g. 0.05:0.1");
+        speed_sd = parse_number("--noise (speed)", simulate_args.noise.substr(0, colon));
+        gap_sd = parse_number("--noise (gap)", simulate_args.noise.substr(colon + 1));
+        if (!(speed_sd >= 0 && gap_sd >= 0 && speed_sd <= 10 && gap_sd <= 100))
+            throw BadInput("--noise = '" + simulate_args.noise + "': expected standard deviations 0 to 10 m/s and 0 to 100 m");
+    }
+    const auto seed = static_cast<unsigned long long>(parse_integer("--seed", simulate_args.seed, 0, 4294967295L, "an integer 0..4294967295"));
+    SimResult r = simulate_platoon(lead, cars, o);
+    const std::string summary = simulation_json(r, label);  // the exact run
+    SimResult measured = r;
+    add_measurement_noise(measured, speed_sd, gap_sd, seed);
     JsonEnvelope e;
     e.command = "simulate";
     e.inputs = JsonObject()
@@ -68,11 +86,14 @@ int run_simulate() {
                    .number("t_end", o.t_end)
                    .number("step", o.step)
                    .number("output_dt", o.output_dt)
+                   .number("noise_speed_sd", speed_sd)
+                   .number("noise_gap_sd", gap_sd)
+                   .integer("seed", static_cast<long long>(seed))
                    .str();
     e.status = to_string(r.status);
     e.message = r.message;
-    e.result = simulation_json(r, label);
-    const std::string csv = simulation_csv(r);
+    e.result = summary;
+    const std::string csv = simulation_csv(measured);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", simulation_svg(r, label)}});
     print_output(format, e, csv, [&] {
         std::ostringstream s;

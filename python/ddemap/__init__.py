@@ -38,14 +38,18 @@ Quick start (the paper's stability chart)::
 
 import json as _json
 import math as _math
+import functools as _functools
 import os as _os
+import sys as _sys
+import time as _time
+import warnings as _warnings
 
 import numpy as _np
 
 from . import _ddemap
 
-__all__ = ["__version__", "Result", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
-           "mixed_ring", "equilibria", "hopf", "orbits", "version"]
+__all__ = ["__version__", "Result", "CalibrationWarning", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
+           "mixed_ring", "mix", "growth", "equilibria", "hopf", "orbits", "version"]
 
 version = _ddemap.version
 __version__ = _ddemap.version
@@ -66,10 +70,40 @@ class Result(dict):
     status = ""
     message = ""
 
+    _envelope = None  # the command's JSON envelope, as the library wrote it
+
     @property
     def converged(self):
         """True when ``status`` is ``"converged"``."""
         return self.status == "converged"
+
+    def to_dict(self):
+        """The command's JSON envelope as plain Python (``command``, ``version``, ``inputs``,
+        ``solver``, ``status``, ``message``, ``result``): what ``ddemap COMMAND --format json``
+        prints, numbers exact. Arrays the wrapper added (e.g. ``series`` of :func:`simulate`)
+        are lists under ``extra``."""
+        e = _json.loads(self._envelope) if self._envelope else {
+            "command": self.command, "version": self.version, "inputs": self.inputs, "solver": self.solver,
+            "status": self.status, "message": self.message, "result": {}}
+        extra = {k: _plain(v) for k, v in self.items() if k not in e["result"]}
+        if extra:
+            e["extra"] = extra
+        return e
+
+    def to_json(self, **kwargs):
+        """:meth:`to_dict` as JSON text (``json.dumps`` keyword arguments pass through);
+        :func:`Result.from_json` reads it back."""
+        return _json.dumps(self.to_dict(), allow_nan=False, **kwargs)
+
+    @staticmethod
+    def from_json(text):
+        """The Result of :meth:`to_json` text (or of ``ddemap COMMAND --format json`` output)."""
+        e = _json.loads(text)
+        extra = e.pop("extra", {})
+        r = _result(_json.dumps(e))
+        for k, v in extra.items():
+            r[k] = _convert(v)
+        return r
 
     def __repr__(self):
         return "Result(command=%r, status=%r, keys=%r)" % (self.command, self.status, sorted(self.keys()))
@@ -106,9 +140,27 @@ def _convert(value):
     return value
 
 
+def _plain(v):
+    """NumPy values -> JSON-ready Python (NaN -> None)."""
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
+    if isinstance(v, _np.ndarray):
+        return _plain(v.tolist())
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    if isinstance(v, (_np.floating, float)):
+        return None if not _math.isfinite(float(v)) else float(v)
+    if isinstance(v, _np.integer):
+        return int(v)
+    if isinstance(v, _np.bool_):
+        return bool(v)
+    return v
+
+
 def _result(envelope_text):
     e = _json.loads(envelope_text)
     r = Result(_convert(e["result"]))
+    r._envelope = envelope_text
     r.command = e["command"]
     r.version = e["version"]
     r.inputs = e["inputs"]
@@ -125,8 +177,10 @@ def _ring(ring, allow_inf=True):
     """ring: N >= 2, or "inf" / math.inf -> 0 (the library's code for infinity)."""
     if allow_inf and (ring in ("inf", "infinity") or (isinstance(ring, float) and _math.isinf(ring) and ring > 0)):
         return 0
-    if isinstance(ring, bool) or not isinstance(ring, (int, _np.integer)) or not 2 <= ring <= 1000000:
-        expected = "an integer N >= 2 (at most 1000000)" + (" or 'inf'" if allow_inf else "; this ring is finite")
+    if isinstance(ring, str) and ring.strip().lower() in ("inf", "infinity") and allow_inf:
+        return 0
+    if isinstance(ring, bool) or not isinstance(ring, (int, _np.integer)) or not 2 <= ring <= 1000000000:
+        expected = "an integer N >= 2 (at most 10^9)" + (" or 'inf'" if allow_inf else "; this ring is finite")
         raise ValueError("ring = %r: expected %s" % (ring, expected))
     return int(ring)
 
@@ -154,6 +208,8 @@ def _axes(parameters, x, counts):
     fixed, axes = {}, []
     for name in sorted(parameters):
         v = parameters[name]
+        if counts and _is_grid(v):
+            v = _grid_axis(name, v)
         if isinstance(v, (tuple, list)):
             if len(v) != (3 if counts else 2):
                 raise ValueError("%s = %r: expected %s" % (name, v, "(LO, HI, COUNT)" if counts else "(LO, HI)"))
@@ -176,6 +232,31 @@ def _axes(parameters, x, counts):
     return fixed, axes
 
 
+def _is_grid(v):
+    """An axis given as its values (a NumPy array, or a list or tuple that is not (LO, HI, COUNT))."""
+    if isinstance(v, _np.ndarray):
+        return True
+    if isinstance(v, (list, tuple)):
+        triple = len(v) == 3 and isinstance(v[2], (int, _np.integer)) and not isinstance(v[2], bool)
+        return not triple and len(v) >= 2
+    return False
+
+
+def _grid_axis(name, values):
+    """Evenly spaced values (np.linspace(lo, hi, count)) -> (lo, hi, count); anything else is an error."""
+    try:
+        a = _np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError("%s: expected numbers (an array such as np.linspace(lo, hi, count), or (LO, HI, COUNT))" % (name,)) from None
+    if a.ndim != 1 or a.size < 2 or not _np.all(_np.isfinite(a)):
+        raise ValueError("%s: expected a one-dimensional array of at least 2 finite values" % (name,))
+    step = (a[-1] - a[0]) / (a.size - 1)
+    if not step > 0 or _np.max(_np.abs(_np.diff(a) - step)) > 1e-9 * (abs(a[-1]) + abs(a[0]) + step):
+        raise ValueError("%s: the %d values are not increasing evenly (the chart's grid is LO..HI in equal steps): "
+                         "expected np.linspace(lo, hi, count) or (LO, HI, COUNT)" % (name, a.size))
+    return (float(a[0]), float(a[-1]), int(a.size))
+
+
 def _text(v):
     """A number as the shortest text that reads back to it (1.0 as "1", as typed on a command line)."""
     t = repr(float(v))
@@ -187,9 +268,216 @@ def _axis_text(axis, grid):
     return name, "%s:%s:%d" % (_text(lo), _text(hi), count if count is not None else grid)
 
 
+_TYPES_TABLE = "a pandas DataFrame, a dict of columns, a list of row dicts"
+
+
+def _is_frame(v):
+    return hasattr(v, "columns") and hasattr(v, "to_dict") and hasattr(v, "__getitem__")
+
+
+def _field(v):
+    """One CSV field: numbers in the shortest form that reads back exactly, NaN/None empty."""
+    if v is None:
+        return ""
+    if isinstance(v, (bool, _np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, (int, _np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, _np.floating)):
+        f = float(v)
+        if _math.isnan(f):
+            return ""
+        return repr(f) if _math.isfinite(f) else ("inf" if f > 0 else "-inf")
+    t = str(v)
+    if any(c in t for c in ',"\n\r'):
+        t = '"' + t.replace('"', '""') + '"'
+    return t
+
+
+def _table_text(value, what):
+    """A table in memory (DataFrame, dict of columns or of one row's values, list of row dicts)
+    as CSV text, or None when `value` is none of these."""
+    if _is_frame(value):
+        columns = [str(c) for c in value.columns]
+        data = [list(value[c]) for c in value.columns]
+    elif isinstance(value, dict):
+        if not value:
+            raise ValueError("%s: an empty dict: expected columns (name -> values)" % (what,))
+        columns = [str(c) for c in value]
+        vals = list(value.values())
+        if all(isinstance(v, (str, int, float, bool, _np.generic)) or v is None for v in vals):
+            data = [[v] for v in vals]  # one row
+        else:
+            data = []
+            for c, v in zip(columns, vals):
+                if isinstance(v, (str, bytes)) or not hasattr(v, "__len__"):
+                    raise ValueError("%s: column %r is %r: expected a sequence of values like the other columns" % (what, c, v))
+                data.append(list(v))
+            lengths = {len(d) for d in data}
+            if len(lengths) != 1:
+                raise ValueError("%s: columns of different lengths %s: expected equal lengths" % (what, sorted(lengths)))
+    elif isinstance(value, (list, tuple)) and value and all(isinstance(r, dict) for r in value):
+        columns = []
+        for r in value:
+            columns += [str(k) for k in r if str(k) not in columns]
+        data = [[r.get(c) for r in value] for c in columns]
+    else:
+        return None
+    rows = len(data[0]) if data else 0
+    lines = [",".join(_field(c) for c in columns)]
+    lines += [",".join(_field(col[i]) for col in data) for i in range(rows)]
+    return "\n".join(lines) + "\n"
+
+
+def _cars(value, what, tables=None):
+    """A car list from Python: (the list's text, {name: table text}). Takes the command line's car
+    list syntax (str), a path (os.PathLike), a table in memory, a Result of calibrate, or a list or
+    tuple of these (joined in order)."""
+    tables = {} if tables is None else tables
+    if isinstance(value, str):
+        if not value.strip():
+            raise ValueError("%s = %r: expected cars (e.g. 'A_min*7', 'mycars.csv', 'ovrv:k1=0.1,k2=0.4,th=1.5,tau=0.5')" % (what, value))
+        return value, tables
+    if isinstance(value, _os.PathLike):
+        return _os.fspath(value), tables
+    if isinstance(value, Result):
+        if value.command != "calibrate" or not value._envelope:
+            raise ValueError("%s: a Result of %r: expected the Result of calibrate (its fits are cars)" % (what, value.command))
+        name = "<calibrate result %d>" % (len(tables) + 1)
+        tables[name] = value._envelope
+        return name, tables
+    text = _table_text(value, what)
+    if text is not None:
+        kind = "DataFrame" if _is_frame(value) else "dict" if isinstance(value, dict) else "rows"
+        name = "<%s %d>" % (kind, len(tables) + 1)
+        tables[name] = text
+        return name, tables
+    if isinstance(value, (list, tuple)) and value:
+        items = []
+        for v in value:
+            item, tables = _cars(v, what, tables)
+            items.append(item)
+        return ",".join(items), tables
+    raise TypeError("%s: %s: expected a car list string ('A_min*7,mycars.csv:Sedan'), an os.PathLike, %s, "
+                    "the Result of calibrate, or a list of these" % (what, type(value).__name__, _TYPES_TABLE))
+
+
+def _traces(values):
+    """The traces of calibrate: [(source, text)], text empty for a file."""
+    out = []
+    for v in values:
+        if isinstance(v, (str, _os.PathLike)):
+            out.append((_os.fspath(v), ""))
+        elif isinstance(v, Result) and v.command == "simulate":
+            out.append(("simulate%d" % (len(out) + 1), _platoon_text(v)))
+        else:
+            text = _table_text(v, "trace %d" % (len(out) + 1))
+            if text is None:
+                raise TypeError("trace %d: %s: expected a CSV path (str or os.PathLike), %s with columns time_s, "
+                                "lead_speed_mps, follower_speed_mps, gap_m, or the Result of simulate"
+                                % (len(out) + 1, type(v).__name__, _TYPES_TABLE))
+            kind = "DataFrame" if _is_frame(v) else "dict" if isinstance(v, dict) else "rows"
+            out.append(("trace%d" % (len(out) + 1), text))
+    return out
+
+
+def _platoon_text(r):
+    """simulate's CSV (time_s, car, position_m, speed_mps, gap_m) from its Result's series."""
+    s = r["series"]
+    t, x, v, g = s["time"], s["position"], s["speed"], s["gap"]
+    lines = ["time_s,car,position_m,speed_mps,gap_m"]
+    for k in range(len(t)):
+        for c in range(v.shape[0]):
+            lines.append("%s,%d,%s,%s,%s" % (_field(t[k]), c, _field(x[c, k]), _field(v[c, k]), "" if c == 0 else _field(g[c, k])))
+    return "\n".join(lines) + "\n"
+
+
+def _lead(lead):
+    """simulate's lead: (file, text, car): a path (P.csv:K for car K of simulate's CSV), a table in
+    memory (time_s, lead_speed_mps), a (t, v) pair of arrays, or (Result of simulate, K)."""
+    if lead is None:
+        return "", "", -1
+    if isinstance(lead, (str, _os.PathLike)):
+        path = _os.fspath(lead)
+        head, _, tail = path.rpartition(":")
+        if not _os.path.exists(path) and head and tail.isdigit():
+            return head, "", int(tail)
+        return path, "", -1
+    if isinstance(lead, tuple) and len(lead) == 2 and isinstance(lead[0], Result):
+        if lead[0].command != "simulate":
+            raise ValueError("lead = (Result of %r, K): expected the Result of simulate" % (lead[0].command,))
+        return "<simulate result>", _platoon_text(lead[0]), _integer("lead car", lead[1], 0, 1000000)
+    if isinstance(lead, tuple) and len(lead) == 2 and not isinstance(lead[0], dict):
+        t, v = (_np.asarray(a, dtype=float) for a in lead)
+        if t.ndim != 1 or t.shape != v.shape:
+            raise ValueError("lead = (t, v): expected two one-dimensional arrays of the same length, got shapes %s and %s" % (t.shape, v.shape))
+        return "<(t, v)>", _table_text({"time_s": t, "lead_speed_mps": v}, "lead"), -1
+    text = _table_text(lead, "lead")
+    if text is None:
+        raise TypeError("lead: %s: expected a CSV path (str or os.PathLike, P.csv:K for car K of simulate's CSV), %s with "
+                        "columns time_s, lead_speed_mps, a (t, v) pair of arrays, or (Result of simulate, K)" % (type(lead).__name__, _TYPES_TABLE))
+    kind = "DataFrame" if _is_frame(lead) else "dict" if isinstance(lead, dict) else "rows"
+    return "<%s>" % kind, text, -1
+
+
+class _StderrProgress:
+    """The default progress: silent for the first second, then one line on stderr, rewritten in
+    place on a terminal, a new line at most every 5 s otherwise (as the command line)."""
+
+    def __init__(self, command):
+        self.command = command
+        self.start = _time.monotonic()
+        self.last = 0.0
+        self.shown = False
+        self.tty = _sys.stderr.isatty()
+
+    def __call__(self, done, total):
+        now = _time.monotonic()
+        if now - self.start < 1.0 or (not self.tty and now - self.last < 5.0):
+            return
+        self.last = now
+        line = "ddemap: %s: %d/%d (%.0f s)" % (self.command, done, total, now - self.start)
+        _sys.stderr.write(("\r" + line + "   ") if self.tty else line + "\n")
+        _sys.stderr.flush()
+        self.shown = True
+
+    def close(self):
+        if self.shown and self.tty:
+            _sys.stderr.write("\n")
+
+
+def _with_progress(f):
+    """Adds ``progress=``: None (the default: a line on stderr for calls over a second), False
+    (none) or a callable ``progress(done, total)`` called at most 5 times a second on the calling
+    thread; an exception it raises stops the call and is raised from it."""
+    command = f.__name__
+
+    @_functools.wraps(f)
+    def call(*args, progress=None, **kwargs):
+        if progress is None:
+            callback = _StderrProgress(command)
+        elif progress is False:
+            callback = None
+        elif callable(progress):
+            callback = progress
+        else:
+            raise TypeError("progress = %r: expected None, False or a callable progress(done, total)" % (progress,))
+        _ddemap.set_progress(callback)
+        try:
+            return f(*args, **kwargs)
+        finally:
+            _ddemap.set_progress(None)
+            if isinstance(callback, _StderrProgress):
+                callback.close()
+
+    call.__doc__ = (f.__doc__ or "") + "\n    ``progress``: None (a line on stderr for calls over a second), False, or a callable ``progress(done, total)``.\n"
+    return call
+
+
 # ------------------------------------------------------------------ commands
 
 
+@_with_progress
 def roots(model="ovrv", ring=22, count=6, system=None, solver="auto", degree=0, **parameters):
     """Rightmost characteristic roots of a ring of ``ring`` identical cars (``ddemap roots``),
     or of any linear DDE ``x' = A0 x + sum_k A_k x(t - tau_k)`` from a JSON file
@@ -228,6 +516,7 @@ def roots(model="ovrv", ring=22, count=6, system=None, solver="auto", degree=0, 
     return _result(_ddemap.roots(model, _parameters(parameters), _ring(ring), count))
 
 
+@_with_progress
 def string(model="ovrv", ring=None, **parameters):
     """Plant and string stability of identical cars (``ddemap string``).
 
@@ -249,6 +538,7 @@ def string(model="ovrv", ring=None, **parameters):
     return _result(_ddemap.string(model, _parameters(parameters), None if ring is None else _ring(ring)))
 
 
+@_with_progress
 def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", **parameters):
     """A stability chart over two model parameters (``ddemap sweep``).
 
@@ -287,6 +577,7 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", **
     return r
 
 
+@_with_progress
 def boundary(model="ovrv", ring=22, seed_grid=41, ring_curves="auto", **parameters):
     """Stability boundaries in a window of two parameters, by continuation (``ddemap boundary``).
 
@@ -316,15 +607,18 @@ def boundary(model="ovrv", ring=22, seed_grid=41, ring_curves="auto", **paramete
     return r
 
 
+@_with_progress
 def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1):
     """Plant, ring and string verdicts of calibrated OVRV vehicles (``ddemap classify``).
 
-    ``vehicles``: None (the paper's calibration table, 14 settings), a CSV file
-    ``name,k1,k2,th,tau[,eta]`` (k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]; what
-    ``calibrate`` writes), or built-in names such as ``"A_min,E_max"``. With the covariance
-    columns of ``calibrate`` the verdicts come with probabilities from ``samples`` parameter
-    draws (seed ``seed``; the first ``ring_samples`` also classified as rings). ``ring``: N or
-    "inf" for the ring verdict.
+    ``vehicles``: None (the paper's calibration table, 14 settings) or cars, as everywhere: a car
+    list in the command line's syntax (``"A_min,E_max"``, ``"mycars.csv"``, ``"mycars.csv:Sedan"``,
+    ``"ovrv:k1=0.1,k2=0.4,th=1.5,tau=0.5"``, each with ``*K``), an ``os.PathLike``, a pandas
+    DataFrame, a dict of columns or a list of row dicts (columns ``name, k1, k2, th, tau[, eta]``
+    as in a car table: k1 [1/s^2], k2 [1/s], th [s], tau [s], eta [m]), the Result of
+    :func:`calibrate`, or a list of these. Each distinct car is classified once. With the
+    covariance of a fit the verdicts come with probabilities from ``samples`` parameter draws
+    (seed ``seed``; the first ``ring_samples`` also classified as rings). ``ring``: N or "inf".
 
     Returns ``vehicles`` (columns per vehicle: parameters, ``plant_stable``, ``ring_stable``,
     ``string_stable``, ``sup_gamma``, ``omega_peak``, ``lowfreq_margin``,
@@ -333,63 +627,78 @@ def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1):
     samples = _integer("samples", samples, 1, 1000000)
     ring_samples = _integer("ring_samples", ring_samples, 0, 1000000)
     seed = _integer("seed", seed, 0, 4294967295)
-    if vehicles is not None and not isinstance(vehicles, str):
-        vehicles = str(vehicles)  # a path-like
-    if vehicles == "":
-        raise ValueError("vehicles = '': expected a CSV file, built-in names or None (the paper's table)")
-    return _result(_ddemap.classify(vehicles or "", _ring(ring), samples, ring_samples, seed))
+    spec, tables = ("", {}) if vehicles is None else _cars(vehicles, "vehicles")
+    return _result(_ddemap.classify(spec, tables, _ring(ring), samples, ring_samples, seed))
 
 
-def simulate(fleet, lead_profile=None, lead=None, on_event="continue", t_end=0.0, step=0.05, output_dt=0.1):
+@_with_progress
+def simulate(fleet, lead_profile=None, lead=None, on_event="continue", t_end=0.0, step=0.05, output_dt=0.1, noise=None, seed=1):
     """A platoon of OVRV cars behind a lead speed profile, nonlinear model (``ddemap simulate``).
 
-    ``fleet``: followers in platoon order, built-in names with repeats (``"A_min*7,C_max"``) or
-    a CSV file (a vehicle table as ``calibrate`` writes). ``lead_profile``: "dip" (default),
-    "oscillatory", "step-low", "step-high"; or ``lead``: a CSV file ``time_s,lead_speed_mps``.
-    ``on_event``: "stop" or "continue" at the first ACC disengagement or collision. ``t_end``
-    [s] (0: the profile's last breakpoint + 30 s), ``step`` [s] (largest integration step),
-    ``output_dt`` [s] (output sampling).
+    ``fleet``: the followers in platoon order, cars as :func:`classify` takes them (a car list
+    such as ``"A_min*7,C_max"``, a path, a DataFrame, dict or rows, a calibrate Result, or a list
+    of these). ``lead_profile``: "dip" (default), "oscillatory", "step-low", "step-high"; or
+    ``lead``: a CSV path with columns ``time_s,lead_speed_mps`` (``"P.csv:K"``: car K of the CSV
+    that simulate writes), a DataFrame or dict with those columns, a ``(t, v)`` pair of arrays
+    [s, m/s], or ``(result_of_simulate, K)``. ``on_event``: "stop" or "continue" (default) at
+    the first ACC disengagement or collision. ``t_end`` [s] (0: the profile's last breakpoint
+    + 30 s), ``step`` [s] (largest integration step), ``output_dt`` [s] (output sampling).
+    ``noise``: ``(sd_speed, sd_gap)`` [m/s, m], Gaussian measurement noise added to the series
+    (not to the dynamics or the summary), drawn with ``seed``.
 
     Returns the command's JSON keys (``cars``: per follower ``lowest_speed``, ``speed_drop``
     [m/s], ``min_gap`` [m], ``events``; ``t_end``, ``steps``, ...) and ``series``: ``time``
     [s] and arrays of shape (cars + 1, samples), row 0 the lead: ``position`` [m], ``speed``
-    [m/s], ``gap`` [m] (row 0 NaN).
+    [m/s], ``gap`` [m] (row 0 NaN). The Result can be passed to :func:`calibrate`.
     """
-    if not isinstance(fleet, str) or not fleet:
-        raise ValueError("fleet = %r: expected built-in names (e.g. 'A_min*7') or a CSV file" % (fleet,))
-    envelope, series = _ddemap.simulate(fleet, lead_profile or "", str(lead) if lead else "", on_event,
-                                        _number("t_end", t_end), _number("step", step), _number("output_dt", output_dt))
+    spec, tables = _cars(fleet, "fleet")
+    lead_file, lead_text, lead_car = _lead(lead)
+    sd_speed, sd_gap = 0.0, 0.0
+    if noise is not None:
+        if not isinstance(noise, (tuple, list)) or len(noise) != 2:
+            raise ValueError("noise = %r: expected (sd_speed, sd_gap) in m/s and m" % (noise,))
+        sd_speed, sd_gap = _number("noise sd_speed", noise[0]), _number("noise sd_gap", noise[1])
+    envelope, series = _ddemap.simulate(spec, tables, lead_profile or "", lead_file, lead_text, lead_car, on_event,
+                                        _number("t_end", t_end), _number("step", step), _number("output_dt", output_dt),
+                                        sd_speed, sd_gap, _integer("seed", seed, 0, 4294967295))
     r = _result(envelope)
     r["series"] = series
     return r
 
 
-def calibrate(*files, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, model="ovrv", runs=None, data_dir=None,
-              report=None):
+@_with_progress
+def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, model="ovrv", runs=None, data_dir=None,
+              report=None, follower=None, warn=True):
     """Fits OVRV to measured car-following traces (``ddemap calibrate``).
 
-    ``files``: CSV traces with columns time_s, lead_speed_mps, follower_speed_mps, gap_m (one
-    fit per file, or one fit of all of them with ``joint=True``, named ``car``). ``train``:
-    ``(T0, T1)`` [s], the training window (default the whole file). ``bounds``: a dict
-    ``{"eta": (5, 15), ...}`` (default the paper's k1 0:1, k2 0:1, th 0:3, tau 0:1, eta 5:15).
-    The fit minimises ``MSE(speed) + gap_weight * MSE(gap)`` [gap_weight in 1/s^2] over the
-    simulated follower (RK4 with the delay).
+    ``traces``: each a CSV path (str or ``os.PathLike``), a pandas DataFrame, dict of columns
+    or list of row dicts with columns time_s, lead_speed_mps, follower_speed_mps, gap_m, or a
+    platoon: the CSV that simulate writes or the Result of :func:`simulate` (every follower a
+    trace, or only ``follower`` K). One fit per trace, or one fit of all of them with
+    ``joint=True``, named ``car``. ``train``: ``(T0, T1)`` [s], the training window (default
+    the whole file). ``bounds``: a dict ``{"eta": (5, 15), ...}`` (default the paper's k1 0:1,
+    k2 0:1, th 0:3, tau 0:1, eta 5:15). The fit minimises ``MSE(speed) + gap_weight * MSE(gap)``
+    [gap_weight in 1/s^2] over the simulated follower (RK4 with the delay).
 
-    ``runs`` (instead of ``files``): a run list, CSV with columns car, file, role[, type]: each
+    ``runs`` (instead of ``traces``): a run list, CSV with columns car, file, role[, type]: each
     car fitted jointly on its ``role=train`` files and tested on its ``role=test`` files (errors
     per type); its file names are relative to ``data_dir`` (default the current folder).
     ``report``: a folder (created as needed) that receives table.csv, table.json, table.md and
     one fit figure per run, fit_CAR_FILE.svg, as ``--report`` writes them.
 
     Returns ``fits`` (per fit the parameters, errors, estimates with 95 % intervals, status,
-    and with ``runs`` the test runs), ``gap_weight`` and ``bounds``, as the command's JSON.
-    Ctrl-C stops it between fits.
+    warnings, and with ``runs`` the test runs), ``gap_weight`` and ``bounds``, as the command's
+    JSON. Each fit's warnings are also issued with ``warnings.warn`` (``warn=False``: not).
+    The Result is a car list for :func:`classify`, :func:`simulate`, :func:`growth`, ...
+    Ctrl-C stops it within a fit.
     """
+    files = traces
     if model != "ovrv":
         raise ValueError("model = %r: calibration supports ovrv" % (model,))
-    if len(files) == 1 and isinstance(files[0], (list, tuple)):
+    if len(files) == 1 and isinstance(files[0], list):
         files = tuple(files[0])
-    files = [str(f) for f in files]
+    files = _traces(files)
+    follower = 0 if follower is None else _integer("follower", follower, 1, 1000000)
     if not files and runs is None:
         raise ValueError("files: expected at least one trace (or runs=RUNS.csv)")
     if train is not None:
@@ -404,15 +713,25 @@ def calibrate(*files, joint=False, car="joint", train=None, bounds=None, gap_wei
             raise ValueError("bounds item %r: expected one of k1, k2, th, tau, eta" % (name,))
         items.append((name, _number("bounds " + name, b[0]), _number("bounds " + name, b[1])))
     if report is not None:
-        report = str(report)
+        report = _os.fspath(report)
         if _os.path.exists(report) and not _os.path.isdir(report):
             raise ValueError("report = %r: expected a folder" % (report,))
         _os.makedirs(report, exist_ok=True)
-    return _result(_ddemap.calibrate(files, bool(joint), car, train, items, _number("gap_weight", gap_weight),
-                                     "" if runs is None else str(runs), "" if data_dir is None else str(data_dir),
-                                     "" if report is None else report))
+    r = _result(_ddemap.calibrate(files, follower, bool(joint), car, train, items, _number("gap_weight", gap_weight),
+                                  "" if runs is None else _os.fspath(runs), "" if data_dir is None else _os.fspath(data_dir),
+                                  "" if report is None else report))
+    if warn:
+        for f in _json.loads(r._envelope)["result"].get("fits", []):
+            for text in f.get("warnings", []):
+                _warnings.warn("calibrate: %s: %s" % (f.get("name", "?"), text), CalibrationWarning, stacklevel=2)
+    return r
 
 
+class CalibrationWarning(UserWarning):
+    """A fit's warning (a parameter the data hardly determine, a bound reached, ...)."""
+
+
+@_with_progress
 def mixed_ring(fleet, ring=None, speed=None, length=None, solver="auto", count=6, degree=0):
     """Rightmost roots of a ring of mixed cars (``ddemap roots --fleet``).
 
@@ -430,17 +749,62 @@ def mixed_ring(fleet, ring=None, speed=None, length=None, solver="auto", count=6
     ``ring_stable``, ``unstable_roots``, the equilibrium and the other keys of the command's
     JSON; ``solver`` (given, used) is an attribute.
     """
-    if not isinstance(fleet, str) or not fleet:
-        raise ValueError("fleet = %r: expected a CSV file or built-in names such as 'A_min,C_max*3'" % (fleet,))
+    fleet, tables = _cars(fleet, "fleet")
     if speed is not None and length is not None:
         raise ValueError("speed and length: expected only one of them")
     count = _integer("count", count, 1, 10000)
     degree = _integer("degree", degree, 0, 200)
     if degree == 1:
         raise ValueError("degree = 1: expected 0 (automatic) or an integer 2..200")
-    return _result(_ddemap.mixed_ring(fleet, False, 0 if ring is None else _ring(ring, allow_inf=False),
+    return _result(_ddemap.mixed_ring(fleet, tables, False, 0 if ring is None else _ring(ring, allow_inf=False),
                                       None if speed is None else _number("speed", speed),
                                       None if length is None else _number("length", length), solver, count, degree))
+
+
+@_with_progress
+def mix(x, y, ring=40, p=(0, 1, 11), draws=0, seed=1, speed=None, length=None, solver="auto"):
+    """Stability of a ring of two car types against the fraction p of type X (``ddemap mix``).
+
+    ``x``, ``y``: one car each, given as :func:`classify` takes cars (``"A_min"``,
+    ``"mycars.csv:Sedan"``, ``"ovrv:k1=..."``, a one-row DataFrame or dict, a calibrate Result
+    of one fit). ``ring``: N >= 2 cars; ``p``: the fractions, ``(LO, HI, COUNT)`` in [0, 1] or an
+    array of values; ``draws`` random arrangements per p besides the evenly spread one (seed
+    ``seed``); the equilibrium at a common ``speed`` [m/s] (default 20) or ring ``length`` [m];
+    ``solver`` as :func:`mixed_ring`.
+
+    Returns ``points`` (per fraction ``p``, ``x_cars``, ``abscissa`` [1/s], its range over the
+    arrangements, ``stable``, ...) and the other keys of the command's JSON.
+    """
+    tables = {}
+    xs, tables = _cars(x, "x", tables)
+    ys, tables = _cars(y, "y", tables)
+    if isinstance(p, tuple) and len(p) == 3 and isinstance(p[2], (int, _np.integer)) and not isinstance(p[2], bool):
+        lo, hi, count = _number("p", p[0]), _number("p", p[1]), _integer("p count", p[2], 1, 100000)
+        fractions = [lo] if count == 1 else [lo + (hi - lo) * i / (count - 1) for i in range(count)]
+    else:
+        fractions = [_number("p", v) for v in _np.atleast_1d(_np.asarray(p, dtype=float)).tolist()]
+    if not fractions or any(not 0 <= f <= 1 for f in fractions):
+        raise ValueError("p = %r: expected fractions in [0, 1]" % (p,))
+    if speed is not None and length is not None:
+        raise ValueError("speed and length: expected only one of them")
+    return _result(_ddemap.mix(xs, ys, tables, _ring(ring, allow_inf=False), fractions, _integer("draws", draws, 0, 10000),
+                               _integer("seed", seed, 0, 4294967295), None if speed is None else _number("speed", speed),
+                               None if length is None else _number("length", length), str(solver)))
+
+
+@_with_progress
+def growth(vehicles=None, followers=15, lead_profile=None, lead=None):
+    """Disturbance growth along platoons of each car (``ddemap growth``): every distinct car of
+    ``vehicles`` (None: the paper's table; otherwise cars as :func:`classify` takes them) in a
+    platoon of ``followers`` identical followers behind the lead (``lead_profile`` or ``lead``
+    as in :func:`simulate`).
+
+    Returns ``vehicles`` (per car the speed drop [m/s], amplification and smallest gap [m] at
+    every position, and where a platoon failed) and the other keys of the command's JSON.
+    """
+    spec, tables = ("", {}) if vehicles is None else _cars(vehicles, "vehicles")
+    lead_file, lead_text, lead_car = _lead(lead)
+    return _result(_ddemap.growth(spec, tables, _integer("followers", followers, 1, 200), lead_profile or "", lead_file, lead_text, lead_car))
 
 
 def _nonlinear_problem(system, model, ring, parameters):
@@ -456,6 +820,7 @@ def _nonlinear_problem(system, model, ring, parameters):
     return "", str(model), _integer("ring", ring, 2, 2000), _parameters(parameters)
 
 
+@_with_progress
 def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_points=400, **parameters):
     """A branch of equilibria of a nonlinear DDE in one parameter (``ddemap equilibria``).
 
@@ -478,6 +843,7 @@ def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_
     return _result(_ddemap.equilibria(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), count, max_points))
 
 
+@_with_progress
 def hopf(par, from_, to, system=None, model=None, ring=None, par2=None, from2=None, to2=None, max_points=400, **parameters):
     """Hopf points on the equilibrium branch with their criticality (``ddemap hopf``).
 
@@ -496,6 +862,7 @@ def hopf(par, from_, to, system=None, model=None, ring=None, par2=None, from2=No
                                 max_points))
 
 
+@_with_progress
 def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False,
            max_step=None, **parameters):
     """The branch of periodic orbits born at a Hopf point (``ddemap orbits``).

@@ -50,6 +50,8 @@
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/equilibrium.hpp"
 #include "ddemap/study/boundary.hpp"
+#include "ddemap/study/growth.hpp"
+#include "ddemap/study/penetration.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/traffic/fleet.hpp"
 #include "ddemap/traffic/model.hpp"
@@ -68,16 +70,20 @@ struct Interrupted : Cancelled {
 };
 
 std::thread::id g_main_thread;
+/// The Python progress callback of the call in progress (set_progress; None: none), called on
+/// the main thread with (done, total) at most 5 times a second. Never destroyed (it may outlive
+/// the interpreter's teardown).
+py::object* g_progress = nullptr;
 
 /// A progress callback that runs the Python signal handlers between units of work (on the
 /// main thread only: Python runs them nowhere else) and stops the computation if one raised.
 Progress interruptible() {
     struct State {
-        std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+        std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now(), reported = last;
         std::atomic<bool> interrupted{false};
     };
     auto state = std::make_shared<State>();
-    return [state](long, long) {
+    return [state](long done, long total) {
         // once interrupted, every later call throws, on any thread: nested loops (a loop whose
         // tasks run loops of their own) all stop
         if (state->interrupted.load()) throw Interrupted();
@@ -89,6 +95,16 @@ Progress interruptible() {
         if (PyErr_CheckSignals() != 0) {
             state->interrupted.store(true);
             throw Interrupted();
+        }
+        if (g_progress && !g_progress->is_none() && now - state->reported >= std::chrono::milliseconds(200)) {
+            state->reported = now;
+            try {
+                (*g_progress)(done, total);
+            } catch (py::error_already_set& e) {  // the callback raised: its exception is what the caller sees
+                e.restore();
+                state->interrupted.store(true);
+                throw Interrupted();
+            }
         }
     };
 }
@@ -126,9 +142,10 @@ std::string root_method(const std::string& solver) {
 }
 
 /// A car list (io/cars.hpp: built-in names, FILE.csv, FILE.csv:NAME, MODEL:k1=..., each with *K).
-Fleet fleet_spec(const std::string& spec) { return to_fleet(read_cars(spec)); }
-std::vector<CalibratedVehicle> vehicles_spec(const std::string& spec) {
-    std::vector<CalibratedVehicle> cars = read_cars(spec);
+/// `tables`: tables in memory by the name the list uses for them (DataFrames, dicts, rows).
+Fleet fleet_spec(const std::string& spec, const CarTables& tables = {}) { return to_fleet(read_cars(spec, kMaxCars, "", &tables)); }
+std::vector<CalibratedVehicle> vehicles_spec(const std::string& spec, const CarTables& tables = {}) {
+    std::vector<CalibratedVehicle> cars = read_cars(spec, kMaxCars, "", &tables);
     require_ovrv(cars, "the cars");
     return cars;
 }
@@ -366,13 +383,13 @@ py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const
     return py::make_tuple(envelope_json(e), curves_arrays(b));
 }
 
-std::string py_classify(const std::string& spec, int cars, int samples, int ring_samples, unsigned long long seed) {
+std::string py_classify(const std::string& spec, const CarTables& tables, int cars, int samples, int ring_samples, unsigned long long seed) {
     std::vector<CalibratedVehicle> vehicles;
     std::string source = "the paper's calibration table (built in)";
     if (spec.empty()) {
         vehicles = paper_calibration_table();
     } else {
-        vehicles = vehicles_spec(spec);
+        vehicles = distinct_cars(vehicles_spec(spec, tables));
         source = spec;
     }
     UncertaintyOptions uo;
@@ -398,8 +415,9 @@ std::string py_classify(const std::string& spec, int cars, int samples, int ring
     return envelope_json(e);
 }
 
-py::tuple py_simulate(const std::string& fleet, const std::string& lead_profile, const std::string& lead_file, const std::string& on_event,
-                   double t_end, double step, double output_dt) {
+py::tuple py_simulate(const std::string& fleet, const CarTables& tables, const std::string& lead_profile, const std::string& lead_file,
+                      const std::string& lead_text, int lead_car, const std::string& on_event, double t_end, double step, double output_dt,
+                      double noise_speed, double noise_gap, unsigned long long seed) {
     SimOptions o;
     o.step = step;
     o.t_end = t_end;
@@ -410,15 +428,18 @@ py::tuple py_simulate(const std::string& fleet, const std::string& lead_profile,
     if (!lead_profile.empty() && !lead_file.empty()) throw std::invalid_argument("give either lead (a CSV file) or lead_profile (a name), not both");
     const std::string label = !lead_file.empty() ? lead_file : lead_profile.empty() ? std::string("dip") : lead_profile;
     const LeadProfile lead = [&] {
-        if (!lead_file.empty()) return LeadProfile::from_csv(read_text_file(lead_file), lead_file);
+        if (!lead_text.empty()) return LeadProfile::from_csv(lead_text, lead_file, lead_car);
+        if (!lead_file.empty()) return LeadProfile::from_csv(read_text_file(lead_file), lead_file, lead_car);
         const auto names = LeadProfile::builtin_names();
         if (std::find(names.begin(), names.end(), label) == names.end())
             throw std::invalid_argument("lead_profile = '" + label + "': expected one of dip, oscillatory, step-low, step-high");
         return LeadProfile::builtin(label);
     }();
-    const std::vector<SimCar> cars = platoon_from(vehicles_spec(fleet));
+    const std::vector<SimCar> cars = platoon_from(vehicles_spec(fleet, tables));
     o.progress = interruptible();
-    const SimResult r = released([&] { return simulate_platoon(lead, cars, o); });
+    SimResult r = released([&] { return simulate_platoon(lead, cars, o); });
+    const std::string summary = simulation_json(r, label);  // the exact run; the series carry the noise
+    add_measurement_noise(r, noise_speed, noise_gap, seed);
     JsonEnvelope e;
     e.command = "simulate";
     e.inputs = JsonObject()
@@ -428,10 +449,13 @@ py::tuple py_simulate(const std::string& fleet, const std::string& lead_profile,
                    .number("t_end", o.t_end)
                    .number("step", o.step)
                    .number("output_dt", o.output_dt)
+                   .number("noise_speed_sd", noise_speed)
+                   .number("noise_gap_sd", noise_gap)
+                   .integer("seed", static_cast<long long>(seed))
                    .str();
     e.status = to_string(r.status);
     e.message = r.message;
-    e.result = simulation_json(r, label);
+    e.result = summary;
     // the time series: (cars + 1, samples) arrays, row 0 the lead (its gap row NaN)
     const auto n = static_cast<py::ssize_t>(r.time.size()), rows = static_cast<py::ssize_t>(r.speed.size());
     py::array_t<double> time(n), position({rows, n}), speed({rows, n}), gap({rows, n});
@@ -451,7 +475,7 @@ py::tuple py_simulate(const std::string& fleet, const std::string& lead_profile,
     return py::make_tuple(envelope_json(e), series);
 }
 
-std::string py_calibrate(const std::vector<std::string>& files, bool joint, const std::string& car, std::optional<std::pair<double, double>> train,
+std::string py_calibrate(const std::vector<std::pair<std::string, std::string>>& files, int follower, bool joint, const std::string& car, std::optional<std::pair<double, double>> train,
                       const std::vector<std::tuple<std::string, double, double>>& bounds, double gap_weight, const std::string& runs,
                       const std::string& data_dir, const std::string& report) {
     CalibrationOptions o;
@@ -480,14 +504,25 @@ std::string py_calibrate(const std::vector<std::string>& files, bool joint, cons
             return read_trace_csv(read_text_file(file), file);
         };
         cars = cars_from_run_list(read_run_list_csv(read_text_file(runs), runs), read, "runs " + runs);
-    } else if (joint) {
-        cars.push_back(CarRuns{car, {}, {}, {}});
-        for (const auto& f : files) cars[0].train.push_back(read_trace_csv(read_text_file(f), f));
     } else {
-        for (const auto& f : files) cars.push_back(CarRuns{base_name(f), {read_trace_csv(read_text_file(f), f)}, {}, {}});
+        // (source, text): a file when the text is empty, else a table in memory named `source`
+        bool platoon = false;
+        if (joint) cars.push_back(CarRuns{car, {}, {}, {}});
+        for (const auto& [source, given] : files) {
+            const std::string text = given.empty() ? read_text_file(source) : given;
+            const bool is_platoon = is_platoon_csv(text);
+            platoon = platoon || is_platoon;
+            for (Trace& t : read_traces_csv(text, source, is_platoon ? follower : 0)) {
+                const std::string name = is_platoon ? base_name(source) + "-" + t.source.substr(t.source.rfind(':') + 1) : base_name(source);
+                if (joint) cars[0].train.push_back(std::move(t));
+                else cars.push_back(CarRuns{name, {std::move(t)}, {}, {}});
+            }
+        }
+        if (follower != 0 && !platoon) throw std::invalid_argument("follower = " + std::to_string(follower) + ": none of the traces is a platoon (simulate's CSV)");
     }
     ExecutionPolicy policy;
     policy.progress = interruptible();
+    o.progress = interruptible();  // Ctrl-C within a fit (design points, Levenberg-Marquardt iterations)
     const std::vector<CarCalibration> results = released([&] { return calibrate_cars(cars, o, policy); });
     std::vector<CalibrationResult> fits;
     std::vector<std::string> names;
@@ -522,9 +557,9 @@ std::string py_calibrate(const std::vector<std::string>& files, bool joint, cons
     return envelope_json(e);
 }
 
-std::string py_mixed_ring(const std::string& spec, bool is_pattern, int cars, std::optional<double> speed, std::optional<double> length,
-                       const std::string& solver, int count, int degree) {
-    Fleet unit = fleet_spec(spec);
+std::string py_mixed_ring(const std::string& spec, const CarTables& tables, bool is_pattern, int cars, std::optional<double> speed,
+                          std::optional<double> length, const std::string& solver, int count, int degree) {
+    Fleet unit = fleet_spec(spec, tables);
     Fleet fleet;
     if (cars <= 0) fleet = unit;
     else
@@ -554,6 +589,89 @@ std::string py_mixed_ring(const std::string& spec, bool is_pattern, int cars, st
     e.status = to_string(rr.status);
     e.message = rr.message;
     e.result = mixed_ring_json(r, fleet.size());
+    return envelope_json(e);
+}
+
+/// One car of a car list (mix --x, --y): the list must name exactly one distinct car.
+FleetCar one_car(const std::string& what, const std::string& spec, const CarTables& tables) {
+    const std::vector<CalibratedVehicle> cars = distinct_cars(read_cars(spec, kMaxCars, "", &tables));
+    if (cars.size() != 1) {
+        std::string names;
+        for (const auto& c : cars) names += (names.empty() ? "" : ", ") + c.name;
+        throw std::invalid_argument(what + " = '" + spec + "': " + std::to_string(cars.size()) + " different cars (" + names + "): expected one car");
+    }
+    return to_fleet(cars).front();
+}
+
+std::string py_mix(const std::string& x_spec, const std::string& y_spec, const CarTables& tables, int cars, const std::vector<double>& fractions,
+                   int draws, unsigned seed, std::optional<double> speed, std::optional<double> length, const std::string& solver) {
+    const FleetCar x = one_car("x", x_spec, tables), y = one_car("y", y_spec, tables);
+    MixOptions o;
+    o.cars = cars;
+    o.fractions = fractions;
+    o.draws = draws;
+    o.seed = seed;
+    if (speed && length) throw std::invalid_argument("speed and length: expected only one of them");
+    if (length) o.ring.length = *length;
+    else o.ring.speed = speed ? *speed : 20.0;
+    o.ring.roots.method = root_method(solver);
+    o.ring.roots.count = 4;
+    o.validate();
+    o.progress = branch_interruptible();
+    o.ring.roots.progress = branch_interruptible();
+    const std::vector<MixPoint> pts = released([&] { return penetration_study(x, y, o); });
+    Status status = Status::Converged;
+    std::string used;
+    for (const auto& pt : pts) {
+        if (pt.status == Status::Cancelled) throw Interrupted();
+        if (pt.status != Status::Converged) status = pt.status;
+        const std::string u = solver_name(pt.method_used);
+        if (used.find(u) == std::string::npos) used += (used.empty() ? "" : ",") + u;
+    }
+    JsonEnvelope e;
+    e.command = "mix";
+    JsonObject in;
+    std::vector<std::string> ps;
+    for (double f : o.fractions) ps.push_back(json_number(f));
+    in.string("x", x_spec).string("y", y_spec).integer("ring", o.cars).json("p", json_array(ps)).integer("draws", o.draws).integer("seed", o.seed);
+    if (std::isnan(o.ring.length)) in.number("speed", o.ring.speed);
+    else in.number("length", o.ring.length);
+    e.inputs = in.str();
+    e.has_solver = true;
+    e.solver_given = solver_name(o.ring.roots.method);
+    e.solver_used = used;
+    e.status = to_string(status);
+    if (status != Status::Converged) e.message = "an arrangement's roots did not converge";
+    e.result = mix_json(pts, o.cars);
+    return envelope_json(e);
+}
+
+std::string py_growth(const std::string& spec, const CarTables& tables, int followers, const std::string& lead_profile, const std::string& lead_file,
+                      const std::string& lead_text, int lead_car) {
+    const std::string label = !lead_file.empty() ? lead_file : lead_profile.empty() ? std::string("dip") : lead_profile;
+    const LeadProfile lead = [&] {
+        if (!lead_profile.empty() && !lead_file.empty()) throw std::invalid_argument("give either lead (a CSV file) or lead_profile (a name), not both");
+        if (!lead_text.empty()) return LeadProfile::from_csv(lead_text, lead_file, lead_car);
+        if (!lead_file.empty()) return LeadProfile::from_csv(read_text_file(lead_file), lead_file, lead_car);
+        const auto names = LeadProfile::builtin_names();
+        if (std::find(names.begin(), names.end(), label) == names.end())
+            throw std::invalid_argument("lead_profile = '" + label + "': expected one of dip, oscillatory, step-low, step-high");
+        return LeadProfile::builtin(label);
+    }();
+    const std::vector<CalibratedVehicle> vehicles = spec.empty() ? paper_calibration_table() : distinct_cars(vehicles_spec(spec, tables));
+    const std::string source = spec.empty() ? "the paper's calibration table (built in)" : spec;
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    const auto g = released([&] { return disturbance_growth(vehicles, lead, followers, SimOptions{}, policy); });
+    JsonEnvelope e;
+    e.command = "growth";
+    e.inputs = JsonObject().string("vehicles", source).string("lead", label).integer("followers", followers).str();
+    for (const GrowthResult& r : g)
+        if (r.status != Status::Converged && e.status == "converged") {
+            e.status = to_string(r.status);
+            e.message = r.name + ": " + r.message;
+        }
+    e.result = growth_json(g, label);
     return envelope_json(e);
 }
 
@@ -732,6 +850,12 @@ PYBIND11_MODULE(_ddemap, m) {
             PyErr_SetString(PyExc_ValueError, e.what());
         }
     });
+    m.def(
+        "set_progress", [](py::object callback) {
+            if (!g_progress) g_progress = new py::object();
+            *g_progress = std::move(callback);
+        },
+        py::arg("callback"), "the progress callback (done, total) of the next calls, or None");
     m.def("roots", &py_roots, py::arg("model"), py::arg("parameters"), py::arg("ring"), py::arg("count"));
     m.def("roots_system", &py_roots_system, py::arg("system"), py::arg("count"), py::arg("degree"), py::arg("solver"));
     m.def("string", &py_string, py::arg("model"), py::arg("parameters"), py::arg("ring"));
@@ -739,13 +863,18 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"));
     m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
           py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"), py::arg("ring_curves"));
-    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"));
-    m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("lead_profile"), py::arg("lead"), py::arg("on_event"), py::arg("t_end"),
-          py::arg("step"), py::arg("output_dt"));
-    m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"),
+    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"));
+    m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("tables"), py::arg("lead_profile"), py::arg("lead"), py::arg("lead_text"),
+          py::arg("lead_car"), py::arg("on_event"), py::arg("t_end"), py::arg("step"), py::arg("output_dt"), py::arg("noise_speed"),
+          py::arg("noise_gap"), py::arg("seed"));
+    m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("follower"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"),
           py::arg("runs"), py::arg("data_dir"), py::arg("report"));
-    m.def("mixed_ring", &py_mixed_ring, py::arg("fleet"), py::arg("is_pattern"), py::arg("ring"), py::arg("speed"), py::arg("length"),
+    m.def("mixed_ring", &py_mixed_ring, py::arg("fleet"), py::arg("tables"), py::arg("is_pattern"), py::arg("ring"), py::arg("speed"), py::arg("length"),
           py::arg("solver"), py::arg("count"), py::arg("degree"));
+    m.def("mix", &py_mix, py::arg("x"), py::arg("y"), py::arg("tables"), py::arg("ring"), py::arg("p"), py::arg("draws"), py::arg("seed"),
+          py::arg("speed"), py::arg("length"), py::arg("solver"));
+    m.def("growth", &py_growth, py::arg("vehicles"), py::arg("tables"), py::arg("followers"), py::arg("lead_profile"), py::arg("lead"),
+          py::arg("lead_text"), py::arg("lead_car"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
           py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),

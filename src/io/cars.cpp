@@ -233,12 +233,16 @@ std::vector<CalibratedVehicle> read_calibration_json(const std::string& text, co
     return distinct_cars(out);
 }
 
-std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars, const std::string& base_dir) {
+std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars, const std::string& base_dir, const CarTables* tables) {
     if (trim(list).empty()) throw std::invalid_argument("an empty car list: expected cars separated by commas (A_min, FILE.csv, FILE.csv:NAME, MODEL:NAME=VALUE,...)");
     std::vector<CalibratedVehicle> out;
     for (const Item& item : split_items(list)) {
         std::vector<CalibratedVehicle> unit;
-        if (starts_inline(item.text)) {
+        if (tables && tables->count(item.text)) {
+            const std::string& text = tables->at(item.text);
+            const std::string t = trim(text.substr(0, std::min<std::size_t>(text.size(), 64)));
+            unit = !t.empty() && t[0] == '{' ? read_calibration_json(text, item.text) : read_car_table(text, item.text);
+        } else if (starts_inline(item.text)) {
             unit.push_back(inline_car(item.text));
         } else {
             std::string file = item.text, name;

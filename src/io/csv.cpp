@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <charconv>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -12,8 +13,8 @@ namespace ddemap {
 std::string format_exact(double v) {
     if (!std::isfinite(v)) throw std::logic_error("a non-finite number (" + std::to_string(v) + ") reached a CSV output");
     char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v == 0.0 ? 0.0 : v);
-    return b;
+    const auto r = std::to_chars(b, b + sizeof b, v == 0.0 ? 0.0 : v);  // the shortest form that reads back exactly
+    return std::string(b, r.ptr);
 }
 
 std::string sweep_csv(const SweepResult& sw) {
@@ -170,7 +171,7 @@ std::string classification_csv(const std::vector<Classification>& rows) {
 
 std::string simulation_csv(const SimResult& r) {
     std::ostringstream csv;
-    csv << "time,car,position,speed,gap\n";
+    csv << "time_s,car,position_m,speed_mps,gap_m\n";
     for (std::size_t k = 0; k < r.time.size(); ++k)
         for (std::size_t c = 0; c < r.speed.size(); ++c) {
             csv << format_exact(r.time[k]) << "," << c << "," << format_exact(r.position[c][k]) << "," << format_exact(r.speed[c][k]) << ",";
@@ -182,7 +183,7 @@ std::string simulation_csv(const SimResult& r) {
 
 std::string growth_csv(const std::vector<GrowthResult>& g) {
     std::ostringstream out;
-    out << "name,position,speed_drop,amplification,min_gap,failure\n";
+    out << "name,position,speed_drop_mps,amplification,min_gap_m,failure\n";
     for (const auto& r : g) {
         for (std::size_t i = 0; i < r.amplification.size(); ++i) {
             out << r.name << "," << i + 1 << "," << format_exact(r.speed_drop[i]) << "," << format_exact(r.amplification[i]) << ","

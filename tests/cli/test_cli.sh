@@ -203,7 +203,7 @@ expect_error "bad.toml:2: x: expected lo < hi" chart "$tmp/bad.toml" --out "$tmp
 
 # simulate: files, JSON keys, events
 if "$bin" simulate --fleet 'B_min*6' --lead-profile dip --out "$tmp/sim" >/dev/null; then
-    head -1 "$tmp/sim.csv" | grep -q '^time,car,position,speed,gap$' && ok || bad "simulate CSV header"
+    head -1 "$tmp/sim.csv" | grep -q '^time_s,car,position_m,speed_mps,gap_m$' && ok || bad "simulate CSV header"
     python3 - "$tmp/sim.json" <<'PY' && ok || bad "simulate JSON"
 import json, sys
 d = json.load(open(sys.argv[1]))["result"]
@@ -235,7 +235,7 @@ printf 'time_s,lead_speed_mps
 expect_error "badlead.csv:3: time_s = 0" simulate --fleet A_min --lead "$tmp/badlead.csv" --out "$tmp/sim3"
 
 # growth
-"$bin" growth --format csv >"$tmp/g.csv" && head -1 "$tmp/g.csv" | grep -q '^name,position,speed_drop,amplification,min_gap,failure$' && ok || bad "growth csv"
+"$bin" growth --format csv >"$tmp/g.csv" && head -1 "$tmp/g.csv" | grep -q '^name,position,speed_drop_mps,amplification,min_gap_m,failure$' && ok || bad "growth csv"
 
 fi  # part classify
 
@@ -1646,6 +1646,70 @@ expect_error "uses only the car ahead; this one uses 2 cars ahead" boundary --mo
 rm -rf "$env"
 
 fi  # part curves
+
+if part chain; then
+# outputs chain into inputs: simulate's CSV is a trace for calibrate (every follower, FILE.csv:K,
+# --follower K) and a lead for simulate (P.csv:K); the round trip simulate (known cars, noise) ->
+# calibrate recovers every parameter within the fit's own 95 % intervals
+ch=$(mktemp -d)
+"$bin" simulate --fleet "ovrv:k1=0.1,k2=0.5,th=1.4,tau=0.4,eta=8,A_min" --lead-profile oscillatory --noise 0.05:0.1 --seed 3 --out "$ch/sim" --quiet >/dev/null &&
+    ok || bad "simulate with --noise"
+head -1 "$ch/sim.csv" | grep -q '^time_s,car,position_m,speed_mps,gap_m$' && ok || bad "simulate's CSV header has units"
+grep -q '0\.10000000000000001\|0\.45000000000000001' "$ch/sim.csv" && bad "CSV numbers not in the shortest form" || ok
+"$bin" calibrate "$ch/sim.csv" --out "$ch/fits" --format json --quiet >"$ch/fits.out" 2>/dev/null && ok || bad "calibrate simulate's CSV"
+python3 - "$ch/fits.out" <<'PY' && ok || bad "round trip: the true parameters lie in the 95 % intervals"
+import json, sys
+d = json.load(open(sys.argv[1]))
+truth = {"sim-1": dict(k1=0.1, k2=0.5, th=1.4, tau=0.4, eta=8.0),
+         "sim-2": dict(k1=0.052, k2=0.338, th=0.819, tau=0.948, eta=8.03)}  # A_min: the paper's Table 1
+fits = {f["name"]: f for f in d["result"]["fits"]}
+assert sorted(fits) == sorted(truth), sorted(fits)
+for name, t in truth.items():
+    assert fits[name]["status"] == "converged", fits[name]["status"]
+    for p, (lo, hi) in fits[name]["ci95"].items():
+        assert lo <= t[p] <= hi, (name, p, lo, hi, t[p])
+        assert hi - lo < 0.25 * max(t[p], 0.2), (name, p, lo, hi)  # informative, not just wide
+PY
+"$bin" classify "$ch/fits.json" --format csv | grep -c '^sim-' | grep -q '^2$' && ok || bad "classify the fits of a simulated platoon"
+"$bin" calibrate "$ch/sim.csv:2" --format csv --quiet | grep -c '^sim-2,' | grep -q '^1$' && ok || bad "calibrate FILE.csv:K"
+"$bin" calibrate "$ch/sim.csv" --follower 1 --format csv --quiet | grep -c '^sim-' | grep -q '^1$' && ok || bad "calibrate --follower"
+expect_error "follower 3: expected 1 to 2" calibrate "$ch/sim.csv:3"
+cp "$ch/sim.csv" "$ch/plain.csv" && python3 -c "
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+lead = {r['time_s']: r['speed_mps'] for r in rows if r['car'] == '0'}
+with open(sys.argv[2], 'w') as out:
+    out.write('time_s,lead_speed_mps,follower_speed_mps,gap_m\n')
+    for r in rows:
+        if r['car'] == '1': out.write('%s,%s,%s,%s\n' % (r['time_s'], lead[r['time_s']], r['speed_mps'], r['gap_m']))
+" "$ch/sim.csv" "$ch/plain.csv"
+expect_error "none of the DATA files is a platoon CSV" calibrate "$ch/plain.csv" --follower 1
+"$bin" simulate --fleet A_min --lead "$ch/sim.csv:2" --out "$ch/behind" --format json --quiet >"$ch/b.json" 2>/dev/null && ok || bad "simulate --lead P.csv:K"
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['inputs']['lead'].endswith('sim.csv:2')" "$ch/b.json" && ok || bad "the lead is named P.csv:K"
+expect_error "name the car that leads" simulate --fleet A_min --lead "$ch/sim.csv" --out "$ch/x"
+expect_error "car 7: expected 0 to 2" simulate --fleet A_min --lead "$ch/sim.csv:7" --out "$ch/x"
+# impossible data: named with the line, never "converged"
+python3 - "$ch" <<'PY'
+import math, sys
+d = sys.argv[1]
+def trace(name, f):
+    with open(d + "/" + name, "w") as out:
+        out.write("time_s,lead_speed_mps,follower_speed_mps,gap_m\n")
+        for i in range(600):
+            t, row = f(i)
+            out.write("%s,%s,%s,%s\n" % (t, *row))
+ok = lambda i: (20 + math.sin(i / 50), 20 + 0.9 * math.sin(i / 50 - 0.5), 30 + math.cos(i / 50))
+trace("neg.csv", lambda i: (i / 10, ok(i)[:2] + (-5,)))
+trace("ms.csv", lambda i: (i * 100, ok(i)))
+trace("fast.csv", lambda i: (i * 1e-4, ok(i)))
+trace("kmh.csv", lambda i: (i / 10, (ok(i)[0] * 3.6 * 2, ok(i)[1], ok(i)[2])))
+PY
+expect_error "neg.csv:2: gap_m = -5: expected > 0 m" calibrate "$ch/neg.csv"
+expect_error "looks like milliseconds" calibrate "$ch/ms.csv"
+expect_error "fast.csv: time_s: a median sampling step of 9.99.*e-05 s: expected a sampling step of 1 ms to 10 s" calibrate "$ch/fast.csv"
+expect_error "divide by 3.6" calibrate "$ch/kmh.csv"
+rm -rf "$ch"
+fi  # part chain
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -17,6 +17,7 @@
 /// that draws or classifies cars takes each distinct car once (distinct_cars).
 
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,12 @@ constexpr std::size_t kMaxCars = 1000000;
 /// it). std::invalid_argument naming the item (and the file, line and column) for anything it
 /// cannot read; a list that would expand to more than `max_cars` cars is refused before it is
 /// built.
-std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars = kMaxCars, const std::string& base_dir = "");
+/// `tables` (optional) holds tables in memory by name (e.g. a pandas DataFrame written as CSV
+/// text by the Python module): an item equal to one of the names (with *K) reads that text, as
+/// a file of that name would be read, before any file on disk.
+using CarTables = std::map<std::string, std::string>;
+std::vector<CalibratedVehicle> read_cars(const std::string& list, std::size_t max_cars = kMaxCars, const std::string& base_dir = "",
+                                         const CarTables* tables = nullptr);
 
 /// The cars of what `calibrate` writes as JSON (its envelope `{"command": "calibrate", ...}`):
 /// one per fit, with the fit's parameters, covariance and bounds. A fit that did not converge

@@ -1,6 +1,6 @@
 #pragma once
 /// \file writers.hpp
-/// CSV writers (formatting only): every double with %.17g, so that it reads back exactly.
+/// CSV writers (formatting only): every double in the shortest form that reads back exactly.
 
 #include <string>
 
@@ -20,7 +20,8 @@
 
 namespace ddemap {
 
-/// %.17g; a non-finite value is an internal error (std::logic_error): no NaN or inf is ever written
+/// The shortest decimal that reads back to the same double (std::to_chars: 0.45, not
+/// 0.45000000000000001); a non-finite value is an internal error (std::logic_error): no NaN or inf is ever written
 std::string format_exact(double v);
 
 /// One row per grid point: the two axis parameters by name, spectral_abscissa, unstable_roots,
@@ -54,7 +55,8 @@ std::string string_csv(const StringResult& s, const RingResult* ring);
 /// name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,
 /// lowfreq_margin,spectral_abscissa,plant_abscissa
 std::string classification_csv(const std::vector<Classification>& rows);
-/// time,car,position,speed,gap (car 0 = lead, no gap)
+/// time_s,car,position_m,speed_mps,gap_m (car 0 = lead, no gap); calibrate and --lead read it back
+/// (read_trace_csv with a follower, LeadProfile::from_csv with a car)
 std::string simulation_csv(const SimResult& r);
 /// name,position,speed_drop,amplification,min_gap,failure
 std::string growth_csv(const std::vector<GrowthResult>& g);

@@ -36,7 +36,84 @@ const char* names[5] = {"k1", "k2", "th", "tau", "eta"};
 
 }  // namespace
 
-Trace read_trace_csv(const std::string& text, const std::string& source) {
+namespace {
+
+/// The checks every trace passes: physical values, a sampling step a car-following fit can use,
+/// enough data.
+void check_trace(const Trace& tr) {
+    const std::size_t n = tr.t.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto fail = [&](const std::string& what, double x, const std::string& hint) {
+            throw std::invalid_argument(tr.source + ": sample " + std::to_string(i + 1) + " (time_s = " + detail::format_number(tr.t[i]) + "): " +
+                                        what + " = " + detail::format_number(x) + ": expected " + hint);
+        };
+        if (tr.lead[i] < 0.0) fail("lead_speed_mps", tr.lead[i], ">= 0 m/s");
+        if (tr.speed[i] < 0.0) fail("follower_speed_mps", tr.speed[i], ">= 0 m/s");
+        if (!(tr.gap[i] > 0.0)) fail("gap_m", tr.gap[i], "> 0 m (the bumper-to-bumper distance; a gap of 0 or less is a collision)");
+        if (tr.speed[i] > 100.0 || tr.lead[i] > 100.0)
+            fail(tr.speed[i] > 100.0 ? "follower_speed_mps" : "lead_speed_mps", std::max(tr.speed[i], tr.lead[i]),
+                 "at most 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");
+    }
+    if (n >= 2) {
+        std::vector<double> dt(n - 1);
+        for (std::size_t i = 0; i + 1 < n; ++i) dt[i] = tr.t[i + 1] - tr.t[i];
+        std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+        const double median = dt[dt.size() / 2];
+        const double largest = *std::max_element(dt.begin(), dt.end());
+        if (median < 1e-3 || median > 10.0) {
+            std::string hint = "a sampling step of 1 ms to 10 s";
+            if (median > 10.0 && median / 1000.0 >= 1e-3 && median / 1000.0 <= 10.0)
+                hint += " (time_s looks like milliseconds: divide the column by 1000)";
+            throw std::invalid_argument(tr.source + ": time_s: a median sampling step of " + detail::format_number(median) + " s: expected " + hint);
+        }
+        if (largest > 10.0)
+            throw std::invalid_argument(tr.source + ": time_s: a gap of " + detail::format_number(largest) +
+                                        " s between two samples: expected at most 10 s (split the trace into runs at the break)");
+    }
+    if (n < 100 || tr.t.back() - tr.t.front() < 20.0) {
+        throw std::invalid_argument(tr.source + ": " + std::to_string(n) + " rows over " +
+                                    detail::format_number(n == 0 ? 0.0 : tr.t.back() - tr.t.front()) +
+                                    " s: expected at least 100 rows and 20 s");
+    }
+}
+
+}  // namespace
+
+Trace platoon_trace(const PlatoonSeries& platoon, int follower) {
+    if (follower < 1 || follower > platoon.followers())
+        throw std::invalid_argument(platoon.source + ": follower " + std::to_string(follower) + ": expected 1 to " + std::to_string(platoon.followers()));
+    const auto f = static_cast<std::size_t>(follower);
+    Trace tr;
+    tr.source = platoon.source + ":" + std::to_string(follower);
+    tr.t = platoon.time;
+    tr.lead = platoon.speed[f - 1];
+    tr.speed = platoon.speed[f];
+    tr.gap = platoon.gap[f];
+    check_trace(tr);
+    return tr;
+}
+
+std::vector<Trace> read_traces_csv(const std::string& text, const std::string& source, int follower) {
+    if (!is_platoon_csv(text)) return {read_trace_csv(text, source, follower)};
+    const PlatoonSeries p = read_platoon_csv(text, source);
+    if (follower > p.followers())
+        throw std::invalid_argument(source + ": follower " + std::to_string(follower) + ": expected 1 to " + std::to_string(p.followers()));
+    std::vector<Trace> out;
+    for (int k = follower ? follower : 1; k <= (follower ? follower : p.followers()); ++k) out.push_back(platoon_trace(p, k));
+    return out;
+}
+
+Trace read_trace_csv(const std::string& text, const std::string& source, int follower) {
+    if (is_platoon_csv(text)) {
+        const PlatoonSeries p = read_platoon_csv(text, source);
+        if (follower == 0 && p.followers() > 1)
+            throw std::invalid_argument(source + " is a platoon of " + std::to_string(p.followers()) +
+                                        " followers (simulate's CSV): name the follower to fit (1 to " + std::to_string(p.followers()) + ")");
+        return platoon_trace(p, follower == 0 ? 1 : follower);
+    }
+    if (follower != 0)
+        throw std::invalid_argument(source + ": follower " + std::to_string(follower) +
+                                    ": a follower is picked only from a platoon CSV (simulate's); this file is one trace");
     detail::CsvReader csv(text, source, "time_s, lead_speed_mps, follower_speed_mps, gap_m");
     const char* cols[4] = {"time_s", "lead_speed_mps", "follower_speed_mps", "gap_m"};
     int idx[4];
@@ -46,17 +123,17 @@ Trace read_trace_csv(const std::string& text, const std::string& source) {
     std::vector<double>* dest[4] = {&tr.t, &tr.lead, &tr.speed, &tr.gap};
     while (csv.next()) {
         for (int c = 0; c < 4; ++c) dest[c]->push_back(csv.number(idx[c], cols[c]));
+        for (int c = 1; c < 4; ++c)
+            if (dest[c]->back() < 0.0 || (c == 3 && dest[c]->back() == 0.0))
+                csv.fail(std::string(cols[c]) + " = " + detail::format_number(dest[c]->back()) + ": expected " +
+                         (c == 3 ? "> 0 m (a gap of 0 or less is a collision)" : ">= 0 m/s"));
         const std::size_t n = tr.t.size();
         if (n > 1 && !(tr.t[n - 1] > tr.t[n - 2])) {
             csv.fail("time_s = " + detail::format_number(tr.t[n - 1]) + " after " + detail::format_number(tr.t[n - 2]) +
                      ": expected increasing times");
         }
     }
-    if (tr.t.size() < 100 || tr.t.back() - tr.t.front() < 20.0) {
-        throw std::invalid_argument(source + ": " + std::to_string(tr.t.size()) + " rows over " +
-                                    detail::format_number(tr.t.empty() ? 0.0 : tr.t.back() - tr.t.front()) +
-                                    " s: expected at least 100 rows and 20 s");
-    }
+    check_trace(tr);
     return tr;
 }
 
@@ -250,6 +327,7 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
     res.status = Status::MaxIterations;
     res.message = "the iteration limit (" + std::to_string(o.max_iterations) + ") was reached";
     for (int it = 0; it < o.max_iterations; ++it) {
+        if (o.progress) o.progress(it, o.max_iterations);
         res.iterations = it + 1;
         // first-order optimality on the box
         double pg = 0.0;
@@ -483,7 +561,9 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
         design.push_back(th);
     }
     std::vector<double> score(design.size());
-    parallel_for(static_cast<long>(design.size()), [&](long i) { score[i] = pb.ssr(design[i]); });
+    ExecutionPolicy design_policy;
+    design_policy.progress = o.progress;
+    parallel_for(static_cast<long>(design.size()), [&](long i) { score[i] = pb.ssr(design[i]); }, design_policy);
     std::vector<std::size_t> order(design.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return score[x] < score[y]; });

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -87,7 +88,75 @@ LeadProfile LeadProfile::builtin(const std::string& name) {
     return ramps({22.4, 26.8}, {20, 60});
 }
 
-LeadProfile LeadProfile::from_csv(const std::string& text, const std::string& source) {
+bool is_platoon_csv(const std::string& text) {
+    try {
+        detail::CsvReader csv(text, "", "");
+        return csv.column("car", false) >= 0 && csv.column("speed_mps", false) >= 0;
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+}
+
+PlatoonSeries read_platoon_csv(const std::string& text, const std::string& source) {
+    detail::CsvReader csv(text, source, "time_s, car, speed_mps, gap_m (the CSV that simulate writes)");
+    const int it = csv.column("time_s"), ic = csv.column("car"), iv = csv.column("speed_mps"), ig = csv.column("gap_m");
+    PlatoonSeries p;
+    p.source = source;
+    std::size_t expected_car = 0;  // the car the next row must hold
+    while (csv.next()) {
+        const double t = csv.number(it, "time_s");
+        const double c = csv.number(ic, "car");
+        if (!(c >= 0 && c == std::floor(c) && c <= 1e6)) csv.fail("column 'car' = " + detail::format_number(c) + ": expected a car number 0, 1, 2, ...");
+        const auto car = static_cast<std::size_t>(c);
+        if (car == 0) {
+            if (!p.time.empty() && expected_car != p.speed.size())
+                csv.fail("car 0 at time_s = " + detail::format_number(t) + ": expected car " + std::to_string(expected_car) +
+                         " of time_s = " + detail::format_number(p.time.back()) + " first (every time lists cars 0 to N)");
+            if (!p.time.empty() && !(t > p.time.back()))
+                csv.fail("time_s = " + detail::format_number(t) + " after " + detail::format_number(p.time.back()) + ": expected increasing times");
+            p.time.push_back(t);
+            if (p.time.size() == 1) {
+                p.speed.emplace_back();
+                p.gap.emplace_back();
+            }
+            expected_car = 0;
+        } else if (p.time.empty()) {
+            csv.fail("car " + std::to_string(car) + " before car 0: expected each time to start with the lead (car 0)");
+        }
+        if (p.time.size() == 1 && car == p.speed.size()) {  // the first time defines the platoon
+            p.speed.emplace_back();
+            p.gap.emplace_back();
+        }
+        if (car != expected_car || car >= p.speed.size())
+            csv.fail("car " + std::to_string(car) + " at time_s = " + detail::format_number(t) + ": expected car " + std::to_string(expected_car) +
+                     " (every time lists cars 0 to N in order)");
+        if (t != p.time.back()) csv.fail("time_s = " + detail::format_number(t) + ": expected " + detail::format_number(p.time.back()) + " as car 0 of this time");
+        const double v = csv.number(iv, "speed_mps");
+        if (v < 0.0) csv.fail("speed_mps = " + detail::format_number(v) + ": expected >= 0");
+        p.speed[car].push_back(v);
+        if (car > 0) p.gap[car].push_back(csv.number(ig, "gap_m"));
+        ++expected_car;
+    }
+    if (p.time.empty()) throw std::invalid_argument(source + ": no rows: expected the CSV that simulate writes");
+    if (expected_car != p.speed.size())
+        throw std::invalid_argument(source + ": the last time lists " + std::to_string(expected_car) + " of " + std::to_string(p.speed.size()) +
+                                    " cars: expected every time to list cars 0 to N (a truncated file?)");
+    if (p.followers() < 1) throw std::invalid_argument(source + ": only the lead (car 0): expected at least one follower");
+    return p;
+}
+
+LeadProfile LeadProfile::from_csv(const std::string& text, const std::string& source, int car) {
+    if (is_platoon_csv(text)) {
+        const PlatoonSeries p = read_platoon_csv(text, source);
+        if (car < 0)
+            throw std::invalid_argument(source + " is a platoon (simulate's CSV, cars 0 to " + std::to_string(p.followers()) +
+                                        "): name the car that leads, e.g. " + source + ":" + std::to_string(p.followers()));
+        if (car > p.followers())
+            throw std::invalid_argument(source + ": car " + std::to_string(car) + ": expected 0 to " + std::to_string(p.followers()));
+        if (p.time.size() < 2) throw std::invalid_argument(source + ": expected at least two samples");
+        return LeadProfile(p.time, p.speed[static_cast<std::size_t>(car)]);
+    }
+    if (car >= 0) throw std::invalid_argument(source + ":" + std::to_string(car) + ": a car number is taken only from a platoon CSV (simulate's), not from a lead speed table");
     detail::CsvReader csv(text, source, "time_s, lead_speed_mps");
     const int it = csv.column("time_s"), iv = csv.column("lead_speed_mps");
     std::vector<double> t, v;
@@ -108,6 +177,23 @@ void SimOptions::validate() const {
     if (!(std::isfinite(t_end) && t_end >= 0.0)) throw std::invalid_argument("t_end = " + detail::format_number(t_end) + ": expected >= 0");
     if (!(std::isfinite(output_dt) && output_dt > 0.0)) throw std::invalid_argument("output_dt = " + detail::format_number(output_dt) + ": expected > 0");
     if (!(std::isfinite(max_speed) && max_speed > 0.0)) throw std::invalid_argument("max_speed = " + detail::format_number(max_speed) + ": expected > 0");
+}
+
+void add_measurement_noise(SimResult& result, double speed_sd, double gap_sd, unsigned long long seed) {
+    for (const auto& [what, sd] : {std::pair<const char*, double>{"speed", speed_sd}, {"gap", gap_sd}})
+        if (!(std::isfinite(sd) && sd >= 0.0))
+            throw std::invalid_argument(std::string("noise on the ") + what + " = " + detail::format_number(sd) + ": expected a finite standard deviation >= 0");
+    std::mt19937_64 gen(seed);
+    // Box-Muller from 53-bit uniforms in (0, 1]: portable, unlike std::normal_distribution
+    const auto uniform = [&gen] { return (static_cast<double>(gen() >> 11) + 1.0) * 0x1.0p-53; };
+    const double two_pi = 6.283185307179586;
+    const auto normal = [&] { return std::sqrt(-2.0 * std::log(uniform())) * std::cos(two_pi * uniform()); };
+    for (std::size_t k = 0; k < result.time.size(); ++k)
+        for (std::size_t c = 0; c < result.speed.size(); ++c) {
+            const double ev = normal(), eg = normal();
+            if (speed_sd > 0.0) result.speed[c][k] += speed_sd * ev;
+            if (c > 0 && gap_sd > 0.0 && k < result.gap[c].size()) result.gap[c][k] += gap_sd * eg;
+        }
 }
 
 SimEstimate estimate_simulation(const LeadProfile& lead, const std::vector<SimCar>& cars, const SimOptions& options) {

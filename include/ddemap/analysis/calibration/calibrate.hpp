@@ -22,6 +22,7 @@
 
 #include "ddemap/core/parameters.hpp"
 #include "ddemap/core/status.hpp"
+#include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/traffic/model.hpp"
 
 namespace ddemap {
@@ -33,8 +34,17 @@ struct Trace {
 };
 
 /// Reads a trace; errors name the source, the line and the column (non-finite values, unsorted
-/// or repeated times, fewer than 100 rows or less than 20 s).
-Trace read_trace_csv(const std::string& text, const std::string& source);
+/// or repeated times, fewer than 100 rows or less than 20 s). The text may also be simulate's
+/// platoon CSV (is_platoon_csv()): `follower` (1..N) picks the follower, car follower - 1 being its
+/// lead; 0 takes the only follower of a platoon of one (a larger platoon asks for a follower).
+Trace read_trace_csv(const std::string& text, const std::string& source, int follower = 0);
+/// Every trace of a CSV text: the trace itself, or of simulate's platoon CSV every follower (or
+/// only `follower`, 1..N, when it is not 0), each with source "SOURCE:K". `follower` != 0 with a
+/// plain trace is an error.
+std::vector<Trace> read_traces_csv(const std::string& text, const std::string& source, int follower = 0);
+/// Follower `follower` (1..N) of a platoon read back from simulate's CSV, as a trace whose
+/// source is "SOURCE:FOLLOWER" (the checks of read_trace_csv apply).
+Trace platoon_trace(const PlatoonSeries& platoon, int follower);
 
 /// The calibrated parameters, in order: k1, k2, th, tau, eta.
 const std::vector<std::string>& calibration_parameter_names();
@@ -65,6 +75,10 @@ struct CalibrationOptions {
     /// of them (the centre of the box is always one of the design points). 6 starts: on the 12
     /// OpenACC traces other seeds then reach the same objective to 1e-5 (with 2 starts they
     /// differed by up to 0.2 %); on synthetic traces one start usually suffices.
+    /// Called after every design point and every Levenberg-Marquardt iteration (on any thread,
+    /// may be empty) with (done, total) of that stage; a callback that throws stops the fit and
+    /// its exception propagates (how a caller cancels a long fit, e.g. on Ctrl-C).
+    Progress progress;
     int design_points = 64;
     int starts = 6;
     unsigned seed = 1;

@@ -29,8 +29,10 @@ public:
     static LeadProfile builtin(const std::string& name);
     static std::vector<std::string> builtin_names();
     static std::string describe_builtin(const std::string& name);
-    /// CSV with columns time_s, lead_speed_mps (other columns ignored); errors name line and column.
-    static LeadProfile from_csv(const std::string& text, const std::string& source);
+    /// CSV with columns time_s, lead_speed_mps (other columns ignored), or simulate's platoon CSV
+    /// (is_platoon_csv()) of which car `car` (0 = its lead, 1..N its followers) becomes the lead;
+    /// `car` is required for a platoon CSV and refused for a speed table. Errors name line and column.
+    static LeadProfile from_csv(const std::string& text, const std::string& source, int car = -1);
 
     double speed(double t) const;
     /// integral of v_0 from 0 to t (exact)
@@ -42,6 +44,20 @@ public:
 private:
     std::vector<double> m_t, m_v, m_x;  // m_x: position at m_t
 };
+
+/// simulate's CSV read back (columns time_s, car, position_m, speed_mps, gap_m; rows by time, then
+/// car 0 = the lead, 1..N the followers): per car its speed and gap at the common times.
+struct PlatoonSeries {
+    std::string source;
+    std::vector<double> time;                     ///< [s], increasing
+    std::vector<std::vector<double>> speed, gap;  ///< [car][sample] in m/s and m (gap[0] is empty)
+    int followers() const { return static_cast<int>(speed.size()) - 1; }
+};
+/// true if the CSV's header has simulate's columns car and speed_mps
+bool is_platoon_csv(const std::string& text);
+/// Reads simulate's CSV; errors name the line (a car missing at a time, times not increasing,
+/// negative speeds, a follower without a gap, fewer than one follower).
+PlatoonSeries read_platoon_csv(const std::string& text, const std::string& source);
 
 struct SimCar {
     std::shared_ptr<const CarModel> model;
@@ -99,6 +115,14 @@ struct SimResult {
     std::string message;
     double diverged_at = 0.0;                     ///< time of the step that diverged (0: none)
 };
+
+/// Measurement noise on a simulated platoon, as a sensor would add it: independent Gaussian errors
+/// of standard deviation `speed_sd` [m/s] on every speed (the lead's included) and `gap_sd` [m]
+/// on every gap, drawn from std::mt19937_64(seed) in the order time, car (the same seed gives the
+/// same noise on every machine: Box-Muller on the generator's raw 64-bit draws). The dynamics are
+/// not changed; positions keep their exact values. std::invalid_argument for a negative or
+/// non-finite deviation.
+void add_measurement_noise(SimResult& result, double speed_sd, double gap_sd, unsigned long long seed);
 
 /// The size of a simulation, known before it runs: steps ~ t_end / min(step, smallest delay)
 /// plus the breakpoints, output samples = t_end / output_dt + 1; memory = the stored steps
