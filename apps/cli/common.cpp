@@ -208,12 +208,13 @@ Format FormatArg::parse() const {
 }
 
 void OutArg::add_to(CLI::App& app, const std::string& writes, bool required) {
-    auto* o = app.add_option("--out", text, "output prefix PREFIX (folders created as needed): writes " + writes);
-    if (required) o->required();
+    option = app.add_option("--out", text, "output prefix PREFIX (folders created as needed): writes " + writes);
+    if (required) option->required();
 }
 
 std::string OutArg::prepare(const std::string& command, std::initializer_list<const char*> suffixes) const {
     namespace fs = std::filesystem;
+    if (text.empty() && option && option->count() > 0) throw BadInput("--out = '': expected an output prefix (e.g. --out results/run1)");
     if (text.empty()) throw BadInput("--out PREFIX is required");
     std::string prefix = text;
     std::error_code ec;

@@ -123,8 +123,10 @@ struct FormatArg {
 /// (an existing one, or a trailing '/') means FOLDER/<command>. Missing folders are created.
 struct OutArg {
     std::string text;
+    CLI::Option* option = nullptr;
     void add_to(CLI::App& app, const std::string& writes, bool required);
-    bool given() const { return !text.empty(); }
+    /// True when --out was given, even as '' (which prepare() refuses: never "nothing written, exit 0").
+    bool given() const { return !text.empty() || (option && option->count() > 0); }
     /// Resolves the prefix and prepares its folder (created as needed, must be writable) and
     /// checks PREFIX + each suffix (not a folder, writable; check_output_file): bad input
     /// otherwise, before any work.

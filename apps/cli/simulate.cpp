@@ -29,7 +29,10 @@ void add_simulate_flags(CLI::App& app) {
         ->type_name("CARS");
     simulate_args.lead.add_to(app);
     simulate_args.out.add_to(app, "PREFIX.csv (time series), PREFIX.json, PREFIX.svg (speeds)", true);
-    app.add_option("--on-event", simulate_args.on_event, "stop or continue at the first disengagement or collision")->capture_default_str();
+    app.add_option("--on-event", simulate_args.on_event,
+                   "at the first disengagement or collision: continue (the default: the whole platoon to the end; a car's values after its "
+                   "own collision are not physical and its lines end there in the figure) or stop")
+        ->capture_default_str();
     app.add_option("--t-end", simulate_args.t_end, "end time [s] (0: the profile's last breakpoint + 30 s)")->capture_default_str();
     app.add_option("--step", simulate_args.step, "largest integration step [s]")->capture_default_str();
     app.add_option("--output-dt", simulate_args.output_dt, "output sampling [s]")->capture_default_str();
@@ -98,17 +101,30 @@ int run_simulate() {
     print_output(format, e, csv, [&] {
         std::ostringstream s;
         s << "simulated  " << counted(static_cast<long long>(cars.size()), "follower") << " to t = " << rounded(r.t_end, 5) << " s (" << r.steps << " steps)\n";
-        s << "car  name      min speed  speed drop  min gap   events\n";
+        std::size_t w = 4;  // the name column fits the longest name
+        for (const auto& c : r.cars) w = std::max(w, c.name.size());
+        s << "car  " << pad("name", w) << "  min speed [m/s]  speed drop [m/s]  min gap [m]  events\n";
         for (const auto& c : r.cars) {
             char line[160];
-            std::snprintf(line, sizeof line, "%3d  %-8s %9.3f %11.3f %8.3f   ", c.car, c.name.c_str(), c.min_speed, c.speed_drop, c.min_gap);
-            s << line;
+            std::snprintf(line, sizeof line, "  %15.3f %17.3f %12.3f  ", c.min_speed, c.speed_drop, c.min_gap);
+            char car[16];
+            std::snprintf(car, sizeof car, "%3d  ", c.car);
+            s << car << pad(c.name, w) << line;
             for (const auto& ev : c.events) s << ev.type << " at " << rounded(ev.time, 4) << " s  ";
             s << "\n";
         }
         s << "wrote      " << prefix << ".csv " << prefix << ".json " << prefix << ".svg\n";
         std::cout << s.str();
     });
+    int collisions = 0;
+    for (const auto& ev : r.events) collisions += ev.type == "collision";
+    if (collisions > 0)  // never silent, whatever the format
+        for (const auto& ev : r.events)
+            if (ev.type == "collision") {
+                std::cerr << "ddemap: simulate: " << counted(collisions, "car") << " collided (the first: car " << ev.car << " at t = " << rounded(ev.time, 4)
+                          << " s); in " << prefix << ".svg their lines end at the collision\n";
+                break;
+            }
     if (r.status != Status::Converged) {
         std::cerr << "ddemap: simulate: UNDECIDED: " << r.message << "\n";
         return exit_not_converged;

@@ -21,20 +21,59 @@ std::string rounded(double v, int digits) {
 }  // namespace
 
 std::string simulation_svg(const SimResult& r, const std::string& lead) {
-    PlotPanel p{"Speeds", "time [s]", "speed [m/s]", {}, {}};
-    for (std::size_t c = 0; c < r.speed.size(); ++c) {
-        PlotSeries sr{c == 0 ? "lead" : "car " + std::to_string(c) + " (" + r.cars[c - 1].name + ")", r.time, r.speed[c],
-                      c == 0 ? "#000000" : "", c == 0};
-        p.series.push_back(sr);
-    }
+    // Speeds and gaps of every car. A car that collides ends at its collision (a red cross): the
+    // simulation may go on (--on-event continue) but its values after the collision are not
+    // physical. Events are named in the note under the legend, never as labels in the plot
+    // (labels of events close in time would overlap).
+    PlotPanel speeds{"Speeds", "time [s]", "speed [m/s]", {}, {}};
+    PlotPanel gaps{"Gaps to the car ahead", "time [s]", "gap [m]", {}, {}};
+    speeds.y_floor = 0.0;
+    gaps.y_floor = 0.0;
+    std::vector<double> end(r.speed.size(), std::numeric_limits<double>::infinity());
     for (const auto& ev : r.events)
-        p.markers.push_back({ev.time, ev.speed, ev.type == "collision" ? "#d62728" : "#000000", ev.type + " car " + std::to_string(ev.car)});
+        if (ev.type == "collision" && ev.car > 0 && static_cast<std::size_t>(ev.car) < end.size())
+            end[static_cast<std::size_t>(ev.car)] = std::min(end[static_cast<std::size_t>(ev.car)], ev.time);
+    for (std::size_t c = 0; c < r.speed.size(); ++c) {
+        const std::string name = c == 0 ? "lead" : "car " + std::to_string(c) + " (" + r.cars[c - 1].name + ")";
+        const std::string colour = c == 0 ? "#000000" : plot_colour(c - 1);
+        PlotSeries v{name, {}, {}, colour, c == 0}, g{name, {}, {}, colour, false};
+        for (std::size_t k = 0; k < r.time.size() && k < r.speed[c].size(); ++k) {
+            if (r.time[k] > end[c]) break;
+            v.x.push_back(r.time[k]);
+            v.y.push_back(r.speed[c][k]);
+            if (c > 0 && k < r.gap[c].size()) {
+                g.x.push_back(r.time[k]);
+                g.y.push_back(r.gap[c][k]);
+            }
+        }
+        speeds.series.push_back(v);
+        if (c > 0) gaps.series.push_back(g);
+    }
+    std::vector<std::string> collided, disengaged;
+    for (const auto& ev : r.events) {
+        if (ev.car > 0 && static_cast<std::size_t>(ev.car) < end.size() && ev.time > end[static_cast<std::size_t>(ev.car)]) continue;  // after its collision
+        const bool collision = ev.type == "collision";
+        const std::string colour = collision ? "#d62728" : "#000000";
+        speeds.markers.push_back({ev.time, ev.speed, colour, ""});
+        gaps.markers.push_back({ev.time, ev.gap, colour, ""});
+        char text[64];
+        std::snprintf(text, sizeof text, "car %d at %.1f s", ev.car, ev.time);
+        (collision ? collided : disengaged).push_back(text);
+    }
     PlotOptions po;
     po.title = "Platoon behind the '" + lead + "' lead profile";
     po.columns = 1;
     po.panel_width = 760;
-    po.panel_height = 340;
-    return render_line_plots_svg({p}, po);
+    po.panel_height = 300;
+    const auto listed = [](const std::vector<std::string>& items) {
+        std::string s;
+        for (std::size_t i = 0; i < items.size() && i < 4; ++i) s += (i ? ", " : "") + items[i];
+        if (items.size() > 4) s += " and " + std::to_string(items.size() - 4) + " more";
+        return s;
+    };
+    if (!collided.empty()) po.note = "red x: collision (" + listed(collided) + "), the car's lines end there";
+    if (!disengaged.empty()) po.note += (po.note.empty() ? "" : "; ") + std::string("black x: ACC disengages (") + listed(disengaged) + ")";
+    return render_line_plots_svg({speeds, gaps}, po);
 }
 
 std::string growth_svg(const std::vector<GrowthResult>& g, const std::string& lead) {

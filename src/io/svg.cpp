@@ -575,6 +575,8 @@ const char* palette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", 
                          "#7f7f7f", "#bcbd22", "#17becf", "#393b79", "#637939", "#8c6d31", "#843c39"};
 }  // namespace
 
+std::string plot_colour(std::size_t i) { return palette[i % 14]; }
+
 std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& o) {
     if (panels.empty()) throw std::invalid_argument("a plot needs at least one panel");
     const int cols = std::max(1, std::min<int>(o.columns, static_cast<int>(panels.size())));
@@ -606,7 +608,22 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     const double slot = std::max(150.0, 29.0 + 7.8 * static_cast<double>(longest) + 14.0);
     const int per_row = std::max(1, static_cast<int>((width - 20) / slot));
     const double legend_h = entries.empty() ? 10 : 20.0 * ((entries.size() + per_row - 1) / per_row) + 12;
-    const double note_h = o.note.empty() ? 0 : 20;
+    // the note, wrapped at spaces to the figure's width (13 px text: about 7.2 px a character)
+    std::vector<std::string> note_lines;
+    {
+        const std::size_t per_line = static_cast<std::size_t>(std::max(20.0, (width - 20) / 7.2));
+        std::istringstream words(o.note);
+        std::string word, line;
+        while (words >> word) {
+            if (!line.empty() && line.size() + 1 + word.size() > per_line) {
+                note_lines.push_back(line);
+                line.clear();
+            }
+            line += (line.empty() ? "" : " ") + word;
+        }
+        if (!line.empty()) note_lines.push_back(line);
+    }
+    const double note_h = 18.0 * static_cast<double>(note_lines.size()) + (note_lines.empty() ? 0 : 4);
     const double height = header + rows * ch + legend_h + note_h;
     std::ostringstream s;
     svg_preamble(s, width, height, o.title);
@@ -701,8 +718,9 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         }
         s << "</g>\n";
     }
-    if (!o.note.empty()) {
-        s << "<text id=\"note\" x=\"10\" y=\"" << num(height - 6) << "\" font-size=\"13\">" << esc(o.note) << "</text>\n";
+    for (std::size_t i = 0; i < note_lines.size(); ++i) {
+        const double y = height - 6 - 18.0 * static_cast<double>(note_lines.size() - 1 - i);
+        s << "<text" << (i == 0 ? " id=\"note\"" : "") << " x=\"10\" y=\"" << num(y) << "\" font-size=\"13\">" << esc(note_lines[i]) << "</text>\n";
     }
     s << "</svg>\n";
     return s.str();

@@ -1708,6 +1708,37 @@ expect_error "neg.csv:2: gap_m = -5: expected > 0 m" calibrate "$ch/neg.csv"
 expect_error "looks like milliseconds" calibrate "$ch/ms.csv"
 expect_error "fast.csv: time_s: a median sampling step of 9.99.*e-05 s: expected a sampling step of 1 ms to 10 s" calibrate "$ch/fast.csv"
 expect_error "divide by 3.6" calibrate "$ch/kmh.csv"
+# a platoon that collides: said on stderr, the cars' lines end at their collisions, the speed and
+# gap axes start at 0 (once the lines went on to -43 m and the speed axis to -5 m/s)
+"$bin" simulate --fleet "B_min*8" --out "$ch/col" --format json >"$ch/col.json" 2>"$ch/col.err"
+grep -q "3 cars collided (the first: car 6 at t = 73.96 s)" "$ch/col.err" && ok || bad "collisions on stderr: $(cat "$ch/col.err")"
+python3 - "$ch/col.svg" "$ch/col.json" <<'PY' && ok || bad "the platoon figure after collisions"
+import json, re, sys
+svg = open(sys.argv[1]).read()
+events = {c["car"]: e["time"] for c in json.load(open(sys.argv[2]))["result"]["cars"] for e in c["events"] if e["type"] == "collision"}
+assert sorted(events) == [6, 7, 8], events
+assert 'text-anchor="end">-' not in svg, "a negative tick on a y axis"
+assert "red x: collision (car 6 at 74.0 s, car 7 at 76.4 s, car 8 at 79.4 s)" in svg
+# every polyline of a collided car ends at its collision: its last x is the largest of the speed panel's lines at most
+ends = {}
+for m in re.finditer(r'<polyline stroke="[^"]*"[^>]*points="([^"]*)"><title>car (\d+) ', svg):
+    xs = [float(p.split(",")[0]) for p in m.group(1).split()]
+    ends.setdefault(int(m.group(2)), []).append(max(xs))
+full = max(ends[1])
+for car in events:
+    assert all(e < full - 20 for e in ends[car]), (car, ends[car], full)
+PY
+# classify is sized before the work: 20,000 cars as rings of every length would take about 15 min
+python3 -c "
+import random
+random.seed(1)
+print('name,k1,k2,th,tau')
+for i in range(20000): print('c%d,%.3f,%.3f,%.2f,%.2f' % (i, random.uniform(0.05, 0.5), random.uniform(0.1, 0.8), random.uniform(0.8, 2), random.uniform(0.1, 0.8)))
+" >"$ch/many.csv"
+expect_error "20000 cars: estimated run time .* is above the limit .* (--allow-large runs it anyway)" classify "$ch/many.csv" --ring inf
+for cmd in "classify A_min" "simulate --fleet A_min" "growth --fleet A_min --followers 2" "string --k1 0.2 --k2 0.4 --th 1.5 --tau 0.5"; do
+    expect_error "--out = '': expected an output prefix" $cmd --out ''
+done
 rm -rf "$ch"
 fi  # part chain
 

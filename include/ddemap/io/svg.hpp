@@ -86,4 +86,8 @@ struct PlotOptions {
 
 std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& options);
 
+/// The i-th colour of the line plots' palette (14 colours, repeating): the colour a series with
+/// an empty colour gets at position i.
+std::string plot_colour(std::size_t i);
+
 }  // namespace ddemap
