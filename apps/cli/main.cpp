@@ -99,6 +99,48 @@ int finish_stdout(int code) {
 }
 }  // namespace
 
+namespace {
+/// Edit distance with transpositions (optimal string alignment; for "did you mean": --tua is
+/// one step from --tau).
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i)
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+        }
+    return d[a.size()][b.size()];
+}
+
+/// " (did you mean --tau?)" for the first --flag of the command line that the command does not
+/// have and that is close to one it has; empty otherwise.
+std::string did_you_mean(const CLI::App* sub, int argc, char** argv) {
+    std::vector<std::string> names;
+    for (const CLI::Option* o : sub->get_options())
+        for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+    for (int i = 2; i < argc; ++i) {
+        std::string a = argv[i];
+        if (a.rfind("--", 0) != 0 || a.size() < 3) continue;
+        a = a.substr(0, a.find('='));
+        if (std::find(names.begin(), names.end(), a) != names.end()) continue;
+        std::string best;
+        std::size_t best_d = std::string::npos;
+        for (const std::string& n : names) {
+            const std::size_t d = edit_distance(a, n);
+            if (d < best_d) {
+                best_d = d;
+                best = n;
+            }
+        }
+        if (!best.empty() && best_d <= std::max<std::size_t>(2, (a.size() - 2) / 3)) return " (did you mean " + best + "?)";
+        return "";
+    }
+    return "";
+}
+}  // namespace
+
 int main(int argc, char** argv) {
     std::cout.rdbuf(&stdout_buffer());
     CLI::App app{"ddemap: stability of delay differential car-following models.\n"
@@ -138,6 +180,11 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
+        for (const auto& [sub, command] : commands)
+            if (std::strcmp(command->name, argv[1]) == 0) {
+                std::cerr << "ddemap: error: " << one_line(e.what()) << did_you_mean(sub, argc, argv) << " (see ddemap " << command->name << " --help)\n";
+                return exit_bad_input;
+            }
         std::cerr << "ddemap: error: " << one_line(e.what()) << " (see ddemap --help)\n";
         return exit_bad_input;
     }

@@ -181,7 +181,7 @@ def test_fit_warnings_are_python_warnings(tmp_path):
 @pytest.mark.slow
 def test_ctrl_c_stops_one_calibrate_fit_within_a_second():
     # one long synthetic trace, one fit (on the calling thread): interrupted a quarter into it
-    t = np.arange(0, 900, 0.1)
+    t = np.arange(0, 2400, 0.1)
     lead = 22 + 2 * np.sin(t / 15)
     sim = ddemap.simulate("A_min", lead=(t, lead))
     call = lambda: ddemap.calibrate(sim, warn=False, progress=False)

@@ -1,3 +1,4 @@
+#include <cctype>
 #include "core/internal/text.hpp"
 
 #include <cerrno>
@@ -101,14 +102,28 @@ CsvReader::CsvReader(const std::string& text, std::string source, std::string ex
         break;
     }
     if (m_header.empty()) throw std::invalid_argument(m_source + ": empty file: expected a header " + m_expected);
+    const std::string& header_line = m_lines[static_cast<std::size_t>(m_header_line - 1)];
+    const std::size_t at = header_line.find_first_not_of(" \t\r\xEF\xBB\xBF");  // spaces and a byte-order mark
+    if (at != std::string::npos && (header_line[at] == '{' || header_line[at] == '['))
+        throw std::invalid_argument(m_source + " is JSON: expected a CSV file with a header " + m_expected);
 }
 
 int CsvReader::column(const std::string& name, bool required) const {
     for (std::size_t i = 0; i < m_header.size(); ++i)
         if (m_header[i] == name) return static_cast<int>(i);
     if (required) {
+        std::string hint;
+        for (const std::string& h : m_header) {
+            std::string lower = h;
+            for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            if (lower == name) hint = "; the header has " + quoted(h) + ": column names are lower case";
+        }
+        if (hint.empty() && m_header.size() == 1 && m_header[0].find(';') != std::string::npos)
+            hint = "; the header is separated by ';': expected commas (export the file as CSV with ',' as the separator and '.' as the decimal point)";
+        else if (hint.empty() && m_header.size() == 1 && m_header[0].find('\t') != std::string::npos)
+            hint = "; the header is separated by tabs: expected commas";
         throw std::invalid_argument(m_source + ":" + std::to_string(m_header_line) + ": missing column " + quoted(name) + " (expected " +
-                                    m_expected + ")");
+                                    m_expected + ")" + hint);
     }
     return -1;
 }

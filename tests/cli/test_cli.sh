@@ -848,7 +848,7 @@ DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:6 --k
 fixture_cal
 if "$bin" calibrate "$excerpt" --bounds k1=0:2,tau=0.1:0.9 --out "$tmp/calb" >/dev/null 2>&1 || [ $? -eq 4 ]; then
     head -1 "$tmp/calb.csv" | grep -q ',cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta$' && ok || bad "calibrate csv bounds columns"
-    sed -n 2p "$tmp/calb.csv" | grep -q ',0,2,0,1,0,3,0.10000000000000001,0.90000000000000002,5,15$' && ok || bad "calibrate csv bounds values"
+    sed -n 2p "$tmp/calb.csv" | grep -q ',0,2,0,1,0,3,0.1,0.9,5,15$' && ok || bad "calibrate csv bounds values"
     if grep -q ',cov_k1_k1' "$tmp/calb.csv" && [ -n "$(sed -n 2p "$tmp/calb.csv" | cut -d, -f15)" ]; then
         "$bin" classify "$tmp/calb.csv" --samples 50 --ring-samples 0 --format json 2>/dev/null | python3 -c "
 import json, sys
@@ -1704,7 +1704,7 @@ trace("ms.csv", lambda i: (i * 100, ok(i)))
 trace("fast.csv", lambda i: (i * 1e-4, ok(i)))
 trace("kmh.csv", lambda i: (i / 10, (ok(i)[0] * 3.6 * 2, ok(i)[1], ok(i)[2])))
 PY
-expect_error "neg.csv:2: gap_m = -5: expected > 0 m" calibrate "$ch/neg.csv"
+expect_error "neg.csv:2: gap_m = -5 and 599 more gaps <= 0 of 600 samples: expected gaps > 0 m" calibrate "$ch/neg.csv"
 expect_error "looks like milliseconds" calibrate "$ch/ms.csv"
 expect_error "fast.csv: time_s: a median sampling step of 9.99.*e-05 s: expected a sampling step of 1 ms to 10 s" calibrate "$ch/fast.csv"
 expect_error "divide by 3.6" calibrate "$ch/kmh.csv"
@@ -1736,6 +1736,16 @@ print('name,k1,k2,th,tau')
 for i in range(20000): print('c%d,%.3f,%.3f,%.2f,%.2f' % (i, random.uniform(0.05, 0.5), random.uniform(0.1, 0.8), random.uniform(0.8, 2), random.uniform(0.1, 0.8)))
 " >"$ch/many.csv"
 expect_error "20000 cars: estimated run time .* is above the limit .* (--allow-large runs it anyway)" classify "$ch/many.csv" --ring inf
+# a mistyped flag: the nearest flag of the command and its help
+expect_error "(did you mean --tau?) (see ddemap string --help)" string --k1 0.1 --k2 0.4 --th 1.5 --tua 0.5
+expect_error "(did you mean --samples?) (see ddemap classify --help)" classify A_min --sample 3
+# CSV headers a spreadsheet writes, and a JSON file where a CSV is expected
+printf 'Time_s,lead_speed_mps,follower_speed_mps,gap_m\n0,1,1,1\n' >"$ch/upper.csv"
+expect_error "the header has 'Time_s': column names are lower case" calibrate "$ch/upper.csv"
+printf 'time_s;lead_speed_mps;follower_speed_mps;gap_m\n0;1;1;1\n' >"$ch/semi.csv"
+expect_error "the header is separated by ';': expected commas" calibrate "$ch/semi.csv"
+printf '{"time_s": [0, 1]}\n' >"$ch/trace.json"
+expect_error "trace.json is JSON: expected a CSV file with a header time_s" calibrate "$ch/trace.json"
 for cmd in "classify A_min" "simulate --fleet A_min" "growth --fleet A_min --followers 2" "string --k1 0.2 --k2 0.4 --th 1.5 --tau 0.5"; do
     expect_error "--out = '': expected an output prefix" $cmd --out ''
 done

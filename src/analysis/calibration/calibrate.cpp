@@ -40,7 +40,7 @@ namespace {
 
 /// The checks every trace passes: physical values, a sampling step a car-following fit can use,
 /// enough data.
-void check_trace(const Trace& tr) {
+void check_trace(const Trace& tr, const std::string& first_bad_gap = "") {
     const std::size_t n = tr.t.size();
     for (std::size_t i = 0; i < n; ++i) {
         const auto fail = [&](const std::string& what, double x, const std::string& hint) {
@@ -49,10 +49,20 @@ void check_trace(const Trace& tr) {
         };
         if (tr.lead[i] < 0.0) fail("lead_speed_mps", tr.lead[i], ">= 0 m/s");
         if (tr.speed[i] < 0.0) fail("follower_speed_mps", tr.speed[i], ">= 0 m/s");
-        if (!(tr.gap[i] > 0.0)) fail("gap_m", tr.gap[i], "> 0 m (the bumper-to-bumper distance; a gap of 0 or less is a collision)");
         if (tr.speed[i] > 100.0 || tr.lead[i] > 100.0)
             fail(tr.speed[i] > 100.0 ? "follower_speed_mps" : "lead_speed_mps", std::max(tr.speed[i], tr.lead[i]),
                  "at most 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");
+    }
+    // gaps <= 0: a collision, or a sensor's reading during a cut-in; a few (at most 1 % of the
+    // samples, as at the start of an OpenACC handling run) are kept, more are refused
+    const auto bad_gaps = static_cast<std::size_t>(std::count_if(tr.gap.begin(), tr.gap.end(), [](double g) { return !(g > 0.0); }));
+    if (bad_gaps > n / 100) {
+        const auto first = static_cast<std::size_t>(std::find_if(tr.gap.begin(), tr.gap.end(), [](double g) { return !(g > 0.0); }) - tr.gap.begin());
+        throw std::invalid_argument((first_bad_gap.empty() ? tr.source + ": sample " + std::to_string(first + 1) + " (time_s = " +
+                                                                 detail::format_number(tr.t[first]) + "): gap_m = " + detail::format_number(tr.gap[first])
+                                                           : first_bad_gap) +
+                                    " and " + std::to_string(bad_gaps - 1) + " more gaps <= 0 of " + std::to_string(n) +
+                                    " samples: expected gaps > 0 m (a gap of 0 or less is a collision; at most 1 % of the samples may be, e.g. during a cut-in)");
     }
     if (n >= 2) {
         std::vector<double> dt(n - 1);
@@ -121,19 +131,19 @@ Trace read_trace_csv(const std::string& text, const std::string& source, int fol
     Trace tr;
     tr.source = source;
     std::vector<double>* dest[4] = {&tr.t, &tr.lead, &tr.speed, &tr.gap};
+    std::string first_bad_gap;  // "SOURCE:LINE: gap_m = X" of the first gap <= 0
     while (csv.next()) {
         for (int c = 0; c < 4; ++c) dest[c]->push_back(csv.number(idx[c], cols[c]));
-        for (int c = 1; c < 4; ++c)
-            if (dest[c]->back() < 0.0 || (c == 3 && dest[c]->back() == 0.0))
-                csv.fail(std::string(cols[c]) + " = " + detail::format_number(dest[c]->back()) + ": expected " +
-                         (c == 3 ? "> 0 m (a gap of 0 or less is a collision)" : ">= 0 m/s"));
+        for (int c = 1; c < 3; ++c)
+            if (dest[c]->back() < 0.0) csv.fail(std::string(cols[c]) + " = " + detail::format_number(dest[c]->back()) + ": expected >= 0 m/s");
+        if (tr.gap.back() <= 0.0 && first_bad_gap.empty()) first_bad_gap = csv.where() + ": gap_m = " + detail::format_number(tr.gap.back());
         const std::size_t n = tr.t.size();
         if (n > 1 && !(tr.t[n - 1] > tr.t[n - 2])) {
             csv.fail("time_s = " + detail::format_number(tr.t[n - 1]) + " after " + detail::format_number(tr.t[n - 2]) +
                      ": expected increasing times");
         }
     }
-    check_trace(tr);
+    check_trace(tr, first_bad_gap);
     return tr;
 }
 
