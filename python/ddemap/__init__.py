@@ -49,7 +49,7 @@ import numpy as _np
 from . import _ddemap
 
 __all__ = ["__version__", "Result", "CalibrationWarning", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
-           "mixed_ring", "mix", "growth", "equilibria", "hopf", "orbits", "version"]
+           "mixed_ring", "mix", "growth", "chart", "paper", "equilibria", "hopf", "orbits", "version"]
 
 version = _ddemap.version
 __version__ = _ddemap.version
@@ -805,6 +805,56 @@ def growth(vehicles=None, followers=15, lead_profile=None, lead=None):
     spec, tables = ("", {}) if vehicles is None else _cars(vehicles, "vehicles")
     lead_file, lead_text, lead_car = _lead(lead)
     return _result(_ddemap.growth(spec, tables, _integer("followers", followers, 1, 200), lead_profile or "", lead_file, lead_text, lead_car))
+
+
+def _prefix(out, command, suffixes):
+    """The output prefix as ``--out`` resolves it: a folder (existing, or ending in /) gets
+    FOLDER/COMMAND; a known suffix is dropped; missing folders are created."""
+    if not isinstance(out, (str, _os.PathLike)):
+        raise TypeError("out: %s: expected a path prefix (str or os.PathLike)" % (type(out).__name__,))
+    out = _os.fspath(out)
+    if not out:
+        raise ValueError("out = '': expected an output prefix (e.g. out='results/run1')")
+    if out.endswith("/") or _os.path.isdir(out):
+        out = _os.path.join(out, command)
+    for suffix in suffixes:
+        if out.endswith(suffix) and len(out) > len(suffix):
+            out = out[: -len(suffix)]
+            break
+    folder = _os.path.dirname(out)
+    if folder:
+        _os.makedirs(folder, exist_ok=True)
+    return out
+
+
+@_with_progress
+def chart(spec, out):
+    """Renders a chart spec (``ddemap chart SPEC --out PREFIX``): ``spec`` is a TOML file (str or
+    ``os.PathLike``; car files it names are found beside it) or TOML text (a str with a newline);
+    writes PREFIX.svg and per panel K its grid PREFIX-panelK.csv and boundaries
+    PREFIX-panelK-boundaries.csv. Returns ``panels``, ``seconds`` and ``files``.
+    """
+    if isinstance(spec, _os.PathLike) or (isinstance(spec, str) and "\n" not in spec):
+        path = _os.fspath(spec)
+        try:
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+        except OSError as e:
+            raise ValueError("spec = %r: cannot read the file (%s)" % (path, e.strerror)) from None
+        source = path
+    elif isinstance(spec, str):
+        text, source = spec, "<spec>"
+    else:
+        raise TypeError("spec: %s: expected a TOML file (str or os.PathLike) or TOML text" % (type(spec).__name__,))
+    return _result(_ddemap.chart(text, source, _prefix(out, "chart", (".svg",))))
+
+
+@_with_progress
+def paper(out):
+    """The seed paper's main job (``ddemap paper --out PREFIX``): the stability diagrams, the
+    classification of the 14 settings and the disturbance growth, written under PREFIX (see
+    docs/guide/charts.md). Returns the command's JSON keys."""
+    return _result(_ddemap.paper(_prefix(out, "paper", (".svg", ".json"))))
 
 
 def _nonlinear_problem(system, model, ring, parameters):

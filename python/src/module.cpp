@@ -47,6 +47,9 @@
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
 #include "ddemap/io/cars.hpp"
+#include "ddemap/io/chart_spec.hpp"
+#include "ddemap/io/paper.hpp"
+#include "builtin_maps.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/equilibrium.hpp"
 #include "ddemap/study/boundary.hpp"
@@ -675,6 +678,42 @@ std::string py_growth(const std::string& spec, const CarTables& tables, int foll
     return envelope_json(e);
 }
 
+/// chart: a chart spec (TOML text; `source` names it and its folder holds the files it names)
+/// rendered to PREFIX.svg and the panels' CSVs.
+std::string py_chart(const std::string& text, const std::string& source, const std::string& prefix) {
+    const ChartSpec spec = parse_chart_spec(text, source);
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    const RenderedChart r = released([&] { return render_chart(spec, policy); });
+    const auto files = chart_files(r, prefix);
+    write_files_atomic(files);
+    std::vector<std::string> names;
+    for (const auto& f : files) names.push_back(json_string(f.first));
+    JsonEnvelope e;
+    e.command = "chart";
+    e.inputs = JsonObject().string("spec", source).string("out", prefix).str();
+    e.result = JsonObject().integer("panels", static_cast<long long>(spec.panels.size())).number("seconds", r.seconds).json("files", json_array(names)).str();
+    return envelope_json(e);
+}
+
+/// paper: the seed paper's job under PREFIX, as `ddemap paper --out PREFIX`.
+std::string py_paper(const std::string& prefix) {
+    const Progress check = interruptible();
+    const PaperJob job = released([&] {
+        return run_paper_job(ddemap::cli::builtin_paper_toml, "maps/paper.toml", ddemap::cli::builtin_classification_toml, "maps/classification.toml",
+                             {}, check);
+    });
+    JsonEnvelope e;
+    e.command = "paper";
+    e.inputs = JsonObject().string("out", prefix).json("ring", json_ring(job.study.options.cars)).string("lead", job.study.options.lead)
+                   .integer("followers", job.study.options.followers).str();
+    e.result = paper_json(job);
+    auto files = paper_files(job, prefix);
+    files.emplace_back(prefix + ".json", envelope_json(e));
+    write_files_atomic(files);
+    return envelope_json(e);
+}
+
 /// The problem of the nonlinear commands (equilibria, hopf, orbits), as their flag group builds it:
 /// a system file, or a built-in ring by name (traffic/nonlinear_ring.hpp) with `par` set to `from`.
 struct NonlinearProblem {
@@ -875,6 +914,8 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("speed"), py::arg("length"), py::arg("solver"));
     m.def("growth", &py_growth, py::arg("vehicles"), py::arg("tables"), py::arg("followers"), py::arg("lead_profile"), py::arg("lead"),
           py::arg("lead_text"), py::arg("lead_car"));
+    m.def("chart", &py_chart, py::arg("text"), py::arg("source"), py::arg("prefix"));
+    m.def("paper", &py_paper, py::arg("prefix"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
           py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),

@@ -14,7 +14,7 @@ import pytest
 
 import ddemap
 
-from test_ddemap import CLI, _interrupted_after, cli_json
+from test_ddemap import CLI, _interrupted_after, cli, cli_json
 
 pd = pytest.importorskip("pandas")
 
@@ -189,3 +189,28 @@ def test_ctrl_c_stops_one_calibrate_fit_within_a_second():
     assert full > 1.5, full
     assert took - at < 1.0, (took, at, full)  # within a second of CPU time
     assert took < 0.7 * full, (took, at, full)
+
+
+def test_chart_writes_what_the_cli_writes(tmp_path):
+    spec = tmp_path / "c.toml"
+    write_cars(tmp_path / "mycars.csv")
+    spec.write_text('title = "My cars"\nring = 22\nvehicles = "mycars.csv"\n'
+                    'x = { name = "k1", lo = 0.01, hi = 0.6, count = 12 }\ny = { name = "k2", lo = 0.01, hi = 1, count = 12 }\n')
+    cli("chart", spec, "--out", tmp_path / "cli" / "c")
+    r = ddemap.chart(spec, out=tmp_path / "py" / "c")
+    assert r["panels"] == 3 and len(r["files"]) == 7
+    for f in sorted(os.listdir(tmp_path / "cli")):
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+    with pytest.raises(ValueError, match="out = ''"):
+        ddemap.chart(spec, out="")
+
+
+@pytest.mark.slow
+def test_paper_writes_what_the_cli_writes(tmp_path):
+    cli("paper", "--out", tmp_path / "cli" / "paper")
+    r = ddemap.paper(out=tmp_path / "py" / "paper")
+    assert r.command == "paper"
+    for f in sorted(os.listdir(tmp_path / "cli")):
+        if f.endswith(".json"):
+            continue  # the chart time differs
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
