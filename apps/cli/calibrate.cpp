@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+#include <mutex>
 #include <sstream>
 
 #include "commands.hpp"
@@ -84,7 +86,7 @@ void add_calibrate_flags(CLI::App& app) {
     app.add_option("--gap-weight", calibrate_args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
     calibrate_args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
     calibrate_args.format.add_to(app);
-    run_flags().add_to(app, false);
+    run_flags().add_to(app, true);
 }
 
 namespace {
@@ -182,12 +184,28 @@ int run_calibrate() {
         check_size("calibrate", counted(static_cast<long long>(cars.size()), "fit") + " over " + rounded(duration / 3600.0, 3) + " h of traces", "time",
                    seconds / std::max(1, std::min<int>(thread_count(), static_cast<int>(cars.size()))));
     }
+    // one fit: its stages as they run (the design's simulations, then the Levenberg-Marquardt
+    // iterations of its starts, from several threads)
+    CalibrationOptions fit_options = o;
+    if (cars.size() == 1) {
+        const Progress design = progress_printer("calibrate", "design points");
+        const Progress iterations = progress_printer("calibrate", "Levenberg-Marquardt iterations (at most)");
+        if (design) {
+            auto lock = std::make_shared<std::mutex>();
+            const long points = o.design_points;
+            fit_options.progress = [design, iterations, lock, points](long done, long total) {
+                std::lock_guard<std::mutex> guard(*lock);
+                if (total == points) design(done, total);
+                else iterations(done + 1, total);
+            };
+        }
+    }
     // one progress line per finished fit: ddemap: calibrate: fits 3/12 done, NAME in 0.41 s (4.2 s, about 12 s left)
     CarFinished finished;
     if (cars.size() > 1)
         if (const LabelledProgress line = labelled_progress_printer("calibrate", "fits"))
             finished = [line](const CarCalibration& c, long done, long total) { line(done, total, c.car + " in " + rounded(c.fit.seconds, 2) + " s"); };
-    const std::vector<CarCalibration> results = calibrate_cars(cars, o, ExecutionPolicy{}, finished);
+    const std::vector<CarCalibration> results = calibrate_cars(cars, fit_options, ExecutionPolicy{}, finished);
     std::vector<CalibrationResult> fits;
     std::vector<std::string> names;
     std::vector<Trace> traces;  // one per fit for the overview figure (its first training run)

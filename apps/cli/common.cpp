@@ -257,6 +257,13 @@ std::string OutArg::prepare(const std::string& command, std::initializer_list<co
 
 std::string output_file(const std::string& flag, const std::string& path) {
     if (path.empty()) throw BadInput(flag + " = '': expected a file name");
+    // its folder is created as needed, as --out's is
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    std::error_code ec;
+    if (!folder.empty() && !std::filesystem::exists(folder, ec)) {
+        std::filesystem::create_directories(folder, ec);
+        if (ec) throw BadInput(flag + " = '" + path + "': the folder '" + folder.string() + "' does not exist and cannot be created (" + ec.message() + ")");
+    }
     try {
         check_output_file(path);
     } catch (const std::invalid_argument& e) {

@@ -18,7 +18,7 @@ void RunFlags::add_to(CLI::App& app, bool sizes) {
     if (sizes)
         app.add_flag("--allow-large", allow_large,
                      "run even when the estimated memory (2 GB), output (100 MB) or time (10 min) is above its limit "
-                     "(README \"Limits and progress\")")
+                     "(docs/reference/outputs.md, \"Limits and progress\")")
             ->group("Run");
     app.add_flag("--quiet", quiet, "no progress lines on stderr")->group("Run");
 }
@@ -72,8 +72,8 @@ void check_size(const std::string& command, const std::string& what, const std::
 namespace {
 
 /// What the printers share: quiet for the first second (short runs print nothing), on a
-/// terminal one line redrawn in place, otherwise one line per finished unit (at most one per
-/// percent of `total`), the elapsed time and, when `estimate`, the time left.
+/// terminal one line redrawn in place, otherwise a line at most every 3 s (and at most one per
+/// percent of `total`) and the last one, the elapsed time and, when `estimate`, the time left.
 class Printer {
 public:
     explicit Printer(std::string command) : m_command(std::move(command)) {
@@ -98,8 +98,10 @@ public:
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
         if (elapsed < m_delay && !m_shown) return;
         const long percent = total > 0 ? done * 100 / total : 100;
+        // off a terminal (a log file): at most one line every 3 s, and one per percent at most
+        const double interval = m_delay > 0.0 ? 3.0 : 0.0;
         if (!m_tty && m_shown && done != total &&
-            (unknown_left ? elapsed - m_last_line < m_delay : percent == m_last_percent))
+            (elapsed - m_last_line < interval || (unknown_left ? elapsed - m_last_line < m_delay : percent == m_last_percent)))
             return;
         m_last_percent = percent;
         m_last_line = elapsed;

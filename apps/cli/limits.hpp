@@ -38,8 +38,8 @@ std::string human_bytes(double bytes);
 std::string human_seconds(double seconds);
 
 /// The one progress printer: `command: LABEL 12/200 (3.1 s, about 48 s left)` on stderr.
-/// On a terminal one line redrawn in place; otherwise one line per finished unit (at most one
-/// per percent of the work). Silent for the first second (short runs print nothing) and with
+/// On a terminal one line redrawn in place; otherwise a line at most every 3 s (at most one
+/// per percent of the work) and the last one. Silent for the first second (short runs print nothing) and with
 /// --quiet. Returns an empty callback when quiet.
 Progress progress_printer(const std::string& command, const std::string& unit);
 

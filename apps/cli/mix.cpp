@@ -85,7 +85,7 @@ int run_mix() {
     if (!mix_args.cars.empty()) ring.text = mix_args.cars;
     MixOptions o;
     o.cars = ring.parse(false);
-    const Axis axis = parse_axis("p", mix_args.p);
+    const Axis axis = parse_axis("--p", mix_args.p);
     for (int i = 0; i < axis.count; ++i) o.fractions.push_back(axis.value(i));
     o.draws = static_cast<int>(parse_integer("--draws", mix_args.draws, 0, 10000, "an integer 0..10000"));
     o.seed = static_cast<unsigned>(parse_integer("--seed", mix_args.seed, 0, 4294967295L, "an integer 0..4294967295"));

@@ -54,6 +54,10 @@ int run_simulate() {
     o.output_dt = parse_number("--output-dt", simulate_args.output_dt);
     if (simulate_args.on_event == "stop") o.on_event = OnEvent::Stop;
     else if (simulate_args.on_event != "continue") throw BadInput("--on-event = '" + simulate_args.on_event + "': expected stop or continue");
+    // each flag's range, named by the flag (SimOptions::validate words them by field)
+    if (!(o.step > 0.0 && o.step <= 1.0)) throw BadInput("--step = " + simulate_args.step + ": expected 0 < step <= 1 s");
+    if (!(o.t_end >= 0.0)) throw BadInput("--t-end = " + simulate_args.t_end + ": expected >= 0 s (0: the profile's last breakpoint + 30 s)");
+    if (!(o.output_dt > 0.0)) throw BadInput("--output-dt = " + simulate_args.output_dt + ": expected > 0 s");
     o.validate();
     const std::string prefix = simulate_args.out.prepare("simulate");
     std::string label;

@@ -32,7 +32,7 @@ Axis parse_axis(const std::string& name, const std::string& text) {
     a.name = name;
     const auto c1 = text.find(':');
     const auto c2 = c1 == std::string::npos ? std::string::npos : text.find(':', c1 + 1);
-    const std::string what = name + " = " + detail::quoted(text) + ": expected LO:HI:COUNT with finite LO < HI and an integer COUNT >= 2";
+    const std::string what = name + " = " + detail::quoted(text) + ": expected LO:HI:COUNT with finite LO < HI and an integer COUNT from 2 to 100000";
     if (c1 == std::string::npos || c2 == std::string::npos || text.find(':', c2 + 1) != std::string::npos) {
         throw std::invalid_argument(what);
     }

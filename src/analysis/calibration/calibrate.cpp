@@ -774,6 +774,11 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
         if (!e.fixed && finite && !(e.upper95 - e.lower95 <= pb.hi[i] - pb.lo[i]))
             res.warnings.push_back(e.name + " is not determined by this trace: its 95 % interval [" + fmt3(e.lower95) + ", " + fmt3(e.upper95) +
                                    "] is wider than its bounds [" + fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) + "]");
+        else if (!e.fixed && finite && !e.at_bound && (e.lower95 < pb.lo[i] || e.upper95 > pb.hi[i]))
+            res.warnings.push_back(e.name + "'s 95 % interval [" + fmt3(e.lower95) + ", " + fmt3(e.upper95) + "] reaches beyond its bounds [" +
+                                   fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) +
+                                   "]: the values outside are not physical or not searched, and the interval (a local, Gaussian approximation) is not "
+                                   "reliable there");
     }
     if (res.condition_number > 1e8) {
         std::string which;
