@@ -6,9 +6,13 @@
 # build) stops the target and leaves the input in build-fuzz/findings/; add it to
 # fuzz/corpus/<target>/ once fixed, so the regression tests replay it. The random seed is fixed
 # (FUZZ_SEED, default 1) so that a run can be repeated; give another seed for a new search.
-# Usage: [FUZZ_SEED=N] scripts/fuzz.sh [SECONDS] [TARGET...]
+# FUZZ_WITH_TESTS=ON also configures the test suite in build-fuzz (scripts/sanitize.sh runs it
+# there: one sanitizer build for both). --build-only configures and builds, fuzzes nothing.
+# Usage: [FUZZ_SEED=N] scripts/fuzz.sh [SECONDS|--build-only] [TARGET...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+build_only=0
+if [ "${1:-}" = --build-only ]; then build_only=1; shift; fi
 seconds=${1:-60}
 shift || true
 scripts/install-deps.sh all
@@ -20,17 +24,20 @@ done
 if [ ${#missing[@]} -gt 0 ]; then
     apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g -O1"
+flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=undefined -fno-omit-frame-pointer -gline-tables-only -O1"
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-CC=clang CXX=clang++ cmake -S . -B build-fuzz "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDDEMAP_BUILD_FUZZERS=ON -DDDEMAP_BUILD_PYTHON=OFF \
-    -DDDEMAP_BUILD_TESTS=OFF -DDDEMAP_BUILD_BENCH=OFF -DDDEMAP_WITH_OPENMP=OFF \
+generator=()
+command -v ninja >/dev/null && [ ! -f build-fuzz/Makefile ] && generator=(-G Ninja)
+CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=None -DDDEMAP_BUILD_FUZZERS=ON -DDDEMAP_BUILD_PYTHON=OFF \
+    -DDDEMAP_BUILD_TESTS="${FUZZ_WITH_TESTS:-OFF}" -DDDEMAP_BUILD_BENCH=OFF -DDDEMAP_WITH_OPENMP=OFF \
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
     targets=(system_json fleet_csv fleet_pattern vehicles_csv trace_csv lead_csv chart_spec axis expression atlas_spec)
 fi
 cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]/#/fuzz_}" >/dev/null
+[ "$build_only" = 1 ] && exit 0
 mkdir -p build-fuzz/findings
 status=0
 for t in "${targets[@]}"; do
