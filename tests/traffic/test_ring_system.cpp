@@ -56,7 +56,8 @@ TEST_CASE("ring system: f vanishes at the equilibrium, and its linearisation is 
     for (const auto& [model, p] : {std::make_pair(std::string("ovrv"), ovrv_p), std::make_pair(std::string("idm"), idm_p),
                                    std::make_pair(std::string("ccc"), ccc_p)}) {
         for (int n : {2, 3, 5}) {
-            CAPTURE(model);
+            const std::string model_name = model;  // a plain variable: CAPTURE takes it in a lambda
+            CAPTURE(model_name);
             CAPTURE(n);
             const auto m = make_model(model, with_speed(p, v));
             const RingSystem ring(*m, n);
@@ -103,7 +104,8 @@ TEST_CASE("ring system: rightmost roots of the linearised system equal those of 
     for (const auto& [model, p] : {std::make_pair(std::string("ovrv"), ovrv_p), std::make_pair(std::string("ccc"), ccc_p),
                                    std::make_pair(std::string("idm"), idm_p)}) {
         for (int n : {4, 6}) {
-            CAPTURE(model);
+            const std::string model_name = model;  // a plain variable: CAPTURE takes it in a lambda
+            CAPTURE(model_name);
             CAPTURE(n);
             const auto m = make_model(model, with_speed(p, 15.0));
             const RingSystem ring(*m, n);
@@ -139,7 +141,8 @@ TEST_CASE("ring system: rightmost roots of the linearised system equal those of 
 TEST_CASE("follower system: the linearised one-car system is the plant") {
     for (const auto& [model, p] : {std::make_pair(std::string("ovrv"), ovrv_p), std::make_pair(std::string("idm"), idm_p),
                                    std::make_pair(std::string("ccc"), ccc_p)}) {
-        CAPTURE(model);
+        const std::string model_name = model;
+        CAPTURE(model_name);
         const double v = 21.0;
         const auto m = make_model(model, with_speed(p, v));
         const FollowerSystem one(*m, v);

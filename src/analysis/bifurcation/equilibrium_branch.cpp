@@ -386,7 +386,8 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
     br.stop = c.stop;
 
     bool roots_ok = true;
-    for (const Eigen::VectorXd& u : c.points) {
+    // the roots of the linearisation at u: the count of unstable roots, the abscissa, stability
+    auto evaluate = [&](const Eigen::VectorXd& u) {
         EquilibriumPoint pt;
         pt.par = u[n];
         pt.x = u.head(n);
@@ -412,7 +413,10 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
             if (root.value.real() > marginal_band(root.value)) ++pt.unstable;
         }
         pt.stable = converged(rr.status) && !rr.roots.empty() && pt.abscissa < -marginal_band(rr.roots.front().value);
-        br.points.push_back(std::move(pt));
+        return pt;
+    };
+    for (const Eigen::VectorXd& u : c.points) {
+        br.points.push_back(evaluate(u));
         if (options.progress) options.progress(static_cast<long>(br.points.size()), static_cast<long>(c.points.size()), u[n]);
     }
 
@@ -470,30 +474,80 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         special_ok = special_ok && converged(h.status);
         br.hopf.push_back(std::move(h));
     };
-    for (std::size_t k = 0; k + 1 < br.points.size(); ++k) {
-        const EquilibriumPoint& a = br.points[k];
-        const EquilibriumPoint& b = br.points[k + 1];
-        int net = 0;  // matched crossings: +1 to the right, -1 to the left
-        for (const cplx& ra : a.roots) {
-            if (!genuine(ra)) continue;
-            const cplx* nearest = nullptr;
-            for (const cplx& rb : b.roots)
-                if (genuine(rb) && (!nearest || std::abs(rb - ra) < std::abs(*nearest - ra))) nearest = &rb;
-            if (!nearest || (ra.real() > 0.0) == (nearest->real() > 0.0)) continue;
-            net += nearest->real() > 0.0 ? 1 : -1;
-            const bool from_a = std::abs(ra.real()) <= std::abs(nearest->real());
-            add_hopf(from_a ? a : b, from_a ? ra : *nearest, static_cast<int>(k));
-        }
-        const int change = b.unstable - a.unstable - 2 * net;  // what the matched crossings leave unexplained
-        if (std::abs(change) <= real_crossing[k]) continue;
-        const EquilibriumPoint* from = nullptr;
-        cplx best(std::numeric_limits<double>::infinity(), 0.0);
-        for (const EquilibriumPoint* p : {&a, &b})
-            for (const cplx& r : p->roots)
-                if (genuine(r) && std::abs(r.real()) < std::abs(best.real())) best = r, from = p;
-        if (from) add_hopf(*from, best, static_cast<int>(k));
+    // One step [a, b]: the matched crossings, then the unexplained rest. Several crossings in one
+    // step (the ring modes of a long ring crowd near the ends of the unstable range) defeat the
+    // matching by nearest root: when the Hopf points located in the step do not explain the
+    // change in the count of unstable roots (2 per Hopf point, 1 for a real crossing), the step
+    // is halved (the equilibrium at the midpoint by Newton at fixed parameter from the chord's
+    // midpoint) and each half searched again, up to 2^12 pieces; a change still unexplained is
+    // reported (the branch's status: a special point was not located).
+    // Hopf points located in [lo, hi], from whichever step's candidate they were corrected (a
+    // candidate may converge to a crossing of a neighbouring step)
+    auto located_in = [&](double lo, double hi) {
+        int count = 0;
+        for (const HopfPoint& h : br.hopf)
+            if (converged(h.status) && h.par >= std::min(lo, hi) - 1e-12 && h.par <= std::max(lo, hi) + 1e-12) ++count;
+        return count;
+    };
+    std::function<void(const EquilibriumPoint&, const EquilibriumPoint&, int, int)> search_step =
+        [&](const EquilibriumPoint& a, const EquilibriumPoint& b, int k, int depth) {
+            int net = 0;  // matched crossings: +1 to the right, -1 to the left
+            for (const cplx& ra : a.roots) {
+                if (!genuine(ra)) continue;
+                const cplx* nearest = nullptr;
+                for (const cplx& rb : b.roots)
+                    if (genuine(rb) && (!nearest || std::abs(rb - ra) < std::abs(*nearest - ra))) nearest = &rb;
+                if (!nearest || (ra.real() > 0.0) == (nearest->real() > 0.0)) continue;
+                net += nearest->real() > 0.0 ? 1 : -1;
+                const bool from_a = std::abs(ra.real()) <= std::abs(nearest->real());
+                add_hopf(from_a ? a : b, from_a ? ra : *nearest, k);
+            }
+            const int change = b.unstable - a.unstable - 2 * net;  // what the matched crossings leave unexplained
+            if (std::abs(change) > real_crossing[static_cast<std::size_t>(k)]) {
+                const EquilibriumPoint* from = nullptr;
+                cplx best(std::numeric_limits<double>::infinity(), 0.0);
+                for (const EquilibriumPoint* p : {&a, &b})
+                    for (const cplx& r : p->roots)
+                        if (genuine(r) && std::abs(r.real()) < std::abs(best.real())) best = r, from = p;
+                if (from) add_hopf(*from, best, k);
+            }
+            const int needed = std::abs(b.unstable - a.unstable) - real_crossing[static_cast<std::size_t>(k)];
+            if (needed <= 2 * located_in(a.par, b.par)) return;
+            if (depth >= 12 || !(a.roots_status == Status::Converged && b.roots_status == Status::Converged)) {
+                special_ok = false;
+                return;
+            }
+            Eigen::VectorXd mid(n);
+            mid = 0.5 * (a.x + b.x);
+            const double pm = 0.5 * (a.par + b.par);
+            const EquilibriumResult em = find_equilibrium(system, mid, options.equilibrium, with(system, j, pm));
+            if (!converged(em.status)) {
+                special_ok = false;
+                return;
+            }
+            Eigen::VectorXd um(n + 1);
+            um << em.x, pm;
+            const EquilibriumPoint m = evaluate(um);
+            search_step(a, m, k, depth + 1);
+            search_step(m, b, k, depth + 1);
+        };
+    for (std::size_t k = 0; k + 1 < br.points.size(); ++k) search_step(br.points[k], br.points[k + 1], static_cast<int>(k), 0);
+    // each located point belongs to the step whose parameter range holds it
+    for (HopfPoint& h : br.hopf) {
+        if (!converged(h.status)) continue;
+        for (std::size_t k = 0; k + 1 < br.points.size(); ++k)
+            if (h.par >= std::min(br.points[k].par, br.points[k + 1].par) && h.par <= std::max(br.points[k].par, br.points[k + 1].par)) {
+                h.after = static_cast<int>(k);
+                break;
+            }
     }
-    std::sort(br.hopf.begin(), br.hopf.end(), [](const HopfPoint& x, const HopfPoint& y) { return x.after < y.after; });
+    // in the order met along the branch: by step, and within a step in its direction
+    std::sort(br.hopf.begin(), br.hopf.end(), [&](const HopfPoint& x, const HopfPoint& y) {
+        if (x.after != y.after) return x.after < y.after;
+        const auto k = static_cast<std::size_t>(x.after);
+        const bool up = k + 1 < br.points.size() ? br.points[k + 1].par >= br.points[k].par : true;
+        return up ? x.par < y.par : x.par > y.par;
+    });
 
     for (EquilibriumPoint& p : br.points)
         if (static_cast<int>(p.roots.size()) > options.roots.count) p.roots.resize(static_cast<std::size_t>(options.roots.count));

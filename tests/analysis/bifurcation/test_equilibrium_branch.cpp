@@ -1,9 +1,12 @@
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "numeric_helpers.hpp"
 #include "tolerances.hpp"
@@ -21,6 +24,42 @@ namespace {
 
 using test::bisect;
 using test::pi;
+
+struct ClosedFormHopf {
+    double headway, omega;
+    int mode;
+};
+
+/// The Hopf points of the ov ring (alpha, tau, v0 = h_st = 1) at the uniform flow with headway in
+/// [lo, hi], from the ring modes' characteristic equation (see the case "the structural zero is
+/// removed" below): mode k (theta = 2 pi k / N, k = 1..N-1; mode N - k at -i omega is the conjugate
+/// of mode k at +i omega) has lambda = i omega, omega > 0, where
+///     omega tau = theta / 2 - pi/2 + arctan(alpha / omega) + 2 pi m   (m = 0, 1, ...)
+/// and V'(h) = omega sqrt(omega^2 + alpha^2) / (2 alpha sin(theta / 2)); V'(h) = 3 y^2 / (1 + y^3)^2
+/// (y = h - 1 > 0) rises to its maximum at y^3 = 1/2 and falls after it, so each crossing value
+/// is met once on either side (when inside [lo, hi]).
+std::vector<ClosedFormHopf> ov_ring_hopf_closed_form(int N, double alpha, double tau, double lo, double hi) {
+    auto slope = [](double h) {
+        const double y = h - 1.0;
+        return y > 0.0 ? 3.0 * y * y / ((1.0 + y * y * y) * (1.0 + y * y * y)) : 0.0;
+    };
+    const double top = 1.0 + std::cbrt(0.5);
+    std::vector<ClosedFormHopf> out;
+    for (int k = 1; k < N; ++k) {
+        const double th = 2 * pi * k / N;
+        for (int m = 0; m < 10; ++m) {
+            const double w = bisect([&](double ww) { return ww * tau - th / 2 + pi / 2 - std::atan(alpha / ww) - 2 * pi * m; }, 1e-12, 1e3);
+            const double f = w * std::sqrt(w * w + alpha * alpha) / (2 * alpha * std::sin(th / 2));
+            if (!(f < slope(top))) break;  // larger m: larger omega and f
+            for (const auto& side : {std::make_pair(1.0 + 1e-12, top), std::make_pair(top, 1e3)}) {
+                const double h = bisect([&](double x) { return slope(x) - f; }, side.first, side.second);
+                if (h >= lo && h <= hi) out.push_back({h, w, k});
+            }
+        }
+    }
+    std::sort(out.begin(), out.end(), [](const ClosedFormHopf& a, const ClosedFormHopf& b) { return a.headway < b.headway; });
+    return out;
+}
 
 }  // namespace
 
@@ -137,6 +176,68 @@ TEST_CASE("ov ring: the structural zero is removed and the Hopf points satisfy t
         CHECK_MESSAGE(matched, "Hopf point at headway " << h.par << ", omega " << h.omega << ", V' " << f);
         // on the uniform flow
         CHECK((h.x.head(N - 1).array() - h.par).abs().maxCoeff() < 1e-10);
+    }
+}
+
+TEST_CASE("ov ring of 33 cars: all 38 Hopf points of the ring modes' closed form, modes crowding near the ends of the range" *
+          doctest::test_suite("slow")) {
+    // Near headway 1.3 and 2.69 the Hopf points of the ring modes k = 1, 2, 3, ... lie 0.0015 to
+    // 0.005 apart, closer than the steps of the branch: several modes cross in one step. Every
+    // crossing must be located (the count of unstable roots at the two ends of a step is explained
+    // by the points located in it, else the step is refined); before that the modes 5 and 6 near
+    // 1.31 were missed without notice (36 of 38, status converged).
+    const int N = 33;
+    const double alpha = 1.0, tau = 1.0;
+    const std::vector<ClosedFormHopf> cf = ov_ring_hopf_closed_form(N, alpha, tau, 1.2, 3.0);
+    REQUIRE(cf.size() == 38);
+    OvRing ring(N, alpha, tau, 1.0, 1.0, 1.2);
+    EquilibriumBranchOptions o;
+    o.parameter = "headway";
+    o.roots.count = 2;
+    o.from = 1.2;
+    o.to = 3.0;
+    const EquilibriumBranch br = equilibrium_branch(ring, ring.uniform_flow(), o);
+    INFO(br.message);
+    for (const HopfPoint& h : br.hopf) INFO("hopf " << h.par << " " << to_string(h.status));
+    CHECK(br.status == Status::Converged);
+    CHECK(br.hopf.size() == cf.size());
+    for (const ClosedFormHopf& c : cf) {
+        int matched = 0;
+        for (const HopfPoint& h : br.hopf)
+            if (h.status == Status::Converged && std::abs(h.par - c.headway) < tol::special_point && std::abs(h.omega - c.omega) < tol::special_point) ++matched;
+        CHECK_MESSAGE(matched == 1, "mode " << c.mode << ": headway " << c.headway << ", omega " << c.omega << " located " << matched << " times");
+    }
+    // in the order met along the branch (here increasing headway)
+    for (std::size_t i = 1; i < br.hopf.size(); ++i) CHECK(br.hopf[i].par > br.hopf[i - 1].par);
+}
+
+TEST_CASE("ov ring of 33 cars: one step over six Hopf points locates all six (the step is refined until the counts agree)" *
+          doctest::test_suite("slow")) {
+    // one continuation step from headway 1.29 to 1.32: the modes k = 1..6 cross in it, the number
+    // of unstable roots goes from 0 to 12
+    const int N = 33;
+    const double alpha = 1.0, tau = 1.0;
+    const std::vector<ClosedFormHopf> cf = ov_ring_hopf_closed_form(N, alpha, tau, 1.29, 1.32);
+    REQUIRE(cf.size() == 6);
+    OvRing ring(N, alpha, tau, 1.0, 1.0, 1.29);
+    EquilibriumBranchOptions o;
+    o.parameter = "headway";
+    o.roots.count = 2;
+    o.from = 1.29;
+    o.to = 1.32;
+    // the step in the unknowns (65 states and the headway; about 5.9 times the headway's change):
+    // the first step ends at about 1.318, past the six crossings, the second on the bound
+    o.continuation.initial_step = o.continuation.max_step = 0.165;
+    const EquilibriumBranch br = equilibrium_branch(ring, ring.uniform_flow(), o);
+    REQUIRE(br.points.size() >= 2);
+    CHECK(br.points[1].par > cf.back().headway);
+    CHECK(br.points[1].unstable - br.points[0].unstable == 12);
+    CHECK(br.status == Status::Converged);
+    REQUIRE(br.hopf.size() == cf.size());
+    for (std::size_t i = 0; i < cf.size(); ++i) {
+        CHECK(br.hopf[i].status == Status::Converged);
+        CHECK(std::abs(br.hopf[i].par - cf[i].headway) < tol::special_point);
+        CHECK(std::abs(br.hopf[i].omega - cf[i].omega) < tol::special_point);
     }
 }
 

@@ -187,7 +187,8 @@ TEST_CASE("wave stability: verdicts against simulation of the full ring (N = 20:
         INFO(s.message);
         REQUIRE(s.status == Status::Converged);
         REQUIRE(s.verdict == Verdict::Unstable);
-        const auto [d0, d1] = simulate_from_wave("ov", {}, "headway", 20, 1, w.branch.degree, p, 1e-4, 8);
+        const std::pair<double, double> dd = simulate_from_wave("ov", {}, "headway", 20, 1, w.branch.degree, p, 1e-4, 8);
+        const double d0 = dd.first, d1 = dd.second;  // plain variables: INFO captures them in a lambda
         INFO("distance from the wave " << d0 << " -> " << d1 << ", max |mu| = " << s.max_nontrivial);
         CHECK(d1 > tol::wave_simulation_growth * d0);
     }
@@ -200,7 +201,8 @@ TEST_CASE("wave stability: verdicts against simulation of the full ring (N = 20:
         INFO(s.message);
         REQUIRE(s.status == Status::Converged);
         REQUIRE(s.verdict == Verdict::Stable);
-        const auto [d0, d1] = simulate_from_wave("idm", kIdm, "gap", 20, 1, w.branch.degree, p, 0.05, 12);
+        const std::pair<double, double> dd = simulate_from_wave("idm", kIdm, "gap", 20, 1, w.branch.degree, p, 0.05, 12);
+        const double d0 = dd.first, d1 = dd.second;
         INFO("distance from the wave " << d0 << " -> " << d1 << ", max |mu| = " << s.max_nontrivial);
         CHECK(d1 < tol::wave_simulation_decay * d0);
     }

@@ -63,7 +63,9 @@ TEST_CASE("ring roots agree with the 40-digit reference to 1e-10 (N = 2 .. 50)" 
     std::map<std::pair<std::string, int>, std::vector<std::map<std::string, std::string>>> groups;
     for (const auto& r : rows) groups[{r.at("case"), std::stoi(r.at("N"))}].push_back(r);
     int compared = 0;
-    for (const auto& [key, group] : groups) {
+    for (const auto& key_group : groups) {
+        const auto& key = key_group.first;  // plain variables: CAPTURE takes them in a lambda
+        const auto& group = key_group.second;
         const int n = key.second;
         const Linearisation lin = ovrv_of(group.front());
         RingOptions ro;
@@ -80,7 +82,9 @@ TEST_CASE("ring roots agree with the 40-digit reference to 1e-10 (N = 2 .. 50)" 
             ref_all.push_back(z);
             if (m > 0 && 2 * m != n) ref_all.push_back(std::conj(z));
         }
-        for (const auto& [m, refs] : ref_by_mode) {
+        for (const auto& mode_refs : ref_by_mode) {
+            const int m = mode_refs.first;  // plain variables: CAPTURE takes them in a lambda
+            const std::vector<cplx>& refs = mode_refs.second;
             RootOptions o;
             o.count = static_cast<int>(refs.size()) + 2;
             const LinearDDE dde = m == 0 ? ring_mode0_dde(lin) : ring_mode_dde(lin, ring_zeta(m, n));

@@ -56,8 +56,9 @@ TEST_CASE("continued string analysis: the same sup |Gamma| and verdicts as the s
         const RootResult plant = plant_of(next);
         const StringResult full = analyse_string(next, plant, StringOptions{});
         const auto c = analyse_string_continued(next, plant, {true, seed.omega});
-        CAPTURE(k1);
-        CAPTURE(k2);
+        const double gain1 = k1, gain2 = k2;  // plain variables: CAPTURE takes them in a lambda
+        CAPTURE(gain1);
+        CAPTURE(gain2);
         if (!c) continue;  // the caller scans: nothing to compare
         ++used;
         check_same(*c, full);
@@ -126,8 +127,9 @@ TEST_CASE("continued string analysis: the exclusion bound against a dense scan o
         const RootResult plant = plant_of(lin);
         const StringResult full = analyse_string(lin, plant, StringOptions{});
         const GainPeak seed = highest(full);
-        CAPTURE(k1);
-        CAPTURE(k2);
+        const double gain1 = k1, gain2 = k2;  // plain variables: CAPTURE takes them in a lambda
+        CAPTURE(gain1);
+        CAPTURE(gain2);
         REQUIRE(seed.gain > 1.0);
         const auto c = analyse_string_continued(lin, plant, {true, seed.omega * 1.05});
         REQUIRE(c.has_value());
