@@ -233,12 +233,12 @@ int run_calibrate() {
     Status status = Status::Converged;
     for (std::size_t i = 0; i < fits.size(); ++i) {
         if (fits[i].status_code != Status::Converged) {
-            status = fits[i].status_code;
-            e.message = names[i] + ": " + fits[i].message;
+            if (status == Status::Converged) status = fits[i].status_code;  // the first, as the message
         }
         for (const auto& w : fits[i].warnings) std::cerr << "ddemap: calibrate: " << names[i] << ": warning: " << w << "\n";
     }
     e.status = to_string(status);
+    e.message = calibration_message(names, fits);
     const std::string csv = calibration_csv(names, fits, o);
     std::vector<std::pair<std::string, std::string>> outputs;
     if (!prefix.empty())

@@ -105,6 +105,7 @@ int run_classify() {
         if (r.has_uncertainty && r.uncertainty.status != Status::Converged)
             std::cerr << "ddemap: classify: " << r.vehicle.name << ": probabilities undecided: " << r.uncertainty.message << "\n";
     e.status = to_string(status);
+    e.message = classification_message(rows);
     const std::string csv = classification_csv(rows);
     if (figure) {
         ExecutionPolicy policy;

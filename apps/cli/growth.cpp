@@ -67,10 +67,8 @@ int run_growth() {
     e.command = "growth";
     e.inputs = JsonObject().string("vehicles", source).string("lead", label).integer("followers", followers).str();
     for (const GrowthResult& r : g)  // the envelope's status: the first platoon that is undecided
-        if (r.status != Status::Converged && e.status == "converged") {
-            e.status = to_string(r.status);
-            e.message = r.name + ": " + r.message;
-        }
+        if (r.status != Status::Converged && e.status == "converged") e.status = to_string(r.status);
+    e.message = growth_message(g);
     e.result = growth_json(g, label);
     const std::string csv = growth_csv(g);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", growth_svg(g, label)}});

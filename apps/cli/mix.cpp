@@ -120,6 +120,7 @@ int run_mix() {
     e.solver_given = solver_name(o.ring.roots.method);
     e.solver_used = used;
     e.status = to_string(status);
+    e.message = mix_message(pts);
     e.result = mix_json(pts, o.cars);
     const std::string csv = mix_csv(pts);
     write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", mix_svg(pts, o, x.label, y.label)}});

@@ -128,7 +128,7 @@ int run_sweep() {
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;
     e.status = sw.uncertified > 0 ? "uncertified" : "converged";
-    e.message = sw.uncertified > 0 ? counted(sw.uncertified, "point") + (sw.uncertified == 1 ? " has" : " have") + " no certificate even after collocation (see their 'certified' column)" : "";
+    e.message = sweep_message(sw);
     e.result = sweep_json(sw, bp);
     const std::string csv = sweep_csv(sw);
     std::vector<std::pair<std::string, std::string>> files = {

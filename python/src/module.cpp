@@ -331,7 +331,7 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;
     e.status = sw.uncertified > 0 ? "uncertified" : "converged";
-    e.message = sw.uncertified > 0 ? std::to_string(sw.uncertified) + " points have no certificate even after collocation (see their 'certified' column)" : "";
+    e.message = sweep_message(sw);
     e.result = sweep_json(sw, bp);
 
     // the grid: one (ny, nx) array per quantity (rows: y, columns: x), as the CSV's columns
@@ -415,6 +415,7 @@ std::string py_classify(const std::string& spec, const CarTables& tables, int ca
     e.inputs = inputs.str();
     e.result = classification_json(rows, cars, source);
     e.status = to_string(classification_status(rows));
+    e.message = classification_message(rows);
     return envelope_json(e);
 }
 
@@ -548,10 +549,10 @@ std::string py_calibrate(const std::vector<std::pair<std::string, std::string>>&
     Status status = Status::Converged;
     for (std::size_t i = 0; i < fits.size(); ++i)
         if (fits[i].status_code != Status::Converged) {
-            status = fits[i].status_code;
-            e.message = names[i] + ": " + fits[i].message;
+            if (status == Status::Converged) status = fits[i].status_code;  // the first, as the message
         }
     e.status = to_string(status);
+    e.message = calibration_message(names, fits);
     if (!report.empty()) {  // the folder exists (the Python wrapper creates it)
         std::vector<std::pair<std::string, std::string>> out = calibration_report_files(results, cars, o, runs.empty() && !joint);
         for (auto& f : out) f.first = report + "/" + f.first;
@@ -644,7 +645,7 @@ std::string py_mix(const std::string& x_spec, const std::string& y_spec, const C
     e.solver_given = solver_name(o.ring.roots.method);
     e.solver_used = used;
     e.status = to_string(status);
-    if (status != Status::Converged) e.message = "an arrangement's roots did not converge";
+    e.message = mix_message(pts);
     e.result = mix_json(pts, o.cars);
     return envelope_json(e);
 }
@@ -670,10 +671,8 @@ std::string py_growth(const std::string& spec, const CarTables& tables, int foll
     e.command = "growth";
     e.inputs = JsonObject().string("vehicles", source).string("lead", label).integer("followers", followers).str();
     for (const GrowthResult& r : g)
-        if (r.status != Status::Converged && e.status == "converged") {
-            e.status = to_string(r.status);
-            e.message = r.name + ": " + r.message;
-        }
+        if (r.status != Status::Converged && e.status == "converged") e.status = to_string(r.status);
+    e.message = growth_message(g);
     e.result = growth_json(g, label);
     return envelope_json(e);
 }

@@ -248,6 +248,52 @@ std::string string_json(const StringResult& s, const RingResult* ring) {
     return text(j);
 }
 
+std::string classification_message(const std::vector<Classification>& rows) {
+    for (const auto& r : rows) {
+        if (r.string.plant_roots.status != Status::Converged) return r.vehicle.name + ": plant roots: " + r.string.plant_roots.message;
+        if (r.ring.status != Status::Converged) return r.vehicle.name + ": ring: " + r.ring.reason;
+        if (r.has_uncertainty && r.uncertainty.status != Status::Converged) return r.vehicle.name + ": " + r.uncertainty.message;
+    }
+    if (rows.empty()) return "";
+    return std::to_string(rows.size()) + (rows.size() == 1 ? " car" : " cars") +
+           ": every plant and ring root search converged with its certificate (" + rows.front().vehicle.name + "'s ring: " + rows.front().ring.reason +
+           "); the string verdicts from the low-frequency coefficient c2 and the peak of |Gamma(i omega)|";
+}
+
+std::string sweep_message(const SweepResult& sw) {
+    if (sw.uncertified > 0)
+        return std::to_string(sw.uncertified) + (sw.uncertified == 1 ? " point has" : " points have") +
+               " no certificate even after collocation (see their 'certified' column)";
+    return "every one of the " + std::to_string(sw.points.size()) + " grid points certified: no root of the plant or of the ring (method " +
+           sw.ring_method + ") lies right of the abscissa reported (argument principle)";
+}
+
+std::string growth_message(const std::vector<GrowthResult>& g) {
+    for (const GrowthResult& r : g)
+        if (r.status != Status::Converged) return r.name + ": " + r.message;
+    return std::to_string(g.size()) + (g.size() == 1 ? " platoon" : " platoons") +
+           " simulated to the end without divergence (classical Runge-Kutta of order 4, steps of at most the smallest delay, "
+           "landing on the lead's breakpoints)";
+}
+
+std::string mix_message(const std::vector<MixPoint>& points) {
+    int arrangements = 0;
+    for (const MixPoint& p : points) {
+        if (p.status != Status::Converged) return "p = " + json_number(p.fraction) + ": an arrangement's roots did not converge (" + to_string(p.status) + ")";
+        arrangements += p.arrangements;
+    }
+    return "the roots of every one of the " + std::to_string(arrangements) + " arrangements located and certified as roots --fleet certifies them";
+}
+
+std::string calibration_message(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits) {
+    for (std::size_t i = 0; i < fits.size(); ++i)
+        if (fits[i].status_code != Status::Converged) return (i < names.size() ? names[i] : "fit " + std::to_string(i + 1)) + ": " + fits[i].message;
+    if (fits.empty()) return "";
+    return std::to_string(fits.size()) + (fits.size() == 1 ? " fit" : " fits") +
+           " converged (bounded Levenberg-Marquardt with exact sensitivities from the best points of a Latin-hypercube design; " + fits.front().message +
+           "); 95 % intervals from the covariance corrected for correlated residuals (Newey-West)";
+}
+
 std::string classification_json(const std::vector<Classification>& rows, int cars, const std::string& source) {
     json j;
     j["source"] = source;

@@ -100,6 +100,15 @@ std::string string_json(const StringResult& s, const RingResult* ring);
 std::string append_ring_method_json(const std::string& object_text, const FastRing& f);
 /// one object per vehicle: parameters, the three verdicts, sup_gamma, ...
 std::string classification_json(const std::vector<Classification>& rows, int cars, const std::string& source);
+
+/// The envelopes' `message` (why the result is trusted, or why not), one wording for the program
+/// and the Python module: the first car, point, platoon or fit that is not converged and why;
+/// otherwise what certifies the result.
+std::string classification_message(const std::vector<Classification>& rows);
+std::string sweep_message(const SweepResult& sweep);
+std::string growth_message(const std::vector<GrowthResult>& g);
+std::string mix_message(const std::vector<MixPoint>& points);
+std::string calibration_message(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits);
 /// the summary of a sweep (and its boundaries): inputs, method, degree, timings, region counts
 std::string sweep_json(const SweepResult& sw, const BoundarySet* b);
 /// the boundary curves' summary

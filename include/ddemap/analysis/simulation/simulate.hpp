@@ -112,7 +112,7 @@ struct SimResult {
     /// Converged, or NumericalIssue when the solution diverged (see SimOptions::max_speed): the
     /// output then ends at t_end, the last step before `diverged_at`, and `message` says why.
     Status status = Status::Converged;
-    std::string message;
+    std::string message;  ///< why the run is trusted (method, steps, no divergence), or why not
     double diverged_at = 0.0;                     ///< time of the step that diverged (0: none)
 };
 
