@@ -579,6 +579,11 @@ std::string plot_colour(std::size_t i) { return palette[i % 14]; }
 
 std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const PlotOptions& o) {
     if (panels.empty()) throw std::invalid_argument("a plot needs at least one panel");
+    // a size that is not finite is a caller's bug (the guard of every number written), caught
+    // before any arithmetic converts it to an integer
+    if (!std::isfinite(o.panel_width) || !std::isfinite(o.panel_height))
+        throw std::logic_error("a non-finite figure size (" + std::to_string(o.panel_width) + " x " + std::to_string(o.panel_height) +
+                               ") reached the SVG writer");
     const int cols = std::max(1, std::min<int>(o.columns, static_cast<int>(panels.size())));
     const int rows = (static_cast<int>(panels.size()) + cols - 1) / cols;
     const double ml = 70, mr = 18, mt = 36, mb = 54;  // type as in the charts: readable at a column width

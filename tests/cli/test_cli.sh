@@ -1017,8 +1017,8 @@ fi
 "$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --points 3 | grep -q "^hopf       alpha = 1.570796327" && ok || bad "orbits table"
 # bad input: nothing on stdout, one line on stderr, exit 2, no file written
 expect_error "parameter 'beta' is not a parameter of this system" orbits --system "$orb/wright.json" --par beta --from 1 --to 2 --out "$orb/bad1"
-expect_error "--hopf = '1': expected an index from 0 to 0 (the branch has 1 Hopf point)" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --hopf 1 --out "$orb/bad2" --svg "$orb/bad2.svg"
-expect_error "no Hopf point on the equilibrium branch in alpha from 0.5 to 1.5" orbits --system "$orb/wright.json" --par alpha --from 0.5 --to 1.5 --out "$orb/bad3"
+expect_error "--hopf = '1': expected an index from 0 to 0 (the branch has 1 Hopf point)" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --hopf 1 --out "$orb/bad2" --svg "$orb/bad2.svg" --quiet
+expect_error "no Hopf point on the equilibrium branch in alpha from 0.5 to 1.5" orbits --system "$orb/wright.json" --par alpha --from 0.5 --to 1.5 --out "$orb/bad3" --quiet
 expect_error "--variable = 'x': expected one of y" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --variable x
 expect_error "--degree" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --degree 0
 expect_error "--intervals" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --intervals 1
