@@ -153,6 +153,22 @@ std::vector<CalibratedVehicle> vehicles_spec(const std::string& spec, const CarT
     return cars;
 }
 
+/// The lead of simulate and growth: a built-in profile by name (default dip), or a speed table or
+/// car K of a platoon CSV, from a file or from text in memory named `file`; `label` names it as
+/// the program does (FILE, FILE:K or the profile's name).
+LeadProfile lead_from(const std::string& profile, const std::string& file, const std::string& text, int car, std::string& label) {
+    if (!profile.empty() && !file.empty()) throw std::invalid_argument("give either lead (a CSV file) or lead_profile (a name), not both");
+    if (!file.empty()) {
+        label = car >= 0 ? file + ":" + std::to_string(car) : file;
+        return LeadProfile::from_csv(text.empty() ? read_text_file(file) : text, file, car);
+    }
+    label = profile.empty() ? std::string("dip") : profile;
+    const auto names = LeadProfile::builtin_names();
+    if (std::find(names.begin(), names.end(), label) == names.end())
+        throw std::invalid_argument("lead_profile = '" + label + "': expected one of dip, oscillatory, step-low, step-high");
+    return LeadProfile::builtin(label);
+}
+
 // ------------------------------------------------------------------ commands
 
 std::string py_roots(const std::string& model_name, const ParameterMap& values, int cars, int count) {
@@ -429,16 +445,8 @@ py::tuple py_simulate(const std::string& fleet, const CarTables& tables, const s
     if (on_event == "stop") o.on_event = OnEvent::Stop;
     else if (on_event != "continue") throw std::invalid_argument("on_event = '" + on_event + "': expected stop or continue");
     o.validate();
-    if (!lead_profile.empty() && !lead_file.empty()) throw std::invalid_argument("give either lead (a CSV file) or lead_profile (a name), not both");
-    const std::string label = !lead_file.empty() ? lead_file : lead_profile.empty() ? std::string("dip") : lead_profile;
-    const LeadProfile lead = [&] {
-        if (!lead_text.empty()) return LeadProfile::from_csv(lead_text, lead_file, lead_car);
-        if (!lead_file.empty()) return LeadProfile::from_csv(read_text_file(lead_file), lead_file, lead_car);
-        const auto names = LeadProfile::builtin_names();
-        if (std::find(names.begin(), names.end(), label) == names.end())
-            throw std::invalid_argument("lead_profile = '" + label + "': expected one of dip, oscillatory, step-low, step-high");
-        return LeadProfile::builtin(label);
-    }();
+    std::string label;
+    const LeadProfile lead = lead_from(lead_profile, lead_file, lead_text, lead_car, label);
     const std::vector<SimCar> cars = platoon_from(vehicles_spec(fleet, tables));
     o.progress = interruptible();
     SimResult r = released([&] { return simulate_platoon(lead, cars, o); });
@@ -652,16 +660,8 @@ std::string py_mix(const std::string& x_spec, const std::string& y_spec, const C
 
 std::string py_growth(const std::string& spec, const CarTables& tables, int followers, const std::string& lead_profile, const std::string& lead_file,
                       const std::string& lead_text, int lead_car) {
-    const std::string label = !lead_file.empty() ? lead_file : lead_profile.empty() ? std::string("dip") : lead_profile;
-    const LeadProfile lead = [&] {
-        if (!lead_profile.empty() && !lead_file.empty()) throw std::invalid_argument("give either lead (a CSV file) or lead_profile (a name), not both");
-        if (!lead_text.empty()) return LeadProfile::from_csv(lead_text, lead_file, lead_car);
-        if (!lead_file.empty()) return LeadProfile::from_csv(read_text_file(lead_file), lead_file, lead_car);
-        const auto names = LeadProfile::builtin_names();
-        if (std::find(names.begin(), names.end(), label) == names.end())
-            throw std::invalid_argument("lead_profile = '" + label + "': expected one of dip, oscillatory, step-low, step-high");
-        return LeadProfile::builtin(label);
-    }();
+    std::string label;
+    const LeadProfile lead = lead_from(lead_profile, lead_file, lead_text, lead_car, label);
     const std::vector<CalibratedVehicle> vehicles = spec.empty() ? paper_calibration_table() : distinct_cars(vehicles_spec(spec, tables));
     const std::string source = spec.empty() ? "the paper's calibration table (built in)" : spec;
     ExecutionPolicy policy;
