@@ -612,7 +612,7 @@ for c in "roots $rootsargs" "string $rootsargs" "classify" "mix --x E_min --y A_
              "simulate --fleet A_min" "boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1" "paper" "sweep --th 1.5 --tau 0.5 --k1 0:1:4 --k2 0:1:4"; do
     start=$(date +%s%N)
     expect_error "$ro_msg" $c --out "$ro_dir/x"
-    [ $(( ($(date +%s%N) - start) / 1000000 )) -lt 2000 ] && ok || bad "$c: the unusable folder was found only after the work"
+    { [ -n "${DDEMAP_SANITIZED:-}" ] || [ $(( ($(date +%s%N) - start) / 1000000 )) -lt 2000 ]; } && ok || bad "$c: the unusable folder was found only after the work"
 done
 chmod 755 "$fio/ro"
 # an output set is all new or all old: a failed move puts every old file back, leaves no temporary file
@@ -1033,7 +1033,7 @@ rwd="$tmp/ringwind"; mkdir -p "$rwd"
 for n in 1000000 1000000000; do
     t0=$(ms_now)
     "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring "$n" --format json >"$rwd/r$n.json" 2>/dev/null &&
-        [ $(( $(ms_now) - t0 )) -lt 3000 ] && ok || bad "roots --ring $n: not done in 3 s or failed"
+        { [ -n "${DDEMAP_SANITIZED:-}" ] || [ $(( $(ms_now) - t0 )) -lt 3000 ]; } && ok || bad "roots --ring $n: not done in 3 s or failed"
 done
 "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0.1 --ring inf --format json >"$rwd/rinf.json" 2>/dev/null
 python3 - "$rwd" <<'PY' && ok || bad "roots --ring 1e6 / 1e9: winding verdict equals the N = inf verdict, listed roots are roots"
@@ -1551,7 +1551,7 @@ if part shortdelay; then
 s0=$(date +%s)
 "$bin" roots --k1 1e6 --k2 0.2 --th 1.5 --tau 1e-9 >"$tmp/stiff.txt" 2>"$tmp/stiff.err" &&
     grep -q '^verdict    ring STABLE' "$tmp/stiff.txt" && grep -q 'M = 0 (converged)' "$tmp/stiff.txt" &&
-    ! grep -q 'UNSETTLED' "$tmp/stiff.txt" && [ $(( $(date +%s) - s0 )) -le 5 ] &&
+    ! grep -q 'UNSETTLED' "$tmp/stiff.txt" && { [ -n "${DDEMAP_SANITIZED:-}" ] || [ $(( $(date +%s) - s0 )) -le 5 ]; } &&
     ok || bad "roots --k1 1e6 --tau 1e-9: converged with a verdict, exit 0, within 5 s: $(cat "$tmp/stiff.txt" "$tmp/stiff.err" | tail -3)"
 "$bin" roots --k1 1e3 --k2 0.2 --th 1e-3 --tau 1e-3 >"$tmp/stiff2.txt" 2>"$tmp/stiff2.err"; rc=$?
 if [ $rc -eq 0 ]; then
@@ -1624,7 +1624,10 @@ d = json.load(open(sys.argv[1] + "/m.out"))
 assert d["solver"]["used"] == "winding" and d["inputs"]["ring_curves"] == "envelope", (d["solver"], d["inputs"])
 rows = list(csv.DictReader(open(sys.argv[1] + "/m-boundaries.csv")))
 assert any(r["subkind"] == "ring" and int(r["mode"]) > 0 for r in rows)
-assert float(sys.argv[3]) - float(sys.argv[2]) < 20, "took %.1f s" % (float(sys.argv[3]) - float(sys.argv[2]))
+# in seconds, not minutes (the per-mode path would take minutes); a sanitized build (scripts/sanitize.sh
+# sets DDEMAP_SANITIZED) is several times slower by design and only checks the rest
+import os
+assert os.environ.get("DDEMAP_SANITIZED") or float(sys.argv[3]) - float(sys.argv[2]) < 20, "took %.1f s" % (float(sys.argv[3]) - float(sys.argv[2]))
 PY
 "$bin" boundary --th 1.5 --tau 0.5 --k1 0.01:1 --k2 0.01:1 --ring 1000000000 --out "$env/b" >/dev/null 2>&1 && grep -q ',hopf,ring,' "$env/b.csv" &&
     ok || bad "boundary --ring 1000000000: the envelope"
