@@ -87,6 +87,13 @@ bool parse_finite(const std::string& text, double& value) {
     return *end == '\0' && errno != ERANGE && std::isfinite(value);
 }
 
+std::string trim(const std::string& s) {
+    const auto b = s.find_first_not_of(" \t\r\n");
+    if (b == std::string::npos) return "";
+    const auto e = s.find_last_not_of(" \t\r\n");
+    return s.substr(b, e - b + 1);
+}
+
 bool is_blank(const std::string& line) { return line.find_first_not_of(" \t\r") == std::string::npos; }
 
 CsvReader::CsvReader(const std::string& text, std::string source, std::string expected)

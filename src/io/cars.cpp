@@ -17,12 +17,7 @@ namespace ddemap {
 
 namespace {
 
-std::string trim(const std::string& s) {
-    const auto b = s.find_first_not_of(" \t\r\n");
-    if (b == std::string::npos) return "";
-    const auto e = s.find_last_not_of(" \t\r\n");
-    return s.substr(b, e - b + 1);
-}
+using detail::trim;
 
 bool ends_with(const std::string& s, const std::string& tail) {
     return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
@@ -115,11 +110,7 @@ CalibratedVehicle inline_car(const std::string& spec) {
     if (v.name.empty()) v.name = spec;
     v.vehicle = v.name;
     try {
-        ParameterMap p = v.parameters;
-        p["speed"] = 20.0;
-        p = make_model(v.model, p)->parameters();
-        p.erase("speed");
-        v.parameters = p;
+        v.parameters = complete_car_parameters(v.model, v.parameters);
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument("car " + detail::quoted(spec) + ": " + e.what());
     }
@@ -221,9 +212,7 @@ std::vector<CalibratedVehicle> read_calibration_json(const std::string& text, co
                     v.bounds.push_back({n, b[0].get<double>(), b[1].get<double>()});
                 }
         try {
-            ParameterMap p = v.parameters;
-            p["speed"] = 20.0;
-            (void)make_model("ovrv", p);
+            (void)complete_car_parameters("ovrv", v.parameters);  // the law's ranges checked
         } catch (const std::invalid_argument& e) {
             throw std::invalid_argument(where + " (" + v.name + "): " + e.what());
         }

@@ -16,12 +16,7 @@ namespace ddemap {
 
 namespace {
 
-std::string trim(const std::string& s) {
-    const auto b = s.find_first_not_of(" \t\r\n");
-    if (b == std::string::npos) return "";
-    const auto e = s.find_last_not_of(" \t\r\n");
-    return s.substr(b, e - b + 1);
-}
+using detail::trim;
 
 const CalibratedVehicle* find_vehicle(const std::string& name) {
     for (const auto& v : paper_calibration_table())

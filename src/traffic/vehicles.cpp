@@ -106,6 +106,14 @@ std::string joined(const std::vector<std::string>& names) {
 
 }  // namespace
 
+ParameterMap complete_car_parameters(const std::string& model, const ParameterMap& parameters) {
+    ParameterMap p = parameters;
+    p["speed"] = 20.0;  // any valid speed: the car's own is set by the ring or the simulation
+    p = make_model(model, p)->parameters();
+    p.erase("speed");
+    return p;
+}
+
 std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std::string& source) {
     const std::string expected = "name and/or vehicle and/or model, the parameters (k1,k2,th,tau[,eta] for ovrv), [count]";
     detail::CsvReader csv(text, source, expected);
@@ -213,11 +221,7 @@ std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std
             csv.fail("a covariance, bounds or min_acc_speed belong to a fit of the ovrv law; this car's model is " + v.model);
         // the model's defaults filled in, its ranges checked (speed: any valid one; it is not kept)
         try {
-            ParameterMap p = v.parameters;
-            p["speed"] = 20.0;
-            p = make_model(v.model, p)->parameters();
-            p.erase("speed");
-            v.parameters = p;
+            v.parameters = complete_car_parameters(v.model, v.parameters);
         } catch (const std::invalid_argument& e) {
             csv.fail(std::string("car ") + detail::quoted(v.name) + ": " + e.what());
         }

@@ -67,6 +67,10 @@ const CalibratedVehicle& builtin_vehicle(const std::string& name);
 /// naming `source`, the line and the column.
 std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std::string& source);
 
+/// A car's parameters completed with its law's defaults and checked against the law's ranges
+/// (make_model at a valid speed, which is not kept): std::invalid_argument from the law otherwise.
+ParameterMap complete_car_parameters(const std::string& model, const ParameterMap& parameters);
+
 /// The same table, every car of the paper's law (ovrv): a car of another model is an error
 /// naming it.
 std::vector<CalibratedVehicle> read_vehicles_csv(const std::string& text, const std::string& source);

@@ -26,6 +26,8 @@ bool parse_finite(const std::string& text, double& value);
 
 /// True for an empty or all-blank line.
 bool is_blank(const std::string& line);
+/// `s` without leading and trailing spaces, tabs and line ends.
+std::string trim(const std::string& s);
 
 /// A CSV text with a header line; blank lines and lines starting with '#' are skipped. Errors
 /// are std::invalid_argument starting with "SOURCE:LINE: ".
