@@ -34,16 +34,9 @@ int run_paper() {
     const std::string prefix = paper_args.out.prepare("paper", {".svg", ".json", "-classification.csv", "-classification.json", "-classification.svg", "-growth.csv", "-growth.svg"});
     const PaperJob job = run_paper_job(builtin_paper_toml, "maps/paper.toml", builtin_classification_toml, "maps/classification.toml", {},
                                        progress_printer("paper", "steps"));
-    JsonEnvelope e;
-    e.command = "paper";
-    e.inputs = JsonObject().string("out", prefix).json("ring", json_ring(job.study.options.cars)).string("lead", job.study.options.lead)
-                   .integer("followers", job.study.options.followers).str();
-    e.result = paper_json(job);
-    auto files = paper_files(job, prefix);
-    files.emplace_back(prefix + ".json", envelope_json(e));
-    write_files_atomic(files);
+    const std::string envelope = write_paper(job, prefix);
     if (format == Format::Json) {
-        print_json(e);
+        std::cout << envelope;  // print_json's text
         return exit_ok;
     }
     std::ostringstream out;

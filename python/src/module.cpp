@@ -702,15 +702,7 @@ std::string py_paper(const std::string& prefix) {
         return run_paper_job(ddemap::cli::builtin_paper_toml, "maps/paper.toml", ddemap::cli::builtin_classification_toml, "maps/classification.toml",
                              {}, check);
     });
-    JsonEnvelope e;
-    e.command = "paper";
-    e.inputs = JsonObject().string("out", prefix).json("ring", json_ring(job.study.options.cars)).string("lead", job.study.options.lead)
-                   .integer("followers", job.study.options.followers).str();
-    e.result = paper_json(job);
-    auto files = paper_files(job, prefix);
-    files.emplace_back(prefix + ".json", envelope_json(e));
-    write_files_atomic(files);
-    return envelope_json(e);
+    return write_paper(job, prefix);
 }
 
 /// The problem of the nonlinear commands (equilibria, hopf, orbits), as their flag group builds it:

@@ -2,6 +2,7 @@
 
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/figures.hpp"
+#include "ddemap/io/files.hpp"
 #include "ddemap/io/json.hpp"
 
 namespace ddemap {
@@ -54,6 +55,19 @@ std::string paper_json(const PaperJob& job) {
         .json("growth", growth_json(job.study.growth, job.study.options.lead))
         .number("seconds", job.seconds)
         .str();
+}
+
+std::string write_paper(const PaperJob& job, const std::string& prefix) {
+    JsonEnvelope e;
+    e.command = "paper";
+    e.inputs = JsonObject().string("out", prefix).json("ring", json_ring(job.study.options.cars)).string("lead", job.study.options.lead)
+                   .integer("followers", job.study.options.followers).str();
+    e.result = paper_json(job);
+    const std::string envelope = envelope_json(e);
+    auto files = paper_files(job, prefix);
+    files.emplace_back(prefix + ".json", envelope);
+    write_files_atomic(files);
+    return envelope;
 }
 
 }  // namespace ddemap

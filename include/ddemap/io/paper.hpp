@@ -36,4 +36,9 @@ std::vector<std::pair<std::string, std::string>> paper_files(const PaperJob& job
 /// The job's summary (JSON text): per panel the sweep summary, the chart time.
 std::string paper_json(const PaperJob& job);
 
+/// The job's files under PREFIX (paper_files) and PREFIX.json, the envelope of `paper` (inputs:
+/// out, ring, lead, followers; result: paper_json), written as one set (write_files_atomic);
+/// returns the envelope's JSON text, what `ddemap paper --format json` prints.
+std::string write_paper(const PaperJob& job, const std::string& prefix);
+
 }  // namespace ddemap
