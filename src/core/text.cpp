@@ -35,6 +35,14 @@ std::string escaped(const std::string& text, std::size_t max_chars) {
     return out;
 }
 
+bool has_control(const std::string& text) {
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c < 0x20 || c == 0x7f) return true;
+    }
+    return false;
+}
+
 std::string quoted(const std::string& text) { return "'" + escaped(text, 80) + "'"; }
 
 std::string format_number(double v) {

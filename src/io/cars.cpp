@@ -1,6 +1,7 @@
 #include "ddemap/io/cars.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -89,8 +90,15 @@ CalibratedVehicle inline_car(const std::string& spec) {
         if (eq == std::string::npos)
             throw std::invalid_argument("car " + detail::quoted(spec) + ": entry " + detail::quoted(entry) + ": expected NAME=VALUE");
         const std::string key = trim(entry.substr(0, eq)), text = trim(entry.substr(eq + 1));
+        const bool identifier = !key.empty() && !std::isdigit(static_cast<unsigned char>(key[0])) &&
+                                std::all_of(key.begin(), key.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+        if (!identifier)
+            throw std::invalid_argument("car " + detail::quoted(spec) + ": entry " + detail::quoted(entry) +
+                                        ": expected NAME=VALUE with NAME a parameter (letters, digits, _)");
         if (key == "name") {
             if (text.empty()) throw std::invalid_argument("car " + detail::quoted(spec) + ": name= is empty: expected a name");
+            if (detail::has_control(text))
+                throw std::invalid_argument("car " + detail::quoted(spec) + ": name = " + detail::quoted(text) + ": expected a name without control characters");
             v.name = text;
             continue;
         }
@@ -177,11 +185,13 @@ std::vector<CalibratedVehicle> read_calibration_json(const std::string& text, co
         if (!f.is_object() || !f.contains("name") || !f["name"].is_string()) throw std::invalid_argument(where + ": no name");
         CalibratedVehicle v;
         v.name = f["name"].get<std::string>();
+        if (v.name.empty() || detail::has_control(v.name))
+            throw std::invalid_argument(where + ": name " + detail::quoted(v.name) + ": expected a non-empty name without control characters");
         v.vehicle = v.name;
         v.setting.clear();
         v.make = 0;
         if (f.contains("status") && f["status"].is_string() && f["status"].get<std::string>() != "converged")
-            throw std::invalid_argument(where + " (" + v.name + "): status " + f["status"].get<std::string>() +
+            throw std::invalid_argument(where + " (" + v.name + "): status " + detail::quoted(f["status"].get<std::string>()) +
                                         ": expected a converged fit (its parameters are not an estimate)");
         for (const char* n : names) {
             if (!f.contains(n) || !f[n].is_number()) throw std::invalid_argument(where + " (" + v.name + "): no number " + n);

@@ -182,6 +182,7 @@ std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std
         v.name = field(c_name);
         if (v.name.empty()) v.name = !vehicle.empty() ? vehicle : c_name >= 0 ? std::string() : v.model + "@" + csv.where();
         if (v.name.empty()) csv.fail("column 'name' is empty: expected a car name");
+        if (detail::has_control(v.name)) csv.fail("column 'name' = " + detail::quoted(v.name) + ": expected a name without control characters");
         if (v.vehicle.empty()) v.vehicle = v.name;
         for (const auto& [name, c] : c_params)
             if (!field(c).empty()) v.parameters[name] = csv.number(c, name);

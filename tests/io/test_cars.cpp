@@ -184,6 +184,20 @@ TEST_CASE("car lists and tables: bad input is named, never taken silently") {
                          std::invalid_argument);
     CHECK_THROWS_WITH_AS(read_car_table("name,model,k1,k2,th,tau\nx,bmw,0.1,0.2,1,0.1\n", "c.csv"),
                          doctest::Contains("column 'model' = 'bmw': expected one of ovrv, idm, ccc"), std::invalid_argument);
+    // control characters in a parameter's name or a car's name: refused, the message one line
+    // (a fuzzer's find: "ccc:k\n1=0.1" echoed the line break)
+    for (const std::string& bad : {std::string("ccc:k\n1=0.1,k6=0.2"), std::string("ovrv:name=a\x01b,k1=0.1,k2=0.2,th=1,tau=0.1")}) {
+        CAPTURE(bad);
+        try {
+            (void)read_cars(bad);
+            FAIL("taken");
+        } catch (const std::invalid_argument& e) {
+            CHECK(std::string(e.what()).find('\n') == std::string::npos);
+            CHECK(std::string(e.what()).find("expected") != std::string::npos);
+        }
+    }
+    CHECK_THROWS_WITH_AS(read_car_table("name,k1,k2,th,tau\na\x02,0.1,0.2,1,0.1\n", "c.csv"), doctest::Contains("'a\\x02': expected a name without control"),
+                         std::invalid_argument);
     CHECK_THROWS_WITH_AS(require_ovrv(read_cars("idm:a=1,b=1.5,th=1.5,tau=0.3"), "simulate --fleet"),
                          doctest::Contains("simulate --fleet takes cars of the paper's law (ovrv); car 'idm:a=1,b=1.5,th=1.5,tau=0.3' has model idm"), std::invalid_argument);
 }

@@ -24,6 +24,10 @@ std::vector<std::string> split_csv_line(const std::string& line);
 /// Parses a whole field as a finite double (no trailing characters, no overflow).
 bool parse_finite(const std::string& text, double& value);
 
+/// True when `text` holds a control character (below 0x20, or 0x7f): refused in names, which
+/// go into messages, CSV rows and figure labels.
+bool has_control(const std::string& text);
+
 /// True for an empty or all-blank line.
 bool is_blank(const std::string& line);
 /// `s` without leading and trailing spaces, tabs and line ends.
