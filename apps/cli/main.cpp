@@ -188,6 +188,20 @@ int main(int argc, char** argv) {
         std::cerr << "ddemap: error: " << one_line(e.what()) << " (see ddemap --help)\n";
         return exit_bad_input;
     }
+    // a value given as '' (`--ring ''`, `--cars ''` from an empty shell variable) is bad input,
+    // never taken as absent
+    for (const auto& [sub, command] : commands) {
+        if (!sub->parsed()) continue;
+        for (const CLI::Option* opt : sub->get_options()) {
+            // absent, a flag, or --out (its own message: an output prefix)
+            if (opt->count() == 0 || opt->get_expected_min() == 0 || opt->check_lname("out")) continue;
+            for (const std::string& r : opt->results())
+                if (r.empty()) {
+                    std::cerr << "ddemap: error: " << (opt->get_lnames().empty() ? opt->get_name() : "--" + opt->get_lnames().front()) << " = '': expected a value (see ddemap " << command->name << " --help)\n";
+                    return exit_bad_input;
+                }
+        }
+    }
     try {
         // test hook: the exit code of an internal error (tests/cli/test_cli.sh)
         const char* fault = std::getenv("DDEMAP_TEST_FAULT");

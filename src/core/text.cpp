@@ -54,6 +54,66 @@ std::string format_number(double v) {
     return buf;
 }
 
+std::size_t invalid_utf8_at(const std::string& text, std::size_t from) {
+    const std::size_t n = text.size();
+    std::size_t i = from;
+    while (i < n) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x80) {
+            ++i;
+            continue;
+        }
+        int len = 0;
+        unsigned lo = 0x80, hi = 0xBF;  // the allowed range of the second byte
+        if (c >= 0xC2 && c <= 0xDF) len = 2;
+        else if (c == 0xE0) len = 3, lo = 0xA0;
+        else if (c >= 0xE1 && c <= 0xEC) len = 3;
+        else if (c == 0xED) len = 3, hi = 0x9F;  // no surrogates
+        else if (c >= 0xEE && c <= 0xEF) len = 3;
+        else if (c == 0xF0) len = 4, lo = 0x90;
+        else if (c >= 0xF1 && c <= 0xF3) len = 4;
+        else if (c == 0xF4) len = 4, hi = 0x8F;  // at most U+10FFFF
+        else return i;
+        if (i + static_cast<std::size_t>(len) > n) return i;
+        const auto c1 = static_cast<unsigned char>(text[i + 1]);
+        if (c1 < lo || c1 > hi) return i;
+        for (int k = 2; k < len; ++k) {
+            const auto ck = static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]);
+            if (ck < 0x80 || ck > 0xBF) return i;
+        }
+        i += static_cast<std::size_t>(len);
+    }
+    return std::string::npos;
+}
+
+std::string utf8_replaced(const std::string& text) {
+    std::size_t bad = invalid_utf8_at(text);
+    if (bad == std::string::npos) return text;
+    std::string out;
+    std::size_t from = 0;
+    while (bad != std::string::npos) {
+        out.append(text, from, bad - from);
+        out += "\xEF\xBF\xBD";  // U+FFFD
+        from = bad + 1;
+        bad = invalid_utf8_at(text, from);
+    }
+    out.append(text, from, std::string::npos);
+    return out;
+}
+
+void require_utf8(const std::string& text, const std::string& source) {
+    const std::size_t bad = invalid_utf8_at(text);
+    if (bad == std::string::npos) return;
+    const std::size_t line_start = bad == 0 ? 0 : text.rfind('\n', bad - 1);
+    const std::size_t column = line_start == std::string::npos ? bad + 1 : (bad == 0 ? 1 : bad - line_start);
+    long line = 1;
+    for (std::size_t i = 0; i < bad; ++i) line += text[i] == '\n';
+    static const char* hex = "0123456789ABCDEF";
+    const auto c = static_cast<unsigned char>(text[bad]);
+    throw std::invalid_argument(source + ":" + std::to_string(line) + ": byte " + std::to_string(column) + " (0x" + hex[c >> 4] + hex[c & 15] +
+                                ") is not UTF-8: expected UTF-8 text");
+}
+
 std::vector<std::string> split_csv_line(const std::string& line) {
     std::vector<std::string> out;
     std::string field;
@@ -106,6 +166,7 @@ bool is_blank(const std::string& line) { return line.find_first_not_of(" \t\r") 
 
 CsvReader::CsvReader(const std::string& text, std::string source, std::string expected)
     : m_source(std::move(source)), m_expected(std::move(expected)) {
+    require_utf8(text, m_source);
     std::istringstream in(text);
     std::string line;
     while (std::getline(in, line)) m_lines.push_back(line);

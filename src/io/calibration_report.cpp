@@ -161,7 +161,7 @@ std::string calibration_report_json(const CalibrationReport& rep) {
     json j;
     j["test_types"] = rep.test_types;
     j["cars"] = cars;
-    return j.dump(2) + "\n";
+    return detail::json_text(j, 2) + "\n";
 }
 
 std::string calibration_report_markdown(const CalibrationReport& rep, const CalibrationOptions& o) {

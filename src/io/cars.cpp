@@ -97,6 +97,7 @@ CalibratedVehicle inline_car(const std::string& spec) {
                                         ": expected NAME=VALUE with NAME a parameter (letters, digits, _)");
         if (key == "name") {
             if (text.empty()) throw std::invalid_argument("car " + detail::quoted(spec) + ": name= is empty: expected a name");
+            detail::require_utf8(text, "car " + detail::quoted(spec) + ": name");
             if (detail::has_control(text))
                 throw std::invalid_argument("car " + detail::quoted(spec) + ": name = " + detail::quoted(text) + ": expected a name without control characters");
             v.name = text;

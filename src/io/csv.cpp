@@ -1,5 +1,7 @@
 #include "ddemap/io/csv.hpp"
 
+#include "core/internal/text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <charconv>
@@ -53,8 +55,11 @@ namespace {
 const char* tf(bool v) { return v ? "true" : "false"; }
 }  // namespace
 
-std::string csv_field(const std::string& s) {
-    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+std::string csv_field(const std::string& text) {
+    // UTF-8 out whatever comes in (the readers refuse names that are not); quoted when it holds
+    // a separator, a quote or a line end, or starts with '#' (a comment line to the readers)
+    const std::string s = detail::utf8_replaced(text);
+    if (s.find_first_of(",\"\n\r") == std::string::npos && (s.empty() || s[0] != '#')) return s;
     std::string out = "\"";
     for (char c : s) {
         if (c == '"') out += '"';

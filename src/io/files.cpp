@@ -15,6 +15,8 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include "core/internal/text.hpp"
+
 namespace ddemap {
 
 namespace {
@@ -298,7 +300,9 @@ std::string read_text_file(const std::string& path) {
         text.append(buf, static_cast<std::size_t>(n));
     }
     ::close(fd);
-    return normalize_input_text(std::move(text));
+    text = normalize_input_text(std::move(text));
+    detail::require_utf8(text, path);  // names go into JSON, CSV and SVG: refused here, before any work
+    return text;
 }
 
 std::string resolve_output_path(const std::string& path) {

@@ -52,7 +52,7 @@ std::string hopf_points_json(const HopfAnalysis& a, const std::vector<std::strin
     branch["status"] = to_string(a.branch.status);
     branch["message"] = a.branch.message;
     j["branch"] = branch;
-    return j.dump();
+    return detail::json_text(j);
 }
 
 std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables) {
@@ -114,7 +114,7 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
         curves.push_back(o);
     }
     j["curves"] = curves;
-    return j.dump();
+    return detail::json_text(j);
 }
 
 std::string hopf_curves_csv(const HopfCurves& hc) {

@@ -21,16 +21,16 @@ json params(const ParameterMap& p) {
     for (const auto& [k, v] : p) o[k] = num(v);
     return o;
 }
-std::string text(const json& j) { return j.dump(); }
+std::string text(const json& j) { return detail::json_text(j); }
 
 }  // namespace
 
 JsonObject& JsonObject::number(const std::string& key, double v) {
-    m_items.emplace_back(key, num(v).dump());
+    m_items.emplace_back(key, detail::json_text(num(v)));
     return *this;
 }
 JsonObject& JsonObject::integer(const std::string& key, long long v) {
-    m_items.emplace_back(key, nlohmann::ordered_json(v).dump());
+    m_items.emplace_back(key, detail::json_text(nlohmann::ordered_json(v)));
     return *this;
 }
 JsonObject& JsonObject::boolean(const std::string& key, bool v) {
@@ -38,7 +38,7 @@ JsonObject& JsonObject::boolean(const std::string& key, bool v) {
     return *this;
 }
 JsonObject& JsonObject::string(const std::string& key, const std::string& v) {
-    m_items.emplace_back(key, nlohmann::ordered_json(v).dump());
+    m_items.emplace_back(key, detail::json_text(nlohmann::ordered_json(v)));
     return *this;
 }
 JsonObject& JsonObject::null(const std::string& key) {
@@ -63,10 +63,10 @@ std::string json_array(const std::vector<std::string>& items) {
     for (std::size_t i = 0; i < items.size(); ++i) s += (i ? "," : "") + items[i];
     return s + "]";
 }
-std::string json_number(double v) { return num(v).dump(); }
-std::string json_string(const std::string& s) { return nlohmann::json(s).dump(); }
-std::string json_ring(int cars) { return ring_value(cars).dump(); }
-std::string json_parameters(const ParameterMap& p) { return params(p).dump(); }
+std::string json_number(double v) { return detail::json_text(num(v)); }
+std::string json_string(const std::string& s) { return detail::json_text(nlohmann::json(s)); }
+std::string json_ring(int cars) { return detail::json_text(ring_value(cars)); }
+std::string json_parameters(const ParameterMap& p) { return detail::json_text(params(p)); }
 
 std::string envelope_json(const JsonEnvelope& e) {
     json j;
@@ -77,7 +77,7 @@ std::string envelope_json(const JsonEnvelope& e) {
     j["status"] = e.status;
     j["message"] = e.message;
     j["result"] = json::parse(e.result);
-    return j.dump(2) + "\n";
+    return detail::json_text(j, 2) + "\n";
 }
 
 namespace {

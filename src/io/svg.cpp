@@ -1,5 +1,7 @@
 #include "ddemap/io/svg.hpp"
 
+#include "core/internal/text.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,15 +16,23 @@ namespace {
 const char* region_fill[4] = {"#d73027", "#fc8d59", "#fee090", "#91bfdb"};
 const char* region_name[4] = {"plant unstable", "ring unstable", "string unstable", "string stable"};
 
-std::string esc(const std::string& s) {
+/// Text for an SVG (XML 1.0) element or attribute: the five markup characters as entities, and
+/// what XML cannot hold (control characters but tab and line ends, bytes that are not UTF-8) as
+/// U+FFFD.
+std::string esc(const std::string& text) {
+    const std::string s = detail::utf8_replaced(text);
     std::string o;
     for (char c : s) {
+        const auto u = static_cast<unsigned char>(c);
         switch (c) {
             case '&': o += "&amp;"; break;
             case '<': o += "&lt;"; break;
             case '>': o += "&gt;"; break;
             case '"': o += "&quot;"; break;
-            default: o += c;
+            case '\'': o += "&#39;"; break;
+            default:
+                if ((u < 0x20 && c != '\t' && c != '\n' && c != '\r') || u == 0x7f) o += "\xEF\xBF\xBD";
+                else o += c;
         }
     }
     return o;
@@ -291,8 +301,11 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         const Axis& ay = sw.spec.y;
         const double ox = (pi % cols) * cw + ml + 5, oy = header + (pi / cols) * ch + mt;
         const double pw = o.panel_width, ph = o.panel_height;
-        auto X = [&](double x) { return ox + (x - ax.lo) / (ax.hi - ax.lo) * pw; };
-        auto Y = [&](double y) { return oy + ph - (y - ay.lo) / (ay.hi - ay.lo) * ph; };
+        // a value far outside the window (a marker at k2 = -1e308, a huge confidence ellipse) is
+        // drawn as if 10^4 panel sizes away: the same direction and a clipped line, never an
+        // overflow to inf and a NaN coordinate
+        auto X = [&](double x) { return ox + std::clamp((x - ax.lo) / (ax.hi - ax.lo), -1e4, 1e4) * pw; };
+        auto Y = [&](double y) { return oy + ph - std::clamp((y - ay.lo) / (ay.hi - ay.lo), -1e4, 1e4) * ph; };
         const std::string id = "panel" + std::to_string(pi + 1);
         s << "<g id=\"" << id << "\">\n";
         // the panel title on one line; too wide, on two (split after "NAME:"), each shortened in

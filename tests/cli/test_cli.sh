@@ -1749,6 +1749,28 @@ printf 'time_s;lead_speed_mps;follower_speed_mps;gap_m\n0;1;1;1\n' >"$ch/semi.cs
 expect_error "the header is separated by ';': expected commas" calibrate "$ch/semi.csv"
 printf '{"time_s": [0, 1]}\n' >"$ch/trace.json"
 expect_error "trace.json is JSON: expected a CSV file with a header time_s" calibrate "$ch/trace.json"
+# text that is not UTF-8 (a Latin-1 name) is refused naming its line and byte, for every reader
+# (once: "internal error: [json.exception.type_error.316] invalid UTF-8 byte" from classify --format json)
+printf 'name,k1,k2,th,tau\nZo\xeb,0.1,0.2,1.5,0.3\n' >"$ch/latin1.csv"
+expect_error "latin1.csv:2: byte 3 (0xEB) is not UTF-8: expected UTF-8 text" classify "$ch/latin1.csv" --format json
+expect_error "latin1.csv:2: byte 3 (0xEB) is not UTF-8" simulate --fleet "$ch/latin1.csv" --out "$ch/lat"
+[ ! -e "$ch/lat.csv" ] && ok || bad "an output after a refused input"
+expect_error "expected a name without control characters" classify "ovrv:name=a$(printf '\001')b,k1=0.1,k2=0.2,th=1.5,tau=0.3"
+printf 'name,k1,k2,th,tau\nZo\xc3\xab,0.1,0.2,1.5,0.3\n' >"$ch/utf8.csv"
+"$bin" classify "$ch/utf8.csv" --format json >"$ch/utf8.json" && grep -q "\"name\": \"Zo$(printf '\303\253')\"" "$ch/utf8.json" && ok || bad "a UTF-8 name through classify's JSON"
+# numbers far outside what the model means: a lead at 1e18 m/s is refused before the work (once
+# an internal error from a NaN in the figure); a marker at k2 = -1e308 is drawn on the window's
+# edge as any marker outside it, with finite coordinates
+printf 'time_s,lead_speed_mps\n0,1e18\n1,20\n' >"$ch/fastlead.csv"
+expect_error "fastlead.csv:2: lead_speed_mps = 1e+18: expected 0 to 100 m/s" simulate --fleet A_min --lead "$ch/fastlead.csv" --out "$ch/fl"
+sed -e 's/^k2 = 0.2$/k2 = -1e308/' -e 's/count = 101/count = 5/' "$(dirname "$0")/../../maps/paper.toml" >"$ch/far.toml"
+grep -q "k2 = -1e308" "$ch/far.toml" || bad "the far marker's spec"
+"$bin" chart "$ch/far.toml" --out "$ch/far" >/dev/null 2>&1 && ! grep -qi "nan\|inf" "$ch/far.svg" && grep -q "paper example (outside)" "$ch/far.svg" \
+    && ok || bad "a marker at k2 = -1e308"
+# a value given as '' (an empty shell variable) is bad input, never taken as absent
+expect_error "--cars = '': expected a value (see ddemap roots --help)" roots --fleet-pattern A_min --cars ''
+expect_error "--ring = '': expected a value" roots --fleet-pattern A_min --ring ''
+expect_error "--tau = '': expected a value" string --k1 0.2 --k2 0.4 --th 1.5 --tau ''
 for cmd in "classify A_min" "simulate --fleet A_min" "growth --fleet A_min --followers 2" "string --k1 0.2 --k2 0.4 --th 1.5 --tau 0.5"; do
     expect_error "--out = '': expected an output prefix" $cmd --out ''
 done

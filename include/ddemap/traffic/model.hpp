@@ -16,6 +16,11 @@
 
 namespace ddemap {
 
+/// The largest speed of a road vehicle the readers take, in m/s (360 km/h): a lead profile, a
+/// platoon or a trace above it is refused as bad input (a speed in km/h, a corrupt row), never
+/// integrated into a non-finite number.
+inline constexpr double kMaxRoadSpeed = 100.0;
+
 /// Linearisation about an equilibrium of a car that reacts to its own gap and speed and to the
 /// speed of the car ahead:
 ///     s_i'(t) = v_{i-1}(t) - v_i(t),

@@ -49,8 +49,8 @@ void check_trace(const Trace& tr, const std::string& first_bad_gap = "") {
         };
         if (tr.lead[i] < 0.0) fail("lead_speed_mps", tr.lead[i], ">= 0 m/s");
         if (tr.speed[i] < 0.0) fail("follower_speed_mps", tr.speed[i], ">= 0 m/s");
-        if (tr.speed[i] > 100.0 || tr.lead[i] > 100.0)
-            fail(tr.speed[i] > 100.0 ? "follower_speed_mps" : "lead_speed_mps", std::max(tr.speed[i], tr.lead[i]),
+        if (tr.speed[i] > kMaxRoadSpeed || tr.lead[i] > kMaxRoadSpeed)
+            fail(tr.speed[i] > kMaxRoadSpeed ? "follower_speed_mps" : "lead_speed_mps", std::max(tr.speed[i], tr.lead[i]),
                  "at most 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");
     }
     // gaps <= 0: a collision, or a sensor's reading during a cut-in; a few (at most 1 % of the

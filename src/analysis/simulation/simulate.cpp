@@ -18,7 +18,9 @@ LeadProfile::LeadProfile(std::vector<double> times, std::vector<double> speeds) 
     if (m_t.empty() || m_t.size() != m_v.size()) throw std::invalid_argument("lead profile: expected as many times as speeds, at least one");
     for (std::size_t i = 0; i < m_t.size(); ++i) {
         if (!std::isfinite(m_t[i]) || !std::isfinite(m_v[i])) throw std::invalid_argument("lead profile: non-finite value at sample " + std::to_string(i + 1));
-        if (m_v[i] < 0.0) throw std::invalid_argument("lead profile: speed " + detail::format_number(m_v[i]) + " at t = " + detail::format_number(m_t[i]) + ": expected >= 0");
+        if (m_v[i] < 0.0 || m_v[i] > kMaxRoadSpeed)
+            throw std::invalid_argument("lead profile: speed " + detail::format_number(m_v[i]) + " at t = " + detail::format_number(m_t[i]) +
+                                        ": expected 0 to 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");
         if (i > 0 && !(m_t[i] > m_t[i - 1])) {
             throw std::invalid_argument("lead profile: time " + detail::format_number(m_t[i]) + " after " + detail::format_number(m_t[i - 1]) + ": expected increasing times");
         }
@@ -132,7 +134,7 @@ PlatoonSeries read_platoon_csv(const std::string& text, const std::string& sourc
                      " (every time lists cars 0 to N in order)");
         if (t != p.time.back()) csv.fail("time_s = " + detail::format_number(t) + ": expected " + detail::format_number(p.time.back()) + " as car 0 of this time");
         const double v = csv.number(iv, "speed_mps");
-        if (v < 0.0) csv.fail("speed_mps = " + detail::format_number(v) + ": expected >= 0");
+        if (v < 0.0 || v > kMaxRoadSpeed) csv.fail("speed_mps = " + detail::format_number(v) + ": expected 0 to 100 m/s (360 km/h)");
         p.speed[car].push_back(v);
         if (car > 0) p.gap[car].push_back(csv.number(ig, "gap_m"));
         ++expected_car;
@@ -166,7 +168,8 @@ LeadProfile LeadProfile::from_csv(const std::string& text, const std::string& so
         if (t.size() > 1 && !(t.back() > t[t.size() - 2])) {
             csv.fail("time_s = " + detail::format_number(t.back()) + ": expected increasing times");
         }
-        if (v.back() < 0.0) csv.fail("lead_speed_mps = " + detail::format_number(v.back()) + ": expected >= 0");
+        if (v.back() < 0.0 || v.back() > kMaxRoadSpeed)
+            csv.fail("lead_speed_mps = " + detail::format_number(v.back()) + ": expected 0 to 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");
     }
     if (t.size() < 2) throw std::invalid_argument(source + ": expected at least two samples");
     return LeadProfile(t, v);

@@ -17,6 +17,19 @@ std::string quoted(const std::string& text);
 /// input (a parser's error description).
 std::string escaped(const std::string& text, std::size_t max_chars = 200);
 
+/// The offset of the first byte of `text` (from `from` on) that is not part of well-formed
+/// UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above U+10FFFF, no truncated
+/// sequence), or std::string::npos when all of it is.
+std::size_t invalid_utf8_at(const std::string& text, std::size_t from = 0);
+
+/// `text` with every byte that is not part of well-formed UTF-8 replaced by U+FFFD (for
+/// writers that must emit UTF-8 whatever they are given, e.g. a path in a JSON string).
+std::string utf8_replaced(const std::string& text);
+
+/// Throws std::invalid_argument "SOURCE:LINE: byte K (0xNN) is not UTF-8: expected UTF-8 text"
+/// (K counted from 1 within the line) when `text` is not well-formed UTF-8.
+void require_utf8(const std::string& text, const std::string& source);
+
 /// Splits one CSV line: commas, double-quoted fields ("" for a quote), fields trimmed of
 /// blanks and carriage returns.
 std::vector<std::string> split_csv_line(const std::string& line);
@@ -34,7 +47,9 @@ bool is_blank(const std::string& line);
 std::string trim(const std::string& s);
 
 /// A CSV text with a header line; blank lines and lines starting with '#' are skipped. Errors
-/// are std::invalid_argument starting with "SOURCE:LINE: ".
+/// are std::invalid_argument starting with "SOURCE:LINE: ". The text must be UTF-8 (every
+/// reader of names takes them through here): a byte that is not is refused naming its line and
+/// its byte within the line (require_utf8).
 class CsvReader {
 public:
     /// `expected` describes the columns for messages, e.g. "name,k1,k2,th,tau[,eta]".

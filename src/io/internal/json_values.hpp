@@ -2,6 +2,7 @@
 // JSON values shared by the io writers (private): a double as a number, or null when it is not
 // finite (JSON has no NaN or infinity), and a vector as an array of those.
 #include <cmath>
+#include <string>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -9,6 +10,13 @@
 namespace ddemap::detail {
 
 using ojson = nlohmann::ordered_json;
+
+/// The JSON text of `j`; a string that is not UTF-8 (a file path given on the command line: the
+/// readers refuse names that are not) has each bad byte written as U+FFFD, never an exception.
+template <class J>
+std::string json_text(const J& j, int indent = -1) {
+    return j.dump(indent, ' ', false, J::error_handler_t::replace);
+}
 
 inline ojson json_value(double v) { return std::isfinite(v) ? ojson(v) : ojson(nullptr); }
 
