@@ -1,5 +1,6 @@
 // roots: rightmost characteristic roots of a ring of identical cars (model flags, --ring),
 // a mixed ring (--fleet FILE.csv or --fleet-pattern), or any linear DDE (--system FILE.json).
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -60,6 +61,17 @@ int run_system(Format format, const std::string& prefix) {
     o.degree = parse_degree();
     o.method = root_method(roots_args.solver);
     if (o.method == "contour") throw BadInput("--solver product goes with --fleet rings: expected auto, dense or sparse for --system");
+    // sized before it is read: the text, the parsed document (about twice the text) and two
+    // parses at about 20 ns per byte (measured), so that a 1 GB dense file is refused at once
+    {
+        std::error_code ec;
+        const auto bytes = static_cast<double>(std::filesystem::file_size(roots_args.system, ec));
+        if (!ec) {
+            const std::string what = "--system " + roots_args.system + " (" + human_bytes(bytes) + " of JSON)";
+            check_size("roots", what, "memory", 3.0 * bytes);
+            check_size("roots", what, "time", 4e-8 * bytes);
+        }
+    }
     const std::string text = read_input_file("--system", roots_args.system);
     std::string equilibrium_json, equilibrium_line;
     Status eq_status = Status::Converged;

@@ -1767,6 +1767,13 @@ sed -e 's/^k2 = 0.2$/k2 = -1e308/' -e 's/count = 101/count = 5/' "$(dirname "$0"
 grep -q "k2 = -1e308" "$ch/far.toml" || bad "the far marker's spec"
 "$bin" chart "$ch/far.toml" --out "$ch/far" >/dev/null 2>&1 && ! grep -qi "nan\|inf" "$ch/far.svg" && grep -q "paper example (outside)" "$ch/far.svg" \
     && ok || bad "a marker at k2 = -1e308"
+# a system file is sized before it is read: an 839 MB file (sparse on disk: nothing to read) is
+# refused at once, not after parsing (a 1.15 GB dense file once took 22 s and 1.15 GB to refuse)
+truncate -s 800M "$ch/huge.json"
+start_ns=$(date +%s%N)
+expect_error "huge.json (839 MB of JSON): estimated memory 2.52 GB is above the limit 2 GB (--allow-large runs it anyway)" roots --system "$ch/huge.json"
+[ $(( ($(date +%s%N) - start_ns) / 1000000 )) -lt 5000 ] && ok || bad "the huge system file took more than 5 s to refuse"
+rm -f "$ch/huge.json"
 # a value given as '' (an empty shell variable) is bad input, never taken as absent
 expect_error "--cars = '': expected a value (see ddemap roots --help)" roots --fleet-pattern A_min --cars ''
 expect_error "--ring = '': expected a value" roots --fleet-pattern A_min --ring ''
