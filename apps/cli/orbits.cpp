@@ -1,6 +1,7 @@
 // orbits: the branch of periodic orbits born at a Hopf point of a nonlinear DDE's equilibrium
 // branch (a system file with expressions, or the built-in ov ring), with Floquet stability,
 // folds of orbits, period doublings and tori; the bifurcation diagram as SVG.
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 
@@ -168,12 +169,17 @@ int run_orbits() {
         out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
         for (const PeriodicOrbit& p : b.points)
             out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[variable] - p.min[variable], 6), 14)
-                << pad(rounded(p.max_nontrivial, 4), 12) << pad(rounded(p.trivial_distance, 2), 12) << (!p.undecided.empty() ? "undecided" : p.stable ? "yes" : "no") << "\n";
+                << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12) << pad(p.multipliers.empty() ? "-" : rounded(p.trivial_distance, 2), 12)
+                << (!p.undecided.empty() ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
         out << crossing_lines(b);
-        if (!b.points.empty())
-            out << "accuracy   max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", max residual = " << rounded(b.max_residual, 2) << "\n";
+        if (!b.points.empty()) {
+            out << "accuracy   ";
+            if (std::any_of(b.points.begin(), b.points.end(), [](const PeriodicOrbit& p) { return !p.multipliers.empty(); }))
+                out << "max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", ";
+            out << "max residual = " << rounded(b.max_residual, 2) << "\n";
+        }
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
         if (!files.empty()) {
             out << "wrote     ";

@@ -270,13 +270,16 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
                             const std::string& variable_unit, const std::string& parameter_unit, const std::string& title) {
     const std::string orbit_colour = "#1f77b4", eq_colour = "#000000";
     std::vector<PlotSeries> series;
-    // consecutive points of one stability form a piece; neighbouring pieces share their end point
-    auto pieces = [&series](const std::vector<double>& x, const std::vector<double>& y, const std::vector<bool>& stable, const std::string& what,
+    // consecutive points of one stability form a piece; neighbouring pieces share their end point.
+    // States: 1 stable (solid), 0 unstable (dashed), 2 undecided (no multipliers, or an orbit
+    // that failed its accuracy check: grey, dashed, never drawn as either verdict)
+    auto pieces = [&series](const std::vector<double>& x, const std::vector<double>& y, const std::vector<int>& state, const std::string& what,
                             const std::string& colour) {
         std::size_t start = 0;
         for (std::size_t i = 1; i <= x.size(); ++i) {
-            if (i < x.size() && stable[i] == stable[start]) continue;
-            PlotSeries s{(stable[start] ? "stable " : "unstable ") + what, {}, {}, colour, !stable[start]};
+            if (i < x.size() && state[i] == state[start]) continue;
+            const int k = state[start];
+            PlotSeries s{(k == 1 ? "stable " : k == 0 ? "unstable " : "undecided ") + what, {}, {}, k == 2 ? std::string("#999999") : colour, k != 1};
             const std::size_t end = std::min(i + 1, x.size());
             s.x.assign(x.begin() + static_cast<std::ptrdiff_t>(start), x.begin() + static_cast<std::ptrdiff_t>(end));
             s.y.assign(y.begin() + static_cast<std::ptrdiff_t>(start), y.begin() + static_cast<std::ptrdiff_t>(end));
@@ -285,21 +288,21 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
         }
     };
     std::vector<double> x, y;
-    std::vector<bool> st;
+    std::vector<int> st;
     for (const PeriodicOrbit& p : orbits.points) {
         x.push_back(p.par);
         y.push_back(p.max[variable] - p.min[variable]);
-        st.push_back(p.stable);
+        st.push_back(!p.undecided.empty() || p.multipliers.empty() ? 2 : p.stable ? 1 : 0);
     }
     if (!x.empty()) pieces(x, y, st, "periodic orbits", orbit_colour);
     std::vector<PlotMarker> markers;
     if (eq) {
         std::vector<double> ex, ey;
-        std::vector<bool> es;
+        std::vector<int> es;
         for (const EquilibriumPoint& p : eq->points) {
             ex.push_back(p.par);
             ey.push_back(0.0);
-            es.push_back(p.stable);
+            es.push_back(p.stable ? 1 : 0);
         }
         if (!ex.empty()) pieces(ex, ey, es, "equilibria", eq_colour);
         for (const HopfPoint& h : eq->hopf) markers.push_back({h.par, 0.0, "#d62728", "Hopf"});
@@ -344,33 +347,40 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
         for (const OrbitCrossing& c : orbits.period_doublings) cuts.push_back(c.par);
         for (const OrbitCrossing& c : orbits.tori) cuts.push_back(c.par);
         std::sort(cuts.begin(), cuts.end());
-        auto stable_at = [](const std::vector<double>& px, const std::vector<bool>& ps, double m) {
+        // stable at m: m lies between two neighbouring points that are both stable
+        auto stable_at = [](const std::vector<double>& px, const std::vector<int>& ps, double m) {
             for (std::size_t i = 0; i + 1 < px.size(); ++i)
-                if ((px[i] - m) * (px[i + 1] - m) <= 0.0 && ps[i] && ps[i + 1]) return true;
+                if ((px[i] - m) * (px[i + 1] - m) <= 0.0 && ps[i] == 1 && ps[i + 1] == 1) return true;
             return false;
         };
         std::vector<double> ex;
-        std::vector<bool> es;
+        std::vector<int> es;
         for (const EquilibriumPoint& p : eq->points) {
             ex.push_back(p.par);
-            es.push_back(p.stable);
+            es.push_back(p.stable ? 1 : 0);
         }
-        double lo = 0.0, hi = 0.0;
-        bool any = false;
+        // the bistable windows: neighbouring qualifying intervals merged, separate ones kept apart
+        // (the 3-car optimal-velocity ring has two, on either side of the unstable equilibria)
+        std::vector<std::pair<double, double>> windows;
         for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
             if (!(cuts[i + 1] > cuts[i])) continue;
             const double m = 0.5 * (cuts[i] + cuts[i + 1]);
             if (!stable_at(x, st, m) || !stable_at(ex, es, m)) continue;
-            if (!any) lo = cuts[i];
-            hi = cuts[i + 1];
-            any = true;
+            if (!windows.empty() && windows.back().second == cuts[i]) windows.back().second = cuts[i + 1];
+            else windows.emplace_back(cuts[i], cuts[i + 1]);
         }
-        lo = std::max(lo, olo);
-        hi = std::min(hi, ohi);
-        if (any && hi > lo)
-            po.note = "bistable (stable orbit and stable equilibrium) for " + parameter_symbol(orbits.parameter) + " in [" + rounded(lo, 4) + ", " +
-                      rounded(hi, 4) + "]; crosses: Hopf red, fold green";
+        std::string text;
+        for (auto [lo, hi] : windows) {
+            lo = std::max(lo, olo);
+            hi = std::min(hi, ohi);
+            if (!(hi > lo)) continue;
+            text += (text.empty() ? "" : " and ") + std::string("[") + rounded(lo, 4) + ", " + rounded(hi, 4) + "]";
+        }
+        if (!text.empty())
+            po.note = "bistable (stable orbit and stable equilibrium) for " + parameter_symbol(orbits.parameter) + " in " + text +
+                      "; crosses: Hopf red, fold green";
     }
+    if (std::count(st.begin(), st.end(), 2) > 0) po.note += "; grey: orbits without a stability verdict";
     return render_line_plots_svg({panel}, po);
 }
 

@@ -524,7 +524,7 @@ std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::strin
         o["period"] = num(p.period);
         o["min"] = vec(p.min);
         o["max"] = vec(p.max);
-        o["stable"] = p.undecided.empty() ? json(p.stable) : json(nullptr);
+        o["stable"] = p.undecided.empty() && !p.multipliers.empty() ? json(p.stable) : json(nullptr);  // null: no verdict
         if (!p.undecided.empty()) o["undecided"] = p.undecided;
         json m = json::array();
         for (std::size_t k = 0; k < p.multipliers.size() && static_cast<int>(k) < multipliers; ++k) m.push_back(pair(p.multipliers[k]));

@@ -1024,6 +1024,19 @@ expect_error "--degree" orbits --system "$orb/wright.json" --par alpha --from 1 
 expect_error "--intervals" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --intervals 1
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits bad input wrote files: $(ls "$orb")"
 "$bin" orbits --help >"$orb/h.txt" 2>&1 && ! grep -q ' TEXT' "$orb/h.txt" && ok || bad "orbits --help has an option without its kind"
+# orbits whose multipliers are not computed (a mesh above the dense monodromy limit): no stability
+# verdict in the table, the JSON (stable null) or the figure (grey), exit 4; once "stable no", exit 0
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 1.4 --to 2 --points 3 --degree 10 --intervals 1700 --format json \
+    --svg "$orb/nomu.svg" --quiet >"$orb/nomu.json" 2>"$orb/nomu.err"
+rc=$?
+[ $rc -eq 4 ] && grep -q "no Floquet multipliers" "$orb/nomu.err" && ok || bad "orbits without multipliers: exit $rc, $(cat "$orb/nomu.err")"
+python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d['status'] == 'numerical_issue', d['status']
+assert all(p['stable'] is None and p['multipliers'] == [] and 'no Floquet multipliers' in p['undecided'] for p in d['result']['points'])
+" "$orb/nomu.json" && grep -q "undecided periodic orbits" "$orb/nomu.svg" && ! grep -q ">stable periodic orbits\|>unstable periodic orbits" "$orb/nomu.svg" \
+    && ok || bad "orbits without multipliers in the JSON and the figure"
 
 fi  # part orbits
 

@@ -251,8 +251,8 @@ bool special_points(const Step& step, const PeriodicOrbit& prev, const PeriodicO
     if (!prev.undecided.empty() || !next.undecided.empty()) {
         if (b.status == Status::Converged) {
             b.status = Status::NumericalIssue;
-            b.message = "the orbit at " + detail::format_number((prev.undecided.empty() ? next : prev).par) + " failed its accuracy check (" +
-                        (prev.undecided.empty() ? next : prev).undecided + "): no stability verdict or special points there";
+            b.message = "the orbit at " + detail::format_number((prev.undecided.empty() ? next : prev).par) + " has no stability verdict (" +
+                        (prev.undecided.empty() ? next : prev).undecided + "): no special points there";
         }
         return false;
     }

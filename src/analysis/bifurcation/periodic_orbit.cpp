@@ -714,6 +714,13 @@ PeriodicOrbit make_orbit(const Setup& c, const Eigen::VectorXd& u, const Correct
             if (k != k1) o.max_nontrivial = std::max(o.max_nontrivial, std::abs(o.multipliers[k]));
         o.stable = o.max_nontrivial < 1.0;
         orbit_continuation::check_accuracy(o);
+    } else if (floquet) {
+        // asked for and not computed: no verdict (never "unstable" by default)
+        o.multipliers.clear();
+        o.stable = false;
+        o.undecided = "no Floquet multipliers: the monodromy matrix of this mesh (" + std::to_string(c.P) + " mesh points per period, " +
+                      std::to_string(c.n) + (c.n == 1 ? " state" : " states") + ", over the delay's history) is above the dense limit of 4000 rows, "
+                      "or its eigensolver failed; fewer --intervals or a lower --degree give them";
     }
     return o;
 }
@@ -803,6 +810,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
     b.points.push_back(make_orbit(*cur, u, first, o.floquet));
     report();
     const double amp0 = amplitude(b.points.front());
+    double amp_max = amp0;
     b.newton_iterations += first.iterations;
     b.jacobians += first.jacobians;
     StepControl step(orbit_continuation::step_control_options(o));
@@ -852,6 +860,17 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
             return;
         }
         PeriodicOrbit orbit = make_orbit(c, v, r, o.floquet);
+        // the branch reached an equilibrium (a Hopf point) and went through it onto the same
+        // orbits, phase-shifted: near the Hopf point p - p_H ~ amplitude^2, so the parameter turns
+        // back within the step while the amplitude is near zero. A fold of orbits turns the
+        // parameter too, but at an amplitude of the order of the branch's; so a turn with both
+        // orbits below a quarter of the largest amplitude seen is taken as the Hopf point: the
+        // branch ends there (once it ran on, looped, and listed the Hopf points as folds)
+        amp_max = std::max(amp_max, amplitude(b.points.back()));
+        if (t(N + 1) * tn(N + 1) < 0.0 && std::max(amplitude(b.points.back()), amplitude(orbit)) < 0.25 * amp_max) {
+            b.stop = "hopf";
+            return;
+        }
         const int after = static_cast<int>(b.points.size()) - 1;
         // folds, period doublings and tori of this step (analysis/bifurcation/internal/orbit_continuation.hpp)
         {

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <vector>
 
 #include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
+#include "ddemap/io/figures.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/integrate.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
@@ -257,6 +259,58 @@ TEST_CASE("ov ring (N = 5): subcritical Hopf, fold of orbits and bistability, ch
     // so the unstable orbit is not reached by simulation, it separates the two attractors
     const DdeSolver small = simulate(ring, from_orbit(0.8), 1500.0, 0.02);
     CHECK(range(small, 0, 1200.0, 1500.0, 0.1) < 1e-3 * (pu.max[0] - pu.min[0]));
+}
+
+TEST_CASE("ov ring (N = 3): the branch from one Hopf point ends at the other, with exactly its two folds and two bistable windows" * doctest::test_suite("slow")) {
+    // the equilibria and both Hopf points first (an independent computation: the equilibrium
+    // branch's root counts), then the orbits from the lower Hopf point over the whole range, as
+    // `orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --points 400` (once: 2.5 loops,
+    // 17 "folds", 3 of them at Hopf points)
+    OvRing ring(3, 1.0, 1.0, 1.0, 1.0, 1.2);
+    EquilibriumBranchOptions eo;
+    eo.parameter = "headway";
+    eo.from = 1.2;
+    eo.to = 3.0;
+    const EquilibriumBranch eq = equilibrium_branch(ring, ring.uniform_flow(), eo);
+    REQUIRE(eq.hopf.size() == 2);
+    const double h1 = std::min(eq.hopf[0].par, eq.hopf[1].par), h2 = std::max(eq.hopf[0].par, eq.hopf[1].par);
+    const HopfPoint& start = eq.hopf[0].par == h1 ? eq.hopf[0] : eq.hopf[1];
+    const OrbitBranch b = orbit_branch_from_hopf(ring, start, options("headway", 1.2, 3.0, 400, 40));
+    CHECK(b.status == Status::Converged);
+    CHECK(b.stop == "hopf");
+    REQUIRE(b.folds.size() == 2);
+    CHECK(b.folds[0].located);
+    CHECK(b.folds[1].located);
+    const double f1 = std::min(b.folds[0].par, b.folds[1].par), f2 = std::max(b.folds[0].par, b.folds[1].par);
+    CHECK(f1 < h1);  // both Hopf points subcritical: the orbits bend back past them
+    CHECK(f2 > h2);
+    // the branch ends next to the other Hopf point, at a small amplitude
+    const PeriodicOrbit& last = b.points.back();
+    double amp_max = 0.0;
+    for (const PeriodicOrbit& p : b.points) amp_max = std::max(amp_max, (p.max - p.min).maxCoeff());
+    CHECK(std::abs(last.par - h2) < 0.05 * (h2 - h1));
+    CHECK((last.max - last.min).maxCoeff() < 0.25 * amp_max);
+    // stability from the multipliers: unstable up to the first fold, stable between the folds,
+    // unstable after the second (one multiplier crosses 1 at each fold)
+    const auto a1 = static_cast<std::size_t>(std::min(b.folds[0].after, b.folds[1].after));
+    const auto a2 = static_cast<std::size_t>(std::max(b.folds[0].after, b.folds[1].after));
+    for (std::size_t i = 0; i < b.points.size(); ++i) {
+        CAPTURE(i);
+        REQUIRE(b.points[i].undecided.empty());
+        if (i <= a1 || i > a2 + 1) CHECK(!b.points[i].stable);
+        else if (i > a1 + 1 && i <= a2) CHECK(b.points[i].stable);
+    }
+    // the figure: two bistable windows [fold, Hopf] on either side of the unstable equilibria,
+    // and stable orbits drawn solid, unstable dashed
+    const std::string svg = bifurcation_svg(&eq, b, 0, "h0", "m", "m", "ov ring of 3 cars");
+    auto g4 = [](double v) {  // 4 significant digits, as the figure's note
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.4g", v);
+        return std::string(buf);
+    };
+    const std::string windows = "[" + g4(f1) + ", " + g4(h1) + "] and [" + g4(h2) + ", " + g4(f2) + "]";
+    CAPTURE(windows);
+    CHECK(svg.find("bistable (stable orbit and stable equilibrium) for headway in " + windows) != std::string::npos);
 }
 
 TEST_CASE("ov ring (N = 5): the fold of orbits converges as the mesh is refined" * doctest::test_suite("slow")) {
