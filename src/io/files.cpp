@@ -172,10 +172,10 @@ bool process_alive(pid_t pid) {
     return !(paren != nullptr && paren[1] == ' ' && paren[2] == 'Z');
 }
 
-/// Removes hidden temporary files of `base` in the folder left by a writer that was killed
-/// (SIGKILL, power loss) on a file system without O_TMPFILE: ".BASE.ddemap-PID-N.tmp" whose
-/// process PID no longer exists.
-void remove_stale_temps(int dirfd, const std::string& base) {
+/// Removes the hidden temporary files that writers killed in this folder left (SIGKILL, power
+/// loss, on a file system without O_TMPFILE): every ".NAME.ddemap-PID-N.tmp" whose process PID
+/// no longer exists, whatever NAME, so that the next write into the folder tidies it.
+void remove_stale_temps(int dirfd) {
     const int fd = ::dup(dirfd);
     if (fd < 0) return;
     DIR* d = ::fdopendir(fd);
@@ -184,13 +184,15 @@ void remove_stale_temps(int dirfd, const std::string& base) {
         return;
     }
     ::rewinddir(d);
-    const std::string head = "." + base + ".ddemap-";
+    const std::string mark = ".ddemap-";
     std::vector<std::string> stale;
     while (const dirent* e = ::readdir(d)) {
         const std::string name = e->d_name;
-        if (name.compare(0, head.size(), head) != 0 || name.size() < head.size() + 5 || name.compare(name.size() - 4, 4, ".tmp") != 0) continue;
+        if (name.size() < 2 || name[0] != '.' || name.size() < mark.size() + 6 || name.compare(name.size() - 4, 4, ".tmp") != 0) continue;
+        const std::size_t at = name.rfind(mark);
+        if (at == std::string::npos || at == 0) continue;
         char* end = nullptr;
-        const long pid = std::strtol(name.c_str() + head.size(), &end, 10);
+        const long pid = std::strtol(name.c_str() + at + mark.size(), &end, 10);
         if (pid <= 0 || end == nullptr || *end != '-') continue;
         if (!process_alive(static_cast<pid_t>(pid))) stale.push_back(name);
     }
@@ -411,7 +413,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         if (t.special) continue;
         t.dirfd = ::open(t.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (t.dirfd < 0) fail(ts, t.given, errno);
-        remove_stale_temps(t.dirfd, t.base);
+        remove_stale_temps(t.dirfd);
         if (t.remove) continue;
         const mode_t mode = t.existed ? t.mode : 0666;
         t.fd = test_fault("named") ? -1 : ::openat(t.dirfd, ".", O_TMPFILE | O_WRONLY | O_CLOEXEC, mode);

@@ -886,6 +886,13 @@ printf 'name,k1,k2,th,tau\nedge,19.5,0.2,1.5,0.2\n' >"$crd/edge.csv"
 rm -rf "$crd/edge" "$crd/edge.csv"
 [ -z "$(ls "$crd" | grep -v '^big\.\(csv\|toml\)$\|^fleet\.csv$')" ] && ok || bad "computable range: files written: $(ls "$crd")"
 
+# the 3-car optimal-velocity ring with default settings: the branch from the first Hopf point ends
+# at the second, with exactly the two folds of orbits, exit 0 (it looped 2.5 times, listed 17
+# "folds", 3 of them at Hopf points, and exited 4), and two separate bistable windows
+"$bin" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --svg "$tmp/ov3.svg" --quiet >"$tmp/ov3.out" 2>"$tmp/ov3.err"
+rc=$?
+[ $rc -eq 0 ] && [ "$(grep -c '^fold ' "$tmp/ov3.out")" -eq 2 ] && grep -q "(ended: hopf)" "$tmp/ov3.out" && ok || bad "ov ring 3 orbits: exit $rc, $(grep -c '^fold ' "$tmp/ov3.out") folds"
+grep -Eq "bistable \(stable orbit and stable equilibrium\) for headway in \[[0-9.]+, [0-9.]+\] and \[[0-9.]+, [0-9.]+\];" "$tmp/ov3.svg" && ok || bad "ov ring 3: two bistable windows"
 fi  # part nonlinear
 
 if part hopf; then

@@ -8,6 +8,7 @@
 #include <string>
 
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "ddemap/io/files.hpp"
@@ -163,4 +164,24 @@ TEST_CASE("write_files_atomic: stale members of a set are removed with it, or ke
     CHECK(!fs::exists(d / "x-boundaries.csv"));
     CHECK(fs::is_directory(d / "x-dir.csv"));  // only regular files are removed
     CHECK(entries(d.path) == 2);
+}
+
+TEST_CASE("write_files_atomic: the next write into a folder removes the temporary files that killed writers left there, whatever their name") {
+    TempDir d;
+    // a process that has ended: a child reaped (its PID is free); this process is alive
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) ::_exit(0);
+    int status = 0;
+    REQUIRE(::waitpid(child, &status, 0) == child);
+    const std::string dead = ".other.csv.ddemap-" + std::to_string(child) + "-1.tmp";
+    const std::string alive = ".mine.csv.ddemap-" + std::to_string(::getpid()) + "-7.tmp";
+    spit(d / dead, "half written");
+    spit(d / alive, "being written");
+    spit(d / ".keep.tmp", "not ours");
+    write_file_atomic(d / "x.csv", "x");
+    CHECK(!fs::exists(d / dead));
+    CHECK(fs::exists(d / alive));
+    CHECK(fs::exists(d / ".keep.tmp"));
+    CHECK(slurp(d / "x.csv") == "x");
 }
