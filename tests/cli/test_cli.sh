@@ -1031,6 +1031,9 @@ expect_error "--degree" orbits --system "$orb/wright.json" --par alpha --from 1 
 expect_error "--intervals" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --intervals 1
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits bad input wrote files: $(ls "$orb")"
 "$bin" orbits --help >"$orb/h.txt" 2>&1 && ! grep -q ' TEXT' "$orb/h.txt" && ok || bad "orbits --help has an option without its kind"
+# a mesh is sized before any work (once: 300 s and 3.4 GB with no guard and no progress)
+expect_error "a mesh of 10000 intervals of degree 20 (2e+05 collocation unknowns): estimated memory 8 GB is above the limit 2 GB (--allow-large runs it anyway)" \
+    orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --degree 20 --intervals 10000
 # orbits whose multipliers are not computed (a mesh above the dense monodromy limit): no stability
 # verdict in the table, the JSON (stable null) or the figure (grey), exit 4; once "stable no", exit 0
 "$bin" orbits --system "$orb/wright.json" --par alpha --from 1.4 --to 2 --points 3 --degree 10 --intervals 1700 --format json \
