@@ -216,3 +216,17 @@ def test_paper_writes_what_the_cli_writes(tmp_path):
         assert (tmp_path / "py" / mine).read_bytes() == pathlib.Path(source, "maps", committed).read_bytes(), mine
     for f in ("paper.json", "paper-classification.csv", "paper-growth.csv", "paper-panel1.csv", "paper-panel1-boundaries.csv"):
         assert (tmp_path / "py" / f).stat().st_size > 0, f
+
+
+def test_text_that_is_not_utf8_and_control_characters_are_refused(tmp_path):
+    # a Latin-1 name from an old spreadsheet: refused naming the line and the byte, as the CLI does
+    latin1 = tmp_path / "latin1.csv"
+    latin1.write_bytes(b"name,k1,k2,th,tau\nZo\xeb,0.1,0.2,1.5,0.3\n")
+    with pytest.raises(ValueError, match=r"latin1.csv:2: byte 3 \(0xEB\) is not UTF-8"):
+        ddemap.classify(latin1)
+    # the same name as UTF-8 (a str from Python is always UTF-8) is taken and written back
+    r = ddemap.classify({"name": ["Zo\u00eb"], "k1": [0.1], "k2": [0.2], "th": [1.5], "tau": [0.3]})
+    assert r["vehicles"]["name"] == ["Zo\u00eb"]
+    assert json.loads(r.to_json())["result"]["vehicles"][0]["name"] == "Zo\u00eb"
+    with pytest.raises(ValueError, match="control characters"):
+        ddemap.classify({"name": ["a\x01b"], "k1": [0.1], "k2": [0.2], "th": [1.5], "tau": [0.3]})
