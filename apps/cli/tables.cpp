@@ -25,6 +25,10 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
     std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s\n", "k1", "k2", "th", "tau", "eta",
                   "plant", "ring", "string", "sup|Gamma|", "w_peak", "c2");
     out << "name" << std::string(static_cast<std::size_t>(width) - 4, ' ') << header;
+    // the units under their columns (c2: the w^2 coefficient of |D(i w)|^2 - |N(i w)|^2)
+    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s\n", "1/s^2", "1/s", "s", "s", "m", "", "", "", "1",
+                  "rad/s", "1/s^2");
+    out << std::string(static_cast<std::size_t>(width), ' ') << header;
     for (const auto& row : rows) {
         char line[256];
         const auto& p = row.vehicle.parameters;
