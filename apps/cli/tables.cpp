@@ -82,15 +82,32 @@ std::string probability_text(const ProbabilityEstimate& e) {
 }
 
 std::string growth_table(const std::vector<GrowthResult>& g) {
-    std::ostringstream out;
-    out << "name     amplification by position (speed drop / lead drop)                       platoon fails at\n";
+    // columns: the name as wide as the longest, then one 6-wide column per follower position
+    // (at most 8 shown), then where the platoon fails
+    std::size_t width = 4, shown = 0;
     for (const auto& r : g) {
-        char head[32];
-        std::snprintf(head, sizeof head, "%-8s", r.name.c_str());
-        out << head;
-        for (std::size_t i = 0; i < r.amplification.size() && i < 8; ++i) out << " " << rounded(r.amplification[i], 3);
-        if (r.amplification.size() > 8) out << " ...";
-        out << "   ";
+        width = std::max(width, r.name.size());
+        shown = std::max(shown, std::min<std::size_t>(r.amplification.size(), 8));
+    }
+    const bool more = std::any_of(g.begin(), g.end(), [](const GrowthResult& r) { return r.amplification.size() > 8; });
+    std::ostringstream out;
+    out << "amplification of the lead's speed drop by follower position (speed drop / lead drop)\n";
+    out << "name" << std::string(width - 4, ' ');
+    for (std::size_t i = 0; i < shown; ++i) {
+        char c[16];
+        std::snprintf(c, sizeof c, " %6s", ("#" + std::to_string(i + 1)).c_str());
+        out << c;
+    }
+    out << (more ? "    " : "") << "   platoon fails at\n";
+    for (const auto& r : g) {
+        out << r.name << std::string(width - r.name.size(), ' ');
+        for (std::size_t i = 0; i < shown; ++i) {
+            char c[16];
+            if (i < r.amplification.size()) std::snprintf(c, sizeof c, " %6.3f", r.amplification[i]);
+            else std::snprintf(c, sizeof c, " %6s", "");
+            out << c;
+        }
+        out << (more ? (r.amplification.size() > 8 ? " ..." : "    ") : "") << "   ";
         if (r.status != Status::Converged) out << "UNDECIDED (" << to_string(r.status) << ")";
         else if (r.failed_at) out << "car " << r.failed_at << " (" << r.failure << " at t = " << rounded(r.failure_time, 4) << " s)";
         else out << "none";
