@@ -17,7 +17,7 @@ namespace ddemap::cli {
 void RunFlags::add_to(CLI::App& app, bool sizes) {
     if (sizes)
         app.add_flag("--allow-large", allow_large,
-                     "run even when the estimated memory (2 GB), output (100 MB) or time (10 min) is above its limit "
+                     "run even when the estimated memory (2 GB), output (100 MB) or time (10 min) is above its limit, and let a root search run past 10 min "
                      "(docs/reference/outputs.md, \"Limits and progress\")")
             ->group("Run");
     app.add_flag("--quiet", quiet, "no progress lines on stderr")->group("Run");
@@ -175,5 +175,30 @@ BranchProgress search_progress_printer(const std::string& command, const std::st
         (*printer)(done, total, "step " + std::to_string(done) + " of at most " + std::to_string(total) + at, false, true);
     };
 }
+
+namespace {
+std::string& time_limit_note() {
+    static std::string note;
+    return note;
+}
+}  // namespace
+
+BranchProgress with_time_limit(BranchProgress inner) {
+    double limit = run_flags().allow_large ? 0.0 : limit_seconds;
+    if (const char* t = std::getenv("DDEMAP_TEST_TIME_LIMIT")) limit = std::atof(t);
+    if (!(limit > 0.0)) return inner;
+    const auto start = std::chrono::steady_clock::now();
+    return [inner, limit, start](long done, long total, double value) {
+        if (inner) inner(done, total, value);
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (elapsed > limit) {
+            time_limit_note() = "stopped at the run-time limit of " + human_seconds(limit) + " after step " + std::to_string(done) + " of at most " +
+                                std::to_string(total) + " (--allow-large lets it run on)";
+            throw Cancelled();
+        }
+    };
+}
+
+std::string time_limit_message() { return time_limit_note(); }
 
 }  // namespace ddemap::cli

@@ -60,4 +60,13 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
 /// one line redrawn in place; otherwise one line per finished step, at most one a second.
 BranchProgress search_progress_printer(const std::string& command, const std::string& par);
 
+/// A root search's progress callback with the run-time limit: a search bounded only by its step
+/// count (roots --fleet --solver sparse on 10^5 cars, a --system with extreme coefficients)
+/// is stopped after limit_seconds (10 min; DDEMAP_TEST_TIME_LIMIT seconds in the tests; none
+/// with --allow-large) by throwing ddemap::Cancelled, so that it ends undecided (exit 4) and
+/// says why (time_limit_message) instead of running on. `inner` (the printer) may be empty.
+BranchProgress with_time_limit(BranchProgress inner);
+/// Non-empty when with_time_limit stopped the search: "stopped at the run-time limit ...".
+std::string time_limit_message();
+
 }  // namespace ddemap::cli

@@ -45,7 +45,11 @@ int parse_degree() {
 /// being a contour count (product), an Arnoldi shift (sparse) or a collocation degree (dense,
 /// where the step shown is M); the search ends when it has found the roots, long before its
 /// budget, so no time left is estimated.
-BranchProgress root_progress() { return search_progress_printer("roots", "Re"); }
+/// The search's progress printer with the run-time limit (limits.hpp with_time_limit).
+BranchProgress root_progress() { return with_time_limit(search_progress_printer("roots", "Re")); }
+
+/// The result's message, or why the run-time limit stopped it.
+std::string root_message(const RootResult& r) { return r.status == Status::Cancelled && !time_limit_message().empty() ? time_limit_message() : r.message; }
 
 /// Prints (and with --out writes PREFIX.csv, PREFIX.json) the command's output.
 void emit(const JsonEnvelope& e, const std::string& csv, const std::string& table, Format format, const std::string& prefix) {
@@ -128,14 +132,14 @@ int run_system(Format format, const std::string& prefix) {
     e.solver_given = solver_name(r.method_given);
     e.solver_used = solver_name(r.method_used);
     e.status = to_string(r.status);
-    e.message = r.message;
+    e.message = root_message(r);
     e.result = system_roots_json(dde, s);
     if (!equilibrium_json.empty()) e.result = JsonObject().json("equilibrium", equilibrium_json).json("linearisation", e.result).str();
     std::ostringstream out;
     out << "system     " << roots_args.system << " (dimension " << dde.dimension() << ", " << dde.delays().size() << " delays)\n";
     out << equilibrium_line;
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
-    out << (r.status == Status::Converged ? "trusted    " : "why not    ") << r.message << "\n";
+    out << (r.status == Status::Converged ? "trusted    " : "why not    ") << root_message(r) << "\n";
     // no root computed (an empty spectrum or a failed solver): the table says so, never "-inf"
     out << "abscissa   " << (std::isfinite(s.spectral_abscissa) ? rounded(s.spectral_abscissa, 10) : std::string("none (no root was computed)")) << "\n";
     out << "verdict    " << verdict_word(s.verdict);
@@ -144,7 +148,7 @@ int run_system(Format format, const std::string& prefix) {
     out << "\n\n";
     out << roots_table(r.roots);
     emit(e, roots_csv(r.roots), out.str(), format, prefix);
-    return report_undecided(r.status, "roots", r.message);
+    return report_undecided(r.status, "roots", root_message(r));
 }
 
 int run_fleet(Format format, const std::string& prefix) {
@@ -184,7 +188,7 @@ int run_fleet(Format format, const std::string& prefix) {
     e.solver_given = solver_name(rr.method_given);
     e.solver_used = solver_name(rr.method_used);
     e.status = to_string(rr.status);
-    e.message = rr.message;
+    e.message = root_message(rr);
     e.result = mixed_ring_json(r, fleet.size());
     std::ostringstream out;
     out << "fleet      " << spec << ": " << fleet.size() << " cars, speed "
@@ -195,7 +199,7 @@ int run_fleet(Format format, const std::string& prefix) {
     else
         out << ", M = " << rr.degree << ", " << rr.shifts << " shifts, " << rr.factorizations << " LU factorisations";
     out << " (" << to_string(rr.status) << ")\n";
-    out << (rr.status == Status::Converged ? "trusted    " : "why not    ") << rr.message << "\n";
+    out << (rr.status == Status::Converged ? "trusted    " : "why not    ") << root_message(rr) << "\n";
     out << "trivial    "
         << (r.trivial_found ? "lambda = 0 found (|lambda| = " + rounded(r.trivial_root, 3) + "), left out"
                             : std::string("not among the rightmost roots"))
@@ -209,7 +213,7 @@ int run_fleet(Format format, const std::string& prefix) {
             << ")\n\n";
     out << roots_table(rr.roots);
     emit(e, roots_csv(rr.roots), out.str(), format, prefix);
-    return report_undecided(rr.status, "roots", rr.message);
+    return report_undecided(rr.status, "roots", root_message(rr));
 }
 
 int run_ring(Format format, const std::string& prefix) {

@@ -1797,6 +1797,12 @@ start_ns=$(date +%s%N)
 expect_error "huge.json (839 MB of JSON): estimated memory 2.52 GB is above the limit 2 GB (--allow-large runs it anyway)" roots --system "$ch/huge.json"
 [ $(( ($(date +%s%N) - start_ns) / 1000000 )) -lt 5000 ] && ok || bad "the huge system file took more than 5 s to refuse"
 rm -f "$ch/huge.json"
+# a search bounded only by its step count stops at the run-time limit (10 min; 1 s here through
+# the test hook), undecided with exit 4, and says which bound stopped it
+DDEMAP_TEST_TIME_LIMIT=1 "$bin" roots --fleet-pattern A_min,B_min --ring 20000 --solver sparse --format json >"$ch/tl.json" 2>"$ch/tl.err"
+rc=$?
+[ $rc -eq 4 ] && grep -q "stopped at the run-time limit of 1 s after step [0-9]* of at most [0-9]* (--allow-large lets it run on)" "$ch/tl.err" \
+    && grep -q '"status": "cancelled"' "$ch/tl.json" && ok || bad "the run-time limit of a root search: exit $rc, $(cat "$ch/tl.err")"
 # a value given as '' (an empty shell variable) is bad input, never taken as absent
 expect_error "--cars = '': expected a value (see ddemap roots --help)" roots --fleet-pattern A_min --cars ''
 expect_error "--ring = '': expected a value" roots --fleet-pattern A_min --ring ''
