@@ -349,6 +349,14 @@ void check_output_file(const std::string& given) {
     }
     if (::access(dir.c_str(), W_OK | X_OK) != 0)
         throw std::invalid_argument("'" + given + "': the folder '" + dir + "' is not writable (" + reason(errno) + ")");
+    // access() answers from the permission bits, and yes for root: a file made and dropped in
+    // the folder proves it (a folder of /proc, a file system that refuses new files), before
+    // the work rather than after it
+    const std::string probe = (dir.empty() ? std::string(".") : dir) + "/" + hidden_name("probe");
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) throw std::invalid_argument("'" + given + "': the folder '" + dir + "' is not writable (" + reason(errno) + ")");
+    ::close(fd);
+    ::unlink(probe.c_str());
 }
 
 void write_file_atomic(const std::string& path, const std::string& text) { write_files_atomic({{path, text}}); }

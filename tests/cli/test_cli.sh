@@ -1803,6 +1803,10 @@ DDEMAP_TEST_TIME_LIMIT=1 "$bin" roots --fleet-pattern A_min,B_min --ring 20000 -
 rc=$?
 [ $rc -eq 4 ] && grep -q "stopped at the run-time limit of 1 s after step [0-9]* of at most [0-9]* (--allow-large lets it run on)" "$ch/tl.err" \
     && grep -q '"status": "cancelled"' "$ch/tl.json" && ok || bad "the run-time limit of a root search: exit $rc, $(cat "$ch/tl.err")"
+# an output that is a link into /proc is found unwritable before the work (once: after it; access()
+# says yes to root there, a file made and dropped in the folder says no)
+ln -s /proc/self/status "$ch/proc.csv"
+expect_error "proc.csv': the folder '/proc/self' is not writable" classify A_min --out "$ch/proc"
 # a value given as '' (an empty shell variable) is bad input, never taken as absent
 expect_error "--cars = '': expected a value (see ddemap roots --help)" roots --fleet-pattern A_min --cars ''
 expect_error "--ring = '': expected a value" roots --fleet-pattern A_min --ring ''

@@ -185,3 +185,11 @@ TEST_CASE("write_files_atomic: the next write into a folder removes the temporar
     CHECK(fs::exists(d / ".keep.tmp"));
     CHECK(slurp(d / "x.csv") == "x");
 }
+
+TEST_CASE("check_output_file: a folder that refuses new files is found before the work, also for root (a link into /proc)") {
+    TempDir d;
+    fs::create_symlink("/proc/self/status", d / "o.csv");
+    CHECK_THROWS_WITH_AS(check_output_file(d / "o.csv"), doctest::Contains("the folder '/proc/self' is not writable"), std::invalid_argument);
+    CHECK_NOTHROW(check_output_file(d / "fine.csv"));
+    CHECK(entries(d.path) == 1);  // the probe file is gone
+}
