@@ -11,7 +11,9 @@ std::string rounded(double v, int digits) {
 }
 
 std::string roots_table(const std::vector<Root>& roots) {
-    std::string out = "  #                re                 im    residual\n";
+    // units in the header (a growth rate in 1/s, an angular frequency in rad/s; the residual is
+    // relative, no unit)
+    std::string out = "  #          re [1/s]        im [rad/s]    residual\n";
     int i = 0;
     for (const auto& x : roots) {
         char line[160];

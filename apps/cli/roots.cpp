@@ -141,7 +141,7 @@ int run_system(Format format, const std::string& prefix) {
     out << "solver     " << solver_name(r.method_used) << ", M = " << r.degree << " (" << to_string(r.status) << ")\n";
     out << (r.status == Status::Converged ? "trusted    " : "why not    ") << root_message(r) << "\n";
     // no root computed (an empty spectrum or a failed solver): the table says so, never "-inf"
-    out << "abscissa   " << (std::isfinite(s.spectral_abscissa) ? rounded(s.spectral_abscissa, 10) : std::string("none (no root was computed)")) << "\n";
+    out << "abscissa   " << (std::isfinite(s.spectral_abscissa) ? rounded(s.spectral_abscissa, 10) + " 1/s" : std::string("none (no root was computed)")) << "\n";
     out << "verdict    " << verdict_word(s.verdict);
     if (s.verdict == Verdict::Undecided) out << " (" << to_string(r.status) << ")";
     else if (s.verdict == Verdict::Marginal) out << " (roots on the imaginary axis to rounding: not asymptotically stable)";
@@ -205,7 +205,7 @@ int run_fleet(Format format, const std::string& prefix) {
                             : std::string("not among the rightmost roots"))
         << "\n";
     if (!std::isnan(r.product_residual)) out << "check      max |prod Gamma_i(lambda) - 1| = " << rounded(r.product_residual, 3) << "\n";
-    out << "abscissa   " << rounded(r.spectral_abscissa, 10) << "\n";
+    out << "abscissa   " << rounded(r.spectral_abscissa, 10) << " 1/s\n";
     if (rr.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
     else
         out << "verdict    " << verdict_word(r.verdict) << " ("
@@ -254,7 +254,7 @@ int run_ring(Format format, const std::string& prefix) {
     if (fast.method_used == "winding" && r.verdict == Verdict::Undecided) {
         out << "abscissa   none (the winding pass is undecided)";
     } else {
-        out << "abscissa   " << rounded(r.spectral_abscissa, 10);
+        out << "abscissa   " << rounded(r.spectral_abscissa, 10) << " 1/s";
         if (cars == 0) out << (r.abscissa_is_limit ? " (approached as theta -> 0)" : " at theta = " + rounded(r.abscissa_theta, 6));
         else out << " (mode " << r.abscissa_mode << ")";
     }
@@ -270,7 +270,7 @@ int run_ring(Format format, const std::string& prefix) {
         out << "roots      UNSETTLED (" << to_string(r.status) << "): the verdict above is certified by the winding count alone; "
             << "the rows below are not certified\n";
     out << "\n";
-    out << "  #   mode        theta                re                 im    residual\n";
+    out << "  #   mode  theta [rad]          re [1/s]        im [rad/s]    residual\n";
     int i = 0;
     for (const auto& x : r.roots) {
         char line[200];
