@@ -273,7 +273,11 @@ public:
         : m_op(op), m_m(op.degree()), m_n(op.dimension()), m_rows(op.degree() + 1), m_kmax(std::max(2, basis)) {
         m_rcap = m_kmax + 2;
         m_q.resize(m_n, m_rcap);
-        m_v = Eigen::MatrixXcd::Zero(m_rows * m_rcap, m_kmax + 1);  // column i: vec(a_i), (M+1) x rcap
+        // column i: vec(a_i), (M+1) x rcap; its rows past (M+1) r_i (r_i: the rank when it was
+        // written) are zero, set when the column is written (a run often stops long before
+        // `basis` columns: zeroing them all up front cost more than the run)
+        m_v.resize(m_rows * m_rcap, m_kmax + 1);
+        m_v.col(0).setZero();
         m_h = Eigen::MatrixXcd::Zero(m_kmax + 1, m_kmax);
         std::mt19937 rng(20261123);
         std::uniform_real_distribution<double> unif(-1.0, 1.0);
@@ -359,6 +363,7 @@ private:
             m_h(m_k, m_k - 1) = 0.0;
         } else {
             m_v.col(m_k).head(len1) = x / beta;
+            m_v.col(m_k).tail(m_v.rows() - len1).setZero();
         }
     }
 
@@ -415,9 +420,9 @@ private:
         const Eigen::Index len = m_rows * m_r;
         const Eigen::MatrixXcd kept = m_v.topLeftCorner(len, k) * u.leftCols(keep);
         const Eigen::VectorXcd next = m_v.col(k).head(len);
-        m_v.setZero();
         m_v.topLeftCorner(len, keep) = kept;
         m_v.col(keep).head(len) = next;
+        m_v.bottomLeftCorner(m_v.rows() - len, keep + 1).setZero();
         m_h.setZero();
         m_h.topLeftCorner(keep, keep) = s.topLeftCorner(keep, keep).triangularView<Eigen::Upper>();
         m_h.row(keep).head(keep) = b;
