@@ -1,5 +1,6 @@
 #include "ddemap/io/files.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -201,6 +202,159 @@ void remove_stale_temps(int dirfd) {
 }
 
 std::string dir_path(const Target& t, const std::string& name) { return t.dir == "/" ? "/" + name : t.dir + "/" + name; }
+// ---- the journal of an output set: completed by the next run after a SIGKILL ---------------
+// A set of two or more files is moved into place one file at a time, and a SIGKILL (or a power
+// loss) cannot be held back. So before the first move a journal ".ddemap-set-PID-N.journal" is
+// made in every folder of the set (written and fsynced under a temporary name, then renamed:
+// it exists whole or not at all). It names each file's new content by device and inode, and the
+// files the set removes. After the last move and the folders' fsync the journals are removed. A
+// writer killed in between leaves its journal, and the next run that writes into the folder or
+// reads a file from it completes the set (complete_output_sets): every file whose entry is not
+// yet the new content gets it from the hidden name holding it, every file the set removes is
+// removed. A writer killed before its journal exists leaves the old set and hidden temporaries
+// (remove_stale_temps).
+
+const std::string journal_prefix = ".ddemap-set-";
+const std::string journal_suffix = ".journal";
+
+/// A field of a journal line: bytes <= ' ', '%' and DEL as %XX (file names may hold any byte).
+std::string escape_field(const std::string& s) {
+    static const char hex[] = "0123456789ABCDEF";
+    std::string out;
+    for (const char ch : s) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c <= 0x20 || c == '%' || c == 0x7f) {
+            out += '%';
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        } else {
+            out += ch;
+        }
+    }
+    return out;
+}
+
+bool unescape_field(const std::string& s, std::string& out) {
+    out.clear();
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        if (s[i] != '%') {
+            out += s[i];
+            continue;
+        }
+        if (i + 2 >= s.size() || !std::isxdigit(static_cast<unsigned char>(s[i + 1])) || !std::isxdigit(static_cast<unsigned char>(s[i + 2])))
+            return false;
+        const long v = std::strtol(s.substr(i + 1, 2).c_str(), nullptr, 16);
+        out += static_cast<char>(v);
+        i += 2;
+    }
+    return true;
+}
+
+struct JournalEntry {
+    bool gone = false;  // a file the set removes (else a file the set writes)
+    unsigned long long dev = 0, ino = 0;
+    std::string dir, base, temp;
+};
+
+bool same_file(int dirfd, const std::string& name, const JournalEntry& e) {
+    struct stat st {};
+    return ::fstatat(dirfd, name.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0 && static_cast<unsigned long long>(st.st_dev) == e.dev &&
+           static_cast<unsigned long long>(st.st_ino) == e.ino;
+}
+
+/// Completes the set of the journal `name` in the folder `dirfd` (its writer is dead) and
+/// removes its journals.
+void complete_journal(int dirfd, const std::string& name) {
+    std::string text;
+    const int fd = ::openat(dirfd, name.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) return;  // completed meanwhile by another run
+    char buf[4096];
+    for (;;) {
+        const ssize_t n = ::read(fd, buf, sizeof buf);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        text.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    std::vector<JournalEntry> entries;
+    bool whole = false;
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+        const std::size_t eol = text.find('\n', pos);
+        if (eol == std::string::npos) break;
+        const std::string line = text.substr(pos, eol - pos);
+        pos = eol + 1;
+        if (line == "end") {
+            whole = true;
+            break;
+        }
+        std::vector<std::string> f;
+        for (std::size_t a = 0; a <= line.size();) {
+            const std::size_t b = std::min(line.find(' ', a), line.size());
+            f.push_back(line.substr(a, b - a));
+            a = b + 1;
+        }
+        JournalEntry e;
+        if (f.size() == 6 && f[0] == "new") {
+            e.gone = false;
+        } else if (f.size() == 5 && f[0] == "gone") {
+            e.gone = true;
+        } else {
+            continue;  // the header line
+        }
+        e.dev = std::strtoull(f[1].c_str(), nullptr, 10);
+        e.ino = std::strtoull(f[2].c_str(), nullptr, 10);
+        if (!unescape_field(f[3], e.dir) || !unescape_field(f[4], e.base) || (!e.gone && !unescape_field(f[5], e.temp))) continue;
+        entries.push_back(e);
+    }
+    if (whole) {
+        for (const JournalEntry& e : entries) {
+            const int d = ::open(e.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+            if (d < 0) continue;
+            if (e.gone) {
+                if (same_file(d, e.base, e)) ::unlinkat(d, e.base.c_str(), 0);
+            } else if (!same_file(d, e.base, e) && same_file(d, e.temp, e)) {
+                ::renameat(d, e.temp.c_str(), d, e.base.c_str());
+            }
+            ::fsync(d);
+            ::close(d);
+        }
+    }
+    // every folder's copy of this journal (the same name), then this one
+    for (const JournalEntry& e : entries) {
+        const int d = ::open(e.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (d < 0) continue;
+        ::unlinkat(d, name.c_str(), 0);
+        ::close(d);
+    }
+    ::unlinkat(dirfd, name.c_str(), 0);
+}
+
+/// Completes every output set in the folder `dirfd` whose writer was killed (see above).
+void complete_output_sets(int dirfd) {
+    const int fd = ::dup(dirfd);
+    if (fd < 0) return;
+    DIR* d = ::fdopendir(fd);
+    if (d == nullptr) {
+        ::close(fd);
+        return;
+    }
+    ::rewinddir(d);
+    std::vector<std::string> dead;
+    while (const dirent* e = ::readdir(d)) {
+        const std::string name = e->d_name;
+        if (name.size() <= journal_prefix.size() + journal_suffix.size() || name.compare(0, journal_prefix.size(), journal_prefix) != 0 ||
+            name.compare(name.size() - journal_suffix.size(), journal_suffix.size(), journal_suffix) != 0)
+            continue;
+        char* end = nullptr;
+        const long pid = std::strtol(name.c_str() + journal_prefix.size(), &end, 10);
+        if (pid <= 0 || end == nullptr || *end != '-') continue;
+        if (!process_alive(static_cast<pid_t>(pid))) dead.push_back(name);
+    }
+    ::closedir(d);
+    for (const auto& name : dead) complete_journal(dirfd, name);
+}
+
 
 void close_all(std::vector<Target>& ts) {
     for (auto& t : ts) {
@@ -245,6 +399,65 @@ bool name_temp(Target& t, int& err) {
     return false;
 }
 
+/// The journals of a set of two or more regular files (see complete_journal), one per folder,
+/// each complete and fsynced before it appears under its name; their (folder fd, name) in
+/// `made`. False (errno in `err`) when one cannot be made: nothing has been moved yet.
+bool write_journals(const std::vector<Target>& ts, std::vector<std::pair<int, std::string>>& made, int& err) {
+    std::string text = "ddemap output set 1\n";
+    std::vector<std::pair<std::string, int>> dirs;  // absolute folder, its fd
+    for (const Target& t : ts) {
+        if (t.special) continue;
+        char abs[PATH_MAX];
+        if (::realpath(t.dir.c_str(), abs) == nullptr) {
+            err = errno;
+            return false;
+        }
+        struct stat st {};
+        const int rc = t.remove ? ::fstatat(t.dirfd, t.base.c_str(), &st, AT_SYMLINK_NOFOLLOW) : ::fstat(t.fd, &st);
+        if (rc != 0) {
+            err = errno;
+            return false;
+        }
+        text += std::string(t.remove ? "gone " : "new ") + std::to_string(static_cast<unsigned long long>(st.st_dev)) + " " +
+                std::to_string(static_cast<unsigned long long>(st.st_ino)) + " " + escape_field(abs) + " " + escape_field(t.base);
+        text += t.remove ? "\n" : " " + escape_field(t.temp) + "\n";
+        bool seen = false;
+        for (const auto& d : dirs) seen = seen || d.first == abs;
+        if (!seen) dirs.emplace_back(abs, t.dirfd);
+    }
+    text += "end\n";
+    const std::string name = journal_prefix + std::to_string(::getpid()) + "-" + std::to_string(++g_counter) + journal_suffix;
+    for (const auto& d : dirs) {
+        const std::string temp = hidden_name("ddemap-set");
+        const int fd = ::openat(d.second, temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+        if (fd < 0) {
+            err = errno;
+            return false;
+        }
+        bool ok = write_all(fd, text, err) && (::fsync(fd) == 0 || ((err = errno), false));
+        ::close(fd);
+        if (ok && ::renameat(d.second, temp.c_str(), d.second, name.c_str()) != 0) {
+            err = errno;
+            ok = false;
+        }
+        if (!ok) {
+            ::unlinkat(d.second, temp.c_str(), 0);
+            return false;
+        }
+        made.emplace_back(d.second, name);
+        if (::fsync(d.second) != 0 && errno != EINVAL) {
+            err = errno;
+            return false;
+        }
+    }
+    return true;
+}
+
+void remove_journals(std::vector<std::pair<int, std::string>>& made) {
+    for (const auto& j : made) ::unlinkat(j.first, j.second.c_str(), 0);
+    made.clear();
+}
+
 }  // namespace
 
 std::string normalize_input_text(std::string text) {
@@ -282,6 +495,7 @@ void refuse_input(const std::string& path) {
 }  // namespace
 
 std::string read_text_file(const std::string& path) {
+    complete_interrupted_output_sets(dir_of(path));  // a set a killed writer left is read whole
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
     if (S_ISDIR(st.st_mode)) throw std::invalid_argument("'" + path + "' is a folder, expected a file");
@@ -359,6 +573,14 @@ void check_output_file(const std::string& given) {
     ::unlink(probe.c_str());
 }
 
+void complete_interrupted_output_sets(const std::string& folder) {
+    const int fd = ::open(folder.empty() ? "." : folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return;
+    complete_output_sets(fd);
+    remove_stale_temps(fd);
+    ::close(fd);
+}
+
 void write_file_atomic(const std::string& path, const std::string& text) { write_files_atomic({{path, text}}); }
 
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files, const std::vector<std::string>& remove) {
@@ -421,6 +643,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         if (t.special) continue;
         t.dirfd = ::open(t.dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (t.dirfd < 0) fail(ts, t.given, errno);
+        complete_output_sets(t.dirfd);  // before the stale temporaries go: they may hold a set's new files
         remove_stale_temps(t.dirfd);
         if (t.remove) continue;
         const mode_t mode = t.existed ? t.mode : 0666;
@@ -454,6 +677,17 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
         if (t.special) continue;
         int err = 0;
         if (!name_temp(t, err)) fail(ts, t.given, err);
+    }
+    // two or more files: a journal first, so that a SIGKILL among the moves is completed later
+    std::vector<std::pair<int, std::string>> journals;
+    std::size_t regular = 0;
+    for (const auto& t : ts) regular += t.special ? 0 : 1;
+    if (regular >= 2) {
+        int err = 0;
+        if (!write_journals(ts, journals, err)) {
+            remove_journals(journals);
+            fail(ts, ts.front().given, err);
+        }
     }
     for (std::size_t i = 0; i < ts.size(); ++i) {
         Target& t = ts[i];
@@ -508,6 +742,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
             else if (u.swapped) ::renameat2(u.dirfd, u.temp.c_str(), u.dirfd, u.base.c_str(), RENAME_EXCHANGE);
             else if (!u.existed) ::unlinkat(u.dirfd, u.base.c_str(), 0);
         }
+        remove_journals(journals);
         fail(ts, t.given, err);
     }
     int err = 0;
@@ -519,7 +754,8 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
             bad = t.given;
         }
     }
-    remove_temps(ts);  // the old contents
+    remove_journals(journals);  // the set is in place: nothing is left to complete
+    remove_temps(ts);           // the old contents
     close_all(ts);
     if (err != 0) throw WriteError("cannot write " + bad + ": " + reason(err));
 }

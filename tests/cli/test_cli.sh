@@ -1817,5 +1817,62 @@ done
 rm -rf "$ch"
 fi  # part chain
 
+if part killset; then
+# ---- output sets under SIGKILL at every system call of their final moves (issue 34) ----------
+# strace kills the writer at the N-th call of one of the calls that place a set (N = 1, 2, ...
+# until a run is no longer killed). Right after the kill the four files of a sweep are all old,
+# or all new, or mixed with the writer's journal beside them; after the next ddemap run that
+# reads from or writes into the folder they are all old or all new, and no hidden file is left.
+command -v strace >/dev/null || { bad "strace is missing (scripts/install-deps.sh installs it)"; }
+ks="$tmp/killset"
+mkdir -p "$ks"
+sweep_set() { "$bin" sweep --th "$1" --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$2/x" >/dev/null 2>&1; }
+mkdir -p "$ks/old" "$ks/new"
+sweep_set 1.5 "$ks/old"
+sweep_set 1.2 "$ks/new"
+printf 'name,k1,k2,th,tau\none,0.2,0.4,1.5,0.3\n' >"$ks/old/cars.csv"
+# the state of the set in folder $1: old, new or mixed (the JSON's timings left out)
+set_state() {
+    local o=0 n=0 f
+    for f in x.csv x.svg x-boundaries.csv x.json; do
+        if cmp -s <(grep -v -E '"seconds"|per_second' "$1/$f" 2>/dev/null) <(grep -v -E '"seconds"|per_second' "$ks/old/$f"); then o=$((o + 1)); fi
+        if cmp -s <(grep -v -E '"seconds"|per_second' "$1/$f" 2>/dev/null) <(grep -v -E '"seconds"|per_second' "$ks/new/$f"); then n=$((n + 1)); fi
+    done
+    if [ $o -eq 4 ]; then echo old; elif [ $n -eq 4 ]; then echo new; else echo "mixed($o old, $n new)"; fi
+}
+kills=0
+for call in renameat2 renameat linkat unlinkat fsync; do
+    for n in $(seq 1 40); do
+        rm -rf "$ks/k"
+        cp -r "$ks/old" "$ks/k"
+        strace -f -o /dev/null -e trace="$call" -e inject="$call":signal=KILL:when="$n" \
+            "$bin" sweep --th 1.2 --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$ks/k/x" >/dev/null 2>&1
+        rc=$?
+        if [ $rc -ne 137 ]; then
+            [ $rc -eq 0 ] && [ "$(set_state "$ks/k")" = new ] && ok || bad "$call #$n: not killed, exit $rc, set $(set_state "$ks/k")"
+            break
+        fi
+        kills=$((kills + 1))
+        state=$(set_state "$ks/k")
+        journal=$(ls -A "$ks/k" | grep -c '^\.ddemap-set-.*\.journal$')
+        [ "$state" = old ] || [ "$state" = new ] || [ "$journal" -ge 1 ] && ok || bad "$call #$n: killed, the set is $state and no journal"
+        # the next run: a reader of a file in the folder (odd N) or a writer into it (even N)
+        if [ $((n % 2)) -eq 1 ]; then
+            "$bin" classify "$ks/k/cars.csv" --format csv >/dev/null 2>&1
+        else
+            "$bin" classify A_min --out "$ks/k/c" >/dev/null 2>&1
+        fi
+        state=$(set_state "$ks/k")
+        [ "$state" = old ] || [ "$state" = new ] && ok || bad "$call #$n: after the next run the set is $state"
+        left=$(ls -A "$ks/k" | grep -v -E '^(x\.csv|x\.svg|x-boundaries\.csv|x\.json|cars\.csv|c\.csv|c\.svg|c\.json)$' | tr '\n' ' ')
+        [ -z "$left" ] && ok || bad "$call #$n: left behind after the next run: $left"
+    done
+done
+# the set of 4 files has 4 moves, a journal renamed in, its removal and 4 old contents dropped:
+# every one of those calls was a kill point
+[ $kills -ge 20 ] && ok || bad "only $kills kill points"
+rm -rf "$ks"
+fi  # part killset
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

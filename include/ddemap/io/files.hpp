@@ -35,6 +35,15 @@ std::string resolve_output_path(const std::string& path);
 /// when its folder is missing, or when the folder (or the special file) is not writable.
 void check_output_file(const std::string& path);
 
+/// Completes the output sets that writers killed during their final moves (SIGKILL, power
+/// loss) left in `folder`: such a writer leaves a journal ".ddemap-set-PID-N.journal" naming each
+/// new file by device and inode, and every file still old gets its new content from the hidden
+/// file holding it (the set is then all new); the journal is removed, and so are the hidden
+/// temporary files of writers no longer running (".NAME.ddemap-PID-N.tmp"). Called by every
+/// read_text_file (in the file's folder) and write_files_atomic (in each output folder), so that
+/// ddemap never reads or extends a half-moved set. Errors are ignored (the next call retries).
+void complete_interrupted_output_sets(const std::string& folder);
+
 /// Writes `text` to `path` as a set of one file (write_files_atomic).
 void write_file_atomic(const std::string& path, const std::string& text);
 
@@ -53,6 +62,11 @@ void write_file_atomic(const std::string& path, const std::string& text);
 ///   never holds old and new files of one command side by side (only regular files).
 /// - a file this process has read (read_text_file) is never written over: std::invalid_argument
 ///   naming it, before anything is written (`classify mycars.csv --out mycars`).
+/// - a set of two or more regular files: before the first move a journal is written in each of
+///   its folders (complete_interrupted_output_sets), removed after the last; a SIGKILL during the
+///   moves leaves it, and the next ddemap run reading from or writing into the folder completes
+///   the set. So the set is all old (killed before the journal) or, once a later run has looked
+///   at the folder, all new.
 /// On a failure the old files stay as they were and no temporary file is left; WriteError
 /// names the path and the system's reason (e.g. "No space left on device").
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files, const std::vector<std::string>& remove = {});
