@@ -52,7 +52,9 @@ int run_string() {
         cars = string_args.ring.parse(true, method == "winding" ? kWindingMaxCars : kModesMaxCars);
     }
     const std::string prefix = string_args.out.given() ? string_args.out.prepare("string", {".csv", ".json"}) : std::string();
-    const StringResult s = analyse_string(lin);
+    StringOptions so;
+    so.peak = true;  // peak (L-infinity) string stability beside the L2 one
+    const StringResult s = analyse_string(lin, so);
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;
     if (cars) {
@@ -62,6 +64,8 @@ int run_string() {
     const RingResult* rp = ring ? &*ring : nullptr;
     Status status = s.plant_roots.status;
     if (ring && ring->status != Status::Converged) status = ring->status;
+    const bool peak_undecided = status == Status::Converged && s.peak->verdict == Verdict::Undecided;
+    if (peak_undecided) status = s.peak->status;
 
     JsonEnvelope e;
     e.command = "string";
@@ -75,7 +79,7 @@ int run_string() {
         e.solver_used = fast->method_used;
     }
     e.status = to_string(status);
-    e.message = ring && ring->status != Status::Converged ? ring->reason : s.plant_roots.message;
+    e.message = ring && ring->status != Status::Converged ? ring->reason : peak_undecided ? s.peak->message : s.plant_roots.message;
     e.result = fast ? append_ring_method_json(string_json(s, rp), *fast) : string_json(s, rp);
     const std::string csv = string_csv(s, rp);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
@@ -98,11 +102,20 @@ int run_string() {
             out << label << (ring->stable ? std::string("stable") : verdict_word(ring->verdict)) << "   (spectral abscissa "
                 << rounded(ring->spectral_abscissa, 6) << ")\n";
         }
-        out << "verdict          string " << verdict_word(s.string_verdict) << "\n";
+        const PeakResult& pk = *s.peak;
+        out << "peak ||h||_1     ";
+        if (pk.verdict == Verdict::Undecided) out << "undecided (" << pk.message << ")";
+        else if (!pk.finite) out << "infinite (the plant is unstable)";
+        else
+            out << rounded(pk.norm, 10) << " (error estimate " << rounded(pk.error, 2) << "); a step of the lead's speed "
+                << (pk.overshoot <= pk.error ? std::string("does not overshoot") : "overshoots by " + rounded(100.0 * pk.overshoot, 4) + " %");
+        out << "\n";
+        out << "verdict          string " << verdict_word(s.string_verdict) << ", peak " << verdict_word(pk.verdict) << "\n";
         std::cout << out.str();
     });
     if (s.plant_roots.status != Status::Converged) return report_undecided(status, "string: plant", s.plant_roots.message);
-    if (ring) return report_undecided(status, "string: ring", ring->reason);
+    if (ring && ring->status != Status::Converged) return report_undecided(status, "string: ring", ring->reason);
+    if (s.peak->verdict == Verdict::Undecided) return report_undecided(s.peak->status, "string: peak", s.peak->message);
     return exit_ok;
 }
 

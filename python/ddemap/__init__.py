@@ -532,8 +532,11 @@ def string(model="ovrv", ring=None, **parameters):
     Returns: ``plant_stable``, ``plant_abscissa`` [1/s], ``plant_margin``, ``sup_gamma``,
     ``omega_peak`` [rad/s] (0 when the sup 1 is only approached as w -> 0), ``peak_margin``,
     ``lowfreq_margin`` (the decisive coefficient), ``lowfreq`` (c2 [s^2], c4, c6, c8),
-    ``string_stable``, ``peaks``; with ``ring`` also ``ring_stable``, ``spectral_abscissa``,
-    ``ring_margin``.
+    ``string_stable``, ``peaks``; the peak (L-infinity) notion, ||h||_1 <= 1 for the impulse
+    response h of Gamma (the follower's speed never overshoots the car ahead's):
+    ``peak_stable`` (None when undecided), ``peak_verdict``, ``peak_norm`` (||h||_1; None when
+    infinite or undecided), ``peak_norm_error``, ``peak_overshoot`` (of a unit step);
+    with ``ring`` also ``ring_stable``, ``spectral_abscissa``, ``ring_margin``.
     """
     return _result(_ddemap.string(model, _parameters(parameters), None if ring is None else _ring(ring)))
 

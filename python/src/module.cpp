@@ -244,7 +244,9 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
     const std::string method = cars ? resolve_ring_method("auto", lin) : std::string();
     const Progress progress = interruptible();
     const StringResult s = released([&] {
-        StringResult r = analyse_string(lin);
+        StringOptions so;
+        so.peak = true;  // as the command: peak (L-infinity) string stability too
+        StringResult r = analyse_string(lin, so);
         if (cars) {
             fast = analyse_ring_fast(lin, *cars, method, 0, progress);
             ring = fast->ring;
@@ -253,6 +255,8 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
     });
     Status status = s.plant_roots.status;
     if (ring && ring->status != Status::Converged) status = ring->status;
+    const bool peak_undecided = status == Status::Converged && s.peak->verdict == Verdict::Undecided;
+    if (peak_undecided) status = s.peak->status;
     JsonEnvelope e;
     e.command = "string";
     JsonObject in = model_inputs(*model);
@@ -264,7 +268,7 @@ std::string py_string(const std::string& model_name, const ParameterMap& values,
         e.solver_used = fast->method_used;
     }
     e.status = to_string(status);
-    e.message = ring && ring->status != Status::Converged ? ring->reason : s.plant_roots.message;
+    e.message = ring && ring->status != Status::Converged ? ring->reason : peak_undecided ? s.peak->message : s.plant_roots.message;
     e.result = fast ? append_ring_method_json(string_json(s, ring ? &*ring : nullptr), *fast) : string_json(s, nullptr);
     return envelope_json(e);
 }

@@ -130,6 +130,7 @@ std::string string_csv(const StringResult& s, const RingResult* ring) {
     std::ostringstream out;
     out << "plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable";
     if (ring) out << ",ring,ring_stable,spectral_abscissa";
+    if (s.peak) out << ",peak_verdict,peak_norm,peak_norm_error";
     out << "\n";
     out << tf(s.plant_stable) << "," << format_exact(s.plant_abscissa) << "," << format_exact(s.sup_gamma) << ","
         << format_exact(s.omega_peak) << "," << format_exact(s.peak_margin) << "," << format_exact(s.lowfreq_margin) << ","
@@ -137,6 +138,13 @@ std::string string_csv(const StringResult& s, const RingResult* ring) {
     if (ring)
         out << "," << (ring->cars == 0 ? std::string("inf") : std::to_string(ring->cars)) << "," << tf(ring->stable) << ","
             << format_exact(ring->spectral_abscissa);
+    if (s.peak) {
+        // an infinite or undecided norm is an empty field (never inf or nan)
+        const PeakResult& p = *s.peak;
+        const bool value = p.verdict != Verdict::Undecided && p.finite;
+        out << "," << to_string(p.verdict) << "," << (value ? format_exact(p.norm) : std::string()) << ","
+            << (value ? format_exact(p.error) : std::string());
+    }
     out << "\n";
     return out.str();
 }

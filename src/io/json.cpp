@@ -238,6 +238,18 @@ std::string string_json(const StringResult& s, const RingResult* ring) {
     j["peaks"] = peaks;
     j["omega_search_max"] = num(s.omega_search_max);
     j["plant_degree"] = s.plant_roots.degree;
+    if (s.peak) {
+        // peak (L-infinity) string stability; peak_norm null when infinite (plant unstable) or undecided
+        const PeakResult& p = *s.peak;
+        const bool decided = p.verdict != Verdict::Undecided;
+        j["peak_verdict"] = to_string(p.verdict);
+        j["peak_stable"] = decided ? json(p.verdict == Verdict::Stable) : json(nullptr);
+        j["peak_norm"] = decided && p.finite ? num(p.norm) : json(nullptr);
+        j["peak_norm_error"] = decided && p.finite ? num(p.error) : json(nullptr);
+        j["peak_overshoot"] = decided && p.finite ? num(p.overshoot) : json(nullptr);
+        j["peak_status"] = to_string(p.status);
+        j["peak_message"] = p.message;
+    }
     if (ring) {
         j["ring"] = ring_value(ring->cars);
         j["ring_stable"] = ring->stable;

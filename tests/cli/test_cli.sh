@@ -510,6 +510,19 @@ assert r["ring_verdict"] == "unstable" and r["spectral_abscissa"] > 0, r
 PY
 "$bin" string --k1 0.2 --k2 0.2 --th 1.5 --tau 1e-9 >"$tmp/v3.txt" 2>"$tmp/v3.err" && grep -q '^plant  *stable' "$tmp/v3.txt" && [ ! -s "$tmp/v3.err" ] &&
     ok || bad "string --tau 1e-9: plant stable, exit 0"
+# peak (L-infinity) string stability: keys, an unstable plant (infinite norm: null, never inf),
+# a delay too short to integrate within the step budget (undecided, exit 4, one line)
+"$bin" string --k1 0.1 --k2 0.2 --th 1.5 --tau 0.3 --format json >"$tmp/pk.json" &&
+    python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['result']; sys.exit(0 if r['peak_verdict'] == 'unstable' and r['peak_stable'] is False and abs(r['peak_norm'] - 1.4901573) < 1e-6 and r['peak_norm_error'] < 1e-7 and r['sup_gamma'] <= r['peak_norm'] else 1)" "$tmp/pk.json" &&
+    ok || bad "string: peak keys $(head -c 300 "$tmp/pk.json")"
+"$bin" string --k1 0.05 --k2 0.8 --th 2 --tau 0.1 --format csv | tail -1 | grep -q ',true,stable,1\.0*[0-9]*,' && ok || bad "string --format csv: a peak-stable car"
+"$bin" string --k1 1 --k2 0.1 --th 0.5 --tau 1.5 --format json >"$tmp/pk2.json"
+python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['result']; sys.exit(0 if not r['plant_stable'] and r['peak_verdict'] == 'unstable' and r['peak_norm'] is None else 1)" "$tmp/pk2.json" &&
+    ok || bad "string: an unstable plant has peak_norm null: $(grep -o '"peak[a-z_]*": [^,]*' "$tmp/pk2.json" | tr '\n' ' ')"
+"$bin" string --k1 0.2 --k2 0.4 --th 1.5 --tau 1e-5 >"$tmp/pk3.txt" 2>"$tmp/pk3.err"
+rc=$?
+[ $rc -eq 4 ] && [ "$(wc -l <"$tmp/pk3.err")" -eq 1 ] && grep -q "peak undecided (budget_exhausted): the step response would need" "$tmp/pk3.err" &&
+    grep -q "peak UNDECIDED" "$tmp/pk3.txt" && ok || bad "string --tau 1e-5: exit $rc, $(cat "$tmp/pk3.err")"
 for t in 1e-300 1e-12 1e-9; do
     "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau $t --count 3 --format json >"$tmp/v4.json" &&
         "$bin" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 0 --count 3 --format json >"$tmp/v5.json" && python3 - "$tmp/v4.json" "$tmp/v5.json" <<'PY' && ok || bad "roots --tau $t continuous with tau = 0"

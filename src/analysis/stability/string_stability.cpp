@@ -117,6 +117,7 @@ void StringOptions::validate() const {
     roots.validate();
     if (plant_roots < 1) throw std::invalid_argument("plant_roots = " + std::to_string(plant_roots) + ": expected >= 1");
     if (grid_points < 16) throw std::invalid_argument("grid_points = " + std::to_string(grid_points) + ": expected >= 16");
+    if (peak) peak_options.validate();
 }
 
 namespace {
@@ -243,8 +244,28 @@ void finish_string(StringResult& r, double lowest, double best_w, double lowest_
 
 }  // namespace
 
+namespace {
+StringResult analyse_string_l2(const Linearisation& lin, RootResult plant, const StringOptions& options);
+}  // namespace
+
 StringResult analyse_string(const Linearisation& lin, RootResult plant, const StringOptions& options) {
     options.validate();
+    StringResult r = analyse_string_l2(lin, std::move(plant), options);
+    if (options.peak) {
+        if (r.plant_verdict == Verdict::Undecided) {
+            PeakResult p;
+            p.status = r.plant_roots.status;
+            p.message = "the plant is undecided: no peak verdict";
+            r.peak = p;
+        } else {
+            r.peak = peak_string_stability(lin, r.plant_abscissa, options.peak_options);
+        }
+    }
+    return r;
+}
+
+namespace {
+StringResult analyse_string_l2(const Linearisation& lin, RootResult plant, const StringOptions& options) {
     StringResult r = string_preamble(lin, plant);
     const TransferFunction tf(lin);
     const double w_hi = r.omega_search_max;
@@ -349,6 +370,7 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
     finish_string(r, lowest, best_w, lowest_peak);
     return r;
 }
+}  // namespace
 
 namespace {
 

@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "ddemap/analysis/stability/peak_stability.hpp"
 #include "ddemap/problem/linear_dde.hpp"
 #include "ddemap/traffic/model.hpp"
 #include "ddemap/solve/roots.hpp"
@@ -59,6 +60,8 @@ struct StringOptions {
     RootOptions roots;            ///< for the plant roots (its count is replaced by plant_roots)
     int plant_roots = 2;          ///< rightmost roots of D computed (>= 1)
     int grid_points = 400;        ///< base samples of |Gamma(i w)| before refinement (>= 16)
+    bool peak = false;            ///< also decide peak (L-infinity) string stability (StringResult::peak)
+    PeakOptions peak_options;
     void validate() const;
 };
 
@@ -91,6 +94,9 @@ struct StringResult {
     /// (a peak, or the low frequencies amplify); Stable when string_stable; Marginal otherwise
     /// (plant marginal, or |Gamma| = 1 to the order of the series at w -> 0).
     Verdict string_verdict = Verdict::Undecided;
+    /// Peak (L-infinity) string stability, ||h||_1 <= 1 (peak_string_stability), when
+    /// StringOptions::peak asked for it: undecided with the plant, unstable with it.
+    std::optional<PeakResult> peak;
 };
 
 StringResult analyse_string(const Linearisation& lin, const StringOptions& options = {});
