@@ -173,22 +173,29 @@ bool process_alive(pid_t pid) {
     return !(paren != nullptr && paren[1] == ' ' && paren[2] == 'Z');
 }
 
+/// The names in the folder `dirfd` (empty when it cannot be read; the fd stays open).
+std::vector<std::string> folder_entries(int dirfd) {
+    std::vector<std::string> names;
+    const int fd = ::dup(dirfd);
+    if (fd < 0) return names;
+    DIR* d = ::fdopendir(fd);
+    if (d == nullptr) {
+        ::close(fd);
+        return names;
+    }
+    ::rewinddir(d);
+    while (const dirent* e = ::readdir(d)) names.emplace_back(e->d_name);
+    ::closedir(d);
+    return names;
+}
+
 /// Removes the hidden temporary files that writers killed in this folder left (SIGKILL, power
 /// loss, on a file system without O_TMPFILE): every ".NAME.ddemap-PID-N.tmp" whose process PID
 /// no longer exists, whatever NAME, so that the next write into the folder tidies it.
 void remove_stale_temps(int dirfd) {
-    const int fd = ::dup(dirfd);
-    if (fd < 0) return;
-    DIR* d = ::fdopendir(fd);
-    if (d == nullptr) {
-        ::close(fd);
-        return;
-    }
-    ::rewinddir(d);
     const std::string mark = ".ddemap-";
     std::vector<std::string> stale;
-    while (const dirent* e = ::readdir(d)) {
-        const std::string name = e->d_name;
+    for (const std::string& name : folder_entries(dirfd)) {
         if (name.size() < 2 || name[0] != '.' || name.size() < mark.size() + 6 || name.compare(name.size() - 4, 4, ".tmp") != 0) continue;
         const std::size_t at = name.rfind(mark);
         if (at == std::string::npos || at == 0) continue;
@@ -197,7 +204,6 @@ void remove_stale_temps(int dirfd) {
         if (pid <= 0 || end == nullptr || *end != '-') continue;
         if (!process_alive(static_cast<pid_t>(pid))) stale.push_back(name);
     }
-    ::closedir(d);
     for (const auto& name : stale) ::unlinkat(dirfd, name.c_str(), 0);
 }
 
@@ -332,17 +338,8 @@ void complete_journal(int dirfd, const std::string& name) {
 
 /// Completes every output set in the folder `dirfd` whose writer was killed (see above).
 void complete_output_sets(int dirfd) {
-    const int fd = ::dup(dirfd);
-    if (fd < 0) return;
-    DIR* d = ::fdopendir(fd);
-    if (d == nullptr) {
-        ::close(fd);
-        return;
-    }
-    ::rewinddir(d);
     std::vector<std::string> dead;
-    while (const dirent* e = ::readdir(d)) {
-        const std::string name = e->d_name;
+    for (const std::string& name : folder_entries(dirfd)) {
         if (name.size() <= journal_prefix.size() + journal_suffix.size() || name.compare(0, journal_prefix.size(), journal_prefix) != 0 ||
             name.compare(name.size() - journal_suffix.size(), journal_suffix.size(), journal_suffix) != 0)
             continue;
@@ -351,7 +348,6 @@ void complete_output_sets(int dirfd) {
         if (pid <= 0 || end == nullptr || *end != '-') continue;
         if (!process_alive(static_cast<pid_t>(pid))) dead.push_back(name);
     }
-    ::closedir(d);
     for (const auto& name : dead) complete_journal(dirfd, name);
 }
 
