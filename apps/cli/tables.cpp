@@ -21,24 +21,43 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
     // the name column as wide as the longest name (names from files can be long), so the columns stay aligned
     int width = 7;
     for (const auto& row : rows) width = std::max(width, static_cast<int>(row.vehicle.name.size()));
+    // peak (L-infinity) verdict and ||h||_1, when asked (classify --peak)
+    const bool peak = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.string.peak.has_value(); });
     char header[256];
-    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s\n", "k1", "k2", "th", "tau", "eta",
+    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s", "k1", "k2", "th", "tau", "eta",
                   "plant", "ring", "string", "sup|Gamma|", "w_peak", "c2");
     out << "name" << std::string(static_cast<std::size_t>(width) - 4, ' ') << header;
+    if (peak) {
+        std::snprintf(header, sizeof header, "   %-9s %10s", "peak", "||h||_1");
+        out << header;
+    }
+    out << "\n";
     // the units under their columns (c2: the w^2 coefficient of |D(i w)|^2 - |N(i w)|^2)
-    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s\n", "1/s^2", "1/s", "s", "s", "m", "", "", "", "1",
+    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s", "1/s^2", "1/s", "s", "s", "m", "", "", "", "1",
                   "rad/s", "1/s^2");
     out << std::string(static_cast<std::size_t>(width), ' ') << header;
+    if (peak) {
+        std::snprintf(header, sizeof header, "   %-9s %10s", "", "1");
+        out << header;
+    }
+    out << "\n";
     for (const auto& row : rows) {
         char line[256];
         const auto& p = row.vehicle.parameters;
         out << row.vehicle.name << std::string(static_cast<std::size_t>(width) - row.vehicle.name.size(), ' ');
-        std::snprintf(line, sizeof line, " %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %10.6f %7.4f %9.2e\n",
+        std::snprintf(line, sizeof line, " %6.3f %6.3f %6.3f %6.3f %6.3f   %-9s %-9s %-9s %10.6f %7.4f %9.2e",
                       p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"),
                       word(row.string.plant_verdict).c_str(), word(row.ring.verdict).c_str(),
                       word(row.string.string_verdict).c_str(), row.string.sup_gamma, row.string.omega_peak,
                       row.string.lowfreq_margin);
         out << line;
+        if (peak) {
+            const PeakResult* pk = row.string.peak ? &*row.string.peak : nullptr;
+            if (pk && pk->verdict != Verdict::Undecided && pk->finite) std::snprintf(line, sizeof line, "   %-9s %10.6f", word(pk->verdict).c_str(), pk->norm);
+            else std::snprintf(line, sizeof line, "   %-9s %10s", pk ? word(pk->verdict).c_str() : "", pk && pk->verdict != Verdict::Undecided ? "inf" : "");
+            out << line;
+        }
+        out << "\n";
     }
     bool any = false;
     for (const auto& row : rows) any = any || row.has_uncertainty;

@@ -611,7 +611,7 @@ def boundary(model="ovrv", ring=22, seed_grid=41, ring_curves="auto", **paramete
 
 
 @_with_progress
-def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1):
+def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1, peak=False):
     """Plant, ring and string verdicts of calibrated OVRV vehicles (``ddemap classify``).
 
     ``vehicles``: None (the paper's calibration table, 14 settings) or cars, as everywhere: a car
@@ -622,6 +622,9 @@ def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1):
     :func:`calibrate`, or a list of these. Each distinct car is classified once. With the
     covariance of a fit the verdicts come with probabilities from ``samples`` parameter draws
     (seed ``seed``; the first ``ring_samples`` also classified as rings). ``ring``: N or "inf".
+    ``peak=True`` also decides peak (L-infinity) string stability (``peak_verdict``,
+    ``peak_stable``, ``peak_norm`` = ||h||_1, ``peak_norm_error``, ``peak_overshoot`` per vehicle;
+    see :func:`string`).
 
     Returns ``vehicles`` (columns per vehicle: parameters, ``plant_stable``, ``ring_stable``,
     ``string_stable``, ``sup_gamma``, ``omega_peak``, ``lowfreq_margin``,
@@ -631,7 +634,9 @@ def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1):
     ring_samples = _integer("ring_samples", ring_samples, 0, 1000000)
     seed = _integer("seed", seed, 0, 4294967295)
     spec, tables = ("", {}) if vehicles is None else _cars(vehicles, "vehicles")
-    return _result(_ddemap.classify(spec, tables, _ring(ring), samples, ring_samples, seed))
+    if not isinstance(peak, bool):
+        raise ValueError(f"peak = {peak!r}: expected True or False")
+    return _result(_ddemap.classify(spec, tables, _ring(ring), samples, ring_samples, seed, peak))
 
 
 @_with_progress

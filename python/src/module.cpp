@@ -406,7 +406,8 @@ py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const
     return py::make_tuple(envelope_json(e), curves_arrays(b));
 }
 
-std::string py_classify(const std::string& spec, const CarTables& tables, int cars, int samples, int ring_samples, unsigned long long seed) {
+std::string py_classify(const std::string& spec, const CarTables& tables, int cars, int samples, int ring_samples, unsigned long long seed,
+                        bool peak) {
     std::vector<CalibratedVehicle> vehicles;
     std::string source = "the paper's calibration table (built in)";
     if (spec.empty()) {
@@ -422,11 +423,14 @@ std::string py_classify(const std::string& spec, const CarTables& tables, int ca
     uo.seed = seed;
     ExecutionPolicy policy;
     policy.progress = interruptible();
-    const auto rows = released([&] { return classify(vehicles, cars, uo, policy); });
+    StringOptions so;
+    so.peak = peak;
+    const auto rows = released([&] { return classify(vehicles, cars, uo, policy, so); });
     JsonEnvelope e;
     e.command = "classify";
     JsonObject inputs;
     inputs.string("vehicles", source).json("ring", json_ring(cars));
+    if (peak) inputs.boolean("peak", true);
     for (const auto& r : rows)
         if (r.has_uncertainty) {
             inputs.integer("samples", uo.samples).integer("ring_samples", uo.ring_samples).integer("seed", static_cast<long long>(uo.seed));
@@ -897,7 +901,7 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"));
     m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
           py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"), py::arg("ring_curves"));
-    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"));
+    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"), py::arg("peak"));
     m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("tables"), py::arg("lead_profile"), py::arg("lead"), py::arg("lead_text"),
           py::arg("lead_car"), py::arg("on_event"), py::arg("t_end"), py::arg("step"), py::arg("output_dt"), py::arg("noise_speed"),
           py::arg("noise_gap"), py::arg("seed"));

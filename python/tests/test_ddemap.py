@@ -181,6 +181,13 @@ def test_classify():
     assert not r["vehicles"]["string_stable"].any()  # the paper: all 14 settings string unstable
     r = ddemap.classify(os.path.join(SOURCE, "examples", "vehicles.csv"), ring="inf")
     same_envelope(r, cli_json("classify", os.path.join(SOURCE, "examples", "vehicles.csv"), "--ring", "inf"))
+    # the peak (L-infinity) verdict: sup |Gamma| <= ||h||_1, so every string-unstable car is peak unstable
+    r = ddemap.classify(peak=True)
+    same_envelope(r, cli_json("classify", "--peak"))
+    v = r["vehicles"]
+    assert all(x == "unstable" for x in v["peak_verdict"]) and (np.asarray(v["sup_gamma"]) <= np.asarray(v["peak_norm"])).all()
+    with pytest.raises(ValueError, match="peak = 1: expected True or False"):
+        ddemap.classify(peak=1)
 
 
 def test_simulate(tmp_path):

@@ -126,6 +126,14 @@ std::string ring_roots_csv(const RingResult& r) {
     return out.str();
 }
 
+namespace {
+/// ",VERDICT,NORM,ERROR": an infinite or undecided norm is an empty field (never inf or nan)
+std::string peak_fields(const PeakResult& p) {
+    const bool value = p.verdict != Verdict::Undecided && p.finite;
+    return "," + to_string(p.verdict) + "," + (value ? format_exact(p.norm) : std::string()) + "," + (value ? format_exact(p.error) : std::string());
+}
+}  // namespace
+
 std::string string_csv(const StringResult& s, const RingResult* ring) {
     std::ostringstream out;
     out << "plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable";
@@ -138,13 +146,7 @@ std::string string_csv(const StringResult& s, const RingResult* ring) {
     if (ring)
         out << "," << (ring->cars == 0 ? std::string("inf") : std::to_string(ring->cars)) << "," << tf(ring->stable) << ","
             << format_exact(ring->spectral_abscissa);
-    if (s.peak) {
-        // an infinite or undecided norm is an empty field (never inf or nan)
-        const PeakResult& p = *s.peak;
-        const bool value = p.verdict != Verdict::Undecided && p.finite;
-        out << "," << to_string(p.verdict) << "," << (value ? format_exact(p.norm) : std::string()) << ","
-            << (value ? format_exact(p.error) : std::string());
-    }
+    if (s.peak) out << peak_fields(*s.peak);
     out << "\n";
     return out.str();
 }
@@ -158,6 +160,9 @@ std::string classification_csv(const std::vector<Classification>& rows) {
     if (any)
         out << ",p_string_unstable,p_string_unstable_se,p_string_unstable_lower,p_string_unstable_upper,c2_lower,c2_upper,"
                "sup_gamma_minus_1_lower,sup_gamma_minus_1_upper,spectral_abscissa_lower,spectral_abscissa_upper,samples";
+    // peak (L-infinity) string stability, when it was asked (classify --peak): the last columns
+    const bool peak = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.string.peak.has_value(); });
+    if (peak) out << ",peak_verdict,peak_norm,peak_norm_error";
     out << "\n";
     for (const auto& row : rows) {
         out << csv_field(row.vehicle.name);
@@ -177,6 +182,7 @@ std::string classification_csv(const std::vector<Classification>& rows) {
         } else if (any) {
             out << ",,,,,,,,,,,";
         }
+        if (peak) out << (row.string.peak ? peak_fields(*row.string.peak) : std::string(",,,"));
         out << "\n";
     }
     return out.str();

@@ -218,6 +218,20 @@ std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
     return text(j);
 }
 
+namespace {
+/// Peak (L-infinity) string stability; peak_norm null when infinite (plant unstable) or undecided.
+void add_peak(json& j, const PeakResult& p) {
+    const bool decided = p.verdict != Verdict::Undecided;
+    j["peak_verdict"] = to_string(p.verdict);
+    j["peak_stable"] = decided ? json(p.verdict == Verdict::Stable) : json(nullptr);
+    j["peak_norm"] = decided && p.finite ? num(p.norm) : json(nullptr);
+    j["peak_norm_error"] = decided && p.finite ? num(p.error) : json(nullptr);
+    j["peak_overshoot"] = decided && p.finite ? num(p.overshoot) : json(nullptr);
+    j["peak_status"] = to_string(p.status);
+    j["peak_message"] = p.message;
+}
+}  // namespace
+
 std::string string_json(const StringResult& s, const RingResult* ring) {
     json j;
     j["plant_stable"] = s.plant_stable;
@@ -238,18 +252,7 @@ std::string string_json(const StringResult& s, const RingResult* ring) {
     j["peaks"] = peaks;
     j["omega_search_max"] = num(s.omega_search_max);
     j["plant_degree"] = s.plant_roots.degree;
-    if (s.peak) {
-        // peak (L-infinity) string stability; peak_norm null when infinite (plant unstable) or undecided
-        const PeakResult& p = *s.peak;
-        const bool decided = p.verdict != Verdict::Undecided;
-        j["peak_verdict"] = to_string(p.verdict);
-        j["peak_stable"] = decided ? json(p.verdict == Verdict::Stable) : json(nullptr);
-        j["peak_norm"] = decided && p.finite ? num(p.norm) : json(nullptr);
-        j["peak_norm_error"] = decided && p.finite ? num(p.error) : json(nullptr);
-        j["peak_overshoot"] = decided && p.finite ? num(p.overshoot) : json(nullptr);
-        j["peak_status"] = to_string(p.status);
-        j["peak_message"] = p.message;
-    }
+    if (s.peak) add_peak(j, *s.peak);
     if (ring) {
         j["ring"] = ring_value(ring->cars);
         j["ring_stable"] = ring->stable;
@@ -322,6 +325,7 @@ std::string classification_json(const std::vector<Classification>& rows, int car
         o["ring_verdict"] = to_string(row.ring.verdict);
         o["string_verdict"] = to_string(row.string.string_verdict);
         o["sup_gamma"] = num(row.string.sup_gamma);
+        if (row.string.peak) add_peak(o, *row.string.peak);
         o["omega_peak"] = num(row.string.omega_peak);
         o["lowfreq_margin"] = num(row.string.lowfreq_margin);
         o["spectral_abscissa"] = num(row.ring.spectral_abscissa);

@@ -166,6 +166,19 @@ if part classify; then
 "$bin" classify --format csv >"$tmp/c.csv" && [ "$(grep -c ',false,false,false,' "$tmp/c.csv")" -eq 0 ] && ok || bad "classify csv"
 [ "$(tail -n +2 "$tmp/c.csv" | wc -l)" -eq 14 ] && ok || bad "classify rows"
 [ "$(cut -d, -f9 "$tmp/c.csv" | grep -c false)" -eq 14 ] && ok || bad "all 14 string unstable"
+# --peak: the peak (L-infinity) verdict and ||h||_1 as the last columns; a string-stable car that
+# overshoots, a monotone one, one whose plant is unstable (infinite norm: "inf" in the table,
+# empty CSV fields, null in JSON)
+printf 'name,k1,k2,th,tau\nover,0.05,0.3,3.0,0.1\nmono,0.05,0.8,2.0,0.1\nwild,1,0.1,0.5,1.5\n' >"$tmp/pk.csv"
+"$bin" classify "$tmp/pk.csv" --peak --format csv >"$tmp/pk.out" && head -1 "$tmp/pk.out" | grep -q ',peak_verdict,peak_norm,peak_norm_error$' &&
+    grep -q '^over,.*,true,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,unstable,1\.01629' "$tmp/pk.out" && grep -q '^mono,.*,stable,1\.000000000[0-9]*,' "$tmp/pk.out" && grep -q '^wild,.*,unstable,,$' "$tmp/pk.out" &&
+    ok || bad "classify --peak csv: $(cat "$tmp/pk.out")"
+"$bin" classify "$tmp/pk.csv" --peak | grep -q '^wild .*UNSTABLE  *inf$' && ok || bad "classify --peak table: the unstable plant's norm"
+"$bin" classify "$tmp/pk.csv" --peak --format json | python3 -c "
+import json,sys; v={r['name']: r for r in json.load(sys.stdin)['result']['vehicles']}
+assert v['wild']['peak_norm'] is None and v['mono']['peak_stable'] is True and v['over']['peak_stable'] is False and v['over']['string_stable'] is True, v" &&
+    ok || bad "classify --peak json"
+"$bin" classify "$tmp/pk.csv" --format csv | head -1 | grep -q 'peak_verdict' && bad "classify without --peak has peak columns" || ok
 printf 'name,k1,k2,th,tau,eta
 mine,0.2,0.6,1.5,0.1,10
 ' >"$tmp/v.csv"

@@ -246,23 +246,25 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
     return out;
 }
 
-std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars, const ExecutionPolicy& policy) {
+std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars, const ExecutionPolicy& policy,
+                                     const StringOptions& string_options) {
+    string_options.validate();
     for (const auto& v : vehicles)  // every vehicle inside the computable range before any work
         require_computable(make_model("ovrv", v.parameters)->linearise(), "vehicle " + detail::quoted(v.name));
     std::vector<Classification> out(vehicles.size());
     parallel_for(static_cast<long>(vehicles.size()), [&](long i) {
         const Linearisation lin = make_model("ovrv", vehicles[i].parameters)->linearise();
         out[i].vehicle = vehicles[i];
-        out[i].string = analyse_string(lin);
+        out[i].string = analyse_string(lin, string_options);
         out[i].ring = analyse_ring(lin, cars);
     }, policy);
     return out;
 }
 
 std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars, const UncertaintyOptions& uncertainty,
-                                     const ExecutionPolicy& policy) {
+                                     const ExecutionPolicy& policy, const StringOptions& string_options) {
     uncertainty.validate();
-    std::vector<Classification> out = classify(vehicles, cars, policy);
+    std::vector<Classification> out = classify(vehicles, cars, policy, string_options);
     ExecutionPolicy inner = policy;
     inner.progress = nullptr;
     for (std::size_t i = 0; i < vehicles.size(); ++i) {
@@ -290,6 +292,7 @@ Status classification_status(const std::vector<Classification>& rows) {
         if (r.ring.status != Status::Converged) status = r.ring.status;
         if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
         if (r.has_uncertainty && r.uncertainty.status != Status::Converged) status = r.uncertainty.status;
+        if (r.string.peak && r.string.peak->verdict == Verdict::Undecided) status = r.string.peak->status;
     }
     return status;
 }

@@ -115,9 +115,10 @@ struct Classification {
 };
 
 /// Plant, ring (N cars, 0 = infinity) and string verdicts of every vehicle (OVRV).
-/// Vehicles run in parallel under `policy`.
+/// Vehicles run in parallel under `policy`. `string_options` is given to analyse_string (e.g.
+/// peak = true adds the peak (L-infinity) verdict of every vehicle, Classification::string.peak).
 std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars,
-                                     const ExecutionPolicy& policy = {});
+                                     const ExecutionPolicy& policy = {}, const StringOptions& string_options = {});
 
 /// The same, and for every vehicle with a covariance its verdicts under the parameter
 /// uncertainty (classify_with_uncertainty, the samples in parallel under `policy`). A vehicle
@@ -125,10 +126,11 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
 /// sampled within them: each parameter `uncertainty.domain` restricts takes the vehicle's bound
 /// instead when it has one (domain_from_fit); a parameter the domain leaves free stays free.
 std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehicles, int cars,
-                                     const UncertaintyOptions& uncertainty, const ExecutionPolicy& policy = {});
+                                     const UncertaintyOptions& uncertainty, const ExecutionPolicy& policy = {},
+                                     const StringOptions& string_options = {});
 
 /// The status of a classification as a whole: converged, or the last status of a vehicle's ring,
-/// plant roots or uncertainty that is not (then its verdicts are undecided).
+/// plant roots, uncertainty or peak verdict that is not (then its verdicts are undecided).
 Status classification_status(const std::vector<Classification>& rows);
 
 /// The sampling domain of classify's uncertainty when the vehicles carry no bounds: calibrate's

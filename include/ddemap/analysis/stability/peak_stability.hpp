@@ -34,7 +34,7 @@ struct PeakResult {
     Verdict verdict = Verdict::Undecided;
     bool finite = false;       ///< ||h||_1 is finite (the plant is stable); else norm is meaningless
     double norm = 0.0;         ///< ||h||_1, the total variation of the unit-step response
-    double error = 0.0;        ///< estimate of |norm - ||h||_1|: two step sizes and the tail
+    double error = 0.0;        ///< estimate of |norm - ||h||_1|: two step sizes, the tail, the sum's rounding
     double overshoot = 0.0;    ///< max_t y(t) - 1 (>= 0; the step response's overshoot)
     double t_end = 0.0;        ///< s: how long the response was followed
     double step = 0.0;         ///< s: the finest step used
