@@ -1850,6 +1850,11 @@ if part killset; then
 # or all new, or mixed with the writer's journal beside them; after the next ddemap run that
 # reads from or writes into the folder they are all old or all new, and no hidden file is left.
 command -v strace >/dev/null || { bad "strace is missing (scripts/install-deps.sh installs it)"; }
+# a machine that forbids ptrace (some containers) cannot run this part: said, not hidden
+if ! strace -f -o /dev/null true 2>/dev/null; then
+    echo "SKIP: killset: strace cannot trace here (ptrace not permitted): $(strace -o /dev/null true 2>&1 | head -1)"
+    killset_skip=1
+fi
 ks="$tmp/killset"
 mkdir -p "$ks"
 sweep_set() { "$bin" sweep --th "$1" --tau 0.5 --k1 0:1:4 --k2 0:1:4 --out "$2/x" >/dev/null 2>&1; }
@@ -1867,7 +1872,9 @@ set_state() {
     if [ $o -eq 4 ]; then echo old; elif [ $n -eq 4 ]; then echo new; else echo "mixed($o old, $n new)"; fi
 }
 kills=0
-for call in renameat2 renameat linkat unlinkat fsync; do
+calls="renameat2 renameat linkat unlinkat fsync"
+[ -z "${killset_skip:-}" ] || calls=""
+for call in $calls; do
     for n in $(seq 1 40); do
         rm -rf "$ks/k"
         cp -r "$ks/old" "$ks/k"
@@ -1896,7 +1903,7 @@ for call in renameat2 renameat linkat unlinkat fsync; do
 done
 # the set of 4 files has 4 moves, a journal renamed in, its removal and 4 old contents dropped:
 # every one of those calls was a kill point
-[ $kills -ge 20 ] && ok || bad "only $kills kill points"
+[ -n "${killset_skip:-}" ] || { [ $kills -ge 20 ] && ok || bad "only $kills kill points"; }
 rm -rf "$ks"
 fi  # part killset
 
