@@ -6,7 +6,7 @@ const std::vector<Command>& command_table() {
     static const std::vector<Command> table = {
         {"roots", "rightmost characteristic roots of a ring of N identical cars, a mixed fleet, or any linear DDE",
          add_roots_flags, run_roots},
-        {"string", "plant and string stability from the head-to-tail transfer function", add_string_flags, run_string},
+        {"string", "plant and string stability (sup |Gamma(iw)| and the peak norm ||h||_1) from the head-to-tail transfer function", add_string_flags, run_string},
         {"classify", "plant, ring and string verdicts of calibrated vehicles (default: the paper's 14 settings)",
          add_classify_flags, run_classify},
         {"sweep",
