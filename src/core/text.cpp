@@ -54,6 +54,12 @@ std::string format_number(double v) {
     return buf;
 }
 
+std::string significant(double v, int digits) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
+}
+
 std::size_t invalid_utf8_at(const std::string& text, std::size_t from) {
     const std::size_t n = text.size();
     std::size_t i = from;

@@ -23,6 +23,7 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include "core/internal/text.hpp"
 #include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 #include "ddemap/traffic/ring_car.hpp"
 
@@ -235,12 +236,7 @@ bool build(const RingCar& car, const std::vector<double>& pv, int cars, int wave
     return true;
 }
 
-std::string fmt(double x) {
-    std::ostringstream s;
-    s.precision(3);
-    s << x;
-    return s.str();
-}
+std::string fmt(double x) { return detail::significant(x, 3); }
 
 }  // namespace
 

@@ -490,12 +490,7 @@ int decorrelation_lag(const Eigen::VectorXd& x, int cap) {
 
 std::string fmt(double x) { return detail::format_number(x); }
 
-std::string fmt3(double x) {
-    std::ostringstream s;
-    s.precision(3);
-    s << x;
-    return s.str();
-}
+std::string fmt3(double x) { return detail::significant(x, 3); }
 
 }  // namespace
 

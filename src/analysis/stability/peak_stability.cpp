@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
+#include "core/internal/text.hpp"
 #include "ddemap/solve/integrate.hpp"
 
 namespace ddemap {
@@ -28,12 +28,7 @@ Terms terms_of(const ExpPoly& p) {
     return out;
 }
 
-std::string num(double x) {
-    std::ostringstream s;
-    s.precision(4);
-    s << x;
-    return s.str();
-}
+std::string num(double x) { return detail::significant(x, 4); }
 
 /// One resolution: the step response on [0, T] with step h, its total variation and more.
 struct Run {

@@ -9,6 +9,9 @@ namespace ddemap::detail {
 /// The shortest of %.15g, %.16g, %.17g that reads back to the same double (for messages).
 std::string format_number(double v);
 
+/// v with `digits` significant digits (%g style: "1.49", "6.9e-10"), for human messages.
+std::string significant(double v, int digits);
+
 /// Input text for an error message: in single quotes, control characters escaped (\n, \r,
 /// \t, \xNN) so that a message stays one line, and cut to 80 characters ("...").
 std::string quoted(const std::string& text);
