@@ -105,7 +105,7 @@ int run_string() {
         const PeakResult& pk = *s.peak;
         out << "peak ||h||_1     ";
         if (pk.verdict == Verdict::Undecided) out << "undecided (" << pk.message << ")";
-        else if (!pk.finite) out << "infinite (the plant is unstable)";
+        else if (!pk.finite) out << (s.plant_stable ? "not computed; > 1, since sup |Gamma(iw)| > 1" : "infinite (the plant is unstable)");
         else
             out << rounded(pk.norm, 10) << " (error estimate " << rounded(pk.error, 2) << "); a step of the lead's speed "
                 << (pk.overshoot <= pk.error ? std::string("does not overshoot") : "overshoots by " + rounded(100.0 * pk.overshoot, 4) + " %");

@@ -532,7 +532,7 @@ PY
 "$bin" string --k1 1 --k2 0.1 --th 0.5 --tau 1.5 --format json >"$tmp/pk2.json"
 python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['result']; sys.exit(0 if not r['plant_stable'] and r['peak_verdict'] == 'unstable' and r['peak_norm'] is None else 1)" "$tmp/pk2.json" &&
     ok || bad "string: an unstable plant has peak_norm null: $(grep -o '"peak[a-z_]*": [^,]*' "$tmp/pk2.json" | tr '\n' ' ')"
-"$bin" string --k1 0.2 --k2 0.4 --th 1.5 --tau 1e-5 >"$tmp/pk3.txt" 2>"$tmp/pk3.err"
+"$bin" string --k1 0.2 --k2 0.6 --th 1.5 --tau 1e-5 >"$tmp/pk3.txt" 2>"$tmp/pk3.err"
 rc=$?
 [ $rc -eq 4 ] && [ "$(wc -l <"$tmp/pk3.err")" -eq 1 ] && grep -q "peak undecided (budget_exhausted): the step response would need" "$tmp/pk3.err" &&
     grep -q "peak UNDECIDED" "$tmp/pk3.txt" && ok || bad "string --tau 1e-5: exit $rc, $(cat "$tmp/pk3.err")"

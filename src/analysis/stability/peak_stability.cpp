@@ -210,9 +210,13 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
         }
         Run coarse = sr.run(h, T, plant_abscissa), fine;
         double diff = 0.0;
-        bool settled = false;
+        bool settled = false, budget = false, have_fine = false;
         for (int halving = 0; halving < 8; ++halving) {
-            if (T / (h / 2.0) > static_cast<double>(options.max_steps)) break;
+            if (T / (h / 2.0) > static_cast<double>(options.max_steps)) {
+                budget = true;
+                break;
+            }
+            have_fine = true;
             fine = sr.run(h / 2.0, T, plant_abscissa);
             h /= 2.0;
             diff = std::abs(fine.norm - coarse.norm);
@@ -222,6 +226,12 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
             }
             coarse = fine;
         }
+        if (!have_fine) {  // not even one halving fits the budget: no error estimate
+            r.status = Status::BudgetExhausted;
+            r.message = "||h||_1 = " + num(coarse.norm) + " at step " + num(h) + " s; checking it at half the step would need " + num(2.0 * T / h) +
+                        " steps (" + num(T) + " s), more than " + num(static_cast<double>(options.max_steps)) + ": no peak verdict";
+            return r;
+        }
         r.norm = fine.norm;
         r.overshoot = fine.overshoot;
         r.t_end = T;
@@ -229,8 +239,8 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
         r.steps = fine.steps;
         r.error = diff + fine.tail + sr.short_error() + fine.rounding;
         if (!settled) {
-            r.status = Status::MaxIterations;
-            r.message = "||h||_1 did not settle: " + num(fine.norm) + " and " + num(coarse.norm) + " at steps " + num(h) + " and " +
+            r.status = budget ? Status::BudgetExhausted : Status::MaxIterations;
+            r.message = std::string(budget ? "||h||_1 did not settle within the step budget: " : "||h||_1 did not settle: ") + num(fine.norm) + " and " + num(coarse.norm) + " at steps " + num(h) + " and " +
                         num(2 * h) + " s (tolerance " + num(options.tolerance) + "): no peak verdict";
             return r;
         }

@@ -259,6 +259,16 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
             r.peak = p;
         } else {
             r.peak = peak_string_stability(lin, r.plant_abscissa, options.peak_options);
+            // |Gamma(i w)| <= ||h||_1 for every w: a certified L2 amplification decides the peak
+            // verdict even where ||h||_1 itself could not be computed (its value stays unknown)
+            if (r.peak->verdict == Verdict::Undecided && r.string_verdict == Verdict::Unstable && r.plant_verdict == Verdict::Stable) {
+                PeakResult p;
+                p.status = Status::Converged;
+                p.verdict = Verdict::Unstable;
+                p.finite = false;
+                p.message = "||h||_1 >= sup |Gamma(i w)| > 1 (the car is L2 string unstable); ||h||_1 itself was not computed: " + r.peak->message;
+                r.peak = p;
+            }
         }
     }
     return r;

@@ -173,3 +173,45 @@ TEST_CASE("peak norm against a simulated platoon of the nonlinear OVRV law: a le
         CHECK(std::abs(l1 / (0.1 * dv) - r.norm) <= tol::peak_pulse_rel * r.norm);
     }
 }
+
+TEST_CASE("peak norm: every step budget gives a settled norm or names the budget, and an L2 amplification still decides the verdict") {
+    // budgets from below one run to above the halvings: each result is converged, or budget
+    // exhausted with the budget in its message (a budget that allowed one run but not its
+    // halving once reported "did not settle: 0 and ..." with a norm of 0)
+    const Linearisation lin = test::ovrv(0.2, 0.6, 1.5, 0.3);
+    const StringResult l2 = analyse_string(lin);
+    REQUIRE(l2.plant_stable);
+    bool halving_refused = false, converged = false;
+    for (long budget = 1000; budget <= 200000; budget = budget * 5 / 4) {
+        PeakOptions o;
+        o.max_steps = budget;
+        const PeakResult p = peak_string_stability(lin, l2.plant_abscissa, o);
+        CAPTURE(budget);
+        CAPTURE(p.message);
+        CHECK((p.status == Status::Converged || p.status == Status::BudgetExhausted));
+        if (p.status == Status::Converged) {
+            converged = true;
+            CHECK(p.norm >= 1.0 - p.error);
+        } else {
+            CHECK(p.verdict == Verdict::Undecided);
+            CHECK(p.message.find("steps") != std::string::npos);
+            if (p.message.find("checking it at half the step would need") != std::string::npos) halving_refused = true;
+        }
+    }
+    CHECK(halving_refused);
+    CHECK(converged);
+    // k1 = 0.0052: the plant's slowest root is about -0.0015 1/s, the response too long for a
+    // budget of 1000 steps; sup |Gamma(i w)| > 1 there (c2 < 0) and |Gamma(i w)| <= ||h||_1
+    const Linearisation slow = test::ovrv(0.0052, 3.38, 0.819, 0.948);
+    StringOptions so;
+    so.peak = true;
+    so.peak_options.max_steps = 1000;
+    const StringResult s = analyse_string(slow, so);
+    REQUIRE(s.plant_stable);
+    REQUIRE(s.string_verdict == Verdict::Unstable);
+    REQUIRE(s.peak.has_value());
+    CHECK(s.peak->verdict == Verdict::Unstable);
+    CHECK(s.peak->status == Status::Converged);
+    CHECK_FALSE(s.peak->finite);
+    CHECK(s.peak->message.find("sup |Gamma(i w)| > 1") != std::string::npos);
+}

@@ -32,7 +32,9 @@ struct PeakResult {
     /// Unstable: the plant is unstable (||h||_1 is infinite) or ||h||_1 - 1 > error;
     /// Undecided: the estimate did not reach the tolerance (status says why).
     Verdict verdict = Verdict::Undecided;
-    bool finite = false;       ///< ||h||_1 is finite (the plant is stable); else norm is meaningless
+    /// norm holds ||h||_1; false when the plant is unstable (||h||_1 is infinite), or when
+    /// analyse_string decided the verdict from sup |Gamma(i w)| > 1 without the norm
+    bool finite = false;
     double norm = 0.0;         ///< ||h||_1, the total variation of the unit-step response
     double error = 0.0;        ///< estimate of |norm - ||h||_1|: two step sizes, the tail, the sum's rounding
     double overshoot = 0.0;    ///< max_t y(t) - 1 (>= 0; the step response's overshoot)
