@@ -310,4 +310,36 @@ constexpr double peak_vs_simulation_rel = 1e-6;
 /// The same from a pulse of 0.2 s: the response is h convolved with the pulse, whose width blurs
 /// the sign changes of h; measured 3e-5 and 1e-6.
 constexpr double peak_pulse_rel = 1e-4;
+/// The smallest vector of a convex hull by projected-gradient iterations to a change of 1e-14:
+/// 1e-10 absolute on vectors of size ~1.
+constexpr double hull_abs = 1e-10;
+/// A smooth quadratic minimised by BFGS to the relative stationarity 1e-6: |x - x*| is at most
+/// 1e-6 / lambda_min(2 A) ~ 3e-7 here; 1e-6.
+constexpr double nonsmooth_smooth_x = 1e-6;
+/// A kink of absolute values (slopes 1 and 2) minimised to stationarity: the error in x is the
+/// error in f divided by the slope, and f is resolved to about 1e-10; 1e-6 leaves a margin.
+constexpr double nonsmooth_kink_x = 1e-6;
+/// mu of OVRV without delay against its closed form: the limit w -> 0 is exact, the asymptote
+/// 1/k2^2 is approached at the scan's last frequency (1e5 times the natural one) to ~1e-10
+/// relative, interior minima are refined by golden sections to 1e-12 in log w; 1e-8.
+constexpr double attenuation_mu_rel = 1e-8;
+/// The weighted norm against its closed form: a maximum located by golden sections to 1e-12 in
+/// log w is exact to ~1e-16 in the value (quadratic); 1e-10 leaves room for the grid's bracket.
+constexpr double attenuation_sup_rel = 1e-10;
+/// |Gamma| |1 + i m* w| <= 1 on an independent grid, and a design's weighted norm by brute
+/// force: m* comes from mu to ~1e-12 relative; 1e-9.
+constexpr double attenuation_bound_rel = 1e-9;
+/// The least plant abscissa of OVRV without delay (-1 at a double root): the minimiser locates
+/// the kink to its final sampling radius 1e-6 of the box; the value error is quadratic on the
+/// complex side and of square-root size on the real side (measured 8e-8); 1e-6.
+constexpr double design_abscissa_value = 1e-6;
+/// Its gains: the square-root side makes them known only to about the square root of the value's
+/// error; 1e-3.
+constexpr double design_abscissa_gains = 1e-3;
+/// The nearest gains against the closed form: the sequential QP stops at steps of 1e-8 of the
+/// distance, then the crossing is bisected to 1e-13; 1e-7.
+constexpr double design_nearest_rel = 1e-7;
+/// sup-gamma's value against a brute-force grid's least value (never worse): both are the same
+/// norm from different frequency grids, ~1e-12 apart at a shared point; 1e-9.
+constexpr double design_grid_abs = 1e-9;
 }  // namespace ddemap::test::tol
