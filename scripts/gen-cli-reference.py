@@ -30,6 +30,10 @@ SUMMARIES = {
                 "settings by default, or a vehicle CSV such as `calibrate` writes. With the covariance columns "
                 "of a fit the verdicts come with probabilities. Guides: [string stability]("
                 + GUIDE + "string-stability.md), [calibration](" + GUIDE + "calibration.md).",
+    "design": "Gains (or any law parameters, `--free`) of one car that minimise a stability objective within "
+              "bounds: the weighted H-infinity norm sup |Gamma(iw)| |1 + i m w|, the peak norm ||h||_1, the plant's "
+              "or a ring's spectral abscissa, or the nearest gains with an attenuation margin of at least m seconds; "
+              "the verdicts at the car and at the design, certified. Guide: [gain design](" + GUIDE + "design.md).",
     "sweep": "A grid over two model parameters (each `LO:HI:COUNT`): spectral abscissa, unstable roots, "
              "sup |Gamma| and the three verdicts at every point, the stability boundaries traced through the "
              "window, and the chart as SVG. Guide: [stability charts](" + GUIDE + "charts.md).",

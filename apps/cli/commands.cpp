@@ -9,6 +9,10 @@ const std::vector<Command>& command_table() {
         {"string", "plant and string stability (sup |Gamma(iw)| and the peak norm ||h||_1) from the head-to-tail transfer function", add_string_flags, run_string},
         {"classify", "plant, ring and string verdicts of calibrated vehicles (default: the paper's 14 settings)",
          add_classify_flags, run_classify},
+        {"design",
+         "gains of one car that minimise sup |Gamma(iw)|, ||h||_1 or a spectral abscissa within bounds, or the nearest string-stable gains; "
+         "the verdicts before and after, certified",
+         add_design_flags, run_design},
         {"sweep",
          "grid sweep over two model parameters (each given as LO:HI:COUNT): spectral abscissa, unstable roots, sup|Gamma| "
          "and verdicts per point; writes PREFIX.csv, .json, .svg, -boundaries.csv",

@@ -22,6 +22,7 @@ const std::vector<Command>& command_table();
 DDEMAP_COMMAND(roots)
 DDEMAP_COMMAND(string)
 DDEMAP_COMMAND(classify)
+DDEMAP_COMMAND(design)
 DDEMAP_COMMAND(sweep)
 DDEMAP_COMMAND(boundary)
 DDEMAP_COMMAND(chart)

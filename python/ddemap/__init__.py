@@ -49,7 +49,7 @@ import numpy as _np
 from . import _ddemap
 
 __all__ = ["__version__", "Result", "CalibrationWarning", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
-           "mixed_ring", "mix", "growth", "chart", "paper", "equilibria", "hopf", "orbits", "version"]
+           "mixed_ring", "mix", "growth", "design", "chart", "paper", "equilibria", "hopf", "orbits", "version"]
 
 version = _ddemap.version
 __version__ = _ddemap.version
@@ -813,6 +813,49 @@ def growth(vehicles=None, followers=15, lead_profile=None, lead=None):
     spec, tables = ("", {}) if vehicles is None else _cars(vehicles, "vehicles")
     lead_file, lead_text, lead_car = _lead(lead)
     return _result(_ddemap.growth(spec, tables, _integer("followers", followers, 1, 200), lead_profile or "", lead_file, lead_text, lead_car))
+
+
+@_with_progress
+def design(car, objective="sup-gamma", free=("k1", "k2"), bounds=None, margin=0.1, weights=None, starts=4, speed=None, ring=None):
+    """Gains of one car that minimise a stability objective within bounds (``ddemap design``).
+
+    ``car``: one car, as :func:`classify` takes cars (``"C_max"``, ``"mycars.csv:Sedan"``, a
+    one-row DataFrame, a fit's Result, ...). ``free``: the law parameters designed (the others,
+    the delay and jam gap among them, held). ``bounds``: ``{name: (lo, hi)}`` for free
+    parameters (default: a tenth to ten times the car's value). ``objective``:
+
+    * ``"sup-gamma"``: sup_w |Gamma(iw)| |1 + i m w| with m = ``margin`` [s]; it is 1 exactly where
+      every wave is damped at least as a first-order lag of m seconds damps it (the attenuation
+      margin m* >= m), and then the result is the nearest such gains to the car's own;
+    * ``"nearest"``: the smallest relative change sqrt(sum w_j^2 ((x_j - x0_j) / x0_j)^2)
+      (``weights`` w_j, default 1) that gives an attenuation margin of at least ``margin``;
+    * ``"peak"``: ||h||_1, the peak (L-infinity) norm;
+    * ``"abscissa"``: the plant's spectral abscissa, or the ring's with ``ring`` (N or "inf").
+
+    ``starts``: runs of the minimiser (the car's values and Halton points of the box).
+
+    Returns ``gains`` ({name: value}), ``objective``, ``change``, ``attenuation_margin`` [s],
+    ``margin_met``, ``infeasibility_proof`` (a proof that no gains of the box are string stable,
+    or None), ``verdicts`` (the certified verdicts at the design, with :func:`string`'s keys),
+    ``initial`` (the same at the car), ``starts`` and the other keys of the command's JSON.
+    """
+    spec, tables = _cars(car, "car")
+    if isinstance(free, str):
+        free = [f.strip() for f in free.split(",")]
+    free = list(free)
+    if not free or not all(isinstance(f, str) and f for f in free):
+        raise ValueError("free = %r: expected parameter names, e.g. ('k1', 'k2')" % (free,))
+    bound_list = []
+    for name, value in (bounds or {}).items():
+        try:
+            lo, hi = value
+        except (TypeError, ValueError):
+            raise ValueError("bounds[%r] = %r: expected a pair (lo, hi)" % (name, value)) from None
+        bound_list.append((str(name), _number("bounds[%r] lo" % name, lo), _number("bounds[%r] hi" % name, hi)))
+    weights = [] if weights is None else [_number("weights", w) for w in weights]
+    return _result(_ddemap.design(spec, tables, str(objective), free, bound_list, _number("margin", margin), weights,
+                                  _integer("starts", starts, 1, 64), None if speed is None else _number("speed", speed),
+                                  None if ring is None else _ring(ring)))
 
 
 def _prefix(out, command, suffixes):

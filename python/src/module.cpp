@@ -24,10 +24,12 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "ddemap/analysis/calibration/calibrate.hpp"
+#include "ddemap/analysis/design/design.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/stability/mixed_ring.hpp"
@@ -43,6 +45,7 @@
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/io/hopf_output.hpp"
 #include <map>
+#include "ddemap/io/csv.hpp"
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/io/system_json.hpp"
@@ -685,6 +688,30 @@ std::string py_growth(const std::string& spec, const CarTables& tables, int foll
     return envelope_json(e);
 }
 
+/// design: the gains of one car that minimise an objective (analysis/design/design.hpp).
+std::string py_design(const std::string& spec, const CarTables& tables, const std::string& objective, const std::vector<std::string>& free,
+                      const std::vector<std::tuple<std::string, double, double>>& bounds, double margin, const std::vector<double>& weights, int starts,
+                      std::optional<double> speed, std::optional<int> cars) {
+    const std::vector<CalibratedVehicle> found = distinct_cars(vehicles_spec(spec, tables));
+    if (found.size() != 1)
+        throw std::invalid_argument("car = '" + spec + "': " + std::to_string(found.size()) + " cars: expected one car (e.g. \"mycars.csv:Sedan\")");
+    const CalibratedVehicle& car = found.front();
+    ParameterMap p = car.parameters;
+    if (speed) p["speed"] = *speed;
+    DesignOptions o;
+    o.objective = parse_design_objective(objective);
+    o.free = free;
+    for (const auto& [name, lo, hi] : bounds) o.bounds.push_back({name, lo, hi});
+    o.margin = margin;
+    o.weights = weights;
+    o.starts = starts;
+    o.cars = cars ? *cars : -1;
+    o.progress = interruptible();
+    const DesignResult r = released([&] { return design_gains(car.model, p, o); });
+    const JsonEnvelope e = design_envelope(r, o, spec, car.name);
+    return envelope_json(e);
+}
+
 /// chart: a chart spec (TOML text; `source` names it and its folder holds the files it names)
 /// rendered to PREFIX.svg and the panels' CSVs.
 std::string py_chart(const std::string& text, const std::string& source, const std::string& prefix) {
@@ -913,6 +940,8 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("speed"), py::arg("length"), py::arg("solver"));
     m.def("growth", &py_growth, py::arg("vehicles"), py::arg("tables"), py::arg("followers"), py::arg("lead_profile"), py::arg("lead"),
           py::arg("lead_text"), py::arg("lead_car"));
+    m.def("design", &py_design, py::arg("car"), py::arg("tables"), py::arg("objective"), py::arg("free"), py::arg("bounds"), py::arg("margin"),
+          py::arg("weights"), py::arg("starts"), py::arg("speed"), py::arg("ring"));
     m.def("chart", &py_chart, py::arg("text"), py::arg("source"), py::arg("prefix"));
     m.def("paper", &py_paper, py::arg("prefix"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),

@@ -124,6 +124,31 @@ def test_string():
     assert r["string_stable"] is False and r["sup_gamma"] > 1
 
 
+@pytest.mark.slow
+def test_design():
+    # the same result as the command, bit for bit (one library on one input)
+    r = ddemap.design("C_max", objective="nearest", progress=False)
+    same_envelope(r, cli_json("design", "C_max", "--objective", "nearest"))
+    assert r.status == "converged" and r["verdicts"]["string_stable"] is True and r["initial"]["verdicts"]["string_stable"] is False
+    assert r["attenuation_margin"] >= 0.1 and r["margin_met"] is True
+    r = ddemap.design("A_min", free="k1,k2,th", bounds={"th": (0.5, 3.0)}, starts=2, progress=False)
+    same_envelope(r, cli_json("design", "A_min", "--free", "k1,k2,th", "--bounds", "th=0.5:3", "--starts", 2))
+    assert set(r["gains"]) == {"k1", "k2", "th"} and 0.5 <= r["gains"]["th"] <= 3.0
+    # a one-row DataFrame is a car; more rows are refused as the command refuses them
+    pd = pytest.importorskip("pandas")
+    cars = pd.read_csv(os.path.join(SOURCE, "examples", "mycars.csv"), comment="#")
+    r = ddemap.design(cars[cars.name == "SUV"], objective="nearest", progress=False)
+    assert r.status == "converged" and r["verdicts"]["string_stable"] is True
+    with pytest.raises(ValueError, match="expected one car"):
+        ddemap.design(cars)
+    with pytest.raises(ValueError, match="expected sup-gamma, peak, abscissa or nearest"):
+        ddemap.design("C_max", objective="fastest")
+    with pytest.raises(ValueError, match="expected a pair"):
+        ddemap.design("C_max", bounds={"k1": 0.3})
+    with pytest.raises(ValueError, match="not free"):
+        ddemap.design("C_max", bounds={"th": (1, 2)})
+
+
 def test_sweep(tmp_path):
     r = ddemap.sweep(th=1.5, tau=0.1, k1=(0.01, 1, 17), k2=(0.05, 0.9, 13), ring=10)
     e = cli_json("sweep", "--th", 1.5, "--tau", 0.1, "--k1", "0.01:1:17", "--k2", "0.05:0.9:13", "--ring", 10,

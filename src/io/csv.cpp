@@ -1,6 +1,7 @@
 #include "ddemap/io/csv.hpp"
 
 #include "core/internal/text.hpp"
+#include "ddemap/analysis/design/design.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -263,4 +264,24 @@ std::string mix_csv(const std::vector<MixPoint>& points) {
     return csv.str();
 }
 
+
+std::string design_csv(const DesignResult& r) {
+    std::ostringstream out;
+    out << "point";
+    for (const std::string& k : r.free) out << "," << csv_field(k);
+    out << ",objective,attenuation_margin,sup_gamma,peak_norm,plant_stable,string_stable,peak_stable,plant_abscissa\n";
+    auto row = [&](const std::string& name, const ParameterMap& p, double value, const AttenuationScan& a, const StringResult& s) {
+        out << name;
+        for (const std::string& k : r.free) out << "," << format_exact(p.at(k));
+        out << "," << (std::isfinite(value) ? format_exact(value) : std::string("inf"));
+        out << "," << (s.plant_stable ? format_exact(a.margin) : std::string());
+        out << "," << format_exact(s.sup_gamma);
+        out << "," << (s.peak && s.peak->finite ? format_exact(s.peak->norm) : std::string());
+        out << "," << (s.plant_stable ? "true" : "false") << "," << (s.string_stable ? "true" : "false") << ","
+            << (s.peak && s.peak->verdict == Verdict::Stable ? "true" : "false") << "," << format_exact(s.plant_abscissa) << "\n";
+    };
+    row("car", r.initial, r.value_initial, r.attenuation_initial, r.string_initial);
+    row("design", r.parameters, r.value, r.attenuation, r.string);
+    return out.str();
+}
 }  // namespace ddemap

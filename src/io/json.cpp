@@ -1,11 +1,13 @@
 #include "ddemap/io/json.hpp"
 
+
 #include <cmath>
 
 #include <nlohmann/json.hpp>
 
 #include "io/internal/json_values.hpp"
 
+#include "ddemap/analysis/design/design.hpp"
 #include "ddemap/io/svg.hpp"  // region_class
 
 namespace ddemap {
@@ -644,6 +646,69 @@ std::string travelling_wave_json(const TravellingWaveBranch& w, const std::vecto
     for (std::size_t i = 0; i < w.branch.points.size() && i < w.defects.size(); ++i) j["points"][i]["defect"] = num(w.defects[i]);
     j["wave"] = wave;
     return text(j);
+}
+
+
+std::string design_json(const DesignResult& r, double margin) {
+    JsonObject gains, initial_gains, bounds;
+    for (const auto& [k, v] : r.gains) gains.number(k, v);
+    for (const std::string& k : r.free) initial_gains.number(k, r.initial.at(k));
+    for (const BoundedParameter& b : r.bounds) bounds.json(b.name, "[" + json_number(b.lower) + "," + json_number(b.upper) + "]");
+    std::string at_bound = "[";
+    for (std::size_t i = 0; i < r.at_bound.size(); ++i) at_bound += (i ? "," : "") + json_string(r.at_bound[i]);
+    at_bound += "]";
+    std::string starts = "[";
+    for (std::size_t i = 0; i < r.starts.size(); ++i) {
+        const DesignStart& s = r.starts[i];
+        JsonObject o;
+        o.string("objective_name", s.objective).json("start", json_parameters(s.start)).json("end", json_parameters(s.end)).number("objective", s.value).string("status", to_string(s.status));
+        o.string("message", s.message).integer("iterations", s.iterations).integer("evaluations", s.evaluations);
+        starts += (i ? "," : "") + o.str();
+    }
+    starts += "]";
+    auto side = [&](const ParameterMap& g, double value, const AttenuationScan& a, const StringResult& s, const std::optional<RingResult>& ring) {
+        JsonObject o;
+        o.json("gains", json_parameters(g)).number("objective", value);
+        if (s.plant_stable) o.number("attenuation_margin", a.margin);
+        else o.null("attenuation_margin");
+        o.json("verdicts", string_json(s, ring ? &*ring : nullptr));
+        return o.str();
+    };
+    JsonObject res;
+    res.string("objective_name", r.objective).number("objective", r.value).json("gains", gains.str()).json("parameters", json_parameters(r.parameters));
+    res.json("bounds", bounds.str()).json("at_bound", at_bound).number("change", r.change);
+    res.number("margin", margin);
+    if (r.string.plant_stable) res.number("attenuation_margin", r.attenuation.margin);
+    else res.null("attenuation_margin");
+    res.boolean("margin_met", r.margin_met);
+    if (r.infeasibility_proof.empty()) res.null("infeasibility_proof");
+    else res.string("infeasibility_proof", r.infeasibility_proof);
+    res.json("verdicts", string_json(r.string, r.ring ? &*r.ring : nullptr));
+    ParameterMap ig;
+    for (const std::string& k : r.free) ig[k] = r.initial.at(k);
+    res.json("initial", side(ig, r.value_initial, r.attenuation_initial, r.string_initial, r.ring_initial));
+    res.string("method", r.method).integer("evaluations", r.evaluations).json("starts", starts);
+    return res.str();
+}
+
+
+JsonEnvelope design_envelope(const DesignResult& r, const DesignOptions& o, const std::string& car, const std::string& name) {
+    JsonEnvelope e;
+    e.command = "design";
+    std::string free = "[";
+    for (std::size_t i = 0; i < o.free.size(); ++i) free += (i ? "," : "") + json_string(o.free[i]);
+    JsonObject in;
+    in.string("car", car).string("name", name).string("model", r.model).json("parameters", json_parameters(r.initial));
+    in.string("objective", r.objective).json("free", free + "]").number("margin", o.margin).integer("starts", o.starts);
+    if (o.cars >= 0) in.json("ring", json_ring(o.cars));
+    e.inputs = in.str();
+    e.has_solver = true;
+    e.solver_given = "auto";
+    e.solver_used = r.method;
+    e.status = to_string(r.status);
+    e.message = r.message;
+    e.result = design_json(r, o.margin);
+    return e;
 }
 
 }  // namespace ddemap

@@ -1908,5 +1908,49 @@ done
 rm -rf "$ks"
 fi  # part killset
 
+if part design; then
+# design: the nearest string-stable gains of C_max, written as CSV and JSON
+"$bin" design C_max --objective nearest --out "$tmp/des/c" >"$tmp/des.txt" 2>"$tmp/des.err" && ok || bad "design C_max nearest: exit $?"
+json_has "$tmp/des/c.json" gains objective change attenuation_margin margin_met infeasibility_proof verdicts initial starts && ok || bad "design json keys"
+python3 - "$tmp/des/c.json" "$tmp/des/c.csv" <<'PY' && ok || bad "design: the JSON and the CSV say the same, the design is certified string stable"
+import csv, json, sys
+d = json.load(open(sys.argv[1]))
+r = d["result"]
+assert d["status"] == "converged", d["message"]
+assert r["verdicts"]["string_stable"] is True and r["initial"]["verdicts"]["string_stable"] is False
+assert r["attenuation_margin"] >= 0.1 and r["margin_met"] is True and r["infeasibility_proof"] is None
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert [x["point"] for x in rows] == ["car", "design"]
+assert float(rows[1]["k1"]) == r["gains"]["k1"] and float(rows[1]["k2"]) == r["gains"]["k2"]  # round-trip exact
+assert rows[1]["string_stable"] == "true" and rows[0]["string_stable"] == "false"
+PY
+grep -q "^string (L2) *UNSTABLE *STABLE$" "$tmp/des.txt" && ok || bad "design table: the L2 verdicts before and after"
+# no gains of the box are string stable (th < tau): the proof, exit 0, the gains unchanged
+"$bin" design A_min --objective nearest --format json >"$tmp/des2.json" && ok || bad "design A_min nearest: exit $?"
+python3 - "$tmp/des2.json" <<'PY' && ok || bad "design A_min: the proof of infeasibility"
+import json, sys
+d = json.load(open(sys.argv[1]))
+r = d["result"]
+assert d["status"] == "converged" and "no gains within the bounds are string stable" in d["message"], d["message"]
+assert r["infeasibility_proof"] and r["gains"] == {"k1": 0.052, "k2": 0.338}, r["gains"]
+PY
+# a car of a file, inline, and bad input: one line, exit 2, nothing on stdout
+expect_code 0 design "$(dirname "$0")/../../examples/mycars.csv:SUV" --free k1,k2,th --starts 2 --format csv
+expect_code 0 design ovrv:k1=0.5,k2=0.5,th=1,tau=0 --objective abscissa --bounds k1=0.1:1,k2=0.01:2 --starts 1
+expect_error "expected sup-gamma, peak, abscissa or nearest" design C_max --objective fastest
+expect_error "expected one car" design A_min,C_max
+expect_error "expected NAME=LO:HI" design C_max --bounds k1=0.1
+expect_error "which is not free" design C_max --bounds th=1:2
+expect_error "expected lower <= upper" design C_max --bounds k1=0.5:0.1
+expect_error "expected LO < HI" design C_max --bounds k1=0.1:0.1
+expect_error "the law's domain" design C_max --bounds k1=-1:0.1
+expect_error "free parameter 'gain'" design C_max --free k1,gain
+expect_error "expected a number of seconds" design C_max --margin 0
+expect_error "expected an integer 1..64" design C_max --starts 0
+expect_error "one per free parameter" design C_max --objective nearest --weights 1
+expect_error "computable range" design ovrv:k1=5,k2=5,th=1,tau=2
+expect_error "CAR is required" design
+fi  # part design
+
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

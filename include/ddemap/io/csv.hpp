@@ -20,6 +20,8 @@
 
 namespace ddemap {
 
+struct DesignResult;
+
 /// The shortest decimal that reads back to the same double (std::to_chars: 0.45, not
 /// 0.45000000000000001); a non-finite value is an internal error (std::logic_error): no NaN or inf is ever written
 std::string format_exact(double v);
@@ -52,6 +54,9 @@ std::string ring_roots_csv(const RingResult& r);
 /// plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable
 /// [,ring,ring_stable,spectral_abscissa]
 std::string string_csv(const StringResult& s, const RingResult* ring);
+/// Two rows, `car` and `design`: the free parameters, the objective, the attenuation margin,
+/// sup |Gamma|, ||h||_1 and the verdicts (columns point, the free names, objective, ...).
+std::string design_csv(const DesignResult& r);
 /// name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,
 /// lowfreq_margin,spectral_abscissa,plant_abscissa
 std::string classification_csv(const std::vector<Classification>& rows);

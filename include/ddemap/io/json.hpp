@@ -31,6 +31,9 @@
 
 namespace ddemap {
 
+struct DesignResult;
+struct DesignOptions;
+
 /// A JSON object built key by key, keys in insertion order.
 class JsonObject {
 public:
@@ -95,6 +98,13 @@ std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vecto
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars);
 /// string stability, with the ring verdict when `ring` is given
 std::string string_json(const StringResult& s, const RingResult* ring);
+/// The result of `design` (analysis/design/design.hpp): objective, gains, change, attenuation
+/// margin, the certified verdicts at the design (`verdicts`, string_json's keys) and at the car
+/// (`initial`), and every run (`starts`); `margin` is the margin asked for.
+std::string design_json(const DesignResult& r, double margin);
+/// The envelope of `design` for the car named `car` (as given) and `name` (its name), with the
+/// options it ran with: inputs, solver {auto, the method used}, status, message, design_json.
+JsonEnvelope design_envelope(const DesignResult& r, const DesignOptions& o, const std::string& car, const std::string& name);
 /// {"ring_method", "listed_by", "winding": {...} or null} of analyse_ring_fast appended to a JSON
 /// object's text (the result of roots or string for a ring of identical cars).
 std::string append_ring_method_json(const std::string& object_text, const FastRing& f);

@@ -1,0 +1,150 @@
+#pragma once
+/// \file design.hpp
+/// Gain design: the parameters of a car's law (by default its gains k1, k2) that minimise a
+/// stability objective within bounds, the others (delay, jam gap, speed) held, with the
+/// verdicts at the result certified by the same analyses as every other verdict.
+///
+/// Objectives (x the free parameters, Gamma the head-to-tail transfer function, D the plant):
+///   sup-gamma  the weighted H-infinity norm sup_w |Gamma(i w)| |1 + i m w|, m = `margin`
+///              (seconds; attenuation_margin.hpp). It is at least 1 (its limit as w -> 0), and
+///              exactly 1 where every wave is damped at least as by a first-order lag of m seconds
+///              (the attenuation margin m* >= m). When a run reaches 1, every such gains are
+///              optimal, and the result is the one nearest the car's own values (the nearest
+///              objective below, run next). (With m -> 0 it is sup |Gamma(i w)|, 1 on the whole
+///              string-stable set, whose boundary it approaches only quadratically: the weight
+///              makes the result lie inside the set, by the margin asked.)
+///   peak       ||h||_1, the peak (L-infinity) string-stability norm (peak_stability.hpp);
+///   abscissa   the spectral abscissa of the plant (cars = -1) or of the ring of `cars` cars
+///              (0: N = infinity);
+///   nearest    the smallest weighted relative change sqrt(sum_j w_j^2 ((x_j - x0_j) / x0_j)^2)
+///              from the car's own values x0 that makes the attenuation margin at least `margin`
+///              (string stable, every wave damped at least as by a lag of `margin` seconds):
+///              by sequential quadratic programming (up to four free parameters): mu is the least
+///              of its pieces (the limit w -> 0 and each local minimum over w, attenuation_scan),
+///              and each piece g = (q(w) - m^2 |N|^2) / |N| >= 0 at its fixed frequency is
+///              linearised; each step solves the convex QP (distance in the weighted relative
+///              metric, the bounds, the linearised pieces) exactly by its active sets, until the
+///              step is below 1e-8 of the distance. (More free parameters: an exact penalty
+///              d(x) + rho max(0, 1 - m*(x) / margin) minimised by BFGS, rho raised until the
+///              result is feasible.) Then the crossing on the segment from x0 is located by
+///              bisection, so that the result meets the margin and the point just before it does not.
+/// sup-gamma, peak and nearest are +infinity where the plant is unstable; a start with an unstable
+/// plant is first moved by minimising the plant's abscissa until it is below zero.
+/// Gradients: where f is differentiable, the envelope (Danskin) formula at the maximising
+/// frequency or the rightmost root: d|Gamma(i w*)|/dx_j, dmu/dx_j = d(q/|N|^2)(w*)/dx_j, and for a
+/// root lambda of the characteristic function Delta, dlambda/dx_j = -(dDelta/dx_j) / Delta'(lambda);
+/// the partials in x_j of N, D and Delta at the fixed w* or lambda by central differences of the
+/// law's linearisation (step 1e-6 relative, error ~1e-12). The peak norm has no such formula here:
+/// its gradient is a central difference of ||h||_1 (step 1e-3 of the bound interval, the norm's
+/// error 1e-9), so `peak` is slower and less precise than the others.
+/// The minimiser: solve/optimize/nonsmooth.hpp, in the coordinates z_j with
+/// x_j = lo_j + (hi_j - lo_j)(1 - cos z_j)/2 (the bounds reached at z_j = 0, pi), from the car's
+/// own values (moved a thousandth of the box inside it when they lie outside or on a bound) and
+/// `starts` - 1 points of a Halton sequence in the box; the best run wins, and among runs whose
+/// objectives tie (to 1e-12 relative: the plateaus of sup-gamma and peak) the one that ended
+/// nearest the car's own values.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ddemap/analysis/stability/attenuation_margin.hpp"
+#include "ddemap/analysis/stability/peak_stability.hpp"
+#include "ddemap/analysis/stability/ring_stability.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
+#include "ddemap/core/execution.hpp"
+#include "ddemap/core/parameters.hpp"
+#include "ddemap/solve/optimize/nonsmooth.hpp"
+
+namespace ddemap {
+
+enum class DesignObjective { SupGamma, Peak, Abscissa, Nearest };
+
+/// "sup-gamma", "peak", "abscissa", "nearest"
+std::string to_string(DesignObjective o);
+/// The objective named by one of those words; std::invalid_argument naming the word otherwise.
+DesignObjective parse_design_objective(const std::string& name);
+
+struct DesignOptions {
+    DesignObjective objective = DesignObjective::SupGamma;
+    /// The law parameters designed (names of CarModel::law_parameter_names(), no repeats).
+    std::vector<std::string> free = {"k1", "k2"};
+    /// Their bounds; a free parameter without one gets [x0 / 10, 10 x0] (x0 its value at the car),
+    /// clipped to the law's domain. A bound on a parameter that is not free is an error.
+    ParameterBounds bounds;
+    /// sup-gamma and nearest: the attenuation margin asked for, in seconds (> 0); the other
+    /// objectives report whether the result meets it.
+    double margin = 0.1;
+    /// nearest: w_j of the weighted relative change (empty: all 1; else one per free parameter, > 0).
+    std::vector<double> weights;
+    /// abscissa: -1 the plant; 0 the ring of infinitely many cars; N >= 2 a ring of N cars. The
+    /// certified ring verdict at the result is reported for every objective when cars >= 0.
+    int cars = -1;
+    int starts = 4;  ///< the car's own values and starts - 1 Halton points (1 to 64)
+    /// The minimiser's options; design locates kinks to 1e-6 of the box (the sampling radius in
+    /// the coordinates z, whose range is [0, pi] for every parameter) in at most 500 iterations.
+    NonsmoothOptions optimizer = [] {
+        NonsmoothOptions o;
+        o.final_radius = 1e-6;
+        o.max_iterations = 500;
+        return o;
+    }();
+    PeakOptions peak;  ///< of the peak objective and of the peak verdict at the result
+    /// After each start: (starts done, starts). It may throw ddemap::Cancelled to stop.
+    Progress progress;
+    /// std::invalid_argument naming the first bad option (the names against the law in design_gains).
+    void validate() const;
+};
+
+/// One run of the minimiser.
+struct DesignStart {
+    std::string objective;  ///< what this run minimised (sup-gamma runs are followed by nearest runs)
+    ParameterMap start;   ///< the free parameters where it started
+    ParameterMap end;     ///< where it ended
+    double value = 0.0;   ///< the objective there (nearest: the change, plus the penalty rho (1 - m*/m) where the margin is not met)
+    Status status = Status::Converged;
+    std::string message;
+    int iterations = 0, evaluations = 0;
+};
+
+struct DesignResult {
+    /// Converged: the best run met the minimiser's stationarity test (or, for nearest, found the
+    /// crossing) and the verdicts at the result are decided; otherwise the minimiser's status
+    /// (the gains are the best found, not an optimum) or the undecided verdict's.
+    Status status = Status::Converged;
+    std::string message;
+    std::string objective;       ///< to_string(options.objective)
+    std::string method;          ///< the minimiser used (BFGS for the objectives, sequential QP for nearest)
+    std::string model;           ///< the law (ovrv, idm, ...)
+    std::vector<std::string> free;
+    ParameterBounds bounds;      ///< the bounds used, one per free parameter
+    ParameterMap initial;        ///< every parameter of the car as given (speed included)
+    ParameterMap parameters;     ///< the same with the free ones designed
+    ParameterMap gains;          ///< the free parameters at the result
+    std::vector<std::string> at_bound;  ///< free parameters on a bound (within 1e-9 of the width)
+    /// The objective at the car's own values (+inf: plant unstable) and at the result; for
+    /// nearest the relative change itself (0 at the car).
+    double value_initial = 0.0;
+    double value = 0.0;
+    double change = 0.0;         ///< the weighted relative change from the car's own values
+    AttenuationScan attenuation_initial, attenuation;  ///< sup |Gamma|, mu and m* (meaningful with a stable plant)
+    bool margin_met = false;     ///< attenuation margin m* >= options.margin at the result (to 1e-9 relative)
+    /// A proof that no gains within the bounds are string stable, when one is known (the ovrv law
+    /// with th and tau held: its low-frequency coefficient is negative at every corner of the
+    /// (k1, k2) box, and linear there); empty otherwise.
+    std::string infeasibility_proof;
+    StringResult string_initial; ///< certified plant, L2 and peak verdicts at the car's own values
+    StringResult string;         ///< the same at the result
+    std::optional<RingResult> ring_initial, ring;  ///< when options.cars >= 0
+    std::string ring_method;     ///< "winding" or "modes" when ring is set
+    std::vector<DesignStart> starts;
+    int evaluations = 0;         ///< objective evaluations over every run
+};
+
+/// Designs the free parameters of the car `model` with `parameters` (every law parameter and
+/// the operating speed, as make_model takes them). std::invalid_argument for bad options, a free
+/// parameter or bound the law does not have, a car value outside its bounds, or a law with more
+/// than one leader; the string objectives need a single leader.
+DesignResult design_gains(const std::string& model, const ParameterMap& parameters, const DesignOptions& options = {});
+
+}  // namespace ddemap

@@ -1,0 +1,869 @@
+#include "ddemap/analysis/design/design.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+
+#include "core/internal/text.hpp"
+#include "ddemap/analysis/stability/ring_fast.hpp"
+#include "ddemap/problem/linear_dde.hpp"
+#include "ddemap/solve/roots.hpp"
+#include "ddemap/traffic/transfer_function.hpp"
+
+namespace ddemap {
+
+std::string to_string(DesignObjective o) {
+    switch (o) {
+        case DesignObjective::SupGamma: return "sup-gamma";
+        case DesignObjective::Peak: return "peak";
+        case DesignObjective::Abscissa: return "abscissa";
+        case DesignObjective::Nearest: return "nearest";
+    }
+    return "?";
+}
+
+DesignObjective parse_design_objective(const std::string& name) {
+    for (DesignObjective o : {DesignObjective::SupGamma, DesignObjective::Peak, DesignObjective::Abscissa, DesignObjective::Nearest})
+        if (to_string(o) == name) return o;
+    throw std::invalid_argument("objective " + detail::quoted(name) + ": expected sup-gamma, peak, abscissa or nearest");
+}
+
+void DesignOptions::validate() const {
+    if (free.empty()) throw std::invalid_argument("design: expected at least one free parameter");
+    for (std::size_t i = 0; i < free.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (free[i] == free[j]) throw std::invalid_argument("design: free parameter " + detail::quoted(free[i]) + " is named twice");
+    if (free.size() > 8) throw std::invalid_argument("design: " + std::to_string(free.size()) + " free parameters: expected at most 8");
+    if (!(margin > 0.0) || !std::isfinite(margin) || margin > 1e3)
+        throw std::invalid_argument("design: margin = " + detail::significant(margin, 6) + " s: expected a number in (0, 1000] seconds");
+    if (!weights.empty()) {
+        if (weights.size() != free.size())
+            throw std::invalid_argument("design: " + std::to_string(weights.size()) + " weights for " + std::to_string(free.size()) +
+                                        " free parameters: expected one per free parameter");
+        for (std::size_t j = 0; j < weights.size(); ++j)
+            if (!(weights[j] > 0.0) || !std::isfinite(weights[j]) || weights[j] > 1e6)
+                throw std::invalid_argument("design: weight of " + free[j] + " = " + detail::significant(weights[j], 6) + ": expected a number in (0, 1e6]");
+    }
+    if (cars < -1 || cars == 1) throw std::invalid_argument("design: cars = " + std::to_string(cars) + ": expected -1 (the plant), 0 (N = infinity) or N >= 2");
+    if (cars > kWindingMaxCars) throw std::invalid_argument("design: cars = " + std::to_string(cars) + ": expected at most 10^9");
+    if (starts < 1 || starts > 64) throw std::invalid_argument("design: starts = " + std::to_string(starts) + ": expected 1 to 64");
+    optimizer.validate();
+    peak.validate();
+    validate_bounds(bounds);
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Steps of the sequential QP at most: it converges linearly where the boundary is curved (the
+// QP's metric is the distance's alone; measured ratios 0.5 to 0.85 per step on the paper's cars)
+constexpr int kSqpSteps = 300;
+// Integrator steps of one ||h||_1 run during a peak search (about 0.05 s)
+constexpr long kSearchPeakSteps = 200000;
+// Evaluations of one run of the peak search at most
+constexpr int kPeakEvaluations = 40;
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+    return s;
+}
+
+// The radical inverse of i in base b (Halton sequence).
+double halton(int i, int b) {
+    double f = 1.0, r = 0.0;
+    for (int k = i; k > 0; k /= b) {
+        f /= b;
+        r += f * (k % b);
+    }
+    return r;
+}
+
+class Problem {
+public:
+    Problem(std::string model, ParameterMap base, const DesignOptions& o) : m_model(std::move(model)), m_base(std::move(base)), m_opt(o) {}
+
+    std::string m_model;
+    ParameterMap m_base;
+    const DesignOptions& m_opt;
+    std::vector<double> lo, hi, x0, w;
+    int evaluations = 0;
+    double rho = 10.0;  // nearest: the penalty weight
+
+    std::size_t n() const { return m_opt.free.size(); }
+    ParameterMap params(const Eigen::VectorXd& x) const {
+        ParameterMap p = m_base;
+        for (std::size_t j = 0; j < n(); ++j) p[m_opt.free[j]] = x[static_cast<Eigen::Index>(j)];
+        return p;
+    }
+    Linearisation lin(const Eigen::VectorXd& x) const { return make_model(m_model, params(x))->linearise(); }
+    double step(std::size_t j, const Eigen::VectorXd& x) const {
+        return 1e-6 * std::max(std::abs(x[static_cast<Eigen::Index>(j)]), 1e-3 * (hi[j] - lo[j]));
+    }
+    // x_j = lo + (hi - lo)(1 - cos z)/2
+    Eigen::VectorXd x_of(const Eigen::VectorXd& z) const {
+        Eigen::VectorXd x(z.size());
+        for (std::size_t j = 0; j < n(); ++j) {
+            const auto J = static_cast<Eigen::Index>(j);
+            x[J] = std::clamp(lo[j] + (hi[j] - lo[j]) * 0.5 * (1.0 - std::cos(z[J])), lo[j], hi[j]);
+        }
+        return x;
+    }
+    Eigen::VectorXd z_of(const Eigen::VectorXd& x) const {
+        Eigen::VectorXd z(x.size());
+        for (std::size_t j = 0; j < n(); ++j) {
+            const auto J = static_cast<Eigen::Index>(j);
+            const double u = hi[j] > lo[j] ? (x[J] - lo[j]) / (hi[j] - lo[j]) : 0.5;
+            z[J] = std::acos(std::clamp(1.0 - 2.0 * u, -1.0, 1.0));
+        }
+        return z;
+    }
+    Eigen::VectorXd dx_dz(const Eigen::VectorXd& z) const {
+        Eigen::VectorXd d(z.size());
+        for (std::size_t j = 0; j < n(); ++j) d[static_cast<Eigen::Index>(j)] = (hi[j] - lo[j]) * 0.5 * std::sin(z[static_cast<Eigen::Index>(j)]);
+        return d;
+    }
+    double distance(const Eigen::VectorXd& x, Eigen::VectorXd* grad) const {
+        double s = 0.0;
+        for (std::size_t j = 0; j < n(); ++j) {
+            const double r = w[j] * (x[static_cast<Eigen::Index>(j)] - x0[j]) / std::abs(x0[j]);
+            s += r * r;
+        }
+        const double d = std::sqrt(s);
+        if (grad) {
+            grad->setZero(static_cast<Eigen::Index>(n()));
+            if (d > 0.0)
+                for (std::size_t j = 0; j < n(); ++j)
+                    (*grad)[static_cast<Eigen::Index>(j)] = w[j] * w[j] * (x[static_cast<Eigen::Index>(j)] - x0[j]) / (x0[j] * x0[j] * d);
+        }
+        return d;
+    }
+
+    // Central differences of a function of the linearisation at fixed frequency or root.
+    template <class F>
+    Eigen::VectorXd partials(const Eigen::VectorXd& x, const F& f) const {
+        Eigen::VectorXd g(static_cast<Eigen::Index>(n()));
+        for (std::size_t j = 0; j < n(); ++j) {
+            const double h = step(j, x);
+            Eigen::VectorXd xp = x, xm = x;
+            xp[static_cast<Eigen::Index>(j)] += h;
+            xm[static_cast<Eigen::Index>(j)] -= h;
+            g[static_cast<Eigen::Index>(j)] = (f(lin(xp)) - f(lin(xm))) / (2.0 * h);
+        }
+        return g;
+    }
+
+    // Rightmost root of the plant: its real part, the gradient (when asked), NaN if not converged.
+    double plant(const Eigen::VectorXd& x, const Linearisation& L, Eigen::VectorXd* grad) const {
+        if (!is_computable(L)) return std::numeric_limits<double>::quiet_NaN();
+        RootOptions ro;
+        ro.count = 2;
+        const RootResult r = rightmost_roots(plant_dde(L), ro);
+        if (r.status != Status::Converged || r.roots.empty()) return std::numeric_limits<double>::quiet_NaN();
+        const cplx lambda = r.roots.front().value;
+        if (grad) {
+            cplx nn, d, dn, dd;
+            TransferFunction(L).evaluate(lambda, nn, d, dn, dd);
+            const Eigen::VectorXd re = partials(x, [&](const Linearisation& l) { return TransferFunction(l).denominator(lambda).real(); });
+            const Eigen::VectorXd im = partials(x, [&](const Linearisation& l) { return TransferFunction(l).denominator(lambda).imag(); });
+            *grad = Eigen::VectorXd(static_cast<Eigen::Index>(n()));
+            for (Eigen::Index j = 0; j < grad->size(); ++j) (*grad)[j] = (-cplx(re[j], im[j]) / dd).real();
+        }
+        return lambda.real();
+    }
+
+    double ring(const Eigen::VectorXd& x, const Linearisation& L, Eigen::VectorXd* grad) const {
+        const FastRing fr = analyse_ring_fast(L, m_opt.cars, resolve_ring_method("auto", L), 1);
+        if (fr.ring.status != Status::Converged) return std::numeric_limits<double>::quiet_NaN();
+        const double a = fr.ring.spectral_abscissa;
+        if (!grad) return a;
+        *grad = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n()));
+        if (fr.ring.abscissa_is_limit) return a;
+        if (!fr.ring.roots.empty()) {
+            const RingRoot& rr = fr.ring.roots.front();
+            const cplx lambda = rr.root.value;
+            const cplx zeta = std::polar(1.0, -rr.theta);
+            cplx nn, d, dn, dd;
+            TransferFunction(L).evaluate(lambda, nn, d, dn, dd);
+            const cplx fprime = dd - zeta * dn;
+            auto delta = [&](const Linearisation& l) {
+                cplx a1, b1;
+                TransferFunction(l).evaluate(lambda, a1, b1);
+                return b1 - zeta * a1;
+            };
+            const Eigen::VectorXd re = partials(x, [&](const Linearisation& l) { return delta(l).real(); });
+            const Eigen::VectorXd im = partials(x, [&](const Linearisation& l) { return delta(l).imag(); });
+            for (Eigen::Index j = 0; j < grad->size(); ++j) (*grad)[j] = (-cplx(re[j], im[j]) / fprime).real();
+            return a;
+        }
+        // no root listed: differences of the abscissa itself
+        for (std::size_t j = 0; j < n(); ++j) {
+            const double h = 1e-5 * (hi[j] - lo[j]);
+            Eigen::VectorXd xp = x, xm = x;
+            xp[static_cast<Eigen::Index>(j)] += h;
+            xm[static_cast<Eigen::Index>(j)] -= h;
+            const double ap = ring(xp, lin(xp), nullptr), am = ring(xm, lin(xm), nullptr);
+            (*grad)[static_cast<Eigen::Index>(j)] = (ap - am) / (2.0 * h);
+        }
+        return a;
+    }
+
+    // mu's gradient at the frequency where the scan found it (the limit w -> 0: c2 / D(0)^2).
+    Eigen::VectorXd mu_gradient(const Eigen::VectorXd& x, const AttenuationScan& s) const {
+        if (s.omega_mu == 0.0)
+            return partials(x, [](const Linearisation& l) {
+                const LowFrequency lf = low_frequency_expansion(l);
+                return lf.c2 / (lf.d0 * lf.d0);
+            });
+        const double wm = s.omega_mu;
+        return partials(x, [wm](const Linearisation& l) {
+            const TransferFunction tf(l);
+            double q = 0.0;
+            tf.attenuation(wm, &q);
+            return q / std::norm(tf.numerator(cplx(0.0, wm)));
+        });
+    }
+    Eigen::VectorXd sup_gradient(const Eigen::VectorXd& x, const AttenuationScan& s) const {
+        if (s.omega_sup == 0.0) return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n()));
+        const double ws = s.omega_sup;
+        return partials(x, [ws](const Linearisation& l) { return std::abs(TransferFunction(l)(cplx(0.0, ws))); });
+    }
+
+    // sup-gamma: the weighted norm sup |Gamma(i w)| |1 + i m w|, m = margin (Danskin at its frequency)
+    double sup_objective(const AttenuationScan& s, const Eigen::VectorXd& x, Eigen::VectorXd* grad) const {
+        if (grad) {
+            if (s.omega_weighted == 0.0) {
+                *grad = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n()));
+            } else {
+                const double ws = s.omega_weighted, wt = std::hypot(1.0, m_opt.margin * ws);
+                *grad = partials(x, [ws, wt](const Linearisation& l) { return std::abs(TransferFunction(l)(cplx(0.0, ws))) * wt; });
+            }
+        }
+        return s.weighted_sup;
+    }
+    double nearest_objective(const AttenuationScan& s, const Eigen::VectorXd& x, Eigen::VectorXd* grad) const {
+        Eigen::VectorXd gd;
+        const double d = distance(x, grad ? &gd : nullptr);
+        const double viol = 1.0 - s.margin / m_opt.margin;
+        if (grad) *grad = gd;
+        if (viol <= 0.0) return d;
+        if (grad) *grad -= (rho / m_opt.margin) * mu_gradient(x, s) / (2.0 * std::max(std::abs(s.margin), 1e-8));
+        return d + rho * viol;
+    }
+    // ||h||_1 during the search, with at most kSearchPeakSteps steps per run: a design whose step
+    // response needs more (a plant that settles slowly) is outside the search's domain, so that
+    // no evaluation takes seconds; the result's own verdict uses the full options.
+    double peak_value(const Linearisation& L, double abscissa) const {
+        PeakOptions o = m_opt.peak;
+        o.max_steps = std::min(o.max_steps, kSearchPeakSteps);
+        o.tolerance = std::max(o.tolerance, 1e-6);  // the differences of the gradient need no more
+        const PeakResult p = peak_string_stability(L, abscissa, o);
+        if (p.verdict == Verdict::Undecided || !p.finite) return std::numeric_limits<double>::quiet_NaN();
+        return p.norm;
+    }
+
+    // The objective in x (gradient in x when asked); +inf / NaN where undefined.
+    std::function<void()> tick;  // after every evaluation of a search (progress)
+    long run_evaluations = 0;    // evaluations of the current run that were reported
+    double value(const Eigen::VectorXd& x, Eigen::VectorXd* grad, DesignObjective o) {
+        ++evaluations;
+        if (tick) tick();
+        const Linearisation L = lin(x);
+        if (!is_computable(L)) return kInf;  // outside the analyses' range: outside the search's domain
+        if (o == DesignObjective::Abscissa) return m_opt.cars < 0 ? plant(x, L, grad) : ring(x, L, grad);
+        const double a = plant(x, L, nullptr);
+        if (!(a < 0.0)) return kInf;
+        if (o == DesignObjective::Peak) {
+            const double v = peak_value(L, a);
+            if (grad && std::isfinite(v)) {
+                *grad = Eigen::VectorXd(static_cast<Eigen::Index>(n()));
+                for (std::size_t j = 0; j < n(); ++j) {
+                    const double h = 1e-3 * (hi[j] - lo[j]);
+                    Eigen::VectorXd xp = x, xm = x;
+                    xp[static_cast<Eigen::Index>(j)] += h;
+                    xm[static_cast<Eigen::Index>(j)] -= h;
+                    const Linearisation Lp = lin(xp), Lm = lin(xm);
+                    const double vp = peak_value(Lp, plant(xp, Lp, nullptr)), vm = peak_value(Lm, plant(xm, Lm, nullptr));
+                    if (!std::isfinite(vp) || !std::isfinite(vm)) return kInf;
+                    (*grad)[static_cast<Eigen::Index>(j)] = (vp - vm) / (2.0 * h);
+                }
+            }
+            return v;
+        }
+        const AttenuationScan s = attenuation_scan(L, m_opt.margin);
+        return o == DesignObjective::SupGamma ? sup_objective(s, x, grad) : nearest_objective(s, x, grad);
+    }
+
+    // One piece of the margin constraint at a fixed frequency w: mu >= m^2 there is
+    //     g = (q(w) - m^2 |N(i w)|^2) / |N(i w)| >= 0,
+    // and at w = 0 (the limit) g = (c2 - m^2 D(0)^2) / |D(0)|: for ovrv 2 B - m^2 k1 with B of
+    // ovrv_infeasibility, linear in (k1, k2), where mu = c2 / k1^2 itself is far from linear.
+    static double margin_piece(const Linearisation& l, double omega, double m2) {
+        if (omega == 0.0) {
+            const LowFrequency lf = low_frequency_expansion(l);
+            return (lf.c2 - m2 * lf.d0 * lf.d0) / std::abs(lf.d0);
+        }
+        const TransferFunction tf(l);
+        double q = 0.0;
+        tf.attenuation(omega, &q);
+        const double nn = std::abs(tf.numerator(cplx(0.0, omega)));
+        return (q - m2 * nn * nn) / nn;
+    }
+
+    struct Sqp {
+        Status status = Status::MaxIterations;
+        std::string message;
+        Eigen::VectorXd x;
+        int iterations = 0;
+    };
+
+    // min sum_j M_j (y_j - x0_j)^2 subject to A y >= b, by the KKT conditions of every active set
+    // of at most n constraints (the problem is convex: the feasible point with multipliers >= 0
+    // is its minimum). false when no active set gives one (the constraints are inconsistent).
+    bool solve_qp(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& M, const Eigen::VectorXd& c, Eigen::VectorXd& y) const {
+        const int k = static_cast<int>(A.rows()), nn = static_cast<int>(A.cols());
+        double best = kInf;
+        for (unsigned mask = 0; mask < (1u << k); ++mask) {
+            const int size = __builtin_popcount(mask);
+            if (size > nn) continue;
+            std::vector<int> S;
+            for (int i = 0; i < k; ++i)
+                if (mask & (1u << i)) S.push_back(i);
+            Eigen::VectorXd cand = c, lambda;
+            if (size > 0) {
+                Eigen::MatrixXd As(size, nn);
+                Eigen::VectorXd bs(size);
+                for (int i = 0; i < size; ++i) {
+                    As.row(i) = A.row(S[static_cast<std::size_t>(i)]);
+                    bs[i] = b[S[static_cast<std::size_t>(i)]];
+                }
+                const Eigen::MatrixXd AMi = As * M.cwiseInverse().asDiagonal();
+                const Eigen::MatrixXd K = AMi * As.transpose();
+                Eigen::FullPivLU<Eigen::MatrixXd> lu(K);
+                if (lu.rank() < size) continue;
+                lambda = lu.solve(bs - As * c);
+                if ((lambda.array() < -1e-12 * (1.0 + lambda.cwiseAbs().maxCoeff())).any()) continue;
+                cand = c + M.cwiseInverse().asDiagonal() * (As.transpose() * lambda);
+            }
+            const Eigen::VectorXd slack = A * cand - b;
+            bool ok = true;
+            for (int i = 0; i < k; ++i)
+                if (slack[i] < -1e-10 * (std::abs(b[i]) + A.row(i).cwiseAbs().dot(cand.cwiseAbs()) + 1e-300)) ok = false;
+            if (!ok) continue;
+            const double obj = (cand - c).cwiseProduct(M).dot(cand - c);
+            if (obj < best) {
+                best = obj;
+                y = cand;
+            }
+        }
+        return std::isfinite(best);
+    }
+
+    // Nearest gains with mu >= margin^2 by sequential quadratic programming on the pieces of mu
+    // (a semi-infinite constraint: every local minimum over w, each linearised at its frequency),
+    // the box as bounds. Each step solves the convex QP exactly.
+    Sqp nearest_sqp(const Eigen::VectorXd& start, int& scans) {
+        Sqp out;
+        const Eigen::Index nn = static_cast<Eigen::Index>(n());
+        Eigen::VectorXd M(nn), c(nn), x = start;
+        for (std::size_t j = 0; j < n(); ++j) {
+            M[static_cast<Eigen::Index>(j)] = w[j] * w[j] / (x0[j] * x0[j]);
+            c[static_cast<Eigen::Index>(j)] = x0[j];
+        }
+        const double target = m_opt.margin * m_opt.margin;
+        std::vector<double> history;  // distances of the iterates that meet the margin
+        for (out.iterations = 0; out.iterations < kSqpSteps; ++out.iterations) {
+            const Linearisation L = lin(x);
+            if (!(plant(x, L, nullptr) < 0.0)) {
+                out.status = Status::NumericalIssue;
+                out.message = "an iterate has an unstable plant";
+                out.x = x;
+                return out;
+            }
+            const AttenuationScan sc = attenuation_scan(L);
+            ++scans;
+            const auto& pieces = sc.mu_minima;
+            const int k = static_cast<int>(pieces.size()) + 2 * static_cast<int>(nn);
+            Eigen::MatrixXd A = Eigen::MatrixXd::Zero(k, nn);
+            Eigen::VectorXd b(k);
+            double least = kInf;
+            for (std::size_t i = 0; i < pieces.size(); ++i) {
+                const double om = pieces[i].omega;
+                const Eigen::VectorXd g = partials(x, [om, target](const Linearisation& l) { return margin_piece(l, om, target); });
+                A.row(static_cast<Eigen::Index>(i)) = g.transpose();
+                b[static_cast<Eigen::Index>(i)] = -margin_piece(L, om, target) + g.dot(x);
+                least = std::min(least, pieces[i].mu);
+            }
+            for (Eigen::Index j = 0; j < nn; ++j) {
+                const auto r = static_cast<Eigen::Index>(pieces.size()) + 2 * j;
+                A(r, j) = 1.0;
+                b[r] = lo[static_cast<std::size_t>(j)];
+                A(r + 1, j) = -1.0;
+                b[r + 1] = -hi[static_cast<std::size_t>(j)];
+            }
+            Eigen::VectorXd y;
+            bool solved = solve_qp(A, b, M, c, y);
+            // far from the boundary the linearised pieces may contradict each other within the
+            // bounds: step on the most violated piece alone (the next step has them all again)
+            std::vector<std::size_t> order(pieces.size());
+            for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+            std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return pieces[i].mu < pieces[j].mu; });
+            for (std::size_t oi = 0; !solved && oi < order.size(); ++oi) {
+                const auto keep = static_cast<Eigen::Index>(order[oi]);
+                Eigen::MatrixXd A1(1 + 2 * nn, nn);
+                Eigen::VectorXd b1(1 + 2 * nn);
+                A1.row(0) = A.row(keep);
+                b1[0] = b[keep];
+                A1.bottomRows(2 * nn) = A.bottomRows(2 * nn);
+                b1.tail(2 * nn) = b.tail(2 * nn);
+                solved = solve_qp(A1, b1, M, c, y);
+            }
+            if (!solved) {
+                out.status = Status::NumericalIssue;
+                out.message = "the linearised margin constraint has no solution within the bounds";
+                out.x = x;
+                return out;
+            }
+            // a step into the region of unstable plants is halved (the margin is not defined there)
+            for (int half = 0; half < 30; ++half) {
+                if (plant(y, lin(y), nullptr) < 0.0) break;
+                y = x + 0.5 * (y - x);
+            }
+            const double step = std::sqrt((y - x).cwiseProduct(M).dot(y - x));
+            const double dist = std::sqrt((y - c).cwiseProduct(M).dot(y - c));
+            if (least >= target * (1.0 - 1e-6)) history.push_back(std::sqrt((x - c).cwiseProduct(M).dot(x - c)));
+            else history.clear();
+            x = y;
+            // the linearisations come from differences of the law (relative error ~1e-10) at
+            // frequencies located to ~1e-12: steps settle at about 1e-10 of the distance
+            if (step <= 1e-8 * (1.0 + dist) && least >= target * (1.0 - 1e-6)) {
+                out.status = Status::Converged;
+                out.message = "sequential QP: the step fell below 1e-8 of the distance with the margin met (" + std::to_string(out.iterations + 1) +
+                              " steps)";
+                out.x = x;
+                return out;
+            }
+        }
+        // steps that keep oscillating at the rounding level of the linearisations while the
+        // distance has settled: the last ten feasible iterates agree
+        if (history.size() >= 10) {
+            const auto [lo_d, hi_d] = std::minmax_element(history.end() - 10, history.end());
+            if (*hi_d - *lo_d <= 1e-7 * (1.0 + *hi_d)) {
+                out.status = Status::Converged;
+                out.message = "sequential QP: the distance settled to 1e-7 over the last 10 of " + std::to_string(kSqpSteps) + " steps (the steps oscillate at the rounding of the linearisations)";
+                out.x = x;
+                return out;
+            }
+        }
+        out.message = "sequential QP: no convergence in " + std::to_string(kSqpSteps) + " steps";
+        out.x = x;
+        return out;
+    }
+
+    NonsmoothFunction in_z(DesignObjective o) {
+        return [this, o](const Eigen::VectorXd& z, Eigen::VectorXd& gz) {
+            const Eigen::VectorXd x = x_of(z);
+            Eigen::VectorXd gx;
+            const double v = value(x, &gx, o);
+            if (!std::isfinite(v)) return v;
+            gz = gx.cwiseProduct(dx_dz(z));
+            return v;
+        };
+    }
+    ParameterMap free_map(const Eigen::VectorXd& x) const {
+        ParameterMap m;
+        for (std::size_t j = 0; j < n(); ++j) m[m_opt.free[j]] = x[static_cast<Eigen::Index>(j)];
+        return m;
+    }
+};
+
+// For the ovrv law with th and tau held, the low-frequency coefficient is
+//     c2 = 2 k1 B,  B = k1 th (th/2 - tau) + k2 (th - tau) - 1,
+// linear in (k1, k2): its largest value over a box is at a corner. When B < 0 at every corner,
+// no gains of the box are string stable (nor have any attenuation margin). Returns that proof.
+std::string ovrv_infeasibility(const std::string& model, const ParameterMap& p, const std::vector<std::string>& free,
+                               const std::vector<double>& lo, const std::vector<double>& hi) {
+    if (model != "ovrv") return {};
+    double k1lo = p.at("k1"), k1hi = k1lo, k2lo = p.at("k2"), k2hi = k2lo;
+    for (std::size_t j = 0; j < free.size(); ++j) {
+        if (free[j] == "k1") {
+            k1lo = lo[j];
+            k1hi = hi[j];
+        } else if (free[j] == "k2") {
+            k2lo = lo[j];
+            k2hi = hi[j];
+        } else if (free[j] != "eta") {
+            return {};
+        }
+    }
+    const double th = p.at("th"), tau = p.at("tau");
+    double best = -kInf;
+    for (double k1 : {k1lo, k1hi})
+        for (double k2 : {k2lo, k2hi}) best = std::max(best, k1 * th * (th / 2.0 - tau) + k2 * (th - tau) - 1.0);
+    if (best >= 0.0) return {};
+    return "no gains within the bounds are string stable: for ovrv, c2 = 2 k1 B with B = k1 th (th/2 - tau) + k2 (th - tau) - 1, linear in "
+           "(k1, k2), is negative at every corner of the box (largest B = " +
+           detail::significant(best, 6) + " with th = " + detail::significant(th, 6) + " s, tau = " + detail::significant(tau, 6) +
+           " s), so |Gamma(i w)| > 1 at low frequencies for every k1, k2 there" + (th <= tau ? " (th <= tau: free th too)" : "");
+}
+
+}  // namespace
+
+DesignResult design_gains(const std::string& model, const ParameterMap& parameters, const DesignOptions& options) {
+    options.validate();
+    const auto car = make_model(model, parameters);  // validates the car itself
+    const Linearisation lin0 = car->linearise();
+    if (lin0.leaders() > 1) require_single_leader(lin0, "design");
+    require_computable(lin0, "the car to design from");
+    const std::vector<std::string> names = car->law_parameter_names();
+    const std::vector<ParameterSpec> specs = model_parameters(model);
+    DesignResult r;
+    r.objective = to_string(options.objective);
+    r.model = model;
+    r.free = options.free;
+    r.initial = car->parameters();
+    Problem P(model, r.initial, options);
+    for (const BoundedParameter& b : options.bounds)
+        if (std::find(options.free.begin(), options.free.end(), b.name) == options.free.end())
+            throw std::invalid_argument("design: a bound on " + b.name + ", which is not free: expected bounds on the free parameters (" +
+                                        join(options.free, ", ") + ") only");
+    for (std::size_t j = 0; j < options.free.size(); ++j) {
+        const std::string& name = options.free[j];
+        if (std::find(names.begin(), names.end(), name) == names.end())
+            throw std::invalid_argument("design: free parameter " + detail::quoted(name) + ": expected one of the " + model + " law's parameters (" +
+                                        join(names, ", ") + ")");
+        const double v = r.initial.at(name);
+        const ParameterSpec* spec = nullptr;
+        for (const ParameterSpec& s : specs)
+            if (s.name == name) spec = &s;
+        double lo, hi;
+        if (const BoundedParameter* b = find_bound(options.bounds, name)) {
+            lo = b->lower;
+            hi = b->upper;
+        } else {
+            if (!(v > 0.0))
+                throw std::invalid_argument("design: " + name + " = " + detail::significant(v, 6) + " has no default bound [" + name + "/10, 10 " + name +
+                                            "]: give its bounds");
+            lo = v / 10.0;
+            hi = v * 10.0;
+        }
+        if (!(hi > lo))
+            throw std::invalid_argument("design: bounds of " + name + " = " + detail::significant(lo, 6) + ":" + detail::significant(hi, 6) +
+                                        ": expected LO < HI");
+        if (spec && (lo < spec->lower || (spec->lower_open && lo <= spec->lower)))
+            throw std::invalid_argument("design: lower bound of " + name + " = " + detail::significant(lo, 6) + ": expected " +
+                                        (spec->lower_open ? "> " : ">= ") + detail::significant(spec->lower, 6) + " (the law's domain)");
+        if (options.objective == DesignObjective::Nearest && v == 0.0)
+            throw std::invalid_argument("design: nearest measures relative changes, and " + name + " = 0 at the car: expected a nonzero value");
+        P.lo.push_back(lo);
+        P.hi.push_back(hi);
+        P.x0.push_back(v);
+        P.w.push_back(options.weights.empty() ? 1.0 : options.weights[j]);
+        r.bounds.push_back({name, lo, hi});
+    }
+    const std::size_t n = options.free.size();
+    Eigen::VectorXd x0(static_cast<Eigen::Index>(n));
+    for (std::size_t j = 0; j < n; ++j) x0[static_cast<Eigen::Index>(j)] = P.x0[j];
+
+    StringOptions so;
+    so.peak = true;
+    so.peak_options = options.peak;
+    r.string_initial = analyse_string(lin0, so);
+    if (r.string_initial.plant_stable) r.attenuation_initial = attenuation_scan(lin0, options.margin);
+    if (options.cars >= 0) r.ring_initial = analyse_ring_fast(lin0, options.cars, resolve_ring_method("auto", lin0), 0).ring;
+    r.value_initial = P.value(x0, nullptr, options.objective);
+    if (std::isnan(r.value_initial)) r.value_initial = kInf;
+
+    // starts: the car's own values moved a thousandth of the width inside the box, then Halton points
+    std::vector<Eigen::VectorXd> starts;
+    {
+        Eigen::VectorXd s = x0;
+        for (std::size_t j = 0; j < n; ++j) {
+            const double m = 1e-3 * (P.hi[j] - P.lo[j]);
+            s[static_cast<Eigen::Index>(j)] = std::clamp(s[static_cast<Eigen::Index>(j)], P.lo[j] + m, P.hi[j] - m);
+        }
+        starts.push_back(s);
+        static const int primes[8] = {2, 3, 5, 7, 11, 13, 17, 19};
+        for (int i = 1; i < options.starts; ++i) {
+            Eigen::VectorXd h(static_cast<Eigen::Index>(n));
+            for (std::size_t j = 0; j < n; ++j) h[static_cast<Eigen::Index>(j)] = P.lo[j] + (P.hi[j] - P.lo[j]) * halton(i, primes[j]);
+            starts.push_back(h);
+        }
+    }
+
+    struct Outcome {
+        double best = kInf;
+        Eigen::VectorXd x;
+        Status status = Status::NumericalIssue;
+        std::string message = "no start gave a finite objective";
+    };
+    const bool two_phases = options.objective == DesignObjective::SupGamma;
+    // the peak norm's gradient is a difference of norms computed to ~1e-7: a looser stationarity
+    // test and a budget of kPeakEvaluations evaluations per run (each is 1 + 2 n norms)
+    NonsmoothOptions search = options.optimizer;
+    if (options.objective == DesignObjective::Peak) {
+        search.max_evaluations = std::min(search.max_evaluations, kPeakEvaluations);
+        search.stationarity_tolerance = std::max(search.stationarity_tolerance, 1e-4);
+    }
+    // both are at least 1: reaching 1 is a global minimum, the run stops there
+    if (options.objective == DesignObjective::Peak) search.target = 1.0 + std::max(options.peak.tolerance, 1e-6);
+    if (options.objective == DesignObjective::SupGamma) search.target = 1.0 + 1e-9;
+    // progress in evaluations: every run counts its budget (an upper bound), the runs of
+    // nearest (sequential QP) and the second phase of sup-gamma one unit each
+    const long per_run = options.objective == DesignObjective::Nearest ? 1 : search.max_evaluations;
+    const long total = static_cast<long>(starts.size()) * (per_run + (two_phases ? 1 : 0)) +
+                       (options.objective == DesignObjective::Peak ? static_cast<long>(starts.size()) + per_run : 0);
+    long done = 0;
+    P.tick = [&] {
+        if (options.progress && per_run > 1 && P.run_evaluations < per_run) {
+            ++P.run_evaluations;
+            options.progress(++done, total);
+        }
+    };
+    // one run of the minimiser of objective `o` from every start; the best end
+    auto run = [&](DesignObjective o) {
+        Outcome out;
+        out.x = starts.front();
+        for (std::size_t k = 0; k < starts.size(); ++k) {
+            DesignStart ds;
+            ds.objective = to_string(o);
+            ds.start = P.free_map(starts[k]);
+            const int ev0 = P.evaluations;
+            Eigen::VectorXd z = P.z_of(starts[k]);
+            NonsmoothResult nr;
+            bool ok = true;
+            // an unstable plant first: lower the plant's abscissa below zero
+            if (o != DesignObjective::Abscissa) {
+                const double a = P.value(P.x_of(z), nullptr, DesignObjective::Abscissa);
+                if (!(a < 0.0)) {
+                    NonsmoothOptions o1 = search;
+                    o1.target = -1e-3;
+                    nr = minimize_nonsmooth(P.in_z(DesignObjective::Abscissa), z, o1);
+                    if (nr.status == Status::Converged && nr.value < 0.0) {
+                        z = nr.x;
+                    } else {
+                        ok = false;
+                        ds.status = nr.status;
+                        ds.message = "the plant is unstable here and its abscissa could not be brought below zero (least " +
+                                     detail::significant(nr.value, 6) + " 1/s)";
+                        ds.value = kInf;
+                    }
+                }
+            }
+            if (ok && o == DesignObjective::Nearest && n <= 4) {
+                int scans = 0;
+                const Problem::Sqp q = P.nearest_sqp(P.x_of(z), scans);
+                P.evaluations += scans;
+                ds.status = q.status;
+                ds.message = q.message;
+                ds.iterations = q.iterations;
+                z = P.z_of(q.x);
+                const Linearisation L = P.lin(q.x);
+                ds.value = P.nearest_objective(attenuation_scan(L, options.margin), q.x, nullptr);  // the distance where feasible
+            } else if (ok) {
+                if (o == DesignObjective::Nearest) {
+                    P.rho = 10.0;
+                    for (int round = 0; round < 4; ++round) {
+                        nr = minimize_nonsmooth(P.in_z(o), z, search);
+                        if (!std::isfinite(nr.value)) break;
+                        z = nr.x;
+                        if (attenuation_scan(P.lin(P.x_of(z))).margin >= options.margin * (1.0 - 1e-6)) break;
+                        P.rho *= 10.0;  // the penalty was too weak: the end is outside the set
+                    }
+                } else {
+                    nr = minimize_nonsmooth(P.in_z(o), z, search);
+                }
+                ds.status = nr.status;
+                ds.message = nr.message;
+                ds.iterations = nr.iterations;
+                ds.value = std::isfinite(nr.value) ? nr.value : kInf;
+                z = nr.x;
+            }
+            const Eigen::VectorXd xe = P.x_of(z);
+            ds.end = P.free_map(xe);
+            ds.evaluations = P.evaluations - ev0;
+            // nearest: compare the runs by distance among the feasible ends
+            double score = ds.value;
+            if (o == DesignObjective::Nearest && std::isfinite(score)) {
+                const Linearisation L = P.lin(xe);
+                const bool feasible = P.plant(xe, L, nullptr) < 0.0 && attenuation_scan(L).margin >= options.margin * (1.0 - 1e-6);
+                score = feasible ? P.distance(xe, nullptr) : 1e6 + score;
+            }
+            // ties (the plateau of peak: every non-overshooting design) go to the run that ended
+            // nearest the car's own values
+            const double tie = std::isfinite(out.best) ? 1e-12 * std::max(1.0, std::abs(out.best)) : 0.0;
+            const bool better = !std::isfinite(out.best)
+                                    ? score < out.best
+                                    : score < out.best - tie || (std::abs(score - out.best) <= tie && P.distance(xe, nullptr) < P.distance(out.x, nullptr));
+            if (better) {
+                out.best = score;
+                out.x = xe;
+                out.status = ds.status;
+                out.message = ds.message;
+            }
+            r.starts.push_back(ds);
+            // sup-gamma and peak are at least 1: a run that reached 1 found a global minimum,
+            // and the remaining starts are not run (their budgets count as done)
+            const double floor_tol = o == DesignObjective::Peak ? std::max(options.peak.tolerance, 1e-6) : 1e-9;
+            if ((o == DesignObjective::Peak || o == DesignObjective::SupGamma) && out.best <= 1.0 + floor_tol) {
+                done += static_cast<long>(starts.size() - k - 1) * per_run;
+                k = starts.size();
+            }
+            // the rest of this run's budget (or its one unit)
+            const long unit = o == DesignObjective::Nearest ? 1 : per_run;
+            done += std::max(0L, unit - P.run_evaluations);
+            P.run_evaluations = 0;
+            if (options.progress) options.progress(done, total);
+        }
+        return out;
+    };
+    // nearest: the crossing on the segment from the car's own values (infeasible) to the best
+    // end, by bisection; false when no run ended feasible
+    auto crossing = [&](const Outcome& out, Eigen::VectorXd& x) {
+        if (!std::isfinite(out.best) || out.best >= 1e6) return false;
+        auto in_box = [&](const Eigen::VectorXd& y) {
+            for (std::size_t j = 0; j < n; ++j)
+                if (y[static_cast<Eigen::Index>(j)] < P.lo[j] || y[static_cast<Eigen::Index>(j)] > P.hi[j]) return false;
+            return true;
+        };
+        auto feasible = [&](const Eigen::VectorXd& y) {
+            if (!in_box(y)) return false;
+            const Linearisation L = P.lin(y);
+            return P.plant(y, L, nullptr) < 0.0 && attenuation_scan(L).margin >= options.margin;
+        };
+        if (feasible(x0)) {
+            x = x0;
+            return true;
+        }
+        double t_in = -1.0;
+        for (double t = 1.0; t <= 1.0 + 1e-2; t = 1.0 + 2.0 * (t - 1.0) + 1e-9) {
+            const Eigen::VectorXd y = x0 + t * (out.x - x0);
+            if (!in_box(y)) break;
+            if (feasible(y)) {
+                t_in = t;
+                break;
+            }
+        }
+        if (t_in < 0.0) return false;
+        double a = 0.0, b = t_in;  // x0 + a d infeasible (or outside the box), x0 + b d feasible
+        for (int it = 0; it < 60 && (b - a) > 1e-13 * b; ++it) {
+            const double m = 0.5 * (a + b);
+            if (feasible(x0 + m * (out.x - x0))) b = m;
+            else a = m;
+        }
+        x = x0 + b * (out.x - x0);
+        return true;
+    };
+
+    // peak: peak stability implies L2 stability. Without L2-stable gains in the box (proved)
+    // there is nothing to search; else the search starts also from the nearest L2 design (a
+    // cheap sequential QP), inside the set where ||h||_1 can reach 1.
+    const std::string l2_proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+    bool skipped = false;
+    if (options.objective == DesignObjective::Peak) {
+        if (!l2_proof.empty()) {
+            skipped = true;
+        } else {
+            const Outcome l2 = run(DesignObjective::Nearest);
+            Eigen::VectorXd xn;
+            if (crossing(l2, xn)) starts.insert(starts.begin(), xn);
+        }
+    }
+    const Outcome first = skipped ? Outcome{} : run(options.objective);
+    Eigen::VectorXd x = skipped ? x0 : first.x;
+    Status best_status = skipped ? Status::Converged : first.status;
+    std::string best_message = skipped ? l2_proof + "; peak (L-infinity) stability implies it, so no gains of the box are peak stable either"
+                                       : first.message;
+    bool infeasible = false, plateau = false;
+    if (options.objective == DesignObjective::Nearest) {
+        infeasible = !crossing(first, x);
+    } else if (two_phases && first.best <= 1.0 + 1e-9) {
+        // sup-gamma reached its least value 1: of those gains, the nearest to the car's own
+        const Outcome second = run(DesignObjective::Nearest);
+        Eigen::VectorXd xn;
+        if (crossing(second, xn)) {
+            plateau = true;
+            x = xn;
+            best_status = second.status;
+            best_message = second.message;
+        }
+    }
+    if (options.progress && done < total) options.progress(total, total);
+    if (infeasible) {
+        x = x0;  // nothing found: the car's own values, unchanged
+        const std::string proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+        best_status = proof.empty() ? Status::BudgetExhausted : Status::Converged;
+        best_message = proof.empty() ? "no gains with an attenuation margin of at least " + detail::significant(options.margin, 6) +
+                                           " s found within the bounds from " + std::to_string(starts.size()) +
+                                           " starts (not a proof that none exist: widen the bounds, free more parameters or add starts)"
+                                     : proof;
+    }
+
+    r.gains = P.free_map(x);
+    r.parameters = P.params(x);
+    const Linearisation L = P.lin(x);
+    r.value = P.value(x, nullptr, options.objective);
+    if (std::isnan(r.value)) r.value = kInf;
+    r.change = P.distance(x, nullptr);
+    if (options.objective == DesignObjective::Nearest) {  // its objective is the change itself
+        r.value_initial = 0.0;
+        r.value = r.change;
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+        const double xj = x[static_cast<Eigen::Index>(j)], width = P.hi[j] - P.lo[j];
+        if (xj - P.lo[j] <= 1e-9 * width || P.hi[j] - xj <= 1e-9 * width) r.at_bound.push_back(options.free[j]);
+    }
+    r.string = analyse_string(L, so);
+    if (r.string.plant_stable) {
+        r.attenuation = attenuation_scan(L, options.margin);
+        r.margin_met = r.attenuation.margin >= options.margin * (1.0 - 1e-9);
+    }
+    if (options.cars >= 0) {
+        const FastRing fr = analyse_ring_fast(L, options.cars, resolve_ring_method("auto", L), 0);
+        r.ring = fr.ring;
+        r.ring_method = fr.method_used;
+    }
+    const std::string bfgs = "BFGS with a weak-Wolfe line search, gradient sampling where it stalls (Lewis-Overton)";
+    const std::string sqp = n <= 4 ? "sequential quadratic programming on the pieces of the attenuation margin"
+                                   : "an exact penalty minimised by " + bfgs;
+    r.method = options.objective == DesignObjective::Nearest ? sqp : plateau ? bfgs + "; on its plateau, the nearest gains by " + sqp : bfgs;
+    r.evaluations = P.evaluations;
+    r.infeasibility_proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+    r.status = best_status;
+    r.message = best_message;
+    const PeakResult& pk = *r.string.peak;
+    if (r.status == Status::Converged) {
+        if (r.string.string_verdict == Verdict::Undecided) {
+            r.status = r.string.plant_roots.status;
+            r.message = "the verdict at the result is undecided: " + r.string.plant_roots.message;
+        } else if (pk.verdict == Verdict::Undecided) {
+            r.status = pk.status;
+            r.message = "the peak verdict at the result is undecided: " + pk.message;
+        } else if (r.ring && r.ring->status != Status::Converged) {
+            r.status = r.ring->status;
+            r.message = "the ring verdict at the result is undecided: " + r.ring->reason;
+        } else if (infeasible || skipped) {
+            r.message = best_message;
+        } else if (options.objective == DesignObjective::Nearest || plateau) {
+            r.message = std::string(plateau ? "sup |Gamma(i w)| |1 + i m w| reaches its least value 1 (m = " + detail::significant(options.margin, 6) +
+                                                  " s); of those gains, the nearest to the car's: a relative change of "
+                                            : "the nearest gains found with an attenuation margin of at least " +
+                                                  detail::significant(options.margin, 6) + " s: a relative change of ") +
+                        detail::significant(r.change, 6) + " (" + std::to_string(r.starts.size()) + " runs of the minimisers)";
+        } else if (options.objective != DesignObjective::Abscissa && !r.string.string_stable) {
+            const std::string proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+            r.message = proof.empty() ? "no string-stable gains found within the bounds from " + std::to_string(starts.size()) +
+                                            " starts (not a proof that none exist): the least objective found is " + detail::significant(r.value, 8) +
+                                            " (" + best_message + ")"
+                                      : proof + "; the least objective found is " + detail::significant(r.value, 8);
+        } else {
+            r.message = "best of " + std::to_string(r.starts.size()) + " runs: " + best_message;
+        }
+    }
+    return r;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,299 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <complex>
+#include <random>
+#include <stdexcept>
+
+#include "ddemap/analysis/design/design.hpp"
+#include "ddemap/traffic/vehicles.hpp"
+#include "fleet_helpers.hpp"
+#include "tolerances.hpp"
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+using cd = std::complex<double>;
+
+ParameterMap car_params(const std::string& name) {
+    ParameterMap p = builtin_vehicle(name).parameters;
+    p["speed"] = 20.0;
+    return p;
+}
+
+/// |Gamma(i w)| of OVRV written out here (independent of TransferFunction):
+/// Gamma = (k1 + k2 s) e^{-s tau} / (s^2 + (k1 th + k2) s + k1 e^{-s tau}).
+double ovrv_gain(const ParameterMap& p, double w) {
+    const double k1 = p.at("k1"), k2 = p.at("k2"), th = p.at("th"), tau = p.at("tau");
+    const cd s(0.0, w), e = std::exp(-s * tau);
+    return std::abs((k1 + k2 * s) * e / (s * s + (k1 * th + k2) * s + k1 * e));
+}
+
+/// sup_w |Gamma(i w)| |1 + i m w| by brute force: 20000 log-spaced frequencies over 1e-4 to 1e3
+/// rad/s, the best refined by golden sections.
+double brute_weighted_sup(const ParameterMap& p, double m) {
+    auto f = [&](double u) {
+        const double w = std::exp(u);
+        return ovrv_gain(p, w) * std::hypot(1.0, m * w);
+    };
+    const int n = 20000;
+    const double a = std::log(1e-4), b = std::log(1e3);
+    double best = 1.0;
+    for (int i = 1; i + 1 < n; ++i) {
+        const double u = a + (b - a) * i / (n - 1), h = (b - a) / (n - 1);
+        const double v = f(u);
+        if (v > f(u - h) && v >= f(u + h)) {
+            double lo = u - h, hi = u + h;
+            for (int it = 0; it < 100; ++it) {
+                const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+                if (f(m1) < f(m2)) lo = m1;
+                else hi = m2;
+            }
+            best = std::max(best, f(0.5 * (lo + hi)));
+        }
+        best = std::max(best, v);
+    }
+    return best;
+}
+}  // namespace
+
+TEST_SUITE_BEGIN("fast");
+
+TEST_CASE("attenuation margin of OVRV without delay against its closed form mu = min(c / k1^2, 1 / k2^2)") {
+    // tau = 0: |D|^2 - |N|^2 = w^4 + c w^2 with c = k1^2 th^2 + 2 k1 k2 th - 2 k1, |N|^2 = k1^2 + k2^2 w^2,
+    // so q / |N|^2 = (w^2 + c) / (k1^2 + k2^2 w^2), monotone in w^2 between c / k1^2 and 1 / k2^2.
+    // The weighted norm: R(W) = (k1^2 + k2^2 W)(1 + m^2 W) / (W^2 + (b^2 - 2 k1) W + k1^2), W = w^2,
+    // b = k1 th + k2, whose stationary points solve a quadratic (the cubic terms cancel).
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    for (int trial = 0; trial < 40; ++trial) {
+        const double k1 = 0.05 + 0.95 * U(rng), k2 = 0.1 + 1.9 * U(rng), th = 0.5 + 2.5 * U(rng), m = 0.05 + 1.5 * U(rng);
+        const Linearisation lin = test::ovrv(k1, k2, th, 0.0);
+        const AttenuationScan s = attenuation_scan(lin, m);
+        const double c = k1 * k1 * th * th + 2.0 * k1 * k2 * th - 2.0 * k1;
+        const double mu = std::min(c / (k1 * k1), 1.0 / (k2 * k2));
+        CAPTURE(k1);
+        CAPTURE(k2);
+        CAPTURE(th);
+        CHECK(std::abs(s.mu - mu) <= tol::attenuation_mu_rel * std::max(1.0, std::abs(mu)));
+        CHECK(s.margin == doctest::Approx(std::copysign(std::sqrt(std::abs(s.mu)), s.mu)));
+        const double b = k1 * th + k2, al = k2 * k2 * m * m, be = k2 * k2 + k1 * k1 * m * m, ga = k1 * k1, de = b * b - 2.0 * k1;
+        auto R = [&](double W) { return (al * W * W + be * W + ga) / (W * W + de * W + k1 * k1); };
+        // (2 al W + be)(W^2 + de W + k1^2) - (al W^2 + be W + ga)(2 W + de) = A2 W^2 + A1 W + A0
+        const double A2 = al * de - be, A1 = 2.0 * al * k1 * k1 - 2.0 * ga, A0 = be * k1 * k1 - ga * de;
+        double sup = std::max(1.0, al);  // W = 0 and W -> infinity
+        const double disc = A1 * A1 - 4.0 * A2 * A0;
+        if (A2 != 0.0 && disc >= 0.0)
+            for (double W : {(-A1 + std::sqrt(disc)) / (2.0 * A2), (-A1 - std::sqrt(disc)) / (2.0 * A2)})
+                if (W > 0.0) sup = std::max(sup, R(W));
+        CHECK(std::sqrt(sup) == doctest::Approx(s.weighted_sup).epsilon(tol::attenuation_sup_rel));
+    }
+}
+
+TEST_CASE("attenuation margin: its sign is the certified L2 verdict, and |Gamma(iw)| |1 + i m* w| <= 1 over random delayed OVRV cars") {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    int stable = 0, unstable = 0;
+    for (int trial = 0; trial < 60; ++trial) {
+        const double k1 = 0.02 + 0.5 * U(rng), k2 = 0.1 + 1.5 * U(rng), th = 0.5 + 2.5 * U(rng), tau = 0.05 + 0.8 * U(rng);
+        const Linearisation lin = test::ovrv(k1, k2, th, tau);
+        if (!is_computable(lin)) continue;
+        const StringResult v = analyse_string(lin);
+        if (!v.plant_stable || (v.string_verdict != Verdict::Stable && v.string_verdict != Verdict::Unstable)) continue;
+        const AttenuationScan s = attenuation_scan(lin);
+        if (std::abs(s.mu) < 1e-9) continue;
+        CAPTURE(k1);
+        CAPTURE(k2);
+        CAPTURE(th);
+        CAPTURE(tau);
+        CHECK((s.mu > 0.0) == (v.string_verdict == Verdict::Stable));
+        if (s.mu <= 0.0) {
+            ++unstable;
+            continue;
+        }
+        ++stable;
+        const ParameterMap p{{"k1", k1}, {"k2", k2}, {"th", th}, {"tau", tau}};
+        // m* bounds the gain everywhere (independent dense evaluation) ...
+        for (int i = 0; i <= 4000; ++i) {
+            const double w = std::exp(std::log(1e-4) + (std::log(1e3) - std::log(1e-4)) * i / 4000.0);
+            CHECK(ovrv_gain(p, w) * std::hypot(1.0, s.margin * w) <= 1.0 + tol::attenuation_bound_rel);
+        }
+        // ... and no larger time constant does: 1 % more fails where mu is reached
+        const double w = s.omega_mu > 0.0 ? s.omega_mu : 1e-3 * std::sqrt(k1);
+        CHECK(ovrv_gain(p, w) * std::hypot(1.0, 1.01 * s.margin * w) > 1.0);
+    }
+    CHECK(stable >= 10);
+    CHECK(unstable >= 10);
+}
+
+TEST_CASE("design abscissa: OVRV without delay reaches the double root of the closed form (k1, k2) = (1, 1), abscissa -1") {
+    // D = s^2 + (k1 th + k2) s + k1 with th = 1: a double root -a/2 when a^2 = 4 k1, a = k1 + k2;
+    // within k1 <= 1 the least abscissa is -1 at k1 = 1, a = 2. The minimum is non-smooth (the
+    // abscissa grows like a square root on the real side).
+    DesignOptions o;
+    o.objective = DesignObjective::Abscissa;
+    o.bounds = {{"k1", 0.1, 1.0}, {"k2", 0.01, 2.0}};
+    const DesignResult r = design_gains("ovrv", {{"k1", 0.5}, {"k2", 0.5}, {"th", 1.0}, {"tau", 0.0}, {"eta", 10.0}, {"speed", 20.0}}, o);
+    CAPTURE(r.message);
+    CHECK(r.status == Status::Converged);
+    CHECK(std::abs(r.value + 1.0) < tol::design_abscissa_value);
+    CHECK(std::abs(r.gains.at("k1") - 1.0) < tol::design_abscissa_gains);
+    CHECK(std::abs(r.gains.at("k2") - 1.0) < tol::design_abscissa_gains);
+    CHECK(r.string.plant_abscissa == doctest::Approx(r.value).epsilon(1e-9));
+}
+
+TEST_CASE("design nearest: C_max reaches the closed-form nearest point of its low-frequency condition, and the margin flips across it") {
+    // ovrv, th and tau held: mu_0 = c2 / k1^2 >= m^2 is 2 B - m^2 k1 >= 0, linear in (k1, k2):
+    // a1 k1 + a2 k2 >= 2, a1 = 2 th (th/2 - tau) - m^2, a2 = 2 (th - tau). In relative changes
+    // r_j = (x_j - x0_j)/x0_j the nearest point is r = beta v / |v|^2, v = (a1 k1_0, a2 k2_0),
+    // beta = 2 - v1 - v2, distance beta / |v| (when the other pieces of mu are inactive there,
+    // which the result's margin confirms).
+    const ParameterMap car = car_params("C_max");
+    DesignOptions o;
+    o.objective = DesignObjective::Nearest;
+    o.starts = 2;
+    const DesignResult r = design_gains("ovrv", car, o);
+    CAPTURE(r.message);
+    REQUIRE(r.status == Status::Converged);
+    const double th = car.at("th"), tau = car.at("tau"), m2 = o.margin * o.margin;
+    const double a1 = 2.0 * th * (th / 2.0 - tau) - m2, a2 = 2.0 * (th - tau);
+    const double v1 = a1 * car.at("k1"), v2 = a2 * car.at("k2"), beta = 2.0 - v1 - v2, vv = v1 * v1 + v2 * v2;
+    CHECK(r.change == doctest::Approx(beta / std::sqrt(vv)).epsilon(tol::design_nearest_rel));
+    CHECK(r.gains.at("k1") == doctest::Approx(car.at("k1") * (1.0 + beta * v1 / vv)).epsilon(tol::design_nearest_rel));
+    CHECK(r.gains.at("k2") == doctest::Approx(car.at("k2") * (1.0 + beta * v2 / vv)).epsilon(tol::design_nearest_rel));
+    // certified string stable there, with the margin; just before it on the segment, not
+    CHECK(r.string.string_verdict == Verdict::Stable);
+    CHECK(r.margin_met);
+    CHECK(brute_weighted_sup(r.parameters, o.margin) <= 1.0 + tol::attenuation_bound_rel);
+    ParameterMap before = r.parameters;
+    for (const char* k : {"k1", "k2"}) before[k] = car.at(k) + (1.0 - 1e-4) * (r.gains.at(k) - car.at(k));
+    CHECK(brute_weighted_sup(before, o.margin) > 1.0);
+    CHECK(r.string_initial.string_verdict == Verdict::Unstable);
+}
+
+TEST_CASE("design sup-gamma: where the weighted norm reaches 1 the result is the nearest such gains, and bad options are refused") {
+    const ParameterMap car = car_params("C_max");
+    DesignOptions o;
+    o.starts = 2;
+    const DesignResult s = design_gains("ovrv", car, o);
+    o.objective = DesignObjective::Nearest;
+    const DesignResult n = design_gains("ovrv", car, o);
+    CAPTURE(s.message);
+    CHECK(s.status == Status::Converged);
+    CHECK(s.value == doctest::Approx(1.0).epsilon(1e-12));
+    CHECK(s.gains.at("k1") == doctest::Approx(n.gains.at("k1")).epsilon(1e-9));
+    CHECK(s.gains.at("k2") == doctest::Approx(n.gains.at("k2")).epsilon(1e-9));
+
+    DesignOptions bad;
+    bad.free = {"k1", "gain"};
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+    bad = DesignOptions{};
+    bad.bounds = {{"th", 1.0, 2.0}};
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);  // th is not free
+    bad = DesignOptions{};
+    bad.bounds = {{"k1", 0.5, 0.1}};
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+    bad = DesignOptions{};
+    bad.bounds = {{"k1", -0.5, 0.1}};
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);  // outside the law's domain
+    bad = DesignOptions{};
+    bad.margin = 0.0;
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+    bad = DesignOptions{};
+    bad.starts = 0;
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+    bad = DesignOptions{};
+    bad.weights = {1.0};
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+    bad = DesignOptions{};
+    bad.free = {"k1", "k1"};
+    CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+}
+
+TEST_SUITE_END();
+TEST_SUITE_BEGIN("slow");
+
+TEST_CASE("design sup-gamma without string-stable gains (A_min, th < tau): never worse than a brute-force grid, and the proof holds on a grid of certified verdicts") {
+    const ParameterMap car = car_params("A_min");
+    DesignOptions o;
+    o.starts = 2;
+    const DesignResult r = design_gains("ovrv", car, o);
+    CAPTURE(r.message);
+    CHECK(r.status == Status::Converged);
+    CHECK_FALSE(r.infeasibility_proof.empty());
+    CHECK_FALSE(r.string.string_stable);
+    // the grid: 25 x 25 over the default box [k/10, 10 k], logarithmic, corners included
+    double grid_min = 1e300;
+    int stable = 0;
+    for (int i = 0; i < 25; ++i)
+        for (int j = 0; j < 25; ++j) {
+            ParameterMap p = car;
+            p["k1"] = car.at("k1") * std::pow(10.0, -1.0 + 2.0 * i / 24.0);
+            p["k2"] = car.at("k2") * std::pow(10.0, -1.0 + 2.0 * j / 24.0);
+            grid_min = std::min(grid_min, brute_weighted_sup(p, o.margin));
+            if (i % 3 == 0 && j % 3 == 0) {
+                const Linearisation lin = make_model("ovrv", p)->linearise();
+                if (analyse_string(lin).string_verdict == Verdict::Stable) ++stable;
+            }
+        }
+    CHECK(r.value <= grid_min + tol::design_grid_abs);
+    CHECK(stable == 0);
+    // nearest says the same, with the car's own gains unchanged
+    o.objective = DesignObjective::Nearest;
+    const DesignResult n = design_gains("ovrv", car, o);
+    CHECK(n.status == Status::Converged);
+    CHECK_FALSE(n.infeasibility_proof.empty());
+    CHECK(n.gains.at("k1") == car.at("k1"));
+    CHECK(n.gains.at("k2") == car.at("k2"));
+}
+
+TEST_CASE("design nearest in three parameters (G_min: k1, k2, th): no point of a smaller sphere about the car meets the margin") {
+    const ParameterMap car = car_params("G_min");
+    DesignOptions o;
+    o.objective = DesignObjective::Nearest;
+    o.free = {"k1", "k2", "th"};
+    o.starts = 2;
+    const DesignResult r = design_gains("ovrv", car, o);
+    CAPTURE(r.message);
+    REQUIRE(r.status == Status::Converged);
+    CHECK(r.margin_met);
+    CHECK(r.string.string_verdict == Verdict::Stable);
+    CHECK(brute_weighted_sup(r.parameters, o.margin) <= 1.0 + tol::attenuation_bound_rel);
+    // 1500 directions of a Fibonacci sphere at 99.9 % of the distance (relative changes), inside the box
+    const double rad = 0.999 * r.change;
+    int checked = 0;
+    for (int i = 0; i < 1500; ++i) {
+        const double z = 1.0 - 2.0 * (i + 0.5) / 1500.0, phi = i * 2.399963229728653, rho = std::sqrt(1.0 - z * z);
+        const double d[3] = {rho * std::cos(phi), rho * std::sin(phi), z};
+        ParameterMap p = car;
+        bool inside = true;
+        const char* names[3] = {"k1", "k2", "th"};
+        for (int j = 0; j < 3; ++j) {
+            p[names[j]] = car.at(names[j]) * (1.0 + rad * d[j]);
+            const BoundedParameter* b = find_bound(r.bounds, names[j]);
+            if (p[names[j]] < b->lower || p[names[j]] > b->upper) inside = false;
+        }
+        if (!inside) continue;
+        ++checked;
+        const Linearisation lin = make_model("ovrv", p)->linearise();
+        if (!is_computable(lin)) continue;
+        CAPTURE(i);
+        CHECK(brute_weighted_sup(p, o.margin) > 1.0);
+    }
+    CHECK(checked > 300);
+}
+
+TEST_CASE("design peak: C_max reaches a certified non-overshooting design (||h||_1 = 1)") {
+    const ParameterMap car = car_params("C_max");
+    DesignOptions o;
+    o.objective = DesignObjective::Peak;
+    o.starts = 2;
+    const DesignResult r = design_gains("ovrv", car, o);
+    CAPTURE(r.message);
+    CHECK(r.status == Status::Converged);
+    REQUIRE(r.string.peak.has_value());
+    CHECK(r.string.peak->verdict == Verdict::Stable);
+    CHECK(r.value <= 1.0 + r.string.peak->error + 1e-7);
+    CHECK(r.string.string_verdict == Verdict::Stable);
+}
