@@ -121,7 +121,7 @@ int run_design() {
                                                                                         : 300.0 * 0.003 * (1.0 + n);
         check_size("design", counted(o.starts, "start"), "time", per_run * (o.starts + 1));
     }
-    o.progress = progress_printer("design", "evaluations (at most)");
+    o.progress = progress_printer("design", o.objective == DesignObjective::Nearest ? "runs" : "evaluations (at most)");
     DesignResult r = design_gains(car.model, p, o);
 
     const JsonEnvelope e = design_envelope(r, o, design_args.car, car.name);

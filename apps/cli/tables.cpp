@@ -24,8 +24,8 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
     // peak (L-infinity) verdict and ||h||_1, when asked (classify --peak)
     const bool peak = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.string.peak.has_value(); });
     char header[256];
-    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s", "k1", "k2", "th", "tau", "eta",
-                  "plant", "ring", "string", "sup|Gamma|", "w_peak", "c2");
+    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s %7s", "k1", "k2", "th", "tau", "eta",
+                  "plant", "ring", "string", "sup|Gamma|", "w_peak", "c2", "m*");
     out << "name" << std::string(static_cast<std::size_t>(width) - 4, ' ') << header;
     if (peak) {
         std::snprintf(header, sizeof header, "   %-9s %10s", "peak", "||h||_1");
@@ -33,8 +33,8 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
     }
     out << "\n";
     // the units under their columns (c2: the w^2 coefficient of |D(i w)|^2 - |N(i w)|^2)
-    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s", "1/s^2", "1/s", "s", "s", "m", "", "", "", "1",
-                  "rad/s", "1/s^2");
+    std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s %7s", "1/s^2", "1/s", "s", "s", "m", "", "", "", "1",
+                  "rad/s", "1/s^2", "s");
     out << std::string(static_cast<std::size_t>(width), ' ') << header;
     if (peak) {
         std::snprintf(header, sizeof header, "   %-9s %10s", "", "1");
@@ -50,6 +50,10 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
                       word(row.string.plant_verdict).c_str(), word(row.ring.verdict).c_str(),
                       word(row.string.string_verdict).c_str(), row.string.sup_gamma, row.string.omega_peak,
                       row.string.lowfreq_margin);
+        out << line;
+        // m*: the attenuation margin (> 0 inside the string-stable set, < 0 outside)
+        if (std::isfinite(row.attenuation_margin)) std::snprintf(line, sizeof line, " %7.3f", row.attenuation_margin);
+        else std::snprintf(line, sizeof line, " %7s", "-");
         out << line;
         if (peak) {
             const PeakResult* pk = row.string.peak ? &*row.string.peak : nullptr;

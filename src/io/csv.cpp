@@ -155,7 +155,7 @@ std::string string_csv(const StringResult& s, const RingResult* ring) {
 std::string classification_csv(const std::vector<Classification>& rows) {
     std::ostringstream out;
     out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
-           "spectral_abscissa,plant_abscissa";
+           "spectral_abscissa,plant_abscissa,attenuation_margin";
     // the verdicts under parameter uncertainty, only when a vehicle carries a covariance
     const bool any = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.has_uncertainty; });
     if (any)
@@ -171,7 +171,8 @@ std::string classification_csv(const std::vector<Classification>& rows) {
         out << "," << tf(row.string.plant_stable) << "," << tf(row.ring.stable) << "," << tf(row.string.string_stable) << ","
             << format_exact(row.string.sup_gamma) << "," << format_exact(row.string.omega_peak) << ","
             << format_exact(row.string.lowfreq_margin) << "," << format_exact(row.ring.spectral_abscissa) << ","
-            << format_exact(row.string.plant_abscissa);
+            << format_exact(row.string.plant_abscissa) << ","
+            << (std::isfinite(row.attenuation_margin) ? format_exact(row.attenuation_margin) : std::string());
         if (any && row.has_uncertainty) {
             const VerdictUncertainty& u = row.uncertainty;
             for (double v : {u.string_unstable.p, u.string_unstable.standard_error, u.string_unstable.lower, u.string_unstable.upper,

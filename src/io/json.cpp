@@ -332,6 +332,7 @@ std::string classification_json(const std::vector<Classification>& rows, int car
         o["lowfreq_margin"] = num(row.string.lowfreq_margin);
         o["spectral_abscissa"] = num(row.ring.spectral_abscissa);
         o["plant_abscissa"] = num(row.string.plant_abscissa);
+        o["attenuation_margin"] = num(row.attenuation_margin);  // null when the plant is not stable
         if (row.has_uncertainty) {
             // the verdicts under the calibration's parameter uncertainty (classify_with_uncertainty)
             const VerdictUncertainty& u = row.uncertainty;

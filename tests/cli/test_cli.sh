@@ -171,7 +171,7 @@ if part classify; then
 # empty CSV fields, null in JSON)
 printf 'name,k1,k2,th,tau\nover,0.05,0.3,3.0,0.1\nmono,0.05,0.8,2.0,0.1\nwild,1,0.1,0.5,1.5\n' >"$tmp/pk.csv"
 "$bin" classify "$tmp/pk.csv" --peak --format csv >"$tmp/pk.out" && head -1 "$tmp/pk.out" | grep -q ',peak_verdict,peak_norm,peak_norm_error$' &&
-    grep -q '^over,.*,true,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,unstable,1\.01629' "$tmp/pk.out" && grep -q '^mono,.*,stable,1\.000000000[0-9]*,' "$tmp/pk.out" && grep -q '^wild,.*,unstable,,$' "$tmp/pk.out" &&
+    grep -q '^over,.*,true,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,unstable,1\.01629' "$tmp/pk.out" && grep -q '^mono,.*,stable,1\.000000000[0-9]*,' "$tmp/pk.out" && grep -q '^wild,.*,unstable,,$' "$tmp/pk.out" &&
     ok || bad "classify --peak csv: $(cat "$tmp/pk.out")"
 "$bin" classify "$tmp/pk.csv" --peak | grep -q '^wild .*UNSTABLE  *inf$' && ok || bad "classify --peak table: the unstable plant's norm"
 "$bin" classify "$tmp/pk.csv" --peak --format json | python3 -c "
@@ -1950,6 +1950,15 @@ expect_error "expected an integer 1..64" design C_max --starts 0
 expect_error "one per free parameter" design C_max --objective nearest --weights 1
 expect_error "computable range" design ovrv:k1=5,k2=5,th=1,tau=2
 expect_error "CAR is required" design
+# classify prints the attenuation margin m*: its sign is the string verdict, the design's meets the margin
+"$bin" classify "$(dirname "$0")/../../examples/mycars.csv",A_min,C_max --format json >"$tmp/desc.json" && ok || bad "classify with m*: exit $?"
+python3 - "$tmp/desc.json" <<'PY' && ok || bad "classify: attenuation_margin > 0 exactly for the string-stable cars"
+import json, sys
+v = json.load(open(sys.argv[1]))["result"]["vehicles"]
+assert len(v) == 5
+for c in v:
+    assert (c["attenuation_margin"] > 0) == c["string_stable"], c
+PY
 fi  # part design
 
 echo "$pass passed, $fail failed"

@@ -1,5 +1,7 @@
 #include "ddemap/analysis/stability/classify.hpp"
 
+#include "ddemap/analysis/stability/attenuation_margin.hpp"
+
 #include "ddemap/analysis/calibration/calibrate.hpp"
 
 #include <algorithm>
@@ -256,6 +258,7 @@ std::vector<Classification> classify(const std::vector<CalibratedVehicle>& vehic
         const Linearisation lin = make_model("ovrv", vehicles[i].parameters)->linearise();
         out[i].vehicle = vehicles[i];
         out[i].string = analyse_string(lin, string_options);
+        if (out[i].string.plant_stable) out[i].attenuation_margin = attenuation_scan(lin).margin;
         out[i].ring = analyse_ring(lin, cars);
     }, policy);
     return out;

@@ -4,6 +4,7 @@
 /// and, for vehicles whose calibration carries a covariance, the same verdicts with the
 /// parameter uncertainty propagated to them by sampling.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -109,6 +110,10 @@ struct Classification {
     CalibratedVehicle vehicle;
     StringResult string;
     RingResult ring;
+    /// The signed attenuation margin m* [s] (attenuation_margin.hpp): how far the car is inside
+    /// (> 0) or outside (< 0) the string-stable set, as the time constant of the slowest lag that
+    /// still bounds |Gamma(i w)|. NaN when the plant is not stable.
+    double attenuation_margin = std::numeric_limits<double>::quiet_NaN();
     /// Only when the vehicle carries a covariance (vehicle.has_covariance) and uncertainty was asked.
     bool has_uncertainty = false;
     VerdictUncertainty uncertainty;
