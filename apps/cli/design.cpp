@@ -59,10 +59,10 @@ void add_design_flags(CLI::App& app) {
     app.add_option("--bounds", design_args.bounds, "bounds NAME=LO:HI,... of free parameters (default: a tenth to ten times the car's value)")
         ->type_name("NAME=LO:HI,...");
     app.add_option("--margin", design_args.margin,
-                   "attenuation margin asked for by nearest, and checked for every objective [s]: every wave is damped from car to car at least as "
-                   "by a first-order lag of this time constant, |Gamma(iw)| <= 1/|1 + i margin w|")
+                   "attenuation margin asked for by nearest and sup-gamma, and checked for every objective [s], 0.001 to 1000: every wave is damped "
+                   "from car to car at least as by a first-order lag of this time constant, |Gamma(iw)| <= 1/|1 + i margin w|")
         ->capture_default_str();
-    app.add_option("--weights", design_args.weights, "nearest: a weight per free parameter of the relative change (default: all 1)")->type_name("W,...");
+    app.add_option("--weights", design_args.weights, "nearest: a weight per free parameter of the relative change, each in [0.001, 1000] (default: all 1)")->type_name("W,...");
     app.add_option("--starts", design_args.starts, "runs of the minimiser: from the car's values and from points of a Halton sequence in the bounds (1..64)")
         ->capture_default_str();
     app.add_option("--speed", design_args.speed, "equilibrium speed [m/s] (idm is linearised about it; default: the law's)");
@@ -97,7 +97,7 @@ int run_design() {
                                 parse_number("--bounds " + name, item.substr(colon + 1))});
         }
     o.margin = parse_number("--margin", design_args.margin);
-    if (!(o.margin > 0.0) || o.margin > 1e3) throw BadInput("--margin = " + design_args.margin + ": expected a number of seconds in (0, 1000]");
+    if (!(o.margin >= 1e-3) || o.margin > 1e3) throw BadInput("--margin = " + design_args.margin + ": expected a number of seconds in [0.001, 1000]");
     if (!design_args.weights.empty())
         for (const std::string& wtext : split_commas(design_args.weights)) o.weights.push_back(parse_number("--weights", wtext));
     o.starts = static_cast<int>(parse_integer("--starts", design_args.starts, 1, 64, "an integer 1..64"));

@@ -1950,6 +1950,17 @@ expect_error "expected an integer 1..64" design C_max --starts 0
 expect_error "one per free parameter" design C_max --objective nearest --weights 1
 expect_error "computable range" design ovrv:k1=5,k2=5,th=1,tau=2
 expect_error "CAR is required" design
+# a box nine decades wide: the car's own values start the search (not a point a thousandth of
+# the width inside), the differences stay inside the law's domain, the same nearest gains
+"$bin" design C_max --objective nearest --bounds k2=1e-9:1e9 --format json >"$tmp/des3.json" && ok || bad "design with a wide box: exit $?"
+python3 - "$tmp/des/c.json" "$tmp/des3.json" <<'PY' && ok || bad "design: a wide box gives the same nearest gains, not at a bound"
+import json, sys
+a, b = (json.load(open(f))["result"] for f in sys.argv[1:])
+assert b["at_bound"] == [], b["at_bound"]
+for k in ("k1", "k2"):
+    assert abs(a["gains"][k] - b["gains"][k]) <= 1e-7 * abs(a["gains"][k]), (a["gains"], b["gains"])
+PY
+expect_error "expected a number of seconds in \[0.001, 1000\]" design C_max --margin 1e-12
 # classify prints the attenuation margin m*: its sign is the string verdict, the design's meets the margin
 "$bin" classify "$(dirname "$0")/../../examples/mycars.csv",A_min,C_max --format json >"$tmp/desc.json" && ok || bad "classify with m*: exit $?"
 python3 - "$tmp/desc.json" <<'PY' && ok || bad "classify: attenuation_margin > 0 exactly for the string-stable cars"

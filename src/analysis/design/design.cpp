@@ -37,15 +37,16 @@ void DesignOptions::validate() const {
         for (std::size_t j = 0; j < i; ++j)
             if (free[i] == free[j]) throw std::invalid_argument("design: free parameter " + detail::quoted(free[i]) + " is named twice");
     if (free.size() > 8) throw std::invalid_argument("design: " + std::to_string(free.size()) + " free parameters: expected at most 8");
-    if (!(margin > 0.0) || !std::isfinite(margin) || margin > 1e3)
-        throw std::invalid_argument("design: margin = " + detail::significant(margin, 6) + " s: expected a number in (0, 1000] seconds");
+    // below a millisecond mu = m^2 is lost in the rounding of its pieces (about 1e-16 of their size)
+    if (!(margin >= 1e-3) || !std::isfinite(margin) || margin > 1e3)
+        throw std::invalid_argument("design: margin = " + detail::significant(margin, 6) + " s: expected a number of seconds in [0.001, 1000]");
     if (!weights.empty()) {
         if (weights.size() != free.size())
             throw std::invalid_argument("design: " + std::to_string(weights.size()) + " weights for " + std::to_string(free.size()) +
                                         " free parameters: expected one per free parameter");
         for (std::size_t j = 0; j < weights.size(); ++j)
-            if (!(weights[j] > 0.0) || !std::isfinite(weights[j]) || weights[j] > 1e6)
-                throw std::invalid_argument("design: weight of " + free[j] + " = " + detail::significant(weights[j], 6) + ": expected a number in (0, 1e6]");
+            if (!(weights[j] >= 1e-3) || !std::isfinite(weights[j]) || weights[j] > 1e3)
+                throw std::invalid_argument("design: weight of " + free[j] + " = " + detail::significant(weights[j], 6) + ": expected a number in [0.001, 1000]");
     }
     if (cars < -1 || cars == 1) throw std::invalid_argument("design: cars = " + std::to_string(cars) + ": expected -1 (the plant), 0 (N = infinity) or N >= 2");
     if (cars > kWindingMaxCars) throw std::invalid_argument("design: cars = " + std::to_string(cars) + ": expected at most 10^9");
@@ -100,8 +101,20 @@ public:
         return p;
     }
     Linearisation lin(const Eigen::VectorXd& x) const { return make_model(m_model, params(x))->linearise(); }
-    double step(std::size_t j, const Eigen::VectorXd& x) const {
-        return 1e-6 * std::max(std::abs(x[static_cast<Eigen::Index>(j)]), 1e-3 * (hi[j] - lo[j]));
+    // A difference step of `rel` relative to x_j (to the box's width where x_j = 0)
+    double step(std::size_t j, const Eigen::VectorXd& x, double rel = 1e-6) const {
+        const double v = std::abs(x[static_cast<Eigen::Index>(j)]);
+        return rel * (v > 0.0 ? v : 1e-3 * (hi[j] - lo[j]));
+    }
+    // d f / d x_j by central differences of step h, forward ones where x_j - h would leave the
+    // box's lower side (the law's domain may end there)
+    template <class G>
+    double difference(std::size_t j, const Eigen::VectorXd& x, double h, const G& f) const {
+        Eigen::VectorXd xp = x, xm = x;
+        xp[static_cast<Eigen::Index>(j)] += h;
+        if (x[static_cast<Eigen::Index>(j)] - h < lo[j]) return (f(xp) - f(x)) / h;
+        xm[static_cast<Eigen::Index>(j)] -= h;
+        return (f(xp) - f(xm)) / (2.0 * h);
     }
     // x_j = lo + (hi - lo)(1 - cos z)/2
     Eigen::VectorXd x_of(const Eigen::VectorXd& z) const {
@@ -146,13 +159,8 @@ public:
     template <class F>
     Eigen::VectorXd partials(const Eigen::VectorXd& x, const F& f) const {
         Eigen::VectorXd g(static_cast<Eigen::Index>(n()));
-        for (std::size_t j = 0; j < n(); ++j) {
-            const double h = step(j, x);
-            Eigen::VectorXd xp = x, xm = x;
-            xp[static_cast<Eigen::Index>(j)] += h;
-            xm[static_cast<Eigen::Index>(j)] -= h;
-            g[static_cast<Eigen::Index>(j)] = (f(lin(xp)) - f(lin(xm))) / (2.0 * h);
-        }
+        for (std::size_t j = 0; j < n(); ++j)
+            g[static_cast<Eigen::Index>(j)] = difference(j, x, step(j, x), [&](const Eigen::VectorXd& y) { return f(lin(y)); });
         return g;
     }
 
@@ -201,12 +209,7 @@ public:
         }
         // no root listed: differences of the abscissa itself
         for (std::size_t j = 0; j < n(); ++j) {
-            const double h = 1e-5 * (hi[j] - lo[j]);
-            Eigen::VectorXd xp = x, xm = x;
-            xp[static_cast<Eigen::Index>(j)] += h;
-            xm[static_cast<Eigen::Index>(j)] -= h;
-            const double ap = ring(xp, lin(xp), nullptr), am = ring(xm, lin(xm), nullptr);
-            (*grad)[static_cast<Eigen::Index>(j)] = (ap - am) / (2.0 * h);
+            (*grad)[static_cast<Eigen::Index>(j)] = difference(j, x, step(j, x, 1e-5), [&](const Eigen::VectorXd& y) { return ring(y, lin(y), nullptr); });
         }
         return a;
     }
@@ -281,14 +284,12 @@ public:
             if (grad && std::isfinite(v)) {
                 *grad = Eigen::VectorXd(static_cast<Eigen::Index>(n()));
                 for (std::size_t j = 0; j < n(); ++j) {
-                    const double h = 1e-3 * (hi[j] - lo[j]);
-                    Eigen::VectorXd xp = x, xm = x;
-                    xp[static_cast<Eigen::Index>(j)] += h;
-                    xm[static_cast<Eigen::Index>(j)] -= h;
-                    const Linearisation Lp = lin(xp), Lm = lin(xm);
-                    const double vp = peak_value(Lp, plant(xp, Lp, nullptr)), vm = peak_value(Lm, plant(xm, Lm, nullptr));
-                    if (!std::isfinite(vp) || !std::isfinite(vm)) return kInf;
-                    (*grad)[static_cast<Eigen::Index>(j)] = (vp - vm) / (2.0 * h);
+                    const double d = difference(j, x, step(j, x, 1e-3), [&](const Eigen::VectorXd& y) {
+                        const Linearisation Ly = lin(y);
+                        return peak_value(Ly, plant(y, Ly, nullptr));
+                    });
+                    if (!std::isfinite(d)) return kInf;
+                    (*grad)[static_cast<Eigen::Index>(j)] = d;
                 }
             }
             return v;
@@ -582,8 +583,11 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     {
         Eigen::VectorXd s = x0;
         for (std::size_t j = 0; j < n; ++j) {
-            const double m = 1e-3 * (P.hi[j] - P.lo[j]);
-            s[static_cast<Eigen::Index>(j)] = std::clamp(s[static_cast<Eigen::Index>(j)], P.lo[j] + m, P.hi[j] - m);
+            // strictly inside: as it is; on or beyond a bound: a millionth of the width inside it
+            // (at a bound itself the coordinate z has a zero derivative)
+            const double m = 1e-6 * (P.hi[j] - P.lo[j]);
+            double& v = s[static_cast<Eigen::Index>(j)];
+            if (!(v > P.lo[j] && v < P.hi[j])) v = std::clamp(v, P.lo[j] + m, P.hi[j] - m);
         }
         starts.push_back(s);
         static const int primes[8] = {2, 3, 5, 7, 11, 13, 17, 19};
@@ -762,7 +766,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     // there is nothing to search; else the search starts also from the nearest L2 design (a
     // cheap sequential QP), inside the set where ||h||_1 can reach 1.
     const std::string l2_proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
-    bool skipped = false;
+    bool skipped = options.objective == DesignObjective::Nearest && !l2_proof.empty();  // nothing to find
     if (options.objective == DesignObjective::Peak) {
         if (!l2_proof.empty()) {
             skipped = true;
@@ -775,11 +779,13 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     const Outcome first = skipped ? Outcome{} : run(options.objective);
     Eigen::VectorXd x = skipped ? x0 : first.x;
     Status best_status = skipped ? Status::Converged : first.status;
-    std::string best_message = skipped ? l2_proof + "; peak (L-infinity) stability implies it, so no gains of the box are peak stable either"
-                                       : first.message;
+    std::string best_message = !skipped ? first.message
+                               : options.objective == DesignObjective::Peak
+                                   ? l2_proof + "; peak (L-infinity) stability implies it, so no gains of the box are peak stable either"
+                                   : l2_proof;
     bool infeasible = false, plateau = false;
     if (options.objective == DesignObjective::Nearest) {
-        infeasible = !crossing(first, x);
+        infeasible = skipped || !crossing(first, x);
     } else if (two_phases && first.best <= 1.0 + 1e-9) {
         // sup-gamma reached its least value 1: of those gains, the nearest to the car's own
         const Outcome second = run(DesignObjective::Nearest);
@@ -813,8 +819,9 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
         r.value = r.change;
     }
     for (std::size_t j = 0; j < n; ++j) {
-        const double xj = x[static_cast<Eigen::Index>(j)], width = P.hi[j] - P.lo[j];
-        if (xj - P.lo[j] <= 1e-9 * width || P.hi[j] - xj <= 1e-9 * width) r.at_bound.push_back(options.free[j]);
+        const double xj = x[static_cast<Eigen::Index>(j)];
+        if (xj - P.lo[j] <= 1e-9 * std::max(std::abs(P.lo[j]), std::abs(xj)) || P.hi[j] - xj <= 1e-9 * std::max(std::abs(P.hi[j]), std::abs(xj)))
+            r.at_bound.push_back(options.free[j]);
     }
     r.string = analyse_string(L, so);
     if (r.string.plant_stable) {

@@ -258,7 +258,13 @@ StringResult analyse_string(const Linearisation& lin, RootResult plant, const St
             p.message = "the plant is undecided: no peak verdict";
             r.peak = p;
         } else {
-            r.peak = peak_string_stability(lin, r.plant_abscissa, options.peak_options);
+            // an L2 string-unstable car is peak unstable whatever ||h||_1 is: its norm is
+            // computed for information with at most kInformativePeakSteps steps (a slowly
+            // settling plant would otherwise take seconds for a verdict already known)
+            PeakOptions po = options.peak_options;
+            if (r.string_verdict == Verdict::Unstable && r.plant_verdict == Verdict::Stable)
+                po.max_steps = std::min(po.max_steps, kInformativePeakSteps);
+            r.peak = peak_string_stability(lin, r.plant_abscissa, po);
             // |Gamma(i w)| <= ||h||_1 for every w: a certified L2 amplification decides the peak
             // verdict even where ||h||_1 itself could not be computed (its value stays unknown)
             if (r.peak->verdict == Verdict::Undecided && r.string_verdict == Verdict::Unstable && r.plant_verdict == Verdict::Stable) {

@@ -39,7 +39,7 @@
 /// error 1e-9), so `peak` is slower and less precise than the others.
 /// The minimiser: solve/optimize/nonsmooth.hpp, in the coordinates z_j with
 /// x_j = lo_j + (hi_j - lo_j)(1 - cos z_j)/2 (the bounds reached at z_j = 0, pi), from the car's
-/// own values (moved a thousandth of the box inside it when they lie outside or on a bound) and
+/// own values (moved a millionth of the box inside it when they lie outside or on a bound) and
 /// `starts` - 1 points of a Halton sequence in the box; the best run wins, and among runs whose
 /// objectives tie (to 1e-12 relative: the plateaus of sup-gamma and peak) the one that ended
 /// nearest the car's own values.
@@ -72,10 +72,11 @@ struct DesignOptions {
     /// Their bounds; a free parameter without one gets [x0 / 10, 10 x0] (x0 its value at the car),
     /// clipped to the law's domain. A bound on a parameter that is not free is an error.
     ParameterBounds bounds;
-    /// sup-gamma and nearest: the attenuation margin asked for, in seconds (> 0); the other
-    /// objectives report whether the result meets it.
+    /// sup-gamma and nearest: the attenuation margin asked for, in seconds (0.001 to 1000; below
+    /// a millisecond mu = m^2 is lost in rounding); the other objectives report whether the
+    /// result meets it.
     double margin = 0.1;
-    /// nearest: w_j of the weighted relative change (empty: all 1; else one per free parameter, > 0).
+    /// nearest: w_j of the weighted relative change (empty: all 1; else one per free parameter, 0.001 to 1000).
     std::vector<double> weights;
     /// abscissa: -1 the plant; 0 the ring of infinitely many cars; N >= 2 a ring of N cars. The
     /// certified ring verdict at the result is reported for every objective when cars >= 0.
@@ -121,7 +122,7 @@ struct DesignResult {
     ParameterMap initial;        ///< every parameter of the car as given (speed included)
     ParameterMap parameters;     ///< the same with the free ones designed
     ParameterMap gains;          ///< the free parameters at the result
-    std::vector<std::string> at_bound;  ///< free parameters on a bound (within 1e-9 of the width)
+    std::vector<std::string> at_bound;  ///< free parameters on a bound (to 1e-9 relative)
     /// The objective at the car's own values (+inf: plant unstable) and at the result; for
     /// nearest the relative change itself (0 at the car).
     double value_initial = 0.0;

@@ -56,6 +56,11 @@ bool is_computable(const Linearisation& lin);
 /// and classifications of files call it too.
 void require_computable(const Linearisation& lin, const std::string& what = std::string());
 
+/// Integrator steps of one ||h||_1 run for a car already L2 string unstable (then peak unstable
+/// whatever the norm): the norm is informative only, and a plant that settles slowly would need
+/// millions of steps; beyond this it is "not computed" (PeakResult::finite false).
+constexpr long kInformativePeakSteps = 200000;
+
 struct StringOptions {
     RootOptions roots;            ///< for the plant roots (its count is replaced by plant_roots)
     int plant_roots = 2;          ///< rightmost roots of D computed (>= 1)
