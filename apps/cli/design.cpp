@@ -110,6 +110,10 @@ int run_design() {
     const CalibratedVehicle& car = cars.front();
     ParameterMap p = car.parameters;
     if (!design_args.speed.empty()) p["speed"] = parse_number("--speed", design_args.speed);
+    if (car.has_covariance && car.model == "ovrv") {  // a fit: judge the design under its uncertainty too
+        o.has_covariance = true;
+        o.covariance = car.covariance;
+    }
     // sized before the work (one core, measured on the paper's cars): an evaluation of the
     // frequency objectives or the plant's abscissa about 3 ms with its gradient, a run at most a
     // few hundred of them; a peak evaluation 1 + 2n norms of about 0.05 s, at most 40 per run; a
@@ -171,6 +175,15 @@ int run_design() {
             auto rv = [](const RingResult& g) { return g.stable ? std::string("stable") : verdict_word(g.verdict); };
             std::snprintf(line, sizeof line, "%-24s %-18s %s\n", ("ring N=" + ring_name(o.cars)).c_str(), rv(*r.ring_initial).c_str(), rv(*r.ring).c_str());
             out << line;
+        }
+        if (r.has_uncertainty) {
+            auto pcell = [](const VerdictUncertainty& u) {
+                const ProbabilityEstimate& e = u.string_unstable;
+                return "p = " + rounded(1.0 - e.p, 3) + " [" + rounded(1.0 - e.upper, 3) + ", " + rounded(1.0 - e.lower, 3) + "]";
+            };
+            std::snprintf(line, sizeof line, "%-24s %-18s %s\n", "P(string stable)", pcell(r.uncertainty_initial).c_str(), pcell(r.uncertainty).c_str());
+            out << line << "  (under the fit's uncertainty of the held parameters, " << r.uncertainty.samples
+                << " draws; 95 % Wilson intervals)\n";
         }
         out << "\n" << to_string(r.status) << ": " << r.message << "\n";
         std::cout << out.str();

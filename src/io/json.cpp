@@ -689,6 +689,20 @@ std::string design_json(const DesignResult& r, double margin) {
     for (const std::string& k : r.free) ig[k] = r.initial.at(k);
     res.json("initial", side(ig, r.value_initial, r.attenuation_initial, r.string_initial, r.ring_initial));
     res.string("method", r.method).integer("evaluations", r.evaluations).json("starts", starts);
+    if (r.has_uncertainty) {
+        // the probability of string stability under the fit's uncertainty of the held parameters
+        auto prob = [](const VerdictUncertainty& u) {
+            JsonObject o;
+            const ProbabilityEstimate& e = u.string_unstable;
+            o.number("p_string_stable", 1.0 - e.p).number("standard_error", e.standard_error);
+            o.json("wilson", "[" + json_number(1.0 - e.upper) + "," + json_number(1.0 - e.lower) + "]");
+            o.integer("samples", u.samples).integer("undecided", u.undecided).string("status", to_string(u.status));
+            return o.str();
+        };
+        res.json("uncertainty", JsonObject().json("design", prob(r.uncertainty)).json("initial", prob(r.uncertainty_initial)).str());
+    } else {
+        res.null("uncertainty");
+    }
     return res.str();
 }
 

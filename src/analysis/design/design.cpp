@@ -53,6 +53,8 @@ void DesignOptions::validate() const {
     if (starts < 1 || starts > 64) throw std::invalid_argument("design: starts = " + std::to_string(starts) + ": expected 1 to 64");
     optimizer.validate();
     peak.validate();
+    if (uncertainty_samples < 1 || uncertainty_samples > 1000000)
+        throw std::invalid_argument("design: uncertainty_samples = " + std::to_string(uncertainty_samples) + ": expected 1 to 1000000");
     validate_bounds(bounds);
 }
 
@@ -62,6 +64,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Steps of the sequential QP at most: it converges linearly where the boundary is curved (the
 // QP's metric is the distance's alone; measured ratios 0.5 to 0.85 per step on the paper's cars)
 constexpr int kSqpSteps = 300;
+// 1/s: the nearest search keeps the plant's spectral abscissa below minus this (linearised)
+constexpr double kPlantMargin = 1e-3;
 // Integrator steps of one ||h||_1 run during a peak search (about 0.05 s)
 constexpr long kSearchPeakSteps = 200000;
 // Evaluations of one run of the peak search at most
@@ -352,7 +356,7 @@ public:
             const Eigen::VectorXd slack = A * cand - b;
             bool ok = true;
             for (int i = 0; i < k; ++i)
-                if (slack[i] < -1e-10 * (std::abs(b[i]) + A.row(i).cwiseAbs().dot(cand.cwiseAbs()) + 1e-300)) ok = false;
+                if (!(slack[i] >= -1e-10 * (std::abs(b[i]) + A.row(i).cwiseAbs().dot(cand.cwiseAbs()) + 1e-300))) ok = false;  // NaN too
             if (!ok) continue;
             const double obj = (cand - c).cwiseProduct(M).dot(cand - c);
             if (obj < best) {
@@ -387,15 +391,25 @@ public:
             const AttenuationScan sc = attenuation_scan(L);
             ++scans;
             const auto& pieces = sc.mu_minima;
-            const int k = static_cast<int>(pieces.size()) + 2 * static_cast<int>(nn);
+            // one more constraint: the plant stays stable, -alpha(x) - kPlantMargin >= 0 linearised
+            // with the root sensitivity (the margin is not defined where it is not)
+            Eigen::VectorXd ga;
+            const double alpha = plant(x, L, &ga);
+            const int k = static_cast<int>(pieces.size()) + 2 * static_cast<int>(nn) + 1;
             Eigen::MatrixXd A = Eigen::MatrixXd::Zero(k, nn);
             Eigen::VectorXd b(k);
             double least = kInf;
             for (std::size_t i = 0; i < pieces.size(); ++i) {
                 const double om = pieces[i].omega;
                 const Eigen::VectorXd g = partials(x, [om, target](const Linearisation& l) { return margin_piece(l, om, target); });
+                const double gv = margin_piece(L, om, target);
+                if (!g.allFinite() || !std::isfinite(gv)) {  // a piece that cannot be linearised: left out of this step
+                    A.row(static_cast<Eigen::Index>(i)).setZero();
+                    b[static_cast<Eigen::Index>(i)] = 0.0;
+                    continue;
+                }
                 A.row(static_cast<Eigen::Index>(i)) = g.transpose();
-                b[static_cast<Eigen::Index>(i)] = -margin_piece(L, om, target) + g.dot(x);
+                b[static_cast<Eigen::Index>(i)] = -gv + g.dot(x);
                 least = std::min(least, pieces[i].mu);
             }
             for (Eigen::Index j = 0; j < nn; ++j) {
@@ -405,22 +419,31 @@ public:
                 A(r + 1, j) = -1.0;
                 b[r + 1] = -hi[static_cast<std::size_t>(j)];
             }
+            A.row(k - 1) = -ga.transpose();
+            b[k - 1] = alpha + kPlantMargin - ga.dot(x);
             Eigen::VectorXd y;
             bool solved = solve_qp(A, b, M, c, y);
             // far from the boundary the linearised pieces may contradict each other within the
-            // bounds: step on the most violated piece alone (the next step has them all again)
-            std::vector<std::size_t> order(pieces.size());
-            for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-            std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return pieces[i].mu < pieces[j].mu; });
-            for (std::size_t oi = 0; !solved && oi < order.size(); ++oi) {
-                const auto keep = static_cast<Eigen::Index>(order[oi]);
-                Eigen::MatrixXd A1(1 + 2 * nn, nn);
-                Eigen::VectorXd b1(1 + 2 * nn);
-                A1.row(0) = A.row(keep);
-                b1[0] = b[keep];
-                A1.bottomRows(2 * nn) = A.bottomRows(2 * nn);
-                b1.tail(2 * nn) = b.tail(2 * nn);
-                solved = solve_qp(A1, b1, M, c, y);
+            // bounds: a restoration step on the most violated piece, x + t M^-1 grad g with t
+            // taking its linearisation to 0, clipped to the box (the next step has them all again)
+            if (!solved) {
+                std::size_t worst = 0;
+                double wv = kInf;
+                for (std::size_t i = 0; i < pieces.size(); ++i)
+                    if (A.row(static_cast<Eigen::Index>(i)).squaredNorm() > 0.0) {
+                        const double gi = A.row(static_cast<Eigen::Index>(i)).dot(x) - b[static_cast<Eigen::Index>(i)];  // g_i(x)
+                        if (gi < wv) {
+                            wv = gi;
+                            worst = i;
+                        }
+                    }
+                if (wv < 0.0) {
+                    const Eigen::VectorXd gr = A.row(static_cast<Eigen::Index>(worst)).transpose();
+                    const Eigen::VectorXd d = M.cwiseInverse().cwiseProduct(gr);
+                    y = x + (-wv / gr.dot(d)) * d;
+                    for (Eigen::Index j = 0; j < nn; ++j) y[j] = std::clamp(y[j], lo[static_cast<std::size_t>(j)], hi[static_cast<std::size_t>(j)]);
+                    solved = (y - x).norm() > 0.0;
+                }
             }
             if (!solved) {
                 out.status = Status::NumericalIssue;
@@ -784,10 +807,38 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
                                    ? l2_proof + "; peak (L-infinity) stability implies it, so no gains of the box are peak stable either"
                                    : l2_proof;
     bool infeasible = false, plateau = false;
+    const std::size_t n_starts = starts.size();
     if (options.objective == DesignObjective::Nearest) {
         infeasible = skipped || !crossing(first, x);
+        if (infeasible && !skipped) {
+            // no sequential QP reached the set: look for a point of it by minimising the weighted
+            // norm (which is 1 exactly there), then walk its boundary to the car from that point
+            const Outcome reach = run(DesignObjective::SupGamma);
+            if (reach.best <= 1.0 + 1e-9) {
+                starts.assign(1, reach.x);
+                const Outcome again = run(DesignObjective::Nearest);
+                if (crossing(again, x)) {
+                    infeasible = false;
+                    best_status = again.status;
+                    best_message = again.message;
+                } else {
+                    // the walk did not converge: the crossing toward the point found, a design
+                    // that meets the margin but is not shown to be the nearest
+                    Outcome found = reach;
+                    found.best = P.distance(reach.x, nullptr);
+                    if (crossing(found, x)) {
+                        infeasible = false;
+                        best_status = again.status == Status::Converged ? Status::MaxIterations : again.status;
+                        best_message = "gains with the margin found (the crossing toward a point where the weighted norm is 1), but the walk to the "
+                                       "nearest ones did not converge (" + again.message + "): not shown to be the nearest";
+                    }
+                }
+            }
+        }
     } else if (two_phases && first.best <= 1.0 + 1e-9) {
-        // sup-gamma reached its least value 1: of those gains, the nearest to the car's own
+        // sup-gamma reached its least value 1: of those gains, the nearest to the car's own,
+        // the point that reached it among the starts
+        starts.insert(starts.begin(), first.x);
         const Outcome second = run(DesignObjective::Nearest);
         Eigen::VectorXd xn;
         if (crossing(second, xn)) {
@@ -803,7 +854,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
         const std::string proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
         best_status = proof.empty() ? Status::BudgetExhausted : Status::Converged;
         best_message = proof.empty() ? "no gains with an attenuation margin of at least " + detail::significant(options.margin, 6) +
-                                           " s found within the bounds from " + std::to_string(starts.size()) +
+                                           " s found within the bounds from " + std::to_string(n_starts) +
                                            " starts (not a proof that none exist: widen the bounds, free more parameters or add starts)"
                                      : proof;
     }
@@ -837,6 +888,29 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     const std::string sqp = n <= 4 ? "sequential quadratic programming on the pieces of the attenuation margin"
                                    : "an exact penalty minimised by " + bfgs;
     r.method = options.objective == DesignObjective::Nearest ? sqp : plateau ? bfgs + "; on its plateau, the nearest gains by " + sqp : bfgs;
+    if (options.has_covariance) {
+        if (model != "ovrv") throw std::invalid_argument("design: a covariance goes with the ovrv law (k1, k2, th, tau, eta); the car is " + model);
+        static const char* order[5] = {"k1", "k2", "th", "tau", "eta"};
+        Eigen::Matrix<double, 5, 5> C = options.covariance;
+        UncertaintyOptions uo;
+        uo.samples = options.uncertainty_samples;
+        uo.ring_samples = 0;
+        for (const BoundedParameter& b : classification_domain())
+            if (std::find(options.free.begin(), options.free.end(), b.name) == options.free.end()) uo.domain.push_back(b);
+        for (int i = 0; i < 5; ++i)
+            if (std::find(options.free.begin(), options.free.end(), order[i]) != options.free.end()) {
+                C.row(i).setZero();
+                C.col(i).setZero();
+            }
+        ParameterMap at_car, at_design;
+        for (const char* k : order) {
+            at_car[k] = r.initial.at(k);
+            at_design[k] = r.parameters.at(k);
+        }
+        r.uncertainty_initial = classify_with_uncertainty(at_car, C, 22, uo);
+        r.uncertainty = classify_with_uncertainty(at_design, C, 22, uo);
+        r.has_uncertainty = true;
+    }
     r.evaluations = P.evaluations;
     r.infeasibility_proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
     r.status = best_status;
@@ -862,7 +936,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
                         detail::significant(r.change, 6) + " (" + std::to_string(r.starts.size()) + " runs of the minimisers)";
         } else if (options.objective != DesignObjective::Abscissa && !r.string.string_stable) {
             const std::string proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
-            r.message = proof.empty() ? "no string-stable gains found within the bounds from " + std::to_string(starts.size()) +
+            r.message = proof.empty() ? "no string-stable gains found within the bounds from " + std::to_string(n_starts) +
                                             " starts (not a proof that none exist): the least objective found is " + detail::significant(r.value, 8) +
                                             " (" + best_message + ")"
                                       : proof + "; the least objective found is " + detail::significant(r.value, 8);

@@ -297,3 +297,39 @@ TEST_CASE("design peak: C_max reaches a certified non-overshooting design (||h||
     CHECK(r.value <= 1.0 + r.string.peak->error + 1e-7);
     CHECK(r.string.string_verdict == Verdict::Stable);
 }
+
+TEST_CASE("design under a fit's uncertainty of the held delay: the probability of string stability against an independent Monte Carlo") {
+    // C_max with an uncertain delay (standard deviation 0.05 s, the other held parameters exact);
+    // the design sits on the margin's boundary, so part of the delays make it string unstable
+    const ParameterMap car = car_params("C_max");
+    DesignOptions o;
+    o.objective = DesignObjective::Nearest;
+    o.starts = 1;
+    o.has_covariance = true;
+    o.covariance(3, 3) = 0.05 * 0.05;
+    o.covariance(0, 0) = 1e-6;  // k1 is free: its variance must be ignored
+    const DesignResult r = design_gains("ovrv", car, o);
+    REQUIRE(r.status == Status::Converged);
+    REQUIRE(r.has_uncertainty);
+    const double p = 1.0 - r.uncertainty.string_unstable.p;
+    CHECK(r.uncertainty_initial.string_unstable.p == 1.0);  // the car itself: unstable for every delay drawn
+    CHECK(p > 0.05);
+    CHECK(p < 0.95);
+    // independent: delays drawn here, the design's gains, the certified verdict of each
+    std::mt19937_64 rng(99);
+    std::normal_distribution<double> tau(car.at("tau"), 0.05);
+    int stable = 0, n = 0;
+    while (n < 2000) {
+        const double t = tau(rng);
+        if (t < 0.0 || t > 1.0) continue;  // calibrate's bounds on tau, as classify's domain
+        ParameterMap q = r.parameters;
+        q["tau"] = t;
+        ++n;
+        if (analyse_string(make_model("ovrv", q)->linearise()).string_verdict == Verdict::Stable) ++stable;
+    }
+    const double pm = static_cast<double>(stable) / n;
+    const double se = std::sqrt(p * (1.0 - p) / r.uncertainty.samples + pm * (1.0 - pm) / n);
+    CAPTURE(p);
+    CAPTURE(pm);
+    CHECK(std::abs(p - pm) <= 4.0 * se);
+}

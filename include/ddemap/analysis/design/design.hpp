@@ -49,6 +49,7 @@
 #include <vector>
 
 #include "ddemap/analysis/stability/attenuation_margin.hpp"
+#include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/analysis/stability/peak_stability.hpp"
 #include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/analysis/stability/string_stability.hpp"
@@ -91,6 +92,13 @@ struct DesignOptions {
         return o;
     }();
     PeakOptions peak;  ///< of the peak objective and of the peak verdict at the result
+    /// The covariance of the car's calibrated (k1, k2, th, tau, eta) (ovrv only; what `calibrate`
+    /// writes): when given, the verdicts at the car and at the design are also judged under the
+    /// uncertainty of the parameters the design holds (classify_with_uncertainty with the rows and
+    /// columns of the free parameters set to zero: they are the engineer's choice, not estimates).
+    bool has_covariance = false;
+    Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
+    int uncertainty_samples = 1000;  ///< parameter draws for those probabilities (>= 1)
     /// After each start: (starts done, starts). It may throw ddemap::Cancelled to stop.
     Progress progress;
     /// std::invalid_argument naming the first bad option (the names against the law in design_gains).
@@ -140,6 +148,11 @@ struct DesignResult {
     std::string ring_method;     ///< "winding" or "modes" when ring is set
     std::vector<DesignStart> starts;
     int evaluations = 0;         ///< objective evaluations over every run
+    /// With DesignOptions::has_covariance: the verdicts at the car and at the design under the
+    /// uncertainty of the held parameters (string_unstable is the probability of string
+    /// instability, with its Wilson interval).
+    bool has_uncertainty = false;
+    VerdictUncertainty uncertainty_initial, uncertainty;
 };
 
 /// Designs the free parameters of the car `model` with `parameters` (every law parameter and
