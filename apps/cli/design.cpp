@@ -19,7 +19,7 @@ namespace ddemap::cli {
 
 namespace {
 struct DesignArgs {
-    std::string car, objective = "sup-gamma", free = "k1,k2", bounds, margin = "0.1", weights, starts = "4", speed;
+    std::string car, objective = "sup-gamma", free = "k1,k2", bounds, margin = "0.1", weights, starts = "4";
     RingArg ring;
     FormatArg format;
     OutArg out;
@@ -51,8 +51,9 @@ std::string verdict_cell(const StringResult& s, const std::string& which) {
 void add_design_flags(CLI::App& app) {
     app.add_option("CAR", design_args.car, std::string("the car to design from (one car): ") + cars_help())->required()->type_name("CAR");
     app.add_option("--objective", design_args.objective,
-                   "sup-gamma (sup |Gamma(iw)|; where it is 1, the larger attenuation margin), peak (||h||_1), abscissa (the plant's spectral "
-                   "abscissa, or the ring's with --ring) or nearest (the smallest relative change to an attenuation margin of at least --margin)")
+                   "sup-gamma (sup |Gamma(iw)| |1 + i m w|, m = --margin; where it reaches 1, the nearest such gains), peak (||h||_1), abscissa "
+                   "(the plant's spectral abscissa, or the ring's with --ring) or nearest (the smallest relative change to an attenuation margin of "
+                   "at least --margin)")
         ->capture_default_str()
         ->type_name("sup-gamma|peak|abscissa|nearest");
     app.add_option("--free", design_args.free, "the law parameters designed, the others held (e.g. k1,k2,th)")->capture_default_str()->type_name("NAME,...");
@@ -61,11 +62,12 @@ void add_design_flags(CLI::App& app) {
     app.add_option("--margin", design_args.margin,
                    "attenuation margin asked for by nearest and sup-gamma, and checked for every objective [s], 0.001 to 1000: every wave is damped "
                    "from car to car at least as by a first-order lag of this time constant, |Gamma(iw)| <= 1/|1 + i margin w|")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->type_name("SECONDS");
     app.add_option("--weights", design_args.weights, "nearest: a weight per free parameter of the relative change, each in [0.001, 1000] (default: all 1)")->type_name("W,...");
     app.add_option("--starts", design_args.starts, "runs of the minimiser: from the car's values and from points of a Halton sequence in the bounds (1..64)")
-        ->capture_default_str();
-    app.add_option("--speed", design_args.speed, "equilibrium speed [m/s] (idm is linearised about it; default: the law's)");
+        ->capture_default_str()
+        ->type_name("N");
     design_args.ring.add_to(app, "", "abscissa of the ring of N cars (N >= 2 or inf) instead of the plant's; with any objective, the ring verdicts too");
     design_args.format.add_to(app);
     design_args.out.add_to(app, "PREFIX.csv (the car and the design) and PREFIX.json", false);
@@ -109,7 +111,6 @@ int run_design() {
         throw BadInput("CAR = '" + design_args.car + "': " + std::to_string(cars.size()) + " cars: expected one car (e.g. FILE.csv:NAME)");
     const CalibratedVehicle& car = cars.front();
     ParameterMap p = car.parameters;
-    if (!design_args.speed.empty()) p["speed"] = parse_number("--speed", design_args.speed);
     if (car.has_covariance && car.model == "ovrv") {  // a fit: judge the design under its uncertainty too
         o.has_covariance = true;
         o.covariance = car.covariance;
