@@ -35,8 +35,10 @@
 /// root lambda of the characteristic function Delta, dlambda/dx_j = -(dDelta/dx_j) / Delta'(lambda);
 /// the partials in x_j of N, D and Delta at the fixed w* or lambda by central differences of the
 /// law's linearisation (step 1e-6 relative, error ~1e-12). The peak norm has no such formula here:
-/// its gradient is a central difference of ||h||_1 (step 1e-3 of the bound interval, the norm's
-/// error 1e-9), so `peak` is slower and less precise than the others.
+/// its gradient is a difference of ||h||_1 (step 1e-3 of the value, the norm computed to 1e-6
+/// with at most 200,000 integrator steps during the search), at most 40 evaluations per run, so
+/// `peak` is slower and less precise than the others. sup-gamma and peak are at least 1: a run
+/// that reaches 1 has found a global minimum, and the remaining starts are skipped.
 /// The minimiser: solve/optimize/nonsmooth.hpp, in the coordinates z_j with
 /// x_j = lo_j + (hi_j - lo_j)(1 - cos z_j)/2 (the bounds reached at z_j = 0, pi), from the car's
 /// own values (moved a millionth of the box inside it when they lie outside or on a bound) and
@@ -99,7 +101,9 @@ struct DesignOptions {
     bool has_covariance = false;
     Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
     int uncertainty_samples = 1000;  ///< parameter draws for those probabilities (>= 1)
-    /// After each start: (starts done, starts). It may throw ddemap::Cancelled to stop.
+    /// After each evaluation of a search, and after each run: (work done, work in all), the work
+    /// counted in evaluations with each run's budget as its share (an upper bound: a run that
+    /// stops early adds the rest of its share). It may throw ddemap::Cancelled to stop.
     Progress progress;
     /// std::invalid_argument naming the first bad option (the names against the law in design_gains).
     void validate() const;
