@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/core/execution.hpp"
@@ -30,10 +31,7 @@ using clock_type = std::chrono::steady_clock;
 
 namespace {
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using ddemap::bench::median;
 
 double cpu_now(clockid_t id) {
     timespec ts{};

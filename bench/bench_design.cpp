@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "ddemap/analysis/design/design.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 
@@ -29,10 +30,7 @@ using namespace ddemap;
 using clock_type = std::chrono::steady_clock;
 
 namespace {
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using ddemap::bench::median;
 double seconds_since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
 }  // namespace
 

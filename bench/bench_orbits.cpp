@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/traffic/nonlinear_ring.hpp"
@@ -41,11 +42,7 @@ double bisect(G g, double lo, double hi) {
     return 0.5 * (lo + hi);
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t k = v.size() / 2;
-    return v.size() % 2 ? v[k] : 0.5 * (v[k - 1] + v[k]);
-}
+using ddemap::bench::median;
 
 struct Problem {
     std::unique_ptr<NonlinearDDE> system;

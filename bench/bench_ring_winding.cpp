@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "ddemap/analysis/stability/ring_winding.hpp"
 #include "ddemap/core/execution.hpp"
 #include "ddemap/study/sweep.hpp"
@@ -36,10 +37,7 @@ SweepSpec chart(int grid, int cars, double th, double tau, const std::string& me
     return spec;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
+using ddemap::bench::median;
 
 }  // namespace
 

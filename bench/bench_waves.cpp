@@ -15,16 +15,13 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "ddemap/analysis/bifurcation/travelling_wave.hpp"
 
 using namespace ddemap;
 
 namespace {
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using ddemap::bench::median;
 }  // namespace
 
 int main(int argc, char** argv) {

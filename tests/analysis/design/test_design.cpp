@@ -22,6 +22,14 @@ ParameterMap car_params(const std::string& name) {
     return p;
 }
 
+/// Options for `objective` from `starts` starts (two: quick, and a second start checks the first).
+DesignOptions options_for(DesignObjective objective, int starts = 2) {
+    DesignOptions o;
+    o.objective = objective;
+    o.starts = starts;
+    return o;
+}
+
 /// |Gamma(i w)| of OVRV written out here (independent of TransferFunction):
 /// Gamma = (k1 + k2 s) e^{-s tau} / (s^2 + (k1 th + k2) s + k1 e^{-s tau}).
 double ovrv_gain(const ParameterMap& p, double w) {
@@ -150,9 +158,7 @@ TEST_CASE("design nearest: C_max reaches the closed-form nearest point of its lo
     // beta = 2 - v1 - v2, distance beta / |v| (when the other pieces of mu are inactive there,
     // which the result's margin confirms).
     const ParameterMap car = car_params("C_max");
-    DesignOptions o;
-    o.objective = DesignObjective::Nearest;
-    o.starts = 2;
+    DesignOptions o = options_for(DesignObjective::Nearest);
     const DesignResult r = design_gains("ovrv", car, o);
     CAPTURE(r.message);
     REQUIRE(r.status == Status::Converged);
@@ -174,8 +180,7 @@ TEST_CASE("design nearest: C_max reaches the closed-form nearest point of its lo
 
 TEST_CASE("design sup-gamma: where the weighted norm reaches 1 the result is the nearest such gains, and bad options are refused") {
     const ParameterMap car = car_params("C_max");
-    DesignOptions o;
-    o.starts = 2;
+    DesignOptions o = options_for(DesignObjective::SupGamma);
     const DesignResult s = design_gains("ovrv", car, o);
     o.objective = DesignObjective::Nearest;
     const DesignResult n = design_gains("ovrv", car, o);
@@ -216,8 +221,7 @@ TEST_SUITE_BEGIN("slow");
 
 TEST_CASE("design sup-gamma without string-stable gains (A_min, th < tau): never worse than a brute-force grid, and the proof holds on a grid of certified verdicts") {
     const ParameterMap car = car_params("A_min");
-    DesignOptions o;
-    o.starts = 2;
+    DesignOptions o = options_for(DesignObjective::SupGamma);
     const DesignResult r = design_gains("ovrv", car, o);
     CAPTURE(r.message);
     CHECK(r.status == Status::Converged);
@@ -286,9 +290,7 @@ TEST_CASE("design nearest in three parameters (G_min: k1, k2, th): no point of a
 
 TEST_CASE("design peak: C_max reaches a certified non-overshooting design (||h||_1 = 1)") {
     const ParameterMap car = car_params("C_max");
-    DesignOptions o;
-    o.objective = DesignObjective::Peak;
-    o.starts = 2;
+    DesignOptions o = options_for(DesignObjective::Peak);
     const DesignResult r = design_gains("ovrv", car, o);
     CAPTURE(r.message);
     CHECK(r.status == Status::Converged);
@@ -302,9 +304,7 @@ TEST_CASE("design under a fit's uncertainty of the held delay: the probability o
     // C_max with an uncertain delay (standard deviation 0.05 s, the other held parameters exact);
     // the design sits on the margin's boundary, so part of the delays make it string unstable
     const ParameterMap car = car_params("C_max");
-    DesignOptions o;
-    o.objective = DesignObjective::Nearest;
-    o.starts = 1;
+    DesignOptions o = options_for(DesignObjective::Nearest, 1);
     o.has_covariance = true;
     o.covariance(3, 3) = 0.05 * 0.05;
     o.covariance(0, 0) = 1e-6;  // k1 is free: its variance must be ignored
