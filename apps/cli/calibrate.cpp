@@ -25,7 +25,7 @@ namespace ddemap::cli {
 namespace {
 struct CalibrateArgs {
     std::vector<std::string> files;
-    std::string train, model = "ovrv", bounds, gap_weight = "0.02", runs, report, car = "joint", data_dir, follower;
+    std::string train, model = "ovrv", bounds, gap_weight = "0.02", runs, report, car = "joint", data_dir, follower, lead_noise = "auto";
     bool joint = false;
     FormatArg format;
     OutArg out;
@@ -41,6 +41,11 @@ CalibrationOptions options() {
     if (calibrate_args.model != "ovrv") throw BadInput("--model = '" + calibrate_args.model + "': calibration supports ovrv");
     CalibrationOptions o;
     o.gap_weight = parse_number("--gap-weight", calibrate_args.gap_weight);
+    if (calibrate_args.lead_noise != "auto") {
+        o.lead_noise = parse_number("--lead-noise", calibrate_args.lead_noise);
+        if (!(o.lead_noise >= 0.0 && o.lead_noise <= 10.0))
+            throw BadInput("--lead-noise = " + calibrate_args.lead_noise + ": expected auto, or 0 to 10 m/s (0: the lead speed is exact)");
+    }
     if (!calibrate_args.train.empty()) {
         const auto colon = calibrate_args.train.find(':');
         if (colon == std::string::npos) throw BadInput("--train = '" + calibrate_args.train + "': expected T0:T1 in seconds");
@@ -84,6 +89,11 @@ void add_calibrate_flags(CLI::App& app) {
     app.add_option("--model", calibrate_args.model, "the model to fit (ovrv)")->capture_default_str();
     app.add_option("--bounds", calibrate_args.bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
     app.add_option("--gap-weight", calibrate_args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
+    app.add_option("--lead-noise", calibrate_args.lead_noise,
+                   "white noise on the measured lead speed that the intervals allow for [m/s]: auto estimates it from each trace's lead "
+                   "speed (its second differences), 0 takes the lead speed as exact")
+        ->type_name("M/S")
+        ->capture_default_str();
     calibrate_args.out.add_to(app, "PREFIX.csv (a vehicle table for classify), PREFIX.json, PREFIX.svg", false);
     calibrate_args.format.add_to(app);
     run_flags().add_to(app, true);
@@ -172,15 +182,16 @@ int run_calibrate() {
             for (auto& [name, t] : traces) cars.push_back(CarRuns{name, {std::move(t)}, {}, {}});
         }
     }
-    // sized before the work: about 0.005 s of CPU per second of trace and fit (the design's 64
-    // simulations and the Levenberg-Marquardt iterations with sensitivities; measured on simulated
-    // 236 s traces at 10 Hz, about 1 s a fit)
+    // sized before the work: about 0.008 s of CPU per second of trace and fit (the design's 64
+    // simulations, the Levenberg-Marquardt iterations with sensitivities and the 200 simulations
+    // of the lead noise; measured on simulated 236 s traces at 10 Hz, about 1 s a fit before the
+    // lead noise, 0.3 s for it on 150 s traces)
     {
         double seconds = 0.0, duration = 0.0;
         for (const auto& c : cars)
             for (const auto& list : {&c.train, &c.test})
                 for (const Trace& t : *list) duration += t.t.back() - t.t.front();
-        seconds = 0.005 * duration;
+        seconds = 0.008 * duration;
         check_size("calibrate", counted(static_cast<long long>(cars.size()), "fit") + " over " + rounded(duration / 3600.0, 3) + " h of traces", "time",
                    seconds / std::max(1, std::min<int>(thread_count(), static_cast<int>(cars.size()))));
     }
@@ -225,6 +236,7 @@ int run_calibrate() {
         for (const auto& t : c.train) files.push_back(json_string(t.source));
     JsonObject in;
     in.json("traces", json_array(files)).string("model", calibrate_args.model).number("gap_weight", o.gap_weight);
+    if (o.lead_noise >= 0.0) in.number("lead_noise", o.lead_noise);
     if (!calibrate_args.runs.empty()) in.string("runs", calibrate_args.runs);
     if (calibrate_args.joint) in.string("joint", calibrate_args.car);
     if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
@@ -260,6 +272,10 @@ int run_calibrate() {
             out << line;
         }
         for (std::size_t i = 0; i < fits.size(); ++i) {
+            double noise = 0.0;
+            for (double x : fits[i].lead_noise) noise = std::max(noise, x);
+            out << names[i] << ": lead-speed noise allowed for in the intervals " << rounded(noise, 3) << " m/s"
+                << (calibrate_args.lead_noise == "auto" ? " (estimated from the lead speed)" : "") << "\n";
             out << names[i] << ": 95 % intervals";
             for (const auto& est : fits[i].estimates)
                 out << "  " << est.name << " "

@@ -675,8 +675,8 @@ def simulate(fleet, lead_profile=None, lead=None, on_event="continue", t_end=0.0
 
 
 @_with_progress
-def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, model="ovrv", runs=None, data_dir=None,
-              report=None, follower=None, warn=True):
+def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, lead_noise="auto", model="ovrv", runs=None,
+              data_dir=None, report=None, follower=None, warn=True):
     """Fits OVRV to measured car-following traces (``ddemap calibrate``).
 
     ``traces``: each a CSV path (str or ``os.PathLike``), a pandas DataFrame, dict of columns
@@ -686,7 +686,9 @@ def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_we
     ``joint=True``, named ``car``. ``train``: ``(T0, T1)`` [s], the training window (default
     the whole file). ``bounds``: a dict ``{"eta": (5, 15), ...}`` (default the paper's k1 0:1,
     k2 0:1, th 0:3, tau 0:1, eta 5:15). The fit minimises ``MSE(speed) + gap_weight * MSE(gap)``
-    [gap_weight in 1/s^2] over the simulated follower (RK4 with the delay).
+    [gap_weight in 1/s^2] over the simulated follower (RK4 with the delay). ``lead_noise``: the
+    white noise on the measured lead speed [m/s] that the intervals allow for (``"auto"``:
+    estimated from each trace's lead speed; 0: the lead speed is exact), as ``--lead-noise``.
 
     ``runs`` (instead of ``traces``): a run list, CSV with columns car, file, role[, type]: each
     car fitted jointly on its ``role=train`` files and tested on its ``role=test`` files (errors
@@ -713,6 +715,12 @@ def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_we
         if len(train) != 2:
             raise ValueError("train = %r: expected (T0, T1) in seconds" % (train,))
         train = (_number("train", train[0]), _number("train", train[1]))
+    if isinstance(lead_noise, str) and lead_noise == "auto":
+        lead_noise = -1.0
+    else:
+        lead_noise = _number("lead_noise", lead_noise)
+        if not 0 <= lead_noise <= 10:
+            raise ValueError("lead_noise = %r: expected 'auto', or 0 to 10 m/s (0: the lead speed is exact)" % (lead_noise,))
     items = []
     for name, b in (bounds or {}).items():
         if len(b) != 2:
@@ -725,7 +733,7 @@ def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_we
         if _os.path.exists(report) and not _os.path.isdir(report):
             raise ValueError("report = %r: expected a folder" % (report,))
         _os.makedirs(report, exist_ok=True)
-    r = _result(_ddemap.calibrate(files, follower, bool(joint), car, train, items, _number("gap_weight", gap_weight),
+    r = _result(_ddemap.calibrate(files, follower, bool(joint), car, train, items, _number("gap_weight", gap_weight), lead_noise,
                                   "" if runs is None else _os.fspath(runs), "" if data_dir is None else _os.fspath(data_dir),
                                   "" if report is None else report))
     if warn:

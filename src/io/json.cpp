@@ -480,6 +480,14 @@ std::string calibration_json(const std::vector<std::string>& names, const std::v
         j["covariance"] = cov;
         j["correlation"] = cor;
         j["effective_samples"] = num(r.effective_samples);
+        // the lead speed's white noise the covariance allows for, per fitted run [m/s], and the
+        // standard errors as they would be with the lead speed exact
+        json ln = json::array();
+        for (double x : r.lead_noise) ln.push_back(num(x));
+        j["lead_noise"] = ln;
+        json sex = json::object();
+        for (int a = 0; a < 5; ++a) sex[r.estimates[static_cast<std::size_t>(a)].name] = num(std::sqrt(std::max(r.covariance_exact_lead(a, a), 0.0)));
+        j["standard_errors_exact_lead"] = sex;
         j["warnings"] = r.warnings;
         j["objective"] = num(r.objective);
         j["starts"] = r.starts;

@@ -272,6 +272,10 @@ assert all(c[i][i] is None or c[i][i] >= 0 for i in range(5))
 assert all(c[i][j] == c[j][i] for i in range(5) for j in range(5))
 assert isinstance(f['warnings'], list) and all(isinstance(w, str) for w in f['warnings'])
 assert f['starts'] >= 1 and f['objective'] >= 0
+# the lead noise allowed for (one run), and the standard errors without it never larger
+assert len(f['lead_noise']) == 1 and 0 <= f['lead_noise'][0] < 0.01
+se, sx = f['standard_errors'], f['standard_errors_exact_lead']
+assert all(sx[n] <= se[n] * (1 + 1e-12) for n in names if se[n] is not None and sx[n] is not None)
 PY
     "$bin" classify "$tmp/cal.csv" --format csv >/dev/null && ok || bad "calibrate table into classify"
     xmllint --noout "$tmp/cal.svg" && ok || bad "calibrate SVG"
@@ -285,6 +289,7 @@ printf 'time_s,lead_speed_mps,follower_speed_mps,gap_m
 expect_error "badtrace.csv:3: column 'follower_speed_mps' = 'x'" calibrate "$tmp/badtrace.csv"
 expect_error "--bounds item 'eta=15'" calibrate "$excerpt" --bounds eta=15
 expect_error "--train = '5'" calibrate "$excerpt" --train 5
+expect_error "--lead-noise = -1: expected auto, or 0 to 10 m/s" calibrate "$excerpt" --lead-noise -1
 
 # calibrate on several files: one progress line per finished fit on stderr, always {"fits": [...]}
 cp "$excerpt" "$tmp/run2.csv"

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numeric>
 #include <random>
@@ -52,6 +53,9 @@ void check_trace(const Trace& tr, const std::string& first_bad_gap = "") {
         if (tr.speed[i] > kMaxRoadSpeed || tr.lead[i] > kMaxRoadSpeed)
             fail(tr.speed[i] > kMaxRoadSpeed ? "follower_speed_mps" : "lead_speed_mps", std::max(tr.speed[i], tr.lead[i]),
                  "at most 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");
+        // a gap beyond 10 km is not car following; one below -100 m is not a sensor's reading of a cut-in
+        if (tr.gap[i] > 1e4 || tr.gap[i] < -100.0)
+            fail("gap_m", tr.gap[i], tr.gap[i] > 0 ? "at most 10000 m (a gap in mm or cm? convert it to m)" : "a gap above -100 m (at most 1 % of the gaps may be 0 or less, e.g. during a cut-in)");
     }
     // gaps <= 0: a collision, or a sensor's reading during a cut-in; a few (at most 1 % of the
     // samples, as at the start of an OpenACC handling run) are kept, more are refused
@@ -70,7 +74,8 @@ void check_trace(const Trace& tr, const std::string& first_bad_gap = "") {
         std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
         const double median = dt[dt.size() / 2];
         const double largest = *std::max_element(dt.begin(), dt.end());
-        if (median < 1e-3 || median > 10.0) {
+        // the limits with a relative allowance for the rounding of decimal times (0.001 - 0 > 1e-3 - 1e-18)
+        if (median < 1e-3 * (1 - 1e-9) || median > 10.0 * (1 + 1e-9)) {
             std::string hint = "a sampling step of 1 ms to 10 s";
             if (median > 10.0 && median / 1000.0 >= 1e-3 && median / 1000.0 <= 10.0)
                 hint += " (time_s looks like milliseconds: divide the column by 1000)";
@@ -198,6 +203,10 @@ void CalibrationOptions::validate() const {
         const BoundedParameter b = bound(profile[i]);
         if (!(b.upper > b.lower)) throw std::invalid_argument("profile '" + profile[i] + "': the parameter is fixed by its bounds");
     }
+    if (!(std::isfinite(lead_noise) && lead_noise <= 10.0))
+        throw std::invalid_argument("lead noise = " + detail::format_number(lead_noise) + ": expected at most 10 m/s (0: the lead speed is exact; negative: estimated)");
+    if (lead_noise_draws < 20 || lead_noise_draws > 100000)
+        throw std::invalid_argument("lead noise draws = " + std::to_string(lead_noise_draws) + ": expected 20 to 100000");
     if (!profile.empty() && profile_points < 3)
         throw std::invalid_argument("profile points = " + std::to_string(profile_points) + ": expected at least 3");
 }
@@ -228,7 +237,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// One run of a (joint) least-squares problem: residuals (speeds, then sqrt(w) gaps) at the
 /// samples t_j >= t_from of the window [a, b] of its trace.
 struct Segment {
-    const Trace* tr = nullptr;
+    const Trace* tr = nullptr;   // what the simulation reads: the run with its history smoothed
+    const Trace* raw = nullptr;  // the run as measured: what the residuals compare with
     double a = 0.0, b = 0.0, t_from = 0.0;
     std::size_t first = 0;             // data index of the trajectory's first row
     std::vector<std::size_t> rows;     // trajectory rows of the residual samples
@@ -242,6 +252,8 @@ struct LsqProblem {
     double step = 0.05, wg = 0.0;
     CalibrationVector lo, hi;
     mutable std::atomic<int> evaluations{0}, jacobians{0};
+    /// the traces the segments point to: each run with its history smoothed (smoothed_history)
+    std::vector<std::unique_ptr<Trace>> owned;
 
     int samples() const {
         int n = 0;
@@ -257,8 +269,8 @@ struct LsqProblem {
         if (J) J->resize(residuals(), 5);
         Eigen::Index off = 0;
         for (const Segment& sg : seg) {
-            const Trace& tr = *sg.tr;
-            const FollowerTrajectory f = simulate_follower(tr, th, sg.a, sg.b, step, J != nullptr, sg.t_from);
+            const Trace& tr = *sg.raw;
+            const FollowerTrajectory f = simulate_follower(*sg.tr, th, sg.a, sg.b, step, J != nullptr, sg.t_from);
             ++evaluations;
             if (J) ++jacobians;
             const int n = sg.samples();
@@ -435,11 +447,13 @@ std::vector<Eigen::VectorXd> latin_hypercube(int n, int p, unsigned seed) {
 
 /// Errors over the samples of [t_a, t_b] at or after t_from.
 /// The simulation starts at max(t_start, t_a + tau).
+/// (`simulated`: the trace the simulation reads, e.g. with its history smoothed; default `tr`)
 FitErrors errors_over(const Trace& tr, const ParameterMap& p, double t_a, double t_b, double t_from, double step,
-                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr, double t_start = -1e300) {
+                      std::vector<double>* sim_speed = nullptr, std::vector<double>* sim_gap = nullptr, double t_start = -1e300,
+                      const Trace* simulated = nullptr) {
     CalibrationVector theta;
     for (int i = 0; i < 5; ++i) theta[i] = p.at(names[i]);
-    FollowerTrajectory f = simulate_follower(tr, theta, t_a, t_b, step, false, t_start);
+    FollowerTrajectory f = simulate_follower(simulated ? *simulated : tr, theta, t_a, t_b, step, false, t_start);
     const std::vector<double>& v = f.speed;
     const std::vector<double>& s = f.gap;
     FitErrors e;
@@ -492,12 +506,77 @@ std::string fmt(double x) { return detail::format_number(x); }
 
 std::string fmt3(double x) { return detail::significant(x, 3); }
 
+/// The Bartlett (Newey-West) long-run sum of the rows g_t of G with bandwidth L,
+///     Omega = sum_{|l| <= L} (1 - |l|/(L+1)) sum_t g_t g_(t-l)^T = 1/(L+1) sum_j S_j S_j^T,
+/// S_j the sum of the rows in the window [j, j + L] (windows that reach past either end take
+/// the rows inside): each pair of rows l apart shares L + 1 - l windows. O((n + L) p^2).
+Eigen::MatrixXd bartlett_long_run(const Eigen::MatrixXd& G, int L) {
+    const Eigen::Index n = G.rows(), p = G.cols();
+    Eigen::MatrixXd prefix = Eigen::MatrixXd::Zero(n + 1, p);
+    for (Eigen::Index t = 0; t < n; ++t) prefix.row(t + 1) = prefix.row(t) + G.row(t);
+    Eigen::MatrixXd Omega = Eigen::MatrixXd::Zero(p, p);
+    for (Eigen::Index j = -L; j < n; ++j) {
+        const Eigen::Index lo = std::max<Eigen::Index>(j, 0), hi = std::min<Eigen::Index>(j + L + 1, n);
+        const Eigen::RowVectorXd S = prefix.row(hi) - prefix.row(lo);
+        Omega.noalias() += S.transpose() * S;
+    }
+    return Omega / (L + 1);
+}
+
 }  // namespace
+
+double lead_noise_estimate(const Trace& tr, double t_a, double t_b) {
+    std::vector<double> z;
+    const std::size_t n = tr.t.size();
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+        if (tr.t[k - 1] < t_a || tr.t[k + 1] > t_b) continue;
+        const double h0 = tr.t[k] - tr.t[k - 1], h1 = tr.t[k + 1] - tr.t[k];
+        if (!(h0 > 0.0 && h1 > 0.0)) continue;
+        const double a = h1 / (h0 + h1), b = h0 / (h0 + h1);  // v_k ~ a v_(k-1) + b v_(k+1)
+        z.push_back(std::abs(tr.lead[k] - a * tr.lead[k - 1] - b * tr.lead[k + 1]) / std::sqrt(1.0 + a * a + b * b));
+    }
+    if (z.size() < 10) return 0.0;
+    auto mid = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2);
+    std::nth_element(z.begin(), mid, z.end());
+    return 1.4826 * *mid;
+}
 
 namespace {
 
 /// The problem of `calibrate` (one run) or `calibrate_joint` (several): bounds, each run's
 /// training window and residual samples (t >= t_a + tau_max).
+/// The trace with its follower speed and gap at the history's samples (times in [a, t_from],
+/// where the simulation takes the data as its initial function) replaced by a quadratic
+/// least-squares fit to the samples in [a, t_from + 2 s]: the simulation starts from the data at
+/// t_from, and measurement noise there is an initial error that the fit would otherwise bend
+/// the parameters to follow (0.1 m of gap noise moved tau of a stiff car by 20 %). Over 3 s of
+/// car following a quadratic is close to the motion (a relative jerk j leaves about
+/// j (1.5 s)^3 / 15 in the gap); 30 samples at 10 Hz divide the noise by about 3.
+Trace smoothed_history(const Trace& tr, double a, double t_from) {
+    Trace out = tr;
+    const double c = 0.5 * (a + t_from + 2.0), w = 0.5 * (t_from + 2.0 - a);
+    std::vector<std::size_t> rows;
+    for (std::size_t k = 0; k < tr.t.size(); ++k)
+        if (tr.t[k] >= a && tr.t[k] <= t_from + 2.0) rows.push_back(k);
+    if (rows.size() < 8) return out;  // too few samples to smooth (a sampling step above 0.4 s)
+    Eigen::MatrixXd X(static_cast<Eigen::Index>(rows.size()), 3);
+    Eigen::MatrixXd Y(static_cast<Eigen::Index>(rows.size()), 2);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const double x = (tr.t[rows[i]] - c) / w;
+        X.row(static_cast<Eigen::Index>(i)) << 1.0, x, x * x;
+        Y.row(static_cast<Eigen::Index>(i)) << tr.speed[rows[i]], tr.gap[rows[i]];
+    }
+    const Eigen::MatrixXd beta = X.colPivHouseholderQr().solve(Y);
+    for (std::size_t k : rows) {
+        if (tr.t[k] > t_from) break;
+        const double x = (tr.t[k] - c) / w;
+        const Eigen::RowVector3d phi(1.0, x, x * x);
+        out.speed[k] = phi * beta.col(0);
+        out.gap[k] = phi * beta.col(1);
+    }
+    return out;
+}
+
 void set_up(LsqProblem& pb, const std::vector<const Trace*>& traces, const CalibrationOptions& o) {
     for (int i = 0; i < 5; ++i) {
         const BoundedParameter bd = o.bound(names[i]);
@@ -518,7 +597,9 @@ void set_up(LsqProblem& pb, const std::vector<const Trace*>& traces, const Calib
         }
         // every candidate is scored on the same samples: those after the longest admissible delay
         Segment sg;
-        sg.tr = trp;
+        pb.owned.push_back(std::make_unique<Trace>(smoothed_history(tr, a, a + pb.hi[3])));
+        sg.tr = pb.owned.back().get();
+        sg.raw = trp;
         sg.a = a;
         sg.b = b;
         sg.t_from = a + pb.hi[3];
@@ -602,7 +683,7 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
     Eigen::VectorXd r;
     Eigen::MatrixXd J;
     const bool finite = pb.eval(theta, r, &J);
-    CalibrationMatrix cov = CalibrationMatrix::Zero(), cov_iid = CalibrationMatrix::Zero();
+    CalibrationMatrix cov = CalibrationMatrix::Zero(), cov_iid = CalibrationMatrix::Zero(), cov_exact = CalibrationMatrix::Zero();
     std::vector<bool> undetermined(5, false);
     double sigma2 = 0.0;
     if (finite && p > 0 && n > p) {
@@ -635,33 +716,36 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
         // independent, so Omega is the sum over runs (no cross-run lags)
         Eigen::MatrixXd Omega = Eigen::MatrixXd::Zero(p, p);
         double b_max = 0.0, eff = 0.0;
+        // the scores g_t = J_t^T r_t of a run's samples (speed and gap residual of the same time together)
+        auto scores = [&](const Eigen::VectorXd& rr, Eigen::Index off, int ns) {
+            Eigen::MatrixXd G(ns, p);
+            for (int t = 0; t < ns; ++t) {
+                G.row(t) = JF.row(off + t) * rr[off + t];
+                if (pb.wg > 0.0) G.row(t) += JF.row(off + ns + t) * rr[off + ns + t];
+            }
+            return G;
+        };
+        std::vector<int> bandwidths;  // per run, -1 for a run too short for scores
         Eigen::Index off = 0;
         for (const Segment& sg : pb.seg) {
             const int ns = sg.samples();
             const Eigen::Index ms = static_cast<Eigen::Index>(ns) * pb.per_sample();
             if (ns < 2) {
+                bandwidths.push_back(-1);
                 off += ms;
                 continue;
             }
             const Eigen::VectorXd rv = r.segment(off, ns);
-            Eigen::MatrixXd G(ns, p);
-            for (int t = 0; t < ns; ++t) {
-                G.row(t) = JF.row(off + t) * r[off + t];
-                if (pb.wg > 0.0) G.row(t) += JF.row(off + ns + t) * r[off + ns + t];
-            }
+            const Eigen::MatrixXd G = scores(r, off, ns);
             // bandwidth: five times the lag at which the residuals decorrelate (the slower stream)
             const int cap = std::max(1, ns / 4);
             int lag = decorrelation_lag(rv, cap);
             if (pb.wg > 0.0) lag = std::max(lag, decorrelation_lag(r.segment(off + ns, ns), cap));
             const int L = std::min(5 * lag, cap);
+            bandwidths.push_back(L);
             res.bandwidth = std::max(res.bandwidth, L);
             b_max = std::max(b_max, static_cast<double>(L) / ns);
-            Omega += G.transpose() * G;
-            for (int l = 1; l <= L; ++l) {
-                const double wl = 1.0 - static_cast<double>(l) / (L + 1);
-                const Eigen::MatrixXd Gl = G.bottomRows(ns - l).transpose() * G.topRows(ns - l);
-                Omega += wl * (Gl + Gl.transpose());
-            }
+            Omega += bartlett_long_run(G, L);
             const std::vector<double> rho = autocorrelation(rv, L);
             double f = 1.0;
             for (int l = 1; l <= L; ++l) f += 2.0 * (1.0 - static_cast<double>(l) / (L + 1)) * rho[static_cast<std::size_t>(l)];
@@ -674,18 +758,85 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
         // when the bandwidth is a sizeable part of the trace, as it is for 10 Hz residuals
         const double bb = b_max;
         res.critical_value = 1.96 + 2.9694 * bb + 0.4160 * bb * bb - 0.5324 * bb * bb * bb;
+        const Eigen::MatrixXd Cx = Hinv * Omega * Hinv;
+        // the lead speed's noise (errors in variables): r = B e - eps at the truth, B = dr/d(lead);
+        // the sandwich needs Cov(J^T r) = J^T (B Sigma_e B^T + Sigma_eps) J. The Newey-West sum
+        // estimates it well for the stationary, quickly decorrelating eps, but the response B e
+        // is correlated over the car's time constants (and the gap integrates e), beyond what
+        // the bandwidth sees. Monte Carlo over draws e_m of white noise at the fit (the model is
+        // linear in the lead, so B e_m = r(lead + e_m) - r(lead)): add E[s s^T] (s = J^T B e_m)
+        // and subtract what the Newey-West sum with the same bandwidth makes of B e_m on average.
+        res.lead_noise.assign(pb.seg.size(), 0.0);
+        for (std::size_t i = 0; i < pb.seg.size(); ++i)
+            res.lead_noise[i] = o.lead_noise >= 0.0 ? o.lead_noise : lead_noise_estimate(*pb.seg[i].tr, pb.seg[i].a, pb.seg[i].b);
+        Eigen::MatrixXd Omega_lead = Eigen::MatrixXd::Zero(p, p);
+        if (std::any_of(res.lead_noise.begin(), res.lead_noise.end(), [](double x) { return x > 0.0; })) {
+            const int M = o.lead_noise_draws;
+            std::vector<Eigen::MatrixXd> part(static_cast<std::size_t>(M));
+            parallel_for(M, [&](long m) {
+                // the draw's own copies of the traces, each lead speed with its noise added
+                std::mt19937_64 rng(0x5eedULL * (o.seed + 1) + static_cast<std::uint64_t>(m));
+                std::normal_distribution<double> z(0.0, 1.0);
+                std::vector<Trace> copies;
+                copies.reserve(pb.seg.size());
+                LsqProblem noisy;
+                noisy.step = pb.step;
+                noisy.wg = pb.wg;
+                noisy.lo = pb.lo;
+                noisy.hi = pb.hi;
+                noisy.seg = pb.seg;
+                for (std::size_t i = 0; i < pb.seg.size(); ++i) {
+                    copies.push_back(*pb.seg[i].tr);
+                    for (double& v : copies.back().lead) v += res.lead_noise[i] * z(rng);
+                }
+                for (std::size_t i = 0; i < pb.seg.size(); ++i) noisy.seg[i].tr = &copies[i];
+                Eigen::VectorXd rm;
+                Eigen::MatrixXd acc = Eigen::MatrixXd::Zero(p, p);
+                if (noisy.eval(theta, rm, nullptr)) {
+                    rm -= r;  // B e_m
+                    Eigen::Index o2 = 0;
+                    for (std::size_t i = 0; i < pb.seg.size(); ++i) {
+                        const int ns = pb.seg[i].samples();
+                        if (bandwidths[i] >= 0 && res.lead_noise[i] > 0.0) {
+                            const Eigen::MatrixXd Gm = scores(rm, o2, ns);
+                            const Eigen::RowVectorXd sm = Gm.colwise().sum();
+                            acc += sm.transpose() * sm - bartlett_long_run(Gm, bandwidths[i]);
+                        }
+                        o2 += static_cast<Eigen::Index>(ns) * pb.per_sample();
+                    }
+                } else {
+                    acc.setConstant(std::numeric_limits<double>::quiet_NaN());
+                }
+                part[static_cast<std::size_t>(m)] = acc;
+            });
+            for (const auto& a : part) Omega_lead += a / M;  // in draw order: the same sum on any thread count
+        }
+        Eigen::MatrixXd C0 = Cx;
+        if (Omega_lead.allFinite() && !Omega_lead.isZero(0.0)) {
+            // Omega + Omega_lead is a covariance estimate: negative eigenvalues (Monte Carlo
+            // scatter where the lead's share is small) are set to 0
+            Eigen::MatrixXd Ot = Omega + Omega_lead;
+            Ot = 0.5 * (Ot + Ot.transpose()).eval();
+            Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eo(Ot);
+            Ot = eo.eigenvectors() * eo.eigenvalues().cwiseMax(0.0).asDiagonal() * eo.eigenvectors().transpose();
+            C0 = Hinv * Ot * Hinv;
+        } else if (!Omega_lead.allFinite()) {
+            res.warnings.push_back("the lead speed's noise could not be simulated at the fit: the intervals take the lead speed as exact");
+        }
         // symmetric by construction; symmetrised so that rounding does not make C(i, j) != C(j, i)
-        const Eigen::MatrixXd C0 = Hinv * Omega * Hinv;
         const Eigen::MatrixXd C = 0.5 * (C0 + C0.transpose());
+        const Eigen::MatrixXd Cxs = 0.5 * (Cx + Cx.transpose());
         const Eigen::MatrixXd Ci = 0.5 * sigma2 * (Hinv + Hinv.transpose());
         for (int i = 0; i < p; ++i)
             for (int j = 0; j < p; ++j) {
                 cov(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = C(i, j);
+                cov_exact(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = Cxs(i, j);
                 cov_iid(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]) = Ci(i, j);
             }
     }
     res.covariance = cov;
     res.covariance_independent = cov_iid;
+    res.covariance_exact_lead = cov_exact;
     for (int i = 0; i < 5; ++i)
         for (int j = 0; j < 5; ++j) {
             const double d = std::sqrt(cov(i, i) * cov(j, j));
@@ -775,6 +926,16 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
                                    "]: the values outside are not physical or not searched, and the interval (a local, Gaussian approximation) is not "
                                    "reliable there");
     }
+    for (const Segment& sg : pb.seg) {
+        const Trace& tr = *sg.raw;
+        std::size_t bad = 0, first = 0;
+        for (std::size_t k = 0; k < tr.gap.size(); ++k)
+            if (!(tr.gap[k] > 0.0) && bad++ == 0) first = k;
+        if (bad > 0)
+            res.warnings.push_back(tr.source + ": " + std::to_string(bad) + " of " + std::to_string(tr.gap.size()) + " gaps are 0 m or less (the first at sample " +
+                                   std::to_string(first + 1) + ", time_s = " + fmt(tr.t[first]) + ": gap_m = " + fmt(tr.gap[first]) +
+                                   "): kept as a sensor's reading (e.g. during a cut-in), but no car follows at such a gap; fit a window without them (--train)");
+    }
     if (res.condition_number > 1e8) {
         std::string which;
         for (int i = 0; i < 5; ++i)
@@ -846,7 +1007,7 @@ CalibrationResult calibrate(const Trace& tr, const CalibrationOptions& o) {
     const double a = pb.seg[0].a, b = pb.seg[0].b;
     CalibrationResult res = fit_problem(pb, o);
     // 4. errors and the naive predictor
-    res.train = errors_over(tr, res.parameters, a, b, pb.seg[0].t_from, o.step, nullptr, nullptr, pb.seg[0].t_from);  // as the objective
+    res.train = errors_over(tr, res.parameters, a, b, pb.seg[0].t_from, o.step, nullptr, nullptr, pb.seg[0].t_from, pb.seg[0].tr);  // as the objective
     res.all = errors_over(tr, res.parameters, first, last, first + res.parameters.at("tau"), o.step, &res.sim_speed, &res.sim_gap);
     // the test part: the file outside the training window, each piece simulated from its own start
     FitErrors test;
@@ -890,11 +1051,11 @@ CalibrationResult calibrate_joint(const std::vector<Trace>& runs, const Calibrat
     // pooled errors: train as the objective (each run's window), all and naive over whole files
     double tv = 0.0, tg = 0.0, av = 0.0, ag = 0.0, nv = 0.0;
     for (const Segment& sg : pb.seg) {
-        const FitErrors e = errors_over(*sg.tr, res.parameters, sg.a, sg.b, sg.t_from, o.step, nullptr, nullptr, sg.t_from);
+        const FitErrors e = errors_over(*sg.raw, res.parameters, sg.a, sg.b, sg.t_from, o.step, nullptr, nullptr, sg.t_from, sg.tr);
         tv += e.rmse_speed * e.rmse_speed * e.samples;
         tg += e.rmse_gap * e.rmse_gap * e.samples;
         res.train.samples += e.samples;
-        const FitEvaluation ev = evaluate_fit(*sg.tr, res.parameters, o.step);
+        const FitEvaluation ev = evaluate_fit(*sg.raw, res.parameters, o.step);
         av += ev.errors.rmse_speed * ev.errors.rmse_speed * ev.errors.samples;
         ag += ev.errors.rmse_gap * ev.errors.rmse_gap * ev.errors.samples;
         res.all.samples += ev.errors.samples;

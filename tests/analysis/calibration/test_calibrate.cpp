@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -95,6 +96,34 @@ TEST_CASE("bad traces are rejected with the line and column") {
     CalibrationOptions o;
     o.set_bounds("eta", 20, 15);
     CHECK_THROWS_AS(o.validate(), std::invalid_argument);
+    // gaps a sensor cannot mean are refused with the sample
+    std::string huge = ok;
+    huge.replace(huge.find("30\n", 50), 3, "1e160\n");
+    CHECK_THROWS_WITH_AS(read_trace_csv(huge, "h.csv"), doctest::Contains("gap_m = 1e+160: expected at most 10000 m"), std::invalid_argument);
+    std::string deep = ok;
+    deep.replace(deep.find("30\n", 50), 3, "-200\n");
+    CHECK_THROWS_WITH_AS(read_trace_csv(deep, "g.csv"), doctest::Contains("gap_m = -200: expected a gap above -100 m"), std::invalid_argument);
+    // a sampling step of exactly 1 ms (as decimal times: 0.001 * k rounds below 1e-3) is accepted
+    std::string ms = "time_s,lead_speed_mps,follower_speed_mps,gap_m\n";
+    char line[64];
+    for (int k = 0; k <= 20500; ++k) {
+        std::snprintf(line, sizeof line, "%.3f,20,20,30\n", 0.001 * k);
+        ms += line;
+    }
+    CHECK_NOTHROW(read_trace_csv(ms, "ms.csv"));
+}
+
+TEST_CASE("calibrate warns of a gap of 0 m or less that it keeps, naming the sample" * doctest::test_suite("slow")) {
+    Trace tr = synthetic({{"k1", 0.1}, {"k2", 0.4}, {"th", 1.2}, {"tau", 0.4}, {"eta", 8}}, 11);
+    tr.gap[1000] = -5.0;  // one bad reading of 3,001: kept (at most 1 % may be), but said
+    CalibrationOptions o;
+    o.design_points = 8;
+    o.starts = 1;
+    o.lead_noise = 0.0;
+    const CalibrationResult r = calibrate(tr, o);
+    bool said = false;
+    for (const auto& w : r.warnings) said = said || w.find("1 of 3001 gaps are 0 m or less (the first at sample 1001") != std::string::npos;
+    CHECK(said);
 }
 
 TEST_CASE("calibration bounds are named: defaults are the paper's, errors name the parameter") {

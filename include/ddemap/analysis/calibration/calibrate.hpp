@@ -3,7 +3,9 @@
 /// Calibration of OVRV with sensing delay from a measured car-following trace (the seed paper's
 /// eq. 7, docs/mathematics.md section 10): the follower is simulated from the measured history on
 /// [t_a, t_a + tau_max] (tau_max: the upper bound of tau; a start that does not move with tau
-/// keeps the objective smooth in tau), driven by the measured lead speed, and the sum of
+/// keeps the objective smooth in tau; its speed and gap a quadratic least-squares fit to the data
+/// on [t_a, t_a + tau_max + 2 s], so that their noise is not an initial error the parameters
+/// bend to follow), driven by the measured lead speed, and the sum of
 /// squares of the residuals at the samples after t_a + tau_max
 ///     r_j = ( v(t_j) - v_m(t_j),  sqrt(w_gap) (s(t_j) - s_m(t_j)) )
 /// (objective = MSE(speed) + w_gap MSE(gap)) is minimised over theta = (k1, k2, th, tau, eta)
@@ -45,6 +47,13 @@ std::vector<Trace> read_traces_csv(const std::string& text, const std::string& s
 /// Follower `follower` (1..N) of a platoon read back from simulate's CSV, as a trace whose
 /// source is "SOURCE:FOLLOWER" (the checks of read_trace_csv apply).
 Trace platoon_trace(const PlatoonSeries& platoon, int follower);
+
+/// The spread of white noise on the trace's lead speed [m/s] from the samples with times in
+/// [t_a, t_b]: sigma = 1.4826 median_k |d_k| / sqrt(1 + a_k^2 + b_k^2), with d_k = v_k - a_k v_(k-1)
+/// - b_k v_(k+1) the residual of linear interpolation between the neighbours (a_k + b_k = 1; for
+/// white noise of spread sigma, d_k has spread sigma sqrt(1 + a_k^2 + b_k^2); the smooth signal
+/// leaves h^2 v''/2 in it: 0.0005 m/s at 10 Hz and a jerk of 0.1 m/s^3). 0 when fewer than 10 samples.
+double lead_noise_estimate(const Trace& trace, double t_a = -1e300, double t_b = 1e300);
 
 /// The calibrated parameters, in order: k1, k2, th, tau, eta.
 const std::vector<std::string>& calibration_parameter_names();
@@ -94,6 +103,16 @@ struct CalibrationOptions {
     std::vector<std::string> profile;
     int profile_points = 21;
     double step = 0.05;  ///< largest integration step [s]
+    /// Noise on the measured lead speed [m/s] (errors in variables, docs/mathematics.md
+    /// section 10): the lead speed drives the simulation, so its noise reaches the residuals
+    /// filtered by the car, correlated over the car's time constants, and the gap integrates it.
+    /// The covariance adds that part exactly under white lead noise of this level (a Monte
+    /// Carlo over `lead_noise_draws` draws at the fit, fixed seed: the scores' covariance
+    /// J^T B Sigma_e B^T J in place of what the Newey-West sum makes of it). Negative (the
+    /// default): the level is estimated from the lead speed itself (its second differences,
+    /// robustly); 0: the lead speed is taken as exact.
+    double lead_noise = -1.0;
+    int lead_noise_draws = 200;  ///< Monte Carlo draws of the lead noise (20 to 100000)
     /// True when validate() would not throw.
     bool is_valid() const;
     /// Throws std::invalid_argument naming the offending option.
@@ -153,6 +172,14 @@ struct CalibrationResult {
     /// The textbook sigma^2 (J^T J)^-1, sigma^2 = SSR / (m - p): valid only for independent
     /// residuals (kept for comparison; too small for 10 Hz data).
     CalibrationMatrix covariance_independent = CalibrationMatrix::Zero();
+    /// The covariance as it would be with the lead speed taken as exact (the Newey-West sandwich
+    /// alone); `covariance` adds the lead noise's share (equal when lead_noise is 0).
+    CalibrationMatrix covariance_exact_lead = CalibrationMatrix::Zero();
+    /// The level of white noise on the lead speed that the covariance allows for [m/s], per run
+    /// (given, or estimated from the run's lead speed: 1.4826 median |d_k| / sqrt(1 + a_k^2 + b_k^2)
+    /// over the residuals d_k = v_k - a_k v_(k-1) - b_k v_(k+1) of linear interpolation between
+    /// neighbours)
+    std::vector<double> lead_noise;
     CalibrationMatrix correlation = CalibrationMatrix::Identity();  ///< of `covariance`
     int bandwidth = 0;                ///< L [samples]: 5 times the lag where the residuals' autocorrelation falls below 0.05, at most n/4
     /// q of the 95 % intervals: the fixed-b critical value of the Bartlett-HAC t-statistic,
