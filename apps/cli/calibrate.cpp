@@ -261,15 +261,22 @@ int run_calibrate() {
     if (!outputs.empty()) write_files_atomic(outputs);
     print_output(format, e, csv, [&] {
         std::ostringstream out;
-        out << "file                                         k1      k2     th     tau    eta   rmse_v  rmse_gap  naive_v  status\n";
+        // the name column as wide as the longest name (names are never cut: two runs of one
+        // campaign differ only at their ends)
+        std::size_t width = 4;
+        for (const auto& n : names) width = std::max(width, n.size());
+        char head[300];
+        std::snprintf(head, sizeof head, " %8s %7s %6s %6s %6s %7s %8s %8s  %s\n", "k1", "k2", "th", "tau", "eta", "rmse_v", "rmse_gap", "naive_v", "status");
+        char units[300];
+        std::snprintf(units, sizeof units, " %8s %7s %6s %6s %6s %7s %8s %8s\n", "[1/s^2]", "[1/s]", "[s]", "[s]", "[m]", "[m/s]", "[m]", "[m/s]");
+        out << std::string("file") + std::string(width - 4, ' ') << head << std::string(width, ' ') << units;
         for (std::size_t i = 0; i < fits.size(); ++i) {
             const auto& r = fits[i];
             const auto& p = r.parameters;
             char line[300];
-            std::snprintf(line, sizeof line, "%-42.42s %7.4f %7.4f %6.3f %6.3f %6.2f %7.3f %8.3f %8.3f  %s\n", names[i].c_str(), p.at("k1"),
-                          p.at("k2"), p.at("th"), p.at("tau"), p.at("eta"), r.all.rmse_speed, r.all.rmse_gap, r.naive.rmse_speed,
-                          r.status.c_str());
-            out << line;
+            std::snprintf(line, sizeof line, " %8.4f %7.4f %6.3f %6.3f %6.2f %7.3f %8.3f %8.3f  %s\n", p.at("k1"), p.at("k2"), p.at("th"), p.at("tau"),
+                          p.at("eta"), r.all.rmse_speed, r.all.rmse_gap, r.naive.rmse_speed, r.status.c_str());
+            out << names[i] << std::string(width - names[i].size(), ' ') << line;
         }
         for (std::size_t i = 0; i < fits.size(); ++i) {
             double noise = 0.0;

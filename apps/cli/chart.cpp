@@ -55,6 +55,8 @@ int run_chart() {
     if (format == Format::Json) {
         JsonEnvelope e;
         e.command = "chart";
+        e.status = chart_uncertified(r) > 0 ? "uncertified" : "converged";
+        e.message = chart_message(r);
         e.inputs = JsonObject().string("spec", chart_args.spec).string("out", prefix).str();
         e.result = JsonObject()
                        .integer("panels", static_cast<long long>(spec.panels.size()))
@@ -65,6 +67,10 @@ int run_chart() {
     } else {
         std::cout << "chart      " << counted(static_cast<long long>(spec.panels.size()), "panel") << " in " << rounded(r.seconds, 3) << " s\nwrote      " << prefix
                   << ".svg, " << prefix << "-panel1.csv .. and their -boundaries.csv\n";
+    }
+    if (chart_uncertified(r) > 0) {  // the reason of the UNDECIDED points on stderr
+        std::cerr << "ddemap: chart undecided (uncertified): " << chart_message(r) << "\n";
+        return exit_not_converged;
     }
     return exit_ok;
 }

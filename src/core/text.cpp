@@ -1,6 +1,7 @@
 #include <cctype>
 #include "core/internal/text.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -188,6 +189,17 @@ CsvReader::CsvReader(const std::string& text, std::string source, std::string ex
     const std::size_t at = header_line.find_first_not_of(" \t\r\xEF\xBB\xBF");  // spaces and a byte-order mark
     if (at != std::string::npos && (header_line[at] == '{' || header_line[at] == '['))
         throw std::invalid_argument(m_source + " is JSON: expected a CSV file with a header " + m_expected);
+}
+
+std::string CsvReader::header_hint(const std::string& column, const std::vector<std::string>& known) const {
+    if (column.find(';') != std::string::npos)
+        return "; the header is separated by ';': expected commas (export the file as CSV with ',' as the separator and '.' as the decimal point)";
+    if (column.find('\t') != std::string::npos) return "; the header is separated by tabs: expected commas";
+    std::string lower = column;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower != column && std::find(known.begin(), known.end(), lower) != known.end())
+        return "; column names are lower case: " + quoted(lower);
+    return "";
 }
 
 int CsvReader::column(const std::string& name, bool required) const {

@@ -276,6 +276,26 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
     return out;
 }
 
+long chart_uncertified(const RenderedChart& chart) {
+    long n = 0;
+    for (const SweepResult& sw : chart.sweeps) n += sw.uncertified;
+    return n;
+}
+
+std::string chart_message(const RenderedChart& chart) {
+    std::size_t points = 0;
+    for (std::size_t k = 0; k < chart.sweeps.size(); ++k) {
+        const SweepResult& sw = chart.sweeps[k];
+        if (sw.uncertified > 0)
+            return "panel " + std::to_string(k + 1) + ": " + std::to_string(sw.uncertified) + (sw.uncertified == 1 ? " point has" : " points have") +
+                   " no certificate even after collocation (see the 'certified' column of its grid CSV)";
+        points += sw.points.size();
+    }
+    return "every one of the " + std::to_string(points) + " grid points of the " + std::to_string(chart.sweeps.size()) +
+           (chart.sweeps.size() == 1 ? " panel" : " panels") +
+           " certified: no root of the plant or of the ring lies right of the abscissa reported (argument principle)";
+}
+
 std::vector<std::pair<std::string, std::string>> chart_files(const RenderedChart& chart, const std::string& prefix) {
     std::vector<std::pair<std::string, std::string>> files{{prefix + ".svg", chart.svg}};
     for (std::size_t i = 0; i < chart.sweeps.size(); ++i) {

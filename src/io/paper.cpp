@@ -60,6 +60,15 @@ std::string paper_json(const PaperJob& job) {
 std::string write_paper(const PaperJob& job, const std::string& prefix) {
     JsonEnvelope e;
     e.command = "paper";
+    {
+        // trusted as its three parts are: the panels' certificates, the classification's, the platoons' integration
+        const std::string chart = chart_message(job.figure), classes = classification_message(job.study.classification),
+                          growth = growth_message(job.study.growth);
+        e.status = chart_uncertified(job.figure) > 0 ? "uncertified" : "converged";
+        for (const GrowthResult& g : job.study.growth)
+            if (g.status != Status::Converged && e.status == "converged") e.status = to_string(g.status);
+        e.message = "panels: " + chart + "; classification: " + classes + "; growth: " + growth;
+    }
     e.inputs = JsonObject().string("out", prefix).json("ring", json_ring(job.study.options.cars)).string("lead", job.study.options.lead)
                    .integer("followers", job.study.options.followers).str();
     e.result = paper_json(job);

@@ -84,6 +84,9 @@ ParameterMap resolve(const std::string& model, const std::vector<ParameterSpec>&
         }
         const double v = it->second;
         if (!std::isfinite(v)) throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected a finite number [" + s.unit + "]");
+        if (std::abs(v) > kMaxParameterMagnitude)
+            throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected at most 1e12 [" +
+                                        s.unit + "] in magnitude");
         if (s.lower_open ? !(v > s.lower) : !(v >= s.lower)) {
             throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected a value " + (s.lower_open ? "> " : ">= ") +
                                         detail::format_number(s.lower) + " [" + s.unit + "]");

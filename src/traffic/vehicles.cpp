@@ -129,9 +129,15 @@ std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std
                            std::find(params.begin(), params.end(), h) != params.end() ||
                            std::find(cov_names.begin(), cov_names.end(), h) != cov_names.end() ||
                            std::find(bound_names.begin(), bound_names.end(), h) != bound_names.end() || calibration_report_columns().count(h);
-        if (!known)
-            throw std::invalid_argument(source + ": column " + detail::quoted(h) + " is not a column of a car table: expected name, vehicle, model, count, " +
-                                        joined(params) + ", min_acc_speed, cov_k1_k1 .. cov_eta_eta, lo_k1 .. hi_eta (remove or rename it)");
+        if (!known) {
+            std::vector<std::string> names = {"name", "vehicle", "model", "count", "min_acc_speed"};
+            names.insert(names.end(), params.begin(), params.end());
+            const std::string hint = csv.header_hint(h, names);
+            throw std::invalid_argument(source + ": column " + detail::quoted(h) + " is not a column of a car table" +
+                                        (hint.empty() ? ": expected name, vehicle, model, count, " + joined(params) +
+                                                            ", min_acc_speed, cov_k1_k1 .. cov_eta_eta, lo_k1 .. hi_eta (remove or rename it)"
+                                                      : hint));
+        }
     }
     const int c_name = csv.column("name", false), c_vehicle = csv.column("vehicle", false), c_model = csv.column("model", false),
               c_count = csv.column("count", false), c_min_speed = csv.column("min_acc_speed", false);

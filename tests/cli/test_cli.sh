@@ -554,8 +554,12 @@ done
 expect_error "computable range" roots --k1 1e6 --k2 0.2 --th 1.5 --tau 0.2
 expect_error "computable range" roots --k1 0.2 --k2 0.2 --th 1e10 --tau 0.2
 expect_error "computable range" roots --k1 0.2 --k2 0.2 --th 1.5 --tau 1e6
-expect_error "expected <= 1e+08" roots --k1 1e300 --k2 0.2 --th 1.5 --tau 0.2
-expect_error "expected <= 1e+08" string --k1 0.2 --k2 1e20 --th 1.5 --tau 0.2
+expect_error "expected <= 1e+08" roots --k1 1e10 --k2 0.2 --th 1.5 --tau 0.2
+expect_error "expected <= 1e+08" string --k1 0.2 --k2 1e11 --th 1.5 --tau 0.2
+# beyond any meaning (and the products of the analyses): named with the unit, never a nan
+expect_error "k1 = 1e+300: expected at most 1e12 \[1/s^2\] in magnitude" roots --k1 1e300 --k2 0.2 --th 1.5 --tau 0.2
+expect_error "th = 1e+308: expected at most 1e12 \[s\]" classify 'ovrv:k1=0.1,k2=0.2,th=1e308,tau=0.1'
+expect_error "speed = 1e+308: expected at most 1e12" roots --fleet A_min,B_min --speed 1e308
 expect_error "expected <= 10" string --k1 19.9 --k2 0.2 --th 1.5 --tau 0.2
 "$bin" roots --k1 19.8 --k2 0.2 --th 1.5 --tau 0.2 --count 3 >"$tmp/v6.txt" && grep -q 'verdict    ring STABLE' "$tmp/v6.txt" &&
     ok || bad "roots just inside the computable range"
@@ -1817,6 +1821,8 @@ printf 'name,k1,k2,th,tau\nZo\xc3\xab,0.1,0.2,1.5,0.3\n' >"$ch/utf8.csv"
 # edge as any marker outside it, with finite coordinates
 printf 'time_s,lead_speed_mps\n0,1e18\n1,20\n' >"$ch/fastlead.csv"
 expect_error "fastlead.csv:2: lead_speed_mps = 1e+18: expected 0 to 100 m/s" simulate --fleet A_min --lead "$ch/fastlead.csv" --out "$ch/fl"
+printf 'time_s,lead_speed_mps\n-1e308,20\n0,22\n' >"$ch/oldlead.csv"  # once a nan in the CSV (exit 3)
+expect_error "time -1e+308 at sample 1: expected -1e9 to 1e9 s" simulate --fleet A_min --lead "$ch/oldlead.csv" --out "$ch/fl"
 sed -e 's/^k2 = 0.2$/k2 = -1e308/' -e 's/count = 101/count = 5/' "$(dirname "$0")/../../maps/paper.toml" >"$ch/far.toml"
 grep -q "k2 = -1e308" "$ch/far.toml" || bad "the far marker's spec"
 "$bin" chart "$ch/far.toml" --out "$ch/far" >/dev/null 2>&1 && ! grep -qi "nan\|inf" "$ch/far.svg" && grep -q "paper example (outside)" "$ch/far.svg" \

@@ -169,6 +169,11 @@ TEST_CASE("car lists and tables: bad input is named, never taken silently") {
     // an unknown column is named; a count is read (never ignored)
     CHECK_THROWS_WITH_AS(read_car_table("name,k1,k2,th,tau,colour\nx,0.1,0.2,1,0.1,red\n", "c.csv"),
                          doctest::Contains("column 'colour' is not a column of a car table"), std::invalid_argument);
+    // a header in upper case or separated by semicolons gets a hint
+    CHECK_THROWS_WITH_AS(read_car_table("NAME,k1,k2,th,tau\nx,0.1,0.2,1,0.1\n", "c.csv"), doctest::Contains("column names are lower case: 'name'"),
+                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_car_table("name;k1;k2;th;tau\nx;0.1;0.2;1;0.1\n", "c.csv"), doctest::Contains("the header is separated by ';'"),
+                         std::invalid_argument);
     CHECK(read_car_table("name,k1,k2,th,tau,count\nx,0.1,0.2,1,0.1,3\n", "c.csv").size() == 3);
     CHECK_THROWS_WITH_AS(read_car_table("name,k1,k2,th,tau,count\nx,0.1,0.2,1,0.1,2.5\n", "c.csv"), doctest::Contains("column 'count' = '2.5'"),
                          std::invalid_argument);

@@ -35,7 +35,10 @@ TEST_CASE("computable range: a mixed ring is checked car by car, a penetration s
     CHECK_THROWS_WITH_AS(require_computable(Fleet{ok, big, ok}, o), doctest::Contains("car 2 (big): gains and delay outside the computable range"),
                          std::invalid_argument);
     CHECK_THROWS_WITH_AS(analyse_mixed_ring(Fleet{ok, ok, big}, o), doctest::Contains("car 3 (big)"), std::invalid_argument);
-    CHECK_THROWS_WITH_AS(analyse_mixed_ring(Fleet{ovrv_car("huge", 1e300), ok}, o), doctest::Contains("car 1 (huge): the gains are outside"),
+    CHECK_THROWS_WITH_AS(analyse_mixed_ring(Fleet{ovrv_car("huge", 1e10), ok}, o), doctest::Contains("car 1 (huge): the gains are outside"),
+                         std::invalid_argument);
+    // beyond any meaning, the car itself is refused (its value and unit named)
+    CHECK_THROWS_WITH_AS(analyse_mixed_ring(Fleet{ovrv_car("huge", 1e300), ok}, o), doctest::Contains("k1 = 1e+300: expected at most 1e12 [1/s^2]"),
                          std::invalid_argument);
     MixOptions m;
     m.cars = 6;

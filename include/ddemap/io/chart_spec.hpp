@@ -68,4 +68,10 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy 
 /// `sweep` writes it) and its boundary curves PREFIX-panelK-boundaries.csv.
 std::vector<std::pair<std::string, std::string>> chart_files(const RenderedChart& chart, const std::string& prefix);
 
+/// The number of grid points of all panels without a certificate (SweepResult::uncertified summed).
+long chart_uncertified(const RenderedChart& chart);
+/// Why the chart is trusted, or which panel is not: "every grid point of the N panels certified
+/// ..." (as sweep_message says it), else "panel K: M points have no certificate ...".
+std::string chart_message(const RenderedChart& chart);
+
 }  // namespace ddemap

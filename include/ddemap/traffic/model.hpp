@@ -58,6 +58,11 @@ struct ParameterSpec {
     bool lower_open = false;     ///< lower bound excluded (value must be > lower)
 };
 
+/// The largest magnitude of any law parameter, in its unit: beyond it the products the
+/// analyses form (k1 (1 + th), eta + th v, N (eta + th v) for a ring) leave double range or mean
+/// nothing physical; refused with the value and the unit.
+constexpr double kMaxParameterMagnitude = 1e12;
+
 /// The car-following law. Implementations validate their parameters on construction and
 /// throw std::invalid_argument with a one-line message naming the value and what was expected.
 ///

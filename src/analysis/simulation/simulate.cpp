@@ -18,6 +18,10 @@ LeadProfile::LeadProfile(std::vector<double> times, std::vector<double> speeds) 
     if (m_t.empty() || m_t.size() != m_v.size()) throw std::invalid_argument("lead profile: expected as many times as speeds, at least one");
     for (std::size_t i = 0; i < m_t.size(); ++i) {
         if (!std::isfinite(m_t[i]) || !std::isfinite(m_v[i])) throw std::invalid_argument("lead profile: non-finite value at sample " + std::to_string(i + 1));
+        // positions are integrated from the times: beyond 1e9 s (32 years) they leave the precision a platoon needs
+        if (std::abs(m_t[i]) > 1e9)
+            throw std::invalid_argument("lead profile: time " + detail::format_number(m_t[i]) + " at sample " + std::to_string(i + 1) +
+                                        ": expected -1e9 to 1e9 s");
         if (m_v[i] < 0.0 || m_v[i] > kMaxRoadSpeed)
             throw std::invalid_argument("lead profile: speed " + detail::format_number(m_v[i]) + " at t = " + detail::format_number(m_t[i]) +
                                         ": expected 0 to 100 m/s (360 km/h; a speed in km/h? divide by 3.6)");

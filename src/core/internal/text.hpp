@@ -60,6 +60,10 @@ public:
     /// Index of a column; -1 if absent and not required; required and absent: an error.
     int column(const std::string& name, bool required = true) const;
     int columns() const { return static_cast<int>(m_header.size()); }
+    /// A hint for a header column that is not expected: "; the header is separated by ';' ..."
+    /// (or tabs), "; column names are lower case: 'name'" when its lower case is one of `known`,
+    /// else empty.
+    std::string header_hint(const std::string& column, const std::vector<std::string>& known) const;
     const std::vector<std::string>& header() const { return m_header; }
     /// Advances to the next data row; false at the end.
     bool next();
