@@ -102,7 +102,7 @@ class Result(dict):
         extra = e.pop("extra", {})
         r = _result(_json.dumps(e))
         for k, v in extra.items():
-            r[k] = _convert(v)
+            r[k] = _restore(v)
         return r
 
     def __repr__(self):
@@ -138,6 +138,21 @@ def _convert(value):
     if isinstance(value, list):
         return _column(value)
     return value
+
+
+def _restore(value):
+    """The arrays the wrapper added (:meth:`Result.to_dict`'s ``extra``) back as NumPy: a list of
+    equal-length lists of numbers as a 2-D array (e.g. ``series["speed"]``, cars x samples), a
+    list of numbers as a 1-D array, dicts entry by entry."""
+    if isinstance(value, dict):
+        return {k: _restore(v) for k, v in value.items()}
+    if isinstance(value, list) and value and all(isinstance(v, list) for v in value):
+        # a row of nulls (e.g. the lead's gap) is a row of NaN
+        rows = [_np.full(len(v), _math.nan) if all(x is None for x in v) else _column(v) for v in value]
+        if all(isinstance(x, _np.ndarray) and x.ndim == 1 for x in rows) and len({(x.shape, x.dtype) for x in rows}) == 1:
+            return _np.array(rows)
+        return rows
+    return _convert(value)
 
 
 def _plain(v):
