@@ -418,6 +418,8 @@ def _lead(lead):
         if not _os.path.exists(path) and head and tail.isdigit():
             return head, "", int(tail)
         return path, "", -1
+    if isinstance(lead, Result):
+        raise TypeError("lead: a Result of %r alone: expected (Result of simulate, K), K the car whose speed leads (0 = its lead)" % (lead.command,))
     if isinstance(lead, tuple) and len(lead) == 2 and isinstance(lead[0], Result):
         if lead[0].command != "simulate":
             raise ValueError("lead = (Result of %r, K): expected the Result of simulate" % (lead[0].command,))

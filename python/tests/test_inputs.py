@@ -133,6 +133,12 @@ def test_rings_to_a_billion_and_inf_spellings():
         ddemap.string(th=1.5, tau=0.3, k1=0.1, k2=0.5, ring=10 ** 9 + 1)
 
 
+def test_simulate_lead_result_without_car_is_a_type_error():
+    s = ddemap.simulate("A_min", t_end=5)
+    with pytest.raises(TypeError, match="expected \\(Result of simulate, K\\)"):
+        ddemap.simulate("A_min", lead=s)
+
+
 def test_results_round_trip_through_json():
     r = ddemap.classify("A_min,E_max")
     text = r.to_json()
