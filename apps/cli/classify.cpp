@@ -65,12 +65,6 @@ int run_classify() {
         vehicles = distinct_cars(vehicles_argument("VEHICLES", classify_args.file));
         source = classify_args.file;
     }
-    const bool figure = !prefix.empty() || !svg_file.empty();
-    ChartSpec chart;
-    if (figure) {
-        chart = classification_chart(parse_chart_spec(builtin_classification_toml, "maps/classification.toml"), vehicles, cars, classify_args.file);
-        if (!chart.panels.empty()) check_sweep_size(panel_sweep(chart, 0), "classify", false, chart.panels.size());
-    }
     UncertaintyOptions uo;
     uo.samples = static_cast<int>(parse_integer("--samples", classify_args.samples, 1, 1000000, "an integer 1..1000000"));
     // calibrate's default search space, replaced per vehicle by the bounds its file carries (lo_NAME, hi_NAME)
@@ -88,6 +82,12 @@ int run_classify() {
             if (v.has_covariance) seconds += 0.0005 * uo.samples + (cars == 0 ? 0.09 : 0.008) * uo.ring_samples;
         }
         check_size("classify", counted(static_cast<long long>(vehicles.size()), "car"), "time", seconds / std::max(1, thread_count()));
+    }
+    const bool figure = !prefix.empty() || !svg_file.empty();
+    ChartSpec chart;
+    if (figure) {
+        chart = classification_chart(parse_chart_spec(builtin_classification_toml, "maps/classification.toml"), vehicles, cars, classify_args.file);
+        if (!chart.panels.empty()) check_sweep_size(panel_sweep(chart, 0), "classify", false, chart.panels.size());
     }
     ExecutionPolicy policy;
     policy.progress = progress_printer("classify", "cars");  // one line per car classified

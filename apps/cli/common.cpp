@@ -284,6 +284,14 @@ std::vector<CalibratedVehicle> cars_argument(const std::string& flag, const std:
 Fleet fleet_argument(const std::string& flag, const std::string& list, int cars) {
     const Fleet unit = to_fleet(cars_argument(flag, list));
     if (cars <= 0) return unit;
+    // the fleet repeated to N cars: never fewer than the fleet (its last cars would be dropped
+    // silently); a last repetition that is cut short is said on stderr
+    if (static_cast<std::size_t>(cars) < unit.size())
+        throw BadInput("--ring " + std::to_string(cars) + ": fewer cars than " + flag + " has (" + std::to_string(unit.size()) +
+                       "): expected at least " + std::to_string(unit.size()) + " (the fleet repeated to N cars), or no --ring for the fleet once");
+    if (static_cast<std::size_t>(cars) % unit.size() != 0)
+        std::cerr << "ddemap: note: --ring " << cars << " is not a multiple of the fleet's " << unit.size() << " cars: the last repetition has only its first "
+                  << static_cast<std::size_t>(cars) % unit.size() << "\n";
     Fleet out;
     out.reserve(static_cast<std::size_t>(cars));
     for (int i = 0; i < cars; ++i) out.push_back(unit[static_cast<std::size_t>(i) % unit.size()]);

@@ -86,7 +86,12 @@ int run_mix() {
     MixOptions o;
     o.cars = ring.parse(false);
     const Axis axis = parse_axis("--p", mix_args.p);
-    for (int i = 0; i < axis.count; ++i) o.fractions.push_back(axis.value(i));
+    for (int i = 0; i < axis.count; ++i) {
+        const double p = axis.value(i);
+        if (!(p >= 0.0 && p <= 1.0))
+            throw BadInput("--p = '" + mix_args.p + "': the fraction " + json_number(p) + ": expected fractions of X in [0, 1]");
+        o.fractions.push_back(p);
+    }
     o.draws = static_cast<int>(parse_integer("--draws", mix_args.draws, 0, 10000, "an integer 0..10000"));
     o.seed = static_cast<unsigned>(parse_integer("--seed", mix_args.seed, 0, 4294967295L, "an integer 0..4294967295"));
     set_equilibrium(o.ring, mix_args.speed, mix_args.length);

@@ -49,7 +49,7 @@ import numpy as _np
 from . import _ddemap
 
 __all__ = ["__version__", "Result", "CalibrationWarning", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
-           "mixed_ring", "mix", "growth", "design", "chart", "paper", "equilibria", "hopf", "orbits", "version"]
+           "mixed_ring", "mix", "growth", "design", "chart", "paper", "atlas", "equilibria", "hopf", "orbits", "version"]
 
 version = _ddemap.version
 __version__ = _ddemap.version
@@ -147,9 +147,10 @@ def _restore(value):
     if isinstance(value, dict):
         return {k: _restore(v) for k, v in value.items()}
     if isinstance(value, list) and value and all(isinstance(v, list) for v in value):
-        # a row of nulls (e.g. the lead's gap) is a row of NaN
-        rows = [_np.full(len(v), _math.nan) if all(x is None for x in v) else _column(v) for v in value]
-        if all(isinstance(x, _np.ndarray) and x.ndim == 1 for x in rows) and len({(x.shape, x.dtype) for x in rows}) == 1:
+        # nested lists level by level (an atlas field has one level per grid dimension); a row of
+        # nulls (e.g. the lead's gap) is a row of NaN
+        rows = [_np.full(len(v), _math.nan) if v and all(x is None for x in v) else _restore(v) for v in value]
+        if all(isinstance(x, _np.ndarray) for x in rows) and len({(x.shape, x.dtype) for x in rows}) == 1:
             return _np.array(rows)
         return rows
     return _convert(value)
@@ -923,6 +924,47 @@ def chart(spec, out):
     else:
         raise TypeError("spec: %s: expected a TOML file (str or os.PathLike) or TOML text" % (type(spec).__name__,))
     return _result(_ddemap.chart(text, source, _prefix(out, "chart", (".svg",))))
+
+
+@_with_progress
+def atlas(spec, out=None, allow_large=False):
+    """An atlas (``ddemap atlas SPEC --out DIR``) computed in this process: ``spec`` is a TOML
+    file (str or ``os.PathLike``) or TOML text (see docs/guide/atlases.md). Sized first: refused
+    above about 600 s of computing or 2 GB of values unless ``allow_large=True`` (the command,
+    which keeps only a chunk in memory, resumes and runs under MPI, is the tool for larger ones).
+
+    Returns ``points``, ``shape`` (rings x axes), ``axes``, ``chunks``, ``regions`` (the count of
+    each verdict class), ``uncertified``, ``seconds``, ``files``; ``fields``: every stored
+    quantity (``string_stable``, ``sup_gamma``, ``spectral_abscissa``, ``region``, ...) as a NumPy
+    array of that shape; ``coordinates``: ``ring`` (0 = infinity) and each axis's values. With
+    ``out`` (a folder) it also writes ``atlas.h5`` and ``atlas.svg`` there, as the command does.
+    """
+    if isinstance(spec, _os.PathLike) or (isinstance(spec, str) and "\n" not in spec):
+        path = _os.fspath(spec)
+        try:
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+        except OSError as e:
+            raise ValueError("spec = %r: cannot read the file (%s)" % (path, e.strerror)) from None
+        source = path
+    elif isinstance(spec, str):
+        text, source = spec, "<spec>"
+    else:
+        raise TypeError("spec: %s: expected a TOML file (str or os.PathLike) or TOML text" % (type(spec).__name__,))
+    prefix = ""
+    if out is not None:
+        folder = _os.fspath(out)
+        if folder == "":
+            raise ValueError("out = '': expected a folder")
+        if _os.path.exists(folder) and not _os.path.isdir(folder):
+            raise ValueError("out = %r: expected a folder" % (folder,))
+        _os.makedirs(folder, exist_ok=True)
+        prefix = _os.path.join(folder, "atlas")
+    envelope, fields, coords = _ddemap.atlas(text, source, prefix, bool(allow_large))
+    r = _result(envelope)
+    r["fields"] = {k: _np.asarray(v) for k, v in fields.items()}
+    r["coordinates"] = {k: _np.asarray(v) for k, v in coords.items()}
+    return r
 
 
 @_with_progress

@@ -52,6 +52,8 @@
 #include "ddemap/io/cars.hpp"
 #include "ddemap/io/chart_spec.hpp"
 #include "ddemap/io/paper.hpp"
+#include "ddemap/io/atlas.hpp"
+#include "ddemap/study/atlas.hpp"
 #include "builtin_maps.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/equilibrium.hpp"
@@ -83,13 +85,13 @@ py::object* g_progress = nullptr;
 
 /// A progress callback that runs the Python signal handlers between units of work (on the
 /// main thread only: Python runs them nowhere else) and stops the computation if one raised.
-Progress interruptible() {
+Progress interruptible(bool report = true) {
     struct State {
         std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now(), reported = last;
         std::atomic<bool> interrupted{false};
     };
     auto state = std::make_shared<State>();
-    return [state](long done, long total) {
+    return [state, report](long done, long total) {
         // once interrupted, every later call throws, on any thread: nested loops (a loop whose
         // tasks run loops of their own) all stop
         if (state->interrupted.load()) throw Interrupted();
@@ -102,7 +104,7 @@ Progress interruptible() {
             state->interrupted.store(true);
             throw Interrupted();
         }
-        if (g_progress && !g_progress->is_none() && now - state->reported >= std::chrono::milliseconds(200)) {
+        if (report && g_progress && !g_progress->is_none() && now - state->reported >= std::chrono::milliseconds(200)) {
             state->reported = now;
             try {
                 (*g_progress)(done, total);
@@ -544,9 +546,20 @@ std::string py_calibrate(const std::vector<std::pair<std::string, std::string>>&
         }
         if (follower != 0 && !platoon) throw std::invalid_argument("follower = " + std::to_string(follower) + ": none of the traces is a platoon (simulate's CSV)");
     }
+    // one counter reaches the progress callback: the fits done of several cars, or the stages of
+    // one fit (its design points, then its Levenberg-Marquardt iterations, counted after them);
+    // the other checks Ctrl-C only
+    const bool one = cars.size() == 1;
     ExecutionPolicy policy;
-    policy.progress = interruptible();
-    o.progress = interruptible();  // Ctrl-C within a fit (design points, Levenberg-Marquardt iterations)
+    policy.progress = interruptible(!one);
+    const Progress stage = interruptible(one);
+    // (every iteration of every start counted once, so the count never goes back)
+    const long points = o.design_points, lm_total = static_cast<long>(o.starts) * o.max_iterations;
+    auto lm_done = std::make_shared<std::atomic<long>>(0);
+    o.progress = [stage, points, lm_total, lm_done](long done, long total) {  // Ctrl-C within a fit
+        if (total == points) stage(done, points + lm_total);
+        else stage(points + std::min(++*lm_done, lm_total), points + lm_total);
+    };
     const std::vector<CarCalibration> results = released([&] { return calibrate_cars(cars, o, policy); });
     std::vector<CalibrationResult> fits;
     std::vector<std::string> names;
@@ -730,6 +743,104 @@ std::string py_chart(const std::string& text, const std::string& source, const s
     e.inputs = JsonObject().string("spec", source).string("out", prefix).str();
     e.result = JsonObject().integer("panels", static_cast<long long>(spec.panels.size())).number("seconds", r.seconds).json("files", json_array(names)).str();
     return envelope_json(e);
+}
+
+/// atlas: an atlas spec (TOML text) computed in this process (the chunks in parallel; no MPI,
+/// no chunk store), sized first as `ddemap atlas` sizes it (refused above 600 s of computing or
+/// 2 GB of values unless `allow_large`). Returns (envelope, fields, coordinates): every stored
+/// quantity as an array of the grid's shape (rings x axes, C order), the ring sizes (0 = inf) and
+/// each axis's values; with a prefix also PREFIX.h5 and PREFIX.svg, as the command writes them.
+py::tuple py_atlas(const std::string& text, const std::string& source, const std::string& prefix, bool allow_large) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const AtlasFile file = parse_atlas_spec(text, source);
+    const AtlasSpec& spec = file.spec;
+    const std::vector<AtlasField>& fields = atlas_fields();
+    const std::size_t nf = fields.size();
+    {
+        // the command's estimate: 5e-5 s per ring mode and point (12 modes on the winding path)
+        const bool winding = spec.ring_method_used() == "winding";
+        double modes = 0.0;
+        for (int n : spec.rings) modes += n == 0 || winding ? 12.0 : n / 2 + 1.0;
+        const int threads = std::max(1u, std::thread::hardware_concurrency());
+        const double seconds = static_cast<double>(spec.points()) / static_cast<double>(spec.rings.size()) * modes * 5e-5 / threads;
+        const double bytes = static_cast<double>(spec.points()) * static_cast<double>(nf) * 8.0 * 2.0;
+        if (!allow_large && (seconds > 600.0 || bytes > 2e9))
+            throw std::invalid_argument("an atlas of " + std::to_string(spec.points()) + " points: about " + json_number(std::round(seconds)) + " s and " +
+                                        json_number(std::round(bytes / 1e6)) +
+                                        " MB of values: above the limit of 600 s or 2000 MB (allow_large=True runs it; the command ddemap atlas "
+                                        "keeps only a chunk in memory and resumes)");
+    }
+    std::vector<double> values(static_cast<std::size_t>(spec.points()) * nf);
+    ExecutionPolicy policy;
+    policy.progress = interruptible();
+    released([&] {
+        parallel_for(spec.chunks(), [&](long c) {
+            const std::vector<double> v = evaluate_atlas_chunk(spec, c);
+            std::copy(v.begin(), v.end(), values.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(spec.chunk_begin(c)) * nf));
+        }, policy);
+        return 0;
+    });
+    std::vector<std::string> files;
+    if (!prefix.empty()) {
+        write_files_atomic({{prefix + ".h5", atlas_hdf5(spec, values, text)}, {prefix + ".svg", atlas_svg(file, values)}});
+        files = {json_string(prefix + ".h5"), json_string(prefix + ".svg")};
+    }
+    // the verdict classes and the points without a certificate, as the command counts them
+    std::size_t f_class = nf, f_certified = nf;
+    for (std::size_t f = 0; f < nf; ++f) {
+        if (std::string(fields[f].name) == "region") f_class = f;
+        if (std::string(fields[f].name) == "certified") f_certified = f;
+    }
+    long classes[4] = {0, 0, 0, 0}, uncertified = 0;
+    for (long i = 0; i < spec.points(); ++i) {
+        const double* v = values.data() + static_cast<std::size_t>(i) * nf;
+        if (f_class < nf) ++classes[std::clamp(static_cast<int>(v[f_class]), 0, 3)];
+        if (f_certified < nf) uncertified += v[f_certified] == 0.0;
+    }
+    const std::vector<long> shape = spec.shape();
+    std::vector<py::ssize_t> dims(shape.begin(), shape.end());
+    py::dict out_fields, coords;
+    for (std::size_t f = 0; f < nf; ++f) {
+        py::array_t<double> a(dims);
+        double* d = a.mutable_data();
+        for (long i = 0; i < spec.points(); ++i) d[i] = values[static_cast<std::size_t>(i) * nf + f];
+        out_fields[fields[f].name] = a;
+    }
+    coords["ring"] = py::array_t<int>(static_cast<py::ssize_t>(spec.rings.size()), spec.rings.data());
+    std::vector<std::string> axis_names;
+    for (const AtlasAxis& ax : spec.axes) {
+        coords[ax.name.c_str()] = py::array_t<double>(static_cast<py::ssize_t>(ax.values.size()), ax.values.data());
+        axis_names.push_back(json_string(ax.name));
+    }
+    std::vector<std::string> shape_json;
+    for (long n : shape) shape_json.push_back(std::to_string(n));
+    JsonEnvelope e;
+    e.command = "atlas";
+    e.inputs = JsonObject().string("spec", source).string("out", prefix).str();
+    e.has_solver = true;
+    e.solver_given = spec.ring_method;
+    e.solver_used = spec.ring_method_used();
+    e.status = uncertified > 0 ? "uncertified" : "converged";
+    e.message = uncertified > 0 ? std::to_string(uncertified) + (uncertified == 1 ? " point has" : " points have") +
+                                      " no certificate even after collocation (see the 'certified' field)"
+                                : "every one of the " + std::to_string(spec.points()) +
+                                      " points certified: no root of the plant or of the ring lies right of the abscissa reported (argument principle)";
+    e.result = JsonObject()
+                   .integer("points", spec.points())
+                   .json("shape", json_array(shape_json))
+                   .json("axes", json_array(axis_names))
+                   .integer("chunks", spec.chunks())
+                   .json("regions", JsonObject()
+                                        .integer("plant_unstable", classes[0])
+                                        .integer("ring_unstable", classes[1])
+                                        .integer("string_unstable", classes[2])
+                                        .integer("string_stable", classes[3])
+                                        .str())
+                   .integer("uncertified", uncertified)
+                   .number("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count())
+                   .json("files", json_array(files))
+                   .str();
+    return py::make_tuple(envelope_json(e), out_fields, coords);
 }
 
 /// paper: the seed paper's job under PREFIX, as `ddemap paper --out PREFIX`.
@@ -946,6 +1057,7 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("weights"), py::arg("starts"), py::arg("speed"), py::arg("ring"));
     m.def("chart", &py_chart, py::arg("text"), py::arg("source"), py::arg("prefix"));
     m.def("paper", &py_paper, py::arg("prefix"));
+    m.def("atlas", &py_atlas, py::arg("text"), py::arg("source"), py::arg("prefix"), py::arg("allow_large"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
           py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),

@@ -554,3 +554,56 @@ def test_ctrl_c_stops_the_dense_step_of_an_infinite_ring():
     assert took - at <= 0.1 * full, (took, at, full)
     # the module still works, and gives the ring's verdict
     assert ddemap.roots(k1=0.2, k2=0.2, th=1.5, tau=0.1, ring="inf", count=2)["ring_stable"] in (True, False)
+
+
+@pytest.mark.slow
+def test_atlas_matches_the_command_bit_for_bit_and_a_sweep(tmp_path):
+    # the module's atlas against `ddemap atlas` (an independent driver: chunk store, slabs): the
+    # same HDF5 bytes; and one (k1, k2) plane against `sweep` over the same axes
+    spec = os.path.join(SOURCE, "maps", "atlas-example.toml")
+    r = ddemap.atlas(spec, out=tmp_path / "py")
+    cli("atlas", spec, "--out", str(tmp_path / "cli") + "/", "--quiet")
+    with open(tmp_path / "py" / "atlas.h5", "rb") as a, open(tmp_path / "cli" / "atlas.h5", "rb") as b:
+        assert a.read() == b.read()
+    assert list(r["shape"]) == [2, 2, 2, 16, 16] and r["points"] == 2048 and r.status == "converged"
+    assert sum(r["regions"].values()) == 2048
+    f, c = r["fields"], r["coordinates"]
+    assert f["string_stable"].shape == (2, 2, 2, 16, 16) and list(c["ring"]) == [22, 0]
+    s = ddemap.sweep(th=2.0, tau=0.4, eta=10.0, k1=(0.01, 1.0, 16), k2=(0.01, 1.0, 16), ring=22, boundaries=False)
+    # sweep grids are (k2, k1), the atlas's last two axes (k1, k2); the sweep continues its peak
+    # search along k1, the atlas's chunks along k2: the same maxima to rounding (measured: 1 ulp)
+    assert np.array_equal(np.asarray(s["grid"]["string_stable"], dtype=bool), f["string_stable"][0, 1, 1].T.astype(bool))
+    assert np.allclose(s["grid"]["sup_gamma"], f["sup_gamma"][0, 1, 1].T, rtol=1e-13, atol=0)
+    # a result that round-trips through JSON keeps its arrays
+    back = ddemap.Result.from_json(r.to_json())
+    assert back["fields"]["sup_gamma"].shape == f["sup_gamma"].shape
+
+
+def test_atlas_is_sized_before_the_work():
+    big = textwrap.dedent("""
+        model = "ovrv"
+        rings = [1000000]
+        ring_method = "modes"
+        [fixed]
+        eta = 10.0
+        th = 1.5
+        [[axis]]
+        name = "tau"
+        lo = 0.1
+        hi = 0.5
+        count = 100
+        [[axis]]
+        name = "k1"
+        lo = 0.01
+        hi = 1
+        count = 100
+        [[axis]]
+        name = "k2"
+        lo = 0.01
+        hi = 1
+        count = 100
+        """)
+    t = time.monotonic()
+    with pytest.raises(ValueError, match="above the limit of 600 s"):
+        ddemap.atlas(big)
+    assert time.monotonic() - t < 5

@@ -133,6 +133,18 @@ def test_rings_to_a_billion_and_inf_spellings():
         ddemap.string(th=1.5, tau=0.3, k1=0.1, k2=0.5, ring=10 ** 9 + 1)
 
 
+@pytest.mark.slow
+def test_calibrate_progress_is_one_counter():
+    sim = ddemap.simulate("A_min,B_min", lead_profile="oscillatory", noise=(0.05, 0.1))
+    for trace, cars in ((ddemap.simulate("A_min", lead_profile="oscillatory", noise=(0.05, 0.1)), 1), (sim, 2)):
+        seen = []
+        ddemap.calibrate(trace, warn=False, progress=lambda d, t: seen.append((d, t)))
+        assert seen, "no progress reported"
+        assert len({t for _, t in seen}) == 1, seen  # one total
+        assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:])), seen  # a count that never goes back
+        assert seen[-1][0] <= seen[-1][1]
+
+
 def test_simulate_lead_result_without_car_is_a_type_error():
     s = ddemap.simulate("A_min", t_end=5)
     with pytest.raises(TypeError, match="expected \\(Result of simulate, K\\)"):

@@ -28,6 +28,7 @@ std::string simulation_svg(const SimResult& r, const std::string& lead) {
     PlotPanel speeds{"Speeds", "time [s]", "speed [m/s]", {}, {}};
     PlotPanel gaps{"Gaps to the car ahead", "time [s]", "gap [m]", {}, {}};
     speeds.y_floor = 0.0;
+    speeds.y_from_floor = true;  // speeds from 0 m/s: a drop is seen against the whole speed
     gaps.y_floor = 0.0;
     std::vector<double> end(r.speed.size(), std::numeric_limits<double>::infinity());
     for (const auto& ev : r.events)

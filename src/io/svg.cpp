@@ -179,7 +179,7 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     // what the figure shows: region classes (grid points), boundary kinds, markers, ellipses
     bool class_shown[4] = {false, false, false, false};
     bool kind_shown[4] = {false, false, false, false};
-    bool any_marker = false, any_ellipse = false, any_outside = false;
+    bool any_marker = false, any_ellipse = false, any_outside = false, any_cut = false;
     const BoundaryKind kinds[4] = {BoundaryKind::RingHopf, BoundaryKind::PlantHopf, BoundaryKind::LowFrequency, BoundaryKind::Peak};
     for (const auto& panel : panels) {
         for (const auto& pt : panel.sweep->points) class_shown[region_class(pt)] = true;
@@ -191,6 +191,10 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         for (const auto& m : panel.markers) {
             any_marker = true;
             any_ellipse = any_ellipse || m.has_ellipse;
+            if (m.has_ellipse) {  // the ellipse's extent along each axis: sqrt(5.991 C_ii)
+                const double ex = std::sqrt(5.991464547107979 * std::max(0.0, m.cov_xx)), ey = std::sqrt(5.991464547107979 * std::max(0.0, m.cov_yy));
+                any_cut = any_cut || m.x - ex < ax.lo || m.x + ex > ax.hi || m.y - ey < ay.lo || m.y + ey > ay.hi;
+            }
             any_outside = any_outside || !(m.x >= ax.lo && m.x <= ax.hi && m.y >= ay.lo && m.y <= ay.hi);
         }
     }
@@ -206,7 +210,9 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     for (int k = 0; k < 4; ++k)
         if (kind_shown[k]) items.push_back({1, k, curve_style(kinds[k]).name});
     if (any_marker) items.push_back({2, 0, "marked setting (k\u2081, k\u2082)"});
-    if (any_ellipse) items.push_back({3, 0, "95 % confidence ellipse of (k\u2081, k\u2082)"});
+    if (any_ellipse)
+        items.push_back({3, 0, any_cut ? "95 % confidence ellipse of (k\u2081, k\u2082), cut where it leaves the window"
+                                       : "95 % confidence ellipse of (k\u2081, k\u2082)"});
     if (any_outside) items.push_back({4, 0, "outside the window (at its edge)"});
     for (const auto& it : items) width = std::max(width, 36 + text_width(it.text, f_legend) + 20);
     // marker labels: the names beside the markers where every panel's names fit (at most 45 % of
@@ -669,6 +675,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             }
         };
         widen(x0, x1);
+        if (p.y_from_floor && y0 >= p.y_floor && y1 > p.y_floor) y0 = p.y_floor;
         widen(y0, y1);
         const double pad = 0.04 * (y1 - y0);
         const bool floored = y0 >= p.y_floor;

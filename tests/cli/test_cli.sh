@@ -451,6 +451,9 @@ PY
 expect_error "the product path has no collocation degree" roots --fleet-pattern "A_min,E_min" --ring 6 --solver product --degree 20
 "$bin" roots --fleet-pattern "A_min,E_min" --ring 6 --degree 20 --format json | python3 -c "import json,sys; sys.exit(0 if json.load(sys.stdin)['result']['degree'] == 20 else 1)" && ok || bad "--degree selects a collocation path"
 expect_error "expected at least" roots --fleet-pattern "A_min" --ring 4 --length 5
+# a ring smaller than its fleet is refused (its last cars were dropped without a word)
+expect_error "--ring 2: fewer cars than --fleet has (4): expected at least 4" roots --fleet "A_min*3,B_min" --ring 2
+"$bin" roots --fleet "A_min*3,B_min" --ring 6 --count 2 >/dev/null 2>"$tmp/cut.err" && grep -q "not a multiple of the fleet's 4 cars: the last repetition has only its first 2" "$tmp/cut.err" && ok || bad "roots --ring cut repetition note: $(cat "$tmp/cut.err")"
 if "$bin" mix --x E_min --y A_min --ring 10 --p 0:1:3 --out "$tmp/mix" >/dev/null && [ -s "$tmp/mix.csv" ] && xmllint --noout "$tmp/mix.svg"; then
     python3 - "$tmp/mix.csv" <<'PY' && ok || bad "mix csv"
 import csv, sys
@@ -459,7 +462,7 @@ assert [r["x_cars"] for r in rows] == ["0", "5", "10"], rows
 assert all(r["status"] == "converged" for r in rows), rows
 PY
 else bad "mix"; fi
-expect_error "p = 1.5" mix --x E_min --y A_min --ring 10 --p 0:1.5:3 --out "$tmp/mix2"
+expect_error "--p = '0:1.5:3': the fraction 1.5: expected fractions of X in \[0, 1\]" mix --x E_min --y A_min --ring 10 --p 0:1.5:3 --out "$tmp/mix2"
 [ ! -e "$tmp/mix2.csv" ] && ok || bad "mix wrote output after an error"
 
 fi  # part fleet
@@ -1776,8 +1779,13 @@ grep -q "3 cars collided (the first: car 6 at t = 73.96 s)" "$ch/col.err" && ok 
 python3 - "$ch/col.svg" "$ch/col.json" <<'PY' && ok || bad "the platoon figure after collisions"
 import json, re, sys
 svg = open(sys.argv[1]).read()
-events = {c["car"]: e["time"] for c in json.load(open(sys.argv[2]))["result"]["cars"] for e in c["events"] if e["type"] == "collision"}
+doc = json.load(open(sys.argv[2]))
+events = {c["car"]: e["time"] for c in doc["result"]["cars"] for e in c["events"] if e["type"] == "collision"}
 assert sorted(events) == [6, 7, 8], events
+# the summary is of the physical part (up to each collision), and the message says so
+for c in doc["result"]["cars"]:
+    assert c["min_gap"] >= 0 and c["lowest_speed"] >= -1e-9, c
+assert "3 cars collided (the first, car 6" in doc["message"] and "not physical" in doc["message"], doc["message"]
 assert 'text-anchor="end">-' not in svg, "a negative tick on a y axis"
 assert "red x: collision (car 6 at 74.0 s, car 7 at 76.4 s, car 8 at 79.4 s)" in svg
 # every polyline of a collided car ends at its collision: its last x is the largest of the speed panel's lines at most

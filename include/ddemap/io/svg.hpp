@@ -74,6 +74,9 @@ struct PlotPanel {
     /// The y axis does not extend below this when no data lie below it (a gap is never
     /// negative: the padding around the data stops at 0 instead of showing -10 m).
     double y_floor = -std::numeric_limits<double>::infinity();
+    /// The y axis starts at y_floor itself when no data lie below it (a speed axis from 0 m/s,
+    /// so that a drop is seen against the whole speed).
+    bool y_from_floor = false;
 };
 
 struct PlotOptions {

@@ -315,8 +315,10 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
         for (int i = 0; i < n; ++i) {
             const double s = y[2 * i], v = y[2 * i + 1];
             auto& c = r.cars[i];
-            if (v < c.min_speed) c.min_speed = v;
-            if (s < c.min_gap) c.min_gap = s;
+            // the summary is of the physical part: up to the car's first collision (the law goes on
+            // through it, the cars passing each other, and its later values mean nothing)
+            if (!collided[i] && v < c.min_speed) c.min_speed = v;
+            if (!collided[i] && s < c.min_gap) c.min_gap = std::max(s, 0.0);
             auto crossing = [&](double a, double b, double level) {  // time where a -> b crosses level
                 const double f = (a - level) / (a - b);
                 return t_prev + std::clamp(f, 0.0, 1.0) * (t - t_prev);
@@ -357,6 +359,16 @@ SimResult simulate_platoon(const LeadProfile& lead, const std::vector<SimCar>& c
                     " s (classical Runge-Kutta of order 4, delayed values by cubic Hermite interpolation, steps landing on the lead's "
                     "breakpoints); the state stayed finite and below the divergence bound";
     std::sort(r.events.begin(), r.events.end(), [](const SimEvent& a, const SimEvent& b) { return a.time < b.time; });
+    {
+        const auto first = std::find_if(r.events.begin(), r.events.end(), [](const SimEvent& e) { return e.type == "collision"; });
+        const long collisions = std::count_if(r.events.begin(), r.events.end(), [](const SimEvent& e) { return e.type == "collision"; });
+        if (first != r.events.end())
+            r.message += "; " + std::to_string(collisions) + (collisions == 1 ? " car collided" : " cars collided") + " (the first, car " +
+                         std::to_string(first->car) + ", at t = " + detail::significant(first->time, 4) + " s)" +
+                         (r.stopped ? ": the run stopped there"
+                                    : ": the law goes on through a collision (the cars pass each other), so each car's values after its "
+                                      "collision are not physical; its lowest speed and smallest gap are those before it");
+    }
     for (auto& c : r.cars) c.speed_drop = v0 - c.min_speed;
 
     // output on a regular grid (continuous extension)

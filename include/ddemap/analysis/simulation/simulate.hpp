@@ -92,9 +92,9 @@ struct SimEvent {
 struct CarSummary {
     int car = 0;
     std::string name;
-    double min_speed = 0.0;     ///< lowest speed reached [m/s]
+    double min_speed = 0.0;     ///< lowest speed reached [m/s], before the car's collision if it has one
     double speed_drop = 0.0;    ///< initial speed minus the lowest speed [m/s]
-    double min_gap = 0.0;       ///< smallest gap [m]
+    double min_gap = 0.0;       ///< smallest gap [m], before the car's collision if it has one (then 0)
     std::vector<SimEvent> events;
 };
 
