@@ -29,45 +29,19 @@ struct SweepArgs {
 
 namespace {
 
-/// The cars of --mark at their values of the swept parameters (x, y), the (x, y) block of a fit's
-/// covariance as their ellipse; a car whose other parameters differ from the chart's fixed ones
-/// is named on stderr (its marker shows its values of x and y on a chart that is not its own).
-std::vector<ChartMarker> car_markers(const SweepSpec& spec) {
-    static const char* fitted[] = {"k1", "k2", "th", "tau", "eta"};
-    auto index = [](const std::string& name) {
-        for (int i = 0; i < 5; ++i)
-            if (name == fitted[i]) return i;
-        return -1;
-    };
+/// The cars of --mark as the chart's markers (car_markers); a car whose other parameters differ
+/// from the chart's is named on stderr.
+std::vector<ChartMarker> mark_cars(const SweepSpec& spec) {
+    std::vector<std::string> notes;
     std::vector<ChartMarker> out;
-    for (const CalibratedVehicle& car : distinct_cars(cars_argument("--mark", sweep_args.mark))) {
-        if (car.model != spec.model)
-            throw BadInput("--mark: car '" + car.name + "' has model " + car.model + ": expected cars of the chart's model " + spec.model);
-        for (const std::string& axis : {spec.x.name, spec.y.name})
-            if (!car.parameters.count(axis)) throw BadInput("--mark: car '" + car.name + "' has no value of " + axis);
-        ChartMarker m;
-        m.x = car.parameters.at(spec.x.name);
-        m.y = car.parameters.at(spec.y.name);
-        m.label = car.name;
-        const int ix = index(spec.x.name), iy = index(spec.y.name);
-        if (car.has_covariance && ix >= 0 && iy >= 0) {
-            m.has_ellipse = true;
-            m.cov_xx = car.covariance(ix, ix);
-            m.cov_xy = car.covariance(ix, iy);
-            m.cov_yy = car.covariance(iy, iy);
-        }
-        std::string differ;
-        for (const auto& [name, value] : spec.fixed) {
-            if (!car.parameters.count(name) || (spec.model == "ovrv" && name == "eta")) continue;  // eta moves no boundary of OVRV's chart
-            const double v = car.parameters.at(name);
-            if (std::abs(v - value) > 1e-9 * std::max(std::abs(v), std::abs(value)))
-                differ += (differ.empty() ? "" : ", ") + name + " = " + rounded(v, 6) + " (the chart's " + rounded(value, 6) + ")";
-        }
-        if (!differ.empty())
-            std::cerr << "ddemap: sweep: --mark: " << car.name << " has " << differ << ": its marker shows its " << spec.x.name << " and "
-                      << spec.y.name << " on a chart that is not its own\n";
-        out.push_back(m);
+    try {
+        out = car_markers(distinct_cars(cars_argument("--mark", sweep_args.mark)), spec, &notes);
+    } catch (const BadInput&) {
+        throw;
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(std::string("--mark: ") + e.what());
     }
+    for (const auto& n : notes) std::cerr << "ddemap: sweep: --mark: " << n << "\n";
     return out;
 }
 
@@ -99,7 +73,7 @@ int run_sweep() {
     // every mode's curve needs every mode's root; the envelope is seeded from the winding sweep
     if (!sweep_args.no_boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
     check_sweep_size(spec, "sweep", true);
-    const std::vector<ChartMarker> marks = sweep_args.mark.empty() ? std::vector<ChartMarker>{} : car_markers(spec);
+    const std::vector<ChartMarker> marks = sweep_args.mark.empty() ? std::vector<ChartMarker>{} : mark_cars(spec);
     const std::string prefix = sweep_args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
     policy.progress = progress_printer("sweep", "rows");
@@ -110,12 +84,12 @@ int run_sweep() {
     if (!sweep_args.no_boundaries) b = trace_boundaries(sw, bo);
     const BoundarySet* bp = sweep_args.no_boundaries ? nullptr : &b;
     ChartOptions co;
-    co.title = "Stability chart: " + fixed_title(spec);
+    co.title = "Stability chart: " + sweep_chart_title(spec);
     co.columns = 1;
     co.panel_width = 520;
     co.panel_height = 440;
     ChartPanel panel;
-    panel.title = fixed_title(spec);
+    panel.title = sweep_chart_title(spec);
     panel.sweep = &sw;
     panel.boundaries = bp;
     panel.markers = marks;

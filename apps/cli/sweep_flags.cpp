@@ -67,20 +67,6 @@ RingCurves parse_ring_curves_flag(const std::string& text, const SweepSpec& spec
     }
 }
 
-std::string fixed_title(const SweepSpec& spec) {
-    std::ostringstream t;
-    // figure titles: parameter symbols with their units (k₁ [1/s²] -> "k₁ = 0.2 1/s²")
-    t << spec.model;
-    for (const auto& [k, v] : spec.fixed) {
-        std::string unit;
-        for (const auto& ps : model_parameters(spec.model))
-            if (ps.name == k && ps.unit != "1") unit = " " + unit_text(ps.unit);
-        t << ", " << parameter_symbol(k) << " = " << rounded(v, 4) << unit;
-    }
-    t << ", N = " << ring_name(spec.cars);
-    return t.str();
-}
-
 JsonObject sweep_inputs(const SweepSpec& spec) {
     auto axis = [](const Axis& a) {
         return JsonObject().string("name", a.name).number("lo", a.lo).number("hi", a.hi).integer("count", a.count).str();

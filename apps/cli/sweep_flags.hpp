@@ -21,8 +21,6 @@ void check_sweep_size(const SweepSpec& spec, const std::string& command, bool wr
 /// the flag for an unknown name or envelope on a law with more than one leader).
 RingCurves parse_ring_curves_flag(const std::string& text, const SweepSpec& spec);
 
-/// "ovrv, th = 1.5, tau = 0.5, N = 22"
-std::string fixed_title(const SweepSpec& spec);
 
 /// {"model", "fixed", "x", "y", "ring"}
 JsonObject sweep_inputs(const SweepSpec& spec);

@@ -560,7 +560,7 @@ def string(model="ovrv", ring=None, **parameters):
 
 
 @_with_progress
-def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", **parameters):
+def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", mark=None, out=None, **parameters):
     """A stability chart over two model parameters (``ddemap sweep``).
 
     Give exactly two parameters as ``(LO, HI, COUNT)`` (the axes, COUNT >= 2 grid points from
@@ -585,10 +585,18 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", **
       ``region`` (0 plant unstable, 1 ring unstable, 2 string unstable, 3 string stable);
       ``grid["x"]``, ``grid["y"]`` are the axes' values;
     * ``curves`` (with ``boundaries``): as :func:`boundary`.
+
+    ``mark``: cars drawn on the chart (as ``--mark``: any car list, a DataFrame or dict of a car
+    table, a Result of :func:`calibrate`, ...), each at its values of the two swept parameters,
+    with its 95 % confidence ellipse where it has a fit's covariance; ``out``: PREFIX of the
+    command's files (PREFIX.csv, .json, .svg, -boundaries.csv; folders created as needed). A
+    marked car whose other parameters differ from the chart's is named in a ``UserWarning``.
     """
     fixed, axes = _axes(parameters, x, True)
     (xn, xt), (yn, yt) = _axis_text(axes[0], 0), _axis_text(axes[1], 0)
-    envelope, grid, curves = _ddemap.sweep(model, fixed, xn, xt, yn, yt, _ring(ring), bool(boundaries), str(ring_curves))
+    spec, tables = ("", {}) if mark is None else _cars(mark, "mark")
+    prefix = "" if out is None else _prefix(out, "sweep", (".csv", ".json", ".svg", "-boundaries.csv"))
+    envelope, grid, curves = _ddemap.sweep(model, fixed, xn, xt, yn, yt, _ring(ring), bool(boundaries), str(ring_curves), spec, tables, prefix)
     r = _result(envelope)
     r["grid"] = grid
     r["x"]["values"] = grid["x"]

@@ -331,8 +331,14 @@ py::list curves_arrays(const BoundarySet& b) {
 }
 
 py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
-                const std::string& y_name, const std::string& y_text, int cars, bool boundaries, const std::string& ring_curves_text) {
+                const std::string& y_name, const std::string& y_text, int cars, bool boundaries, const std::string& ring_curves_text,
+                const std::string& mark, const CarTables& tables, const std::string& prefix) {
     SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    // the cars to mark, read and checked before the work (their notes as Python warnings)
+    std::vector<std::string> notes;
+    const std::vector<ChartMarker> marks =
+        mark.empty() ? std::vector<ChartMarker>{} : car_markers(distinct_cars(read_cars(mark, kMaxCars, "", &tables)), spec, &notes);
+    for (const auto& n : notes) PyErr_WarnEx(PyExc_UserWarning, ("sweep: mark: " + n).c_str(), 1);
     const RingCurves ring_curves = resolve_ring_curves(parse_ring_curves(ring_curves_text), spec);
     // as the CLI: every mode's curve needs every mode's root; the envelope takes the winding sweep
     if (boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
@@ -351,13 +357,32 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     e.command = "sweep";
     JsonObject in;
     sweep_inputs(spec, in);
-    e.inputs = in.boolean("boundaries", boundaries).string("ring_curves", ring_curves_name(ring_curves)).str();
+    in.boolean("boundaries", boundaries).string("ring_curves", ring_curves_name(ring_curves));
+    if (!mark.empty()) in.string("mark", mark);
+    e.inputs = in.str();
     e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
     e.solver_given = spec.ring_method;
     e.solver_used = sw.ring_method;
     e.status = sw.uncertified > 0 ? "uncertified" : "converged";
     e.message = sweep_message(sw);
     e.result = sweep_json(sw, bp);
+    if (!prefix.empty()) {
+        // the files of `ddemap sweep --out PREFIX`: grid, envelope, chart (with the marks), boundaries
+        ChartOptions co;
+        co.title = "Stability chart: " + sweep_chart_title(spec);
+        co.columns = 1;
+        co.panel_width = 520;
+        co.panel_height = 440;
+        ChartPanel panel;
+        panel.title = sweep_chart_title(spec);
+        panel.sweep = &sw;
+        panel.boundaries = bp;
+        panel.markers = marks;
+        std::vector<std::pair<std::string, std::string>> files = {
+            {prefix + ".csv", sweep_csv(sw)}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", render_chart_svg({panel}, co)}};
+        if (bp) files.emplace_back(prefix + "-boundaries.csv", boundary_csv(spec, b));
+        write_files_atomic(files, bp ? std::vector<std::string>{} : std::vector<std::string>{prefix + "-boundaries.csv"});
+    }
 
     // the grid: one (ny, nx) array per quantity (rows: y, columns: x), as the CSV's columns
     const py::ssize_t nx = spec.x.count, ny = spec.y.count;
@@ -1038,7 +1063,7 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("roots_system", &py_roots_system, py::arg("system"), py::arg("count"), py::arg("degree"), py::arg("solver"));
     m.def("string", &py_string, py::arg("model"), py::arg("parameters"), py::arg("ring"));
     m.def("sweep", &py_sweep, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"), py::arg("y_axis"),
-          py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"));
+          py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"), py::arg("mark"), py::arg("tables"), py::arg("prefix"));
     m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
           py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"), py::arg("ring_curves"));
     m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"), py::arg("peak"));

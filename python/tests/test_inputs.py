@@ -251,3 +251,25 @@ def test_text_that_is_not_utf8_and_control_characters_are_refused(tmp_path):
     assert json.loads(r.to_json())["result"]["vehicles"][0]["name"] == "Zo\u00eb"
     with pytest.raises(ValueError, match="control characters"):
         ddemap.classify({"name": ["a\x01b"], "k1": [0.1], "k2": [0.2], "th": [1.5], "tau": [0.3]})
+
+
+@pytest.mark.slow
+def test_sweep_marks_cars_from_memory_as_the_command_does(tmp_path):
+    # three cars of a DataFrame on one chart: the same SVG as `ddemap sweep --mark FILE`
+    import pandas as pd
+    cars = pd.DataFrame({"name": ["Sedan", "SUV", "Hatchback"], "k1": [0.2, 0.08, 0.15], "k2": [0.6, 0.3, 0.4],
+                         "th": [2.0, 2.0, 2.0], "tau": [0.2, 0.2, 0.2]})
+    cars.to_csv(tmp_path / "cars.csv", index=False)
+    r = ddemap.sweep(th=2.0, tau=0.2, k1=(0.01, 0.4, 40), k2=(0.01, 1, 40), mark=cars, out=tmp_path / "py")
+    subprocess.run([CLI, "sweep", "--th", "2", "--tau", "0.2", "--k1", "0.01:0.4:40", "--k2", "0.01:1:40", "--mark", str(tmp_path / "cars.csv"),
+                    "--out", str(tmp_path / "cli"), "--quiet"], check=True, capture_output=True)
+    svg = (tmp_path / "py.svg").read_text()
+    assert svg == (tmp_path / "cli.svg").read_text()
+    assert all(name in svg for name in ("Sedan", "SUV", "Hatchback"))
+    assert (tmp_path / "py.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    assert r.inputs["mark"] == "<DataFrame 1>"
+    # a car of another (tau, th) is named in a warning; a car without an axis's value is refused
+    with pytest.warns(UserWarning, match="on a chart that is not its own"):
+        ddemap.sweep(th=1.5, tau=0.2, k1=(0.01, 0.4, 8), k2=(0.01, 1, 8), mark=cars, boundaries=False)
+    with pytest.raises(ValueError, match="has model idm"):
+        ddemap.sweep(th=1.5, tau=0.2, k1=(0.01, 0.4, 8), k2=(0.01, 1, 8), mark="idm:th=1.5,tau=0.2,name=X", boundaries=False)

@@ -276,6 +276,56 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
     return out;
 }
 
+std::string sweep_chart_title(const SweepSpec& spec) {
+    // parameter symbols with their units (k1 [1/s^2] -> "k₁ = 0.2 1/s²")
+    std::string t = spec.model;
+    for (const auto& [k, v] : spec.fixed) {
+        std::string unit;
+        for (const auto& ps : model_parameters(spec.model))
+            if (ps.name == k && ps.unit != "1") unit = " " + unit_text(ps.unit);
+        t += ", " + parameter_symbol(k) + " = " + detail::significant(v == 0.0 ? 0.0 : v, 4) + unit;
+    }
+    return t + ", N = " + (spec.cars == 0 ? std::string("inf") : std::to_string(spec.cars));
+}
+
+std::vector<ChartMarker> car_markers(const std::vector<CalibratedVehicle>& cars, const SweepSpec& spec, std::vector<std::string>* notes) {
+    static const char* fitted[] = {"k1", "k2", "th", "tau", "eta"};
+    auto index = [](const std::string& name) {
+        for (int i = 0; i < 5; ++i)
+            if (name == fitted[i]) return i;
+        return -1;
+    };
+    std::vector<ChartMarker> out;
+    for (const CalibratedVehicle& car : cars) {
+        if (car.model != spec.model)
+            throw std::invalid_argument("car '" + car.name + "' has model " + car.model + ": expected cars of the chart's model " + spec.model);
+        for (const std::string& axis : {spec.x.name, spec.y.name})
+            if (!car.parameters.count(axis)) throw std::invalid_argument("car '" + car.name + "' has no value of " + axis);
+        ChartMarker m;
+        m.x = car.parameters.at(spec.x.name);
+        m.y = car.parameters.at(spec.y.name);
+        m.label = car.name;
+        const int ix = index(spec.x.name), iy = index(spec.y.name);
+        if (car.has_covariance && ix >= 0 && iy >= 0) {
+            m.has_ellipse = true;
+            m.cov_xx = car.covariance(ix, ix);
+            m.cov_xy = car.covariance(ix, iy);
+            m.cov_yy = car.covariance(iy, iy);
+        }
+        std::string differ;
+        for (const auto& [name, value] : spec.fixed) {
+            if (!car.parameters.count(name) || (spec.model == "ovrv" && name == "eta")) continue;  // eta moves no boundary of OVRV's chart
+            const double v = car.parameters.at(name);
+            if (std::abs(v - value) > 1e-9 * std::max(std::abs(v), std::abs(value)))
+                differ += (differ.empty() ? "" : ", ") + name + " = " + detail::significant(v, 6) + " (the chart's " + detail::significant(value, 6) + ")";
+        }
+        if (!differ.empty() && notes)
+            notes->push_back(car.name + " has " + differ + ": its marker shows its " + spec.x.name + " and " + spec.y.name + " on a chart that is not its own");
+        out.push_back(m);
+    }
+    return out;
+}
+
 long chart_uncertified(const RenderedChart& chart) {
     long n = 0;
     for (const SweepResult& sw : chart.sweeps) n += sw.uncertified;

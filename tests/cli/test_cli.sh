@@ -1829,6 +1829,10 @@ printf 'name,k1,k2,th,tau\nZo\xc3\xab,0.1,0.2,1.5,0.3\n' >"$ch/utf8.csv"
 # edge as any marker outside it, with finite coordinates
 printf 'time_s,lead_speed_mps\n0,1e18\n1,20\n' >"$ch/fastlead.csv"
 expect_error "fastlead.csv:2: lead_speed_mps = 1e+18: expected 0 to 100 m/s" simulate --fleet A_min --lead "$ch/fastlead.csv" --out "$ch/fl"
+# sweep --mark: the cars of a table as labelled markers, a car of another (tau, th) named on stderr
+"$bin" sweep --th 2 --tau 0.2 --k1 0.01:0.4:20 --k2 0.01:1:20 --mark "$(dirname "$0")/../../examples/mycars.csv" --out "$ch/mk" --quiet 2>"$ch/mk.err" &&
+    grep -q ">Sedan<" "$ch/mk.svg" && grep -q "SUV has tau = 0.5 (the chart's 0.2), th = 1.8 (the chart's 2)" "$ch/mk.err" && xmllint --noout "$ch/mk.svg" &&
+    ok || bad "sweep --mark: $(cat "$ch/mk.err")"
 printf 'time_s,lead_speed_mps\n-1e308,20\n0,22\n' >"$ch/oldlead.csv"  # once a nan in the CSV (exit 3)
 expect_error "time -1e+308 at sample 1: expected -1e9 to 1e9 s" simulate --fleet A_min --lead "$ch/oldlead.csv" --out "$ch/fl"
 sed -e 's/^k2 = 0.2$/k2 = -1e308/' -e 's/count = 101/count = 5/' "$(dirname "$0")/../../maps/paper.toml" >"$ch/far.toml"

@@ -14,6 +14,7 @@
 #include "ddemap/core/execution.hpp"
 #include "ddemap/io/svg.hpp"
 #include "ddemap/traffic/model.hpp"
+#include "ddemap/traffic/vehicles.hpp"
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
@@ -67,6 +68,18 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy 
 /// The files of a rendered chart: PREFIX.svg, and for panel K its grid PREFIX-panelK.csv (as
 /// `sweep` writes it) and its boundary curves PREFIX-panelK-boundaries.csv.
 std::vector<std::pair<std::string, std::string>> chart_files(const RenderedChart& chart, const std::string& prefix);
+
+/// A sweep chart's title: "MODEL, p = v unit, ..., N = n" (each fixed parameter with its symbol,
+/// its value to 4 digits and its unit).
+std::string sweep_chart_title(const SweepSpec& spec);
+
+/// The cars as markers of a sweep's chart: each at its values of the two swept parameters, with
+/// the (x, y) block of a fit's covariance as its 95 % ellipse. std::invalid_argument (naming
+/// the car) for a car of another model or without a value of an axis. A car whose other
+/// parameters differ from the chart's fixed ones (eta excepted on OVRV's charts, where it moves
+/// no boundary) adds a line to `notes`: its marker shows its x and y on a chart not its own.
+std::vector<ChartMarker> car_markers(const std::vector<CalibratedVehicle>& cars, const SweepSpec& spec,
+                                     std::vector<std::string>* notes = nullptr);
 
 /// The number of grid points of all panels without a certificate (SweepResult::uncertified summed).
 long chart_uncertified(const RenderedChart& chart);
