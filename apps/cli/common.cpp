@@ -1,6 +1,9 @@
 #include <cctype>
 #include "common.hpp"
 
+#include <cerrno>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
@@ -26,8 +29,10 @@ double parse_number(const std::string& flag, const std::string& text) {
     char* end = nullptr;
     errno = 0;
     const double v = std::strtod(s, &end);
-    if (text.empty() || end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-        throw BadInput(flag + " = '" + text + "': expected a finite number");
+    // ERANGE on underflow (1e-310: a subnormal or 0) is a finite number, judged by the flag's range
+    const bool overflow = errno == ERANGE && !(std::abs(v) <= std::numeric_limits<double>::min());
+    if (text.empty() || end == s || *end != '\0' || overflow || !std::isfinite(v)) {
+        throw BadInput(flag + " = '" + text + "': expected a finite number" + (overflow ? " (beyond the range of doubles, about 1.8e308)" : ""));
     }
     return v;
 }

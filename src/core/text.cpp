@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -12,9 +13,13 @@
 namespace ddemap::detail {
 
 std::string escaped(const std::string& text, std::size_t max_chars) {
+    // bytes that are not part of valid UTF-8 are shown as \xNN too: a message stays valid text
+    std::vector<bool> invalid(text.size(), false);
+    for (std::size_t i = invalid_utf8_at(text, 0); i < text.size(); i = invalid_utf8_at(text, i + 1)) invalid[i] = true;
     std::string out;
     std::size_t shown = 0;
-    for (const char ch : text) {
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char ch = text[i];
         if (shown >= max_chars) {
             out += "...";
             break;
@@ -23,7 +28,7 @@ std::string escaped(const std::string& text, std::size_t max_chars) {
         if (c == '\n') out += "\\n";
         else if (c == '\r') out += "\\r";
         else if (c == '\t') out += "\\t";
-        else if (c < 0x20 || c == 0x7f) {
+        else if (c < 0x20 || c == 0x7f || invalid[i]) {
             static const char* hex = "0123456789abcdef";
             out += "\\x";
             out += hex[c >> 4];
@@ -159,7 +164,10 @@ bool parse_finite(const std::string& text, double& value) {
     char* end = nullptr;
     errno = 0;
     value = std::strtod(text.c_str(), &end);
-    return *end == '\0' && errno != ERANGE && std::isfinite(value);
+    // ERANGE is overflow (+-HUGE_VAL: not finite) or underflow (1e-310: a subnormal or 0, a finite
+    // number that the value's own range check judges)
+    const bool underflow = errno == ERANGE && std::abs(value) <= std::numeric_limits<double>::min();
+    return *end == '\0' && (errno != ERANGE || underflow) && std::isfinite(value);
 }
 
 std::string trim(const std::string& s) {

@@ -442,8 +442,14 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
                    << " on any root with Re >= " << sigma;
             } else {
                 result.status = Status::MaxDegreeReached;
-                os << "max degree M=" << m << " reached before the roots settled (change " << change
-                   << ", resolved radius " << covered << " of needed " << needed << ")";
+                // (no earlier degree with the same roots in the strip to compare with: no change to name)
+                os << "max degree M=" << m << " reached before the roots settled (";
+                if (std::isfinite(change)) os << "change " << change << " from M=" << previous_degree;
+                else os << "no earlier degree to compare with";
+                os << ", resolved radius " << covered << " of needed ";
+                if (std::isfinite(needed)) os << needed;
+                else os << "an unbounded radius (the root bound is not finite)";
+                os << ")";
             }
             result.message = os.str();
             return result;

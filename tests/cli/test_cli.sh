@@ -1820,6 +1820,12 @@ expect_error "trace.json is JSON: expected a CSV file with a header time_s" cali
 printf 'name,k1,k2,th,tau\nZo\xeb,0.1,0.2,1.5,0.3\n' >"$ch/latin1.csv"
 expect_error "latin1.csv:2: byte 3 (0xEB) is not UTF-8: expected UTF-8 text" classify "$ch/latin1.csv" --format json
 expect_error "latin1.csv:2: byte 3 (0xEB) is not UTF-8" simulate --fleet "$ch/latin1.csv" --out "$ch/lat"
+# the same byte in an inline name is shown escaped: the message itself stays valid UTF-8
+"$bin" classify "$(printf 'ovrv:k1=0.1,k2=0.2,th=1.5,tau=0.3,name=Zo\xeb')" 2>"$ch/lat.err"; rc=$?
+[ $rc -eq 2 ] && grep -q 'name=Zo\\xeb' "$ch/lat.err" && iconv -f UTF-8 -t UTF-8 "$ch/lat.err" >/dev/null 2>&1 && ok || bad "inline non-UTF-8 name: exit $rc, $(cat -v "$ch/lat.err")"
+# numbers that underflow (1e-310) are finite: judged by their range, not called non-finite; overflow is named
+expect_error "expected a finite number (beyond the range of doubles" string --k1 1e999 --k2 0.2 --th 1.5 --tau 0.2
+"$bin" string --k1 0.2 --k2 1e-310 --th 1.5 --tau 0.2 >/dev/null 2>&1 && ok || bad "string --k2 1e-310 refused"
 [ ! -e "$ch/lat.csv" ] && ok || bad "an output after a refused input"
 expect_error "expected a name without control characters" classify "ovrv:name=a$(printf '\001')b,k1=0.1,k2=0.2,th=1.5,tau=0.3"
 printf 'name,k1,k2,th,tau\nZo\xc3\xab,0.1,0.2,1.5,0.3\n' >"$ch/utf8.csv"
