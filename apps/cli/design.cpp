@@ -12,6 +12,7 @@
 #include "ddemap/analysis/design/design.hpp"
 #include "ddemap/analysis/stability/ring_fast.hpp"
 #include "ddemap/io/cars.hpp"
+#include "ddemap/io/chart_spec.hpp"
 #include "ddemap/io/csv.hpp"
 #include "ddemap/io/json.hpp"
 
@@ -70,7 +71,7 @@ void add_design_flags(CLI::App& app) {
         ->type_name("N");
     design_args.ring.add_to(app, "", "abscissa of the ring of N cars (N >= 2 or inf) instead of the plant's; with any objective, the ring verdicts too");
     design_args.format.add_to(app);
-    design_args.out.add_to(app, "PREFIX.csv (the car and the design) and PREFIX.json", false);
+    design_args.out.add_to(app, "PREFIX.csv (the car and the design), PREFIX.json and PREFIX.svg (both on their (k1, k2) stability charts)", false);
     run_flags().add_to(app, false);
 }
 
@@ -104,7 +105,7 @@ int run_design() {
         for (const std::string& wtext : split_commas(design_args.weights)) o.weights.push_back(parse_number("--weights", wtext));
     o.starts = static_cast<int>(parse_integer("--starts", design_args.starts, 1, 64, "an integer 1..64"));
     if (!design_args.ring.empty()) o.cars = design_args.ring.parse(true, kWindingMaxCars);
-    const std::string prefix = design_args.out.given() ? design_args.out.prepare("design", {".csv", ".json"}) : std::string();
+    const std::string prefix = design_args.out.given() ? design_args.out.prepare("design", {".csv", ".json", ".svg"}) : std::string();
 
     const auto cars = distinct_cars(vehicles_argument("CAR", design_args.car));
     if (cars.size() != 1)
@@ -131,7 +132,15 @@ int run_design() {
 
     const JsonEnvelope e = design_envelope(r, o, design_args.car, car.name);
     const std::string csv = design_csv(r);
-    if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    if (!prefix.empty()) {
+        // the figure: the car and the design on the (k1, k2) chart(s), the ring of --ring (22 cars by default)
+        ExecutionPolicy policy;
+        policy.progress = progress_printer("design", "chart rows");
+        const std::string svg = design_chart_svg(r, car.name, o.cars >= 0 ? o.cars : 22, car.has_covariance ? &car.covariance : nullptr, policy);
+        std::vector<std::pair<std::string, std::string>> files = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}};
+        if (!svg.empty()) files.emplace_back(prefix + ".svg", svg);
+        write_files_atomic(files);
+    }
     print_output(format, e, csv, [&] {
         std::ostringstream out;
         out << "car        " << car.name << " (" << car.model << ")\n";

@@ -326,6 +326,83 @@ std::vector<ChartMarker> car_markers(const std::vector<CalibratedVehicle>& cars,
     return out;
 }
 
+std::string design_chart_svg(const DesignResult& d, const std::string& car_name, int cars, const Eigen::Matrix<double, 5, 5>* covariance,
+                             const ExecutionPolicy& policy) {
+    if (!d.initial.count("k1") || !d.initial.count("k2") || !d.parameters.count("k1") || !d.parameters.count("k2")) return "";
+    const double x0 = d.initial.at("k1"), y0 = d.initial.at("k2"), x1 = d.parameters.at("k1"), y1 = d.parameters.at("k2");
+    // the ellipse's extent along each axis, sqrt(5.991 C_ii)
+    const double ex = covariance ? std::sqrt(5.991464547107979 * std::max(0.0, (*covariance)(0, 0))) : 0.0;
+    const double ey = covariance ? std::sqrt(5.991464547107979 * std::max(0.0, (*covariance)(1, 1))) : 0.0;
+    auto window = [](double a, double b, double e) {
+        double lo = std::min(a, b) - e, hi = std::max(a, b) + e;
+        const double span = std::max(hi - lo, 0.1 * std::max(std::abs(a), std::abs(b)));
+        lo -= 0.25 * span;
+        hi += 0.25 * span;
+        lo = std::max(lo, 0.02 * hi);  // gains above 0 (the charts' convention)
+        return std::pair<double, double>{lo, hi};
+    };
+    const auto [xlo, xhi] = window(x0, x1, ex);
+    const auto [ylo, yhi] = window(y0, y1, ey);
+    auto spec_at = [&](const ParameterMap& params) {
+        SweepSpec s;
+        s.model = d.model;
+        // (OVRV's chart depends on neither eta nor the speed: left out of the title)
+        for (const auto& [k, v] : params)
+            if (k != "k1" && k != "k2" && !(d.model == "ovrv" && (k == "eta" || k == "speed"))) s.fixed[k] = v;
+        s.x = Axis{"k1", xlo, xhi, 81};
+        s.y = Axis{"k2", ylo, yhi, 81};
+        s.cars = cars;
+        return s;
+    };
+    bool others_changed = false;
+    for (const auto& [k, v] : d.initial)
+        if (k != "k1" && k != "k2" && d.parameters.count(k) && d.parameters.at(k) != v) others_changed = true;
+    ChartMarker car;
+    car.x = x0;
+    car.y = y0;
+    car.label = car_name;
+    if (covariance) {
+        car.has_ellipse = true;
+        car.cov_xx = (*covariance)(0, 0);
+        car.cov_xy = (*covariance)(0, 1);
+        car.cov_yy = (*covariance)(1, 1);
+    }
+    ChartMarker designed;
+    designed.x = x1;
+    designed.y = y1;
+    designed.label = car_name + ", designed";
+    std::vector<SweepSpec> specs = {spec_at(d.initial)};
+    if (others_changed) specs.push_back(spec_at(d.parameters));
+    std::vector<SweepResult> sweeps;
+    std::vector<BoundarySet> bounds;
+    for (const SweepSpec& s : specs) {
+        sweeps.push_back(run_sweep(s, policy));
+        bounds.push_back(trace_boundaries(sweeps.back(), BoundaryOptions{}));
+    }
+    std::vector<ChartPanel> panels;
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+        ChartPanel p;
+        p.title = (others_changed ? (i == 0 ? "the car's chart: " : "the design's chart: ") : std::string()) + sweep_chart_title(specs[i]);
+        p.sweep = &sweeps[i];
+        p.boundaries = &bounds[i];
+        if (i == 0) p.markers.push_back(car);
+        if (i == 0 && !others_changed) p.markers.push_back(designed);
+        if (i == 1) {
+            ChartMarker own = car;
+            own.label = car_name + " (its k1, k2)";
+            own.has_ellipse = false;
+            p.markers = {own, designed};
+        }
+        panels.push_back(p);
+    }
+    ChartOptions co;
+    co.title = "Gain design for " + car_name + " (" + d.objective + "): from its gains to the designed ones";
+    co.columns = static_cast<int>(panels.size());
+    co.panel_width = 420;
+    co.panel_height = 360;
+    return render_chart_svg(panels, co);
+}
+
 long chart_uncertified(const RenderedChart& chart) {
     long n = 0;
     for (const SweepResult& sw : chart.sweeps) n += sw.uncertified;

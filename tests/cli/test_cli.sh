@@ -1954,6 +1954,12 @@ assert float(rows[1]["k1"]) == r["gains"]["k1"] and float(rows[1]["k2"]) == r["g
 assert rows[1]["string_stable"] == "true" and rows[0]["string_stable"] == "false"
 PY
 grep -q "^string (L2) *UNSTABLE *STABLE$" "$tmp/des.txt" && ok || bad "design table: the L2 verdicts before and after"
+# the figure: the car and the design on one (k1, k2) chart (th held), on two when th is designed too
+xmllint --noout "$tmp/des/c.svg" && grep -q ">C_max<" "$tmp/des/c.svg" && grep -q ">C_max, designed<" "$tmp/des/c.svg" &&
+    ! grep -q "the design&#39;s chart" "$tmp/des/c.svg" && ok || bad "design figure (k1, k2 free)"
+"$bin" design C_max --free k1,k2,th --objective nearest --out "$tmp/des/t" --quiet >/dev/null &&
+    xmllint --noout "$tmp/des/t.svg" && grep -q "the car&#39;s chart" "$tmp/des/t.svg" && grep -q "the design&#39;s chart" "$tmp/des/t.svg" &&
+    ok || bad "design figure (k1, k2, th free): two panels"
 # no gains of the box are string stable (th < tau): the proof, exit 0, the gains unchanged
 "$bin" design A_min --objective nearest --format json >"$tmp/des2.json" && ok || bad "design A_min nearest: exit $?"
 python3 - "$tmp/des2.json" <<'PY' && ok || bad "design A_min: the proof of infeasibility"

@@ -18,6 +18,7 @@
 #include "ddemap/study/boundary.hpp"
 #include "ddemap/study/sweep.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
+#include "ddemap/analysis/design/design.hpp"
 
 namespace ddemap {
 
@@ -80,6 +81,16 @@ std::string sweep_chart_title(const SweepSpec& spec);
 /// no boundary) adds a line to `notes`: its marker shows its x and y on a chart not its own.
 std::vector<ChartMarker> car_markers(const std::vector<CalibratedVehicle>& cars, const SweepSpec& spec,
                                      std::vector<std::string>* notes = nullptr);
+
+/// A design on its (k1, k2) stability charts (`design --out`): the car's gains ("CAR") and the
+/// designed ones ("CAR, designed") as markers on the chart of the car's other parameters, with
+/// the car's 95 % confidence ellipse of (k1, k2) when `covariance` (order k1, k2, th, tau, eta)
+/// is given; when the design changed other parameters too (th, ...), a second panel shows the
+/// chart at the designed values with both markers. The window holds both points (and the
+/// ellipse's extent) with a quarter of their span around them; ring of `cars` cars (0 = inf).
+/// Empty when the law has no k1 and k2.
+std::string design_chart_svg(const DesignResult& design, const std::string& car_name, int cars, const Eigen::Matrix<double, 5, 5>* covariance,
+                             const ExecutionPolicy& policy = {});
 
 /// The number of grid points of all panels without a certificate (SweepResult::uncertified summed).
 long chart_uncertified(const RenderedChart& chart);
