@@ -707,7 +707,23 @@ std::string design_json(const DesignResult& r, double margin) {
             o.integer("samples", u.samples).integer("undecided", u.undecided).string("status", to_string(u.status));
             return o.str();
         };
-        res.json("uncertainty", JsonObject().json("design", prob(r.uncertainty)).json("initial", prob(r.uncertainty_initial)).str());
+        // the least attenuation margin over the fit's 95 % ellipsoid of the held parameters
+        // (null: a plant unstable there)
+        auto worst = [](const WorstMargin& w) {
+            JsonObject o;
+            if (std::isfinite(w.margin)) o.number("attenuation_margin", w.margin);
+            else o.null("attenuation_margin");
+            o.number("nominal", w.nominal).json("at", json_parameters(w.at));
+            std::vector<std::string> held;
+            for (const auto& h : w.held) held.push_back(json_string(h));
+            o.json("held", json_array(held)).number("radius2", w.radius2).boolean("plant_unstable", w.plant_unstable).integer("evaluations", w.evaluations);
+            return o.str();
+        };
+        res.json("uncertainty", JsonObject()
+                                    .json("design", prob(r.uncertainty))
+                                    .json("initial", prob(r.uncertainty_initial))
+                                    .json("worst_case", JsonObject().json("design", worst(r.worst)).json("initial", worst(r.worst_initial)).str())
+                                    .str());
     } else {
         res.null("uncertainty");
     }

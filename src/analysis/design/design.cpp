@@ -1,6 +1,7 @@
 #include "ddemap/analysis/design/design.hpp"
 
 #include <algorithm>
+#include <random>
 #include <cmath>
 #include <limits>
 #include <functional>
@@ -536,6 +537,120 @@ std::string ovrv_infeasibility(const std::string& model, const ParameterMap& p, 
 
 }  // namespace
 
+WorstMargin worst_attenuation_margin(const ParameterMap& parameters, const Eigen::Matrix<double, 5, 5>& covariance) {
+    static const char* order[4] = {"k1", "k2", "th", "tau"};
+    WorstMargin w;
+    std::vector<int> held;
+    for (int i = 0; i < 4; ++i)
+        if (covariance(i, i) > 0.0 && std::isfinite(covariance(i, i))) held.push_back(i);
+    const int d = static_cast<int>(held.size());
+    // m* at a point (-inf where the plant is not stable: no attenuation to speak of)
+    auto margin_at = [&](const ParameterMap& p) {
+        ++w.evaluations;
+        const Linearisation L = make_model("ovrv", p)->linearise();
+        if (!is_computable(L)) return -kInf;
+        RootOptions ro;
+        ro.count = 2;
+        const RootResult rr = rightmost_roots(plant_dde(L), ro);
+        if (rr.status != Status::Converged || rr.roots.empty() || !(rr.roots.front().value.real() < 0.0)) {
+            w.plant_unstable = true;
+            return -kInf;
+        }
+        return attenuation_scan(L).margin;
+    };
+    w.nominal = margin_at(parameters);
+    w.margin = w.nominal;
+    for (int i : held) w.held.push_back(order[i]);
+    for (int i : held) w.at[order[i]] = parameters.at(order[i]);
+    if (d == 0) return w;
+    static const double chi2[5] = {0.0, 3.841458820694124, 5.991464547107979, 7.814727903251178, 9.487729036781154};
+    w.radius2 = chi2[d];
+    Eigen::MatrixXd Ch(d, d);
+    for (int a = 0; a < d; ++a)
+        for (int b = 0; b < d; ++b) Ch(a, b) = covariance(held[static_cast<std::size_t>(a)], held[static_cast<std::size_t>(b)]);
+    const Eigen::LLT<Eigen::MatrixXd> llt(Ch);
+    if (llt.info() != Eigen::Success) throw std::invalid_argument("worst attenuation margin: the covariance of the held parameters is not positive definite");
+    const Eigen::MatrixXd Lc = llt.matrixL();
+    const double r = std::sqrt(w.radius2);
+    // the point p0 + s r L u, clipped to the law's domain
+    auto point = [&](const Eigen::VectorXd& u, double s) {
+        ParameterMap p = parameters;
+        const Eigen::VectorXd dp = s * r * (Lc * u);
+        for (int a = 0; a < d; ++a) {
+            const int i = held[static_cast<std::size_t>(a)];
+            double v = parameters.at(order[i]) + dp[a];
+            v = std::max(v, i < 2 ? 1e-9 : 0.0);
+            p[order[i]] = v;
+        }
+        return p;
+    };
+    auto consider = [&](const Eigen::VectorXd& u, double s) {
+        const ParameterMap p = point(u, s);
+        const double m = margin_at(p);
+        if (m < w.margin) {
+            w.margin = m;
+            for (int i : held) w.at[order[i]] = p.at(order[i]);
+        }
+        return m;
+    };
+    std::vector<Eigen::VectorXd> dirs;
+    if (d == 1) {
+        dirs = {Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, -1.0)};
+    } else if (d == 2) {
+        for (int k = 0; k < 72; ++k) {
+            const double t = 2.0 * M_PI * k / 72.0;
+            Eigen::VectorXd u(2);
+            u << std::cos(t), std::sin(t);
+            dirs.push_back(u);
+        }
+    } else {
+        std::mt19937_64 rng(20261129);
+        std::normal_distribution<double> z(0.0, 1.0);
+        for (int k = 0; k < 200; ++k) {
+            Eigen::VectorXd u(d);
+            for (int a = 0; a < d; ++a) u[a] = z(rng);
+            dirs.push_back(u.normalized());
+        }
+    }
+    int best = 0;
+    double best_m = kInf;
+    for (std::size_t k = 0; k < dirs.size(); ++k) {
+        consider(dirs[k], 0.5);
+        const double m = consider(dirs[k], 1.0);
+        if (m < best_m) {
+            best_m = m;
+            best = static_cast<int>(k);
+        }
+    }
+    if (d == 2 && std::isfinite(best_m)) {
+        // golden section in the angle around the least of the grid, on the boundary
+        const double h = 2.0 * M_PI / 72.0, g = 0.5 * (std::sqrt(5.0) - 1.0);
+        double a = 2.0 * M_PI * best / 72.0 - h, b = a + 2.0 * h;
+        auto at_angle = [&](double t) {
+            Eigen::VectorXd u(2);
+            u << std::cos(t), std::sin(t);
+            return consider(u, 1.0);
+        };
+        double c = b - g * (b - a), e = a + g * (b - a), fc = at_angle(c), fe = at_angle(e);
+        for (int it = 0; it < 30 && b - a > 1e-6; ++it) {
+            if (fc < fe) {
+                b = e;
+                e = c;
+                fe = fc;
+                c = b - g * (b - a);
+                fc = at_angle(c);
+            } else {
+                a = c;
+                c = e;
+                fc = fe;
+                e = a + g * (b - a);
+                fe = at_angle(e);
+            }
+        }
+    }
+    return w;
+}
+
 DesignResult design_gains(const std::string& model, const ParameterMap& parameters, const DesignOptions& options) {
     options.validate();
     const auto car = make_model(model, parameters);  // validates the car itself
@@ -909,6 +1024,8 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
         }
         r.uncertainty_initial = classify_with_uncertainty(at_car, C, 22, uo);
         r.uncertainty = classify_with_uncertainty(at_design, C, 22, uo);
+        r.worst_initial = worst_attenuation_margin(at_car, C);
+        r.worst = worst_attenuation_margin(at_design, C);
         r.has_uncertainty = true;
     }
     r.evaluations = P.evaluations;

@@ -120,6 +120,26 @@ struct DesignStart {
     int iterations = 0, evaluations = 0;
 };
 
+/// The least attenuation margin m* (analysis/stability/attenuation_margin.hpp) over the 95 %
+/// confidence ellipsoid of a fitted OVRV car's held parameters: {p : (p - p0)^T C_h^-1 (p - p0)
+/// <= chi2_d(0.95)}, C_h the covariance of the d held parameters among k1, k2, th, tau (eta
+/// moves no root of the linearisation) with a positive variance. Searched on the boundary and at
+/// half its radius along 2 (d = 1), 72 (d = 2, then the least refined by golden section in the
+/// angle) or 200 (d >= 3, Fibonacci or fixed-seed) directions; values of th, tau below 0 and of
+/// k1, k2 below 1e-9 are taken at those limits. A point whose plant is unstable has m* = -inf.
+struct WorstMargin {
+    double margin = 0.0;             ///< s: the least m* found (-inf: a plant unstable in the ellipsoid)
+    double nominal = 0.0;            ///< s: m* at the centre
+    ParameterMap at;                 ///< the held parameters where it is reached
+    std::vector<std::string> held;   ///< the parameters searched (empty: m* of the centre alone)
+    double radius2 = 0.0;            ///< chi2_d(0.95)
+    int evaluations = 0;
+    bool plant_unstable = false;     ///< some point of the ellipsoid has an unstable plant
+};
+/// `parameters`: k1, k2, th, tau, eta of an OVRV car; `covariance`: order k1, k2, th, tau, eta,
+/// the rows and columns of parameters that are not held set to 0.
+WorstMargin worst_attenuation_margin(const ParameterMap& parameters, const Eigen::Matrix<double, 5, 5>& covariance);
+
 struct DesignResult {
     /// Converged: the best run met the minimiser's stationarity test (or, for nearest, found the
     /// crossing) and the verdicts at the result are decided; otherwise the minimiser's status
@@ -157,6 +177,10 @@ struct DesignResult {
     /// instability, with its Wilson interval).
     bool has_uncertainty = false;
     VerdictUncertainty uncertainty_initial, uncertainty;
+    /// With a covariance: the worst attenuation margin over the fit's 95 % ellipsoid of the held
+    /// parameters, at the car and at the design (the design meets the margin robustly when
+    /// worst.margin >= options.margin).
+    WorstMargin worst_initial, worst;
 };
 
 /// Designs the free parameters of the car `model` with `parameters` (every law parameter and
