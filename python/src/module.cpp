@@ -746,6 +746,10 @@ std::string py_design(const std::string& spec, const CarTables& tables, const st
     o.weights = weights;
     o.starts = starts;
     o.cars = cars ? *cars : -1;
+    if (car.has_covariance && car.model == "ovrv") {  // a fit: judged under its uncertainty too, as the command does
+        o.has_covariance = true;
+        o.covariance = car.covariance;
+    }
     o.progress = interruptible();
     const DesignResult r = released([&] { return design_gains(car.model, p, o); });
     const JsonEnvelope e = design_envelope(r, o, spec, car.name);

@@ -607,3 +607,20 @@ def test_atlas_is_sized_before_the_work():
     with pytest.raises(ValueError, match="above the limit of 600 s"):
         ddemap.atlas(big)
     assert time.monotonic() - t < 5
+
+
+@pytest.mark.slow
+def test_design_of_a_fit_is_judged_under_its_uncertainty_as_the_command(tmp_path):
+    # a car with a covariance (what calibrate writes): the same envelope as the command, with the
+    # probability of string stability and the worst margin over the ellipsoid (once missing in Python)
+    names = ["k1", "k2", "th", "tau", "eta"]
+    cols = ["cov_%s_%s" % (names[i], names[j]) for i in range(5) for j in range(i, 5)]
+    cov = dict.fromkeys(cols, 0.0)
+    cov.update(cov_tau_tau=0.02 ** 2, cov_th_th=0.05 ** 2, cov_k1_k1=1e-6, cov_k2_k2=1e-4)
+    path = tmp_path / "fit.csv"
+    path.write_text("name,k1,k2,th,tau,eta," + ",".join(cols) + "\nCfit,0.018,0.152,1.986,0.324,13.81," + ",".join(repr(cov[c]) for c in cols) + "\n")
+    r = ddemap.design(path, objective="nearest", progress=False)
+    same_envelope(r, cli_json("design", path, "--objective", "nearest"))
+    u = r["uncertainty"]
+    assert 0 <= u["design"]["p_string_stable"] <= 1 and u["worst_case"]["design"]["held"] == ["th", "tau"]
+    assert u["worst_case"]["design"]["attenuation_margin"] <= r["attenuation_margin"]
