@@ -10,7 +10,7 @@ build=(g++ make cmake ninja-build pkg-config
        libeigen3-dev libspectra-dev libsuitesparse-dev
        libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
        libhdf5-dev libopenmpi-dev openmpi-bin)  # ddemap atlas (HDF5, MPI)
-rest=(python3 doctest-dev libxml2-utils librsvg2-bin strace
+rest=(python3 doctest-dev libxml2-utils librsvg2-bin strace time
       pybind11-dev python3-dev python3-numpy python3-pandas python3-pytest python3-matplotlib python3-venv
       python3-h5py hdf5-tools)
 case "$what" in

@@ -1,4 +1,7 @@
 #include "ddemap/io/system_json.hpp"
+#include <cstring>
+#include <cctype>
+#include <algorithm>
 
 #include <cmath>
 #include <stdexcept>
@@ -102,6 +105,35 @@ bool real_sparse_of(const std::vector<Eigen::Triplet<cplx>>& t, int n, SparseMat
 
 }  // namespace
 
+std::optional<LinearDdeShape> quick_peek_linear_dde_json(const std::string& text) {
+    if (text.find("\"triplets\"") != std::string::npos || text.find("\"equations\"") != std::string::npos) return std::nullopt;
+    auto after_key = [&](const char* key) -> std::size_t {  // the position after "KEY" and its colon
+        std::size_t k = text.find(key);
+        if (k == std::string::npos) return k;
+        k += std::strlen(key);
+        while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+        if (k >= text.size() || text[k] != ':') return std::string::npos;
+        ++k;
+        while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+        return k;
+    };
+    LinearDdeShape s;
+    const std::size_t d = after_key("\"dimension\"");
+    if (d == std::string::npos) return std::nullopt;
+    std::size_t e = d;
+    while (e < text.size() && e - d < 12 && std::isdigit(static_cast<unsigned char>(text[e]))) ++e;
+    if (e == d || e - d >= 12) return std::nullopt;
+    s.dimension = std::stol(text.substr(d, e - d));
+    const std::size_t l = after_key("\"delays\"");
+    if (l == std::string::npos || text[l] != '[') return std::nullopt;
+    const std::size_t r = text.find(']', l);
+    if (r == std::string::npos || r - l > 1000000) return std::nullopt;
+    const std::string list = text.substr(l + 1, r - l - 1);
+    if (list.find_first_not_of(" \t\r\n") == std::string::npos) s.delays = 0;
+    else s.delays = static_cast<std::size_t>(std::count(list.begin(), list.end(), ',')) + 1;
+    return s;
+}
+
 LinearDdeShape peek_linear_dde_json(const std::string& text, const std::string& source) {
     json j;
     try {
@@ -195,7 +227,11 @@ LinearDDE read_linear_dde_json(const std::string& text, const std::string& sourc
 }
 
 bool is_nonlinear_system_json(const std::string& text) {
-    const nlohmann::ordered_json j = nlohmann::ordered_json::parse(text, nullptr, false);
+    // a text search first (a linear file of 500 MB was parsed whole here, 1 GB of memory);
+    // then only the top level is kept
+    if (text.find("\"equations\"") == std::string::npos) return false;
+    const nlohmann::ordered_json j =
+        nlohmann::ordered_json::parse(text, [](int depth, nlohmann::ordered_json::parse_event_t, nlohmann::ordered_json&) { return depth <= 1; }, false);
     return !j.is_discarded() && j.is_object() && j.contains("equations");
 }
 

@@ -13,6 +13,7 @@
 /// (LinearDDE sparse storage), otherwise dense.
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -34,6 +35,10 @@ struct LinearDdeShape {
     long nonzeros = 0;
 };
 LinearDdeShape peek_linear_dde_json(const std::string& text, const std::string& source);
+/// The same by a text search only (no tokenisation: about 0.1 s for 500 MB), for a file with no
+/// "triplets" (held dense): the first "dimension": N and the length of the first "delays": [...]
+/// list. Empty when the text does not show them plainly (then peek_linear_dde_json decides).
+std::optional<LinearDdeShape> quick_peek_linear_dde_json(const std::string& text);
 
 /// Parses the JSON text; std::invalid_argument naming `source` and the field on error.
 /// Coefficients are 0 or of magnitude 1e-100 to 1e100, delays from 0 to 1e100.
