@@ -83,16 +83,6 @@ int run_sweep() {
     bo.ring_curves = ring_curves;
     if (!sweep_args.no_boundaries) b = trace_boundaries(sw, bo);
     const BoundarySet* bp = sweep_args.no_boundaries ? nullptr : &b;
-    ChartOptions co;
-    co.title = "Stability chart: " + sweep_chart_title(spec);
-    co.columns = 1;
-    co.panel_width = 520;
-    co.panel_height = 440;
-    ChartPanel panel;
-    panel.title = sweep_chart_title(spec);
-    panel.sweep = &sw;
-    panel.boundaries = bp;
-    panel.markers = marks;
     JsonEnvelope e;
     e.command = "sweep";
     JsonObject inputs = sweep_inputs(spec).boolean("boundaries", !sweep_args.no_boundaries).string("ring_curves", ring_curves_name(ring_curves));
@@ -106,7 +96,7 @@ int run_sweep() {
     e.result = sweep_json(sw, bp);
     const std::string csv = sweep_csv(sw);
     std::vector<std::pair<std::string, std::string>> files = {
-        {prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", render_chart_svg({panel}, co)}};
+        {prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", sweep_chart_svg(spec, sw, bp, marks)}};
     if (bp) files.emplace_back(prefix + "-boundaries.csv", boundary_csv(spec, b));
     // without boundaries an earlier run's PREFIX-boundaries.csv is not left beside the new chart
     write_files_atomic(files, bp ? std::vector<std::string>{} : std::vector<std::string>{prefix + "-boundaries.csv"});

@@ -892,6 +892,21 @@ def design(car, objective="sup-gamma", free=("k1", "k2"), bounds=None, margin=0.
                                   None if ring is None else _ring(ring)))
 
 
+def _spec_text(spec):
+    """A spec given as a TOML file (str or os.PathLike) or as TOML text (a str with a newline):
+    (its text, the name it goes by in messages)."""
+    if isinstance(spec, _os.PathLike) or (isinstance(spec, str) and "\n" not in spec):
+        path = _os.fspath(spec)
+        try:
+            with open(path, encoding="utf-8") as f:
+                return f.read(), path
+        except OSError as e:
+            raise ValueError("spec = %r: cannot read the file (%s)" % (path, e.strerror)) from None
+    if isinstance(spec, str):
+        return spec, "<spec>"
+    raise TypeError("spec: %s: expected a TOML file (str or os.PathLike) or TOML text" % (type(spec).__name__,))
+
+
 def _prefix(out, command, suffixes):
     """The output prefix as ``--out`` resolves it: a folder (existing, or ending in /) gets
     FOLDER/COMMAND; a known suffix is dropped; missing folders are created."""
@@ -919,18 +934,7 @@ def chart(spec, out):
     writes PREFIX.svg and per panel K its grid PREFIX-panelK.csv and boundaries
     PREFIX-panelK-boundaries.csv. Returns ``panels``, ``seconds`` and ``files``.
     """
-    if isinstance(spec, _os.PathLike) or (isinstance(spec, str) and "\n" not in spec):
-        path = _os.fspath(spec)
-        try:
-            with open(path, encoding="utf-8") as f:
-                text = f.read()
-        except OSError as e:
-            raise ValueError("spec = %r: cannot read the file (%s)" % (path, e.strerror)) from None
-        source = path
-    elif isinstance(spec, str):
-        text, source = spec, "<spec>"
-    else:
-        raise TypeError("spec: %s: expected a TOML file (str or os.PathLike) or TOML text" % (type(spec).__name__,))
+    text, source = _spec_text(spec)
     return _result(_ddemap.chart(text, source, _prefix(out, "chart", (".svg",))))
 
 
@@ -947,18 +951,7 @@ def atlas(spec, out=None, allow_large=False):
     array of that shape; ``coordinates``: ``ring`` (0 = infinity) and each axis's values. With
     ``out`` (a folder) it also writes ``atlas.h5`` and ``atlas.svg`` there, as the command does.
     """
-    if isinstance(spec, _os.PathLike) or (isinstance(spec, str) and "\n" not in spec):
-        path = _os.fspath(spec)
-        try:
-            with open(path, encoding="utf-8") as f:
-                text = f.read()
-        except OSError as e:
-            raise ValueError("spec = %r: cannot read the file (%s)" % (path, e.strerror)) from None
-        source = path
-    elif isinstance(spec, str):
-        text, source = spec, "<spec>"
-    else:
-        raise TypeError("spec: %s: expected a TOML file (str or os.PathLike) or TOML text" % (type(spec).__name__,))
+    text, source = _spec_text(spec)
     prefix = ""
     if out is not None:
         folder = _os.fspath(out)

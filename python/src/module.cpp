@@ -368,18 +368,8 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     e.result = sweep_json(sw, bp);
     if (!prefix.empty()) {
         // the files of `ddemap sweep --out PREFIX`: grid, envelope, chart (with the marks), boundaries
-        ChartOptions co;
-        co.title = "Stability chart: " + sweep_chart_title(spec);
-        co.columns = 1;
-        co.panel_width = 520;
-        co.panel_height = 440;
-        ChartPanel panel;
-        panel.title = sweep_chart_title(spec);
-        panel.sweep = &sw;
-        panel.boundaries = bp;
-        panel.markers = marks;
         std::vector<std::pair<std::string, std::string>> files = {
-            {prefix + ".csv", sweep_csv(sw)}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", render_chart_svg({panel}, co)}};
+            {prefix + ".csv", sweep_csv(sw)}, {prefix + ".json", envelope_json(e)}, {prefix + ".svg", sweep_chart_svg(spec, sw, bp, marks)}};
         if (bp) files.emplace_back(prefix + "-boundaries.csv", boundary_csv(spec, b));
         write_files_atomic(files, bp ? std::vector<std::string>{} : std::vector<std::string>{prefix + "-boundaries.csv"});
     }

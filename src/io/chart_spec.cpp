@@ -288,6 +288,20 @@ std::string sweep_chart_title(const SweepSpec& spec) {
     return t + ", N = " + (spec.cars == 0 ? std::string("inf") : std::to_string(spec.cars));
 }
 
+std::string sweep_chart_svg(const SweepSpec& spec, const SweepResult& sweep, const BoundarySet* boundaries, const std::vector<ChartMarker>& markers) {
+    ChartOptions co;
+    co.title = "Stability chart: " + sweep_chart_title(spec);
+    co.columns = 1;
+    co.panel_width = 520;
+    co.panel_height = 440;
+    ChartPanel panel;
+    panel.title = sweep_chart_title(spec);
+    panel.sweep = &sweep;
+    panel.boundaries = boundaries;
+    panel.markers = markers;
+    return render_chart_svg({panel}, co);
+}
+
 std::vector<ChartMarker> car_markers(const std::vector<CalibratedVehicle>& cars, const SweepSpec& spec, std::vector<std::string>* notes) {
     static const char* fitted[] = {"k1", "k2", "th", "tau", "eta"};
     auto index = [](const std::string& name) {

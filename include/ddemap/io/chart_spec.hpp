@@ -70,6 +70,10 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy 
 /// `sweep` writes it) and its boundary curves PREFIX-panelK-boundaries.csv.
 std::vector<std::pair<std::string, std::string>> chart_files(const RenderedChart& chart, const std::string& prefix);
 
+/// The figure of `sweep --out`: one panel, the sweep's regions, its boundaries (optional) and
+/// the markers, titled by sweep_chart_title.
+std::string sweep_chart_svg(const SweepSpec& spec, const SweepResult& sweep, const BoundarySet* boundaries, const std::vector<ChartMarker>& markers);
+
 /// A sweep chart's title: "MODEL, p = v unit, ..., N = n" (each fixed parameter with its symbol,
 /// its value to 4 digits and its unit).
 std::string sweep_chart_title(const SweepSpec& spec);

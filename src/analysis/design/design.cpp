@@ -11,6 +11,7 @@
 #include "core/internal/text.hpp"
 #include "ddemap/analysis/stability/ring_fast.hpp"
 #include "ddemap/problem/linear_dde.hpp"
+#include "ddemap/solve/optimize/golden.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/traffic/transfer_function.hpp"
 
@@ -623,30 +624,17 @@ WorstMargin worst_attenuation_margin(const ParameterMap& parameters, const Eigen
         }
     }
     if (d == 2 && std::isfinite(best_m)) {
-        // golden section in the angle around the least of the grid, on the boundary
-        const double h = 2.0 * M_PI / 72.0, g = 0.5 * (std::sqrt(5.0) - 1.0);
-        double a = 2.0 * M_PI * best / 72.0 - h, b = a + 2.0 * h;
+        // golden section in the angle around the least of the grid, on the boundary (consider
+        // keeps the least value and its point; the evaluations are counted there)
+        const double h = 2.0 * M_PI / 72.0, a = 2.0 * M_PI * best / 72.0 - h;
         auto at_angle = [&](double t) {
             Eigen::VectorXd u(2);
             u << std::cos(t), std::sin(t);
             return consider(u, 1.0);
         };
-        double c = b - g * (b - a), e = a + g * (b - a), fc = at_angle(c), fe = at_angle(e);
-        for (int it = 0; it < 30 && b - a > 1e-6; ++it) {
-            if (fc < fe) {
-                b = e;
-                e = c;
-                fe = fc;
-                c = b - g * (b - a);
-                fc = at_angle(c);
-            } else {
-                a = c;
-                c = e;
-                fc = fe;
-                e = a + g * (b - a);
-                fe = at_angle(e);
-            }
-        }
+        double least = 0.0;
+        int calls = 0;
+        golden_minimize(at_angle, a, a + 2.0 * h, least, calls, 1e-6, 30);
     }
     return w;
 }

@@ -7,41 +7,12 @@
 #include <vector>
 
 #include "ddemap/analysis/stability/string_stability.hpp"
+#include "ddemap/solve/optimize/golden.hpp"
 
 namespace ddemap {
 
 namespace {
 
-// Golden-section minimisation of h(u) on [a, b]; returns the abscissa and writes the value.
-template <class F>
-double golden_min(const F& h, double a, double b, double& value, int& evaluations) {
-    const double r = 0.5 * (std::sqrt(5.0) - 1.0);
-    double c = b - r * (b - a), d = a + r * (b - a);
-    double fc = h(c), fd = h(d);
-    evaluations += 2;
-    for (int it = 0; it < 80 && (b - a) > 1e-12 * std::max(1.0, std::abs(a)); ++it) {
-        if (fc <= fd) {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - r * (b - a);
-            fc = h(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + r * (b - a);
-            fd = h(d);
-        }
-        ++evaluations;
-    }
-    if (fc <= fd) {
-        value = fc;
-        return c;
-    }
-    value = fd;
-    return d;
-}
 
 // Refines the (up to) three lowest interior local minima of v on the grid u; returns the best
 // (value, u) over them and the grid.
@@ -57,7 +28,7 @@ std::pair<double, double> refine_minima(const F& h, const std::vector<double>& u
     std::pair<double, double> best{v[ib], u[ib]};
     for (std::size_t i : minima) {
         double val = 0.0;
-        const double at = golden_min(h, u[i - 1], u[i + 1], val, evaluations);
+        const double at = golden_minimize(h, u[i - 1], u[i + 1], val, evaluations);
         if (all) all->push_back({val, at});
         if (val < best.first) best = {val, at};
     }
