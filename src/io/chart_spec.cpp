@@ -355,16 +355,16 @@ std::string design_chart_svg(const DesignResult& d, const std::string& car_name,
         lo = std::max(lo, 0.02 * hi);  // gains above 0 (the charts' convention)
         return std::pair<double, double>{lo, hi};
     };
-    const auto [xlo, xhi] = window(x0, x1, ex);
-    const auto [ylo, yhi] = window(y0, y1, ey);
+    // (pairs, not structured bindings: clang refuses to capture those in the lambda below)
+    const std::pair<double, double> xr = window(x0, x1, ex), yr = window(y0, y1, ey);
     auto spec_at = [&](const ParameterMap& params) {
         SweepSpec s;
         s.model = d.model;
         // (OVRV's chart depends on neither eta nor the speed: left out of the title)
         for (const auto& [k, v] : params)
             if (k != "k1" && k != "k2" && !(d.model == "ovrv" && (k == "eta" || k == "speed"))) s.fixed[k] = v;
-        s.x = Axis{"k1", xlo, xhi, 81};
-        s.y = Axis{"k2", ylo, yhi, 81};
+        s.x = Axis{"k1", xr.first, xr.second, 81};
+        s.y = Axis{"k2", yr.first, yr.second, 81};
         s.cars = cars;
         return s;
     };
