@@ -357,4 +357,16 @@ constexpr double design_nearest_rel = 1e-7;
 /// sup-gamma's value against a brute-force grid's least value (never worse): both are the same
 /// norm from different frequency grids, ~1e-12 apart at a shared point; 1e-9.
 constexpr double design_grid_abs = 1e-9;
+/// A fold curve of periodic orbits in two parameters against a fold located on a one-parameter
+/// branch (same mesh, degree 4 on 40 intervals): both solve the same discrete equations, the
+/// curve's point by Newton to 1e-10 relative to max |u| (~3 here), the branch's by regula falsi on
+/// the tangent's parameter component to 1e-11 of the range (near a fold the parameter is
+/// quadratic in the arclength, so its error is smaller still); 1e-8 in the parameter and the
+/// period (relative), while a point off the curve is off by the step, ~1e-2.
+constexpr double fold_curve_vs_branch = 1e-8;
+/// What a fold curve of orbits ending at a generalised Hopf point adds to its O(a^2) distance
+/// from it (a the end orbit's amplitude, the distance's coefficient measured 0.1 on the 3-car ov
+/// ring): the orbit's collocation error at small amplitude (degree 4, 40 intervals: ~1e-8) and the
+/// generalised Hopf point's location (1e-13 of L1's scale); 1e-6.
+constexpr double fold_curve_floor = 1e-6;
 }  // namespace ddemap::test::tol

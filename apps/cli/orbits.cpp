@@ -25,6 +25,7 @@ struct OrbitsArgs {
     NonlinearProblemArgs problem;
     std::string hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
     std::string wave, initial_step, max_step;
+    std::string par2, from2, to2;
     CLI::Option* hopf_option = nullptr;
     bool adapt = false;
     bool no_stability = false;
@@ -47,8 +48,14 @@ void add_orbits_flags(CLI::App& app) {
                  "move the mesh after every orbit to equidistribute |x^(d+1)|^(1/(d+1)) (more accurate orbits, less accurate multipliers; see README)");
     app.add_option("--variable", orbits_args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
     app.add_option("--svg", orbits_args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
+    app.add_option("--par2", orbits_args.par2,
+                   "a second parameter: continue every fold of the branch as a curve of folds of periodic orbits in (--par, --par2), "
+                   "in the box [--from, --to] x [--from2, --to2] (a curve also ends where it meets the Hopf curve, at a generalised Hopf point)")
+        ->type_name("NAME");
+    app.add_option("--from2", orbits_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
+    app.add_option("--to2", orbits_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     orbits_args.format.add_to(app);
-    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json", false);
+    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json; with --par2 also PREFIX-folds.csv (one row per fold curve point)", false);
     run_flags().add_to(app, false);
 
     app.add_option("--wave", orbits_args.wave,
@@ -69,14 +76,23 @@ void add_orbits_flags(CLI::App& app) {
 }
 
 int run_orbits() {
+    if (!orbits_args.wave.empty() && !orbits_args.par2.empty()) throw BadInput("--par2: not with --wave (expected the orbits of a system or ring without --wave)");
     if (!orbits_args.wave.empty())
         return run_orbits_wave({orbits_args.problem, orbits_args.wave, orbits_args.degree, orbits_args.intervals, orbits_args.points, orbits_args.initial_step, orbits_args.svg, orbits_args.variable, orbits_args.adapt,
                                 orbits_args.hopf_option && orbits_args.hopf_option->count() > 0, orbits_args.format, orbits_args.out, orbits_args.max_step, orbits_args.no_stability, orbits_args.stability});
+    if (!orbits_args.par2.empty() || !orbits_args.from2.empty() || !orbits_args.to2.empty()) {
+        if (!orbits_args.wave.empty()) throw BadInput("--par2: not with --wave (expected the orbits of a system or ring without --wave)");
+        if (orbits_args.par2.empty()) throw BadInput("--from2/--to2 without --par2: expected --par2 NAME with them");
+        if (orbits_args.from2.empty() || orbits_args.to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + orbits_args.par2);
+    }
     if (!orbits_args.initial_step.empty()) throw BadInput("--initial-step: only with --wave (expected --wave K)");
     if (orbits_args.no_stability) throw BadInput("--no-stability: only with --wave (expected --wave K)");
     if (orbits_args.stability) throw BadInput("--stability: only with --wave (expected --wave K)");
     const Format format = orbits_args.format.parse();
-    const std::string prefix = orbits_args.out.given() ? orbits_args.out.prepare("orbits", {".csv", ".json"}) : std::string();
+    const bool two = !orbits_args.par2.empty();
+    const std::string prefix = !orbits_args.out.given() ? std::string()
+                               : two                    ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv"})
+                                                        : orbits_args.out.prepare("orbits", {".csv", ".json"});
     const std::string svg_file = orbits_args.svg.empty() ? std::string() : output_file("--svg", orbits_args.svg);
     PeriodicOrbitOptions o;
     const std::string& par = orbits_args.problem.par;
@@ -119,6 +135,26 @@ int run_orbits() {
         check_size("orbits", what + " for " + std::to_string(o.max_points) + " orbits", "time",
                    2e-4 * (o.degree / 4.0) * unknowns * o.max_points);
     }
+    OrbitFoldCurveOptions fo;
+    if (two) {
+        if (orbits_args.par2 == par) throw BadInput("--par2 = '" + orbits_args.par2 + "': expected a parameter other than --par");
+        const int j2 = built.system->parameter_index(orbits_args.par2);  // unknown: bad input naming the known ones
+        fo.parameter2 = orbits_args.par2;
+        fo.from2 = parse_number("--from2", orbits_args.from2);
+        fo.to2 = parse_number("--to2", orbits_args.to2);
+        if (!(fo.from2 < fo.to2)) throw BadInput("--from2 = '" + orbits_args.from2 + "', --to2 = '" + orbits_args.to2 + "': expected --from2 < --to2");
+        const double held = built.system->parameter_values()[static_cast<std::size_t>(j2)];
+        if (!(held >= fo.from2 && held <= fo.to2))
+            throw BadInput("--par2 " + orbits_args.par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
+        if (o.adapt) throw BadInput("--par2: not with --adapt (the fold curves are computed on the uniform mesh)");
+        // each fold curve point is a few Newton steps on the extended system (measured 0.08 s for
+        // 800 unknowns: about 1e-4 (d / 4) N seconds), at most 2 --points of them per curve; two
+        // curves assumed (a branch has as many as it has folds, known only after it)
+        const double n = static_cast<double>(built.system->dimension());
+        const double unknowns = static_cast<double>(o.intervals) * o.degree * n;
+        check_size("orbits", "fold curves of " + std::to_string(2 * o.max_points) + " points at most on a mesh of " + rounded(unknowns, 3) + " unknowns",
+                   "time", 2.0 * 2.0 * 1e-4 * (o.degree / 4.0) * unknowns * o.max_points);
+    }
     JsonObject& inputs = built.inputs;
     inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf_index).integer("degree", o.degree)
         .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
@@ -147,6 +183,38 @@ int run_orbits() {
         b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
     }
 
+    // the curves of folds in (par, par2): one per fold of the branch that lies on none already traced
+    std::vector<OrbitFoldCurve> curves;
+    std::vector<int> curve_fold;  // the index of the fold each curve starts from
+    if (two) {
+        inputs.string("par2", fo.parameter2).number("from2", fo.from2).number("to2", fo.to2);
+        fo.orbit = o;
+        const double held = built.system->parameter_values()[static_cast<std::size_t>(built.system->parameter_index(fo.parameter2))];
+        for (std::size_t k = 0; k < b.folds.size(); ++k) {
+            const OrbitFold& f = b.folds[k];
+            if (!f.located) continue;
+            // on a curve already traced: a segment of it crosses par2 = held at this fold's par
+            bool known = false;
+            for (const OrbitFoldCurve& c : curves)
+                for (std::size_t i = 0; i + 1 < c.points.size() && !known; ++i) {
+                    const OrbitFoldCurvePoint &a = c.points[i], &z = c.points[i + 1];
+                    if ((a.par2 - held) * (z.par2 - held) > 0.0 || a.par2 == z.par2) continue;
+                    const double p = a.par + (z.par - a.par) * (held - a.par2) / (z.par2 - a.par2);
+                    known = std::abs(p - f.par) <= 1e-6 * std::abs(o.to - o.from);
+                }
+            if (known) continue;
+            fo.orbit.progress = branch_progress_printer("orbits", "fold curve points", par, false);
+            curves.push_back(orbit_fold_curve(*built.system, f, fo));
+            fo.orbit.progress = nullptr;
+            curve_fold.push_back(static_cast<int>(k));
+            const OrbitFoldCurve& c = curves.back();
+            if (c.status != Status::Converged && b.status == Status::Converged) {
+                b.status = c.status;
+                b.message = "the fold curve from the fold at " + par + " = " + rounded(f.par, 10) + ": " + c.message;
+            }
+        }
+    }
+
     JsonEnvelope e;
     e.command = "orbits";
     e.inputs = inputs.str();
@@ -156,12 +224,14 @@ int run_orbits() {
     hj.integer("index", hopf_index).number("par", h.par).number("omega", h.omega).string("status", to_string(h.status));
     std::string result = orbit_branch_json(b, variables);
     result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    if (two) result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) + "}";
     e.result = result;
     const std::string csv = orbit_branch_csv(b, variables);
     std::vector<std::pair<std::string, std::string>> files;
     if (!prefix.empty()) {
         files.push_back({prefix + ".csv", csv});
         files.push_back({prefix + ".json", envelope_json(e)});
+        if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables)});
     }
     if (!svg_file.empty()) {
         const std::string punit = built.units.count(par) ? built.units.at(par) : std::string();
@@ -186,6 +256,25 @@ int run_orbits() {
         for (const OrbitFold& f : b.folds)
             out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
         out << crossing_lines(b);
+        for (std::size_t k = 0; k < curves.size(); ++k) {
+            const OrbitFoldCurve& c = curves[k];
+            const OrbitFold& f = b.folds[static_cast<std::size_t>(curve_fold[k])];
+            out << "fold curve " << k << " from the fold at " << par << " = " << rounded(f.par, 10) << ": " << counted(static_cast<long long>(c.points.size()), "point")
+                << " in (" << par << ", " << c.parameter2 << "), ended: " << c.stop_backward << " and " << c.stop_forward << "\n";
+            out << "  " << pad(par, 14) << pad(c.parameter2, 14) << pad("period", 14) << pad("amp " + v, 12) << pad("|g|", 10) << "|mu_2 - 1|\n";
+            for (const OrbitFoldCurvePoint& q : c.points)
+                out << "  " << pad(rounded(q.par, 8), 14) << pad(rounded(q.par2, 8), 14) << pad(rounded(q.orbit.period, 8), 14)
+                    << pad(rounded(q.orbit.max[variable] - q.orbit.min[variable], 5), 12) << pad(rounded(q.test, 2), 10)
+                    << (std::isfinite(q.second_distance) ? rounded(q.second_distance, 2) : std::string("-")) << "\n";
+            for (const auto& [end, stop] : {std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.front(), c.stop_backward},
+                                            std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.back(), c.stop_forward}})
+                if (stop == "hopf")
+                    out << "  ends at a generalised Hopf point (the orbits shrink onto the Hopf curve) near " << par << " = " << rounded(end->par, 6) << ", "
+                        << c.parameter2 << " = " << rounded(end->par2, 6) << " (amplitude " << rounded(end->orbit.max[variable] - end->orbit.min[variable], 3) << ")\n";
+            out << "  accuracy max |g| = " << rounded(c.max_test, 2) << ", max residual = " << rounded(c.max_residual, 2);
+            if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);
+            out << "\n";
+        }
         if (!b.points.empty()) {
             out << "accuracy   ";
             if (std::any_of(b.points.begin(), b.points.end(), [](const PeriodicOrbit& p) { return !p.multipliers.empty(); }))

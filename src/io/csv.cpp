@@ -108,6 +108,23 @@ std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string
     return out;
 }
 
+std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables) {
+    if (curves.empty()) return "curve\n";
+    std::string out = "curve," + csv_field(curves.front().parameter) + "," + csv_field(curves.front().parameter2) + ",period,fold_test,second_distance";
+    for (const auto& v : variables) out += "," + csv_field("min_" + v);
+    for (const auto& v : variables) out += "," + csv_field("max_" + v);
+    out += "\n";
+    for (std::size_t k = 0; k < curves.size(); ++k)
+        for (const OrbitFoldCurvePoint& q : curves[k].points) {
+            out += std::to_string(k) + "," + format_exact(q.par) + "," + format_exact(q.par2) + "," + format_exact(q.orbit.period) + "," +
+                   format_exact(q.test) + "," + (std::isfinite(q.second_distance) ? format_exact(q.second_distance) : std::string());
+            for (Eigen::Index i = 0; i < q.orbit.min.size(); ++i) out += "," + format_exact(q.orbit.min[i]);
+            for (Eigen::Index i = 0; i < q.orbit.max.size(); ++i) out += "," + format_exact(q.orbit.max[i]);
+            out += "\n";
+        }
+    return out;
+}
+
 std::string roots_csv(const std::vector<Root>& roots) {
     std::string out = "re,im,residual,newton_step\n";
     for (const auto& x : roots)

@@ -536,6 +536,35 @@ std::string mix_json(const std::vector<MixPoint>& points, int cars) {
     return text(json{{"ring", cars}, {"points", arr}});
 }
 
+std::string orbit_fold_curves_json(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables) {
+    const auto vec = detail::json_values;
+    json all = json::array();
+    for (const OrbitFoldCurve& c : curves) {
+        json j;
+        j["parameter"] = c.parameter;
+        j["parameter2"] = c.parameter2;
+        j["variables"] = variables;
+        j["degree"] = c.degree;
+        j["intervals"] = c.intervals;
+        j["start"] = c.start;
+        json points = json::array();
+        for (const OrbitFoldCurvePoint& q : c.points)
+            points.push_back({{"par", num(q.par)}, {"par2", num(q.par2)}, {"period", num(q.orbit.period)}, {"min", vec(q.orbit.min)},
+                              {"max", vec(q.orbit.max)}, {"fold_test", num(q.test)}, {"second_distance", num(q.second_distance)},
+                              {"trivial_distance", num(q.orbit.trivial_distance)}, {"residual", num(q.orbit.residual)}});
+        j["points"] = points;
+        j["stop_backward"] = c.stop_backward;
+        j["stop_forward"] = c.stop_forward;
+        j["status"] = to_string(c.status);
+        j["message"] = c.message;
+        j["method"] = c.method;
+        j["certificate"] = {{"max_residual", num(c.max_residual)}, {"max_fold_test", num(c.max_test)},
+                            {"max_trivial_distance", num(c.max_trivial_distance)}};
+        all.push_back(j);
+    }
+    return text(all);
+}
+
 std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers) {
     const auto vec = detail::json_values;
     auto pair = [](cplx z) { return json::array({num(z.real()), num(z.imag())}); };

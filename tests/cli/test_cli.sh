@@ -1037,6 +1037,40 @@ wnd="$tmp/winding"; mkdir -p "$wnd"
     ok || bad "sweep with boundaries: per-mode roots"
 rm -rf "$wnd"
 
+# fold curves of periodic orbits in two parameters (orbits --par2): the 3-car ov ring in (headway,
+# tau); each curve's point on the face tau = 0.8 must be a fold of the one-parameter branch computed
+# at tau = 0.8 (a second path), every point has g = 0, and the CSV holds the JSON's numbers exactly
+fc="$tmp/foldcurves"; mkdir -p "$fc"
+if "$bin" orbits --model ov --ring 3 --headway 1.2 --par headway --from 1.2 --to 3 --par2 tau --from2 0.8 --to2 1.2 --format json --quiet --out "$fc/a" >"$fc/a.json" &&
+   "$bin" orbits --model ov --ring 3 --headway 1.2 --tau 0.8 --par headway --from 1.2 --to 3 --format json --quiet >"$fc/b.json"; then
+    python3 - "$fc/a.json" "$fc/b.json" "$fc/a-folds.csv" <<'PY' && ok || bad "orbits --par2: the fold curves against the folds at tau = 0.8"
+import json, sys, csv
+a = json.load(open(sys.argv[1])); b = json.load(open(sys.argv[2]))
+assert a["status"] == "converged" and a["inputs"]["par2"] == "tau"
+curves = a["result"]["fold_curves"]
+assert len(curves) == 2, len(curves)
+folds08 = [f["par"] for f in b["result"]["folds"]]
+assert len(folds08) == 2
+for c in curves:
+    assert c["status"] == "converged" and c["stop_backward"] == "bound", (c["stop_backward"], c["message"])
+    end = c["points"][0]
+    assert end["par2"] == 0.8
+    assert min(abs(end["par"] - f) for f in folds08) < 1e-8, (end["par"], folds08)
+    assert all(p["fold_test"] < 1e-12 and p["residual"] < 1e-8 and p["second_distance"] < 1e-2 for p in c["points"])
+rows = list(csv.DictReader(open(sys.argv[3])))
+assert len(rows) == sum(len(c["points"]) for c in curves)
+assert float(rows[0]["headway"]) == curves[0]["points"][0]["par"] and float(rows[0]["tau"]) == 0.8
+PY
+else
+    bad "orbits --par2 exit status"
+fi
+expect_error "--par2 needs --from2 and --to2" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --out "$fc/bad1"
+expect_error "--par2 = 'headway': expected a parameter other than --par" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 headway --from2 1 --to2 2
+expect_error "expected it in \[--from2, --to2\]" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 1.5 --to2 2 --out "$fc/bad2"
+expect_error "--par2: not with --wave" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 0.5 --to2 2 --wave 1
+expect_error "--from2/--to2 without --par2" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --from2 0.5
+expect_error "'nope'" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 nope --from2 0.5 --to2 2
+[ -z "$(ls "$fc" | grep bad)" ] && ok || bad "orbits --par2 bad input wrote files: $(ls "$fc")"
 fi  # part hopf
 
 if part orbits; then

@@ -46,6 +46,10 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
 /// kind,PAR,period,stable,trivial_distance,max_nontrivial,min_VAR..,max_VAR..: one row per orbit
 /// (kind "orbit"), fold ("fold"), period doubling ("period_doubling") and torus ("torus").
 std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables);
+/// Curves of folds of periodic orbits: one row per point, curve (index), the two parameters (named),
+/// period, fold_test |g|, second_distance |mu_2 - 1| (empty without multipliers), min_ and max_
+/// of every variable.
+std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables);
 
 /// re,im,residual,newton_step
 std::string roots_csv(const std::vector<Root>& roots);

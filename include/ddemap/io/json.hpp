@@ -142,6 +142,11 @@ std::string mix_json(const std::vector<MixPoint>& points, int cars);
 /// "folds": [{"par", "period", "located"}], "period_doublings" and "tori": [{"par", "period",
 /// "multiplier": [re, im]}], "stop", "method", "certificate": {"max_residual", "max_trivial_distance"}}.
 std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers = 10);
+/// Curves of folds of periodic orbits in two parameters (orbit_fold_curve), an array: per curve
+/// its parameters, points (par, par2, period, min, max of every variable, fold_test |g|,
+/// second_distance |mu_2 - 1|, trivial_distance, residual), how each end ended, status, message,
+/// method and certificate.
+std::string orbit_fold_curves_json(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables);
 
 /// A branch of travelling waves (analysis/travelling_wave.hpp): the keys of orbit_branch_json
 /// (the variables are car 0's; "stable" is null where no multiplier was computed, i.e. N above

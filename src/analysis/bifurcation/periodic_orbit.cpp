@@ -24,6 +24,7 @@
 #include "analysis/bifurcation/internal/orbit_continuation.hpp"
 #include "analysis/bifurcation/internal/orbit_mesh.hpp"
 #include "core/internal/eigen_threads.hpp"
+#include "core/internal/text.hpp"
 
 namespace ddemap {
 
@@ -1107,6 +1108,362 @@ OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess
     follow(c, u, t, r, options, b);
     finish(b);
     return b;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Curves of folds of periodic orbits in two parameters (the header's orbit_fold_curve)
+
+namespace {
+
+/// The problem in two parameters on one mesh: c1 continues in p1 (its column of df/dp), c2 in
+/// p2; each base holds the other parameter's current value. z = (X, T, p1, p2).
+struct FoldSystem {
+    FoldSystem(const Setup& a, const Setup& b) : c1(a), c2(b) {}
+    Setup c1, c2;
+    int N = 0;
+    Eigen::VectorXd w;  // weights of the norm (N + 3)
+    double norm(const Eigen::VectorXd& v) const { return std::sqrt((w.array() * v.array().square()).sum()); }
+    /// (X, T, p1) of z, for the functions of one parameter; c1's base set to z's p2
+    Eigen::VectorXd orbit_part(const Eigen::VectorXd& z) {
+        c1.base[static_cast<std::size_t>(c2.j)] = z(N + 2);
+        return z.head(N + 2);
+    }
+};
+
+/// F(z) (N + 1: collocation and phase) and with J its Jacobian in (X, T, p1, p2), (N + 1) x (N + 3).
+bool fold_assemble(FoldSystem& fs, const Eigen::VectorXd& z, const Eigen::MatrixXd& ref, Eigen::VectorXd& F, SpD* J) {
+    const int N = fs.N;
+    const Eigen::VectorXd u1 = fs.orbit_part(z);
+    if (!J) return assemble(fs.c1, u1, ref, nullptr, 0.0, F, nullptr);
+    SpD J1, J2;
+    if (!assemble(fs.c1, u1, ref, nullptr, 0.0, F, &J1)) return false;
+    fs.c2.base[static_cast<std::size_t>(fs.c1.j)] = z(N + 1);
+    Eigen::VectorXd u2(N + 2), F2;
+    u2.head(N + 1) = z.head(N + 1);
+    u2(N + 1) = z(N + 2);
+    if (!assemble(fs.c2, u2, ref, nullptr, 0.0, F2, &J2)) return false;
+    std::vector<Triplet> t;
+    t.reserve(static_cast<std::size_t>(J1.nonZeros()) + static_cast<std::size_t>(N) + 1);
+    for (int k = 0; k < J1.outerSize(); ++k)
+        for (SpD::InnerIterator it(J1, k); it; ++it)
+            if (it.row() <= N) t.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()), it.value());
+    for (SpD::InnerIterator it(J2, N + 1); it; ++it)
+        if (it.row() <= N) t.emplace_back(static_cast<int>(it.row()), N + 2, it.value());
+    J->resize(N + 1, N + 3);
+    J->setFromTriplets(t.begin(), t.end());
+    return true;
+}
+
+/// The fold test of the bordered system (see the header): v, g from [A b; c^T 0] [v; g] = [0; 1]
+/// and w from the transposed system, A = D_(X,T) [F; phase] (J's first N + 1 columns).
+struct FoldTest {
+    Eigen::VectorXd v, w;
+    double g = std::numeric_limits<double>::quiet_NaN();
+};
+bool fold_test(const SpD& J, const Eigen::VectorXd& b, const Eigen::VectorXd& c, FoldTest& out) {
+    const int M = static_cast<int>(J.rows());  // N + 1
+    std::vector<Triplet> t;
+    t.reserve(static_cast<std::size_t>(J.nonZeros()) + 2 * static_cast<std::size_t>(M));
+    for (int k = 0; k < M; ++k)
+        for (SpD::InnerIterator it(J, k); it; ++it) t.emplace_back(static_cast<int>(it.row()), k, it.value());
+    for (int i = 0; i < M; ++i) {
+        if (b(i) != 0.0) t.emplace_back(i, M, b(i));
+        if (c(i) != 0.0) t.emplace_back(M, i, c(i));
+    }
+    SpD B(M + 1, M + 1);
+    B.setFromTriplets(t.begin(), t.end());
+    B.makeCompressed();
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(B);
+    if (lu.info() != Eigen::Success) return false;
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(M + 1);
+    e(M) = 1.0;
+    const Eigen::VectorXd x = lu.solve(e);
+    const Eigen::VectorXd y = lu.transpose().solve(e);
+    if (!x.allFinite() || !y.allFinite()) return false;
+    out.v = x.head(M);
+    out.g = x(M);
+    out.w = y.head(M);
+    return true;
+}
+
+struct FoldCorrection {
+    bool ok = false;
+    int iterations = 0;
+    double residual = std::numeric_limits<double>::infinity();  // max |F|
+    double test = std::numeric_limits<double>::infinity();      // |g|
+    Eigen::VectorXd tangent;  // the extended Jacobian's inverse times e_last (not normalised)
+    FoldTest fold;            // at the result
+};
+
+/// Newton on [F; g; a . z - beta] = 0 in z = (X, T, p1, p2), a sparse LU of the extended
+/// Jacobian every step; g's row by the central difference of the header.
+FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::MatrixXd& ref, const Eigen::VectorXd& b, const Eigen::VectorXd& c,
+                            const Eigen::VectorXd& a, double beta, const PeriodicOrbitOptions& o) {
+    const int N = fs.N;
+    FoldCorrection r;
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    bool factored = false;
+    double last_step = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd F, Fp, Fm;
+    SpD J, Jp, Jm;
+    for (int it = 0; it <= o.max_iterations; ++it) {
+        if (!fold_assemble(fs, z, ref, F, &J)) return r;
+        FoldTest ft;
+        if (!fold_test(J, b, c, ft)) return r;
+        r.residual = F.lpNorm<Eigen::Infinity>();
+        r.test = std::abs(ft.g);
+        r.fold = ft;
+        if (it > 0 && last_step <= o.tolerance * std::max(1.0, z.lpNorm<Eigen::Infinity>())) {
+            r.ok = r.residual <= o.residual_tolerance && factored;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+            e(N + 2) = 1.0;
+            r.tangent = lu.solve(e);  // one step earlier: an O(|dz|) difference in a normalised direction
+            if (!r.tangent.allFinite()) r.ok = false;
+            return r;
+        }
+        if (it == o.max_iterations) break;
+        // g_z = -w^T A_z v, A_z v by the central difference of J^T w along v (the (X, T) part)
+        const double vmax = ft.v.lpNorm<Eigen::Infinity>();
+        if (!(vmax > 0.0)) return r;
+        const double eps = 1e-5 * std::max(1.0, z.head(N + 1).lpNorm<Eigen::Infinity>()) / vmax;
+        Eigen::VectorXd zp = z, zm = z;
+        zp.head(N + 1) += eps * ft.v;
+        zm.head(N + 1) -= eps * ft.v;
+        if (!fold_assemble(fs, zp, ref, Fp, &Jp) || !fold_assemble(fs, zm, ref, Fm, &Jm)) return r;
+        const Eigen::VectorXd grad = -((Jp.transpose() * ft.w) - (Jm.transpose() * ft.w)) / (2.0 * eps);
+        std::vector<Triplet> t;
+        t.reserve(static_cast<std::size_t>(J.nonZeros()) + 2 * static_cast<std::size_t>(N + 3));
+        for (int k = 0; k < J.outerSize(); ++k)
+            for (SpD::InnerIterator q(J, k); q; ++q) t.emplace_back(static_cast<int>(q.row()), k, q.value());
+        for (int k = 0; k < N + 3; ++k) {
+            if (grad(k) != 0.0) t.emplace_back(N + 1, k, grad(k));
+            if (a(k) != 0.0) t.emplace_back(N + 2, k, a(k));
+        }
+        SpD E(N + 3, N + 3);
+        E.setFromTriplets(t.begin(), t.end());
+        E.makeCompressed();
+        lu.compute(E);
+        if (lu.info() != Eigen::Success) return r;
+        factored = true;
+        Eigen::VectorXd rhs(N + 3);
+        rhs.head(N + 1) = F;
+        rhs(N + 1) = ft.g;
+        rhs(N + 2) = a.dot(z) - beta;
+        const Eigen::VectorXd dz = lu.solve(rhs);
+        if (!dz.allFinite()) return r;
+        z -= dz;
+        ++r.iterations;
+        last_step = dz.lpNorm<Eigen::Infinity>();
+    }
+    return r;
+}
+
+}  // namespace
+
+bool OrbitFoldCurveOptions::is_valid(std::string* why) const {
+    if (!orbit.is_valid(why)) return false;
+    const char* w = nullptr;
+    if (parameter2.empty()) w = "parameter2: expected a name";
+    else if (parameter2 == orbit.parameter) w = "parameter2: expected a parameter other than the first";
+    else if (!std::isfinite(from2) || !std::isfinite(to2) || from2 == to2) w = "from2, to2: expected two different finite values";
+    if (w && why) *why = w;
+    return w == nullptr;
+}
+
+OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fold, const OrbitFoldCurveOptions& options) {
+    const SingleThreadedEigen single;
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("fold curve options: " + why);
+    const PeriodicOrbitOptions& o = options.orbit;
+    const PeriodicMesh mesh(o.degree, o.intervals);
+    if (fold.orbit.profile.rows() != mesh.points() || fold.orbit.profile.cols() != system.dimension())
+        throw std::invalid_argument("fold curve: the fold's orbit must lie on the uniform mesh of the options' degree and intervals");
+    if (!(fold.orbit.period > 0.0)) throw std::invalid_argument("fold curve: expected a fold with a period > 0");
+    const Setup s1 = make_setup(system, mesh, o, fold.orbit.period);
+    PeriodicOrbitOptions o2 = o;
+    o2.parameter = options.parameter2;
+    o2.from = options.from2;
+    o2.to = options.to2;
+    const Setup s2 = make_setup(system, mesh, o2, fold.orbit.period);
+    FoldSystem fs(s1, s2);
+    const int N = s1.N();
+    fs.N = N;
+    fs.w.resize(N + 3);
+    fs.w.head(N + 2) = s1.w;
+    fs.w(N + 2) = s2.w(N + 1);
+    const double lo1 = std::min(o.from, o.to), hi1 = std::max(o.from, o.to);
+    const double lo2 = std::min(options.from2, options.to2), hi2 = std::max(options.from2, options.to2);
+    const double p20 = system.parameter_values()[static_cast<std::size_t>(s2.j)];
+    if (!(p20 >= lo2 && p20 <= hi2))
+        throw std::invalid_argument("fold curve: " + options.parameter2 + " = " + detail::format_number(p20) + " lies outside its range [" +
+                                    detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
+
+    OrbitFoldCurve curve;
+    curve.parameter = o.parameter;
+    curve.parameter2 = options.parameter2;
+    curve.degree = o.degree;
+    curve.intervals = o.intervals;
+    curve.method = "the minimally augmented fold system (the fold test g of the bordered Jacobian of the collocation and phase "
+                   "conditions appended) on " + method_text(mesh) + "; both parameters free, pseudo-arclength; sparse LU of the extended Jacobian";
+
+    Eigen::VectorXd z(N + 3);
+    for (int i = 0; i < s1.P; ++i) z.segment(static_cast<Eigen::Index>(i) * s1.n, s1.n) = fold.orbit.profile.row(i).transpose();
+    z(N) = fold.orbit.period;
+    z(N + 1) = fold.par;
+    z(N + 2) = p20;
+    // the bordering vectors: from fixed pseudo-random ones, two rounds of the bordered solves
+    Eigen::VectorXd bv(N + 1), cv(N + 1);
+    for (int i = 0; i <= N; ++i) {
+        bv(i) = std::sin(1.0 + 0.7 * i);
+        cv(i) = std::cos(0.3 + 1.3 * i);
+    }
+    Eigen::MatrixXd ref = derivative_at_collocation(fs.c1, fs.orbit_part(z));
+    auto failed = [&](const std::string& m) {
+        curve.status = Status::MaxIterations;
+        curve.message = m;
+        curve.stop_backward = curve.stop_forward = "first_point_failed";
+        return curve;
+    };
+    for (int round = 0; round < 2; ++round) {
+        Eigen::VectorXd F;
+        SpD J;
+        FoldTest ft;
+        if (!fold_assemble(fs, z, ref, F, &J) || !fold_test(J, bv, cv, ft)) return failed("the fold's orbit gives no finite Jacobian");
+        cv = ft.v / ft.v.norm();
+        bv = ft.w / ft.w.norm();
+    }
+    Eigen::VectorXd e2 = Eigen::VectorXd::Zero(N + 3);
+    e2(N + 2) = 1.0;
+    FoldCorrection r0 = correct_fold(fs, z, ref, bv, cv, e2, p20, o);
+    curve.newton_iterations += r0.iterations;
+    if (!r0.ok) return failed("the fold did not converge as a point of the fold system at " + options.parameter2 + " = " + detail::format_number(p20));
+    Eigen::VectorXd t0 = r0.tangent / fs.norm(r0.tangent);
+
+    auto make_point = [&](const Eigen::VectorXd& zz, const FoldCorrection& r) {
+        OrbitFoldCurvePoint q;
+        Correction c;
+        c.residual = r.residual;
+        c.iterations = r.iterations;
+        c.ok = true;
+        q.orbit = make_orbit(fs.c1, fs.orbit_part(zz), c, o.floquet);
+        q.par = zz(N + 1);
+        q.par2 = zz(N + 2);
+        q.test = r.test;
+        if (q.orbit.multipliers.size() >= 2) {
+            std::vector<double> dist;
+            for (cplx m : q.orbit.multipliers) dist.push_back(std::abs(m - 1.0));
+            std::sort(dist.begin(), dist.end());
+            q.second_distance = dist[1];
+        }
+        return q;
+    };
+    const OrbitFoldCurvePoint first = make_point(z, r0);
+    const double T0 = z(N);
+    const long total = 2L * o.max_points;
+    long done = 1;
+    if (o.progress) o.progress(done, total, first.par);
+
+    // one direction from the start: the points after it, and why it ended
+    auto follow_fold = [&](double sign, std::string& stop) {
+        std::vector<OrbitFoldCurvePoint> out;
+        Eigen::VectorXd u = z, t = sign * t0, b = bv, c = cv;
+        StepControl step(orbit_continuation::step_control_options(o));
+        double amp_max = amplitude(first.orbit);
+        stop = "max_points";
+        while (static_cast<int>(out.size()) + 1 < o.max_points) {
+            const double h = step.h();
+            const Eigen::MatrixXd rf = derivative_at_collocation(fs.c1, fs.orbit_part(u));
+            Eigen::VectorXd v = u + h * t;
+            const Eigen::VectorXd a = fs.w.cwiseProduct(t);
+            FoldCorrection r = correct_fold(fs, v, rf, b, c, a, a.dot(u + h * t), o);
+            curve.newton_iterations += r.iterations;
+            const bool jump = r.ok && step.jumped(fs.norm(v - u));
+            if (!r.ok || jump) {
+                if (!step.reject()) {
+                    stop = "step_below_minimum";
+                    if (curve.status == Status::Converged) {
+                        curve.status = jump ? Status::NumericalIssue : Status::MaxIterations;
+                        curve.message = "the fold curve's corrector failed at (" + o.parameter + ", " + options.parameter2 + ") = (" +
+                                        detail::format_number(u(N + 1)) + ", " + detail::format_number(u(N + 2)) + ") with the step below " +
+                                        detail::format_number(o.min_step);
+                    }
+                    return out;
+                }
+                continue;
+            }
+            Eigen::VectorXd tn = r.tangent / fs.norm(r.tangent);
+            if (tn.dot(fs.w.cwiseProduct(t)) < 0.0) tn = -tn;
+            const double p1 = v(N + 1), p2 = v(N + 2);
+            if (p1 < lo1 || p1 > hi1 || p2 < lo2 || p2 > hi2) {
+                // the point on the face it crossed (the first parameter's, else the second's)
+                Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+                double bound = 0.0;
+                if (p1 < lo1 || p1 > hi1) {
+                    e(N + 1) = 1.0;
+                    bound = p1 < lo1 ? lo1 : hi1;
+                } else {
+                    e(N + 2) = 1.0;
+                    bound = p2 < lo2 ? lo2 : hi2;
+                }
+                Eigen::VectorXd wz = v;
+                const FoldCorrection rb = correct_fold(fs, wz, rf, b, c, e, bound, o);
+                curve.newton_iterations += rb.iterations;
+                if (rb.ok) out.push_back(make_point(wz, rb));
+                else if (curve.status == Status::Converged) {
+                    curve.status = Status::MaxIterations;
+                    curve.message = "the fold curve's point on the face of the box did not converge";
+                }
+                stop = "bound";
+                return out;
+            }
+            // the curve reached a generalised Hopf point (where it meets the Hopf curve, the
+            // orbits' amplitude a -> 0 and (p1, p2) moves like a^2) and went through it onto the
+            // same folds phase-shifted: the direction in (p1, p2) turns back within the step at a
+            // small amplitude. Such a step ends the curve (once it ran back along itself); a cusp
+            // of the fold curve turns too, but at the amplitude of its orbits
+            OrbitFoldCurvePoint next = make_point(v, r);
+            const double amp = amplitude(next.orbit), amp_prev = out.empty() ? amplitude(first.orbit) : amplitude(out.back().orbit);
+            const double turn = fs.w(N + 1) * t(N + 1) * tn(N + 1) + fs.w(N + 2) * t(N + 2) * tn(N + 2);
+            // (the step is halved to come closer first, down to 2 % of the largest amplitude)
+            if (turn < 0.0 && std::max(amp, amp_prev) < 0.25 * amp_max) {
+                if (amp_prev > 0.02 * amp_max && step.reject()) continue;
+                stop = "hopf";
+                return out;
+            }
+            amp_max = std::max(amp_max, amp);
+            out.push_back(std::move(next));
+            if (o.progress) o.progress(++done, total, out.back().par);
+            if (amp < 0.02 * amp_max) {
+                stop = "hopf";
+                return out;
+            }
+            if (v(N) > o.max_period_factor * T0) {
+                stop = "period";
+                return out;
+            }
+            u = v;
+            t = tn;
+            c = r.fold.v / r.fold.v.norm();
+            b = r.fold.w / r.fold.w.norm();
+            step.accept(r.iterations <= 3);
+        }
+        return out;
+    };
+    std::vector<OrbitFoldCurvePoint> backward = follow_fold(-1.0, curve.stop_backward);
+    std::vector<OrbitFoldCurvePoint> forward = follow_fold(1.0, curve.stop_forward);
+    curve.points.assign(backward.rbegin(), backward.rend());
+    curve.start = static_cast<int>(curve.points.size());
+    curve.points.push_back(first);
+    curve.points.insert(curve.points.end(), forward.begin(), forward.end());
+    for (const OrbitFoldCurvePoint& q : curve.points) {
+        curve.max_residual = std::max(curve.max_residual, q.orbit.residual);
+        curve.max_test = std::max(curve.max_test, q.test);
+        if (std::isfinite(q.orbit.trivial_distance)) curve.max_trivial_distance = std::max(curve.max_trivial_distance, q.orbit.trivial_distance);
+    }
+    if (curve.message.empty())
+        curve.message = std::to_string(curve.points.size()) + " folds of orbits, ended: " + curve.stop_backward + " and " + curve.stop_forward;
+    return curve;
 }
 
 }  // namespace ddemap

@@ -209,6 +209,74 @@ OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess
 std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
                                     const Eigen::MatrixXd& profile, double period, double par);
 
+/// Options of a curve of folds of periodic orbits in two parameters (orbit_fold_curve).
+struct OrbitFoldCurveOptions {
+    /// the first parameter (parameter, from, to: its range), the mesh (degree, intervals; the
+    /// uniform mesh, `adapt` is not used), the steps and tolerances of the continuation in the
+    /// weighted norm of PeriodicOrbitOptions extended by (p2 / |to2 - from2|)^2, and max_points:
+    /// the most points in each direction from the start
+    PeriodicOrbitOptions orbit;
+    std::string parameter2;  ///< the second parameter (a name of the system, not `orbit.parameter`)
+    double from2 = 0.0;      ///< its range [min(from2, to2), max(from2, to2)]: the curve ends on its faces
+    double to2 = 1.0;
+    bool is_valid(std::string* why = nullptr) const;
+};
+
+/// One point of a fold curve: the orbit (with its Floquet multipliers when orbit.floquet) at
+/// (par, par2) where the branch in `par` turns.
+struct OrbitFoldCurvePoint {
+    double par = 0.0, par2 = 0.0;
+    PeriodicOrbit orbit;  ///< its par is `par`
+    /// |g|, the fold test function of the bordered system (see orbit_fold_curve): 0 at a fold
+    double test = std::numeric_limits<double>::quiet_NaN();
+    /// an independent check from the Floquet multipliers: at a fold of orbits the trivial
+    /// multiplier 1 is double, so the second nearest to 1 is near it too; |mu_2 - 1| (NaN
+    /// without multipliers). The collocation splits the double multiplier like the square root
+    /// of its error, so it is of the order of sqrt(trivial_distance)
+    double second_distance = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// A curve of folds of periodic orbits in (parameter, parameter2), ordered along the curve.
+struct OrbitFoldCurve {
+    std::string parameter, parameter2;
+    int degree = 0, intervals = 0;
+    std::vector<OrbitFoldCurvePoint> points;
+    int start = 0;  ///< index of the point corrected from the given fold
+    /// why each end ended: "bound" (a face of the box), "max_points", "period" (above
+    /// max_period_factor times the start's: towards a homoclinic orbit), "hopf" (the amplitude fell
+    /// below 2 % of the largest on the curve, or the curve turned back in (p1, p2) below a quarter of
+    /// it: at a generalised Hopf point, where the curve
+    /// meets the Hopf curve), "step_below_minimum"; first the end before `start`, then the end after
+    std::string stop_backward, stop_forward;
+    Status status = Status::Converged;
+    std::string message;
+    std::string method;
+    double max_residual = 0.0;          ///< certificate: max over points of max |F| (collocation and phase)
+    double max_test = 0.0;              ///< certificate: max over points of |g|
+    double max_trivial_distance = 0.0;  ///< max over points of |mu_trivial - 1| (with multipliers)
+    int newton_iterations = 0;
+};
+
+/// The curve of folds of periodic orbits through the fold `fold` of a branch in
+/// options.orbit.parameter (its orbit on the uniform mesh of options.orbit.degree and
+/// .intervals: a branch computed with those and adapt off), followed in both directions in
+/// (parameter, parameter2), parameter2 starting at its value in `system`.
+///
+/// The fold condition is appended to the collocation system (the minimally augmented system,
+/// as DDE-BIFTOOL's and MatCont's folds of periodic orbits): with A = D_(x,T) [F; phase], the
+/// square Jacobian of the collocation equations and the phase condition in the profile and the
+/// period, and vectors b, c (the left and right null vectors of A at the previous point),
+///     [A b; c^T 0] [v; g] = [0; 1]
+/// defines the scalar g(x, T, p1, p2), zero exactly where A is singular: where the branch in p1
+/// has a turning point (a fold). The unknowns (x, T, p1, p2) solve F = 0, phase = 0, g = 0 and the
+/// pseudo-arclength condition; Newton's row of g is g_z = -w^T A_z v (w from the transposed
+/// system), the second derivative w^T A_z v taken as a central difference of the Jacobian's
+/// transpose times w along v: (J(z + e v)^T w - J(z - e v)^T w) / (2 e). Each Newton step is a
+/// sparse LU of the (N + 3) square extended Jacobian. The phase reference is the previous point.
+/// std::invalid_argument for invalid options, unknown parameters, parameter2 outside its range,
+/// a fold whose profile does not fit the mesh; non-convergence is a status.
+OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fold, const OrbitFoldCurveOptions& options);
+
 /// x(s) of an orbit on `mesh` at s (any real: taken mod 1), all n components (for an orbit of a
 /// branch: PeriodicMesh(branch.degree, orbit.breakpoints)).
 Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s);
