@@ -395,11 +395,20 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         // complete in a strip reaching below the axis (strip_floor < 0: every root with
         // Re >= strip_floor is among those found), so no unstable root is missed and the stable
         // ones nearest the axis are seen. (Asking for a fixed number of stable roots instead
-        // cost a dense collocation of degree ~90 and 3 s per point on a 5-car ring.)
+        // cost a dense collocation of degree ~90 and 3 s per point on a 5-car ring; starting from
+        // 8 roots, 20 s per point on the 3-car ov ring at tau = 0.3, where the 7th and 8th lie near
+        // Re = -24 and the dense degree grew to its cap for them: the request starts at the
+        // options' count and grows only while the strip does not reach below the axis.)
         const LinearDDE lin = linearise(system, pt.x, curve.values(u));
         RootOptions ro = options.roots;
-        ro.count = std::max(ro.count, 8);
+        ro.count = std::max(ro.count, 2);
         RootResult rr = rightmost_roots(lin, ro);
+        if (!converged(rr.status) && ro.count < 8) {
+            // a few roots may not settle between degrees where more do (a cut through a cluster,
+            // as on DDE-BIFTOOL's delayed Duffing oscillator): the former request of 8
+            ro.count = 8;
+            rr = rightmost_roots(lin, ro);
+        }
         while (converged(rr.status) && !rr.roots.empty() && !(rr.strip_floor < 0.0) && ro.count < 256 &&
                static_cast<int>(rr.roots.size()) >= ro.count) {
             ro.count *= 2;

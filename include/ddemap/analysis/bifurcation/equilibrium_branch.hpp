@@ -50,7 +50,7 @@ struct EquilibriumBranchOptions {
         return c;
     }();
     /// At every point; count: the roots reported. More are computed for the detection of Hopf
-    /// points: at least 8, doubled (up to 256) until the result is certified complete in a strip
+    /// points: from count (at least 2; 8 when those do not converge), doubled (up to 256) until the result is certified complete in a strip
     /// Re >= strip_floor with strip_floor < 0, so that every unstable root and the stable ones
     /// nearest the axis are seen.
     RootOptions roots;
