@@ -69,8 +69,13 @@ SUMMARIES = {
              "Guide: [atlases](" + GUIDE + "atlases.md).",
     "orbits": "The branch of periodic orbits born at a Hopf point, with periods, amplitudes, Floquet "
               "multipliers and the folds, period doublings and tori located; with `--wave K` the travelling "
-              "waves of a ring in a reduced form whose cost does not depend on N. Guide: [bifurcations]("
+              "waves of a ring in a reduced form whose cost does not depend on N; with `--par2` every fold of "
+              "orbits followed as a curve in two parameters. Guide: [bifurcations]("
               + GUIDE + "bifurcations.md).",
+    "bistability": "Where stable periodic orbits (stop-and-go waves) coexist with a stable equilibrium (uniform "
+                   "flow) in two parameters: the Hopf curves with their criticality and generalised Hopf points, "
+                   "the curves of folds of periodic orbits, and the cells of the box they cut, each decided by a "
+                   "one-parameter slice; the chart as SVG. Guide: [bifurcations](" + GUIDE + "bifurcations.md).",
 }
 
 OPTION = re.compile(r"^  (-\S.*?|[A-Za-z][\w.]*( .*?)?)(?:\s{2,}(\S.*))?$")

@@ -46,6 +46,9 @@ const std::vector<Command>& command_table() {
         {"orbits", "the branch of periodic orbits from a Hopf point of a nonlinear DDE (--system FILE or --model ov|idm --ring N) in one parameter: "
          "period, amplitude, Floquet stability, folds, period doublings, tori; --svg the bifurcation diagram",
          add_orbits_flags, run_orbits},
+        {"bistability", "where stable stop-and-go waves coexist with stable uniform flow, in two parameters: Hopf curves with their "
+         "criticality, curves of folds of periodic orbits, and the cells of the box they cut decided by slices; writes PREFIX.svg, .json, -curves.csv",
+         add_bistability_flags, run_bistability},
     };
     return table;
 }

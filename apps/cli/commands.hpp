@@ -37,6 +37,7 @@ DDEMAP_COMMAND(hopf)
 DDEMAP_COMMAND(atlas)
 
 DDEMAP_COMMAND(orbits)
+DDEMAP_COMMAND(bistability)
 #undef DDEMAP_COMMAND
 
 }  // namespace ddemap::cli

@@ -385,4 +385,87 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
     return render_line_plots_svg({panel}, po);
 }
 
+std::string bistability_svg(const BistabilityChart& chart, const std::string& unit, const std::string& unit2, const std::string& title) {
+    PlotPanel panel;
+    panel.title = "";
+    auto label = [](const std::string& name, const std::string& u) { return u.empty() ? name : name + " [" + unit_text(u) + "]"; };
+    panel.x_label = label(parameter_symbol(chart.parameter), unit);
+    panel.y_label = label(parameter_symbol(chart.parameter2), unit2);
+    panel.x_min = chart.from;
+    panel.x_max = chart.to;
+    panel.y_min = chart.from2;
+    panel.y_max = chart.to2;
+    // the cells: a polygon through the ends of their intervals (one per line), else one
+    // rectangle per interval (a cell with several intervals on a line)
+    PlotFill bistable{"bistable: stable wave and stable uniform flow", {}, "#f4a340", 0.55};
+    PlotFill unstable{"equilibrium unstable", {}, "#9e9e9e", 0.35};
+    PlotFill undecided{"undecided", {}, "#404040", 0.6};
+    int rows = 0;
+    for (const BistabilityCell& c : chart.cells) rows = std::max<int>(rows, static_cast<int>(c.intervals.size()));
+    for (const BistabilityCell& c : chart.cells) {
+        PlotFill* f = c.status != Status::Converged ? &undecided : c.bistable ? &bistable : !c.equilibrium_stable ? &unstable : nullptr;
+        if (!f || c.intervals.empty()) continue;
+        // the lines' spacing: the smallest gap between two of its lines
+        double dy = chart.to2 - chart.from2;
+        for (std::size_t i = 0; i + 1 < c.intervals.size(); ++i)
+            if (c.intervals[i + 1].par2 > c.intervals[i].par2) dy = std::min(dy, c.intervals[i + 1].par2 - c.intervals[i].par2);
+        bool one_per_line = true;
+        for (std::size_t i = 0; i + 1 < c.intervals.size(); ++i) one_per_line = one_per_line && c.intervals[i + 1].par2 > c.intervals[i].par2;
+        if (one_per_line && c.intervals.size() > 1) {
+            std::vector<std::pair<double, double>> poly;
+            const double y0 = std::max(chart.from2, c.intervals.front().par2 - 0.5 * dy), y1 = std::min(chart.to2, c.intervals.back().par2 + 0.5 * dy);
+            poly.emplace_back(c.intervals.front().lo, y0);
+            for (const auto& iv : c.intervals) poly.emplace_back(iv.lo, iv.par2);
+            poly.emplace_back(c.intervals.back().lo, y1);
+            poly.emplace_back(c.intervals.back().hi, y1);
+            for (auto it = c.intervals.rbegin(); it != c.intervals.rend(); ++it) poly.emplace_back(it->hi, it->par2);
+            poly.emplace_back(c.intervals.front().hi, y0);
+            f->polygons.push_back(std::move(poly));
+        } else {
+            for (const auto& iv : c.intervals)
+                f->polygons.push_back({{iv.lo, iv.par2 - 0.5 * dy}, {iv.hi, iv.par2 - 0.5 * dy}, {iv.hi, iv.par2 + 0.5 * dy}, {iv.lo, iv.par2 + 0.5 * dy}});
+        }
+    }
+    for (PlotFill* f : {&bistable, &unstable, &undecided})
+        if (!f->polygons.empty()) panel.fills.push_back(std::move(*f));
+    // the Hopf curves in pieces of one criticality (neighbouring pieces share their end point)
+    for (const HopfCurve& c : chart.hopf.curves) {
+        std::size_t start = 0;
+        auto kind = [&](std::size_t i) {
+            const HopfCoefficients& k = c.points[i].coefficients;
+            return k.status != Status::Converged ? 0 : k.l1 < 0.0 ? 1 : k.l1 > 0.0 ? 2 : 0;
+        };
+        for (std::size_t i = 1; i <= c.points.size(); ++i) {
+            if (i < c.points.size() && kind(i) == kind(start)) continue;
+            const int k = kind(start);
+            PlotSeries sr{k == 1 ? "Hopf, supercritical (L1 < 0)" : k == 2 ? "Hopf, subcritical (L1 > 0)" : "Hopf, L1 not decided", {}, {},
+                          k == 0 ? std::string("#999999") : std::string("#d62728"), k != 1};
+            for (std::size_t j = start; j < std::min(i + 1, c.points.size()); ++j) {
+                sr.x.push_back(c.points[j].par);
+                sr.y.push_back(c.points[j].par2);
+            }
+            panel.series.push_back(std::move(sr));
+            start = i;
+        }
+        for (const GeneralisedHopfPoint& g : c.generalised)
+            if (g.status == Status::Converged) panel.markers.push_back({g.par, g.par2, "#000000", "GH"});
+    }
+    for (const OrbitFoldCurve& c : chart.folds) {
+        PlotSeries sr{"fold of periodic orbits", {}, {}, "#2ca02c", false};
+        for (const OrbitFoldCurvePoint& q : c.points) {
+            sr.x.push_back(q.par);
+            sr.y.push_back(q.par2);
+        }
+        panel.series.push_back(std::move(sr));
+    }
+    PlotOptions po;
+    po.title = title;
+    po.columns = 1;
+    po.panel_width = 560.0;
+    po.panel_height = 420.0;
+    po.note = "shading: the verdict of each cell of the box cut by the curves, from a slice in " + parameter_symbol(chart.parameter) +
+              " at one point of it (orbits born at a Hopf point; isolas not seen); GH: generalised Hopf point (L1 = 0)";
+    return render_line_plots_svg({panel}, po);
+}
+
 }  // namespace ddemap

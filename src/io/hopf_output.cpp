@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ddemap/io/csv.hpp"
+#include "ddemap/io/json.hpp"
 #include "io/internal/json_values.hpp"
 
 namespace ddemap {
@@ -130,6 +131,50 @@ std::string hopf_curves_csv(const HopfCurves& hc) {
             out += std::to_string(k) + ",generalised_hopf," + exact(g.par) + "," + exact(g.par2) + "," + exact(g.omega) + "," + exact(g.l1) +
                    ",degenerate," + to_string(g.status) + "\n";
     }
+    return out;
+}
+
+std::string bistability_json(const BistabilityChart& c, const std::vector<std::string>& variables) {
+    json j;
+    j["parameter"] = c.parameter;
+    j["parameter2"] = c.parameter2;
+    j["box"] = json::array({num(c.from), num(c.to), num(c.from2), num(c.to2)});
+    j["hopf"] = json::parse(hopf_curves_json(c.hopf, c.parameter2, variables));
+    j["fold_curves"] = json::parse(orbit_fold_curves_json(c.folds, variables));
+    json cells = json::array();
+    for (const BistabilityCell& k : c.cells) {
+        json o;
+        o["par"] = num(k.par);
+        o["par2"] = num(k.par2);
+        o["equilibrium_stable"] = k.equilibrium_stable;
+        o["stable_orbit"] = k.stable_orbit;
+        o["bistable"] = k.bistable;
+        o["status"] = to_string(k.status);
+        o["message"] = k.message;
+        json iv = json::array();
+        for (const auto& x : k.intervals) iv.push_back(json::array({num(x.par2), num(x.lo), num(x.hi)}));
+        o["intervals"] = iv;
+        cells.push_back(o);
+    }
+    j["cells"] = cells;
+    j["slices"] = c.slices;
+    j["rounds"] = c.rounds;
+    return detail::json_text(j);
+}
+
+std::string bistability_csv(const BistabilityChart& c) {
+    std::string out = "curve,kind," + csv_field(c.parameter) + "," + csv_field(c.parameter2) + "\n";
+    for (std::size_t k = 0; k < c.hopf.curves.size(); ++k) {
+        for (const HopfCurvePoint& p : c.hopf.curves[k].points) {
+            const HopfCoefficients& q = p.coefficients;
+            const char* kind = !converged(q.status) ? "hopf" : q.l1 < 0.0 ? "hopf_supercritical" : q.l1 > 0.0 ? "hopf_subcritical" : "hopf";
+            out += std::to_string(k) + "," + kind + "," + exact(p.par) + "," + exact(p.par2) + "\n";
+        }
+        for (const GeneralisedHopfPoint& g : c.hopf.curves[k].generalised)
+            if (g.status == Status::Converged) out += std::to_string(k) + ",generalised_hopf," + exact(g.par) + "," + exact(g.par2) + "\n";
+    }
+    for (std::size_t k = 0; k < c.folds.size(); ++k)
+        for (const OrbitFoldCurvePoint& p : c.folds[k].points) out += std::to_string(k) + ",fold_of_orbits," + exact(p.par) + "," + exact(p.par2) + "\n";
     return out;
 }
 

@@ -612,6 +612,10 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     // legend entries: the series names of the first panel
     std::vector<std::pair<std::string, std::string>> entries;
     std::vector<bool> dashed_entries;
+    std::vector<std::pair<std::string, std::string>> fill_entries;
+    if (o.legend)
+        for (const auto& f : panels.front().fills)
+            if (!f.name.empty()) fill_entries.emplace_back(f.name, f.colour);
     if (o.legend) {
         std::size_t i = 0;
         for (const auto& sr : panels.front().series) {
@@ -629,9 +633,11 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     // one slot per entry, wide enough for the longest name (13 px text: about 7.8 px a character)
     std::size_t longest = 0;
     for (const auto& e : entries) longest = std::max(longest, e.first.size());
+    for (const auto& e : fill_entries) longest = std::max(longest, e.first.size());
     const double slot = std::max(150.0, 29.0 + 7.8 * static_cast<double>(longest) + 14.0);
     const int per_row = std::max(1, static_cast<int>((width - 20) / slot));
-    const double legend_h = entries.empty() ? 10 : 20.0 * ((entries.size() + per_row - 1) / per_row) + 12;
+    const std::size_t legend_count = entries.size() + fill_entries.size();
+    const double legend_h = legend_count == 0 ? 10 : 20.0 * ((legend_count + per_row - 1) / per_row) + 12;
     // the note, wrapped at spaces to the figure's width (13 px text: about 7.2 px a character)
     std::vector<std::string> note_lines;
     {
@@ -674,17 +680,27 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
                 hi = mid + 0.5;
             }
         };
-        widen(x0, x1);
-        if (p.y_from_floor && y0 >= p.y_floor && y1 > p.y_floor) y0 = p.y_floor;
-        widen(y0, y1);
-        const double pad = 0.04 * (y1 - y0);
-        const bool floored = y0 >= p.y_floor;
-        y0 -= pad;
-        y1 += pad;
-        const double sx = nice_step(x1 - x0), sy = nice_step(y1 - y0);
-        x0 = std::floor(x0 / sx) * sx; x1 = std::ceil(x1 / sx) * sx;
-        y0 = std::floor(y0 / sy) * sy; y1 = std::ceil(y1 / sy) * sy;
-        if (floored && y0 < p.y_floor) y0 = p.y_floor;
+        const bool fixed = std::isfinite(p.x_min) && std::isfinite(p.x_max) && std::isfinite(p.y_min) && std::isfinite(p.y_max) &&
+                           p.x_max > p.x_min && p.y_max > p.y_min;
+        double sx = 0.0, sy = 0.0;
+        if (fixed) {
+            x0 = p.x_min; x1 = p.x_max; y0 = p.y_min; y1 = p.y_max;
+            sx = nice_step(x1 - x0);
+            sy = nice_step(y1 - y0);
+        } else {
+            widen(x0, x1);
+            if (p.y_from_floor && y0 >= p.y_floor && y1 > p.y_floor) y0 = p.y_floor;
+            widen(y0, y1);
+            const double pad = 0.04 * (y1 - y0);
+            const bool floored = y0 >= p.y_floor;
+            y0 -= pad;
+            y1 += pad;
+            sx = nice_step(x1 - x0);
+            sy = nice_step(y1 - y0);
+            x0 = std::floor(x0 / sx) * sx; x1 = std::ceil(x1 / sx) * sx;
+            y0 = std::floor(y0 / sy) * sy; y1 = std::ceil(y1 / sy) * sy;
+            if (floored && y0 < p.y_floor) y0 = p.y_floor;
+        }
         const double ox = (pi % cols) * cw + ml + 5, oy = header + (pi / cols) * ch + mt;
         const double pw = o.panel_width, ph = o.panel_height;
         auto X = [&](double x) { return ox + (x - x0) / (x1 - x0) * pw; };
@@ -711,6 +727,19 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         s << "<text transform=\"translate(" << num(ox - 52) << "," << num(oy + ph / 2) << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"14\">"
           << esc(p.y_label) << "</text>\n";
         s << "</g>\n";
+        if (!p.fills.empty()) {
+            s << "<clipPath id=\"" << id << "-clip\"><rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph)
+              << "\"/></clipPath>\n";
+            s << "<g id=\"" << id << "-fills\" clip-path=\"url(#" << id << "-clip)\" stroke=\"none\">\n";
+            for (const auto& f : p.fills)
+                for (const auto& poly : f.polygons) {
+                    s << "<polygon fill=\"" << f.colour << "\" fill-opacity=\"" << num(f.opacity) << "\" points=\"";
+                    for (const auto& [px, py] : poly)
+                        if (std::isfinite(px) && std::isfinite(py)) s << num(X(px)) << "," << num(Y(py)) << " ";
+                    s << "\"><title>" << esc(f.name) << "</title></polygon>\n";
+                }
+            s << "</g>\n";
+        }
         s << "<g id=\"" << id << "-series\" fill=\"none\" stroke-width=\"1.4\" stroke-linejoin=\"round\">\n";
         std::size_t si = 0;
         for (const auto& sr : p.series) {
@@ -732,7 +761,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
         }
         s << "</g>\n</g>\n";
     }
-    if (!entries.empty()) {
+    if (legend_count > 0) {
         const double ly = header + rows * ch + 4;
         s << "<g id=\"legend\" font-size=\"13\">\n";
         for (std::size_t i = 0; i < entries.size(); ++i) {
@@ -740,6 +769,12 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
             s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7) << "\" x2=\"" << num(x + 24) << "\" y2=\"" << num(y + 7)
               << "\" stroke=\"" << entries[i].second << "\" stroke-width=\"2\"" << (dashed_entries[i] ? " stroke-dasharray=\"5,3\"" : "")
               << "/>\n<text x=\"" << num(x + 29) << "\" y=\"" << num(y + 11) << "\">" << esc(entries[i].first) << "</text>\n";
+        }
+        for (std::size_t k = 0; k < fill_entries.size(); ++k) {
+            const std::size_t i = entries.size() + k;
+            const double x = 10 + (i % per_row) * slot, y = ly + (i / per_row) * 20;
+            s << "<rect x=\"" << num(x) << "\" y=\"" << num(y) << "\" width=\"24\" height=\"14\" fill=\"" << fill_entries[k].second
+              << "\" fill-opacity=\"0.45\"/>\n<text x=\"" << num(x + 29) << "\" y=\"" << num(y + 11) << "\">" << esc(fill_entries[k].first) << "</text>\n";
         }
         s << "</g>\n";
     }

@@ -1071,6 +1071,40 @@ expect_error "--par2: not with --wave" orbits --model ov --ring 3 --par headway 
 expect_error "--from2/--to2 without --par2" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --from2 0.5
 expect_error "'nope'" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 nope --from2 0.5 --to2 2
 [ -z "$(ls "$fc" | grep bad)" ] && ok || bad "orbits --par2 bad input wrote files: $(ls "$fc")"
+# the bistability chart of the 3-car ov ring in (headway, tau): curves and cells as JSON and CSV,
+# the figure; the two bistable windows at tau = 1 lie between the Hopf points and the folds of the
+# one-parameter branch there (checked above and in test_periodic_orbit.cpp)
+if "$bin" bistability --model ov --ring 3 --headway 1.2 --par headway --from 1.2 --to 3 --par2 tau --from2 0.3 --to2 2 --format json --quiet --out "$fc/bi" >"$fc/bi.json"; then
+    python3 - "$fc/bi.json" "$fc/bi-curves.csv" <<'PY' && ok || bad "bistability: cells and curves of the 3-car ov ring"
+import json, sys, csv
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "converged" and d["command"] == "bistability"
+r = d["result"]
+assert len(r["fold_curves"]) == 3 and sum(len(c["generalised_hopf"]) for c in r["hopf"]["curves"]) == 3
+def cell(p1, p2):
+    best = None
+    for c in r["cells"]:
+        for y, lo, hi in c["intervals"]:
+            if lo <= p1 <= hi and (best is None or abs(y - p2) < best[0]):
+                best = (abs(y - p2), c)
+    return best[1]
+assert cell(2.6, 1.0)["bistable"] and cell(1.32, 1.0)["bistable"]
+assert not cell(2.9, 1.0)["bistable"] and not cell(2.0, 1.0)["equilibrium_stable"]
+rows = list(csv.DictReader(open(sys.argv[2])))
+kinds = {x["kind"] for x in rows}
+assert {"hopf_supercritical", "hopf_subcritical", "generalised_hopf", "fold_of_orbits"} <= kinds, kinds
+assert sum(x["kind"] == "fold_of_orbits" for x in rows) == sum(len(c["points"]) for c in r["fold_curves"])
+PY
+    xmllint --noout "$fc/bi.svg" && grep -q "bistable: stable wave and stable uniform flow" "$fc/bi.svg" && grep -q "fold of periodic orbits" "$fc/bi.svg" \
+        && ok || bad "bistability --out: the figure"
+else
+    bad "bistability exit status"
+fi
+expect_error "--par2 = 'headway': expected a parameter other than --par" bistability --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 headway --from2 1 --to2 2 --out "$fc/bad3"
+expect_error "expected it in \[--from2, --to2\]" bistability --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 1.5 --to2 2 --out "$fc/bad4"
+expect_error "--rows" bistability --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 0.5 --to2 2 --rows 2
+expect_error "--par2 is required" bistability --model ov --ring 3 --par headway --from 1.2 --to 3
+[ -z "$(ls "$fc" | grep bad)" ] && ok || bad "bistability bad input wrote files: $(ls "$fc")"
 fi  # part hopf
 
 if part orbits; then

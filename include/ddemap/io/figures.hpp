@@ -8,6 +8,7 @@
 
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/io/chart_spec.hpp"
@@ -39,5 +40,12 @@ ChartSpec classification_chart(const ChartSpec& base, const std::vector<Calibrat
 /// of orbits marked. Labels: "NAME [UNIT]" when a unit is given.
 std::string bifurcation_svg(const EquilibriumBranch* equilibria, const OrbitBranch& orbits, int variable, const std::string& variable_name,
                             const std::string& variable_unit, const std::string& parameter_unit, const std::string& title);
+
+/// The bistability chart (analysis/bifurcation/bistability.hpp) in (p1, p2) over its box: the
+/// cells shaded by their verdict (orange: a stable periodic orbit and a stable equilibrium;
+/// grey: the equilibrium unstable; dark grey: undecided), the Hopf curves (red; solid where L1 <
+/// 0, supercritical, dashed where L1 > 0, subcritical), the fold curves of periodic orbits (green)
+/// and the generalised Hopf points (marked GH). Units in the axis labels when given.
+std::string bistability_svg(const BistabilityChart& chart, const std::string& unit, const std::string& unit2, const std::string& title);
 
 }  // namespace ddemap

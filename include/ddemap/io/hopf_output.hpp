@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 
 namespace ddemap {
@@ -29,5 +30,15 @@ std::string hopf_curves_csv(const HopfCurves& c);
 /// The criticality word of a point: to_string(criticality), or "undecided" when its
 /// coefficients did not converge.
 std::string criticality_word(const HopfCoefficients& c);
+
+/// The bistability chart (analysis/bifurcation/bistability.hpp): {"parameter", "parameter2",
+/// "box": [from, to, from2, to2], "hopf": hopf_curves_json, "fold_curves": orbit_fold_curves_json,
+/// "cells": [{"par", "par2", "equilibrium_stable", "stable_orbit", "bistable", "status",
+/// "message", "intervals": [[par2, lo, hi], ...]}], "slices", "rounds"}.
+std::string bistability_json(const BistabilityChart& c, const std::vector<std::string>& variables);
+/// The curves, one row per point: curve,kind,par,par2 with kind hopf_supercritical,
+/// hopf_subcritical, hopf (L1 not decided), generalised_hopf or fold_of_orbits (curve numbered
+/// within its kind: Hopf curves, then fold curves).
+std::string bistability_csv(const BistabilityChart& c);
 
 }  // namespace ddemap

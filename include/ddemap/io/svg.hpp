@@ -67,6 +67,14 @@ struct PlotMarker {
     std::string label;  ///< optional text next to the cross
 };
 
+/// A filled region under the series (e.g. a bistable region): polygons of one colour, one legend entry.
+struct PlotFill {
+    std::string name;
+    std::vector<std::vector<std::pair<double, double>>> polygons;  ///< (x, y) corners of each
+    std::string colour;
+    double opacity = 0.45;
+};
+
 struct PlotPanel {
     std::string title, x_label, y_label;
     std::vector<PlotSeries> series;
@@ -77,6 +85,10 @@ struct PlotPanel {
     /// The y axis starts at y_floor itself when no data lie below it (a speed axis from 0 m/s,
     /// so that a drop is seen against the whole speed).
     bool y_from_floor = false;
+    std::vector<PlotFill> fills{};  ///< drawn first, under the series, clipped to the plot area
+    /// a fixed window [x_min, x_max] x [y_min, y_max] (all four finite: no padding, ticks inside it)
+    double x_min = std::numeric_limits<double>::quiet_NaN(), x_max = std::numeric_limits<double>::quiet_NaN();
+    double y_min = std::numeric_limits<double>::quiet_NaN(), y_max = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PlotOptions {
