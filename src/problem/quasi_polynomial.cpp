@@ -156,7 +156,9 @@ int QuasiPolynomial::zeros_right_of(double sigma) const {
     // equals the change along the upper half: only [0, r] is sampled (half the work)
     const bool real = is_real();
     int pieces = real ? 4 : 8;
-    if (m_max_delay > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil((real ? 1.0 : 2.0) * r * m_max_delay * 4.0 / M_PI)));
+    // (capped in double before the conversion: r times the delay is not bounded)
+    if (m_max_delay > 0.0)
+        pieces = std::max(pieces, static_cast<int>(std::min(real ? 2048.0 : 4096.0, std::ceil((real ? 1.0 : 2.0) * r * m_max_delay * 4.0 / M_PI))));
     pieces = std::min(pieces, real ? 2048 : 4096);
     // e^{-sigma d_j} is the same at every sample of the line: computed once per term
     const Magnitudes mags(m_terms, sigma);

@@ -1015,8 +1015,10 @@ public:
         // roughly square cells to start with
         const double w = beta - alpha;
         const int cap = m_res ? 64 : std::numeric_limits<int>::max();  // cells are split as needed anyway
-        const int nx = std::clamp(static_cast<int>(std::ceil(w / std::max(height, 1e-300))), 1, cap);
-        const int ny = std::clamp(static_cast<int>(std::ceil(height / std::max(w, 1e-300))), 1, cap);
+        // (clamped in double before the conversion: the ratio of the sides is not bounded)
+        const double dcap = static_cast<double>(cap);
+        const int nx = static_cast<int>(std::clamp(std::ceil(w / std::max(height, 1e-300)), 1.0, dcap));
+        const int ny = static_cast<int>(std::clamp(std::ceil(height / std::max(w, 1e-300)), 1.0, dcap));
         for (int i = 0; i < nx; ++i)
             for (int j = 0; j < ny; ++j)
                 queue.push(Cell{{alpha + w * i / nx, alpha + w * (i + 1) / nx, height * j / ny, height * (j + 1) / ny}});

@@ -322,8 +322,8 @@ RingWindingTable winding_table(const TransferFunction& gamma, double sigma, int 
     Pass pass{f, sigma == 0.0, touch, {}, {}, {}, 0};
     const double tau = lin.max_delay();
     int pieces = 4;
-    if (tau > 0.0) pieces = std::max(pieces, static_cast<int>(std::ceil(r * tau * 4.0 / M_PI)));
-    pieces = std::min(pieces, 4096);
+    // (capped in double before the conversion: r tau is not bounded, an int cannot hold it)
+    if (tau > 0.0) pieces = std::max(pieces, static_cast<int>(std::min(4096.0, std::ceil(r * tau * 4.0 / M_PI))));
     Sample a = f(0.0);
     if (!f.failed) {
         if (sigma != 0.0 && a.side == 0) f.fail("Gamma(sigma) is on the unit circle to rounding");
