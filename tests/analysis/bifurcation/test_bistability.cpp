@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "analysis/bifurcation/dde_simulation.hpp"
 #include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
@@ -19,32 +20,10 @@
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
+using ddemap::test::range;
+using ddemap::test::simulate;
 
 namespace {
-
-DdeSolver simulate(const NonlinearDDE& sys, const std::function<void(double, double*)>& history, double t_end, double h) {
-    const int n = sys.dimension(), m = sys.delay_count();
-    const std::vector<double> tau = sys.delays();
-    DdeSolver s(n, 0.0, history, [&sys, n, m, tau](double t, const double* y, const DdeSolver& sol, double* dy) {
-        Eigen::VectorXd u(static_cast<Eigen::Index>(n) * (m + 1));
-        for (int i = 0; i < n; ++i) u(i) = y[i];
-        for (int k = 0; k < m; ++k)
-            for (int i = 0; i < n; ++i) u((k + 1) * n + i) = sol.value(i, t - tau[static_cast<std::size_t>(k)]);
-        const Eigen::VectorXd f = sys.f(u);
-        for (int i = 0; i < n; ++i) dy[i] = f(i);
-    });
-    s.integrate(t_end, h, {});
-    return s;
-}
-
-double range(const DdeSolver& s, int j, double t0, double t1, double dt) {
-    double lo = 1e300, hi = -1e300;
-    for (double t = t0; t <= t1; t += dt) {
-        lo = std::min(lo, s.value(j, t));
-        hi = std::max(hi, s.value(j, t));
-    }
-    return hi - lo;
-}
 
 /// The cell whose interval on the line nearest p2 holds p1.
 const BistabilityCell* cell_at(const BistabilityChart& c, double p1, double p2) {

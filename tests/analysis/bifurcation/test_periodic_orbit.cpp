@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tolerances.hpp"
+#include "analysis/bifurcation/dde_simulation.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/io/figures.hpp"
@@ -18,6 +19,9 @@ TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
 namespace tol = ddemap::test::tol;
+using ddemap::test::crossings;
+using ddemap::test::range;
+using ddemap::test::simulate;
 
 namespace {
 
@@ -44,50 +48,6 @@ PeriodicOrbitOptions options(const std::string& par, double from, double to, int
     o.max_points = points;
     o.intervals = intervals;
     return o;
-}
-
-/// Integrates the system with the project's DDE integrator (RK4 with Hermite history) from the
-/// history `history` on [-tau_max, 0] to t_end with step h.
-DdeSolver simulate(const NonlinearDDE& sys, const std::function<void(double, double*)>& history, double t_end, double h) {
-    const int n = sys.dimension(), m = sys.delay_count();
-    const std::vector<double> tau = sys.delays();
-    DdeSolver s(n, 0.0, history, [&sys, n, m, tau](double t, const double* y, const DdeSolver& sol, double* dy) {
-        Eigen::VectorXd u(static_cast<Eigen::Index>(n) * (m + 1));
-        for (int i = 0; i < n; ++i) u(i) = y[i];
-        for (int k = 0; k < m; ++k)
-            for (int i = 0; i < n; ++i) u((k + 1) * n + i) = sol.value(i, t - tau[static_cast<std::size_t>(k)]);
-        const Eigen::VectorXd f = sys.f(u);
-        for (int i = 0; i < n; ++i) dy[i] = f(i);
-    });
-    s.integrate(t_end, h, {});
-    return s;
-}
-
-/// Upward crossings of component j through `level` in [t0, t1], located by bisection on the
-/// integrator's continuous extension.
-std::vector<double> crossings(const DdeSolver& s, int j, double level, double t0, double t1, double dt) {
-    std::vector<double> out;
-    for (double t = t0; t + dt <= t1; t += dt) {
-        double a = t, b = t + dt;
-        if (!(s.value(j, a) < level && s.value(j, b) >= level)) continue;
-        for (int i = 0; i < 60; ++i) {
-            const double mid = 0.5 * (a + b);
-            (s.value(j, mid) < level ? a : b) = mid;
-        }
-        out.push_back(0.5 * (a + b));
-    }
-    return out;
-}
-
-/// max - min of component j on [t0, t1] sampled at dt (refined around the extremes by the
-/// integrator's Hermite extension: sampling error O(dt^2 |y''|)).
-double range(const DdeSolver& s, int j, double t0, double t1, double dt) {
-    double lo = 1e300, hi = -1e300;
-    for (double t = t0; t <= t1; t += dt) {
-        lo = std::min(lo, s.value(j, t));
-        hi = std::max(hi, s.value(j, t));
-    }
-    return hi - lo;
 }
 
 /// The subcritical Hopf point of the ov ring (N = 5, alpha = tau = v0 = h_st = 1) at the upper end of
