@@ -166,6 +166,10 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     po.max_points = o.max_points;
     OrbitFoldCurveOptions fo;
     fo.orbit = po;
+    // the fold curves only bound the cells: their points' multipliers (a certificate of `orbits
+    // --par2`, one dense monodromy eigenproblem per point, most of the time on longer rings) are
+    // not computed; |g| and the residual certify them
+    fo.orbit.floquet = false;
     fo.parameter2 = o.parameter2;
     fo.from2 = o.from2;
     fo.to2 = o.to2;

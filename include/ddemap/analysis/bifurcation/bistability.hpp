@@ -8,7 +8,7 @@
 /// criticality changes) and the curves of folds of periodic orbits (orbit_fold_curve). The chart:
 ///  1. the Hopf curves through the Hopf points of the equilibrium branch in p1 at the held p2;
 ///  2. the orbit branches in p1 from every Hopf point at the held p2, and the fold curve through
-///     every fold on them;
+///     every fold on them (without the Floquet multipliers of its points: |g| certifies them);
 ///  3. the cells: the box cut by these curves. Each of `rows` horizontal lines p2 = const is cut at
 ///     the curves' crossings (linear between curve points) into intervals; intervals of
 ///     neighbouring lines that overlap belong to one cell (union-find);
