@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "analysis/bifurcation/dde_simulation.hpp"
+#include "analysis/bifurcation/ov_ring_branch.hpp"
 #include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
@@ -24,6 +25,18 @@ using ddemap::test::range;
 using ddemap::test::simulate;
 
 namespace {
+
+/// The box of the charts: headway 1.2 to 3, tau 0.3 to 2.
+BistabilityOptions ov3_chart_options() {
+    BistabilityOptions o;
+    o.parameter = "headway";
+    o.from = 1.2;
+    o.to = 3.0;
+    o.parameter2 = "tau";
+    o.from2 = 0.3;
+    o.to2 = 2.0;
+    return o;
+}
 
 /// The cell whose interval on the line nearest p2 holds p1.
 const BistabilityCell* cell_at(const BistabilityChart& c, double p1, double p2) {
@@ -43,13 +56,7 @@ const BistabilityCell* cell_at(const BistabilityChart& c, double p1, double p2) 
 TEST_CASE("bistability chart of the ov ring (N = 3) in (headway, tau): its verdicts against simulations from two initial states" *
           doctest::test_suite("slow")) {
     OvRing ring(3, 1.0, 1.0, 1.0, 1.0, 1.2);
-    BistabilityOptions o;
-    o.parameter = "headway";
-    o.from = 1.2;
-    o.to = 3.0;
-    o.parameter2 = "tau";
-    o.from2 = 0.3;
-    o.to2 = 2.0;
+    BistabilityOptions o = ov3_chart_options();
     const BistabilityChart chart = bistability_chart(ring, ring.uniform_flow(), o);
     REQUIRE(chart.status == Status::Converged);
     CHECK(ring.parameter_values()[static_cast<std::size_t>(ring.parameter_index("tau"))] == 1.0);  // restored
@@ -75,18 +82,7 @@ TEST_CASE("bistability chart of the ov ring (N = 3) in (headway, tau): its verdi
     CHECK(!u->equilibrium_stable);
     CHECK(b != n);
     // the stable large wave at tau = 1 near headway 2.6, from the branch of orbits
-    EquilibriumBranchOptions eo;
-    eo.parameter = "headway";
-    eo.from = 1.2;
-    eo.to = 3.0;
-    const EquilibriumBranch eq = equilibrium_branch(ring, ring.uniform_flow(), eo);
-    REQUIRE(eq.hopf.size() == 2);
-    PeriodicOrbitOptions po;
-    po.parameter = "headway";
-    po.from = 1.2;
-    po.to = 3.0;
-    po.max_points = 400;
-    const OrbitBranch br = orbit_branch_from_hopf(ring, eq.hopf[0].par < eq.hopf[1].par ? eq.hopf[0] : eq.hopf[1], po);
+    const OrbitBranch br = ddemap::test::ov3_headway_branch(1.0);
     const PeriodicOrbit* wave = nullptr;
     for (const PeriodicOrbit& p : br.points)
         if (p.stable && (!wave || std::abs(p.par - 2.6) < std::abs(wave->par - 2.6))) wave = &p;
@@ -119,13 +115,8 @@ TEST_CASE("bistability chart of the ov ring (N = 3) in (headway, tau): its verdi
 
 TEST_CASE("bistability options: bad input is std::invalid_argument, and the system's parameter is left as it was") {
     OvRing ring(3, 1.0, 1.0, 1.0, 1.0, 1.2);
-    BistabilityOptions o;
-    o.parameter = "headway";
-    o.from = 1.2;
-    o.to = 3.0;
+    BistabilityOptions o = ov3_chart_options();
     o.parameter2 = "headway";
-    o.from2 = 0.3;
-    o.to2 = 2.0;
     CHECK_THROWS_AS(bistability_chart(ring, ring.uniform_flow(), o), std::invalid_argument);
     o.parameter2 = "tau";
     o.rows = 2;

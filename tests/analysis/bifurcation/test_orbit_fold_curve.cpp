@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tolerances.hpp"
+#include "analysis/bifurcation/ov_ring_branch.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
@@ -23,31 +24,11 @@ namespace tol = ddemap::test::tol;
 
 namespace {
 
-PeriodicOrbitOptions headway_options() {
-    PeriodicOrbitOptions o;
-    o.parameter = "headway";
-    o.from = 1.2;
-    o.to = 3.0;
-    o.max_points = 400;
-    return o;
-}
-
-/// The branch of orbits in the headway from the lower Hopf point of the 3-car ring at this tau.
-OrbitBranch headway_branch(double tau) {
-    OvRing ring(3, 1.0, tau, 1.0, 1.0, 1.2);
-    EquilibriumBranchOptions eo;
-    eo.parameter = "headway";
-    eo.from = 1.2;
-    eo.to = 3.0;
-    const EquilibriumBranch eq = equilibrium_branch(ring, ring.uniform_flow(), eo);
-    REQUIRE(eq.hopf.size() == 2);
-    const HopfPoint& start = eq.hopf[0].par < eq.hopf[1].par ? eq.hopf[0] : eq.hopf[1];
-    return orbit_branch_from_hopf(ring, start, headway_options());
-}
+using ddemap::test::ov3_headway_options;
 
 OrbitFoldCurveOptions curve_options(double from2, double to2) {
     OrbitFoldCurveOptions f;
-    f.orbit = headway_options();
+    f.orbit = ov3_headway_options();
     f.orbit.from = 0.5;
     f.orbit.to = 5.0;
     f.orbit.max_points = 200;
@@ -68,9 +49,9 @@ void check_double_multiplier(const OrbitFoldCurvePoint& q) {
 
 TEST_CASE("fold curve of orbits (ov ring N = 3): its point on the face tau = 0.8 is the fold of the one-parameter branch at tau = 0.8" *
           doctest::test_suite("slow")) {
-    const OrbitBranch at1 = headway_branch(1.0);
+    const OrbitBranch at1 = ddemap::test::ov3_headway_branch(1.0);
     REQUIRE(at1.folds.size() == 2);
-    const OrbitBranch at08 = headway_branch(0.8);
+    const OrbitBranch at08 = ddemap::test::ov3_headway_branch(0.8);
     REQUIRE(at08.status == Status::Converged);
     REQUIRE(at08.folds.size() == 2);
     OvRing ring(3, 1.0, 1.0, 1.0, 1.0, 1.2);
@@ -123,7 +104,7 @@ TEST_CASE("fold curves of orbits (ov ring N = 3) end at the generalised Hopf poi
         for (const GeneralisedHopfPoint& g : c.generalised)
             if (g.status == Status::Converged) gh.push_back(g);
     REQUIRE(gh.size() == 2);
-    const OrbitBranch at1 = headway_branch(1.0);
+    const OrbitBranch at1 = ddemap::test::ov3_headway_branch(1.0);
     REQUIRE(at1.folds.size() == 2);
     std::vector<bool> met(gh.size(), false);
     for (const OrbitFold& fold : at1.folds) {
