@@ -2,6 +2,7 @@
 // Small numerical helpers shared by the tests (independent of the library's own solvers).
 #include <algorithm>
 #include <cmath>
+#include <complex>
 
 namespace ddemap::test {
 
@@ -17,6 +18,19 @@ double bisect(G g, double lo, double hi) {
         else hi = mid;
     }
     return 0.5 * (lo + hi);
+}
+
+/// The distance from z to the nearest point of a set of complex numbers or of roots (their .value).
+inline std::complex<double> point_of(const std::complex<double>& z) { return z; }
+template <class R>
+auto point_of(const R& r) -> decltype(std::complex<double>(r.value)) {
+    return r.value;
+}
+template <class Set>
+double nearest(const Set& set, std::complex<double> z) {
+    double d = 1e300;
+    for (const auto& w : set) d = std::min(d, std::abs(point_of(w) - z));
+    return d;
 }
 
 }  // namespace ddemap::test

@@ -14,11 +14,13 @@
 #include "ddemap/io/atlas.hpp"
 #include "ddemap/io/files.hpp"
 #include "ddemap/study/sweep.hpp"
+#include "temp_dir.hpp"
 #include "tolerances.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
+using ddemap::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
@@ -65,18 +67,6 @@ std::string error_of(const std::string& text) {
     return "";
 }
 
-struct TempDir {
-    std::string path;
-    TempDir() {
-        std::string t = (fs::temp_directory_path() / "ddemap-atlas-XXXXXX").string();
-        REQUIRE(::mkdtemp(&t[0]) != nullptr);
-        path = t;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-};
 
 }  // namespace
 
@@ -257,7 +247,7 @@ TEST_CASE("atlas spec: the ring method, and rings up to the winding path's limit
 
 TEST_CASE("atlas store: finished chunks survive, a torn last record is dropped, another spec is refused") {
     TempDir dir;
-    const std::string path = dir.path + "/atlas.chunks";
+    const std::string path = dir / "atlas.chunks";
     const AtlasSpec s = parse_atlas_spec(good_spec, "a.toml").spec;
     const std::size_t nf = atlas_fields().size();
     auto chunk_values = [&](long c) {
@@ -334,17 +324,17 @@ TEST_CASE("atlas store: finished chunks survive, a torn last record is dropped, 
     other.chunk = 6;
     CHECK_THROWS_AS(AtlasStore(path, other, 42, true, done), std::invalid_argument);
     {
-        std::ofstream out(dir.path + "/junk");
+        std::ofstream out(dir / "junk");
         out << "not a store";
     }
-    CHECK_THROWS_AS(AtlasStore(dir.path + "/junk", s, 42, true, done), std::invalid_argument);
+    CHECK_THROWS_AS(AtlasStore(dir / "junk", s, 42, true, done), std::invalid_argument);
     // without resume: a fresh store; with resume and no store: a fresh store too
     {
         AtlasStore st(path, s, 42, false, done);
         CHECK(st.loaded() == 0);
     }
     {
-        AtlasStore st(dir.path + "/new.chunks", s, 42, true, done);
+        AtlasStore st(dir / "new.chunks", s, 42, true, done);
         CHECK(st.loaded() == 0);
     }
     CHECK(atlas_fingerprint("a") != atlas_fingerprint("b"));
@@ -366,12 +356,12 @@ TEST_CASE("atlas HDF5: a written file is recognised as the atlas of its spec, an
     TempDir dir;
     const AtlasSpec s = parse_atlas_spec(good_spec, "a.toml").spec;
     std::vector<double> values(static_cast<std::size_t>(s.points()) * atlas_fields().size(), 1.0);
-    const std::string path = dir.path + "/atlas.h5";
+    const std::string path = dir / "atlas.h5";
     write_file_atomic(path, atlas_hdf5(s, values, good_spec));
     CHECK(atlas_hdf5_matches(path, good_spec));
     CHECK_FALSE(atlas_hdf5_matches(path, std::string(good_spec) + "# edited\n"));
-    CHECK_FALSE(atlas_hdf5_matches(dir.path + "/missing.h5", good_spec));
-    CHECK_FALSE(atlas_hdf5_matches(dir.path, good_spec));  // a folder
+    CHECK_FALSE(atlas_hdf5_matches(dir / "missing.h5", good_spec));
+    CHECK_FALSE(atlas_hdf5_matches(dir.path.string(), good_spec));  // a folder
     write_file_atomic(path, "not HDF5");
     CHECK_FALSE(atlas_hdf5_matches(path, good_spec));
 }
@@ -397,7 +387,7 @@ TEST_CASE("atlas HDF5: written in slabs from a chunk reader, the same bytes as i
     // planes), and the whole grid in one slab
     for (long slab : {1L, 7L, 12L, 40L, 1000L}) {
         CAPTURE(slab);
-        const std::string path = dir.path + "/a.h5";
+        const std::string path = dir / "a.h5";
         reads = 0;
         write_atlas_hdf5(path, s, read, good_spec, slab);
         std::ifstream in(path, std::ios::binary);
@@ -407,8 +397,8 @@ TEST_CASE("atlas HDF5: written in slabs from a chunk reader, the same bytes as i
         CHECK(reads <= 2 * s.chunks() + s.points() / slab + 1);  // a chunk is read again only where a slab cuts it
         CHECK(atlas_hdf5_matches(path, good_spec));
     }
-    CHECK_THROWS_AS(write_atlas_hdf5(dir.path + "/a.h5", s, read, good_spec, 0), std::invalid_argument);
-    CHECK_THROWS_AS(write_atlas_hdf5(dir.path + "/missing/a.h5", s, read, good_spec), WriteError);
+    CHECK_THROWS_AS(write_atlas_hdf5(dir / "a.h5", s, read, good_spec, 0), std::invalid_argument);
+    CHECK_THROWS_AS(write_atlas_hdf5(dir / "missing/a.h5", s, read, good_spec), WriteError);
 }
 
 TEST_CASE("atlas figure: from a chunk reader, and thinned to its point budget") {

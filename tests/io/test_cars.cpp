@@ -10,6 +10,7 @@
 #include "ddemap/io/cars.hpp"
 #include "ddemap/traffic/fleet.hpp"
 #include "ddemap/traffic/vehicles.hpp"
+#include "temp_dir.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -18,19 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A folder of its own, removed at the end; the files are written into it.
-struct Folder {
-    fs::path path;
-    Folder() {
-        char tmpl[] = "/tmp/ddemap-cars-XXXXXX";
-        path = ::mkdtemp(tmpl);
-    }
-    ~Folder() { fs::remove_all(path); }
-    std::string file(const std::string& name, const std::string& text) const {
-        std::ofstream(path / name) << text;
-        return (path / name).string();
-    }
-};
+using Folder = ddemap::test::TempDir;
 
 const std::string kTable =
     "name,k1,k2,th,tau,eta\n"

@@ -12,26 +12,14 @@
 #include <unistd.h>
 
 #include "ddemap/io/files.hpp"
+#include "temp_dir.hpp"
 
 using namespace ddemap;
 namespace fs = std::filesystem;
+using ddemap::test::TempDir;
 
 namespace {
 
-/// A fresh folder under the system's temporary folder, removed at the end of the test.
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string t = (fs::temp_directory_path() / "ddemap-files-XXXXXX").string();
-        REQUIRE(::mkdtemp(&t[0]) != nullptr);
-        path = t;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& name) const { return (path / name).string(); }
-};
 
 std::string slurp(const std::string& path) {
     std::ifstream in(path, std::ios::binary);

@@ -14,10 +14,12 @@
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
+#include "numeric_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
+using ddemap::test::nearest;
 using ddemap::test::linearised;
 using ddemap::test::ovrv;
 using ddemap::test::random_car;
@@ -35,12 +37,6 @@ std::vector<Linearisation> small_ring(int n, unsigned seed) {
     std::vector<Linearisation> cars;
     for (int i = 0; i < n; ++i) cars.push_back(linearised(random_car(rng, false)));
     return cars;
-}
-
-double nearest(const std::vector<Root>& set, cplx z) {
-    double d = 1e300;
-    for (const auto& w : set) d = std::min(d, std::abs(w.value - z));
-    return d;
 }
 
 RootOptions with(const std::string& method, int count) {

@@ -14,22 +14,18 @@
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
+#include "numeric_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
+using ddemap::test::nearest;
 namespace tol = ddemap::test::tol;
 using ddemap::test::linearised;
 using ddemap::test::ovrv;
 using ddemap::test::random_car;
 
 namespace {
-
-double nearest(const std::vector<Root>& set, cplx z) {
-    double d = 1e300;
-    for (const auto& w : set) d = std::min(d, std::abs(w.value - z));
-    return d;
-}
 
 /// N random OVRV cars (some repeated, so that grouping into types is exercised), linearised at 20 m/s.
 std::vector<Linearisation> random_ring(std::mt19937& rng, int n) {

@@ -16,21 +16,17 @@
 #include "ddemap/traffic/ring_determinant.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
+#include "numeric_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
+using ddemap::test::nearest;
 namespace tol = ddemap::test::tol;
 using ddemap::test::linearised;
 using ddemap::test::random_car;
 
 namespace {
-
-double nearest(const std::vector<Root>& set, cplx z) {
-    double d = 1e300;
-    for (const auto& w : set) d = std::min(d, std::abs(w.value - z));
-    return d;
-}
 
 /// N cars in random order: a fraction `ccc` of connected cruise control cars; `kinds` random
 /// cars of each law are drawn first and the ring repeats them (so types are grouped).

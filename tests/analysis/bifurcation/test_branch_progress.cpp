@@ -13,6 +13,7 @@
 #include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "fleet_helpers.hpp"
+#include "numeric_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -20,7 +21,7 @@ using namespace ddemap;
 
 namespace {
 
-const double pi = 3.14159265358979323846;
+using ddemap::test::pi;
 
 /// What a callback saw.
 struct Seen {

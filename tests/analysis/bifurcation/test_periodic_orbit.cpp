@@ -14,6 +14,7 @@
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/integrate.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
+#include "numeric_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -25,7 +26,7 @@ using ddemap::test::simulate;
 
 namespace {
 
-const double pi = 3.14159265358979323846;
+using ddemap::test::pi;
 
 /// The Hopf point of y' = -a y(t - 1) (g(y) y(t - 1) terms alike) at y = 0: a = omega = pi/2, q = 1.
 HopfPoint scalar_hopf() {

@@ -13,21 +13,17 @@
 #include "ddemap/analysis/stability/ring_stability.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
+#include "numeric_helpers.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
 using namespace ddemap;
+using ddemap::test::nearest;
 namespace tol = ddemap::test::tol;
 using ddemap::test::linearised;
 using ddemap::test::random_car;
 
 namespace {
-
-double nearest(const std::vector<cplx>& set, cplx z) {
-    double d = 1e300;
-    for (cplx w : set) d = std::min(d, std::abs(w - z));
-    return d;
-}
 
 std::vector<cplx> eigenvalues_of(const std::vector<Root>& roots) {
     std::vector<cplx> v;

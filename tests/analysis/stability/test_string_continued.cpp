@@ -13,7 +13,7 @@ using namespace ddemap;
 
 namespace {
 
-Linearisation ovrv(double k1, double k2, double th, double tau) {
+Linearisation ovrv_car(double k1, double k2, double th, double tau) {
     return make_model("ovrv", {{"k1", k1}, {"k2", k2}, {"th", th}, {"tau", tau}})->linearise();
 }
 
@@ -48,8 +48,8 @@ TEST_CASE("continued string analysis: the same sup |Gamma| and verdicts as the s
     int used = 0;
     for (int i = 0; i < 60; ++i) {
         const double k1 = u(rng), k2 = u(rng);
-        const Linearisation lin = ovrv(k1, k2, 1.5, 0.5);
-        const Linearisation next = ovrv(k1 + 0.005, k2, 1.5, 0.5);  // the next point of a 200-point row
+        const Linearisation lin = ovrv_car(k1, k2, 1.5, 0.5);
+        const Linearisation next = ovrv_car(k1 + 0.005, k2, 1.5, 0.5);  // the next point of a 200-point row
         const StringResult here = analyse_string(lin, plant_of(lin), StringOptions{});
         const GainPeak seed = highest(here);
         if (seed.gain < 1.0) continue;
@@ -69,7 +69,7 @@ TEST_CASE("continued string analysis: the same sup |Gamma| and verdicts as the s
 
 TEST_CASE("continued string analysis: a neighbour's maximiser on the lower of two peaks never yields the lower peak") {
     // tau 1.2, th 1.5: peaks near w = 0.030 (|Gamma| 1.0017) and w = 0.507 (1.285)
-    const Linearisation lin = ovrv(0.65, 0.8, 1.5, 1.2);
+    const Linearisation lin = ovrv_car(0.65, 0.8, 1.5, 1.2);
     const RootResult plant = plant_of(lin);
     const StringResult full = analyse_string(lin, plant, StringOptions{});
     REQUIRE(full.peaks.size() == 2);
@@ -94,18 +94,18 @@ TEST_CASE("continued string analysis: the verdict next to the string-stability b
     // along k2 at k1 = 0.5 the sup of |Gamma| falls to 1 (th 1.5, tau 0.5): bisect the scan's verdict
     const double k1 = 0.5;
     double lo = 0.05, hi = 1.0;  // string unstable at lo, stable at hi
-    REQUIRE(!analyse_string(ovrv(k1, lo, 1.5, 0.5)).string_stable);
-    REQUIRE(analyse_string(ovrv(k1, hi, 1.5, 0.5)).string_stable);
+    REQUIRE(!analyse_string(ovrv_car(k1, lo, 1.5, 0.5)).string_stable);
+    REQUIRE(analyse_string(ovrv_car(k1, hi, 1.5, 0.5)).string_stable);
     for (int i = 0; i < 40; ++i) {
         const double mid = 0.5 * (lo + hi);
-        (analyse_string(ovrv(k1, mid, 1.5, 0.5)).string_stable ? hi : lo) = mid;
+        (analyse_string(ovrv_car(k1, mid, 1.5, 0.5)).string_stable ? hi : lo) = mid;
     }
     const double seed_k2 = lo - 1e-3;
-    const StringResult seeded = analyse_string(ovrv(k1, seed_k2, 1.5, 0.5));
+    const StringResult seeded = analyse_string(ovrv_car(k1, seed_k2, 1.5, 0.5));
     const GainPeak seed = highest(seeded);
     REQUIRE(seed.gain > 1.0);
     for (double k2 : {lo - 1e-4, lo - 1e-6, lo, hi, hi + 1e-6, hi + 1e-4}) {
-        const Linearisation lin = ovrv(k1, k2, 1.5, 0.5);
+        const Linearisation lin = ovrv_car(k1, k2, 1.5, 0.5);
         const RootResult plant = plant_of(lin);
         const StringResult full = analyse_string(lin, plant, StringOptions{});
         const auto c = analyse_string_continued(lin, plant, {true, seed.omega});
@@ -114,7 +114,7 @@ TEST_CASE("continued string analysis: the verdict next to the string-stability b
         check_same(*c, full);
     }
     // a little further from the boundary, on the unstable side, the shortcut decides (and agrees)
-    const Linearisation lin = ovrv(k1, seed_k2, 1.5, 0.5);
+    const Linearisation lin = ovrv_car(k1, seed_k2, 1.5, 0.5);
     const auto c = analyse_string_continued(lin, plant_of(lin), {true, seed.omega});
     REQUIRE(c.has_value());
     check_same(*c, seeded);
@@ -123,7 +123,7 @@ TEST_CASE("continued string analysis: the verdict next to the string-stability b
 TEST_CASE("continued string analysis: the exclusion bound against a dense scan of the axis") {
     for (const auto& [k1, k2, th, tau] : {std::array<double, 4>{0.3, 0.2, 1.5, 0.5}, std::array<double, 4>{0.9, 0.4, 1.5, 0.5},
                                           std::array<double, 4>{0.65, 0.8, 1.5, 1.2}, std::array<double, 4>{0.5, 0.2, 2.5, 0.8}}) {
-        const Linearisation lin = ovrv(k1, k2, th, tau);
+        const Linearisation lin = ovrv_car(k1, k2, th, tau);
         const RootResult plant = plant_of(lin);
         const StringResult full = analyse_string(lin, plant, StringOptions{});
         const GainPeak seed = highest(full);
