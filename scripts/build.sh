@@ -16,6 +16,9 @@ if [ "${*:-}" = ddemap_cli ]; then
 else
     scripts/install-deps.sh all
     options=(-DDDEMAP_BUILD_TESTS=ON -DDDEMAP_BUILD_BENCH=ON -DDDEMAP_BUILD_PYTHON=ON)
+    # a new folder compiles the test files in unity batches (16 % less CPU from scratch); a folder
+    # configured before keeps its choice (-DDDEMAP_UNITY_TESTS=OFF: one file per change)
+    [ -f "$dir/CMakeCache.txt" ] || options+=(-DDDEMAP_UNITY_TESTS=ON)
 fi
 # a folder configured earlier with another generator: configure it anew for Ninja
 if [ -f "$dir/CMakeCache.txt" ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' "$dir/CMakeCache.txt"; then

@@ -7,7 +7,9 @@
 # fuzz/corpus/<target>/ once fixed, so the regression tests replay it. The random seed is fixed
 # (FUZZ_SEED, default 1) so that a run can be repeated; give another seed for a new search.
 # FUZZ_WITH_TESTS=ON also configures the test suite in build-fuzz (scripts/sanitize.sh runs it
-# there: one sanitizer build for both). --build-only configures and builds, fuzzes nothing.
+# there: one sanitizer build for both); the test files themselves and the explicit instantiations
+# of Eigen's decompositions compile without the sanitizers (DDEMAP_TESTS_UNINSTRUMENTED,
+# DDEMAP_EIGEN_UNINSTRUMENTED: ddemap's library and program keep them), the test files in unity batches. --build-only configures and builds, fuzzes nothing.
 # Usage: [FUZZ_SEED=N] scripts/fuzz.sh [SECONDS|--build-only] [TARGET...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,7 +32,7 @@ command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 generator=()
 command -v ninja >/dev/null && [ ! -f build-fuzz/Makefile ] && generator=(-G Ninja)
 CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" "${launcher[@]}" -DCMAKE_BUILD_TYPE=None -DDDEMAP_BUILD_FUZZERS=ON -DDDEMAP_BUILD_PYTHON=OFF \
-    -DDDEMAP_BUILD_TESTS="${FUZZ_WITH_TESTS:-OFF}" -DDDEMAP_BUILD_BENCH=OFF -DDDEMAP_WITH_OPENMP=OFF \
+    -DDDEMAP_BUILD_TESTS="${FUZZ_WITH_TESTS:-OFF}" -DDDEMAP_TESTS_UNINSTRUMENTED=ON -DDDEMAP_EIGEN_UNINSTRUMENTED=ON -DDDEMAP_UNITY_TESTS=ON -DDDEMAP_BUILD_BENCH=OFF -DDDEMAP_WITH_OPENMP=OFF \
     -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then

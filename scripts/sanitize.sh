@@ -2,9 +2,10 @@
 # CI checks beyond scripts/test.sh, on one clang build (build-fuzz/) with AddressSanitizer,
 # UndefinedBehaviorSanitizer and libFuzzer's coverage instrumentation, so that the library is
 # compiled once for both steps:
-#  1. every fast-labelled test through ctest under the sanitizers, but for four command-line
-#     parts that run calibrations and travelling waves through the program (cli_chain,
-#     cli_calibrate, cli_shortdelay, cli_waves3: 693 s of CPU on CI's machine under the sanitizers,
+#  1. every fast-labelled test through ctest under the sanitizers (the test files themselves are
+#     compiled without them: scripts/fuzz.sh), but for three command-line
+#     parts that run calibrations and travelling waves through the program (cli_calibrate,
+#     cli_shortdelay, cli_waves3, and cli_chain, now slow: 693 s of CPU on CI's machine under the sanitizers,
 #     a third of the step; their library code runs under the sanitizers in the unit tests, and they
 #     run in full in scripts/test.sh). Before a release run `ctest --test-dir build-fuzz` in
 #     full (slow ones included);
