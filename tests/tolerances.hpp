@@ -117,6 +117,11 @@ constexpr double newton_quadratic = 10.0;
 /// last printed digit is at most 5e-6 (values < 1) or 5e-5 (values in [1, 10)), relative 5e-5.
 constexpr double published_5_digits_rel = 5e-5;
 
+/// DDE-BIFTOOL's double Hopf point of the neuron demo, printed with 10 decimals: its two copies
+/// (located from either Hopf curve) differ by up to 3.5e-9, so agreement within 1e-8 is
+/// agreement to DDE-BIFTOOL's own accuracy.
+constexpr double published_double_hopf = 1e-8;
+
 /// A Monte Carlo estimate against its exact value, in units of the estimate's own standard
 /// error: |estimate - exact| <= 4.5 SE fails by chance with probability 7e-6 (normal tails), so
 /// a pass is not luck, while a bias of a few standard errors (a wrong sampler) fails.

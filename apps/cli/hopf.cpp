@@ -125,7 +125,7 @@ int run_hopf() {
         if (two)
             for (std::size_t k = 0; k < curves.curves.size(); ++k) {
                 const HopfCurve& c = curves.curves[k];
-                out << "curve " << k << "    from Hopf point " << c.start << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << hopf_args.par2
+                out << "curve " << k << "    " << (c.start >= 0 ? "from Hopf point " + std::to_string(c.start) : std::string("from a double Hopf point")) << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << hopf_args.par2
                     << "), " << to_string(c.status) << "\n";
                 out << "  " << pad(par, 14) << pad(hopf_args.par2, 14) << pad("omega", 12) << pad("L1", 13) << "criticality\n";
                 const std::size_t step = std::max<std::size_t>(1, c.points.size() / 20);
@@ -138,6 +138,14 @@ int run_hopf() {
                 for (const GeneralisedHopfPoint& g : c.generalised)
                     out << "  generalised Hopf (L1 = 0): " << par << " = " << rounded(g.par, 10) << ", " << hopf_args.par2 << " = " << rounded(g.par2, 10)
                         << ", omega = " << rounded(g.omega, 8) << " (" << to_string(g.status) << ")\n";
+                for (const DoubleHopfPoint& d : c.double_hopf)
+                    out << (d.resonant ? "  double Hopf, 1:1 resonant: " : "  double Hopf: ") << par << " = " << rounded(d.par, 10) << ", " << hopf_args.par2 << " = " << rounded(d.par2, 10) << ", omega = "
+                        << rounded(d.omega1, 8) << " and " << rounded(d.omega2, 8)
+                        << (d.other_curve >= 0 ? " (crossing curve " + std::to_string(d.other_curve) + ")" : std::string()) << " (" << to_string(d.status)
+                        << ", residual " << rounded(d.residual, 2) << ")\n";
+                for (const ZeroHopfPoint& z : c.zero_hopf)
+                    out << "  zero-Hopf (a real root at 0): " << par << " = " << rounded(z.par, 10) << ", " << hopf_args.par2 << " = " << rounded(z.par2, 10)
+                        << ", omega = " << rounded(z.omega, 8) << " (" << to_string(z.status) << ")\n";
             }
         if (status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(status) << "): " << message << "\n";
         if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";

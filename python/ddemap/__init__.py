@@ -1021,7 +1021,9 @@ def hopf(par, from_, to, system=None, model=None, ring=None, par2=None, from2=No
     L1 = Re c1 / omega), its ``criticality`` (subcritical L1 > 0, supercritical L1 < 0),
     ``dre_dpar`` (d Re lambda / d par) and ``amplitude_coefficient`` (max - min of each variable
     of the bifurcating orbit per sqrt|par - par_H|). With ``par2``, ``from2``, ``to2``: the Hopf
-    curves in (par, par2) through those points and the generalised Hopf points (L1 = 0) on them.
+    curves in (par, par2) through those points, the generalised Hopf points (L1 = 0), the double
+    Hopf points (``double_hopf``: two pairs on the axis, where two curves cross; the second curve
+    is traced from there) and the zero-Hopf points (``zero_hopf``) on them.
     Returns the command's JSON as Python objects.
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)

@@ -112,6 +112,36 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
             gh.push_back(q);
         }
         o["generalised_hopf"] = gh;
+        json dh = json::array();
+        for (const DoubleHopfPoint& d : c.double_hopf) {
+            json q;
+            q["par"] = num(d.par);
+            q["par2"] = num(d.par2);
+            q["omega1"] = num(d.omega1);
+            q["omega2"] = num(d.omega2);
+            q["residual"] = num(d.residual);
+            q["other_curve"] = d.other_curve;
+            q["resonant_1_1"] = d.resonant;
+            q["status"] = to_string(d.status);
+            q["message"] = d.message;
+            dh.push_back(q);
+        }
+        o["double_hopf"] = dh;
+        json zh = json::array();
+        for (const ZeroHopfPoint& z : c.zero_hopf) {
+            json q;
+            q["par"] = num(z.par);
+            q["par2"] = num(z.par2);
+            q["omega"] = num(z.omega);
+            q["det_delta0"] = num(z.det);
+            q["residual"] = num(z.residual);
+            q["status"] = to_string(z.status);
+            zh.push_back(q);
+        }
+        o["zero_hopf"] = zh;
+        json unstable = json::array();
+        for (const HopfCurvePoint& p : c.points) unstable.push_back(p.unstable);
+        o["unstable_beside_pair"] = unstable;
         curves.push_back(o);
     }
     j["curves"] = curves;
@@ -130,6 +160,10 @@ std::string hopf_curves_csv(const HopfCurves& hc) {
         for (const GeneralisedHopfPoint& g : c.generalised)
             out += std::to_string(k) + ",generalised_hopf," + exact(g.par) + "," + exact(g.par2) + "," + exact(g.omega) + "," + exact(g.l1) +
                    ",degenerate," + to_string(g.status) + "\n";
+        for (const DoubleHopfPoint& d : c.double_hopf)
+            out += std::to_string(k) + ",double_hopf," + exact(d.par) + "," + exact(d.par2) + "," + exact(d.omega2) + ",,," + to_string(d.status) + "\n";
+        for (const ZeroHopfPoint& z : c.zero_hopf)
+            out += std::to_string(k) + ",zero_hopf," + exact(z.par) + "," + exact(z.par2) + "," + exact(z.omega) + ",,," + to_string(z.status) + "\n";
     }
     return out;
 }

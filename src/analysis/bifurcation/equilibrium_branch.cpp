@@ -315,6 +315,32 @@ FoldPoint correct_steady_state(const NonlinearDDE& system, int j, const Eigen::V
 }
 }  // namespace
 
+EquilibriumRoots equilibrium_roots(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, RootOptions ro) {
+    EquilibriumRoots r;
+    const LinearDDE lin = linearise(system, x, p);
+    ro.count = std::max(ro.count, 2);
+    RootResult rr = rightmost_roots(lin, ro);
+    if (!converged(rr.status) && ro.count < 8) {
+        // a few roots may not settle between degrees where more do (a cut through a cluster,
+        // as on DDE-BIFTOOL's delayed Duffing oscillator): the former request of 8
+        ro.count = 8;
+        rr = rightmost_roots(lin, ro);
+    }
+    while (converged(rr.status) && !rr.roots.empty() && !(rr.strip_floor < 0.0) && ro.count < 256 &&
+           static_cast<int>(rr.roots.size()) >= ro.count) {
+        ro.count *= 2;
+        rr = rightmost_roots(lin, ro);
+    }
+    r.status = rr.status;
+    r.abscissa = rr.spectral_abscissa();
+    for (const Root& root : rr.roots) {
+        r.roots.push_back(root.value);
+        if (root.value.real() > marginal_band(root.value)) ++r.unstable;
+    }
+    r.stable = converged(rr.status) && !rr.roots.empty() && r.abscissa < -marginal_band(rr.roots.front().value);
+    return r;
+}
+
 HopfPoint correct_hopf(const NonlinearDDE& system, int j, const Eigen::VectorXd& x0, double par0, double omega0, const VectorXc& q0in,
                        const NewtonOptions& options, double residual_tolerance) {
     check_parameter(system, j);
@@ -399,29 +425,13 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
         // 8 roots, 20 s per point on the 3-car ov ring at tau = 0.3, where the 7th and 8th lie near
         // Re = -24 and the dense degree grew to its cap for them: the request starts at the
         // options' count and grows only while the strip does not reach below the axis.)
-        const LinearDDE lin = linearise(system, pt.x, curve.values(u));
-        RootOptions ro = options.roots;
-        ro.count = std::max(ro.count, 2);
-        RootResult rr = rightmost_roots(lin, ro);
-        if (!converged(rr.status) && ro.count < 8) {
-            // a few roots may not settle between degrees where more do (a cut through a cluster,
-            // as on DDE-BIFTOOL's delayed Duffing oscillator): the former request of 8
-            ro.count = 8;
-            rr = rightmost_roots(lin, ro);
-        }
-        while (converged(rr.status) && !rr.roots.empty() && !(rr.strip_floor < 0.0) && ro.count < 256 &&
-               static_cast<int>(rr.roots.size()) >= ro.count) {
-            ro.count *= 2;
-            rr = rightmost_roots(lin, ro);
-        }
-        pt.roots_status = rr.status;
-        roots_ok = roots_ok && converged(rr.status);
-        pt.abscissa = rr.spectral_abscissa();
-        for (const Root& root : rr.roots) {
-            pt.roots.push_back(root.value);
-            if (root.value.real() > marginal_band(root.value)) ++pt.unstable;
-        }
-        pt.stable = converged(rr.status) && !rr.roots.empty() && pt.abscissa < -marginal_band(rr.roots.front().value);
+        const EquilibriumRoots er = equilibrium_roots(system, pt.x, curve.values(u), options.roots);
+        pt.roots_status = er.status;
+        roots_ok = roots_ok && converged(er.status);
+        pt.abscissa = er.abscissa;
+        pt.roots = er.roots;
+        pt.unstable = er.unstable;
+        pt.stable = er.stable;
         return pt;
     };
     for (const Eigen::VectorXd& u : c.points) {

@@ -344,60 +344,257 @@ HopfCoefficients coefficients_at(const NonlinearDDE& s, int j1, const HopfCurveP
     return c;
 }
 
-/// Illinois regula falsi on L1 along the chord from ua to ub (each trial corrected onto the curve).
-GeneralisedHopfPoint locate_generalised(const NonlinearDDE& s, int j1, const HopfCurveProblem& pr, const Eigen::VectorXd& ua,
-                                        const Eigen::VectorXd& ub, double fa, double fb, const HopfCurveOptions& o) {
-    const int n = s.dimension();
-    GeneralisedHopfPoint g;
+/// Illinois regula falsi on a test function g along the chord from ua to ub, g(ua) = fa and
+/// g(ub) = fb of opposite signs, every trial corrected onto the curve. g(u, value) returns false
+/// where it is not defined (the search stops there); done(u, value) says when a trial is the zero.
+struct ChordZero {
+    Eigen::VectorXd u;
+    Status status = Status::MaxIterations;
+};
+template <class G, class Done>
+ChordZero chord_zero(const HopfCurveProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub, double fa, double fb,
+                     const NewtonOptions& newton, G g, Done done) {
+    ChordZero z;
+    z.u = ua;
     const Eigen::VectorXd d = ub - ua;
     const Eigen::VectorXd dir = d / d.norm();
     double slo = 0.0, shi = 1.0, flo = fa, fhi = fb;
     int last = 0;
-    Eigen::VectorXd best = ua;
     for (int it = 0; it < 80; ++it) {
         const double sm = (slo * fhi - shi * flo) / (fhi - flo);
         const Eigen::VectorXd v = ua + sm * d;
         Eigen::VectorXd u = v;
-        const CorrectorResult cr = correct(pr, u, dir, dir.dot(v), o.continuation.newton);
+        const CorrectorResult cr = correct(pr, u, dir, dir.dot(v), newton);
         if (!converged(cr.status)) {
-            g.status = cr.status;
+            z.status = cr.status;
             break;
         }
-        const HopfCoefficients c = coefficients_at(s, j1, pr, u, o.coefficients);
-        if (!converged(c.status)) {
-            g.status = c.status;
+        double value = 0.0;
+        if (!g(u, value)) {
+            z.status = Status::NumericalIssue;
             break;
         }
-        best = u;
-        g.l1 = c.l1;
-        g.residual = c.residual;
-        // to rounding: L1 at the rounding level of its terms, or the chord interval at rounding
-        if (std::abs(c.l1) <= 1e-13 * c.l1_scale || shi - slo <= 1e-14) {
-            g.status = Status::Converged;
+        z.u = u;
+        // to rounding: the test function at the rounding level of its terms, or the chord interval at rounding
+        if (done(u, value) || shi - slo <= 1e-14) {
+            z.status = Status::Converged;
             break;
         }
-        if ((c.l1 < 0.0) == (flo < 0.0)) {
-            slo = sm, flo = c.l1;
+        if ((value < 0.0) == (flo < 0.0)) {
+            slo = sm, flo = value;
             if (last == -1) fhi *= 0.5;
             last = -1;
         } else {
-            shi = sm, fhi = c.l1;
+            shi = sm, fhi = value;
             if (last == 1) flo *= 0.5;
             last = 1;
         }
     }
-    g.x = best.head(n);
-    g.par = best[n];
-    g.omega = best[3 * n + 1];
-    g.par2 = best[3 * n + 2];
+    return z;
+}
+
+/// Illinois regula falsi on L1 along the chord from ua to ub.
+GeneralisedHopfPoint locate_generalised(const NonlinearDDE& s, int j1, const HopfCurveProblem& pr, const Eigen::VectorXd& ua,
+                                        const Eigen::VectorXd& ub, double fa, double fb, const HopfCurveOptions& o) {
+    const int n = s.dimension();
+    GeneralisedHopfPoint g;
+    HopfCoefficients last;
+    const ChordZero z = chord_zero(
+        pr, ua, ub, fa, fb, o.continuation.newton,
+        [&](const Eigen::VectorXd& u, double& value) {
+            last = coefficients_at(s, j1, pr, u, o.coefficients);
+            value = last.l1;
+            return converged(last.status);
+        },
+        [&](const Eigen::VectorXd&, double value) { return std::abs(value) <= 1e-13 * last.l1_scale; });
+    g.status = z.status;
+    if (z.u.size() == ua.size() && converged(last.status)) g.l1 = last.l1, g.residual = last.residual;
+    g.x = z.u.head(n);
+    g.par = z.u[n];
+    g.omega = z.u[3 * n + 1];
+    g.par2 = z.u[3 * n + 2];
     return g;
 }
 
-}  // namespace
+/// det Delta(0) = det(-sum_k A_k) at the equilibrium x, scaled by the n-th power of the largest
+/// column norm (a real root through 0 changes its sign), with the size of its terms.
+bool scaled_det0(const NonlinearDDE& s, const Eigen::VectorXd& x, const std::vector<double>& p, double& value) {
+    try {
+        const LinearDDE lin = linearise(s, x, p);
+        const MatrixXc d = lin.characteristic_matrix(cplx(0.0, 0.0));
+        const Eigen::MatrixXd m = d.real();
+        double scale = 1.0;
+        for (Eigen::Index c = 0; c < m.cols(); ++c) scale = std::max(scale, m.col(c).norm());
+        value = (m / scale).partialPivLu().determinant();
+        return std::isfinite(value);
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+}
 
-HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCurveOptions& o) {
-    std::string why;
-    if (!o.is_valid(&why)) throw std::invalid_argument("Hopf curve options: " + why);
+ZeroHopfPoint locate_zero_hopf(const NonlinearDDE& s, const HopfCurveProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub,
+                               const HopfCurveOptions& o) {
+    const int n = s.dimension();
+    ZeroHopfPoint zh;
+    double fa = 0.0, fb = 0.0;
+    if (!scaled_det0(s, ua.head(n), pr.values(ua), fa) || !scaled_det0(s, ub.head(n), pr.values(ub), fb) || (fa < 0.0) == (fb < 0.0)) {
+        zh.status = Status::NumericalIssue;
+        zh.x = ua.head(n), zh.par = ua[n], zh.omega = ua[3 * n + 1], zh.par2 = ua[3 * n + 2];
+        return zh;
+    }
+    const ChordZero z = chord_zero(
+        pr, ua, ub, fa, fb, o.continuation.newton,
+        [&](const Eigen::VectorXd& u, double& value) { return scaled_det0(s, u.head(n), pr.values(u), value); },
+        [&](const Eigen::VectorXd&, double value) { return std::abs(value) <= 1e-13; });
+    zh.status = z.status;
+    zh.x = z.u.head(n), zh.par = z.u[n], zh.omega = z.u[3 * n + 1], zh.par2 = z.u[3 * n + 2];
+    scaled_det0(s, zh.x, pr.values(z.u), zh.det);
+    Eigen::VectorXd f;
+    if (pr.residual(z.u, f)) zh.residual = f.cwiseAbs().maxCoeff();
+    return zh;
+}
+
+/// The stacked double Hopf system in v = (x, p1, Re q1, Im q1, omega1, p2, Re q2, Im q2, omega2).
+bool double_hopf_system(const NonlinearDDE& s, int j1, int j2, const VectorXc& q01, const VectorXc& q02, const Eigen::VectorXd& v,
+                        Eigen::VectorXd& g, Eigen::MatrixXd* jac) {
+    const int n = s.dimension();
+    std::vector<double> p = s.parameter_values();
+    p[static_cast<std::size_t>(j1)] = v[n];
+    p[static_cast<std::size_t>(j2)] = v[3 * n + 2];
+    Eigen::VectorXd z1 = v.head(3 * n + 2), z2(3 * n + 2);
+    z2 << v.head(n + 1), v.segment(3 * n + 3, 2 * n + 1);
+    Eigen::VectorXd f1, f2, tmp;
+    Eigen::MatrixXd J1, J2, J1b, J2b;
+    if (!hopf_system(s, j1, q01, z1, f1, jac ? &J1 : nullptr, p) || !hopf_system(s, j1, q02, z2, f2, jac ? &J2 : nullptr, p)) return false;
+    g.resize(5 * n + 4);
+    g.head(3 * n + 2) = f1;
+    g.tail(2 * n + 2) = f2.tail(2 * n + 2);
+    if (jac) {
+        // the p2 columns: the same systems with p2 as their parameter
+        z1[n] = v[3 * n + 2];
+        z2[n] = v[3 * n + 2];
+        if (!hopf_system(s, j2, q01, z1, tmp, &J1b, p) || !hopf_system(s, j2, q02, z2, tmp, &J2b, p)) return false;
+        Eigen::MatrixXd& J = *jac;
+        J = Eigen::MatrixXd::Zero(5 * n + 4, 5 * n + 4);
+        J.block(0, 0, 3 * n + 2, 3 * n + 2) = J1;
+        J.block(0, 3 * n + 2, 3 * n + 2, 1) = J1b.col(n);
+        const Eigen::Index r = 3 * n + 2, m = 2 * n + 2;
+        J.block(r, 0, m, n + 1) = J2.block(n, 0, m, n + 1);
+        J.block(r, 3 * n + 2, m, 1) = J2b.block(n, n, m, 1);
+        J.block(r, 3 * n + 3, m, 2 * n + 1) = J2.block(n, n + 1, m, 2 * n + 1);
+    }
+    return g.allFinite();
+}
+
+/// Newton on the double Hopf system from (x, p1, q1, omega1, p2) on a Hopf curve and a guess of
+/// the second pair's omega2 (its null vector from the smallest singular value of Delta(i omega2)).
+DoubleHopfPoint locate_double_hopf(const NonlinearDDE& s, int j1, int j2, const Eigen::VectorXd& u, double omega2, const NewtonOptions& newton) {
+    const int n = s.dimension();
+    DoubleHopfPoint dh;
+    const HopfCurveProblem pr1(s, j1, j2, q_of(u, n));
+    const std::vector<double> p = pr1.values(u);
+    VectorXc q2;
+    try {
+        const MatrixXc d = linearise(s, u.head(n), p).characteristic_matrix(cplx(0.0, omega2));
+        const Eigen::JacobiSVD<MatrixXc> svd(d, Eigen::ComputeFullV);
+        q2 = svd.matrixV().col(n - 1);
+    } catch (const std::invalid_argument&) {
+        dh.status = Status::NumericalIssue;
+        dh.message = "the characteristic matrix is not defined at the guess";
+        return dh;
+    }
+    const VectorXc q1 = q_of(u, n);
+    const VectorXc q01 = q1 / q1.squaredNorm(), q02 = q2 / q2.squaredNorm();  // q0^H q = 1 at the start
+    Eigen::VectorXd v(5 * n + 4);
+    v << u.head(3 * n + 3), q2.real(), q2.imag(), omega2;
+    Eigen::VectorXd g;
+    Eigen::MatrixXd J;
+    dh.status = Status::MaxIterations;
+    for (int it = 0; it <= newton.max_iterations; ++it) {
+        if (!double_hopf_system(s, j1, j2, q01, q02, v, g, &J)) {
+            dh.status = Status::NumericalIssue;
+            dh.message = "the double Hopf system is not defined at an iterate";
+            break;
+        }
+        dh.residual = g.cwiseAbs().maxCoeff();
+        const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+        if (!lu.isInvertible()) {
+            dh.status = Status::NumericalIssue;
+            dh.message = "the double Hopf system is singular (the two curves are tangent, or the frequencies coincide)";
+            break;
+        }
+        const Eigen::VectorXd step = lu.solve(g);
+        v -= step;
+        if (step.cwiseAbs().maxCoeff() <= newton.step_tolerance * std::max(1.0, v.cwiseAbs().maxCoeff())) {
+            if (double_hopf_system(s, j1, j2, q01, q02, v, g, nullptr)) dh.residual = g.cwiseAbs().maxCoeff();
+            dh.status = dh.residual <= 1e-9 ? Status::Converged : Status::NumericalIssue;
+            break;
+        }
+    }
+    dh.x = v.head(n);
+    dh.par = v[n];
+    dh.omega1 = v[3 * n + 1];
+    dh.par2 = v[3 * n + 2];
+    dh.omega2 = v[5 * n + 3];
+    dh.q2 = v.segment(3 * n + 3, n).cast<cplx>() + I1 * v.segment(4 * n + 3, n).cast<cplx>();
+    dh.q2 /= dh.q2.norm();
+    if (converged(dh.status)) {
+        if (!(dh.omega1 > 0.0) || !(dh.omega2 > 0.0)) {
+            dh.status = Status::NumericalIssue;
+            dh.message = "a frequency converged to omega <= 0 (a Bogdanov-Takens or zero-Hopf point nearby)";
+        } else if (std::abs(dh.omega1 - dh.omega2) <= 1e-6 * std::max(dh.omega1, dh.omega2)) {
+            dh.resonant = true;
+            dh.message = "a 1:1 resonance: the pair +-i omega is double there (the second curve is the same curve), residual " +
+                         detail::format_number(dh.residual);
+        } else {
+            dh.message = "two pairs on the imaginary axis, residual " + detail::format_number(dh.residual);
+        }
+    }
+    return dh;
+}
+
+/// A root that crossed the axis between two points of a curve: its real parts at both ends and
+/// its imaginary part, matched by nearness (the curve's own pair +-i omega left out).
+struct Crossing {
+    double re_a, re_b, im_a, im_b;
+};
+
+std::vector<Crossing> crossings(const HopfCurvePoint& a, const HopfCurvePoint& b) {
+    // the roots with Im >= 0 but the curve's own root i omega (the one nearest it: a second root
+    // near i omega, as next to a 1:1 resonance, stays in)
+    auto upper = [](const HopfCurvePoint& p) {
+        std::vector<cplx> v;
+        for (const cplx z : p.roots)
+            if (z.imag() >= 0.0) v.push_back(z);
+        const auto own = std::min_element(v.begin(), v.end(), [&](cplx x, cplx y) {
+            return std::abs(x - cplx(0.0, p.omega)) < std::abs(y - cplx(0.0, p.omega));
+        });
+        if (own != v.end()) v.erase(own);
+        return v;
+    };
+    const std::vector<cplx> ra = upper(a), rb = upper(b);
+    // one-to-one matching, nearest pairs first
+    struct Pair {
+        double d;
+        std::size_t i, k;
+    };
+    std::vector<Pair> pairs;
+    for (std::size_t i = 0; i < ra.size(); ++i)
+        for (std::size_t k = 0; k < rb.size(); ++k) pairs.push_back({std::abs(ra[i] - rb[k]), i, k});
+    std::sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) { return x.d < y.d; });
+    std::vector<char> used_a(ra.size(), 0), used_b(rb.size(), 0);
+    std::vector<Crossing> out;
+    for (const Pair& pr : pairs) {
+        if (used_a[pr.i] || used_b[pr.k]) continue;
+        used_a[pr.i] = used_b[pr.k] = 1;
+        const cplx za = ra[pr.i], zb = rb[pr.k];
+        if ((za.real() > marginal_band(za)) != (zb.real() > marginal_band(zb))) out.push_back({za.real(), zb.real(), za.imag(), zb.imag()});
+    }
+    return out;
+}
+
+/// The Hopf curve through `start` (p1 = start.par) at p2 = held2.
+HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double held2, const HopfCurveOptions& o) {
     const int j1 = s.parameter_index(o.branch.parameter), j2 = s.parameter_index(o.parameter2);
     check_system(s, j1, "Hopf curve");
     const int n = s.dimension();
@@ -407,7 +604,6 @@ HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCu
         curve.message = "the starting Hopf point was not located";
         return curve;
     }
-    const double held2 = s.parameter_values()[static_cast<std::size_t>(j2)];
     const double lo1 = std::min(o.branch.from, o.branch.to), hi1 = std::max(o.branch.from, o.branch.to);
     const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
     if (!(held2 >= lo2 && held2 <= hi2))
@@ -526,6 +722,80 @@ HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCu
     std::sort(curve.generalised.begin(), curve.generalised.end(),
               [](const GeneralisedHopfPoint& a, const GeneralisedHopfPoint& b) { return a.after < b.after; });
 
+    // codimension two: the roots at every point; where the count right of the axis changes, the
+    // roots that crossed (a pair: double Hopf, a real root: zero-Hopf) must explain the change
+    bool codim2_ok = true;
+    std::string codim2_message;
+    if (o.codimension_two) {
+        for (std::size_t k = 0; k < all.size(); ++k) {
+            HopfCurvePoint& pt = curve.points[k];
+            // from 2 roots, grown until every root right of the axis is certified found (asking
+            // for more at once cost 5 to 20 times as much on the 3-car ov ring at small delays)
+            RootOptions ro = o.branch.roots;
+            ro.count = 2;
+            const EquilibriumRoots er = equilibrium_roots(s, pt.x, all[k].problem->values(all[k].u), ro);
+            if (!converged(er.status)) {
+                codim2_ok = false;
+                codim2_message = "the characteristic roots did not converge at " + std::to_string(k) + " point(s) of the curve";
+                continue;
+            }
+            pt.roots = er.roots;
+            pt.unstable = er.unstable;
+        }
+        for (std::size_t k = 0; k + 1 < all.size(); ++k) {
+            HopfCurvePoint &a = curve.points[k], &b = curve.points[k + 1];
+            if (a.unstable < 0 || b.unstable < 0 || a.unstable == b.unstable) continue;
+            std::vector<Crossing> cs;
+            int explained = 0;
+            // the root that crossed may lie beyond the strip certified at one end (just left of
+            // the axis): more roots at both ends until the crossings explain the change
+            for (int more = 0; more < 3; ++more) {
+                cs = crossings(a, b);
+                explained = 0;
+                for (const Crossing& c : cs) explained += (c.re_b > c.re_a ? 1 : -1) * (std::abs(c.im_a) + std::abs(c.im_b) <= 1e-8 ? 1 : 2);
+                if (explained == b.unstable - a.unstable) break;
+                for (std::size_t e : {k, k + 1}) {
+                    HopfCurvePoint& pt = curve.points[e];
+                    RootOptions ro = o.branch.roots;
+                    ro.count = 2 * static_cast<int>(pt.roots.size()) + 8;
+                    const EquilibriumRoots er = equilibrium_roots(s, pt.x, all[e].problem->values(all[e].u), ro);
+                    if (converged(er.status) && er.unstable == pt.unstable) pt.roots = er.roots;
+                }
+            }
+            if (explained != b.unstable - a.unstable) {
+                codim2_ok = false;
+                codim2_message = "between points " + std::to_string(k) + " and " + std::to_string(k + 1) + " the count of roots right of the axis changes by " +
+                                 std::to_string(b.unstable - a.unstable) + ", the crossings matched explain " + std::to_string(explained);
+            }
+            // the two samples in the later sample's normalisation
+            const HopfCurveProblem& pr = *all[k + 1].problem;
+            Eigen::VectorXd ua = all[k].u;
+            const VectorXc qa = q_of(ua, n);
+            const VectorXc qn = qa / pr.q0().dot(qa);
+            ua.segment(n + 1, n) = qn.real();
+            ua.segment(2 * n + 1, n) = qn.imag();
+            const Eigen::VectorXd& ub = all[k + 1].u;
+            for (const Crossing& c : cs) {
+                if (std::abs(c.im_a) + std::abs(c.im_b) <= 1e-8) {
+                    ZeroHopfPoint zh = locate_zero_hopf(s, pr, ua, ub, o);
+                    zh.after = static_cast<int>(k);
+                    if (!converged(zh.status)) codim2_ok = false, codim2_message = "a zero-Hopf point was not located";
+                    curve.zero_hopf.push_back(std::move(zh));
+                    continue;
+                }
+                const double frac = std::clamp(c.re_a / (c.re_a - c.re_b), 0.0, 1.0);
+                Eigen::VectorXd u = ua + frac * (ub - ua);
+                const Eigen::VectorXd dir = (ub - ua).normalized();
+                const CorrectorResult cr = correct(pr, u, dir, dir.dot(u), o.continuation.newton);
+                if (!converged(cr.status)) u = ua + frac * (ub - ua);
+                DoubleHopfPoint dh = locate_double_hopf(s, j1, j2, u, c.im_a + frac * (c.im_b - c.im_a), o.branch.special);
+                dh.after = static_cast<int>(k);
+                if (!converged(dh.status)) codim2_ok = false, codim2_message = "a double Hopf point was not located: " + dh.message;
+                curve.double_hopf.push_back(std::move(dh));
+            }
+        }
+    }
+
     auto ended_well = [](ContinuationStop st) {
         return st == ContinuationStop::Bound || st == ContinuationStop::ClosedLoop || st == ContinuationStop::LeftDomain;
     };
@@ -539,13 +809,37 @@ HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCu
     } else if (!genh_ok) {
         curve.status = Status::MaxIterations;
     }
-    curve.message = std::to_string(curve.points.size()) + " points, " + std::to_string(curve.generalised.size()) +
-                    " generalised Hopf points; ended: " + to_string(stops[0]) + (closed ? "" : " and " + to_string(stops[1]));
+    curve.message = std::to_string(curve.points.size()) + " points, " + std::to_string(curve.generalised.size()) + " generalised Hopf, " +
+                    std::to_string(curve.double_hopf.size()) + " double Hopf, " + std::to_string(curve.zero_hopf.size()) +
+                    " zero-Hopf points; ended: " + to_string(stops[0]) + (closed ? "" : " and " + to_string(stops[1]));
     for (int d = 0; d < 2; ++d)
         if (!ended_well(stops[d]) && !(d == 1 && closed) && !messages[d].empty()) curve.message += " (" + messages[d] + ")";
+    // a curve that leaves the domain as omega falls to 0 ends near a Bogdanov-Takens point (not located)
+    double wmax = 0.0;
+    for (const HopfCurvePoint& p : curve.points) wmax = std::max(wmax, p.omega);
+    for (int d = 0; d < 2; ++d) {
+        if (stops[d] != ContinuationStop::LeftDomain || curve.points.empty()) continue;
+        const HopfCurvePoint& end = d == 0 ? curve.points.back() : curve.points.front();
+        if (end.omega <= 0.01 * wmax)
+            curve.message += "; near a Bogdanov-Takens point at its " + std::string(d == 0 ? "forward" : "backward") + " end (omega " +
+                             detail::format_number(end.omega) + " -> 0; not located)";
+    }
     if (!coefficients_ok) curve.message += "; L1 not computed at some points";
     if (!genh_ok) curve.message += "; a generalised Hopf point was not located";
+    if (!codim2_ok) {
+        if (converged(curve.status)) curve.status = Status::NumericalIssue;
+        curve.message += "; " + codim2_message;
+    }
     return curve;
+}
+
+}  // namespace
+
+HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCurveOptions& o) {
+    std::string why;
+    if (!o.is_valid(&why)) throw std::invalid_argument("Hopf curve options: " + why);
+    const int j2 = s.parameter_index(o.parameter2);
+    return trace_hopf_curve(s, start, s.parameter_values()[static_cast<std::size_t>(j2)], o);
 }
 
 HopfCurves hopf_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
@@ -561,26 +855,47 @@ HopfCurves hopf_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, cons
     r.start = hopf_points(s, guess, o.branch, o.coefficients);
     r.status = r.start.branch.status;
     const double w1 = std::abs(o.branch.to - o.branch.from), w2 = hi2 - lo2;
-    for (std::size_t i = 0; i < r.start.branch.hopf.size(); ++i) {
-        const HopfPoint& h = r.start.branch.hopf[i];
-        if (!converged(h.status)) continue;
-        // skip a start that lies on a curve already traced (distance to its polyline in the scaled box)
-        bool seen = false;
-        for (const HopfCurve& c : r.curves) {
-            for (std::size_t k = 0; k + 1 < c.points.size() && !seen; ++k) {
+    // the index of the traced curve through (p1, p2, omega) (distance to its polyline in the scaled box), or -1
+    auto on_curve = [&](double p1, double p2, double omega) {
+        const Eigen::Vector3d ph(p1 / w1, p2 / w2, omega);
+        for (std::size_t i = 0; i < r.curves.size(); ++i) {
+            const HopfCurve& c = r.curves[i];
+            for (std::size_t k = 0; k + 1 < c.points.size(); ++k) {
                 const HopfCurvePoint &a = c.points[k], &b = c.points[k + 1];
-                const Eigen::Vector3d pa(a.par / w1, a.par2 / w2, a.omega), pb(b.par / w1, b.par2 / w2, b.omega), ph(h.par / w1, held2 / w2, h.omega);
+                const Eigen::Vector3d pa(a.par / w1, a.par2 / w2, a.omega), pb(b.par / w1, b.par2 / w2, b.omega);
                 const Eigen::Vector3d ab = pb - pa;
                 const double t = ab.squaredNorm() > 0.0 ? std::clamp((ph - pa).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-                seen = (pa + t * ab - ph).norm() <= 1e-3;
+                if ((pa + t * ab - ph).norm() <= 1e-3) return static_cast<int>(i);
             }
-            if (seen) break;
         }
-        if (seen) continue;
-        HopfCurve c = hopf_curve(s, h, o);
+        return -1;
+    };
+    for (std::size_t i = 0; i < r.start.branch.hopf.size(); ++i) {
+        const HopfPoint& h = r.start.branch.hopf[i];
+        if (!converged(h.status) || on_curve(h.par, held2, h.omega) >= 0) continue;  // on a curve already traced
+        HopfCurve c = trace_hopf_curve(s, h, held2, o);
         c.start = static_cast<int>(i);
         if (converged(r.status) && !converged(c.status)) r.status = c.status;
         r.curves.push_back(std::move(c));
+    }
+    // the second curve through every double Hopf point, when no traced curve passes through it
+    // (started from the point's second pair: p1 free at its p2), until every such point has one
+    for (std::size_t i = 0; i < r.curves.size() && r.curves.size() < 64; ++i) {
+        for (std::size_t k = 0; k < r.curves[i].double_hopf.size(); ++k) {
+            const DoubleHopfPoint dh = r.curves[i].double_hopf[k];
+            if (!converged(dh.status) || dh.resonant) continue;
+            int other = on_curve(dh.par, dh.par2, dh.omega2);
+            if (other < 0) {
+                HopfPoint h;
+                h.par = dh.par, h.x = dh.x, h.omega = dh.omega2, h.q = dh.q2, h.status = Status::Converged, h.residual = dh.residual;
+                HopfCurve c = trace_hopf_curve(s, h, dh.par2, o);
+                c.start = -1;
+                if (converged(r.status) && !converged(c.status)) r.status = c.status;
+                r.curves.push_back(std::move(c));
+                other = static_cast<int>(r.curves.size()) - 1;
+            }
+            r.curves[i].double_hopf[k].other_curve = other;
+        }
     }
     r.message = r.start.branch.message + "; " + std::to_string(r.curves.size()) + " Hopf curve(s)";
     for (const HopfCurve& c : r.curves)

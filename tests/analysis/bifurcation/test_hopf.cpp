@@ -470,3 +470,162 @@ TEST_CASE("Hopf coefficients: inputs and failures") {
     ho.to2 = 1.0;  // the held beta = 3 is outside
     CHECK_THROWS_AS(hopf_curves(two, Eigen::VectorXd::Zero(1), ho), std::invalid_argument);
 }
+
+namespace {
+
+/// The roots of the linearisation at (x, p) within `band` of the imaginary axis with Im > 0,
+/// from the linear root solver (solve/roots.hpp), an algorithm independent of the defining systems.
+std::vector<cplx> axis_roots(const NonlinearDDE& s, const Eigen::VectorXd& x, const std::vector<double>& p, double band) {
+    RootOptions ro;
+    ro.count = 12;
+    const RootResult rr = rightmost_roots(linearise(s, x, p), ro);
+    REQUIRE(rr.status == Status::Converged);
+    std::vector<cplx> out;
+    for (const Root& r : rr.roots)
+        if (std::abs(r.value.real()) <= band && r.value.imag() > 0.0) out.push_back(r.value);
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("DDE-BIFTOOL neuron demo: the double Hopf point where its two Hopf curves cross, from either curve" *
+          doctest::test_suite("reference")) {
+    // DDE-Biftool, demos/neuron/html/demo1_normalforms.html (published output of br_bifdet along
+    // the Hopf curves of demo1_hopf.m in (a21, taus)): "hoho point found at par(4) = 0.2072962661,
+    // par(7) = 8.6340742204", "omega1 = 0.3287154066, omega2 = 0.9157115877" on branch2 (from the
+    // Hopf point a21 = 0.80712 at taus = 1.5), and par(4) = 0.2072962626, par(7) = 8.6340742187 on
+    // branch3, the second curve, which demo1_hopf.m starts from that double Hopf point.
+    // At a21 = 0 the neurons decouple and the pair of -kappa + beta e^{-lambda taus} is double
+    // (a 1:1 resonance, which the demo calls spurious): omega = sqrt(1 - kappa^2) = sqrt(3)/2 and
+    // omega taus = 2 pi / 3 + 2 pi k, in closed form (the demo prints 2.4183994947 and 9.6735990351).
+    ExpressionSystem neuron = neuron_system();
+    HopfCurveOptions o;
+    o.branch.parameter = "a21";
+    o.branch.from = 0.0;  // demo1_hopf.m's box
+    o.branch.to = 4.0;
+    o.parameter2 = "taus";
+    o.from2 = 0.0;
+    o.to2 = 10.0;
+    const HopfCurves hc = hopf_curves(neuron, Eigen::VectorXd::Zero(2), o);
+    INFO(hc.message);
+    CHECK(hc.status == Status::Converged);
+    REQUIRE(hc.start.branch.hopf.size() == 1);  // a21 = 0.80712 at taus = 1.5
+    REQUIRE(hc.curves.size() == 2);             // the second one started from the double Hopf point
+    CHECK(hc.curves[1].start == -1);
+    const double w0 = std::sqrt(3.0) / 2.0;
+    std::vector<DoubleHopfPoint> genuine;
+    for (std::size_t i = 0; i < 2; ++i) {
+        int resonant = 0;
+        for (const DoubleHopfPoint& d : hc.curves[i].double_hopf) {
+            REQUIRE(d.status == Status::Converged);
+            if (d.resonant) {
+                ++resonant;
+                CHECK(std::abs(d.par) < tol::special_point);
+                CHECK(std::abs(d.omega1 - w0) < tol::special_point);
+                CHECK(std::abs(d.par2 - (2 * pi / 3 + 2 * pi * static_cast<double>(i)) / w0) < tol::special_point);
+            } else {
+                genuine.push_back(d);
+                CHECK(d.other_curve == static_cast<int>(1 - i));
+            }
+        }
+        CHECK(resonant == 1);
+    }
+    REQUIRE(genuine.size() == 2);  // one crossing, seen from both curves
+    CHECK(std::abs(genuine[0].par - genuine[1].par) < 1e-12);
+    CHECK(std::abs(genuine[0].par2 - genuine[1].par2) < 1e-12);
+    const DoubleHopfPoint& d = genuine[0];
+    CHECK(std::abs(d.par - 0.2072962661) < tol::published_double_hopf);
+    CHECK(std::abs(d.par2 - 8.6340742204) < tol::published_double_hopf);
+    CHECK(std::abs(d.omega1 - 0.3287154066) < tol::published_double_hopf);
+    CHECK(std::abs(d.omega2 - 0.9157115877) < tol::published_double_hopf);
+    CHECK(d.residual < 1e-11);
+    // the linear root solver finds both pairs on the axis there
+    std::vector<double> p = neuron.parameter_values();
+    p[3] = d.par, p[6] = d.par2;
+    const std::vector<cplx> on_axis = axis_roots(neuron, d.x, p, 1e-9);
+    REQUIRE(on_axis.size() == 2);
+    const double lo = std::min(on_axis[0].imag(), on_axis[1].imag()), hi = std::max(on_axis[0].imag(), on_axis[1].imag());
+    CHECK(std::abs(lo - std::min(d.omega1, d.omega2)) < 1e-9);
+    CHECK(std::abs(hi - std::max(d.omega1, d.omega2)) < 1e-9);
+    MESSAGE("neuron double Hopf: a21 " << d.par << ", taus " << d.par2 << ", omega " << d.omega1 << " and " << d.omega2 << ", residual " << d.residual);
+}
+
+TEST_CASE("double Hopf points: two delayed equations with crossing Hopf lines, the second curve started at the crossing") {
+    // y1' = -c1 y1(t - 1) (1 + y1),  y2' = -c2 y2(t - 3/2) + y1 + y2^2 (triangular: det Delta =
+    // (lambda + c1 e^-lambda)(lambda + c2 e^-3lambda/2)), c1 = a + b / 2, c2 = a / 2 + b. The Hopf
+    // curves are the lines c1 = pi/2 (omega pi/2) and c2 = pi/3 (omega pi/3), crossing at
+    // a = 4 pi / 9, b = pi / 9 (no resonance: 2 omega is neither frequency).
+    ExpressionSystem sys({"y1", "y2"}, {"a", "b"}, {1.0, 0.0}, {"-(a + b/2)*y1(t - 1)*(1 + y1)", "-(a/2 + b)*y2(t - 1.5) + y1 + y2^2"});
+    HopfCurveOptions o;
+    o.branch.parameter = "a";
+    o.branch.from = 1.2;
+    o.branch.to = 2.0;
+    o.parameter2 = "b";
+    o.from2 = -0.5;
+    o.to2 = 0.6;
+    const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(2), o);
+    INFO(hc.message);
+    CHECK(hc.status == Status::Converged);
+    // at b = 0 the branch in a meets only c1 = pi/2 (a = 1.5708) in [1.2, 2] (c2 = pi/3 needs a = 2.09):
+    // the second curve is traced only because it is started from the double Hopf point
+    REQUIRE(hc.start.branch.hopf.size() == 1);
+    CHECK(hc.curves.size() == 2);
+    int located = 0, linked = 0;
+    for (std::size_t i = 0; i < hc.curves.size(); ++i) {
+        const HopfCurve& c = hc.curves[i];
+        CHECK(c.status == Status::Converged);
+        for (const DoubleHopfPoint& d : c.double_hopf) {
+            REQUIRE(d.status == Status::Converged);
+            ++located;
+            CHECK(std::abs(d.par - 4 * pi / 9) < tol::special_point);
+            CHECK(std::abs(d.par2 - pi / 9) < tol::special_point);
+            const double w1 = std::min(d.omega1, d.omega2), w2 = std::max(d.omega1, d.omega2);
+            CHECK(std::abs(w1 - pi / 3) < tol::special_point);
+            CHECK(std::abs(w2 - pi / 2) < tol::special_point);
+            if (d.other_curve >= 0 && d.other_curve != static_cast<int>(i)) ++linked;
+        }
+    }
+    // found from both curves, each naming the other
+    CHECK(located == 2);
+    CHECK(linked == 2);
+}
+
+TEST_CASE("zero-Hopf point: the Hopf curve passes the fold of the equilibria, where a real root crosses 0") {
+    // y1' = -(a + y2) y1(t - 1) (1 + y1),  y2' = b - y2^2: equilibria y1 = 0, y2 = +-sqrt(b) (a fold
+    // at b = 0); the Hopf curve a + y2 = pi/2 (omega pi/2) is a = pi/2 -+ sqrt(b) in (a, b), and at
+    // b = 0 it passes from y2 > 0 (the root -2 y2 < 0) to y2 < 0 (a real root > 0): a zero-Hopf point
+    // at a = pi/2, b = 0, where det Delta(0) = 0.
+    ExpressionSystem sys({"y1", "y2"}, {"a", "b"}, {1.0, 0.25}, {"-(a + y2)*y1(t - 1)*(1 + y1)", "b - y2^2"});
+    Eigen::VectorXd guess(2);
+    guess << 0.0, 0.5;
+    HopfCurveOptions o;
+    o.branch.parameter = "a";
+    o.branch.from = 0.5;
+    o.branch.to = 2.5;
+    o.parameter2 = "b";
+    o.from2 = -0.1;
+    o.to2 = 1.0;
+    const HopfCurves hc = hopf_curves(sys, guess, o);
+    INFO(hc.message);
+    CHECK(hc.status == Status::Converged);
+    REQUIRE(hc.curves.size() == 1);
+    const HopfCurve& c = hc.curves[0];
+    REQUIRE(c.zero_hopf.size() == 1);
+    const ZeroHopfPoint& z = c.zero_hopf[0];
+    CHECK(z.status == Status::Converged);
+    CHECK(std::abs(z.par - pi / 2) < tol::special_point);
+    CHECK(std::abs(z.par2) < tol::special_point);
+    CHECK(std::abs(z.omega - pi / 2) < tol::special_point);
+    CHECK(std::abs(z.x[1]) < 1e-6);  // y2 = sqrt(b): the square root of the parameter error
+    CHECK(z.residual < 1e-9);
+    CHECK(c.double_hopf.empty());
+    // the count of roots right of the axis besides the pair: 0 on the y2 > 0 side, 1 on the other
+    int zeros = 0, ones = 0;
+    for (const HopfCurvePoint& p : c.points) {
+        CHECK((p.unstable == 0 || p.unstable == 1));
+        (p.unstable == 0 ? zeros : ones) += 1;
+        if (p.unstable >= 0) CHECK((p.unstable == 1) == (p.x[1] < 0.0));
+    }
+    CHECK(zeros > 0);
+    CHECK(ones > 0);
+}

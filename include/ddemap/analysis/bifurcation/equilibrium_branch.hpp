@@ -149,6 +149,20 @@ bool hopf_system(const NonlinearDDE& system, int parameter, const VectorXc& q0, 
 HopfPoint correct_hopf(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& x0, double par0, double omega0,
                        const VectorXc& q0 = {}, const NewtonOptions& newton = {40, 1e-12}, double residual_tolerance = 1e-9);
 
+/// The characteristic roots of the linearisation at the equilibrium x (all parameter values p):
+/// requested from options.count (at least 2; 8 when those do not converge), doubled (up to 256)
+/// until the result is certified complete in a strip Re >= strip_floor with strip_floor < 0, so
+/// that every root with Re >= 0 is among them. unstable: the roots right of marginal_band (a root
+/// on the axis is not counted); stable: every root left of it.
+struct EquilibriumRoots {
+    std::vector<cplx> roots;  ///< rightmost first
+    int unstable = 0;
+    double abscissa = std::numeric_limits<double>::quiet_NaN();
+    bool stable = false;
+    Status status = Status::NumericalIssue;
+};
+EquilibriumRoots equilibrium_roots(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, RootOptions options);
+
 /// Newton on the fold system from (x0, p_j = par0).
 FoldPoint correct_fold(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& x0, double par0,
                        const NewtonOptions& newton = {40, 1e-12}, double residual_tolerance = 1e-9);

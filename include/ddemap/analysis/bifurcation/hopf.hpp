@@ -126,6 +126,12 @@ struct HopfCurveOptions {
     }();
     int segment = 25;
     HopfCoefficientOptions coefficients;
+    /// Codimension-two points on the curves: at every point the characteristic roots
+    /// (equilibrium_roots with branch.roots) and the count of roots right of the axis besides the
+    /// curve's pair; where it changes in a step, the root that crossed is located: a complex pair
+    /// gives a double Hopf point (DoubleHopfPoint), a real root a zero-Hopf point (ZeroHopfPoint).
+    /// A change that the points located do not explain makes the curve's status NumericalIssue.
+    bool codimension_two = true;
     /// After every point traced on a curve (both directions; the equilibrium branch in p1
     /// reports through branch.progress): (points of this curve so far, at most
     /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
@@ -137,6 +143,43 @@ struct HopfCurvePoint {
     double par = 0.0, par2 = 0.0, omega = 0.0;
     Eigen::VectorXd x;
     HopfCoefficients coefficients;
+    /// The characteristic roots right of the axis besides the curve's pair +-i omega (-1: not
+    /// computed, codimension_two off or the roots did not converge) and the roots themselves.
+    int unstable = -1;
+    std::vector<cplx> roots;
+};
+
+/// A double Hopf (Hopf-Hopf) point: two pairs +-i omega1, +-i omega2 (omega1 != omega2) at one
+/// equilibrium, where two Hopf curves cross. Located by Newton on the stacked defining system in
+/// (x, p1, q1, omega1, p2, q2, omega2), 5n + 4 real unknowns:
+///     f(x; p) = 0,  Delta(i omega1) q1 = 0,  q01^H q1 = 1,  Delta(i omega2) q2 = 0,  q02^H q2 = 1,
+/// with the exact Jacobian (hopf_system's blocks; the p2 column from hopf_system in p2).
+struct DoubleHopfPoint {
+    double par = 0.0, par2 = 0.0;
+    double omega1 = 0.0;  ///< the frequency of the curve it was found on
+    double omega2 = 0.0;  ///< the frequency of the pair that crossed the axis there
+    Eigen::VectorXd x;
+    VectorXc q2;          ///< the null vector of Delta(i omega2), ||q2|| = 1 (starts the other curve)
+    Status status = Status::MaxIterations;
+    std::string message;
+    double residual = std::numeric_limits<double>::infinity();  ///< max |.| of the stacked system
+    int after = 0;         ///< index of the curve point before it
+    int other_curve = -1;  ///< index in HopfCurves::curves of the Hopf curve with omega2 through it (-1: none traced)
+    /// omega1 = omega2 (to 1e-6): a 1:1 resonance, the pair +-i omega double (as at a21 = 0 of
+    /// DDE-BIFTOOL's neuron demo, which calls it spurious); no second curve starts there.
+    bool resonant = false;
+};
+
+/// A zero-Hopf (fold-Hopf) point: a real root crosses 0 on the Hopf curve (det Delta(0) changes
+/// sign). Located by Illinois regula falsi on det Delta(0) / ||Delta(0)||^n along the chord of
+/// the step, every trial corrected onto the curve.
+struct ZeroHopfPoint {
+    double par = 0.0, par2 = 0.0, omega = 0.0;
+    Eigen::VectorXd x;
+    Status status = Status::MaxIterations;
+    double residual = std::numeric_limits<double>::infinity();  ///< of the Hopf system
+    double det = 0.0;  ///< the scaled det Delta(0) at the located point
+    int after = 0;
 };
 
 struct GeneralisedHopfPoint {
@@ -149,9 +192,11 @@ struct GeneralisedHopfPoint {
 };
 
 struct HopfCurve {
-    int start = 0;  ///< the index of the Hopf point of the branch it starts from
+    int start = 0;  ///< the index of the Hopf point of the branch it starts from (-1: from a double Hopf point of another curve)
     std::vector<HopfCurvePoint> points;  ///< in order along the curve
     std::vector<GeneralisedHopfPoint> generalised;
+    std::vector<DoubleHopfPoint> double_hopf;  ///< where the count of roots right of the axis changed by 2
+    std::vector<ZeroHopfPoint> zero_hopf;      ///< where it changed by 1
     ContinuationStop stop_backward = ContinuationStop::MaxPoints, stop_forward = ContinuationStop::MaxPoints;
     Status status = Status::Converged;
     std::string message;
@@ -159,7 +204,10 @@ struct HopfCurve {
 
 struct HopfCurves {
     HopfAnalysis start;  ///< the equilibrium branch in p1 and its Hopf points
-    std::vector<HopfCurve> curves;  ///< one per distinct curve through the converged Hopf points
+    /// One per distinct curve through the converged Hopf points of the branch in p1, then one
+    /// from every double Hopf point whose second pair lies on no traced curve (the second curve
+    /// through it, started from (x, p1, p2, omega2, q2) with p1 free).
+    std::vector<HopfCurve> curves;
     Status status = Status::Converged;
     std::string message;
 };
