@@ -109,6 +109,11 @@ int run_bistability() {
             for (const GeneralisedHopfPoint& g : c.generalised)
                 out << "  generalised Hopf (L1 = 0): " << p1 << " = " << rounded(g.par, 10) << ", " << p2 << " = " << rounded(g.par2, 10) << " ("
                     << to_string(g.status) << ")\n";
+            for (const DoubleHopfPoint& d : c.double_hopf)
+                out << "  double Hopf" << (d.resonant ? ", 1:1 resonant" : "") << ": " << p1 << " = " << rounded(d.par, 10) << ", " << p2 << " = "
+                    << rounded(d.par2, 10) << ", omega = " << rounded(d.omega1, 8) << " and " << rounded(d.omega2, 8) << " (" << to_string(d.status) << ")\n";
+            for (const ZeroHopfPoint& z : c.zero_hopf)
+                out << "  zero-Hopf: " << p1 << " = " << rounded(z.par, 10) << ", " << p2 << " = " << rounded(z.par2, 10) << " (" << to_string(z.status) << ")\n";
         }
         for (std::size_t k = 0; k < chart.folds.size(); ++k) {
             const OrbitFoldCurve& c = chart.folds[k];

@@ -49,7 +49,7 @@ import numpy as _np
 from . import _ddemap
 
 __all__ = ["__version__", "Result", "CalibrationWarning", "roots", "string", "sweep", "boundary", "classify", "simulate", "calibrate",
-           "mixed_ring", "mix", "growth", "design", "chart", "paper", "atlas", "equilibria", "hopf", "orbits", "version"]
+           "mixed_ring", "mix", "growth", "design", "chart", "paper", "atlas", "equilibria", "hopf", "orbits", "bistability", "version"]
 
 version = _ddemap.version
 __version__ = _ddemap.version
@@ -1031,6 +1031,27 @@ def hopf(par, from_, to, system=None, model=None, ring=None, par2=None, from2=No
     return _result(_ddemap.hopf(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), par2 or "",
                                 None if from2 is None else _number("from2", from2), None if to2 is None else _number("to2", to2),
                                 max_points))
+
+
+@_with_progress
+def bistability(par, from_, to, par2, from2, to2, system=None, model=None, ring=None, degree=4, intervals=40, points=400, rows=200,
+                **parameters):
+    """Where stable stop-and-go waves coexist with a stable equilibrium in two parameters
+    (``ddemap bistability``).
+
+    The problem as in :func:`equilibria`; the box ``[from_, to] x [from2, to2]`` (the system's
+    value of ``par2`` inside it). Returns ``hopf`` (the Hopf curves with criticality,
+    generalised, double Hopf and zero-Hopf points, as :func:`hopf` with ``par2``),
+    ``fold_curves`` (the curves of folds of periodic orbits) and ``cells`` (each with ``par``,
+    ``par2``, ``equilibrium_stable``, ``stable_orbit``, ``bistable``, ``status``), as the
+    command's JSON. ``degree``, ``intervals``: the orbits' mesh; ``points``: orbits per branch and
+    points per curve direction; ``rows``: the lines that cut the box into cells.
+    """
+    sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
+    return _result(_ddemap.bistability(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), par2,
+                                       _number("from2", from2), _number("to2", to2), _integer("degree", degree, 1, 20),
+                                       _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000),
+                                       _integer("rows", rows, 4, 10000)))
 
 
 @_with_progress

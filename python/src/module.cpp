@@ -31,6 +31,7 @@
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/design/design.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
+#include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/stability/mixed_ring.hpp"
 #include "ddemap/analysis/stability/ring_stability.hpp"
@@ -979,6 +980,40 @@ std::string py_hopf(const std::string& system_file, const std::string& model, in
     return envelope_json(e);
 }
 
+std::string py_bistability(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
+                           double from, double to, const std::string& par2, double from2, double to2, int degree, int intervals, int points, int rows) {
+    NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
+    if (!(from < to)) throw std::invalid_argument("from = " + json_number(from) + ", to = " + json_number(to) + ": expected from < to");
+    if (par2 == par) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
+    const int j2 = pb.system->parameter_index(par2);
+    if (!(from2 < to2)) throw std::invalid_argument("from2 = " + json_number(from2) + ", to2 = " + json_number(to2) + ": expected from2 < to2");
+    const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
+    if (!(held >= from2 && held <= to2))
+        throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
+    BistabilityOptions o;
+    o.parameter = par;
+    o.from = from;
+    o.to = to;
+    o.parameter2 = par2;
+    o.from2 = from2;
+    o.to2 = to2;
+    o.degree = degree;
+    o.intervals = intervals;
+    o.max_points = points;
+    o.rows = rows;
+    pb.inputs.string("par", o.parameter).number("from", o.from).number("to", o.to).string("par2", o.parameter2).number("from2", o.from2).number("to2", o.to2)
+        .integer("degree", o.degree).integer("intervals", o.intervals).integer("points", o.max_points).integer("rows", o.rows);
+    o.progress = branch_interruptible();
+    const BistabilityChart chart = released([&] { return bistability_chart(*pb.system, pb.guess, o); });
+    JsonEnvelope e;
+    e.command = "bistability";
+    e.inputs = pb.inputs.str();
+    e.status = to_string(chart.status);
+    e.message = chart.message;
+    e.result = bistability_json(chart, pb.variables);
+    return envelope_json(e);
+}
+
 std::string py_orbits(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
                       double from, double to, int hopf, int degree, int intervals, int points, bool adapt, std::optional<double> max_step) {
     PeriodicOrbitOptions o;
@@ -1081,6 +1116,9 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("max_points"));
+    m.def("bistability", &py_bistability, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
+          py::arg("from_"), py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("degree"), py::arg("intervals"),
+          py::arg("points"), py::arg("rows"));
     m.def("orbits", &py_orbits, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"), py::arg("max_step"));
 }

@@ -285,6 +285,20 @@ def test_equilibria(tmp_path):
 
 
 @pytest.mark.slow
+def test_bistability():
+    # the 3-car ov ring's chart (README tour step 5): the same envelope as the command
+    args = dict(model="ov", ring=3, headway=1.2)
+    r = ddemap.bistability("headway", 1.2, 3, "tau", 0.3, 2, **args)
+    same_envelope(r, cli_json("bistability", "--model", "ov", "--ring", 3, "--headway", 1.2, "--par", "headway", "--from", 1.2, "--to", 3,
+                              "--par2", "tau", "--from2", 0.3, "--to2", 2))
+    cells = r["cells"]
+    flags = cells["bistable"] if isinstance(cells, dict) else [c["bistable"] for c in cells]
+    assert r.status == "converged" and any(flags)
+    with pytest.raises(ValueError, match="expected a parameter other than par"):
+        ddemap.bistability("headway", 1.2, 3, "headway", 0.3, 2, model="ov", ring=3)
+
+
+@pytest.mark.slow
 def test_hopf(tmp_path):
     # Wright's equation: one supercritical Hopf point at alpha = pi/2 (closed forms: tests/cli/test_cli.sh)
     system = tmp_path / "wright.json"
