@@ -316,8 +316,11 @@ FoldPoint correct_steady_state(const NonlinearDDE& system, int j, const Eigen::V
 }  // namespace
 
 EquilibriumRoots equilibrium_roots(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, RootOptions ro) {
+    return equilibrium_roots(linearise(system, x, p), std::move(ro));
+}
+
+EquilibriumRoots equilibrium_roots(const LinearDDE& lin, RootOptions ro) {
     EquilibriumRoots r;
-    const LinearDDE lin = linearise(system, x, p);
     ro.count = std::max(ro.count, 2);
     RootResult rr = rightmost_roots(lin, ro);
     if (!converged(rr.status) && ro.count < 8) {

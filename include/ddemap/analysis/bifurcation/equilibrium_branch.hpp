@@ -162,6 +162,9 @@ struct EquilibriumRoots {
     Status status = Status::NumericalIssue;
 };
 EquilibriumRoots equilibrium_roots(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, RootOptions options);
+/// The same for a linearisation already formed (thread-safe: independent linearisations may be
+/// processed in parallel).
+EquilibriumRoots equilibrium_roots(const LinearDDE& linearisation, RootOptions options);
 
 /// Newton on the fold system from (x0, p_j = par0).
 FoldPoint correct_fold(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& x0, double par0,
