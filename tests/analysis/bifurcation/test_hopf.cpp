@@ -629,3 +629,58 @@ TEST_CASE("zero-Hopf point: the Hopf curve passes the fold of the equilibria, wh
     CHECK(zeros > 0);
     CHECK(ones > 0);
 }
+
+TEST_CASE("ov ring (N = 5) in (headway, tau): the root counts along every Hopf curve equal the ring modes' closed form, no double Hopf point" *
+          doctest::test_suite("slow")) {
+    // Mode k (theta_k = 2 pi k / N) is unstable where V'(h) > f_k(tau), f_k = omega sqrt(omega^2 + alpha^2) /
+    // (2 alpha sin(theta_k / 2)) with omega tau = theta_k / 2 - pi / 2 + arctan(alpha / omega) (the closed form of
+    // test_equilibrium_branch.cpp): mode k crosses at +i omega_k, and its root's conjugate (a root of mode N - k)
+    // at -i omega_k, so every unstable mode brings a conjugate pair. On the curve of mode m the roots right of the
+    // axis besides its pair are 2 per mode k != m with V'(h) > f_k(tau); the curves f_k(tau) never cross, so there
+    // is no double Hopf point in this plane.
+    const int N = 5;
+    const double alpha = 1.0;
+    OvRing ring(N, alpha, 1.0, 1.0, 1.0, 1.2);
+    HopfCurveOptions o;
+    o.branch.parameter = "headway";
+    o.branch.from = 1.2;
+    o.branch.to = 3.0;
+    o.parameter2 = "tau";
+    o.from2 = 0.5;
+    o.to2 = 1.5;
+    const HopfCurves hc = hopf_curves(ring, ring.uniform_flow(), o);
+    INFO(hc.message);
+    CHECK(hc.status == Status::Converged);
+    REQUIRE(hc.curves.size() >= 2);
+    auto f = [&](int k, double tau) {
+        const double th = 2 * pi * k / N;
+        const double w = bisect([&](double ww) { return ww * tau - th / 2 + pi / 2 - std::atan(alpha / ww); }, 1e-9, 10.0);
+        return w * std::sqrt(w * w + alpha * alpha) / (2 * alpha * std::sin(th / 2));
+    };
+    int compared = 0;
+    for (const HopfCurve& c : hc.curves) {
+        CHECK(c.double_hopf.empty());
+        CHECK(c.zero_hopf.empty());
+        for (const HopfCurvePoint& p : c.points) {
+            REQUIRE(p.unstable >= 0);
+            const double slope = ring.optimal_velocity_slope(p.par);
+            // the curve's mode: the one whose f_k is V'(h) here
+            int m = 1;
+            for (int k = 1; k < N; ++k)
+                if (std::abs(f(k, p.par2) - slope) < std::abs(f(m, p.par2) - slope)) m = k;
+            REQUIRE(std::abs(f(m, p.par2) - slope) < 1e-6);
+            int expected = 0;
+            bool near = false;
+            for (int k = 1; k < N; ++k) {
+                if (k == m) continue;
+                near = near || std::abs(slope - f(k, p.par2)) < 1e-6;
+                if (slope > f(k, p.par2)) expected += 2;
+            }
+            if (near) continue;
+            CHECK_MESSAGE(p.unstable == expected, "headway " << p.par << ", tau " << p.par2 << ": " << p.unstable << " roots right of the axis");
+            ++compared;
+        }
+    }
+    CHECK(compared > 50);
+    MESSAGE("root counts compared with the closed form at " << compared << " Hopf-curve points");
+}
