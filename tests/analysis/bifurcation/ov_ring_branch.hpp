@@ -19,14 +19,20 @@ inline PeriodicOrbitOptions ov3_headway_options() {
     return o;
 }
 
-inline OrbitBranch ov3_headway_branch(double tau) {
-    OvRing ring(3, 1.0, tau, 1.0, 1.0, 1.2);
+/// The equilibrium branch of the ring in the headway over [1.2, 3] (its two Hopf points required).
+inline EquilibriumBranch ov3_headway_equilibria(const OvRing& ring) {
     EquilibriumBranchOptions eo;
     eo.parameter = "headway";
     eo.from = 1.2;
     eo.to = 3.0;
-    const EquilibriumBranch eq = equilibrium_branch(ring, ring.uniform_flow(), eo);
+    EquilibriumBranch eq = equilibrium_branch(ring, ring.uniform_flow(), eo);
     REQUIRE(eq.hopf.size() == 2);
+    return eq;
+}
+
+inline OrbitBranch ov3_headway_branch(double tau) {
+    OvRing ring(3, 1.0, tau, 1.0, 1.0, 1.2);
+    const EquilibriumBranch eq = ov3_headway_equilibria(ring);
     const HopfPoint& start = eq.hopf[0].par < eq.hopf[1].par ? eq.hopf[0] : eq.hopf[1];
     return orbit_branch_from_hopf(ring, start, ov3_headway_options());
 }

@@ -50,6 +50,18 @@ double wright_range(double alpha, double a0, double t_end, double h) {
     return hi - lo;
 }
 
+/// Hopf-curve options for the box [from, to] x [from2, to2] in (p1, p2), the rest by default.
+HopfCurveOptions curve_box(const std::string& p1, double from, double to, const std::string& p2, double from2, double to2) {
+    HopfCurveOptions o;
+    o.branch.parameter = p1;
+    o.branch.from = from;
+    o.branch.to = to;
+    o.parameter2 = p2;
+    o.from2 = from2;
+    o.to2 = to2;
+    return o;
+}
+
 ExpressionSystem neuron_system() {
     return ExpressionSystem({"x1", "x2"}, {"kappa", "beta", "a12", "a21", "tau1", "tau2", "taus"}, {0.5, -1, 1, 0.5, 0.2, 0.2, 1.5},
                             {"-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))",
@@ -237,13 +249,7 @@ TEST_CASE("a cubic term flips the criticality: x' = -a x(t - 1) + b x x(t - 1) +
     }
     // the Hopf curve in (a, c): the line a = pi/2, with the generalised Hopf point at c*
     ExpressionSystem sys({"x"}, {"a", "b", "c"}, {1.2, b, 0.0}, {"-a*x(t - 1) + b*x*x(t - 1) + c*x^3"});
-    HopfCurveOptions o;
-    o.branch.parameter = "a";
-    o.branch.from = 1.2;
-    o.branch.to = 2.0;
-    o.parameter2 = "c";
-    o.from2 = -0.5;
-    o.to2 = 0.5;
+    HopfCurveOptions o = curve_box("a", 1.2, 2.0, "c", -0.5, 0.5);
     const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(1), o);
     CHECK(hc.status == Status::Converged);
     REQUIRE(hc.curves.size() == 1);
@@ -267,13 +273,7 @@ TEST_CASE("a cubic term flips the criticality: x' = -a x(t - 1) + b x x(t - 1) +
 
 TEST_CASE("the Hopf curve of x' = -a x(t - tau) + x x(t - tau) - x^3 in (a, tau) is a tau = pi/2, omega = a") {
     ExpressionSystem sys({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*x(t - tau) + x*x(t - tau) - x^3"});
-    HopfCurveOptions o;
-    o.branch.parameter = "a";
-    o.branch.from = 1.0;
-    o.branch.to = 2.5;
-    o.parameter2 = "tau";
-    o.from2 = 0.7;
-    o.to2 = 2.0;
+    HopfCurveOptions o = curve_box("a", 1.0, 2.5, "tau", 0.7, 2.0);
     const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(1), o);
     CHECK(hc.status == Status::Converged);
     REQUIRE(hc.curves.size() == 1);
@@ -380,13 +380,7 @@ TEST_CASE("DDE-BIFTOOL demo 1 (neuron): the Hopf curve in (a21, taus) is supercr
     // (The printed "L1: -0.0127" at the double Hopf point comes from the 2014 double-Hopf normal
     // form, Re g2100 / omega1 in that version's scaling: not the Hopf normalisation used here.)
     ExpressionSystem neuron = neuron_system();
-    HopfCurveOptions o;
-    o.branch.parameter = "a21";
-    o.branch.from = 0.3;
-    o.branch.to = 2.0;
-    o.parameter2 = "taus";
-    o.from2 = 0.0;
-    o.to2 = 10.0;
+    HopfCurveOptions o = curve_box("a21", 0.3, 2.0, "taus", 0.0, 10.0);
     const HopfCurves hc = hopf_curves(neuron, Eigen::VectorXd::Zero(2), o);
     REQUIRE(hc.curves.size() == 1);
     const HopfCurve& c = hc.curves[0];
@@ -499,13 +493,8 @@ TEST_CASE("DDE-BIFTOOL neuron demo: the double Hopf point where its two Hopf cur
     // (a 1:1 resonance, which the demo calls spurious): omega = sqrt(1 - kappa^2) = sqrt(3)/2 and
     // omega taus = 2 pi / 3 + 2 pi k, in closed form (the demo prints 2.4183994947 and 9.6735990351).
     ExpressionSystem neuron = neuron_system();
-    HopfCurveOptions o;
-    o.branch.parameter = "a21";
-    o.branch.from = 0.0;  // demo1_hopf.m's box
-    o.branch.to = 4.0;
-    o.parameter2 = "taus";
-    o.from2 = 0.0;
-    o.to2 = 10.0;
+    // demo1_hopf.m's box
+    HopfCurveOptions o = curve_box("a21", 0.0, 4.0, "taus", 0.0, 10.0);
     const HopfCurves hc = hopf_curves(neuron, Eigen::VectorXd::Zero(2), o);
     INFO(hc.message);
     CHECK(hc.status == Status::Converged);
@@ -556,13 +545,7 @@ TEST_CASE("double Hopf points: two delayed equations with crossing Hopf lines, t
     // curves are the lines c1 = pi/2 (omega pi/2) and c2 = pi/3 (omega pi/3), crossing at
     // a = 4 pi / 9, b = pi / 9 (no resonance: 2 omega is neither frequency).
     ExpressionSystem sys({"y1", "y2"}, {"a", "b"}, {1.0, 0.0}, {"-(a + b/2)*y1(t - 1)*(1 + y1)", "-(a/2 + b)*y2(t - 1.5) + y1 + y2^2"});
-    HopfCurveOptions o;
-    o.branch.parameter = "a";
-    o.branch.from = 1.2;
-    o.branch.to = 2.0;
-    o.parameter2 = "b";
-    o.from2 = -0.5;
-    o.to2 = 0.6;
+    HopfCurveOptions o = curve_box("a", 1.2, 2.0, "b", -0.5, 0.6);
     const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(2), o);
     INFO(hc.message);
     CHECK(hc.status == Status::Converged);
@@ -598,13 +581,7 @@ TEST_CASE("zero-Hopf point: the Hopf curve passes the fold of the equilibria, wh
     ExpressionSystem sys({"y1", "y2"}, {"a", "b"}, {1.0, 0.25}, {"-(a + y2)*y1(t - 1)*(1 + y1)", "b - y2^2"});
     Eigen::VectorXd guess(2);
     guess << 0.0, 0.5;
-    HopfCurveOptions o;
-    o.branch.parameter = "a";
-    o.branch.from = 0.5;
-    o.branch.to = 2.5;
-    o.parameter2 = "b";
-    o.from2 = -0.1;
-    o.to2 = 1.0;
+    HopfCurveOptions o = curve_box("a", 0.5, 2.5, "b", -0.1, 1.0);
     const HopfCurves hc = hopf_curves(sys, guess, o);
     INFO(hc.message);
     CHECK(hc.status == Status::Converged);
@@ -641,13 +618,7 @@ TEST_CASE("ov ring (N = 5) in (headway, tau): the root counts along every Hopf c
     const int N = 5;
     const double alpha = 1.0;
     OvRing ring(N, alpha, 1.0, 1.0, 1.0, 1.2);
-    HopfCurveOptions o;
-    o.branch.parameter = "headway";
-    o.branch.from = 1.2;
-    o.branch.to = 3.0;
-    o.parameter2 = "tau";
-    o.from2 = 0.5;
-    o.to2 = 1.5;
+    HopfCurveOptions o = curve_box("headway", 1.2, 3.0, "tau", 0.5, 1.5);
     const HopfCurves hc = hopf_curves(ring, ring.uniform_flow(), o);
     INFO(hc.message);
     CHECK(hc.status == Status::Converged);

@@ -15,6 +15,7 @@
 #include "ddemap/solve/integrate.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
 #include "numeric_helpers.hpp"
+#include "analysis/bifurcation/ov_ring_branch.hpp"
 
 TEST_SUITE_BEGIN("fast");
 
@@ -228,12 +229,7 @@ TEST_CASE("ov ring (N = 3): the branch from one Hopf point ends at the other, wi
     // `orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --points 400` (once: 2.5 loops,
     // 17 "folds", 3 of them at Hopf points)
     OvRing ring(3, 1.0, 1.0, 1.0, 1.0, 1.2);
-    EquilibriumBranchOptions eo;
-    eo.parameter = "headway";
-    eo.from = 1.2;
-    eo.to = 3.0;
-    const EquilibriumBranch eq = equilibrium_branch(ring, ring.uniform_flow(), eo);
-    REQUIRE(eq.hopf.size() == 2);
+    const EquilibriumBranch eq = ddemap::test::ov3_headway_equilibria(ring);
     const double h1 = std::min(eq.hopf[0].par, eq.hopf[1].par), h2 = std::max(eq.hopf[0].par, eq.hopf[1].par);
     const HopfPoint& start = eq.hopf[0].par == h1 ? eq.hopf[0] : eq.hopf[1];
     const OrbitBranch b = orbit_branch_from_hopf(ring, start, options("headway", 1.2, 3.0, 400, 40));
