@@ -91,7 +91,7 @@ int run_bistability() {
     e.status = to_string(chart.status);
     e.message = chart.message;
     e.result = bistability_json(chart, pb.variables);
-    const std::string csv = bistability_csv(chart);
+    const std::string csv = bistability_csv(chart, pb.units);
     if (!prefix.empty()) {
         const std::string u1 = pb.units.count(o.parameter) ? pb.units.at(o.parameter) : std::string();
         const std::string u2 = pb.units.count(o.parameter2) ? pb.units.at(o.parameter2) : std::string();

@@ -66,7 +66,7 @@ int run_equilibria() {
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, variables);
-    const std::string csv = equilibrium_branch_csv(b, variables);
+    const std::string csv = equilibrium_branch_csv(b, variables, pb.units);
     if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
     print_output(format, e, csv, [&] {
         std::ostringstream out;

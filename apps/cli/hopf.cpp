@@ -96,7 +96,7 @@ int run_hopf() {
         status = curves.status;
         message = curves.message;
         e.result = hopf_curves_json(curves, hopf_args.par2, pb.variables);
-        csv = hopf_curves_csv(curves);
+        csv = hopf_curves_csv(curves, hopf_args.par2, pb.units);
     } else {
         o.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true);
         points = hopf_points(system, pb.guess, o);
@@ -104,7 +104,7 @@ int run_hopf() {
         status = points.status;
         message = points.message;
         e.result = hopf_points_json(points, pb.variables);
-        csv = hopf_points_csv(points, pb.variables);
+        csv = hopf_points_csv(points, pb.variables, pb.units);
     }
     e.status = to_string(status);
     e.message = message;

@@ -226,12 +226,12 @@ int run_orbits() {
     result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
     if (two) result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) + "}";
     e.result = result;
-    const std::string csv = orbit_branch_csv(b, variables);
+    const std::string csv = orbit_branch_csv(b, variables, built.units);
     std::vector<std::pair<std::string, std::string>> files;
     if (!prefix.empty()) {
         files.push_back({prefix + ".csv", csv});
         files.push_back({prefix + ".json", envelope_json(e)});
-        if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables)});
+        if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables, built.units)});
     }
     if (!svg_file.empty()) {
         const std::string punit = built.units.count(par) ? built.units.at(par) : std::string();

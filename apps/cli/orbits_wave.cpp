@@ -91,7 +91,7 @@ int run_orbits_wave(const OrbitsWaveArgs& a) {
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = travelling_wave_json(w, variables);
-    const std::string csv = orbit_branch_csv(b, variables);
+    const std::string csv = orbit_branch_csv(b, variables, built.units);
     std::vector<std::pair<std::string, std::string>> files;
     if (!prefix.empty()) {
         files.push_back({prefix + ".csv", csv});

@@ -88,7 +88,10 @@ py::object* g_progress = nullptr;
 /// main thread only: Python runs them nowhere else) and stops the computation if one raised.
 Progress interruptible(bool report = true) {
     struct State {
-        std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now(), reported = last;
+        // the first unit of work on the main thread is checked and reported at once (a short call
+        // reports too), the later ones at most 20 and 5 times a second
+        std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now() - std::chrono::milliseconds(50),
+                                              reported = std::chrono::steady_clock::now() - std::chrono::milliseconds(200);
         std::atomic<bool> interrupted{false};
     };
     auto state = std::make_shared<State>();

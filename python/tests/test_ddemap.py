@@ -160,10 +160,13 @@ def test_sweep(tmp_path):
     assert g["region"].shape == (13, 17) and len(rows) == 13 * 17
     for i, row in enumerate(rows):
         iy, ix = divmod(i, 17)
-        assert float(row["k1"]) == g["x"][ix] == r["x"]["values"][ix]
-        assert float(row["k2"]) == g["y"][iy] == r["y"]["values"][iy]
-        for k in ("spectral_abscissa", "sup_gamma", "omega_peak", "plant_abscissa", "lowfreq_margin", "peak_gain"):
-            assert float(row[k]) == g[k][iy, ix], (k, i)
+        assert float(row["k1_per_s2"]) == g["x"][ix] == r["x"]["values"][ix]
+        assert float(row["k2_per_s"]) == g["y"][iy] == r["y"]["values"][iy]
+        # the CSV's columns carry their units, the grid's keys are the quantities' names
+        for k, column in (("spectral_abscissa", "spectral_abscissa_per_s"), ("sup_gamma", "sup_gamma"),
+                          ("omega_peak", "omega_peak_rad_per_s"), ("plant_abscissa", "plant_abscissa_per_s"),
+                          ("lowfreq_margin", "lowfreq_margin"), ("peak_gain", "peak_gain")):
+            assert float(row[column]) == g[k][iy, ix], (k, i)
         for k in ("plant_stable", "ring_stable", "string_stable", "certified"):
             assert (row[k] == "true") == g[k][iy, ix], (k, i)
         for k in ("unstable_roots", "abscissa_mode"):
@@ -171,7 +174,7 @@ def test_sweep(tmp_path):
         region = 0 if not row["plant_stable"] == "true" else 1 if not row["ring_stable"] == "true" else \
             2 if not row["string_stable"] == "true" else 3
         assert g["region"][iy, ix] == region
-    same_curves(r["curves"], read_csv(tmp_path / "s-boundaries.csv"), "k1", "k2")
+    same_curves(r["curves"], read_csv(tmp_path / "s-boundaries.csv"), "k1_per_s2", "k2_per_s")
     assert r["boundaries"]["curves"] == len(r["curves"]) > 0
 
 
@@ -183,7 +186,7 @@ def same_curves(curves, rows, x, y):
         assert (int(pts[0]["mode"]) if pts[0]["mode"] else None) == c["mode"]
         assert [float(row[x]) for row in pts] == list(c["x"])
         assert [float(row[y]) for row in pts] == list(c["y"])
-        assert [float(row["omega"]) for row in pts] == list(c["omega"])
+        assert [float(row["omega_rad_per_s"]) for row in pts] == list(c["omega"])
 
 
 def test_boundary(tmp_path):
@@ -197,7 +200,7 @@ def test_boundary(tmp_path):
         for k in ("branch", "kind", "subkind", "mode", "points", "max_residual", "closed"):
             assert c[k] == s[k], k
     assert r["seeds"] == e["result"]["seeds"] and r["rejected_seeds"] == e["result"]["rejected_seeds"]
-    same_curves(r["curves"], read_csv(tmp_path / "b.csv"), "k1", "k2")
+    same_curves(r["curves"], read_csv(tmp_path / "b.csv"), "k1_per_s2", "k2_per_s")
 
 
 def test_classify():

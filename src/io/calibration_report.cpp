@@ -1,5 +1,8 @@
 #include "ddemap/io/calibration_report.hpp"
 
+#include "ddemap/core/units.hpp"
+#include "ddemap/traffic/model.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -107,10 +110,13 @@ CalibrationReport calibration_report(const std::vector<CarCalibration>& cars) {
 std::string calibration_report_csv(const CalibrationReport& rep) {
     std::ostringstream csv;
     csv << "car,train_runs";
-    for (const auto& n : calibration_parameter_names()) csv << "," << n << "," << n << "_lo," << n << "_hi";
-    csv << ",train_rmse_speed,train_rmse_gap,naive_rmse_speed";
+    for (const auto& n : calibration_parameter_names()) {
+        const std::string u = unit_suffix(parameter_unit(n));
+        csv << "," << n << u << "," << n << "_lo" << u << "," << n << "_hi" << u;
+    }
+    csv << ",train_rmse_speed_mps,train_rmse_gap_m,naive_rmse_speed_mps";
     for (const auto& t : rep.test_types)
-        csv << "," << csv_field(t + "_rmse_speed") << "," << csv_field(t + "_rmse_gap") << "," << csv_field(t + "_naive_rmse_speed") << ","
+        csv << "," << csv_field(t + "_rmse_speed_mps") << "," << csv_field(t + "_rmse_gap_m") << "," << csv_field(t + "_naive_rmse_speed_mps") << ","
             << csv_field(t + "_samples");
     csv << ",warnings,status\n";
     auto opt = [](double v) { return std::isfinite(v) ? format_exact(v) : std::string(); };

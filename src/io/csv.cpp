@@ -2,6 +2,8 @@
 
 #include "core/internal/text.hpp"
 #include "ddemap/analysis/design/design.hpp"
+#include "ddemap/core/units.hpp"
+#include "ddemap/traffic/model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -20,11 +22,21 @@ std::string format_exact(double v) {
     return std::string(b, r.ptr);
 }
 
+namespace {
+/// A car parameter's column: its name with the unit of the built-in models (k1_per_s2, th_s).
+std::string parameter_column(const std::string& name) { return column_name(name, parameter_unit(name)); }
+}  // namespace
+
+std::string named_column(const std::string& name, const ColumnUnits& units, const std::string& key) {
+    const auto it = units.find(key.empty() ? name : key);
+    return csv_field(column_name(name, it == units.end() ? std::string() : it->second));
+}
+
 std::string sweep_csv(const SweepResult& sw) {
     std::ostringstream s;
-    s << sw.spec.x.name << "," << sw.spec.y.name
-      << ",spectral_abscissa,unstable_roots,sup_gamma,omega_peak,plant_stable,ring_stable,string_stable,"
-         "abscissa_mode,plant_abscissa,lowfreq_margin,peak_gain,certified\n";
+    s << parameter_column(sw.spec.x.name) << "," << parameter_column(sw.spec.y.name)
+      << ",spectral_abscissa_per_s,unstable_roots,sup_gamma,omega_peak_rad_per_s,plant_stable,ring_stable,string_stable,"
+         "abscissa_mode,plant_abscissa_per_s,lowfreq_margin,peak_gain,certified\n";
     auto b = [](bool v) { return v ? "true" : "false"; };
     for (const auto& p : sw.points) {
         s << format_exact(p.x) << "," << format_exact(p.y) << "," << format_exact(p.spectral_abscissa) << ",";
@@ -40,7 +52,7 @@ std::string sweep_csv(const SweepResult& sw) {
 
 std::string boundary_csv(const SweepSpec& spec, const BoundarySet& set) {
     std::ostringstream s;
-    s << "branch,kind,subkind,mode," << spec.x.name << "," << spec.y.name << ",omega\n";
+    s << "branch,kind,subkind,mode," << parameter_column(spec.x.name) << "," << parameter_column(spec.y.name) << ",omega_rad_per_s\n";
     for (std::size_t i = 0; i < set.curves.size(); ++i) {
         const auto& c = set.curves[i];
         for (const auto& p : c.points) {
@@ -69,10 +81,10 @@ std::string csv_field(const std::string& text) {
     return out + "\"";
 }
 
-std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables) {
-    std::string out = "kind," + csv_field(b.parameter);
-    for (const auto& v : variables) out += "," + csv_field(v);
-    out += ",abscissa,unstable,stable,omega,status\n";
+std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units) {
+    std::string out = "kind," + named_column(b.parameter, units);
+    for (const auto& v : variables) out += "," + named_column(v, units);
+    out += ",abscissa_per_s,unstable,stable,omega_rad_per_s,status\n";
     auto xs = [](const Eigen::VectorXd& x) {
         std::string s;
         for (Eigen::Index i = 0; i < x.size(); ++i) s += "," + format_exact(x[i]);
@@ -87,10 +99,10 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
     return out;
 }
 
-std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables) {
-    std::string out = "kind," + csv_field(b.parameter) + ",period,stable,trivial_distance,max_nontrivial";
-    for (const auto& v : variables) out += "," + csv_field("min_" + v);
-    for (const auto& v : variables) out += "," + csv_field("max_" + v);
+std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units) {
+    std::string out = "kind," + named_column(b.parameter, units) + ",period_s,stable,trivial_distance,max_nontrivial";
+    for (const auto& v : variables) out += "," + named_column("min_" + v, units, v);
+    for (const auto& v : variables) out += "," + named_column("max_" + v, units, v);
     out += "\n";
     const std::string empty_extremes(2 * variables.size(), ',');
     auto finite = [](double v) { return std::isfinite(v) ? format_exact(v) : std::string(); };
@@ -108,11 +120,12 @@ std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string
     return out;
 }
 
-std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables) {
+std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables, const ColumnUnits& units) {
     if (curves.empty()) return "curve\n";
-    std::string out = "curve," + csv_field(curves.front().parameter) + "," + csv_field(curves.front().parameter2) + ",period,fold_test,second_distance";
-    for (const auto& v : variables) out += "," + csv_field("min_" + v);
-    for (const auto& v : variables) out += "," + csv_field("max_" + v);
+    std::string out = "curve," + named_column(curves.front().parameter, units) + "," + named_column(curves.front().parameter2, units) +
+                      ",period_s,fold_test,second_distance";
+    for (const auto& v : variables) out += "," + named_column("min_" + v, units, v);
+    for (const auto& v : variables) out += "," + named_column("max_" + v, units, v);
     out += "\n";
     for (std::size_t k = 0; k < curves.size(); ++k)
         for (const OrbitFoldCurvePoint& q : curves[k].points) {
@@ -126,7 +139,7 @@ std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, con
 }
 
 std::string roots_csv(const std::vector<Root>& roots) {
-    std::string out = "re,im,residual,newton_step\n";
+    std::string out = "re_per_s,im_rad_per_s,residual,newton_step_per_s\n";
     for (const auto& x : roots)
         out += format_exact(x.value.real()) + "," + format_exact(x.value.imag()) + "," + format_exact(x.residual) + "," +
                format_exact(x.newton_step) + "\n";
@@ -135,7 +148,7 @@ std::string roots_csv(const std::vector<Root>& roots) {
 
 std::string ring_roots_csv(const RingResult& r) {
     std::ostringstream out;
-    out << "mode,theta,re,im,residual,newton_step\n";
+    out << "mode,theta_rad,re_per_s,im_rad_per_s,residual,newton_step_per_s\n";
     for (const auto& x : r.roots) {
         out << (x.mode < 0 ? std::string() : std::to_string(x.mode)) << "," << format_exact(x.theta) << ","
             << format_exact(x.root.value.real()) << "," << format_exact(x.root.value.imag()) << ","
@@ -154,8 +167,8 @@ std::string peak_fields(const PeakResult& p) {
 
 std::string string_csv(const StringResult& s, const RingResult* ring) {
     std::ostringstream out;
-    out << "plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable";
-    if (ring) out << ",ring,ring_stable,spectral_abscissa";
+    out << "plant_stable,plant_abscissa_per_s,sup_gamma,omega_peak_rad_per_s,peak_margin,lowfreq_margin,string_stable";
+    if (ring) out << ",ring,ring_stable,spectral_abscissa_per_s";
     if (s.peak) out << ",peak_verdict,peak_norm,peak_norm_error";
     out << "\n";
     out << tf(s.plant_stable) << "," << format_exact(s.plant_abscissa) << "," << format_exact(s.sup_gamma) << ","
@@ -171,13 +184,15 @@ std::string string_csv(const StringResult& s, const RingResult* ring) {
 
 std::string classification_csv(const std::vector<Classification>& rows) {
     std::ostringstream out;
-    out << "name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,lowfreq_margin,"
-           "spectral_abscissa,plant_abscissa,attenuation_margin";
+    out << "name";
+    for (const char* k : {"k1", "k2", "th", "tau", "eta"}) out << "," << parameter_column(k);
+    out << ",plant_stable,ring_stable,string_stable,sup_gamma,omega_peak_rad_per_s,lowfreq_margin,"
+           "spectral_abscissa_per_s,plant_abscissa_per_s,attenuation_margin_s";
     // the verdicts under parameter uncertainty, only when a vehicle carries a covariance
     const bool any = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.has_uncertainty; });
     if (any)
-        out << ",p_string_unstable,p_string_unstable_se,p_string_unstable_lower,p_string_unstable_upper,c2_lower,c2_upper,"
-               "sup_gamma_minus_1_lower,sup_gamma_minus_1_upper,spectral_abscissa_lower,spectral_abscissa_upper,samples";
+        out << ",p_string_unstable,p_string_unstable_se,p_string_unstable_lower,p_string_unstable_upper,c2_lower_per_s2,c2_upper_per_s2,"
+               "sup_gamma_minus_1_lower,sup_gamma_minus_1_upper,spectral_abscissa_lower_per_s,spectral_abscissa_upper_per_s,samples";
     // peak (L-infinity) string stability, when it was asked (classify --peak): the last columns
     const bool peak = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.string.peak.has_value(); });
     if (peak) out << ",peak_verdict,peak_norm,peak_norm_error";
@@ -238,13 +253,14 @@ std::string growth_csv(const std::vector<GrowthResult>& g) {
 std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
                             const CalibrationOptions& options) {
     std::ostringstream csv;
-    csv << "name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,"
-           "naive_rmse_speed,status";
+    csv << "name";
+    for (const char* k : {"k1", "k2", "th", "tau", "eta"}) csv << "," << parameter_column(k);
+    csv << ",rmse_speed_mps,rmse_gap_m,train_rmse_speed_mps,train_rmse_gap_m,test_rmse_speed_mps,test_rmse_gap_m,naive_rmse_speed_mps,status";
     // the covariance (upper triangle, the columns `classify` reads); empty cells when the trace
     // does not determine a parameter (an infinite standard error: the covariance understates it)
     for (const auto& c : covariance_column_names()) csv << "," << c;
     // the bounds the fit searched within (classify restricts its parameter samples to them)
-    for (const auto& c : bounds_column_names()) csv << "," << c;
+    for (const auto& c : bounds_column_names()) csv << "," << c.substr(0, 3) << parameter_column(c.substr(3));
     csv << "\n";
     std::string bounds;
     for (const auto& name : calibration_parameter_names()) {
@@ -271,7 +287,7 @@ std::string calibration_csv(const std::vector<std::string>& names, const std::ve
 
 std::string mix_csv(const std::vector<MixPoint>& points) {
     std::ostringstream csv;
-    csv << "p,x_cars,spectral_abscissa,spectral_abscissa_min,spectral_abscissa_max,speed,ring_stable,unstable_roots,"
+    csv << "p,x_cars,spectral_abscissa_per_s,spectral_abscissa_min_per_s,spectral_abscissa_max_per_s,speed_mps,ring_stable,unstable_roots,"
            "arrangements,max_residual,status\n";
     for (const auto& pt : points) {
         csv << format_exact(pt.fraction) << "," << pt.x_cars << "," << format_exact(pt.abscissa) << "," << format_exact(pt.abscissa_min)
@@ -286,8 +302,9 @@ std::string mix_csv(const std::vector<MixPoint>& points) {
 std::string design_csv(const DesignResult& r) {
     std::ostringstream out;
     out << "point";
-    for (const std::string& k : r.free) out << "," << csv_field(k);
-    out << ",objective,attenuation_margin,sup_gamma,peak_norm,plant_stable,string_stable,peak_stable,plant_abscissa\n";
+    for (const std::string& k : r.free) out << "," << csv_field(parameter_column(k));
+    out << "," << column_name("objective", r.objective == "abscissa" ? "1/s" : "")
+        << ",attenuation_margin_s,sup_gamma,peak_norm,plant_stable,string_stable,peak_stable,plant_abscissa_per_s\n";
     auto row = [&](const std::string& name, const ParameterMap& p, double value, const AttenuationScan& a, const StringResult& s) {
         out << name;
         for (const std::string& k : r.free) out << "," << format_exact(p.at(k));

@@ -56,9 +56,9 @@ std::string hopf_points_json(const HopfAnalysis& a, const std::vector<std::strin
     return detail::json_text(j);
 }
 
-std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables) {
-    std::string out = "par,omega,l1,criticality,dre_dpar,side";
-    for (const auto& v : variables) out += "," + csv_field(v);
+std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables, const ColumnUnits& units) {
+    std::string out = named_column(a.branch.parameter, units) + ",omega_rad_per_s,l1,criticality,dre_dpar,side";
+    for (const auto& v : variables) out += "," + named_column(v, units);
     for (const auto& v : variables) out += "," + csv_field("amp_" + v);
     out += ",residual,status\n";
     for (const HopfCoefficients& c : a.points) {
@@ -148,8 +148,9 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
     return detail::json_text(j);
 }
 
-std::string hopf_curves_csv(const HopfCurves& hc) {
-    std::string out = "curve,kind,par,par2,omega,l1,criticality,status\n";
+std::string hopf_curves_csv(const HopfCurves& hc, const std::string& parameter2, const ColumnUnits& units) {
+    std::string out = "curve,kind," + named_column(hc.start.branch.parameter, units) + "," + named_column(parameter2, units) +
+                      ",omega_rad_per_s,l1,criticality,status\n";
     for (std::size_t k = 0; k < hc.curves.size(); ++k) {
         const HopfCurve& c = hc.curves[k];
         for (const HopfCurvePoint& p : c.points) {
@@ -196,8 +197,8 @@ std::string bistability_json(const BistabilityChart& c, const std::vector<std::s
     return detail::json_text(j);
 }
 
-std::string bistability_csv(const BistabilityChart& c) {
-    std::string out = "curve,kind," + csv_field(c.parameter) + "," + csv_field(c.parameter2) + "\n";
+std::string bistability_csv(const BistabilityChart& c, const ColumnUnits& units) {
+    std::string out = "curve,kind," + named_column(c.parameter, units) + "," + named_column(c.parameter2, units) + "\n";
     for (std::size_t k = 0; k < c.hopf.curves.size(); ++k) {
         for (const HopfCurvePoint& p : c.hopf.curves[k].points) {
             const HopfCoefficients& q = p.coefficients;

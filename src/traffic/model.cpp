@@ -231,6 +231,13 @@ std::vector<ParameterSpec> model_parameters(const std::string& model) {
     throw std::invalid_argument("model " + detail::quoted(model) + ": expected one of ovrv, idm, ccc");
 }
 
+std::string parameter_unit(const std::string& name) {
+    for (const auto& m : model_names())
+        for (const auto& spec : model_parameters(m))
+            if (spec.name == name) return spec.unit;
+    return "";
+}
+
 std::unique_ptr<CarModel> make_model(const std::string& model, const ParameterMap& values) {
     if (model == "ovrv") return std::make_unique<OvrvModel>(values);
     if (model == "idm") return std::make_unique<IdmModel>(values);

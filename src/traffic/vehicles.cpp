@@ -1,5 +1,7 @@
 #include "ddemap/traffic/vehicles.hpp"
 
+#include "ddemap/core/units.hpp"
+
 #include "core/internal/text.hpp"
 #include "ddemap/traffic/model.hpp"
 
@@ -75,8 +77,18 @@ namespace {
 /// The columns `calibrate` writes besides the parameters, the covariance and the bounds: part of
 /// the format, not read.
 const std::set<std::string>& calibration_report_columns() {
-    static const std::set<std::string> names = {"rmse_speed",      "rmse_gap",      "train_rmse_speed", "train_rmse_gap",
-                                                "test_rmse_speed", "test_rmse_gap", "naive_rmse_speed", "status"};
+    // with their units (rmse_speed_mps) and, as written before 2026-11-29, without
+    static const std::set<std::string> names = [] {
+        std::set<std::string> n = {"status"};
+        for (const char* split : {"", "train_", "test_", "naive_"}) {
+            for (const char* q : {"rmse_speed", "rmse_gap"}) {
+                const std::string c = std::string(split) + q;
+                n.insert(c);
+                n.insert(c + (q == std::string("rmse_speed") ? "_mps" : "_m"));
+            }
+        }
+        return n;
+    }();
     return names;
 }
 
@@ -120,6 +132,17 @@ std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std
     const std::vector<std::string>& params = model_parameter_columns();
     const std::vector<std::string> cov_names = covariance_column_names();
     const std::vector<std::string> bound_names = bounds_column_names();
+    // a parameter column may carry its unit (k1_per_s2, lo_th_s: what classify and calibrate
+    // write): read as the parameter's name
+    for (int i = 0; i < csv.columns(); ++i) {
+        const std::string h = csv.header()[static_cast<std::size_t>(i)];
+        for (const std::string prefix : {"", "lo_", "hi_"}) {
+            if (h.rfind(prefix, 0) != 0) continue;
+            const std::string rest = h.substr(prefix.size());
+            for (const auto& p : params)
+                if (rest != p && strip_unit(rest, parameter_unit(p)) == p) csv.rename_column(i, prefix + p);
+        }
+    }
     // every column known, and none twice
     std::set<std::string> seen;
     for (const auto& h : csv.header()) {

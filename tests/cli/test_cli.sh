@@ -136,11 +136,11 @@ if OMP_NUM_THREADS=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --k2 0.01:1:
    OMP_NUM_THREADS=2 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:30 --k2 0.01:1:25 --out "$tmp/s2" >/dev/null; then
     cmp -s "$tmp/s1.csv" "$tmp/s2.csv" && ok || bad "sweep CSV differs between 1 and 2 threads"
     [ "$(wc -l <"$tmp/s1.csv")" -eq 751 ] && ok || bad "sweep CSV rows"
-    head -1 "$tmp/s1.csv" | grep -q '^k1,k2,spectral_abscissa,unstable_roots,sup_gamma,omega_peak,plant_stable,ring_stable,string_stable' && ok || bad "sweep CSV header"
+    head -1 "$tmp/s1.csv" | grep -q '^k1_per_s2,k2_per_s,spectral_abscissa_per_s,unstable_roots,sup_gamma,omega_peak_rad_per_s,plant_stable,ring_stable,string_stable' && ok || bad "sweep CSV header"
     xmllint --noout "$tmp/s1.svg" && ok || bad "sweep SVG is not valid XML"
     grep -q '<text' "$tmp/s1.svg" && grep -q 'id="panel1-boundaries"' "$tmp/s1.svg" && ok || bad "sweep SVG layers"
     json_has "$tmp/s1.json" model fixed x y ring degree seconds version && ok || bad "sweep JSON keys"
-    head -1 "$tmp/s1-boundaries.csv" | grep -q '^branch,kind,subkind,mode,k1,k2,omega' && ok || bad "boundaries CSV header"
+    head -1 "$tmp/s1-boundaries.csv" | grep -q '^branch,kind,subkind,mode,k1_per_s2,k2_per_s,omega_rad_per_s' && ok || bad "boundaries CSV header"
 else
     bad "sweep exit status"
 fi
@@ -323,8 +323,8 @@ f = json.load(open(sys.argv[1]))['result']['fits'][0]
 t = f['tests'][0]
 assert t['type'] == 'same' and t['rmse_speed'] == f['train_runs'][0]['rmse_speed'] and t['rmse_gap'] == f['train_runs'][0]['rmse_gap']
 rows = list(csv.DictReader(open(sys.argv[2] + '/table.csv')))
-assert len(rows) == 1 and rows[0]['car'] == 'rav4' and float(rows[0]['same_rmse_speed']) == t['rmse_speed']
-assert float(rows[0]['k1']) == f['k1'] and float(rows[0]['k1_lo']) == f['ci95']['k1'][0]
+assert len(rows) == 1 and rows[0]['car'] == 'rav4' and float(rows[0]['same_rmse_speed_mps']) == t['rmse_speed']
+assert float(rows[0]['k1_per_s2']) == f['k1'] and float(rows[0]['k1_lo_per_s2']) == f['ci95']['k1'][0]
 j = json.load(open(sys.argv[2] + '/table.json'))
 assert j['test_types'] == ['same'] and j['cars'][0]['test']['same']['rmse_gap'] == t['rmse_gap']
 md = open(sys.argv[2] + '/table.md').read()
@@ -813,6 +813,9 @@ fi
 # the ov ring (5 cars, one headway eliminated): six Hopf points (modes 1, 2, 3 on both sides of the inflection of V)
 if "$bin" equilibria --model ov --ring 5 --par headway --from 1.2 --to 3 --format csv >"$tmp/ov.csv"; then
     [ "$(grep -c '^hopf,' "$tmp/ov.csv")" -eq 6 ] && ! grep -qi 'nan\|inf' "$tmp/ov.csv" && ok || bad "equilibria ov ring: 6 Hopf points"
+    # the ring's units in the header: headway and headways in m, speeds in m/s, rates in 1/s and rad/s
+    head -1 "$tmp/ov.csv" | grep -q '^kind,headway_m,h0_m,h1_m,h2_m,h3_m,v0_mps,v1_mps,v2_mps,v3_mps,v4_mps,abscissa_per_s,unstable,stable,omega_rad_per_s,status$' &&
+        ok || bad "equilibria CSV header with units: $(head -1 "$tmp/ov.csv")"
 else
     bad "equilibria --model ov exit status"
 fi
@@ -885,7 +888,7 @@ DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" sweep --th 1.5 --tau 0.5 --k1 0.01:1:6 --k
 # calibrate's CSV carries the bounds the fit used; classify samples within them (not calibrate's defaults)
 fixture_cal
 if "$bin" calibrate "$excerpt" --bounds k1=0:2,tau=0.1:0.9 --out "$tmp/calb" >/dev/null 2>&1 || [ $? -eq 4 ]; then
-    head -1 "$tmp/calb.csv" | grep -q ',cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta$' && ok || bad "calibrate csv bounds columns"
+    head -1 "$tmp/calb.csv" | grep -q ',cov_eta_eta,lo_k1_per_s2,hi_k1_per_s2,lo_k2_per_s,hi_k2_per_s,lo_th_s,hi_th_s,lo_tau_s,hi_tau_s,lo_eta_m,hi_eta_m$' && ok || bad "calibrate csv bounds columns"
     sed -n 2p "$tmp/calb.csv" | grep -q ',0,2,0,1,0,3,0.1,0.9,5,15$' && ok || bad "calibrate csv bounds values"
     if grep -q ',cov_k1_k1' "$tmp/calb.csv" && [ -n "$(sed -n 2p "$tmp/calb.csv" | cut -d, -f15)" ]; then
         "$bin" classify "$tmp/calb.csv" --samples 50 --ring-samples 0 --format json 2>/dev/null | python3 -c "
@@ -975,7 +978,7 @@ else
     bad "hopf --par2 exit status"
 fi
 "$bin" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 2 --par2 b --from2 0.5 --to2 2 --format csv | head -1 |
-    grep -q '^curve,kind,par,par2,omega,l1,criticality,status$' && ok || bad "hopf --par2 csv header"
+    grep -q '^curve,kind,alpha,b,omega_rad_per_s,l1,criticality,status$' && ok || bad "hopf --par2 csv header"
 expect_error "parameter 'q' is not a parameter of this system" hopf --system "$tmp/wright.json" --par q --from 1 --to 2
 expect_error "expected --from < --to" hopf --system "$tmp/wright.json" --par alpha --from 2 --to 1
 expect_error "expected a value other than --from" hopf --system "$tmp/wright.json" --par alpha --from 1 --to 1
@@ -1059,7 +1062,7 @@ for c in curves:
     assert all(p["fold_test"] < 1e-12 and p["residual"] < 1e-8 and p["second_distance"] < 1e-2 for p in c["points"])
 rows = list(csv.DictReader(open(sys.argv[3])))
 assert len(rows) == sum(len(c["points"]) for c in curves)
-assert float(rows[0]["headway"]) == curves[0]["points"][0]["par"] and float(rows[0]["tau"]) == 0.8
+assert float(rows[0]["headway_m"]) == curves[0]["points"][0]["par"] and float(rows[0]["tau_s"]) == 0.8
 PY
 else
     bad "orbits --par2 exit status"
@@ -1121,7 +1124,7 @@ assert len(p) == 8 and all(set(q) >= {"par", "period", "min", "max", "stable", "
 assert abs(p[0]["period"] - 4) < 1e-3 and all(q["par"] > math.pi / 2 and q["stable"] for q in p)
 assert all(abs(complex(*q["multipliers"][0]) - 1) < 1e-8 for q in p)  # the trivial multiplier, the largest here
 rows = list(csv.DictReader(open(sys.argv[2])))
-assert [r["kind"] for r in rows].count("orbit") == 8 and float(rows[0]["period"]) == p[0]["period"]  # round trip exact
+assert [r["kind"] for r in rows].count("orbit") == 8 and float(rows[0]["period_s"]) == p[0]["period"]  # round trip exact
 PY
     xmllint --noout "$orb/w.svg" && grep -q 'stable periodic orbits' "$orb/w.svg" && ok || bad "orbits --svg"
 else
@@ -1374,9 +1377,9 @@ for a, b in zip(n, i):
     # the smallest wave numbers within the marginal band of the axis (so not "stable" either)
     if b["ring_stable"] == "false":
         assert a["ring_stable"] == "false" and int(a["unstable_roots"]) > 0, (a, b)
-        assert abs(float(a["spectral_abscissa"]) - float(b["spectral_abscissa"])) < 1e-10, (a, b)
+        assert abs(float(a["spectral_abscissa_per_s"]) - float(b["spectral_abscissa_per_s"])) < 1e-10, (a, b)
     else:
-        assert int(a["unstable_roots"]) == 0 and abs(float(a["spectral_abscissa"])) < 1e-12, (a, b)
+        assert int(a["unstable_roots"]) == 0 and abs(float(a["spectral_abscissa_per_s"])) < 1e-12, (a, b)
 PY
 expect_error "expected at most 1000000 cars for sweep with every mode's ring curve" sweep --th 1.5 --tau 0.5 --k1 0.1:1:4 --k2 0.1:1:4 --ring 1000001 --ring-curves all --out "$big/b"
 expect_error "expected at most 1000000 cars for boundary --ring-curves all" boundary --th 1.5 --tau 0.5 --k1 0.1:1 --k2 0.1:1 --ring 2000000 --ring-curves all --out "$big/c"
@@ -1803,6 +1806,10 @@ for name, t in truth.items():
         assert hi - lo < 0.25 * max(t[p], 0.2), (name, p, lo, hi)  # informative, not just wide
 PY
 "$bin" classify "$ch/fits.json" --format csv | grep -c '^sim-' | grep -q '^2$' && ok || bad "classify the fits of a simulated platoon"
+# the fits' CSV (its header with units: k1_per_s2, lo_k1_per_s2, rmse_speed_mps) is the same car table as their JSON
+head -1 "$ch/fits.csv" | grep -q '^name,k1_per_s2,k2_per_s,th_s,tau_s,eta_m,rmse_speed_mps,rmse_gap_m,' && ok || bad "calibrate CSV header with units"
+"$bin" classify "$ch/fits.csv" --format csv >"$ch/c1.csv" && "$bin" classify "$ch/fits.json" --format csv >"$ch/c2.csv" &&
+    cmp -s "$ch/c1.csv" "$ch/c2.csv" && ok || bad "classify reads the fits' CSV and JSON alike"
 "$bin" calibrate "$ch/sim.csv:2" --format csv --quiet | grep -c '^sim-2,' | grep -q '^1$' && ok || bad "calibrate FILE.csv:K"
 "$bin" calibrate "$ch/sim.csv" --follower 1 --format csv --quiet | grep -c '^sim-' | grep -q '^1$' && ok || bad "calibrate --follower"
 expect_error "follower 3: expected 1 to 2" calibrate "$ch/sim.csv:3"
@@ -2029,7 +2036,7 @@ assert r["verdicts"]["string_stable"] is True and r["initial"]["verdicts"]["stri
 assert r["attenuation_margin"] >= 0.1 and r["margin_met"] is True and r["infeasibility_proof"] is None
 rows = list(csv.DictReader(open(sys.argv[2])))
 assert [x["point"] for x in rows] == ["car", "design"]
-assert float(rows[1]["k1"]) == r["gains"]["k1"] and float(rows[1]["k2"]) == r["gains"]["k2"]  # round-trip exact
+assert float(rows[1]["k1_per_s2"]) == r["gains"]["k1"] and float(rows[1]["k2_per_s"]) == r["gains"]["k2"]  # round-trip exact
 assert rows[1]["string_stable"] == "true" and rows[0]["string_stable"] == "false"
 PY
 grep -q "^string (L2) *UNSTABLE *STABLE$" "$tmp/des.txt" && ok || bad "design table: the L2 verdicts before and after"

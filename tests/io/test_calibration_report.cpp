@@ -70,9 +70,9 @@ TEST_CASE("calibration report: test errors pooled per type, held-out parts, CSV/
     std::getline(lines, header);
     std::getline(lines, row_a);
     std::getline(lines, row_b);
-    CHECK(header.rfind("car,train_runs,k1,k1_lo,k1_hi,k2,", 0) == 0);
-    CHECK(header.find(",dips_rmse_speed,dips_rmse_gap,dips_naive_rmse_speed,dips_samples,low_rmse_speed,") != std::string::npos);
-    CHECK(header.find(",held out_rmse_speed,") != std::string::npos);
+    CHECK(header.rfind("car,train_runs,k1_per_s2,k1_lo_per_s2,k1_hi_per_s2,k2_per_s,", 0) == 0);
+    CHECK(header.find(",dips_rmse_speed_mps,dips_rmse_gap_m,dips_naive_rmse_speed_mps,dips_samples,low_rmse_speed_mps,") != std::string::npos);
+    CHECK(header.find(",held out_rmse_speed_mps,") != std::string::npos);
     CHECK(row_a.rfind("a,data/a_train.csv," + format_exact(0.05) + ",", 0) == 0);
     CHECK(row_b.find(",,,,0,") != std::string::npos);  // car b has no dips run
     CHECK(std::count(header.begin(), header.end(), ',') == std::count(row_a.begin(), row_a.end(), ','));

@@ -117,6 +117,33 @@ TEST_CASE("what calibrate writes is a car table: its CSV with covariance and bou
     CHECK(v[0].has_covariance);
     CHECK(v[0].covariance(1, 1) == doctest::Approx(0.04));
     CHECK(v[0].bounds.size() == 5);
+    // the same fit with units in its header (what calibrate writes since 2026-11-29) reads the same
+    std::string with_units = csv;
+    for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+             {"name,k1,k2,th,tau,eta,", "name,k1_per_s2,k2_per_s,th_s,tau_s,eta_m,"},
+             {"rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,test_rmse_gap,naive_rmse_speed,",
+              "rmse_speed_mps,rmse_gap_m,train_rmse_speed_mps,train_rmse_gap_m,test_rmse_speed_mps,test_rmse_gap_m,naive_rmse_speed_mps,"},
+             {"lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta",
+              "lo_k1_per_s2,hi_k1_per_s2,lo_k2_per_s,hi_k2_per_s,lo_th_s,hi_th_s,lo_tau_s,hi_tau_s,lo_eta_m,hi_eta_m"}}) {
+        const auto at = with_units.find(from);
+        REQUIRE(at != std::string::npos);
+        with_units.replace(at, from.size(), to);
+    }
+    const auto u = read_car_table(with_units, "fits-units.csv");
+    REQUIRE(u.size() == 1);
+    CHECK(u[0].parameters == v[0].parameters);
+    CHECK(u[0].covariance == v[0].covariance);
+    REQUIRE(u[0].bounds.size() == v[0].bounds.size());
+    for (std::size_t i = 0; i < u[0].bounds.size(); ++i) {
+        CHECK(u[0].bounds[i].name == v[0].bounds[i].name);
+        CHECK(u[0].bounds[i].lower == v[0].bounds[i].lower);
+        CHECK(u[0].bounds[i].upper == v[0].bounds[i].upper);
+    }
+    // a unit that is not the parameter's is not taken for it: an unknown column, named
+    CHECK_THROWS_WITH_AS(read_car_table("name,k1_per_s,k2,th,tau\nA,0.1,0.2,1,0.1\n", "c.csv"), doctest::Contains("column 'k1_per_s'"),
+                         std::invalid_argument);
+    CHECK_THROWS_WITH_AS(read_car_table("name,k1,k1_per_s2,k2,th,tau\nA,0.1,0.1,0.2,1,0.1\n", "c.csv"), doctest::Contains("appears twice"),
+                         std::invalid_argument);
     const std::string json = R"({"command": "calibrate", "version": "0.1.0", "inputs": {}, "solver": null, "status": "converged", "message": "",
         "result": {"fits": [{"name": "RAV4", "k1": 0.1, "k2": 0.45, "th": 0.16, "tau": 0.43, "eta": 15, "status": "converged",
                    "covariance": [[1e-3,0,0,0,0],[0,4e-2,0,0,0],[0,0,0.17,0,0],[0,0,0,0.29,0],[0,0,0,0,30]]}],

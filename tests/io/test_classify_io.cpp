@@ -59,7 +59,7 @@ TEST_CASE("calibration CSV carries the fit's bounds and classify samples within 
     o.set_bounds("tau", 0.45, 0.55);
     o.set_bounds("eta", 2.0, 12.0);
     const std::string csv = calibration_csv({"car"}, {r}, o);
-    CHECK(csv.substr(0, csv.find('\n')).find(",cov_eta_eta,lo_k1,hi_k1,lo_k2,hi_k2,lo_th,hi_th,lo_tau,hi_tau,lo_eta,hi_eta") !=
+    CHECK(csv.substr(0, csv.find('\n')).find(",cov_eta_eta,lo_k1_per_s2,hi_k1_per_s2,lo_k2_per_s,hi_k2_per_s,lo_th_s,hi_th_s,lo_tau_s,hi_tau_s,lo_eta_m,hi_eta_m") !=
           std::string::npos);
     const auto v = read_vehicles_csv(csv, "fits.csv");
     REQUIRE(v.size() == 1);

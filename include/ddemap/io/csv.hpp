@@ -1,7 +1,10 @@
 #pragma once
 /// \file writers.hpp
-/// CSV writers (formatting only): every double in the shortest form that reads back exactly.
+/// CSV writers (formatting only): every double in the shortest form that reads back exactly;
+/// every column that holds a quantity with a unit carries it (core/units.hpp: `gap_m`,
+/// `omega_peak_rad_per_s`; time in seconds, for a system of one's own its time unit).
 
+#include <map>
 #include <string>
 
 #include <vector>
@@ -22,61 +25,76 @@ namespace ddemap {
 
 struct DesignResult;
 
+/// The units of named quantities (variables and parameters of a nonlinear system, e.g.
+/// {"headway", "m"}): the nonlinear writers add them to their column names; a name without an
+/// entry gets no unit.
+using ColumnUnits = std::map<std::string, std::string>;
+
 /// The shortest decimal that reads back to the same double (std::to_chars: 0.45, not
 /// 0.45000000000000001); a non-finite value is an internal error (std::logic_error): no NaN or inf is ever written
 std::string format_exact(double v);
 
-/// One row per grid point: the two axis parameters by name, spectral_abscissa, unstable_roots,
-/// sup_gamma, omega_peak, plant_stable, ring_stable, string_stable, abscissa_mode,
-/// plant_abscissa, lowfreq_margin, peak_gain, certified.
+/// One row per grid point: the two axis parameters by name with unit (k1_per_s2),
+/// spectral_abscissa_per_s, unstable_roots, sup_gamma, omega_peak_rad_per_s, plant_stable,
+/// ring_stable, string_stable, abscissa_mode, plant_abscissa_per_s, lowfreq_margin, peak_gain,
+/// certified.
 std::string sweep_csv(const SweepResult& sweep);
 
 /// One row per curve point: branch, kind (hopf|string), subkind (plant|ring|lowfreq|peak),
-/// mode (empty unless ring), the two parameters by name, omega.
+/// mode (empty unless ring), the two parameters by name with unit, omega_rad_per_s.
 std::string boundary_csv(const SweepSpec& spec, const BoundarySet& set);
 
 /// Quotes a CSV field if needed.
 std::string csv_field(const std::string& s);
+/// The CSV column of a named quantity: csv_field(name + the suffix of its unit), the unit looked
+/// up in `units` under `key` (default: the name itself; `min_h0` takes the unit of `h0`).
+std::string named_column(const std::string& name, const ColumnUnits& units, const std::string& key = "");
 
 /// An equilibrium branch, one row per point and per special point:
-/// kind (point|fold|hopf),PARAMETER,<variables>,abscissa,unstable,stable,omega,status
-/// (abscissa, unstable, stable empty on special rows; omega only on hopf rows).
-std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables);
+/// kind (point|fold|hopf),PARAMETER,<variables>,abscissa_per_s,unstable,stable,omega_rad_per_s,status
+/// (abscissa, unstable, stable empty on special rows; omega only on hopf rows); names with
+/// their units from `units`.
+std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units = {});
 
-/// kind,PAR,period,stable,trivial_distance,max_nontrivial,min_VAR..,max_VAR..: one row per orbit
-/// (kind "orbit"), fold ("fold"), period doubling ("period_doubling") and torus ("torus").
-std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables);
+/// kind,PAR,period_s,stable,trivial_distance,max_nontrivial,min_VAR..,max_VAR..: one row per orbit
+/// (kind "orbit"), fold ("fold"), period doubling ("period_doubling") and torus ("torus"); names
+/// with their units from `units`.
+std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units = {});
 /// Curves of folds of periodic orbits: one row per point, curve (index), the two parameters (named),
-/// period, fold_test |g|, second_distance |mu_2 - 1| (empty without multipliers), min_ and max_
-/// of every variable.
-std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables);
+/// period_s, fold_test |g|, second_distance |mu_2 - 1| (empty without multipliers), min_ and max_
+/// of every variable; names with their units from `units`.
+std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables,
+                                  const ColumnUnits& units = {});
 
-/// re,im,residual,newton_step
+/// re_per_s,im_rad_per_s,residual,newton_step_per_s
 std::string roots_csv(const std::vector<Root>& roots);
-/// mode,theta,re,im,residual,newton_step (mode empty for N = inf)
+/// mode,theta_rad,re_per_s,im_rad_per_s,residual,newton_step_per_s (mode empty for N = inf)
 std::string ring_roots_csv(const RingResult& r);
-/// plant_stable,plant_abscissa,sup_gamma,omega_peak,peak_margin,lowfreq_margin,string_stable
-/// [,ring,ring_stable,spectral_abscissa]
+/// plant_stable,plant_abscissa_per_s,sup_gamma,omega_peak_rad_per_s,peak_margin,lowfreq_margin,
+/// string_stable[,ring,ring_stable,spectral_abscissa_per_s][,peak_verdict,peak_norm,peak_norm_error]
 std::string string_csv(const StringResult& s, const RingResult* ring);
 /// Two rows, `car` and `design`: the free parameters, the objective, the attenuation margin,
 /// sup |Gamma|, ||h||_1 and the verdicts (columns point, the free names, objective, ...).
 std::string design_csv(const DesignResult& r);
-/// name,k1,k2,th,tau,eta,plant_stable,ring_stable,string_stable,sup_gamma,omega_peak,
-/// lowfreq_margin,spectral_abscissa,plant_abscissa
+/// name,k1_per_s2,k2_per_s,th_s,tau_s,eta_m,plant_stable,ring_stable,string_stable,sup_gamma,
+/// omega_peak_rad_per_s,lowfreq_margin,spectral_abscissa_per_s,plant_abscissa_per_s,
+/// attenuation_margin_s (then the uncertainty and peak columns when there are any)
 std::string classification_csv(const std::vector<Classification>& rows);
 /// time_s,car,position_m,speed_mps,gap_m (car 0 = lead, no gap); calibrate and --lead read it back
 /// (read_trace_csv with a follower, LeadProfile::from_csv with a car)
 std::string simulation_csv(const SimResult& r);
-/// name,position,speed_drop,amplification,min_gap,failure
+/// name,position,speed_drop_mps,amplification,min_gap_m,failure
 std::string growth_csv(const std::vector<GrowthResult>& g);
-/// name,k1,k2,th,tau,eta,rmse_speed,rmse_gap,train_rmse_speed,train_rmse_gap,test_rmse_speed,
-/// test_rmse_gap,naive_rmse_speed,status, the 15 covariance columns cov_k1_k1 .. cov_eta_eta,
-/// then the bounds of the fit, lo_k1,hi_k1 .. lo_eta,hi_eta (options.bound(NAME)); a vehicle
-/// table for read_vehicles_csv, which reads the covariance and the bounds back.
+/// name,k1_per_s2,k2_per_s,th_s,tau_s,eta_m,rmse_speed_mps,rmse_gap_m,train_rmse_speed_mps,
+/// train_rmse_gap_m,test_rmse_speed_mps,test_rmse_gap_m,naive_rmse_speed_mps,status, the 15
+/// covariance columns cov_k1_k1 .. cov_eta_eta (in the products of the two parameters' units),
+/// then the bounds of the fit, lo_k1_per_s2,hi_k1_per_s2 .. lo_eta_m,hi_eta_m
+/// (options.bound(NAME)); a car table for read_car_table, which reads the parameters, the
+/// covariance and the bounds back.
 std::string calibration_csv(const std::vector<std::string>& names, const std::vector<CalibrationResult>& fits,
                             const CalibrationOptions& options);
-/// p,x_cars,spectral_abscissa,spectral_abscissa_min,spectral_abscissa_max,speed,ring_stable,
-/// unstable_roots,arrangements,max_residual,status
+/// p,x_cars,spectral_abscissa_per_s,spectral_abscissa_min_per_s,spectral_abscissa_max_per_s,
+/// speed_mps,ring_stable,unstable_roots,arrangements,max_residual,status
 std::string mix_csv(const std::vector<MixPoint>& points);
 
 }  // namespace ddemap

@@ -9,6 +9,7 @@
 
 #include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
+#include "ddemap/io/csv.hpp"
 
 namespace ddemap {
 
@@ -17,15 +18,18 @@ namespace ddemap {
 /// "branch": {"points", "stop", "status"}}. criticality is "undecided" for a point without
 /// coefficients (its status says why).
 std::string hopf_points_json(const HopfAnalysis& a, const std::vector<std::string>& variables);
-/// kind,par,omega,l1,criticality,dre_dpar,side,VAR...(equilibrium),amp_VAR...,residual,status
-std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables);
+/// PAR,omega_rad_per_s,l1,criticality,dre_dpar,side,VAR...(equilibrium),amp_VAR...,residual,status
+/// (PAR and VAR the names with their units from `units`; amp_VAR in VAR's unit per square root of
+/// PAR's).
+std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string>& variables, const ColumnUnits& units = {});
 
 /// {"parameter", "parameter2", "hopf": [the starting points as above], "curves": [{"start",
 /// "status", "message", "stop": [backward, forward], "points": [{"par", "par2", "omega", "l1",
 /// "criticality", "dre_dpar"}], "generalised_hopf": [{"par", "par2", "omega", "l1", "status"}]}]}
 std::string hopf_curves_json(const HopfCurves& c, const std::string& parameter2, const std::vector<std::string>& variables);
-/// curve,kind,par,par2,omega,l1,criticality,status (kind: point or generalised_hopf)
-std::string hopf_curves_csv(const HopfCurves& c);
+/// curve,kind,PAR,PAR2,omega_rad_per_s,l1,criticality,status (kind: point, generalised_hopf,
+/// double_hopf or zero_hopf; PAR and PAR2 the parameters' names with their units from `units`)
+std::string hopf_curves_csv(const HopfCurves& c, const std::string& parameter2, const ColumnUnits& units = {});
 
 /// The criticality word of a point: to_string(criticality), or "undecided" when its
 /// coefficients did not converge.
@@ -36,9 +40,9 @@ std::string criticality_word(const HopfCoefficients& c);
 /// "cells": [{"par", "par2", "equilibrium_stable", "stable_orbit", "bistable", "status",
 /// "message", "intervals": [[par2, lo, hi], ...]}], "slices", "rounds"}.
 std::string bistability_json(const BistabilityChart& c, const std::vector<std::string>& variables);
-/// The curves, one row per point: curve,kind,par,par2 with kind hopf_supercritical,
+/// The curves, one row per point: curve,kind,PAR,PAR2 (names with units) with kind hopf_supercritical,
 /// hopf_subcritical, hopf (L1 not decided), generalised_hopf or fold_of_orbits (curve numbered
 /// within its kind: Hopf curves, then fold curves).
-std::string bistability_csv(const BistabilityChart& c);
+std::string bistability_csv(const BistabilityChart& c, const ColumnUnits& units = {});
 
 }  // namespace ddemap

@@ -217,6 +217,9 @@ private:
 std::vector<std::string> model_names();
 /// Parameter specifications of a built-in model (std::invalid_argument for an unknown name).
 std::vector<ParameterSpec> model_parameters(const std::string& model);
+/// The unit of a parameter of the built-in models (the same in every model that has it; "speed"
+/// included), "" for a name none of them has: what column headers carry (`k1_per_s2`).
+std::string parameter_unit(const std::string& name);
 /// Builds a model from named values; missing required values, unknown names, non-finite or
 /// out-of-range values throw std::invalid_argument.
 std::unique_ptr<CarModel> make_model(const std::string& model, const ParameterMap& values);

@@ -2,6 +2,7 @@
 // Internal text helpers shared by the readers and the error messages of the library (private:
 // not installed; the layers include it as "core/internal/text.hpp").
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ddemap::detail {
@@ -65,6 +66,9 @@ public:
     /// else empty.
     std::string header_hint(const std::string& column, const std::vector<std::string>& known) const;
     const std::vector<std::string>& header() const { return m_header; }
+    /// Gives header column `index` the name `name` (a reader's canonical spelling of a column
+    /// that a file may write in another, e.g. with its unit: `k1_per_s2` -> `k1`).
+    void rename_column(int index, std::string name) { m_header.at(static_cast<std::size_t>(index)) = std::move(name); }
     /// Advances to the next data row; false at the end.
     bool next();
     /// "SOURCE:LINE" of the current row.
