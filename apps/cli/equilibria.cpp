@@ -1,5 +1,8 @@
 // equilibria: a branch of equilibria of a nonlinear DDE in one parameter (a system file with
-// expressions, or the built-in ov ring), its stability, folds and Hopf points.
+// expressions, or the built-in ov ring), its stability, folds and Hopf points; with --par2 the fold
+// curves through its folds in two parameters, with their cusp and Bogdanov-Takens points.
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -10,7 +13,9 @@
 #include "limits.hpp"
 #include "nonlinear_flags.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
 #include "ddemap/io/csv.hpp"
+#include "ddemap/io/figures.hpp"
 #include "ddemap/io/json.hpp"
 #include "ddemap/io/svg.hpp"
 
@@ -21,20 +26,97 @@ namespace {
 struct EquilibriaArgs {
     NonlinearProblemArgs problem;
     std::string count = "4", points = "400";
+    std::string par2, from2, to2, svg;
     FormatArg format;
     OutArg out;
 } equilibria_args;
 
-/// Left-aligned in a column of width w (at least one space after).
+/// equilibria --par2: the fold curves through the folds of the branch in --par.
+int run_fold_curves(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOptions& o, Format format, const std::string& prefix) {
+    const EquilibriaArgs& a = equilibria_args;
+    const NonlinearDDE& system = *pb.system;
+    if (a.from2.empty() || a.to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + a.par2);
+    if (a.par2 == a.problem.par) throw BadInput("--par2 = '" + a.par2 + "': expected a parameter other than --par");
+    const int j2 = system.parameter_index(a.par2);  // unknown: bad input naming the known ones
+    FoldCurveOptions co;
+    co.branch = o;
+    co.parameter2 = a.par2;
+    co.from2 = parse_number("--from2", a.from2);
+    co.to2 = parse_number("--to2", a.to2);
+    if (!(co.from2 < co.to2)) throw BadInput("--from2 = '" + a.from2 + "', --to2 = '" + a.to2 + "': expected --from2 < --to2");
+    const double held = system.parameter_values()[static_cast<std::size_t>(j2)];
+    if (!(held >= co.from2 && held <= co.to2))
+        throw BadInput("--par2 " + a.par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
+    co.continuation.max_points = o.continuation.max_points;
+    pb.inputs.string("par2", a.par2).number("from2", co.from2).number("to2", co.to2);
+    const std::string svg_file = a.svg.empty() ? std::string() : output_file("--svg", a.svg);
+
+    co.branch.progress = branch_progress_printer("equilibria", "points", a.problem.par, true);
+    co.progress = branch_progress_printer("equilibria", "fold-curve points", a.problem.par, false);
+    const FoldCurves fc = fold_curves(system, pb.guess, co);
+    co.branch.progress = nullptr;  // ends an open progress line before the output
+    co.progress = nullptr;
+    JsonEnvelope e;
+    e.command = "equilibria";
+    e.inputs = pb.inputs.str();
+    e.has_solver = true;
+    e.solver_given = solver_name(o.roots.method);
+    e.solver_used = e.solver_given;
+    e.status = to_string(fc.status);
+    e.message = fc.message;
+    e.result = fold_curves_json(fc, a.par2, pb.variables);
+    const std::string csv = fold_curves_csv(fc, a.par2, pb.variables, pb.units);
+    std::vector<std::pair<std::string, std::string>> files;
+    if (!prefix.empty()) files = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}};
+    if (!svg_file.empty()) {
+        auto unit = [&](const std::string& name) { return pb.units.count(name) ? pb.units.at(name) : std::string(); };
+        std::string title = "Fold curves of equilibria in (" + a.problem.par + ", " + a.par2 + ")";
+        if (!a.problem.model.empty()) title += ", " + a.problem.model + " ring of " + a.problem.ring + " cars";
+        files.push_back({svg_file, two_parameter_svg(nullptr, &fc, a.problem.par, a.par2, o.from, o.to, co.from2, co.to2, unit(a.problem.par), unit(a.par2), title)});
+    }
+    if (!files.empty()) write_files_atomic(files);
+    print_output(format, e, csv, [&] {
+        std::ostringstream out;
+        const std::string& par = a.problem.par;
+        out << "branch     " << fc.start.points.size() << (fc.start.points.size() == 1 ? " equilibrium" : " equilibria") << " in " << par << " from " << rounded(o.from) << " to "
+            << rounded(o.to) << ", " << counted(static_cast<long long>(fc.start.folds.size()), "fold") << "\n";
+        for (std::size_t k = 0; k < fc.curves.size(); ++k) {
+            const FoldCurve& c = fc.curves[k];
+            out << "curve " << k << "    from fold " << c.start << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << a.par2
+                << "), ended " << to_string(c.stop_backward) << " and " << to_string(c.stop_forward) << ", " << to_string(c.status) << "\n";
+            out << "  " << pad(par, 14) << pad(a.par2, 14) << pad("cusp test", 13) << "BT test\n";
+            const std::size_t step = std::max<std::size_t>(1, c.points.size() / 20);
+            for (std::size_t i = 0; i < c.points.size(); i += step) {
+                const FoldCurvePoint& p = c.points[i];
+                out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.par2, 8), 14) << pad(std::isfinite(p.cusp_test) ? rounded(p.cusp_test, 4) : "-", 13)
+                    << (std::isfinite(p.bt_test) ? rounded(p.bt_test, 4) : "-") << "\n";
+            }
+            for (const FoldCurveSpecialPoint& p : c.special)
+                out << "  " << (p.kind == "cusp" ? "cusp (two fold curves meet)" : "Bogdanov-Takens (a double root at 0; a Hopf curve ends here)") << ": " << par << " = " << rounded(p.par, 10) << ", " << a.par2 << " = "
+                    << rounded(p.par2, 10) << " (" << to_string(p.status) << ", residual " << rounded(p.residual, 2) << ")\n";
+        }
+        if (fc.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(fc.status) << "): " << fc.message << "\n";
+        if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
+        if (!svg_file.empty()) out << "wrote      " << svg_file << "\n";
+        std::cout << out.str();
+    });
+    if (fc.status != Status::Converged) std::cerr << "ddemap: undecided: " << fc.message << "\n";
+    return exit_code(fc.status);
+}
 
 }  // namespace
 
 void add_equilibria_flags(CLI::App& app) {
     equilibria_args.problem.add_to(app);
     app.add_option("--count", equilibria_args.count, "rightmost roots reported at every point")->capture_default_str();
-    app.add_option("--max-points", equilibria_args.points, "the most points of the branch")->capture_default_str();
+    app.add_option("--max-points", equilibria_args.points, "the most points of the branch (and of each fold curve per direction)")->capture_default_str();
+    app.add_option("--par2", equilibria_args.par2, "a second parameter: continue the folds in (--par, --par2), with their cusp and Bogdanov-Takens points")
+        ->type_name("NAME");
+    app.add_option("--from2", equilibria_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
+    app.add_option("--to2", equilibria_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
+    app.add_option("--svg", equilibria_args.svg, "--par2: the two-parameter diagram (fold curves; cusp and Bogdanov-Takens points)")->type_name("FILE");
     equilibria_args.format.add_to(app);
-    equilibria_args.out.add_to(app, "PREFIX.csv (one row per point and special point) and PREFIX.json", false);
+    equilibria_args.out.add_to(app, "PREFIX.csv (one row per point and special point, or per fold-curve point with --par2) and PREFIX.json", false);
     run_flags().add_to(app, false);
 }
 
@@ -53,6 +135,10 @@ int run_equilibria() {
     const Eigen::VectorXd& guess = pb.guess;
     JsonObject& inputs = pb.inputs;
     inputs.string("par", equilibria_args.problem.par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
+    const bool two = !equilibria_args.par2.empty();
+    if (!two && (!equilibria_args.from2.empty() || !equilibria_args.to2.empty())) throw BadInput("--from2/--to2 without --par2: expected --par2 NAME with them");
+    if (!two && !equilibria_args.svg.empty()) throw BadInput("--svg = '" + equilibria_args.svg + "' draws the curves of --par2: expected --par2 NAME with it");
+    if (two) return run_fold_curves(pb, o, format, prefix);
 
     o.progress = branch_progress_printer("equilibria", "points", equilibria_args.problem.par, true);
     const EquilibriumBranch b = equilibrium_branch(*system, guess, o);

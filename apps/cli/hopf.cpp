@@ -12,6 +12,7 @@
 #include "nonlinear_flags.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/io/files.hpp"
+#include "ddemap/io/figures.hpp"
 #include "ddemap/io/hopf_output.hpp"
 #include "ddemap/io/json.hpp"
 
@@ -21,7 +22,7 @@ namespace {
 
 struct HopfArgs {
     NonlinearProblemArgs problem;
-    std::string par2, from2, to2, points = "400";
+    std::string par2, from2, to2, points = "400", svg;
     FormatArg format;
     OutArg out;
 } hopf_args;
@@ -37,6 +38,8 @@ void add_hopf_flags(CLI::App& app) {
     app.add_option("--from2", hopf_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
     app.add_option("--to2", hopf_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     app.add_option("--max-points", hopf_args.points, "the most points of the branch, and of a Hopf curve in each direction")->capture_default_str();
+    app.add_option("--svg", hopf_args.svg, "--par2: the two-parameter diagram (Hopf curves by criticality; generalised, double and zero-Hopf points)")
+        ->type_name("FILE");
     hopf_args.format.add_to(app);
     hopf_args.out.add_to(app, "PREFIX.csv (one row per Hopf point, or per curve point with --par2) and PREFIX.json", false);
     run_flags().add_to(app, false);
@@ -49,6 +52,8 @@ int run_hopf() {
     if (!(pb.from < pb.to)) throw BadInput("--from = '" + hopf_args.problem.from + "', --to = '" + hopf_args.problem.to + "': expected --from < --to");
     const bool two = !hopf_args.par2.empty();
     if (!two && (!hopf_args.from2.empty() || !hopf_args.to2.empty())) throw BadInput("--from2/--to2 without --par2: expected --par2 NAME with them");
+    if (!two && !hopf_args.svg.empty()) throw BadInput("--svg = '" + hopf_args.svg + "' draws the curves of --par2: expected --par2 NAME with it");
+    const std::string svg_file = hopf_args.svg.empty() ? std::string() : output_file("--svg", hopf_args.svg);
     EquilibriumBranchOptions o;
     o.parameter = hopf_args.problem.par;
     o.from = pb.from;
@@ -109,7 +114,16 @@ int run_hopf() {
     e.status = to_string(status);
     e.message = message;
     const HopfAnalysis& start = two ? curves.start : points;
-    if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    std::vector<std::pair<std::string, std::string>> files;
+    if (!prefix.empty()) files = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}};
+    if (!svg_file.empty()) {
+        auto unit = [&](const std::string& name) { return pb.units.count(name) ? pb.units.at(name) : std::string(); };
+        std::string title = "Hopf curves in (" + hopf_args.problem.par + ", " + hopf_args.par2 + ")";
+        if (!hopf_args.problem.model.empty()) title += ", " + hopf_args.problem.model + " ring of " + hopf_args.problem.ring + " cars";
+        files.push_back({svg_file, two_parameter_svg(&curves, nullptr, hopf_args.problem.par, hopf_args.par2, o.from, o.to, co.from2, co.to2,
+                                                     unit(hopf_args.problem.par), unit(hopf_args.par2), title)});
+    }
+    if (!files.empty()) write_files_atomic(files);
     print_output(format, e, csv, [&] {
         std::ostringstream out;
         const std::string& par = hopf_args.problem.par;
@@ -149,6 +163,7 @@ int run_hopf() {
             }
         if (status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(status) << "): " << message << "\n";
         if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
+        if (!svg_file.empty()) out << "wrote      " << svg_file << "\n";
         std::cout << out.str();
     });
     return report_undecided(status, "hopf", message);

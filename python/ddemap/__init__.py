@@ -990,7 +990,7 @@ def _nonlinear_problem(system, model, ring, parameters):
 
 
 @_with_progress
-def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_points=400, **parameters):
+def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_points=400, par2=None, from2=None, to2=None, **parameters):
     """A branch of equilibria of a nonlinear DDE in one parameter (``ddemap equilibria``).
 
     ``system``: a JSON file (variables, parameters, equations, equilibrium guess), or ``model``
@@ -1005,11 +1005,18 @@ def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_
 
     Returns ``points`` (columns ``par``, ``x``, ``abscissa``, ``unstable``, ``stable``, ...),
     ``folds``, ``hopf`` (``par``, ``omega`` [rad/s], ...), ``stop``: the command's JSON.
+
+    With ``par2``, ``from2``, ``to2`` (``equilibria --par2``): the fold curves in (par, par2)
+    through the branch's folds, with their cusp and Bogdanov-Takens points: ``branch`` (the
+    branch in ``par``), ``curves`` (each with ``points``: ``par``, ``par2``, ``x``,
+    ``cusp_test``, ``bt_test``; ``special``: ``kind`` ``cusp`` or ``bogdanov_takens``, ``par``,
+    ``par2``, ``status``).
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     count = _integer("count", count, 1, 100)
     max_points = _integer("max_points", max_points, 2, 100000)
-    return _result(_ddemap.equilibria(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), count, max_points))
+    return _result(_ddemap.equilibria(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), count, max_points, par2 or "",
+                                      None if from2 is None else _number("from2", from2), None if to2 is None else _number("to2", to2)))
 
 
 @_with_progress

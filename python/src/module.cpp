@@ -33,6 +33,7 @@
 #include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
 #include "ddemap/analysis/stability/mixed_ring.hpp"
 #include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/analysis/simulation/simulate.hpp"
@@ -909,7 +910,8 @@ NonlinearProblem nonlinear_problem(const std::string& system_file, const std::st
 }
 
 std::string py_equilibria(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters,
-                          const std::string& par, double from, double to, int count, int max_points) {
+                          const std::string& par, double from, double to, int count, int max_points, const std::string& par2,
+                          std::optional<double> from2, std::optional<double> to2) {
     NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
     EquilibriumBranchOptions o;
     o.parameter = par;
@@ -918,14 +920,40 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
     o.roots.count = count;
     o.continuation.max_points = max_points;
     pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
-    o.progress = branch_interruptible();
-    const EquilibriumBranch b = released([&] { return equilibrium_branch(*pb.system, pb.guess, o); });
+    const bool two = !par2.empty();
+    if (!two && (from2 || to2)) throw std::invalid_argument("from2/to2 without par2: expected par2=NAME with them");
     JsonEnvelope e;
     e.command = "equilibria";
-    e.inputs = pb.inputs.str();
     e.has_solver = true;  // as the CLI: the root method (its names there: shift_invert = sparse, contour = product)
     e.solver_given = o.roots.method == "shift_invert" ? "sparse" : o.roots.method == "contour" ? "product" : o.roots.method;
     e.solver_used = e.solver_given;
+    if (two) {  // the fold curves through the branch's folds, as `equilibria --par2`
+        if (!from2 || !to2) throw std::invalid_argument("par2 needs from2 and to2: expected the box of " + par2);
+        if (par2 == par) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
+        const int j2 = pb.system->parameter_index(par2);
+        FoldCurveOptions co;
+        co.branch = o;
+        co.parameter2 = par2;
+        co.from2 = *from2;
+        co.to2 = *to2;
+        if (!(co.from2 < co.to2)) throw std::invalid_argument("from2 = " + json_number(co.from2) + ", to2 = " + json_number(co.to2) + ": expected from2 < to2");
+        const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
+        if (!(held >= co.from2 && held <= co.to2))
+            throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
+        co.continuation.max_points = max_points;
+        pb.inputs.string("par2", par2).number("from2", co.from2).number("to2", co.to2);
+        co.branch.progress = branch_interruptible();
+        co.progress = branch_interruptible();
+        const FoldCurves c = released([&] { return fold_curves(*pb.system, pb.guess, co); });
+        e.inputs = pb.inputs.str();
+        e.status = to_string(c.status);
+        e.message = c.message;
+        e.result = fold_curves_json(c, par2, pb.variables);
+        return envelope_json(e);
+    }
+    o.progress = branch_interruptible();
+    const EquilibriumBranch b = released([&] { return equilibrium_branch(*pb.system, pb.guess, o); });
+    e.inputs = pb.inputs.str();
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, pb.variables);
@@ -1116,7 +1144,7 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("paper", &py_paper, py::arg("prefix"));
     m.def("atlas", &py_atlas, py::arg("text"), py::arg("source"), py::arg("prefix"), py::arg("allow_large"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
-          py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"));
+          py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"), py::arg("par2"), py::arg("from2"), py::arg("to2"));
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("max_points"));
     m.def("bistability", &py_bistability, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),

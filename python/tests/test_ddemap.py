@@ -287,6 +287,20 @@ def test_equilibria(tmp_path):
     same_envelope(r, cli_json("equilibria", "--model", "idm", "--ring", 5, "--th", 1.2, "--tau", 0.6, "--par", "gap", "--from", 6, "--to", 40))
 
 
+def test_fold_curves(tmp_path):
+    # x' = p1 + x^2 + p2 x(t - 2): the fold curve p1 = p2^2 / 4 with a Bogdanov-Takens point at p2 = -1/2
+    # (closed forms: tests/analysis/bifurcation/test_fold_curve.cpp); the same envelope as equilibria --par2
+    system = tmp_path / "bt.json"
+    system.write_text(json.dumps({"variables": ["x"], "parameters": {"p1": -0.5, "p2": 0.5, "tau": 2},
+                                  "equations": ["p1 + x^2 + p2*x(t - tau)"], "equilibrium": [-1]}))
+    r = ddemap.equilibria("p1", -0.5, 2, system=system, par2="p2", from2=-1.5, to2=1.5)
+    same_envelope(r, cli_json("equilibria", "--system", system, "--par", "p1", "--from", -0.5, "--to", 2, "--par2", "p2",
+                              "--from2", -1.5, "--to2", 1.5))
+    assert r.status == "converged"
+    with pytest.raises(ValueError, match="par2 needs from2 and to2"):
+        ddemap.equilibria("p1", -0.5, 2, system=system, par2="p2")
+
+
 @pytest.mark.slow
 def test_bistability():
     # the 3-car ov ring's chart (README tour step 5): the same envelope as the command

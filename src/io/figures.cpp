@@ -385,6 +385,41 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
     return render_line_plots_svg({panel}, po);
 }
 
+namespace {
+/// The Hopf curves in pieces of one criticality (neighbouring pieces share their end point), red:
+/// solid where supercritical, dashed where subcritical, grey where L1 is not decided; the
+/// generalised Hopf points marked GH, and with `codim2` also the double Hopf (DH) and zero-Hopf
+/// (ZH) points.
+void add_hopf_curves(PlotPanel& panel, const HopfCurves& curves, bool codim2) {
+    for (const HopfCurve& c : curves.curves) {
+        std::size_t start = 0;
+        auto kind = [&](std::size_t i) {
+            const HopfCoefficients& k = c.points[i].coefficients;
+            return k.status != Status::Converged ? 0 : k.l1 < 0.0 ? 1 : k.l1 > 0.0 ? 2 : 0;
+        };
+        for (std::size_t i = 1; i <= c.points.size(); ++i) {
+            if (i < c.points.size() && kind(i) == kind(start)) continue;
+            const int k = kind(start);
+            PlotSeries sr{k == 1 ? "Hopf, supercritical (L1 < 0)" : k == 2 ? "Hopf, subcritical (L1 > 0)" : "Hopf, L1 not decided", {}, {},
+                          k == 0 ? std::string("#999999") : std::string("#d62728"), k != 1};
+            for (std::size_t j = start; j < std::min(i + 1, c.points.size()); ++j) {
+                sr.x.push_back(c.points[j].par);
+                sr.y.push_back(c.points[j].par2);
+            }
+            panel.series.push_back(std::move(sr));
+            start = i;
+        }
+        for (const GeneralisedHopfPoint& g : c.generalised)
+            if (g.status == Status::Converged) panel.markers.push_back({g.par, g.par2, "#000000", "GH"});
+        if (!codim2) continue;
+        for (const DoubleHopfPoint& d : c.double_hopf)
+            if (d.status == Status::Converged) panel.markers.push_back({d.par, d.par2, "#000000", "DH"});
+        for (const ZeroHopfPoint& z : c.zero_hopf)
+            if (z.status == Status::Converged) panel.markers.push_back({z.par, z.par2, "#000000", "ZH"});
+    }
+}
+}  // namespace
+
 std::string bistability_svg(const BistabilityChart& chart, const std::string& unit, const std::string& unit2, const std::string& title) {
     PlotPanel panel;
     panel.title = "";
@@ -428,28 +463,7 @@ std::string bistability_svg(const BistabilityChart& chart, const std::string& un
     }
     for (PlotFill* f : {&bistable, &unstable, &undecided})
         if (!f->polygons.empty()) panel.fills.push_back(std::move(*f));
-    // the Hopf curves in pieces of one criticality (neighbouring pieces share their end point)
-    for (const HopfCurve& c : chart.hopf.curves) {
-        std::size_t start = 0;
-        auto kind = [&](std::size_t i) {
-            const HopfCoefficients& k = c.points[i].coefficients;
-            return k.status != Status::Converged ? 0 : k.l1 < 0.0 ? 1 : k.l1 > 0.0 ? 2 : 0;
-        };
-        for (std::size_t i = 1; i <= c.points.size(); ++i) {
-            if (i < c.points.size() && kind(i) == kind(start)) continue;
-            const int k = kind(start);
-            PlotSeries sr{k == 1 ? "Hopf, supercritical (L1 < 0)" : k == 2 ? "Hopf, subcritical (L1 > 0)" : "Hopf, L1 not decided", {}, {},
-                          k == 0 ? std::string("#999999") : std::string("#d62728"), k != 1};
-            for (std::size_t j = start; j < std::min(i + 1, c.points.size()); ++j) {
-                sr.x.push_back(c.points[j].par);
-                sr.y.push_back(c.points[j].par2);
-            }
-            panel.series.push_back(std::move(sr));
-            start = i;
-        }
-        for (const GeneralisedHopfPoint& g : c.generalised)
-            if (g.status == Status::Converged) panel.markers.push_back({g.par, g.par2, "#000000", "GH"});
-    }
+    add_hopf_curves(panel, chart.hopf, false);
     for (const OrbitFoldCurve& c : chart.folds) {
         PlotSeries sr{"fold of periodic orbits", {}, {}, "#2ca02c", false};
         for (const OrbitFoldCurvePoint& q : c.points) {
@@ -465,6 +479,41 @@ std::string bistability_svg(const BistabilityChart& chart, const std::string& un
     po.panel_height = 420.0;
     po.note = "shading: the verdict of each cell of the box cut by the curves, from a slice in " + parameter_symbol(chart.parameter) +
               " at one point of it (orbits born at a Hopf point; isolas not seen); GH: generalised Hopf point (L1 = 0)";
+    return render_line_plots_svg({panel}, po);
+}
+
+std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, const std::string& parameter, const std::string& parameter2,
+                              double from, double to, double from2, double to2, const std::string& unit, const std::string& unit2,
+                              const std::string& title) {
+    PlotPanel panel;
+    auto label = [](const std::string& name, const std::string& u) { return u.empty() ? name : name + " [" + unit_text(u) + "]"; };
+    panel.x_label = label(parameter_symbol(parameter), unit);
+    panel.y_label = label(parameter_symbol(parameter2), unit2);
+    panel.x_min = from;
+    panel.x_max = to;
+    panel.y_min = from2;
+    panel.y_max = to2;
+    if (hopf) add_hopf_curves(panel, *hopf, true);
+    if (folds)
+        for (const FoldCurve& c : folds->curves) {
+            PlotSeries sr{"fold of equilibria", {}, {}, "#1f77b4", false};
+            for (const FoldCurvePoint& q : c.points) {
+                sr.x.push_back(q.par);
+                sr.y.push_back(q.par2);
+            }
+            panel.series.push_back(std::move(sr));
+            for (const FoldCurveSpecialPoint& q : c.special)
+                if (q.status == Status::Converged) panel.markers.push_back({q.par, q.par2, "#000000", q.kind == "cusp" ? "CP" : "BT"});
+        }
+    PlotOptions po;
+    po.title = title;
+    po.columns = 1;
+    po.panel_width = 560.0;
+    po.panel_height = 420.0;
+    std::string note;
+    if (hopf) note = "GH: generalised Hopf (L1 = 0), DH: double Hopf, ZH: zero-Hopf";
+    if (folds) note += std::string(note.empty() ? "" : "; ") + "CP: cusp, BT: Bogdanov-Takens (a Hopf curve ends there)";
+    po.note = note;
     return render_line_plots_svg({panel}, po);
 }
 

@@ -185,6 +185,52 @@ std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vecto
     return text(j);
 }
 
+std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2, const std::vector<std::string>& variables) {
+    const auto vec = detail::json_values;
+    json j;
+    j["parameter"] = c.start.parameter;
+    j["parameter2"] = parameter2;
+    j["branch"] = json::parse(equilibrium_branch_json(c.start, variables));
+    json curves = json::array();
+    for (const FoldCurve& k : c.curves) {
+        json o;
+        o["start"] = k.start;
+        o["status"] = to_string(k.status);
+        o["message"] = k.message;
+        o["stop"] = json::array({to_string(k.stop_backward), to_string(k.stop_forward)});
+        json pts = json::array();
+        for (const FoldCurvePoint& p : k.points) {
+            json q;
+            q["par"] = num(p.par);
+            q["par2"] = num(p.par2);
+            q["x"] = vec(p.x);
+            q["cusp_test"] = num(p.cusp_test);
+            q["bt_test"] = num(p.bt_test);
+            q["residual"] = num(p.residual);
+            pts.push_back(q);
+        }
+        o["points"] = pts;
+        json sp = json::array();
+        for (const FoldCurveSpecialPoint& p : k.special) {
+            json q;
+            q["kind"] = p.kind;
+            q["par"] = num(p.par);
+            q["par2"] = num(p.par2);
+            q["x"] = vec(p.x);
+            q["test"] = num(p.test);
+            q["other"] = num(p.other);
+            q["status"] = to_string(p.status);
+            q["residual"] = num(p.residual);
+            q["after"] = p.after;
+            sp.push_back(q);
+        }
+        o["special"] = sp;
+        curves.push_back(o);
+    }
+    j["curves"] = curves;
+    return text(j);
+}
+
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars) {
     const RootResult& rr = r.roots;
     json j;

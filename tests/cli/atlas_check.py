@@ -25,6 +25,16 @@ import numpy as np
 
 RTOL = 1e-8
 
+UNIT_SUFFIXES = ("_rad_per_s", "_per_s2", "_per_s", "_mps2", "_mps", "_rad", "_s", "_m")
+
+
+def unitless(column):
+    """The quantity of a CSV column: its name without the unit suffix ddemap writes."""
+    for suffix in UNIT_SUFFIXES:
+        if column.endswith(suffix):
+            return column[: -len(suffix)]
+    return column
+
 
 def walk(f):
     out = {}
@@ -80,7 +90,8 @@ def sweep(path, ddemap, sweep_dir):
             args += [f"--{name}", f"{float(a['lo'])!r}:{float(a['hi'])!r}:{a['count']}"]
         run = subprocess.run(args, capture_output=True, text=True)
         assert run.returncode in (0, 4), f"{' '.join(args)}: exit {run.returncode}: {run.stderr}"
-        rows = list(csv.DictReader(io.StringIO(run.stdout)))
+        # the sweep's columns carry their units (k1_per_s2, spectral_abscissa_per_s): read by quantity
+        rows = [{unitless(k): v for k, v in r.items()} for r in csv.DictReader(io.StringIO(run.stdout))]
         assert len(rows) == len(xs) * len(ys), "the sweep has another number of points"
         for row in rows:
             ix = int(np.flatnonzero(xs == float(row[xname]))[0])

@@ -820,6 +820,46 @@ else
     bad "equilibria --model ov exit status"
 fi
 "$bin" equilibria --system "$tmp/fold.json" --par p --from 0.9 --to -1 | grep -q "^hopf       p = 0.6168502" && ok || bad "equilibria table"
+# fold curves in two parameters (equilibria --par2): x' = p1 + x^2 + p2 x(t - 2) has the fold curve
+# p1 = p2^2 / 4 and a Bogdanov-Takens point at p2 = -1/tau = -0.5, p1 = 1/16 (Delta'(0) = 1 + tau p2 = 0);
+# x' = p1 + p2 x(t - 1) - x^3 the curve (-2 x^3, 3 x^2) with its cusp at the origin
+echo '{"variables": ["x"], "parameters": {"p1": -0.5, "p2": 0.5, "tau": 2}, "equations": ["p1 + x^2 + p2*x(t - tau)"], "equilibrium": [-1]}' >"$tmp/bt.json"
+echo '{"variables": ["x"], "parameters": {"p1": -1, "p2": 1}, "equations": ["p1 + p2*x(t - 1) - x^3"], "equilibrium": [-1.3]}' >"$tmp/cusp.json"
+"$bin" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 -1.5 --to2 1.5 --format json --out "$tmp/btc" >"$tmp/bt.out" &&
+    "$bin" equilibria --system "$tmp/cusp.json" --par p1 --from -1.5 --to 1.5 --par2 p2 --from2 -0.5 --to2 2 --format json >"$tmp/cusp.out" &&
+    python3 - "$tmp/bt.out" "$tmp/cusp.out" "$tmp/btc.csv" <<'PY' && ok || bad "equilibria --par2: fold curves, the Bogdanov-Takens point and the cusp against closed forms"
+import csv, json, sys
+bt = json.load(open(sys.argv[1])); cu = json.load(open(sys.argv[2]))
+assert bt["status"] == "converged" and cu["status"] == "converged", (bt["message"], cu["message"])
+assert bt["inputs"]["par2"] == "p2" and bt["result"]["parameter2"] == "p2"
+c = bt["result"]["curves"]
+assert len(c) == 1 and c[0]["stop"] == ["bound", "bound"], c[0]["stop"]
+assert all(abs(p["par"] - p["par2"] ** 2 / 4) < 1e-8 for p in c[0]["points"])
+s = c[0]["special"]
+assert [x["kind"] for x in s] == ["bogdanov_takens"] and s[0]["status"] == "converged"
+assert abs(s[0]["par"] - 1 / 16) < 1e-8 and abs(s[0]["par2"] + 0.5) < 1e-8 and abs(s[0]["x"][0] - 0.25) < 1e-8
+k = cu["result"]["curves"]
+assert len(k) == 1 and [x["kind"] for x in k[0]["special"]] == ["cusp"]
+assert abs(k[0]["special"][0]["par"]) < 1e-8 and abs(k[0]["special"][0]["par2"]) < 1e-8
+rows = list(csv.DictReader(open(sys.argv[3])))
+assert [r["kind"] for r in rows].count("point") == len(c[0]["points"]) and [r for r in rows if r["kind"] == "bogdanov_takens"]
+assert float([r for r in rows if r["kind"] == "bogdanov_takens"][0]["p2"]) == s[0]["par2"]  # round trip exact
+PY
+"$bin" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 -1.5 --to2 1.5 | grep -q "Bogdanov-Takens (a double root at 0; a Hopf curve ends here): p1 = 0.0625, p2 = -0.5 (converged" &&
+    ok || bad "equilibria --par2 table"
+# the two-parameter diagrams: the fold curve with its BT point; the Hopf curves of the 3-car ov ring with its GH points
+"$bin" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 -1.5 --to2 1.5 --svg "$tmp/two/bt.svg" >/dev/null &&
+    xmllint --noout "$tmp/two/bt.svg" && grep -q ">BT<" "$tmp/two/bt.svg" && grep -q "fold of equilibria" "$tmp/two/bt.svg" &&
+    ok || bad "equilibria --par2 --svg"
+"$bin" hopf --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 0.3 --to2 2 --svg "$tmp/two/hopf.svg" --quiet >/dev/null &&
+    xmllint --noout "$tmp/two/hopf.svg" && [ "$(grep -c '>GH<' "$tmp/two/hopf.svg")" -eq 2 ] && grep -q "Hopf, subcritical" "$tmp/two/hopf.svg" &&
+    grep -q "τ \[s\]" "$tmp/two/hopf.svg" && ok || bad "hopf --par2 --svg"
+expect_error "draws the curves of --par2" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --svg "$tmp/two/x.svg"
+expect_error "draws the curves of --par2" hopf --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --svg "$tmp/two/x.svg"
+[ ! -e "$tmp/two/x.svg" ] && ok || bad "a refused --svg wrote its file"
+expect_error "--par2 needs --from2 and --to2" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2
+expect_error "expected it in [--from2, --to2]" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 1 --to2 2
+expect_error "--from2/--to2 without --par2" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --from2 1
 
 # a published model as a system file: DDE-BIFTOOL's neuron demo (demo1_hopf: Hopf at a21 = 0.80712, omega = 0.78197)
 cat >"$tmp/neuron.json" <<'EOF2'

@@ -12,6 +12,7 @@
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/analysis/stability/ring_stability.hpp"
 #include "ddemap/analysis/simulation/simulate.hpp"
@@ -55,6 +56,12 @@ std::string named_column(const std::string& name, const ColumnUnits& units, cons
 /// (abscissa, unstable, stable empty on special rows; omega only on hopf rows); names with
 /// their units from `units`.
 std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units = {});
+
+/// Fold curves, one row per curve point, cusp and Bogdanov-Takens point:
+/// curve,kind (point|cusp|bogdanov_takens),PAR,PAR2,<variables>,cusp_test,bt_test,residual,status
+/// (names with their units from `units`; the tests empty on special rows, status empty on points).
+std::string fold_curves_csv(const FoldCurves& c, const std::string& parameter2, const std::vector<std::string>& variables,
+                            const ColumnUnits& units = {});
 
 /// kind,PAR,period_s,stable,trivial_distance,max_nontrivial,min_VAR..,max_VAR..: one row per orbit
 /// (kind "orbit"), fold ("fold"), period doubling ("period_doubling") and torus ("torus"); names

@@ -9,6 +9,8 @@
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/analysis/bifurcation/bistability.hpp"
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
+#include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/analysis/simulation/simulate.hpp"
 #include "ddemap/io/chart_spec.hpp"
@@ -47,5 +49,14 @@ std::string bifurcation_svg(const EquilibriumBranch* equilibria, const OrbitBran
 /// 0, supercritical, dashed where L1 > 0, subcritical), the fold curves of periodic orbits (green)
 /// and the generalised Hopf points (marked GH). Units in the axis labels when given.
 std::string bistability_svg(const BistabilityChart& chart, const std::string& unit, const std::string& unit2, const std::string& title);
+
+/// The two-parameter bifurcation diagram over the box [from, to] x [from2, to2] of (p1, p2): the
+/// Hopf curves (`hopf`, may be null; red, solid where supercritical, dashed where subcritical,
+/// grey where L1 is not decided) with their generalised Hopf (GH), double Hopf (DH) and
+/// zero-Hopf (ZH) points, and the fold curves of equilibria (`folds`, may be null; blue) with their
+/// cusp (CP) and Bogdanov-Takens (BT) points. Units in the axis labels when given.
+std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, const std::string& parameter, const std::string& parameter2,
+                              double from, double to, double from2, double to2, const std::string& unit, const std::string& unit2,
+                              const std::string& title);
 
 }  // namespace ddemap

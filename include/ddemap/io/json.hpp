@@ -14,6 +14,7 @@
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
 #include "ddemap/analysis/stability/mixed_ring.hpp"
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/analysis/stability/ring_fast.hpp"
@@ -94,6 +95,12 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& r);
 /// "unstable", "stable", "roots_status", "roots": [[re, im], ...]}], "folds": [{"kind" ("fold" or "branch_point"), "par", "x", "status",
 /// "residual"}], "hopf": [{"par", "omega", "x", "status", "residual"}], "stop"}
 std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vector<std::string>& variables);
+/// fold curves in two parameters: {"parameter", "parameter2", "branch": equilibrium_branch_json
+/// of the branch in p1, "curves": [{"start", "status", "message", "stop": [backward, forward],
+/// "points": [{"par", "par2", "x", "cusp_test", "bt_test", "residual"}], "special": [{"kind"
+/// ("cusp" or "bogdanov_takens"), "par", "par2", "x", "test", "other", "status", "residual",
+/// "after"}]}]}
+std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2, const std::vector<std::string>& variables);
 /// roots of a mixed ring (analyse_mixed_ring)
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars);
 /// string stability, with the ring verdict when `ring` is given

@@ -154,13 +154,17 @@ bool EquilibriumBranchOptions::is_valid(std::string* why) const {
 }
 
 bool fold_system(const NonlinearDDE& system, int j, const Eigen::VectorXd& v0, const Eigen::VectorXd& z, Eigen::VectorXd& out,
-                 Eigen::MatrixXd* jac) {
+                 Eigen::MatrixXd* jac, const std::vector<double>& values) {
     const int n = system.dimension();
     if (z.size() != 2 * n + 1 || v0.size() != n)
         throw std::invalid_argument("fold system: z has " + std::to_string(z.size()) + " and v0 " + std::to_string(v0.size()) +
                                     " entries: expected 2n + 1 and n (n = " + std::to_string(n) + ")");
+    if (!values.empty() && values.size() != system.parameter_values().size())
+        throw std::invalid_argument("fold system: " + std::to_string(values.size()) + " parameter values: expected " +
+                                    std::to_string(system.parameter_values().size()));
     try {
-        const std::vector<double> p = with(system, j, z[n]);
+        std::vector<double> p = values.empty() ? system.parameter_values() : values;
+        p[static_cast<std::size_t>(j)] = z[n];
         const Eigen::VectorXd st = system.stack_constant(z.head(n));
         const Eigen::VectorXd v = z.segment(n + 1, n);
         const std::vector<Eigen::MatrixXd> b = system.jacobians(st, p);

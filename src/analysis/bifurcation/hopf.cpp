@@ -1,5 +1,7 @@
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 
+#include "analysis/bifurcation/internal/chord_zero.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -344,62 +346,13 @@ HopfCoefficients coefficients_at(const NonlinearDDE& s, int j1, const HopfCurveP
     return c;
 }
 
-/// Illinois regula falsi on a test function g along the chord from ua to ub, g(ua) = fa and
-/// g(ub) = fb of opposite signs, every trial corrected onto the curve. g(u, value) returns false
-/// where it is not defined (the search stops there); done(u, value) says when a trial is the zero.
-struct ChordZero {
-    Eigen::VectorXd u;
-    Status status = Status::MaxIterations;
-};
-template <class G, class Done>
-ChordZero chord_zero(const HopfCurveProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub, double fa, double fb,
-                     const NewtonOptions& newton, G g, Done done) {
-    ChordZero z;
-    z.u = ua;
-    const Eigen::VectorXd d = ub - ua;
-    const Eigen::VectorXd dir = d / d.norm();
-    double slo = 0.0, shi = 1.0, flo = fa, fhi = fb;
-    int last = 0;
-    for (int it = 0; it < 80; ++it) {
-        const double sm = (slo * fhi - shi * flo) / (fhi - flo);
-        const Eigen::VectorXd v = ua + sm * d;
-        Eigen::VectorXd u = v;
-        const CorrectorResult cr = correct(pr, u, dir, dir.dot(v), newton);
-        if (!converged(cr.status)) {
-            z.status = cr.status;
-            break;
-        }
-        double value = 0.0;
-        if (!g(u, value)) {
-            z.status = Status::NumericalIssue;
-            break;
-        }
-        z.u = u;
-        // to rounding: the test function at the rounding level of its terms, or the chord interval at rounding
-        if (done(u, value) || shi - slo <= 1e-14) {
-            z.status = Status::Converged;
-            break;
-        }
-        if ((value < 0.0) == (flo < 0.0)) {
-            slo = sm, flo = value;
-            if (last == -1) fhi *= 0.5;
-            last = -1;
-        } else {
-            shi = sm, fhi = value;
-            if (last == 1) flo *= 0.5;
-            last = 1;
-        }
-    }
-    return z;
-}
-
 /// Illinois regula falsi on L1 along the chord from ua to ub.
 GeneralisedHopfPoint locate_generalised(const NonlinearDDE& s, int j1, const HopfCurveProblem& pr, const Eigen::VectorXd& ua,
                                         const Eigen::VectorXd& ub, double fa, double fb, const HopfCurveOptions& o) {
     const int n = s.dimension();
     GeneralisedHopfPoint g;
     HopfCoefficients last;
-    const ChordZero z = chord_zero(
+    const detail::ChordZero z = detail::chord_zero(
         pr, ua, ub, fa, fb, o.continuation.newton,
         [&](const Eigen::VectorXd& u, double& value) {
             last = coefficients_at(s, j1, pr, u, o.coefficients);
@@ -442,7 +395,7 @@ ZeroHopfPoint locate_zero_hopf(const NonlinearDDE& s, const HopfCurveProblem& pr
         zh.x = ua.head(n), zh.par = ua[n], zh.omega = ua[3 * n + 1], zh.par2 = ua[3 * n + 2];
         return zh;
     }
-    const ChordZero z = chord_zero(
+    const detail::ChordZero z = detail::chord_zero(
         pr, ua, ub, fa, fb, o.continuation.newton,
         [&](const Eigen::VectorXd& u, double& value) { return scaled_det0(s, u.head(n), pr.values(u), value); },
         [&](const Eigen::VectorXd&, double value) { return std::abs(value) <= 1e-13; });

@@ -126,9 +126,11 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
 /// and, when J is given, its exact Jacobian: the x and p_j columns of (sum_k A_k) v are
 /// D^2 f[(S v, 0), (S e_i, 0)] and D^2 f[(S v, 0), (0, e_j)] (S the constant stacking), one
 /// evaluation in Dual<Dual<double>> each. False when F is not defined at z (a bad delay, a
-/// non-finite value); std::invalid_argument for sizes that do not fit.
+/// non-finite value); std::invalid_argument for sizes that do not fit. `values` (optional, all
+/// the parameter values) replaces the held values of the parameters other than p_j (fold curves,
+/// analysis/bifurcation/fold_curve.hpp).
 bool fold_system(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& v0, const Eigen::VectorXd& z, Eigen::VectorXd& F,
-                 Eigen::MatrixXd* J = nullptr);
+                 Eigen::MatrixXd* J = nullptr, const std::vector<double>& values = {});
 
 /// The Hopf system F(z), z = (x, p_j, Re q, Im q, omega) (3n + 2 unknowns):
 ///     F = (f(x, ..., x; p),  Re, Im of Delta(i omega; x, p) q,  Re, Im of q0^H q - 1),

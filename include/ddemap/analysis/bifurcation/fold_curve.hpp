@@ -1,0 +1,107 @@
+#pragma once
+/// \file fold_curve.hpp
+/// Two-parameter continuation of folds (saddle-nodes) of equilibria, with the cusp and
+/// Bogdanov-Takens points on them.
+///
+/// A fold of the equilibria of x'(t) = f(x(t), x(t - tau_1), ...; p) is an equilibrium where
+/// J = A_0 + ... + A_m (A_k = D_{u_k} f at the constant history) is singular: a characteristic
+/// root at 0 (Delta(0) = -J). The fold curve in (p1, p2) is followed by pseudo-arclength
+/// (solve/continuation.hpp) on the fold system (equilibrium_branch.hpp, fold_system) with p2 free,
+/// u = (x, p1, v, p2): 2n + 1 equations
+///     f(x, ..., x; p) = 0,   J v = 0,   v0 . v = 1,
+/// in 2n + 2 unknowns, with the exact Jacobian (the p2 column from the fold system in p2); v0 is
+/// renewed (v0 = v / |v|^2) every `segment` points. The delays do not enter (a constant history),
+/// so the curve is that of the ODE x' = f(x, ..., x; p); the stability along it is the DDE's.
+///
+/// With w the left null vector (w^T J = 0, |w| = 1, |v| = 1, the sign of w carried along the
+/// curve), two test functions are followed at every point:
+///     cusp:              a = w . D^2 f[S v, S v]              (S: the constant stacking),
+///     Bogdanov-Takens:   b = w . Delta'(0) v = w . (I + sum_k tau_k A_k) v.
+/// a is the quadratic coefficient of the fold's normal form (up to the factor 1 / (2 b)): the
+/// fold is non-degenerate where a != 0, a cusp where a = 0. b = 0 where the root at 0 is double
+/// (Delta'(0) v lies in the range of J): a Bogdanov-Takens point, where a Hopf curve ends on the
+/// fold curve. Each sign change between two points is located by Illinois regula falsi along the
+/// chord, every trial corrected onto the curve (as the generalised Hopf points of Hopf curves).
+/// Cf. DDE-BIFTOOL's fold continuation (p_tofold, br_contn) and its normal-form tests.
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/core/execution.hpp"
+#include "ddemap/problem/nonlinear_dde.hpp"
+#include "ddemap/solve/continuation.hpp"
+
+namespace ddemap {
+
+struct FoldCurveOptions {
+    EquilibriumBranchOptions branch;  ///< p1 = branch.parameter, the box [branch.from, branch.to]
+    std::string parameter2;
+    double from2 = 0.0, to2 = 1.0;    ///< the box in p2 (the held p2 must lie in it)
+    /// Steps are measured with p1, p2 scaled by their box sides; initial/max step 0 = automatic
+    /// (0.01 and 0.05 of the box).
+    ContinuationOptions continuation = [] {
+        ContinuationOptions c;
+        c.initial_step = 0.0;
+        c.max_step = 0.0;
+        c.min_step = 1e-9;
+        c.max_points = 400;  // per direction
+        return c;
+    }();
+    int segment = 25;
+    /// After every point traced on a curve (both directions; the equilibrium branch in p1
+    /// reports through branch.progress): (points of this curve so far, at most
+    /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
+    BranchProgress progress;
+    bool is_valid(std::string* why = nullptr) const;
+};
+
+struct FoldCurvePoint {
+    double par = 0.0, par2 = 0.0;
+    Eigen::VectorXd x;
+    double cusp_test = 0.0;  ///< a = w . D^2 f[S v, S v] (|v| = |w| = 1)
+    double bt_test = 0.0;    ///< b = w . Delta'(0) v
+    double residual = std::numeric_limits<double>::infinity();  ///< max |.| of the fold system
+};
+
+/// A codimension-two point on a fold curve: kind "cusp" (a = 0) or "bogdanov_takens" (b = 0).
+struct FoldCurveSpecialPoint {
+    std::string kind;
+    double par = 0.0, par2 = 0.0;
+    Eigen::VectorXd x;
+    double test = 0.0;      ///< the test function at the located point
+    double other = 0.0;     ///< the other test function there (b at a cusp, a at a Bogdanov-Takens point)
+    Status status = Status::MaxIterations;
+    double residual = std::numeric_limits<double>::infinity();  ///< of the fold system
+    int after = 0;          ///< index of the curve point before it
+};
+
+struct FoldCurve {
+    int start = 0;  ///< the index of the fold of the branch in p1 it starts from
+    std::vector<FoldCurvePoint> points;  ///< in order along the curve
+    std::vector<FoldCurveSpecialPoint> special;  ///< cusp and Bogdanov-Takens points, in order
+    ContinuationStop stop_backward = ContinuationStop::MaxPoints, stop_forward = ContinuationStop::MaxPoints;
+    Status status = Status::Converged;
+    std::string message;
+};
+
+struct FoldCurves {
+    EquilibriumBranch start;  ///< the equilibrium branch in p1 and its folds
+    /// One per distinct curve through the located folds (kind "fold") of the branch in p1 (a fold
+    /// that lies on a curve already traced starts none).
+    std::vector<FoldCurve> curves;
+    /// Converged when the branch in p1 did and every curve did (ended on the box, closed, or at a
+    /// regular end) with every special point located.
+    Status status = Status::Converged;
+    std::string message;
+};
+
+/// The fold curves through the folds of the equilibrium branch in p1 (from `guess` at
+/// branch.from, p2 as held). std::invalid_argument for invalid options, unknown parameters, a
+/// held p2 outside [from2, to2], or a system without second derivatives.
+FoldCurves fold_curves(const NonlinearDDE& system, const Eigen::VectorXd& guess, const FoldCurveOptions& options);
+
+}  // namespace ddemap

@@ -1,0 +1,406 @@
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "analysis/bifurcation/internal/chord_zero.hpp"
+#include "core/internal/text.hpp"
+
+namespace ddemap {
+
+namespace {
+
+/// The fold curve in u = (x, p1, v, p2).
+class FoldCurveProblem final : public ContinuationProblem {
+public:
+    FoldCurveProblem(const NonlinearDDE& s, int j1, int j2, Eigen::VectorXd v0) : m_s(s), m_j1(j1), m_j2(j2), m_v0(std::move(v0)), m_n(s.dimension()) {}
+    int equations() const override { return 2 * m_n + 1; }
+    std::vector<double> values(const Eigen::VectorXd& u) const {
+        std::vector<double> p = m_s.parameter_values();
+        p[static_cast<std::size_t>(m_j1)] = u[m_n];
+        p[static_cast<std::size_t>(m_j2)] = u[2 * m_n + 1];
+        return p;
+    }
+    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
+        return fold_system(m_s, m_j1, m_v0, u.head(2 * m_n + 1), f, nullptr, values(u));
+    }
+    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override {
+        Eigen::VectorXd f1, f2;
+        Eigen::MatrixXd j1, j2;
+        const std::vector<double> p = values(u);
+        Eigen::VectorXd z = u.head(2 * m_n + 1);
+        if (!fold_system(m_s, m_j1, m_v0, z, f1, &j1, p)) return false;
+        z[m_n] = u[2 * m_n + 1];
+        if (!fold_system(m_s, m_j2, m_v0, z, f2, &j2, p)) return false;
+        j.resize(2 * m_n + 1, 2 * m_n + 2);
+        j.leftCols(2 * m_n + 1) = j1;
+        j.col(2 * m_n + 1) = j2.col(m_n);
+        return true;
+    }
+    const Eigen::VectorXd& normalisation() const { return m_v0; }
+    bool in_domain(const Eigen::VectorXd& u) const override {
+        try {
+            const std::vector<double> d = m_s.delays(values(u));
+            return std::all_of(d.begin(), d.end(), [](double t) { return std::isfinite(t) && t >= 0.0; });
+        } catch (const std::invalid_argument&) {
+            return false;
+        }
+    }
+
+private:
+    const NonlinearDDE& m_s;
+    int m_j1, m_j2;
+    Eigen::VectorXd m_v0;
+    int m_n;
+};
+
+/// J = A_0 + ... + A_m from the blocks.
+Eigen::MatrixXd summed_jacobian(const std::vector<Eigen::MatrixXd>& a) {
+    Eigen::MatrixXd j = a[0];
+    for (std::size_t k = 1; k < a.size(); ++k) j += a[k];
+    return j;
+}
+
+/// sum_k ||A_k||_inf: the size of the linearisation (the shift of null_vector is relative to it).
+double block_size(const std::vector<Eigen::MatrixXd>& a) {
+    double s = 0.0;
+    for (const auto& b : a) s += b.cwiseAbs().rowwise().sum().maxCoeff();
+    return s;
+}
+
+/// The null vector of J (or of J^T) by three steps of inverse iteration on J + delta I,
+/// delta = 1e-12 times the size of the blocks (sum_k ||A_k||_inf, 1 when all vanish): J itself
+/// may vanish at a fold; |z| = 1.
+Eigen::VectorXd null_vector(const Eigen::MatrixXd& j, bool left, double scale) {
+    const Eigen::Index n = j.rows();
+    if (!(scale > 0.0) || !std::isfinite(scale)) scale = 1.0;
+    const Eigen::MatrixXd m = (left ? Eigen::MatrixXd(j.transpose()) : j) + 1e-12 * scale * Eigen::MatrixXd::Identity(n, n);
+    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(m);
+    Eigen::VectorXd z = Eigen::VectorXd::Ones(n) / std::sqrt(static_cast<double>(n));
+    for (int it = 0; it < 3; ++it) {
+        z = lu.solve(z);
+        const double len = z.norm();
+        if (!(len > 0.0) || !std::isfinite(len)) return Eigen::VectorXd();
+        z /= len;
+    }
+    return z;
+}
+
+/// The two test functions at a point u of the curve, with w oriented by w . w_ref > 0
+/// (w_ref empty: as it comes); w (|w| = 1) returned for the next point's orientation.
+struct Tests {
+    double cusp = 0.0, bt = 0.0;
+    Eigen::VectorXd w;
+    bool ok = false;
+};
+Tests tests_at(const NonlinearDDE& s, const FoldCurveProblem& pr, const Eigen::VectorXd& u, const Eigen::VectorXd& w_ref) {
+    Tests t;
+    const int n = s.dimension();
+    try {
+        const std::vector<double> p = pr.values(u);
+        const Eigen::VectorXd st = s.stack_constant(u.head(n));
+        const std::vector<Eigen::MatrixXd> a = s.jacobians(st, p);
+        const Eigen::MatrixXd j = summed_jacobian(a);
+        Eigen::VectorXd v = u.segment(n + 1, n);
+        const double vn = v.norm();
+        if (!(vn > 0.0)) return t;
+        v /= vn;
+        // w: the bordered system [J v; w_ref^T 0]^T, i.e. [J^T w_ref; v^T 0] [w; s] = [0; 1], keeps
+        // the sign of w_ref; without a reference, inverse iteration
+        Eigen::VectorXd w;
+        if (w_ref.size() == n) {
+            Eigen::MatrixXd m(n + 1, n + 1);
+            m.topLeftCorner(n, n) = j.transpose();
+            m.topRightCorner(n, 1) = v;
+            m.bottomLeftCorner(1, n) = w_ref.transpose();
+            m(n, n) = 0.0;
+            Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + 1);
+            rhs[n] = 1.0;
+            w = Eigen::PartialPivLU<Eigen::MatrixXd>(m).solve(rhs).head(n);
+        } else {
+            w = null_vector(j, true, block_size(a));
+        }
+        const double wn = w.norm();
+        if (!(wn > 0.0) || !std::isfinite(wn)) return t;
+        w /= wn;
+        const std::vector<double> tau = s.delays(p);
+        Eigen::VectorXd dv = v;  // Delta'(0) v = (I + sum_k tau_k A_k) v
+        for (std::size_t k = 1; k < a.size(); ++k) dv += tau[k - 1] * (a[k] * v);
+        const Eigen::VectorXd sv = s.stack_constant(v);
+        // D^2 f[S v, S v] at the parameter values p: f(x + e1 S v + e2 S v) in Dual<Dual<double>>
+        using D1 = Dual<double>;
+        using D2 = NonlinearDDE::Dual2;
+        std::vector<D2> U(static_cast<std::size_t>(st.size())), P(p.size()), out(static_cast<std::size_t>(n));
+        for (Eigen::Index i = 0; i < st.size(); ++i) U[static_cast<std::size_t>(i)] = D2(D1(st[i], sv[i]), D1(sv[i], 0.0));
+        for (std::size_t i = 0; i < p.size(); ++i) P[i] = D2(p[i]);
+        s.evaluate(U.data(), P.data(), out.data());
+        Eigen::VectorXd b2(n);
+        for (int r = 0; r < n; ++r) b2[r] = out[static_cast<std::size_t>(r)].deriv.deriv;
+        t.cusp = w.dot(b2);
+        t.bt = w.dot(dv);
+        t.w = w;
+        t.ok = std::isfinite(t.cusp) && std::isfinite(t.bt);
+    } catch (const std::invalid_argument&) {
+        t.ok = false;
+    }
+    return t;
+}
+
+struct CurveSample {
+    Eigen::VectorXd u;
+    std::shared_ptr<FoldCurveProblem> problem;  // the normalisation it was computed with
+};
+
+double fold_residual(const FoldCurveProblem& pr, const Eigen::VectorXd& u) {
+    Eigen::VectorXd f;
+    return pr.residual(u, f) ? f.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+}
+
+/// The curve through the fold `start` of the branch in p1 (at the held p2).
+FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double held2, const FoldCurveOptions& o) {
+    const int j1 = s.parameter_index(o.branch.parameter), j2 = s.parameter_index(o.parameter2);
+    const int n = s.dimension();
+    FoldCurve curve;
+    const double lo1 = std::min(o.branch.from, o.branch.to), hi1 = std::max(o.branch.from, o.branch.to);
+    const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
+
+    ContinuationOptions co = o.continuation;
+    const int N = 2 * n + 2;
+    co.scale = Eigen::VectorXd::Ones(N);
+    co.scale[n] = hi1 - lo1;
+    co.scale[2 * n + 1] = hi2 - lo2;
+    if (co.initial_step == 0.0) co.initial_step = 0.01;
+    if (co.max_step == 0.0) co.max_step = 0.05;
+    co.initial_step = std::min(co.initial_step, co.max_step);
+    co.min_step = std::min(co.min_step, co.initial_step);
+    co.lower = Eigen::VectorXd::Constant(N, -std::numeric_limits<double>::infinity());
+    co.upper = Eigen::VectorXd::Constant(N, std::numeric_limits<double>::infinity());
+    co.lower[n] = lo1, co.upper[n] = hi1, co.lower[2 * n + 1] = lo2, co.upper[2 * n + 1] = hi2;
+    const int budget = o.continuation.max_points;
+
+    // the null vector at the start
+    std::vector<double> p0 = s.parameter_values();
+    p0[static_cast<std::size_t>(j1)] = start.par;
+    const std::vector<Eigen::MatrixXd> a0 = s.jacobians(s.stack_constant(start.x), p0);
+    const Eigen::VectorXd v = null_vector(summed_jacobian(a0), false, block_size(a0));
+    if (v.size() != n) {
+        curve.status = Status::NumericalIssue;
+        curve.message = "no null vector at the starting fold";
+        return curve;
+    }
+    Eigen::VectorXd u0(N);
+    u0 << start.x, start.par, v, held2;
+
+    long traced = 1;  // the start
+    if (o.progress)
+        co.on_point = [&](const Eigen::VectorXd& u) { o.progress(++traced, 2L * budget - 1, u[n]); };
+    std::vector<CurveSample> samples[2];
+    ContinuationStop stops[2] = {ContinuationStop::MaxPoints, ContinuationStop::MaxPoints};
+    Status dir_status[2] = {Status::Converged, Status::Converged};
+    std::string messages[2];
+    for (int d = 0; d < 2; ++d) {
+        if (d == 1 && stops[0] == ContinuationStop::ClosedLoop) break;  // the forward pass went round
+        auto pr = std::make_shared<FoldCurveProblem>(s, j1, j2, v);
+        Eigen::VectorXd t;
+        if (!tangent(*pr, u0, Eigen::VectorXd(), t)) {
+            stops[d] = ContinuationStop::TangentFailed;
+            dir_status[d] = Status::NumericalIssue;
+            messages[d] = "no tangent at the starting fold (the fold system is singular there)";
+            samples[d].push_back({u0, pr});
+            continue;
+        }
+        Eigen::VectorXd direction = d == 0 ? t : Eigen::VectorXd(-t);
+        Eigen::VectorXd u = u0;
+        int left = budget - 1;
+        samples[d].push_back({u0, pr});
+        while (true) {
+            ContinuationOptions seg = co;
+            seg.max_points = std::min(o.segment, left) + 1;
+            const ContinuationResult c = continue_branch(*pr, u, direction, seg);
+            for (std::size_t k = 1; k < c.points.size(); ++k) samples[d].push_back({c.points[k], pr});
+            left -= static_cast<int>(c.points.size()) - 1;
+            stops[d] = c.stop;
+            dir_status[d] = c.status;
+            messages[d] = c.message;
+            if (c.stop != ContinuationStop::MaxPoints || left <= 0 || c.points.size() < 2) break;
+            // renew the normalisation: v / |v|^2 becomes v0 (v0 . v = 1 still holds)
+            u = c.points.back();
+            direction = c.tangents.back();
+            const Eigen::VectorXd vl = u.segment(n + 1, n);
+            pr = std::make_shared<FoldCurveProblem>(s, j1, j2, Eigen::VectorXd(vl / vl.squaredNorm()));
+            samples[d].back() = {u, pr};
+        }
+    }
+    curve.stop_forward = stops[0];
+    curve.stop_backward = stops[1];
+
+    std::vector<CurveSample> all(samples[1].rbegin(), samples[1].rend());
+    if (!all.empty()) all.pop_back();  // the start again
+    all.insert(all.end(), samples[0].begin(), samples[0].end());
+
+    // the test functions with w carried along the curve (its sign from the previous point)
+    std::vector<Tests> tests;
+    Eigen::VectorXd w_prev;
+    bool tests_ok = true;
+    for (const CurveSample& sm : all) {
+        Tests t = tests_at(s, *sm.problem, sm.u, w_prev);
+        tests_ok = tests_ok && t.ok;
+        if (t.ok) w_prev = t.w;
+        FoldCurvePoint pt;
+        pt.par = sm.u[n];
+        pt.par2 = sm.u[2 * n + 1];
+        pt.x = sm.u.head(n);
+        pt.cusp_test = t.ok ? t.cusp : std::numeric_limits<double>::quiet_NaN();
+        pt.bt_test = t.ok ? t.bt : std::numeric_limits<double>::quiet_NaN();
+        pt.residual = fold_residual(*sm.problem, sm.u);
+        curve.points.push_back(std::move(pt));
+        tests.push_back(std::move(t));
+    }
+    bool special_ok = true;
+    for (std::size_t k = 0; k + 1 < all.size(); ++k) {
+        if (!tests[k].ok || !tests[k + 1].ok) continue;
+        for (int which = 0; which < 2; ++which) {
+            const double fa = which == 0 ? tests[k].cusp : tests[k].bt, fb = which == 0 ? tests[k + 1].cusp : tests[k + 1].bt;
+            if (fa == 0.0 || (fa < 0.0) == (fb < 0.0)) continue;
+            // both ends on the later sample's normalisation (v0 . v = 1; at a segment's start
+            // v0 = v_b / |v_b|^2): the earlier sample's v rescaled (a fold's v is defined up to scale)
+            const FoldCurveProblem& pr = *all[k + 1].problem;
+            Eigen::VectorXd ua = all[k].u;
+            const double sc = pr.normalisation().dot(ua.segment(n + 1, n));
+            if (sc != 0.0 && std::isfinite(sc)) ua.segment(n + 1, n) /= sc;
+            const Eigen::VectorXd w_ref = tests[k].w;
+            const double scale_a = std::max(std::abs(fa), std::abs(fb));
+            const detail::ChordZero z = detail::chord_zero(
+                pr, ua, all[k + 1].u, fa, fb, o.branch.special,
+                [&](const Eigen::VectorXd& uu, double& value) {
+                    const Tests tt = tests_at(s, pr, uu, w_ref);
+                    if (!tt.ok) return false;
+                    value = which == 0 ? tt.cusp : tt.bt;
+                    return true;
+                },
+                [&](const Eigen::VectorXd&, double value) { return std::abs(value) <= 1e-13 * scale_a; });
+            FoldCurveSpecialPoint sp;
+            sp.kind = which == 0 ? "cusp" : "bogdanov_takens";
+            sp.after = static_cast<int>(k);
+            sp.status = z.status;
+            sp.par = z.u[n];
+            sp.par2 = z.u[2 * n + 1];
+            sp.x = z.u.head(n);
+            const Tests tz = tests_at(s, pr, z.u, w_ref);
+            sp.test = tz.ok ? (which == 0 ? tz.cusp : tz.bt) : std::numeric_limits<double>::quiet_NaN();
+            sp.other = tz.ok ? (which == 0 ? tz.bt : tz.cusp) : std::numeric_limits<double>::quiet_NaN();
+            sp.residual = fold_residual(pr, z.u);
+            if (converged(sp.status) && !(sp.residual <= o.branch.special_residual)) sp.status = Status::NumericalIssue;
+            special_ok = special_ok && converged(sp.status);
+            curve.special.push_back(std::move(sp));
+        }
+    }
+    std::sort(curve.special.begin(), curve.special.end(), [](const FoldCurveSpecialPoint& a, const FoldCurveSpecialPoint& b) { return a.after < b.after; });
+
+    auto regular = [](ContinuationStop st) {
+        return st == ContinuationStop::Bound || st == ContinuationStop::ClosedLoop || st == ContinuationStop::LeftDomain;
+    };
+    std::string msg;
+    for (int d = 0; d < 2; ++d) {
+        if (d == 1 && stops[0] == ContinuationStop::ClosedLoop) continue;
+        if (!regular(stops[d])) {
+            curve.status = converged(dir_status[d]) ? Status::BudgetExhausted : dir_status[d];
+            msg += std::string(msg.empty() ? "" : "; ") + (d == 0 ? "forward" : "backward") + ": " + to_string(stops[d]) +
+                   (messages[d].empty() ? "" : " (" + messages[d] + ")");
+        }
+    }
+    if (!tests_ok) {
+        if (converged(curve.status)) curve.status = Status::NumericalIssue;
+        msg += std::string(msg.empty() ? "" : "; ") + "the cusp and Bogdanov-Takens tests could not be evaluated at every point";
+    }
+    if (!special_ok) {
+        if (converged(curve.status)) curve.status = Status::NumericalIssue;
+        msg += std::string(msg.empty() ? "" : "; ") + "a cusp or Bogdanov-Takens point was not located";
+    }
+    curve.message = msg.empty() ? std::to_string(curve.points.size()) + " points, both ends on the box or closed" : msg;
+    return curve;
+}
+
+/// True when the fold point lies on the traced curve (within 1e-6 of the box in p1, p2 and of
+/// x's scale, between two consecutive points).
+bool on_curve(const FoldCurve& c, const FoldPoint& f, double held2, double side1, double side2) {
+    for (const FoldCurvePoint& p : c.points) {
+        const double dx = (p.x - f.x).cwiseAbs().maxCoeff() / std::max(1.0, f.x.cwiseAbs().maxCoeff());
+        if (std::abs(p.par - f.par) <= 1e-6 * side1 && std::abs(p.par2 - held2) <= 1e-6 * side2 && dx <= 1e-6) return true;
+    }
+    // between points: the segment crossing p2 = held2 near (f.par, f.x)
+    for (std::size_t k = 0; k + 1 < c.points.size(); ++k) {
+        const FoldCurvePoint &a = c.points[k], &b = c.points[k + 1];
+        if ((a.par2 - held2) * (b.par2 - held2) > 0.0 || a.par2 == b.par2) continue;
+        const double s = (held2 - a.par2) / (b.par2 - a.par2);
+        const double par = a.par + s * (b.par - a.par);
+        const Eigen::VectorXd x = a.x + s * (b.x - a.x);
+        const double dx = (x - f.x).cwiseAbs().maxCoeff() / std::max(1.0, f.x.cwiseAbs().maxCoeff());
+        if (std::abs(par - f.par) <= 1e-3 * side1 && dx <= 1e-3) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+bool FoldCurveOptions::is_valid(std::string* why) const {
+    std::string m;
+    if (!branch.is_valid(&m)) m = "branch." + m;
+    else if (parameter2.empty()) m = "parameter2: expected the name of the second parameter";
+    else if (parameter2 == branch.parameter) m = "parameter2 = '" + parameter2 + "': expected a parameter other than the first";
+    else if (!std::isfinite(from2) || !std::isfinite(to2) || from2 == to2) m = "from2/to2: expected finite, distinct values";
+    else if (segment < 2) m = "segment: expected at least 2 points";
+    else if (continuation.initial_step < 0.0 || continuation.max_step < 0.0) m = "continuation steps: expected values >= 0 (0 = automatic)";
+    if (!m.empty() && why) *why = m;
+    return m.empty();
+}
+
+FoldCurves fold_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, const FoldCurveOptions& o) {
+    std::string why;
+    if (!o.is_valid(&why)) throw std::invalid_argument("fold curve options: " + why);
+    s.parameter_index(o.branch.parameter);
+    const int j2 = s.parameter_index(o.parameter2);
+    if (!s.has_higher_derivatives())
+        throw std::invalid_argument("fold curves: the system gives no second derivatives: expected an expression system or a built-in model (NonlinearDDEOf)");
+    const double held2 = s.parameter_values()[static_cast<std::size_t>(j2)];
+    const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
+    if (!(held2 >= lo2 && held2 <= hi2))
+        throw std::invalid_argument(o.parameter2 + " = " + detail::format_number(held2) + " (its value in the system): expected a value in [" +
+                                    detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
+    FoldCurves out;
+    out.start = equilibrium_branch(s, guess, o.branch);
+    std::string msg;
+    if (!converged(out.start.status)) {
+        out.status = out.start.status;
+        msg = "the equilibrium branch in " + o.branch.parameter + ": " + out.start.message;
+    }
+    const double side1 = std::abs(o.branch.to - o.branch.from), side2 = hi2 - lo2;
+    for (std::size_t i = 0; i < out.start.folds.size(); ++i) {
+        const FoldPoint& f = out.start.folds[i];
+        if (f.kind != "fold" || !converged(f.status)) continue;
+        const bool traced = std::any_of(out.curves.begin(), out.curves.end(), [&](const FoldCurve& c) { return on_curve(c, f, held2, side1, side2); });
+        if (traced) continue;
+        FoldCurve c = trace_fold_curve(s, f, held2, o);
+        c.start = static_cast<int>(i);
+        if (!converged(c.status)) {
+            if (converged(out.status)) out.status = c.status;
+            msg += std::string(msg.empty() ? "" : "; ") + "curve " + std::to_string(out.curves.size()) + ": " + c.message;
+        }
+        out.curves.push_back(std::move(c));
+    }
+    if (msg.empty()) {
+        int cusps = 0, bts = 0;
+        for (const FoldCurve& c : out.curves)
+            for (const FoldCurveSpecialPoint& p : c.special) (p.kind == "cusp" ? cusps : bts)++;
+        msg = std::to_string(out.curves.size()) + " fold curve" + (out.curves.size() == 1 ? "" : "s") + ", " + std::to_string(cusps) + " cusp" +
+              (cusps == 1 ? "" : "s") + ", " + std::to_string(bts) + " Bogdanov-Takens point" + (bts == 1 ? "" : "s");
+    }
+    out.message = msg;
+    return out;
+}
+
+}  // namespace ddemap

@@ -1,0 +1,149 @@
+// Fold curves of equilibria in two parameters (analysis/bifurcation/fold_curve.hpp) against
+// closed forms: the cusp of x' = p1 + p2 x(t - 1) - x^3, and a Bogdanov-Takens point whose place
+// depends on the delay, x' = p1 + x^2 + p2 x(t - 2).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "tolerances.hpp"
+#include "ddemap/analysis/bifurcation/fold_curve.hpp"
+#include "ddemap/analysis/bifurcation/hopf.hpp"
+#include "ddemap/problem/expression_system.hpp"
+
+TEST_SUITE_BEGIN("fast");
+
+using namespace ddemap;
+namespace tol = ddemap::test::tol;
+
+namespace {
+
+FoldCurveOptions fold_box(const std::string& p1, double from, double to, const std::string& p2, double from2, double to2) {
+    FoldCurveOptions o;
+    o.branch.parameter = p1;
+    o.branch.from = from;
+    o.branch.to = to;
+    o.parameter2 = p2;
+    o.from2 = from2;
+    o.to2 = to2;
+    return o;
+}
+
+}  // namespace
+
+TEST_CASE("fold curve with a cusp: x' = p1 + p2 x(t - 1) - x^3, the curve (p1, p2) = (-2 x^3, 3 x^2)") {
+    // F(x) = p1 + p2 x - x^3: F = F_x = 0 gives p2 = 3 x^2, p1 = -2 x^3, one curve through both
+    // folds of the branch in p1 at p2 = 1 (x = -+1/sqrt(3)); the cusp (F_xx = -6 x = 0) at the origin
+    ExpressionSystem sys({"x"}, {"p1", "p2"}, {-1.0, 1.0}, {"p1 + p2*x(t - 1) - x^3"});
+    Eigen::VectorXd guess(1);
+    guess << -1.3;
+    const FoldCurves fc = fold_curves(sys, guess, fold_box("p1", -1.5, 1.5, "p2", -0.5, 2.0));
+    INFO(fc.message);
+    CHECK(fc.status == Status::Converged);
+    REQUIRE(fc.start.folds.size() == 2);
+    REQUIRE(fc.curves.size() == 1);  // the second fold lies on the first one's curve
+    const FoldCurve& c = fc.curves[0];
+    CHECK(c.stop_forward == ContinuationStop::Bound);
+    CHECK(c.stop_backward == ContinuationStop::Bound);
+    REQUIRE(c.points.size() > 20);
+    double xmin = 1e300, xmax = -1e300;
+    for (const FoldCurvePoint& p : c.points) {
+        const double x = p.x[0];
+        CHECK(std::abs(p.par2 - 3 * x * x) < tol::special_point);
+        CHECK(std::abs(p.par + 2 * x * x * x) < tol::special_point);
+        CHECK(p.residual < 1e-9);
+        // the tests: a = w F'' v^2 = -+6 x (w's sign carried along), b = w (1 + tau p2) v, |b| = 1 + p2
+        CHECK(std::abs(std::abs(p.cusp_test) - 6 * std::abs(x)) < 1e-8);
+        CHECK(std::abs(std::abs(p.bt_test) - (1 + p.par2)) < 1e-8);
+        xmin = std::min(xmin, x);
+        xmax = std::max(xmax, x);
+    }
+    // both ends on the face p2 = 2: x = -+sqrt(2/3)
+    CHECK(std::abs(xmin + std::sqrt(2.0 / 3.0)) < tol::special_point);
+    CHECK(std::abs(xmax - std::sqrt(2.0 / 3.0)) < tol::special_point);
+    REQUIRE(c.special.size() == 1);
+    const FoldCurveSpecialPoint& cusp = c.special[0];
+    CHECK(cusp.kind == "cusp");
+    CHECK(cusp.status == Status::Converged);
+    CHECK(std::abs(cusp.x[0]) < tol::special_point);
+    CHECK(std::abs(cusp.par) < tol::special_point);
+    CHECK(std::abs(cusp.par2) < tol::special_point);
+    CHECK(std::abs(std::abs(cusp.other) - 1.0) < tol::special_point);  // b = 1 + p2 there: not a BT point
+    // the sign of a changes at the cusp and nowhere else (w carried continuously)
+    int changes = 0;
+    for (std::size_t k = 0; k + 1 < c.points.size(); ++k) changes += (c.points[k].cusp_test < 0) != (c.points[k + 1].cusp_test < 0);
+    CHECK(changes == 1);
+}
+
+TEST_CASE("fold curve with a Bogdanov-Takens point: x' = p1 + x^2 + p2 x(t - tau), the double root at 0 where p2 = -1/tau") {
+    // F(x) = p1 + x^2 + p2 x: folds at x = -p2/2, p1 = p2^2/4; Delta(lambda) = lambda - 2 x - p2 e^{-lambda tau}
+    // has Delta(0) = 0 there and Delta'(0) = 1 + tau p2 = 0 at p2 = -1/tau: the Bogdanov-Takens point
+    // (p1, p2) = (1/(4 tau^2), -1/tau), x = 1/(2 tau). No cusp (F_xx = 2).
+    for (double tau : {2.0, 0.8}) {
+        CAPTURE(tau);
+        ExpressionSystem sys({"x"}, {"p1", "p2", "tau"}, {-0.5, 0.5, tau}, {"p1 + x^2 + p2*x(t - tau)"});
+        Eigen::VectorXd guess(1);
+        guess << -1.0;  // -0.5 + 1 - 0.5 = 0 at p1 = -0.5, p2 = 0.5
+        const FoldCurves fc = fold_curves(sys, guess, fold_box("p1", -0.5, 2.0, "p2", -1.5, 1.5));
+        INFO(fc.message);
+        CHECK(fc.status == Status::Converged);
+        REQUIRE(fc.curves.size() == 1);
+        const FoldCurve& c = fc.curves[0];
+        for (const FoldCurvePoint& p : c.points) {
+            CHECK(std::abs(p.par - p.par2 * p.par2 / 4) < tol::special_point);
+            CHECK(std::abs(p.x[0] + p.par2 / 2) < tol::special_point);
+        }
+        REQUIRE(c.special.size() == 1);
+        const FoldCurveSpecialPoint& bt = c.special[0];
+        CHECK(bt.kind == "bogdanov_takens");
+        CHECK(bt.status == Status::Converged);
+        CHECK(std::abs(bt.par2 + 1 / tau) < tol::special_point);
+        CHECK(std::abs(bt.par - 1 / (4 * tau * tau)) < tol::special_point);
+        CHECK(std::abs(bt.x[0] - 1 / (2 * tau)) < tol::special_point);
+        CHECK(std::abs(std::abs(bt.other) - 2.0) < 1e-8);  // a = w F'' v^2 = 2 (|v| = |w| = 1): not a cusp
+    }
+}
+
+TEST_CASE("the Hopf curve of x' = p1 + x^2 + p2 x(t - 2) ends at the Bogdanov-Takens point of its fold curve (omega -> 0)") {
+    // an independent check of the located point: the Hopf curve iw = 2 x + p2 e^{-2 i w} (p2 = -w / sin 2w)
+    // leaves the domain omega > 0 at the BT point; its last point is within O(omega^2) of it
+    ExpressionSystem sys({"x"}, {"p1", "p2", "tau"}, {-0.5, -0.8, 2.0}, {"p1 + x^2 + p2*x(t - tau)"});
+    Eigen::VectorXd guess(1);
+    guess << 0.5;
+    FoldCurveOptions fo = fold_box("p1", -0.5, 1.0, "p2", -1.5, -0.3);
+    const FoldCurves fc = fold_curves(sys, guess, fo);
+    REQUIRE(fc.curves.size() == 1);
+    REQUIRE(fc.curves[0].special.size() == 1);
+    const FoldCurveSpecialPoint& bt = fc.curves[0].special[0];
+    REQUIRE(bt.kind == "bogdanov_takens");
+    HopfCurveOptions ho;
+    ho.branch = fo.branch;
+    ho.parameter2 = "p2";
+    ho.from2 = -1.5;
+    ho.to2 = -0.3;
+    const HopfCurves hc = hopf_curves(sys, guess, ho);
+    INFO(hc.message);
+    REQUIRE(hc.curves.size() == 1);
+    const HopfCurve& c = hc.curves[0];
+    CHECK((c.stop_forward == ContinuationStop::LeftDomain || c.stop_backward == ContinuationStop::LeftDomain));
+    const auto last = std::min_element(c.points.begin(), c.points.end(), [](const HopfCurvePoint& a, const HopfCurvePoint& b) { return a.omega < b.omega; });
+    CHECK(last->omega < 0.1);
+    const double w2 = last->omega * last->omega;
+    CHECK(std::abs(last->par - bt.par) < w2);
+    CHECK(std::abs(last->par2 - bt.par2) < w2);
+    CHECK(std::abs(last->x[0] - bt.x[0]) < w2);
+}
+
+TEST_CASE("fold curves: bad options are refused naming the field") {
+    ExpressionSystem sys({"x"}, {"p1", "p2"}, {-1.0, 1.0}, {"p1 + p2*x - x^3"});
+    Eigen::VectorXd guess(1);
+    guess << -1.3;
+    FoldCurveOptions o = fold_box("p1", -1.5, 1.5, "p1", -0.5, 2.0);
+    CHECK_THROWS_WITH_AS(fold_curves(sys, guess, o), doctest::Contains("expected a parameter other than the first"), std::invalid_argument);
+    o = fold_box("p1", -1.5, 1.5, "p2", 2.0, 3.0);
+    CHECK_THROWS_WITH_AS(fold_curves(sys, guess, o), doctest::Contains("p2 = 1 (its value in the system): expected a value in [2, 3]"),
+                         std::invalid_argument);
+    o = fold_box("p1", -1.5, 1.5, "q", -0.5, 2.0);
+    CHECK_THROWS_AS(fold_curves(sys, guess, o), std::invalid_argument);
+}
