@@ -35,20 +35,8 @@ struct EquilibriaArgs {
 int run_fold_curves(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOptions& o, Format format, const std::string& prefix) {
     const EquilibriaArgs& a = equilibria_args;
     const NonlinearDDE& system = *pb.system;
-    if (a.from2.empty() || a.to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + a.par2);
-    if (a.par2 == a.problem.par) throw BadInput("--par2 = '" + a.par2 + "': expected a parameter other than --par");
-    const int j2 = system.parameter_index(a.par2);  // unknown: bad input naming the known ones
     FoldCurveOptions co;
-    co.branch = o;
-    co.parameter2 = a.par2;
-    co.from2 = parse_number("--from2", a.from2);
-    co.to2 = parse_number("--to2", a.to2);
-    if (!(co.from2 < co.to2)) throw BadInput("--from2 = '" + a.from2 + "', --to2 = '" + a.to2 + "': expected --from2 < --to2");
-    const double held = system.parameter_values()[static_cast<std::size_t>(j2)];
-    if (!(held >= co.from2 && held <= co.to2))
-        throw BadInput("--par2 " + a.par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
-    co.continuation.max_points = o.continuation.max_points;
-    pb.inputs.string("par2", a.par2).number("from2", co.from2).number("to2", co.to2);
+    second_parameter(pb, o, a.par2, a.from2, a.to2, co);
     const std::string svg_file = a.svg.empty() ? std::string() : output_file("--svg", a.svg);
 
     co.branch.progress = branch_progress_printer("equilibria", "points", a.problem.par, true);

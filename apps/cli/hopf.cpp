@@ -65,21 +65,7 @@ int run_hopf() {
     inputs.string("par", hopf_args.problem.par).number("from", o.from).number("to", o.to);
 
     HopfCurveOptions co;
-    if (two) {
-        if (hopf_args.from2.empty() || hopf_args.to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + hopf_args.par2);
-        if (hopf_args.par2 == hopf_args.problem.par) throw BadInput("--par2 = '" + hopf_args.par2 + "': expected a parameter other than --par");
-        const int j2 = system.parameter_index(hopf_args.par2);  // unknown: bad input naming the known ones
-        co.branch = o;
-        co.parameter2 = hopf_args.par2;
-        co.from2 = parse_number("--from2", hopf_args.from2);
-        co.to2 = parse_number("--to2", hopf_args.to2);
-        if (!(co.from2 < co.to2)) throw BadInput("--from2 = '" + hopf_args.from2 + "', --to2 = '" + hopf_args.to2 + "': expected --from2 < --to2");
-        const double held = system.parameter_values()[static_cast<std::size_t>(j2)];
-        if (!(held >= co.from2 && held <= co.to2))
-            throw BadInput("--par2 " + hopf_args.par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
-        co.continuation.max_points = max_points;
-        inputs.string("par2", hopf_args.par2).number("from2", co.from2).number("to2", co.to2);
-    }
+    if (two) second_parameter(pb, o, hopf_args.par2, hopf_args.from2, hopf_args.to2, co);
 
     JsonEnvelope e;
     e.command = "hopf";

@@ -84,4 +84,21 @@ NonlinearProblemArgs::Problem NonlinearProblemArgs::load() const {
     return r;
 }
 
+void second_parameter(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOptions& o, const std::string& par2, const std::string& from2,
+                      const std::string& to2, TwoParameterOptions& co) {
+    if (from2.empty() || to2.empty()) throw BadInput("--par2 needs --from2 and --to2: expected the box of " + par2);
+    if (par2 == o.parameter) throw BadInput("--par2 = '" + par2 + "': expected a parameter other than --par");
+    const int j2 = pb.system->parameter_index(par2);  // unknown: bad input naming the known ones
+    co.branch = o;
+    co.parameter2 = par2;
+    co.from2 = parse_number("--from2", from2);
+    co.to2 = parse_number("--to2", to2);
+    if (!(co.from2 < co.to2)) throw BadInput("--from2 = '" + from2 + "', --to2 = '" + to2 + "': expected --from2 < --to2");
+    const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
+    if (!(held >= co.from2 && held <= co.to2))
+        throw BadInput("--par2 " + par2 + " = " + rounded(held, 15) + " (its value in the system): expected it in [--from2, --to2]");
+    co.continuation.max_points = o.continuation.max_points;
+    pb.inputs.string("par2", par2).number("from2", co.from2).number("to2", co.to2);
+}
+
 }  // namespace ddemap::cli

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
 
+#include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/io/json.hpp"
 #include "ddemap/problem/nonlinear_dde.hpp"
 
@@ -38,5 +39,12 @@ struct NonlinearProblemArgs {
     /// (BadInput); a built-in ring is set to --par = --from for its guess (the uniform flow).
     Problem load() const;
 };
+
+/// The second parameter of a two-parameter curve (hopf --par2, equilibria --par2): --from2 and
+/// --to2 required, --par2 another parameter of the system, its held value in [--from2, --to2]
+/// (BadInput naming the flag otherwise); the branch options `o` copied into `co` and the three
+/// recorded in the problem's inputs.
+void second_parameter(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOptions& o, const std::string& par2, const std::string& from2,
+                      const std::string& to2, TwoParameterOptions& co);
 
 }  // namespace ddemap::cli

@@ -909,6 +909,25 @@ NonlinearProblem nonlinear_problem(const std::string& system_file, const std::st
     return r;
 }
 
+/// The second parameter of a two-parameter curve (hopf, equilibria with par2): its box checked
+/// as the command line checks it, in the Python arguments' names; the branch options copied in.
+void second_parameter(NonlinearProblem& pb, const EquilibriumBranchOptions& o, const std::string& par2, std::optional<double> from2,
+                      std::optional<double> to2, TwoParameterOptions& co) {
+    if (!from2 || !to2) throw std::invalid_argument("par2 needs from2 and to2: expected the box of " + par2);
+    if (par2 == o.parameter) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
+    const int j2 = pb.system->parameter_index(par2);
+    co.branch = o;
+    co.parameter2 = par2;
+    co.from2 = *from2;
+    co.to2 = *to2;
+    if (!(co.from2 < co.to2)) throw std::invalid_argument("from2 = " + json_number(co.from2) + ", to2 = " + json_number(co.to2) + ": expected from2 < to2");
+    const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
+    if (!(held >= co.from2 && held <= co.to2))
+        throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
+    co.continuation.max_points = o.continuation.max_points;
+    pb.inputs.string("par2", par2).number("from2", co.from2).number("to2", co.to2);
+}
+
 std::string py_equilibria(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters,
                           const std::string& par, double from, double to, int count, int max_points, const std::string& par2,
                           std::optional<double> from2, std::optional<double> to2) {
@@ -928,20 +947,8 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
     e.solver_given = o.roots.method == "shift_invert" ? "sparse" : o.roots.method == "contour" ? "product" : o.roots.method;
     e.solver_used = e.solver_given;
     if (two) {  // the fold curves through the branch's folds, as `equilibria --par2`
-        if (!from2 || !to2) throw std::invalid_argument("par2 needs from2 and to2: expected the box of " + par2);
-        if (par2 == par) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
-        const int j2 = pb.system->parameter_index(par2);
         FoldCurveOptions co;
-        co.branch = o;
-        co.parameter2 = par2;
-        co.from2 = *from2;
-        co.to2 = *to2;
-        if (!(co.from2 < co.to2)) throw std::invalid_argument("from2 = " + json_number(co.from2) + ", to2 = " + json_number(co.to2) + ": expected from2 < to2");
-        const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
-        if (!(held >= co.from2 && held <= co.to2))
-            throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
-        co.continuation.max_points = max_points;
-        pb.inputs.string("par2", par2).number("from2", co.from2).number("to2", co.to2);
+        second_parameter(pb, o, par2, from2, to2, co);
         co.branch.progress = branch_interruptible();
         co.progress = branch_interruptible();
         const FoldCurves c = released([&] { return fold_curves(*pb.system, pb.guess, co); });
@@ -973,21 +980,7 @@ std::string py_hopf(const std::string& system_file, const std::string& model, in
     o.continuation.max_points = max_points;
     pb.inputs.string("par", par).number("from", o.from).number("to", o.to);
     HopfCurveOptions co;
-    if (two) {
-        if (!from2 || !to2) throw std::invalid_argument("par2 needs from2 and to2: expected the box of " + par2);
-        if (par2 == par) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
-        const int j2 = pb.system->parameter_index(par2);
-        co.branch = o;
-        co.parameter2 = par2;
-        co.from2 = *from2;
-        co.to2 = *to2;
-        if (!(co.from2 < co.to2)) throw std::invalid_argument("from2 = " + json_number(co.from2) + ", to2 = " + json_number(co.to2) + ": expected from2 < to2");
-        const double held = pb.system->parameter_values()[static_cast<std::size_t>(j2)];
-        if (!(held >= co.from2 && held <= co.to2))
-            throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
-        co.continuation.max_points = max_points;
-        pb.inputs.string("par2", par2).number("from2", co.from2).number("to2", co.to2);
-    }
+    if (two) second_parameter(pb, o, par2, from2, to2, co);
     JsonEnvelope e;
     e.command = "hopf";
     e.inputs = pb.inputs.str();

@@ -1,5 +1,7 @@
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 
+#include "analysis/bifurcation/internal/curve_trace.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -47,14 +49,7 @@ public:
         }
         return j.allFinite();
     }
-    bool in_domain(const Eigen::VectorXd& u) const override {
-        try {
-            const std::vector<double> d = m_s.delays(values(u));
-            return std::all_of(d.begin(), d.end(), [](double t) { return std::isfinite(t) && t >= 0.0; });
-        } catch (const std::invalid_argument&) {
-            return false;
-        }
-    }
+    bool in_domain(const Eigen::VectorXd& u) const override { return detail::delays_valid(m_s, values(u)); }
 
 private:
     const NonlinearDDE& m_s;
@@ -381,6 +376,19 @@ HopfPoint correct_hopf(const NonlinearDDE& system, int j, const Eigen::VectorXd&
     r.status = converged(s.status) && !(r.residual <= residual_tolerance && r.omega > 0.0) ? Status::NumericalIssue : s.status;
     return r;
 }
+
+bool TwoParameterOptions::is_valid(std::string* why) const {
+    std::string m;
+    if (!branch.is_valid(&m)) m = "branch." + m;
+    else if (parameter2.empty()) m = "parameter2: expected the name of the second parameter";
+    else if (parameter2 == branch.parameter) m = "parameter2 = '" + parameter2 + "': expected a parameter other than the first";
+    else if (!std::isfinite(from2) || !std::isfinite(to2) || from2 == to2) m = "from2/to2: expected finite, distinct values";
+    else if (segment < 2) m = "segment: expected at least 2 points";
+    else if (continuation.initial_step < 0.0 || continuation.max_step < 0.0) m = "continuation steps: expected values >= 0 (0 = automatic)";
+    if (!m.empty() && why) *why = m;
+    return m.empty();
+}
+
 
 EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options) {
     std::string why;

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "analysis/bifurcation/internal/chord_zero.hpp"
+#include "analysis/bifurcation/internal/curve_trace.hpp"
 #include "core/internal/text.hpp"
 
 namespace ddemap {
@@ -15,47 +16,18 @@ namespace ddemap {
 namespace {
 
 /// The fold curve in u = (x, p1, v, p2).
-class FoldCurveProblem final : public ContinuationProblem {
+class FoldCurveProblem final : public detail::TwoParameterCurve {
 public:
-    FoldCurveProblem(const NonlinearDDE& s, int j1, int j2, Eigen::VectorXd v0) : m_s(s), m_j1(j1), m_j2(j2), m_v0(std::move(v0)), m_n(s.dimension()) {}
-    int equations() const override { return 2 * m_n + 1; }
-    std::vector<double> values(const Eigen::VectorXd& u) const {
-        std::vector<double> p = m_s.parameter_values();
-        p[static_cast<std::size_t>(m_j1)] = u[m_n];
-        p[static_cast<std::size_t>(m_j2)] = u[2 * m_n + 1];
-        return p;
-    }
-    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
-        return fold_system(m_s, m_j1, m_v0, u.head(2 * m_n + 1), f, nullptr, values(u));
-    }
-    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override {
-        Eigen::VectorXd f1, f2;
-        Eigen::MatrixXd j1, j2;
-        const std::vector<double> p = values(u);
-        Eigen::VectorXd z = u.head(2 * m_n + 1);
-        if (!fold_system(m_s, m_j1, m_v0, z, f1, &j1, p)) return false;
-        z[m_n] = u[2 * m_n + 1];
-        if (!fold_system(m_s, m_j2, m_v0, z, f2, &j2, p)) return false;
-        j.resize(2 * m_n + 1, 2 * m_n + 2);
-        j.leftCols(2 * m_n + 1) = j1;
-        j.col(2 * m_n + 1) = j2.col(m_n);
-        return true;
-    }
+    FoldCurveProblem(const NonlinearDDE& s, int j1, int j2, Eigen::VectorXd v0)
+        : TwoParameterCurve(s, j1, j2, 2 * s.dimension() + 1,
+                            [&s, v0](int j, const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac, const std::vector<double>& p) {
+                                return fold_system(s, j, v0, z, out, jac, p);
+                            }),
+          m_v0(std::move(v0)) {}
     const Eigen::VectorXd& normalisation() const { return m_v0; }
-    bool in_domain(const Eigen::VectorXd& u) const override {
-        try {
-            const std::vector<double> d = m_s.delays(values(u));
-            return std::all_of(d.begin(), d.end(), [](double t) { return std::isfinite(t) && t >= 0.0; });
-        } catch (const std::invalid_argument&) {
-            return false;
-        }
-    }
 
 private:
-    const NonlinearDDE& m_s;
-    int m_j1, m_j2;
     Eigen::VectorXd m_v0;
-    int m_n;
 };
 
 /// J = A_0 + ... + A_m from the blocks.
@@ -150,11 +122,6 @@ Tests tests_at(const NonlinearDDE& s, const FoldCurveProblem& pr, const Eigen::V
     return t;
 }
 
-struct CurveSample {
-    Eigen::VectorXd u;
-    std::shared_ptr<FoldCurveProblem> problem;  // the normalisation it was computed with
-};
-
 double fold_residual(const FoldCurveProblem& pr, const Eigen::VectorXd& u) {
     Eigen::VectorXd f;
     return pr.residual(u, f) ? f.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
@@ -168,18 +135,8 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
     const double lo1 = std::min(o.branch.from, o.branch.to), hi1 = std::max(o.branch.from, o.branch.to);
     const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
 
-    ContinuationOptions co = o.continuation;
     const int N = 2 * n + 2;
-    co.scale = Eigen::VectorXd::Ones(N);
-    co.scale[n] = hi1 - lo1;
-    co.scale[2 * n + 1] = hi2 - lo2;
-    if (co.initial_step == 0.0) co.initial_step = 0.01;
-    if (co.max_step == 0.0) co.max_step = 0.05;
-    co.initial_step = std::min(co.initial_step, co.max_step);
-    co.min_step = std::min(co.min_step, co.initial_step);
-    co.lower = Eigen::VectorXd::Constant(N, -std::numeric_limits<double>::infinity());
-    co.upper = Eigen::VectorXd::Constant(N, std::numeric_limits<double>::infinity());
-    co.lower[n] = lo1, co.upper[n] = hi1, co.lower[2 * n + 1] = lo2, co.upper[2 * n + 1] = hi2;
+    ContinuationOptions co = detail::curve_options(o.continuation, N, n, lo1, hi1, 2 * n + 1, lo2, hi2);
     const int budget = o.continuation.max_points;
 
     // the null vector at the start
@@ -198,55 +155,22 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
     long traced = 1;  // the start
     if (o.progress)
         co.on_point = [&](const Eigen::VectorXd& u) { o.progress(++traced, 2L * budget - 1, u[n]); };
-    std::vector<CurveSample> samples[2];
-    ContinuationStop stops[2] = {ContinuationStop::MaxPoints, ContinuationStop::MaxPoints};
-    Status dir_status[2] = {Status::Converged, Status::Converged};
-    std::string messages[2];
-    for (int d = 0; d < 2; ++d) {
-        if (d == 1 && stops[0] == ContinuationStop::ClosedLoop) break;  // the forward pass went round
-        auto pr = std::make_shared<FoldCurveProblem>(s, j1, j2, v);
-        Eigen::VectorXd t;
-        if (!tangent(*pr, u0, Eigen::VectorXd(), t)) {
-            stops[d] = ContinuationStop::TangentFailed;
-            dir_status[d] = Status::NumericalIssue;
-            messages[d] = "no tangent at the starting fold (the fold system is singular there)";
-            samples[d].push_back({u0, pr});
-            continue;
-        }
-        Eigen::VectorXd direction = d == 0 ? t : Eigen::VectorXd(-t);
-        Eigen::VectorXd u = u0;
-        int left = budget - 1;
-        samples[d].push_back({u0, pr});
-        while (true) {
-            ContinuationOptions seg = co;
-            seg.max_points = std::min(o.segment, left) + 1;
-            const ContinuationResult c = continue_branch(*pr, u, direction, seg);
-            for (std::size_t k = 1; k < c.points.size(); ++k) samples[d].push_back({c.points[k], pr});
-            left -= static_cast<int>(c.points.size()) - 1;
-            stops[d] = c.stop;
-            dir_status[d] = c.status;
-            messages[d] = c.message;
-            if (c.stop != ContinuationStop::MaxPoints || left <= 0 || c.points.size() < 2) break;
-            // renew the normalisation: v / |v|^2 becomes v0 (v0 . v = 1 still holds)
-            u = c.points.back();
-            direction = c.tangents.back();
-            const Eigen::VectorXd vl = u.segment(n + 1, n);
-            pr = std::make_shared<FoldCurveProblem>(s, j1, j2, Eigen::VectorXd(vl / vl.squaredNorm()));
-            samples[d].back() = {u, pr};
-        }
-    }
-    curve.stop_forward = stops[0];
-    curve.stop_backward = stops[1];
-
-    std::vector<CurveSample> all(samples[1].rbegin(), samples[1].rend());
-    if (!all.empty()) all.pop_back();  // the start again
-    all.insert(all.end(), samples[0].begin(), samples[0].end());
+    // between segments v / |v|^2 becomes v0 (v0 . v = 1 still holds)
+    auto renew = [&](Eigen::VectorXd& u, Eigen::VectorXd&) {
+        const Eigen::VectorXd vl = u.segment(n + 1, n);
+        return std::make_shared<FoldCurveProblem>(s, j1, j2, Eigen::VectorXd(vl / vl.squaredNorm()));
+    };
+    const detail::TracedCurve<FoldCurveProblem> traced_curve = detail::trace_both_ways(
+        std::make_shared<FoldCurveProblem>(s, j1, j2, v), u0, co, o.segment, budget, renew, "no tangent at the starting fold (the fold system is singular there)");
+    curve.stop_forward = traced_curve.stops[0];
+    curve.stop_backward = traced_curve.stops[1];
+    const auto& all = traced_curve.samples;
 
     // the test functions with w carried along the curve (its sign from the previous point)
     std::vector<Tests> tests;
     Eigen::VectorXd w_prev;
     bool tests_ok = true;
-    for (const CurveSample& sm : all) {
+    for (const auto& sm : all) {
         Tests t = tests_at(s, *sm.problem, sm.u, w_prev);
         tests_ok = tests_ok && t.ok;
         if (t.ok) w_prev = t.w;
@@ -301,18 +225,8 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
     }
     std::sort(curve.special.begin(), curve.special.end(), [](const FoldCurveSpecialPoint& a, const FoldCurveSpecialPoint& b) { return a.after < b.after; });
 
-    auto regular = [](ContinuationStop st) {
-        return st == ContinuationStop::Bound || st == ContinuationStop::ClosedLoop || st == ContinuationStop::LeftDomain;
-    };
-    std::string msg;
-    for (int d = 0; d < 2; ++d) {
-        if (d == 1 && stops[0] == ContinuationStop::ClosedLoop) continue;
-        if (!regular(stops[d])) {
-            curve.status = converged(dir_status[d]) ? Status::BudgetExhausted : dir_status[d];
-            msg += std::string(msg.empty() ? "" : "; ") + (d == 0 ? "forward" : "backward") + ": " + to_string(stops[d]) +
-                   (messages[d].empty() ? "" : " (" + messages[d] + ")");
-        }
-    }
+    curve.status = traced_curve.end_status();
+    std::string msg = traced_curve.ended_well() ? std::string() : traced_curve.end_text();
     if (!tests_ok) {
         if (converged(curve.status)) curve.status = Status::NumericalIssue;
         msg += std::string(msg.empty() ? "" : "; ") + "the cusp and Bogdanov-Takens tests could not be evaluated at every point";
@@ -346,18 +260,6 @@ bool on_curve(const FoldCurve& c, const FoldPoint& f, double held2, double side1
 }
 
 }  // namespace
-
-bool FoldCurveOptions::is_valid(std::string* why) const {
-    std::string m;
-    if (!branch.is_valid(&m)) m = "branch." + m;
-    else if (parameter2.empty()) m = "parameter2: expected the name of the second parameter";
-    else if (parameter2 == branch.parameter) m = "parameter2 = '" + parameter2 + "': expected a parameter other than the first";
-    else if (!std::isfinite(from2) || !std::isfinite(to2) || from2 == to2) m = "from2/to2: expected finite, distinct values";
-    else if (segment < 2) m = "segment: expected at least 2 points";
-    else if (continuation.initial_step < 0.0 || continuation.max_step < 0.0) m = "continuation steps: expected values >= 0 (0 = automatic)";
-    if (!m.empty() && why) *why = m;
-    return m.empty();
-}
 
 FoldCurves fold_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, const FoldCurveOptions& o) {
     std::string why;

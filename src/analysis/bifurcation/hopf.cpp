@@ -1,6 +1,7 @@
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 
 #include "analysis/bifurcation/internal/chord_zero.hpp"
+#include "analysis/bifurcation/internal/curve_trace.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -104,46 +105,18 @@ void check_system(const NonlinearDDE& s, int j, const char* what) {
 }
 
 /// The Hopf curve in u = (x, p1, Re q, Im q, omega, p2).
-class HopfCurveProblem final : public ContinuationProblem {
+class HopfCurveProblem final : public detail::TwoParameterCurve {
 public:
-    HopfCurveProblem(const NonlinearDDE& s, int j1, int j2, VectorXc q0) : m_s(s), m_j1(j1), m_j2(j2), m_q0(std::move(q0)), m_n(s.dimension()) {}
-    int equations() const override { return 3 * m_n + 2; }
-    std::vector<double> values(const Eigen::VectorXd& u) const {
-        std::vector<double> p = m_s.parameter_values();
-        p[static_cast<std::size_t>(m_j1)] = u[m_n];
-        p[static_cast<std::size_t>(m_j2)] = u[3 * m_n + 2];
-        return p;
-    }
-    bool residual(const Eigen::VectorXd& u, Eigen::VectorXd& f) const override {
-        return hopf_system(m_s, m_j1, m_q0, u.head(3 * m_n + 2), f, nullptr, values(u));
-    }
-    bool jacobian(const Eigen::VectorXd& u, Eigen::MatrixXd& j) const override {
-        Eigen::VectorXd f1, f2;
-        Eigen::MatrixXd j1, j2;
-        const std::vector<double> p = values(u);
-        Eigen::VectorXd z = u.head(3 * m_n + 2);
-        if (!hopf_system(m_s, m_j1, m_q0, z, f1, &j1, p)) return false;
-        z[m_n] = u[3 * m_n + 2];
-        if (!hopf_system(m_s, m_j2, m_q0, z, f2, &j2, p)) return false;
-        j.resize(3 * m_n + 2, 3 * m_n + 3);
-        j.leftCols(3 * m_n + 2) = j1;
-        j.col(3 * m_n + 2) = j2.col(m_n);
-        return true;
-    }
-    bool in_domain(const Eigen::VectorXd& u) const override {
-        if (!(u[3 * m_n + 1] > 0.0)) return false;
-        try {
-            const std::vector<double> d = m_s.delays(values(u));
-            return std::all_of(d.begin(), d.end(), [](double t) { return std::isfinite(t) && t >= 0.0; });
-        } catch (const std::invalid_argument&) {
-            return false;
-        }
-    }
+    HopfCurveProblem(const NonlinearDDE& s, int j1, int j2, VectorXc q0)
+        : TwoParameterCurve(s, j1, j2, 3 * s.dimension() + 2,
+                            [&s, q0](int j, const Eigen::VectorXd& z, Eigen::VectorXd& out, Eigen::MatrixXd* jac, const std::vector<double>& p) {
+                                return hopf_system(s, j, q0, z, out, jac, p);
+                            }),
+          m_q0(std::move(q0)), m_n(s.dimension()) {}
+    bool in_domain(const Eigen::VectorXd& u) const override { return u[3 * m_n + 1] > 0.0 && TwoParameterCurve::in_domain(u); }
     const VectorXc& q0() const { return m_q0; }
 
 private:
-    const NonlinearDDE& m_s;
-    int m_j1, m_j2;
     VectorXc m_q0;
     int m_n;
 };
@@ -318,23 +291,15 @@ HopfAnalysis hopf_points(const NonlinearDDE& s, const Eigen::VectorXd& guess, co
 
 bool HopfCurveOptions::is_valid(std::string* why) const {
     std::string m;
-    if (!branch.is_valid(&m)) m = "branch." + m;
-    else if (parameter2.empty()) m = "parameter2: expected the name of the second parameter";
-    else if (parameter2 == branch.parameter) m = "parameter2 = '" + parameter2 + "': expected a parameter other than the first";
-    else if (!std::isfinite(from2) || !std::isfinite(to2) || from2 == to2) m = "from2/to2: expected finite, distinct values";
-    else if (segment < 2) m = "segment: expected at least 2 points";
-    else if (!coefficients.is_valid(&m)) m = "coefficients." + m;
-    else if (continuation.initial_step < 0.0 || continuation.max_step < 0.0) m = "continuation steps: expected values >= 0 (0 = automatic)";
+    if (!TwoParameterOptions::is_valid(&m)) {
+    } else if (!coefficients.is_valid(&m)) {
+        m = "coefficients." + m;
+    }
     if (!m.empty() && why) *why = m;
     return m.empty();
 }
 
 namespace {
-
-struct CurveSample {
-    Eigen::VectorXd u;
-    std::shared_ptr<HopfCurveProblem> problem;  // the normalisation it was computed with
-};
 
 /// L1 at a point u of the curve.
 HopfCoefficients coefficients_at(const NonlinearDDE& s, int j1, const HopfCurveProblem& pr, const Eigen::VectorXd& u,
@@ -563,18 +528,8 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
         throw std::invalid_argument(o.parameter2 + " = " + detail::format_number(held2) + " (its value in the system): expected a value in [" +
                                     detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
 
-    ContinuationOptions co = o.continuation;
     const int N = 3 * n + 3;
-    co.scale = Eigen::VectorXd::Ones(N);
-    co.scale[n] = hi1 - lo1;
-    co.scale[3 * n + 2] = hi2 - lo2;
-    if (co.initial_step == 0.0) co.initial_step = 0.01;
-    if (co.max_step == 0.0) co.max_step = 0.05;
-    co.initial_step = std::min(co.initial_step, co.max_step);
-    co.min_step = std::min(co.min_step, co.initial_step);
-    co.lower = Eigen::VectorXd::Constant(N, -std::numeric_limits<double>::infinity());
-    co.upper = Eigen::VectorXd::Constant(N, std::numeric_limits<double>::infinity());
-    co.lower[n] = lo1, co.upper[n] = hi1, co.lower[3 * n + 2] = lo2, co.upper[3 * n + 2] = hi2;
+    ContinuationOptions co = detail::curve_options(o.continuation, N, n, lo1, hi1, 3 * n + 2, lo2, hi2);
     const int budget = o.continuation.max_points;
 
     VectorXc q = start.q / start.q.norm();
@@ -584,56 +539,23 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
     long traced = 1;  // the start
     if (o.progress)
         co.on_point = [&](const Eigen::VectorXd& u) { o.progress(++traced, 2L * budget - 1, u[n]); };
-    std::vector<CurveSample> samples[2];
-    ContinuationStop stops[2] = {ContinuationStop::MaxPoints, ContinuationStop::MaxPoints};
-    Status dir_status[2] = {Status::Converged, Status::Converged};
-    std::string messages[2];
-    for (int d = 0; d < 2; ++d) {
-        if (d == 1 && stops[0] == ContinuationStop::ClosedLoop) break;  // the forward pass went round
-        auto pr = std::make_shared<HopfCurveProblem>(s, j1, j2, q);
-        Eigen::VectorXd t;
-        if (!tangent(*pr, u0, Eigen::VectorXd(), t)) {
-            stops[d] = ContinuationStop::TangentFailed;
-            dir_status[d] = Status::NumericalIssue;
-            messages[d] = "no tangent at the starting Hopf point (the Hopf system is singular there)";
-            samples[d].push_back({u0, pr});
-            continue;
-        }
-        Eigen::VectorXd direction = d == 0 ? t : Eigen::VectorXd(-t);
-        Eigen::VectorXd u = u0;
-        int left = budget - 1;
-        samples[d].push_back({u0, pr});
-        while (true) {
-            ContinuationOptions seg = co;
-            seg.max_points = std::min(o.segment, left) + 1;
-            const ContinuationResult c = continue_branch(*pr, u, direction, seg);
-            for (std::size_t k = 1; k < c.points.size(); ++k) samples[d].push_back({c.points[k], pr});
-            left -= static_cast<int>(c.points.size()) - 1;
-            stops[d] = c.stop;
-            dir_status[d] = c.status;
-            messages[d] = c.message;
-            if (c.stop != ContinuationStop::MaxPoints || left <= 0 || c.points.size() < 2) break;
-            // renew the normalisation: q / |q| becomes both q and q0
-            u = c.points.back();
-            Eigen::VectorXd tl = c.tangents.back();
-            const VectorXc ql = q_of(u, n);
-            const double len = ql.norm();
-            u.segment(n + 1, 2 * n) /= len;
-            tl.segment(n + 1, 2 * n) /= len;
-            direction = tl;
-            pr = std::make_shared<HopfCurveProblem>(s, j1, j2, q_of(u, n));
-            samples[d].back() = {u, pr};
-        }
-    }
+    // between segments the normalisation is renewed: q / |q| becomes both q and q0
+    auto renew = [&](Eigen::VectorXd& u, Eigen::VectorXd& t) {
+        const double len = q_of(u, n).norm();
+        u.segment(n + 1, 2 * n) /= len;
+        t.segment(n + 1, 2 * n) /= len;
+        return std::make_shared<HopfCurveProblem>(s, j1, j2, q_of(u, n));
+    };
+    const detail::TracedCurve<HopfCurveProblem> traced_curve = detail::trace_both_ways(
+        std::make_shared<HopfCurveProblem>(s, j1, j2, q), u0, co, o.segment, budget, renew,
+        "no tangent at the starting Hopf point (the Hopf system is singular there)");
+    const ContinuationStop* stops = traced_curve.stops;
     curve.stop_forward = stops[0];
     curve.stop_backward = stops[1];
-
-    std::vector<CurveSample> all(samples[1].rbegin(), samples[1].rend());
-    if (!all.empty()) all.pop_back();  // the start again
-    all.insert(all.end(), samples[0].begin(), samples[0].end());
+    const auto& all = traced_curve.samples;
 
     bool coefficients_ok = true;
-    for (const CurveSample& sm : all) {
+    for (const auto& sm : all) {
         HopfCurvePoint pt;
         pt.par = sm.u[n];
         pt.par2 = sm.u[3 * n + 2];
@@ -758,14 +680,8 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
         }
     }
 
-    auto ended_well = [](ContinuationStop st) {
-        return st == ContinuationStop::Bound || st == ContinuationStop::ClosedLoop || st == ContinuationStop::LeftDomain;
-    };
-    const bool closed = stops[0] == ContinuationStop::ClosedLoop;
-    const bool ends_ok = ended_well(stops[0]) && (closed || ended_well(stops[1]));
-    if (!ends_ok) {
-        const int bad = ended_well(stops[0]) ? 1 : 0;
-        curve.status = stops[bad] == ContinuationStop::MaxPoints ? Status::BudgetExhausted : converged(dir_status[bad]) ? Status::NumericalIssue : dir_status[bad];
+    if (!traced_curve.ended_well()) {
+        curve.status = traced_curve.end_status();
     } else if (!coefficients_ok) {
         curve.status = Status::NumericalIssue;
     } else if (!genh_ok) {
@@ -773,9 +689,7 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
     }
     curve.message = std::to_string(curve.points.size()) + " points, " + std::to_string(curve.generalised.size()) + " generalised Hopf, " +
                     std::to_string(curve.double_hopf.size()) + " double Hopf, " + std::to_string(curve.zero_hopf.size()) +
-                    " zero-Hopf points; ended: " + to_string(stops[0]) + (closed ? "" : " and " + to_string(stops[1]));
-    for (int d = 0; d < 2; ++d)
-        if (!ended_well(stops[d]) && !(d == 1 && closed) && !messages[d].empty()) curve.message += " (" + messages[d] + ")";
+                    " zero-Hopf points; " + traced_curve.end_text();
     // a curve that leaves the domain as omega falls to 0 ends near a Bogdanov-Takens point (not located)
     double wmax = 0.0;
     for (const HopfCurvePoint& p : curve.points) wmax = std::max(wmax, p.omega);
@@ -784,7 +698,7 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
         const HopfCurvePoint& end = d == 0 ? curve.points.back() : curve.points.front();
         if (end.omega <= 0.01 * wmax)
             curve.message += "; near a Bogdanov-Takens point at its " + std::string(d == 0 ? "forward" : "backward") + " end (omega " +
-                             detail::format_number(end.omega) + " -> 0; not located)";
+                             detail::format_number(end.omega) + " -> 0; located on the fold curve of the equilibria there, fold_curves)";
     }
     if (!coefficients_ok) curve.message += "; L1 not computed at some points";
     if (!genh_ok) curve.message += "; a generalised Hopf point was not located";

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tolerances.hpp"
+#include "two_parameter_box.hpp"
 #include "ddemap/analysis/bifurcation/fold_curve.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/problem/expression_system.hpp"
@@ -20,14 +21,7 @@ namespace tol = ddemap::test::tol;
 namespace {
 
 FoldCurveOptions fold_box(const std::string& p1, double from, double to, const std::string& p2, double from2, double to2) {
-    FoldCurveOptions o;
-    o.branch.parameter = p1;
-    o.branch.from = from;
-    o.branch.to = to;
-    o.parameter2 = p2;
-    o.from2 = from2;
-    o.to2 = to2;
-    return o;
+    return test::two_parameter_box<FoldCurveOptions>(p1, from, to, p2, from2, to2);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "numeric_helpers.hpp"
+#include "two_parameter_box.hpp"
 #include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
 #include "ddemap/io/hopf_output.hpp"
@@ -52,14 +53,7 @@ double wright_range(double alpha, double a0, double t_end, double h) {
 
 /// Hopf-curve options for the box [from, to] x [from2, to2] in (p1, p2), the rest by default.
 HopfCurveOptions curve_box(const std::string& p1, double from, double to, const std::string& p2, double from2, double to2) {
-    HopfCurveOptions o;
-    o.branch.parameter = p1;
-    o.branch.from = from;
-    o.branch.to = to;
-    o.parameter2 = p2;
-    o.from2 = from2;
-    o.to2 = to2;
-    return o;
+    return test::two_parameter_box<HopfCurveOptions>(p1, from, to, p2, from2, to2);
 }
 
 ExpressionSystem neuron_system() {

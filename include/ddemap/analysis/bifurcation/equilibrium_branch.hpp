@@ -168,6 +168,33 @@ EquilibriumRoots equilibrium_roots(const NonlinearDDE& system, const Eigen::Vect
 /// processed in parallel).
 EquilibriumRoots equilibrium_roots(const LinearDDE& linearisation, RootOptions options);
 
+/// The box and the continuation of a curve of special points of the equilibria in two parameters
+/// (Hopf curves, hopf.hpp; fold curves, fold_curve.hpp): every curve starts at a special point of
+/// the equilibrium branch in p1 (at the held p2) and is followed both ways by pseudo-arclength until
+/// it leaves the box [branch.from, branch.to] x [from2, to2] (or the budget ends); the
+/// normalisation of its defining system is renewed every `segment` points.
+struct TwoParameterOptions {
+    EquilibriumBranchOptions branch;  ///< p1 = branch.parameter, the box [branch.from, branch.to]
+    std::string parameter2;
+    double from2 = 0.0, to2 = 1.0;    ///< the box in p2 (the held p2 must lie in it)
+    /// Steps are measured with p1, p2 scaled by their box sides; initial/max step 0 = automatic
+    /// (0.01 and 0.05 of the box).
+    ContinuationOptions continuation = [] {
+        ContinuationOptions c;
+        c.initial_step = 0.0;
+        c.max_step = 0.0;
+        c.min_step = 1e-9;
+        c.max_points = 400;  // per direction
+        return c;
+    }();
+    int segment = 25;
+    /// After every point traced on a curve (both directions; the equilibrium branch in p1
+    /// reports through branch.progress): (points of this curve so far, at most
+    /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
+    BranchProgress progress;
+    bool is_valid(std::string* why = nullptr) const;
+};
+
 /// Newton on the fold system from (x0, p_j = par0).
 FoldPoint correct_fold(const NonlinearDDE& system, int parameter, const Eigen::VectorXd& x0, double par0,
                        const NewtonOptions& newton = {40, 1e-12}, double residual_tolerance = 1e-9);

@@ -37,27 +37,9 @@
 
 namespace ddemap {
 
-struct FoldCurveOptions {
-    EquilibriumBranchOptions branch;  ///< p1 = branch.parameter, the box [branch.from, branch.to]
-    std::string parameter2;
-    double from2 = 0.0, to2 = 1.0;    ///< the box in p2 (the held p2 must lie in it)
-    /// Steps are measured with p1, p2 scaled by their box sides; initial/max step 0 = automatic
-    /// (0.01 and 0.05 of the box).
-    ContinuationOptions continuation = [] {
-        ContinuationOptions c;
-        c.initial_step = 0.0;
-        c.max_step = 0.0;
-        c.min_step = 1e-9;
-        c.max_points = 400;  // per direction
-        return c;
-    }();
-    int segment = 25;
-    /// After every point traced on a curve (both directions; the equilibrium branch in p1
-    /// reports through branch.progress): (points of this curve so far, at most
-    /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
-    BranchProgress progress;
-    bool is_valid(std::string* why = nullptr) const;
-};
+/// The box and continuation of the fold curves (TwoParameterOptions: the equilibrium branch in p1
+/// whose folds start the curves, the second parameter and its box, the steps and the budget).
+struct FoldCurveOptions : TwoParameterOptions {};
 
 struct FoldCurvePoint {
     double par = 0.0, par2 = 0.0;

@@ -110,21 +110,7 @@ HopfAnalysis hopf_points(const NonlinearDDE& system, const Eigen::VectorXd& gues
 /// of the equilibrium branch in p1 (at the held p2), is followed both ways until it leaves the box
 /// [from, to] x [from2, to2] (or omega reaches 0, or the budget ends), with L1 at every point;
 /// generalised Hopf points (L1 changes sign) are located by Illinois regula falsi along the curve.
-struct HopfCurveOptions {
-    EquilibriumBranchOptions branch;  ///< p1 = branch.parameter, the box [branch.from, branch.to]
-    std::string parameter2;
-    double from2 = 0.0, to2 = 1.0;    ///< the box in p2 (the held p2 must lie in it)
-    /// Steps are measured with p1, p2 scaled by their box sides; initial/max step 0 = automatic
-    /// (0.01 and 0.05 of the box).
-    ContinuationOptions continuation = [] {
-        ContinuationOptions c;
-        c.initial_step = 0.0;
-        c.max_step = 0.0;
-        c.min_step = 1e-9;
-        c.max_points = 400;  // per direction
-        return c;
-    }();
-    int segment = 25;
+struct HopfCurveOptions : TwoParameterOptions {
     HopfCoefficientOptions coefficients;
     /// Codimension-two points on the curves: at every point the characteristic roots
     /// (equilibrium_roots with branch.roots) and the count of roots right of the axis besides the
@@ -132,10 +118,7 @@ struct HopfCurveOptions {
     /// gives a double Hopf point (DoubleHopfPoint), a real root a zero-Hopf point (ZeroHopfPoint).
     /// A change that the points located do not explain makes the curve's status NumericalIssue.
     bool codimension_two = true;
-    /// After every point traced on a curve (both directions; the equilibrium branch in p1
-    /// reports through branch.progress): (points of this curve so far, at most
-    /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
-    BranchProgress progress;
+    /// TwoParameterOptions::is_valid and the coefficients' options.
     bool is_valid(std::string* why = nullptr) const;
 };
 
