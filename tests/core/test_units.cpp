@@ -16,7 +16,9 @@ TEST_CASE("unit suffixes of column names and their removal") {
         {"", ""},           {"1", ""},           {"-", ""},           {"s", "_s"},         {"m", "_m"},
         {"m/s", "_mps"},    {"m/s^2", "_mps2"},  {"1/s", "_per_s"},   {"1/s^2", "_per_s2"}, {"rad", "_rad"},
         {"rad/s", "_rad_per_s"}, {"kg m/s", "_kg_m_per_s"}};
-    for (const auto& [unit, suffix] : table) {
+    for (const auto& row : table) {  // no structured binding: CAPTURE's lambda may not capture one (clang 14)
+        const std::string& unit = row.first;
+        const std::string& suffix = row.second;
         CAPTURE(unit);
         CHECK(unit_suffix(unit) == suffix);
         CHECK(column_name("x", unit) == "x" + suffix);
