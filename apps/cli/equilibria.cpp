@@ -72,16 +72,20 @@ int run_fold_curves(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOp
             const FoldCurve& c = fc.curves[k];
             out << "curve " << k << "    from fold " << c.start << ": " << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << a.par2
                 << "), ended " << to_string(c.stop_backward) << " and " << to_string(c.stop_forward) << ", " << to_string(c.status) << "\n";
-            out << "  " << pad(par, 14) << pad(a.par2, 14) << pad("cusp test", 13) << "BT test\n";
+            out << "  " << pad(par, 14) << pad(a.par2, 14) << pad("cusp test", 13) << pad("BT test", 13) << "unstable\n";
             const std::size_t step = std::max<std::size_t>(1, c.points.size() / 20);
             for (std::size_t i = 0; i < c.points.size(); i += step) {
                 const FoldCurvePoint& p = c.points[i];
                 out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.par2, 8), 14) << pad(std::isfinite(p.cusp_test) ? rounded(p.cusp_test, 4) : "-", 13)
-                    << (std::isfinite(p.bt_test) ? rounded(p.bt_test, 4) : "-") << "\n";
+                    << pad(std::isfinite(p.bt_test) ? rounded(p.bt_test, 4) : "-", 13) << (p.unstable >= 0 ? std::to_string(p.unstable) : std::string("-")) << "\n";
             }
             for (const FoldCurveSpecialPoint& p : c.special)
-                out << "  " << (p.kind == "cusp" ? "cusp (two fold curves meet)" : "Bogdanov-Takens (a double root at 0; a Hopf curve ends here)") << ": " << par << " = " << rounded(p.par, 10) << ", " << a.par2 << " = "
-                    << rounded(p.par2, 10) << " (" << to_string(p.status) << ", residual " << rounded(p.residual, 2) << ")\n";
+                out << "  "
+                    << (p.kind == "cusp"              ? std::string("cusp (two fold curves meet)")
+                        : p.kind == "bogdanov_takens" ? std::string("Bogdanov-Takens (a double root at 0; a Hopf curve ends here)")
+                                                      : "zero-Hopf (a pair +-i " + rounded(p.omega, 8) + " on the axis; a Hopf curve crosses here)")
+                    << ": " << par << " = " << rounded(p.par, 10) << ", " << a.par2 << " = " << rounded(p.par2, 10) << " (" << to_string(p.status)
+                    << ", residual " << rounded(p.residual, 2) << ")\n";
         }
         if (fc.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(fc.status) << "): " << fc.message << "\n";
         if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";

@@ -503,7 +503,8 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
             }
             panel.series.push_back(std::move(sr));
             for (const FoldCurveSpecialPoint& q : c.special)
-                if (q.status == Status::Converged) panel.markers.push_back({q.par, q.par2, "#000000", q.kind == "cusp" ? "CP" : "BT"});
+                if (q.status == Status::Converged)
+                    panel.markers.push_back({q.par, q.par2, "#000000", q.kind == "cusp" ? "CP" : q.kind == "bogdanov_takens" ? "BT" : "ZH"});
         }
     PlotOptions po;
     po.title = title;
@@ -512,7 +513,7 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
     po.panel_height = 420.0;
     std::string note;
     if (hopf) note = "GH: generalised Hopf (L1 = 0), DH: double Hopf, ZH: zero-Hopf";
-    if (folds) note += std::string(note.empty() ? "" : "; ") + "CP: cusp, BT: Bogdanov-Takens (a Hopf curve ends there)";
+    if (folds) note += std::string(note.empty() ? "" : "; ") + "CP: cusp, BT: Bogdanov-Takens (a Hopf curve ends there)" + (hopf ? "" : ", ZH: zero-Hopf");
     po.note = note;
     return render_line_plots_svg({panel}, po);
 }

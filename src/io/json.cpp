@@ -207,6 +207,7 @@ std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2,
             q["cusp_test"] = num(p.cusp_test);
             q["bt_test"] = num(p.bt_test);
             q["residual"] = num(p.residual);
+            q["unstable"] = p.unstable >= 0 ? json(p.unstable) : json(nullptr);
             pts.push_back(q);
         }
         o["points"] = pts;
@@ -217,6 +218,7 @@ std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2,
             q["par"] = num(p.par);
             q["par2"] = num(p.par2);
             q["x"] = vec(p.x);
+            q["omega"] = p.kind == "zero_hopf" ? num(p.omega) : json(nullptr);
             q["test"] = num(p.test);
             q["other"] = num(p.other);
             q["status"] = to_string(p.status);

@@ -57,9 +57,10 @@ std::string named_column(const std::string& name, const ColumnUnits& units, cons
 /// their units from `units`.
 std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units = {});
 
-/// Fold curves, one row per curve point, cusp and Bogdanov-Takens point:
-/// curve,kind (point|cusp|bogdanov_takens),PAR,PAR2,<variables>,cusp_test,bt_test,residual,status
-/// (names with their units from `units`; the tests empty on special rows, status empty on points).
+/// Fold curves, one row per curve point, cusp, Bogdanov-Takens and zero-Hopf point:
+/// curve,kind (point|cusp|bogdanov_takens|zero_hopf),PAR,PAR2,<variables>,cusp_test,bt_test,
+/// unstable,omega_rad_per_s,residual,status (names with their units from `units`; the tests and
+/// the count on points, omega on zero_hopf rows, status on special rows).
 std::string fold_curves_csv(const FoldCurves& c, const std::string& parameter2, const std::vector<std::string>& variables,
                             const ColumnUnits& units = {});
 

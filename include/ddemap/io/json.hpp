@@ -97,9 +97,9 @@ std::string system_roots_json(const LinearDDE& dde, const SystemRootResult& r);
 std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vector<std::string>& variables);
 /// fold curves in two parameters: {"parameter", "parameter2", "branch": equilibrium_branch_json
 /// of the branch in p1, "curves": [{"start", "status", "message", "stop": [backward, forward],
-/// "points": [{"par", "par2", "x", "cusp_test", "bt_test", "residual"}], "special": [{"kind"
-/// ("cusp" or "bogdanov_takens"), "par", "par2", "x", "test", "other", "status", "residual",
-/// "after"}]}]}
+/// "points": [{"par", "par2", "x", "cusp_test", "bt_test", "residual", "unstable"}], "special":
+/// [{"kind" ("cusp", "bogdanov_takens" or "zero_hopf"), "par", "par2", "x", "omega" (zero_hopf),
+/// "test", "other", "status", "residual", "after"}]}]}
 std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2, const std::vector<std::string>& variables);
 /// roots of a mixed ring (analyse_mixed_ring)
 std::string mixed_ring_json(const MixedRingResult& r, std::size_t cars);

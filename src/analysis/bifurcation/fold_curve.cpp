@@ -10,6 +10,8 @@
 #include "analysis/bifurcation/internal/chord_zero.hpp"
 #include "analysis/bifurcation/internal/curve_trace.hpp"
 #include "core/internal/text.hpp"
+#include "ddemap/core/execution.hpp"
+#include "ddemap/solve/roots.hpp"
 
 namespace ddemap {
 
@@ -127,6 +129,78 @@ double fold_residual(const FoldCurveProblem& pr, const Eigen::VectorXd& u) {
     return pr.residual(u, f) ? f.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
 }
 
+/// The roots right of the axis (beyond the marginal band) but the one nearest 0: the fold's own
+/// root, at 0 to rounding (near a cusp or a Bogdanov-Takens point only to about its square root).
+int unstable_besides_zero(const std::vector<cplx>& roots) {
+    if (roots.empty()) return 0;
+    const auto own = std::min_element(roots.begin(), roots.end(), [](cplx a, cplx b) { return std::abs(a) < std::abs(b); });
+    int n = 0;
+    for (auto it = roots.begin(); it != roots.end(); ++it)
+        if (it != own && it->real() > marginal_band(*it)) ++n;
+    return n;
+}
+
+/// The count at a point u of the curve (-1 when the roots did not converge), and the roots.
+int count_at(const NonlinearDDE& s, const FoldCurveProblem& pr, const Eigen::VectorXd& u, const RootOptions& ro, std::vector<cplx>* roots = nullptr) {
+    const EquilibriumRoots er = equilibrium_roots(s, u.head(s.dimension()), pr.values(u), ro);
+    if (!converged(er.status)) return -1;
+    if (roots) *roots = er.roots;
+    return unstable_besides_zero(er.roots);
+}
+
+/// A zero-Hopf point between ua and ub (on pr's normalisation) where the count goes from ca to
+/// cb = ca +- 2: bisection of the count along the chord, every trial corrected onto the curve,
+/// until the bracket is below 1e-13 of the chord (a count that is neither ca nor cb: two events
+/// in the step, not located).
+FoldCurveSpecialPoint locate_zero_hopf(const NonlinearDDE& s, const FoldCurveProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub,
+                                       int ca, int cb, const RootOptions& ro, const NewtonOptions& newton, double residual_tolerance) {
+    const int n = s.dimension();
+    FoldCurveSpecialPoint z;
+    z.kind = "zero_hopf";
+    const Eigen::VectorXd d = ub - ua;
+    const Eigen::VectorXd dir = d.normalized();
+    double lo = 0.0, hi = 1.0;
+    Eigen::VectorXd best = ub;
+    std::vector<cplx> best_roots;
+    z.status = Status::MaxIterations;
+    for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        Eigen::VectorXd u = ua + mid * d;
+        const CorrectorResult cr = correct(pr, u, dir, dir.dot(u), newton);
+        if (!converged(cr.status)) {
+            z.status = cr.status;
+            break;
+        }
+        std::vector<cplx> roots;
+        const int c = count_at(s, pr, u, ro, &roots);
+        if (c == ca) {
+            lo = mid;
+        } else if (c == cb) {
+            hi = mid;
+            best = u;
+            best_roots = roots;
+        } else {
+            z.status = Status::NumericalIssue;  // another count: more than one event in the step
+            break;
+        }
+        if (hi - lo <= 1e-13) {
+            z.status = Status::Converged;
+            break;
+        }
+    }
+    z.par = best[n];
+    z.par2 = best[2 * n + 1];
+    z.x = best.head(n);
+    // the pair on the axis: the root with Im > 0 nearest it
+    double re_min = std::numeric_limits<double>::infinity();
+    for (const cplx r : best_roots)
+        if (r.imag() > 1e-8 && std::abs(r.real()) < re_min) re_min = std::abs(r.real()), z.omega = r.imag();
+    Eigen::VectorXd f;
+    z.residual = pr.residual(best, f) ? f.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+    if (converged(z.status) && !(z.residual <= residual_tolerance && z.omega > 0.0)) z.status = Status::NumericalIssue;
+    return z;
+}
+
 /// The curve through the fold `start` of the branch in p1 (at the held p2).
 FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double held2, const FoldCurveOptions& o) {
     const int j1 = s.parameter_index(o.branch.parameter), j2 = s.parameter_index(o.parameter2);
@@ -223,6 +297,57 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
             curve.special.push_back(std::move(sp));
         }
     }
+    // the roots at every point (the linearisations formed in order on this thread, their roots in
+    // parallel, from 2 roots grown until every root right of the axis is certified found); where
+    // the count changes in a step, the Bogdanov-Takens points located there (+-1 each) and a
+    // zero-Hopf point (+-2) must explain it
+    bool counts_ok = true;
+    std::string counts_message;
+    {
+        RootOptions ro = o.branch.roots;
+        ro.count = 2;
+        ro.progress = nullptr;
+        std::vector<EquilibriumRoots> ers(all.size());
+        std::vector<LinearDDE> lins;
+        lins.reserve(all.size());
+        for (const auto& sm : all) lins.push_back(linearise(s, sm.u.head(n), sm.problem->values(sm.u)));
+        parallel_for(static_cast<long>(all.size()), [&](long k) { ers[static_cast<std::size_t>(k)] = equilibrium_roots(lins[static_cast<std::size_t>(k)], ro); });
+        int failed = 0;
+        for (std::size_t k = 0; k < all.size(); ++k) {
+            if (!converged(ers[k].status)) {
+                ++failed;
+                continue;
+            }
+            curve.points[k].roots = ers[k].roots;
+            curve.points[k].unstable = unstable_besides_zero(ers[k].roots);
+        }
+        if (failed > 0) {
+            counts_ok = false;
+            counts_message = "the characteristic roots did not converge at " + std::to_string(failed) + " point(s) of the curve";
+        }
+        for (std::size_t k = 0; k + 1 < all.size(); ++k) {
+            const int ca = curve.points[k].unstable, cb = curve.points[k + 1].unstable;
+            if (ca < 0 || cb < 0 || ca == cb) continue;
+            const int bts = static_cast<int>(std::count_if(curve.special.begin(), curve.special.end(), [&](const FoldCurveSpecialPoint& p) {
+                return p.kind == "bogdanov_takens" && p.after == static_cast<int>(k);
+            }));
+            if (std::abs(cb - ca) == 1 && bts == 1) continue;  // a real root through 0 at the Bogdanov-Takens point
+            if (std::abs(cb - ca) == 2 && bts == 0) {
+                const FoldCurveProblem& pr = *all[k + 1].problem;
+                Eigen::VectorXd ua = all[k].u;
+                const double sc = pr.normalisation().dot(ua.segment(n + 1, n));
+                if (sc != 0.0 && std::isfinite(sc)) ua.segment(n + 1, n) /= sc;
+                FoldCurveSpecialPoint z = locate_zero_hopf(s, pr, ua, all[k + 1].u, ca, cb, ro, o.branch.special, o.branch.special_residual);
+                z.after = static_cast<int>(k);
+                if (!converged(z.status)) counts_ok = false, counts_message = "a zero-Hopf point was not located (more than one crossing in a step?)";
+                curve.special.push_back(std::move(z));
+                continue;
+            }
+            counts_ok = false;
+            counts_message = "between points " + std::to_string(k) + " and " + std::to_string(k + 1) + " the count of roots right of the axis changes by " +
+                             std::to_string(cb - ca) + " with " + std::to_string(bts) + " Bogdanov-Takens point(s) located there";
+        }
+    }
     std::sort(curve.special.begin(), curve.special.end(), [](const FoldCurveSpecialPoint& a, const FoldCurveSpecialPoint& b) { return a.after < b.after; });
 
     curve.status = traced_curve.end_status();
@@ -234,6 +359,10 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
     if (!special_ok) {
         if (converged(curve.status)) curve.status = Status::NumericalIssue;
         msg += std::string(msg.empty() ? "" : "; ") + "a cusp or Bogdanov-Takens point was not located";
+    }
+    if (!counts_ok) {
+        if (converged(curve.status)) curve.status = Status::NumericalIssue;
+        msg += std::string(msg.empty() ? "" : "; ") + counts_message;
     }
     curve.message = msg.empty() ? std::to_string(curve.points.size()) + " points, both ends on the box or closed" : msg;
     return curve;
@@ -295,11 +424,12 @@ FoldCurves fold_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, cons
         out.curves.push_back(std::move(c));
     }
     if (msg.empty()) {
-        int cusps = 0, bts = 0;
+        int cusps = 0, bts = 0, zhs = 0;
         for (const FoldCurve& c : out.curves)
-            for (const FoldCurveSpecialPoint& p : c.special) (p.kind == "cusp" ? cusps : bts)++;
+            for (const FoldCurveSpecialPoint& p : c.special) (p.kind == "cusp" ? cusps : p.kind == "bogdanov_takens" ? bts : zhs)++;
         msg = std::to_string(out.curves.size()) + " fold curve" + (out.curves.size() == 1 ? "" : "s") + ", " + std::to_string(cusps) + " cusp" +
-              (cusps == 1 ? "" : "s") + ", " + std::to_string(bts) + " Bogdanov-Takens point" + (bts == 1 ? "" : "s");
+              (cusps == 1 ? "" : "s") + ", " + std::to_string(bts) + " Bogdanov-Takens point" + (bts == 1 ? "" : "s") + ", " + std::to_string(zhs) +
+              " zero-Hopf point" + (zhs == 1 ? "" : "s") + "; root counts along every curve explained";
     }
     out.message = msg;
     return out;

@@ -99,6 +99,43 @@ TEST_CASE("fold curve with a Bogdanov-Takens point: x' = p1 + x^2 + p2 x(t - tau
     }
 }
 
+TEST_CASE("a fold curve with a Bogdanov-Takens and a zero-Hopf point: the root counts along it explained by both") {
+    // x' = p1 - p2 x(t - 2) + x^2 with an oscillator y' = (x - 1/2) y + rotation: the fold curve
+    // (p1, p2) = (p2^2 / 4, p2), x = p2 / 2; Delta'(0) e_x = (1 - 2 p2) e_x: BT at p2 = 1/2 (a real root
+    // through 0: the count besides the fold's root goes 0 -> 1); the pair x - 1/2 +- i crosses the
+    // axis at x = 1/2: zero-Hopf at (p1, p2) = (1/4, 1) with omega = 1 (1 -> 3)
+    ExpressionSystem sys({"x", "y1", "y2"}, {"p1", "p2", "tau"}, {-0.5, -0.5, 2.0},
+                         {"p1 - p2*x(t - tau) + x^2", "(x - 0.5)*y1 - y2", "y1 + (x - 0.5)*y2"});
+    Eigen::VectorXd guess(3);
+    guess << -1.0, 0.0, 0.0;
+    const FoldCurves fc = fold_curves(sys, guess, fold_box("p1", -0.5, 2.0, "p2", -1.5, 1.5));
+    INFO(fc.message);
+    CHECK(fc.status == Status::Converged);
+    REQUIRE(fc.curves.size() == 1);
+    const FoldCurve& c = fc.curves[0];
+    for (const FoldCurvePoint& p : c.points) {
+        CHECK(std::abs(p.par - p.par2 * p.par2 / 4) < tol::special_point);
+        REQUIRE(p.unstable >= 0);
+        // the closed-form count away from the two points (within 1e-6 of them a root is near the axis)
+        if (std::abs(p.par2 - 0.5) > 1e-6 && std::abs(p.par2 - 1.0) > 1e-6) CHECK(p.unstable == (p.par2 < 0.5 ? 0 : p.par2 < 1.0 ? 1 : 3));
+    }
+    REQUIRE(c.special.size() == 2);
+    const FoldCurveSpecialPoint* bt = nullptr;
+    const FoldCurveSpecialPoint* zh = nullptr;
+    for (const FoldCurveSpecialPoint& q : c.special) (q.kind == "bogdanov_takens" ? bt : zh) = &q;
+    REQUIRE(bt != nullptr);
+    REQUIRE(zh != nullptr);
+    CHECK(zh->kind == "zero_hopf");
+    CHECK(bt->status == Status::Converged);
+    CHECK(zh->status == Status::Converged);
+    CHECK(std::abs(bt->par2 - 0.5) < tol::special_point);
+    CHECK(std::abs(bt->par - 0.0625) < tol::special_point);
+    CHECK(std::abs(zh->par2 - 1.0) < tol::special_point);
+    CHECK(std::abs(zh->par - 0.25) < tol::special_point);
+    CHECK(std::abs(zh->x[0] - 0.5) < tol::special_point);
+    CHECK(std::abs(zh->omega - 1.0) < 1e-8);
+}
+
 TEST_CASE("the Hopf curve of x' = p1 + x^2 + p2 x(t - 2) ends at the Bogdanov-Takens point of its fold curve (omega -> 0)") {
     // an independent check of the located point: the Hopf curve iw = 2 x + p2 e^{-2 i w} (p2 = -w / sin 2w)
     // leaves the domain omega > 0 at the BT point; its last point is within O(omega^2) of it

@@ -22,6 +22,12 @@
 /// (Delta'(0) v lies in the range of J): a Bogdanov-Takens point, where a Hopf curve ends on the
 /// fold curve. Each sign change between two points is located by Illinois regula falsi along the
 /// chord, every trial corrected onto the curve (as the generalised Hopf points of Hopf curves).
+/// At every point the characteristic roots are computed (equilibrium_roots with branch.roots) and
+/// counted right of the axis, the fold's own root at 0 excepted; where the count changes in a
+/// step, the change must be explained: +-1 by a Bogdanov-Takens point located in the step (a
+/// real root through 0), +-2 by a zero-Hopf point (a pair through the axis at +-i omega, located
+/// by bisection of the count along the chord, every trial corrected onto the curve); a change
+/// that is not makes the curve's status NumericalIssue.
 /// Cf. DDE-BIFTOOL's fold continuation (p_tofold, br_contn) and its normal-form tests.
 
 #include <limits>
@@ -29,6 +35,8 @@
 #include <vector>
 
 #include <Eigen/Core>
+
+#include "ddemap/core/types.hpp"
 
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
 #include "ddemap/core/execution.hpp"
@@ -47,11 +55,17 @@ struct FoldCurvePoint {
     double cusp_test = 0.0;  ///< a = w . D^2 f[S v, S v] (|v| = |w| = 1)
     double bt_test = 0.0;    ///< b = w . Delta'(0) v
     double residual = std::numeric_limits<double>::infinity();  ///< max |.| of the fold system
+    /// The characteristic roots right of the axis besides the fold's root at 0 (-1: the roots did
+    /// not converge) and the roots themselves (rightmost first).
+    int unstable = -1;
+    std::vector<cplx> roots;
 };
 
-/// A codimension-two point on a fold curve: kind "cusp" (a = 0) or "bogdanov_takens" (b = 0).
+/// A codimension-two point on a fold curve: kind "cusp" (a = 0), "bogdanov_takens" (b = 0) or
+/// "zero_hopf" (a pair +-i omega on the axis besides the root at 0).
 struct FoldCurveSpecialPoint {
     std::string kind;
+    double omega = 0.0;     ///< zero_hopf: the pair's frequency
     double par = 0.0, par2 = 0.0;
     Eigen::VectorXd x;
     double test = 0.0;      ///< the test function at the located point
@@ -64,7 +78,7 @@ struct FoldCurveSpecialPoint {
 struct FoldCurve {
     int start = 0;  ///< the index of the fold of the branch in p1 it starts from
     std::vector<FoldCurvePoint> points;  ///< in order along the curve
-    std::vector<FoldCurveSpecialPoint> special;  ///< cusp and Bogdanov-Takens points, in order
+    std::vector<FoldCurveSpecialPoint> special;  ///< cusp, Bogdanov-Takens and zero-Hopf points, in order
     ContinuationStop stop_backward = ContinuationStop::MaxPoints, stop_forward = ContinuationStop::MaxPoints;
     Status status = Status::Converged;
     std::string message;
