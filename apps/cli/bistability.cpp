@@ -93,10 +93,10 @@ int run_bistability() {
     e.result = bistability_json(chart, pb.variables);
     const std::string csv = bistability_csv(chart, pb.units);
     if (!prefix.empty()) {
-        const std::string u1 = pb.units.count(o.parameter) ? pb.units.at(o.parameter) : std::string();
-        const std::string u2 = pb.units.count(o.parameter2) ? pb.units.at(o.parameter2) : std::string();
+        const std::string u1 = pb.unit(o.parameter);
+        const std::string u2 = pb.unit(o.parameter2);
         std::string title = "Bistability of stop-and-go waves and uniform flow";
-        if (!bi_args.problem.model.empty()) title += ", " + bi_args.problem.model + " ring of " + bi_args.problem.ring + " cars";
+        title += bi_args.problem.ring_title();
         write_files_atomic({{prefix + ".svg", bistability_svg(chart, u1, u2, title)}, {prefix + ".json", envelope_json(e)}, {prefix + "-curves.csv", csv}});
     }
     print_output(format, e, csv, [&] {

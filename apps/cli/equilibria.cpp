@@ -57,10 +57,8 @@ int run_fold_curves(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOp
     std::vector<std::pair<std::string, std::string>> files;
     if (!prefix.empty()) files = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}};
     if (!svg_file.empty()) {
-        auto unit = [&](const std::string& name) { return pb.units.count(name) ? pb.units.at(name) : std::string(); };
-        std::string title = "Fold curves of equilibria in (" + a.problem.par + ", " + a.par2 + ")";
-        if (!a.problem.model.empty()) title += ", " + a.problem.model + " ring of " + a.problem.ring + " cars";
-        files.push_back({svg_file, two_parameter_svg(nullptr, &fc, a.problem.par, a.par2, o.from, o.to, co.from2, co.to2, unit(a.problem.par), unit(a.par2), title)});
+        const std::string title = "Fold curves of equilibria in (" + a.problem.par + ", " + a.par2 + ")" + a.problem.ring_title();
+        files.push_back({svg_file, two_parameter_svg(nullptr, &fc, a.problem.par, a.par2, o.from, o.to, co.from2, co.to2, pb.unit(a.problem.par), pb.unit(a.par2), title)});
     }
     if (!files.empty()) write_files_atomic(files);
     print_output(format, e, csv, [&] {

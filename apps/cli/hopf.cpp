@@ -103,11 +103,9 @@ int run_hopf() {
     std::vector<std::pair<std::string, std::string>> files;
     if (!prefix.empty()) files = {{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}};
     if (!svg_file.empty()) {
-        auto unit = [&](const std::string& name) { return pb.units.count(name) ? pb.units.at(name) : std::string(); };
-        std::string title = "Hopf curves in (" + hopf_args.problem.par + ", " + hopf_args.par2 + ")";
-        if (!hopf_args.problem.model.empty()) title += ", " + hopf_args.problem.model + " ring of " + hopf_args.problem.ring + " cars";
+        const std::string title = "Hopf curves in (" + hopf_args.problem.par + ", " + hopf_args.par2 + ")" + hopf_args.problem.ring_title();
         files.push_back({svg_file, two_parameter_svg(&curves, nullptr, hopf_args.problem.par, hopf_args.par2, o.from, o.to, co.from2, co.to2,
-                                                     unit(hopf_args.problem.par), unit(hopf_args.par2), title)});
+                                                     pb.unit(hopf_args.problem.par), pb.unit(hopf_args.par2), title)});
     }
     if (!files.empty()) write_files_atomic(files);
     print_output(format, e, csv, [&] {

@@ -34,7 +34,14 @@ struct NonlinearProblemArgs {
         /// system or model (and ring), then every parameter other than --par with its value
         JsonObject inputs;
         std::map<std::string, std::string> units;  ///< of variables and parameters, where known (built-in rings)
+        /// The unit of a variable or parameter ("" where unknown).
+        std::string unit(const std::string& name) const {
+            const auto it = units.find(name);
+            return it == units.end() ? std::string() : it->second;
+        }
     };
+    /// ", ov ring of 5 cars" for a built-in ring, "" for a system file: the end of a figure's title.
+    std::string ring_title() const { return model.empty() ? std::string() : ", " + model + " ring of " + ring + " cars"; }
     /// The problem, with --par checked (BadInput naming the known names) and --from != --to
     /// (BadInput); a built-in ring is set to --par = --from for its guess (the uniform flow).
     Problem load() const;

@@ -234,11 +234,11 @@ int run_orbits() {
         if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables, built.units)});
     }
     if (!svg_file.empty()) {
-        const std::string punit = built.units.count(par) ? built.units.at(par) : std::string();
-        const std::string vunit = built.units.count(variables[static_cast<std::size_t>(variable)]) ? built.units.at(variables[static_cast<std::size_t>(variable)]) : std::string();
+        const std::string punit = built.unit(par);
+        const std::string vunit = built.unit(variables[static_cast<std::size_t>(variable)]);
         std::ostringstream title;
         title << "Periodic orbits from the Hopf point at " << par << " = " << rounded(h.par, 6);
-        if (!orbits_args.problem.model.empty()) title << ", " << orbits_args.problem.model << " ring of " << orbits_args.problem.ring << " cars";
+        title << orbits_args.problem.ring_title();
         files.push_back({svg_file, bifurcation_svg(&eq, b, variable, variables[static_cast<std::size_t>(variable)], vunit, punit, title.str())});
     }
     if (!files.empty()) write_files_atomic(files);

@@ -83,11 +83,7 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
     j["hopf"] = hopf;
     json curves = json::array();
     for (const HopfCurve& c : hc.curves) {
-        json o;
-        o["start"] = c.start;
-        o["status"] = to_string(c.status);
-        o["message"] = c.message;
-        o["stop"] = json::array({to_string(c.stop_backward), to_string(c.stop_forward)});
+        json o = detail::curve_json(c.start, c.status, c.message, c.stop_backward, c.stop_forward);
         json pts = json::array();
         for (const HopfCurvePoint& p : c.points) {
             const bool ok = converged(p.coefficients.status);

@@ -193,11 +193,7 @@ std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2,
     j["branch"] = json::parse(equilibrium_branch_json(c.start, variables));
     json curves = json::array();
     for (const FoldCurve& k : c.curves) {
-        json o;
-        o["start"] = k.start;
-        o["status"] = to_string(k.status);
-        o["message"] = k.message;
-        o["stop"] = json::array({to_string(k.stop_backward), to_string(k.stop_forward)});
+        json o = detail::curve_json(k.start, k.status, k.message, k.stop_backward, k.stop_forward);
         json pts = json::array();
         for (const FoldCurvePoint& p : k.points) {
             json q;

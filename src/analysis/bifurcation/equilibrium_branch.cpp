@@ -390,6 +390,15 @@ bool TwoParameterOptions::is_valid(std::string* why) const {
 }
 
 
+double TwoParameterOptions::held_second(const NonlinearDDE& system) const {
+    const double held = system.parameter_values()[static_cast<std::size_t>(system.parameter_index(parameter2))];
+    const double lo = std::min(from2, to2), hi = std::max(from2, to2);
+    if (!(held >= lo && held <= hi))
+        throw std::invalid_argument(parameter2 + " = " + detail::format_number(held) + " (its value in the system): expected a value in [" +
+                                    detail::format_number(lo) + ", " + detail::format_number(hi) + "]");
+    return held;
+}
+
 EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options) {
     std::string why;
     if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);

@@ -307,23 +307,15 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
         RootOptions ro = o.branch.roots;
         ro.count = 2;
         ro.progress = nullptr;
-        std::vector<EquilibriumRoots> ers(all.size());
-        std::vector<LinearDDE> lins;
-        lins.reserve(all.size());
-        for (const auto& sm : all) lins.push_back(linearise(s, sm.u.head(n), sm.problem->values(sm.u)));
-        parallel_for(static_cast<long>(all.size()), [&](long k) { ers[static_cast<std::size_t>(k)] = equilibrium_roots(lins[static_cast<std::size_t>(k)], ro); });
-        int failed = 0;
+        const detail::RootsAlong ra = detail::roots_along(s, all, ro);
         for (std::size_t k = 0; k < all.size(); ++k) {
-            if (!converged(ers[k].status)) {
-                ++failed;
-                continue;
-            }
-            curve.points[k].roots = ers[k].roots;
-            curve.points[k].unstable = unstable_besides_zero(ers[k].roots);
+            if (!converged(ra.roots[k].status)) continue;
+            curve.points[k].roots = ra.roots[k].roots;
+            curve.points[k].unstable = unstable_besides_zero(ra.roots[k].roots);
         }
-        if (failed > 0) {
+        if (ra.failed > 0) {
             counts_ok = false;
-            counts_message = "the characteristic roots did not converge at " + std::to_string(failed) + " point(s) of the curve";
+            counts_message = ra.message();
         }
         for (std::size_t k = 0; k + 1 < all.size(); ++k) {
             const int ca = curve.points[k].unstable, cb = curve.points[k + 1].unstable;
@@ -393,15 +385,11 @@ bool on_curve(const FoldCurve& c, const FoldPoint& f, double held2, double side1
 FoldCurves fold_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, const FoldCurveOptions& o) {
     std::string why;
     if (!o.is_valid(&why)) throw std::invalid_argument("fold curve options: " + why);
-    s.parameter_index(o.branch.parameter);
-    const int j2 = s.parameter_index(o.parameter2);
+    s.parameter_index(o.branch.parameter);  // an unknown name is refused here, parameter2 by held_second
     if (!s.has_higher_derivatives())
         throw std::invalid_argument("fold curves: the system gives no second derivatives: expected an expression system or a built-in model (NonlinearDDEOf)");
-    const double held2 = s.parameter_values()[static_cast<std::size_t>(j2)];
+    const double held2 = o.held_second(s);
     const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
-    if (!(held2 >= lo2 && held2 <= hi2))
-        throw std::invalid_argument(o.parameter2 + " = " + detail::format_number(held2) + " (its value in the system): expected a value in [" +
-                                    detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
     FoldCurves out;
     out.start = equilibrium_branch(s, guess, o.branch);
     std::string msg;

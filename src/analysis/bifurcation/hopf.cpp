@@ -602,29 +602,15 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
     bool codim2_ok = true;
     std::string codim2_message;
     if (o.codimension_two) {
-        // the linearisations in order (the system is evaluated on this thread), their roots in
-        // parallel: from 2 roots, grown until every root right of the axis is certified found
-        // (asking for more at once cost 5 to 20 times as much on the 3-car ov ring at small delays)
-        std::vector<LinearDDE> lins;
-        lins.reserve(all.size());
-        for (std::size_t k = 0; k < all.size(); ++k) lins.push_back(linearise(s, curve.points[k].x, all[k].problem->values(all[k].u)));
-        std::vector<EquilibriumRoots> ers(all.size());
-        RootOptions ro = o.branch.roots;
-        ro.count = 2;
-        ro.progress = nullptr;
-        parallel_for(static_cast<long>(all.size()), [&](long k) { ers[static_cast<std::size_t>(k)] = equilibrium_roots(lins[static_cast<std::size_t>(k)], ro); });
-        int failed = 0;
+        detail::RootsAlong ra = detail::roots_along(s, all, o.branch.roots);
         for (std::size_t k = 0; k < all.size(); ++k) {
-            if (!converged(ers[k].status)) {
-                ++failed;
-                continue;
-            }
-            curve.points[k].roots = std::move(ers[k].roots);
-            curve.points[k].unstable = ers[k].unstable;
+            if (!converged(ra.roots[k].status)) continue;
+            curve.points[k].roots = std::move(ra.roots[k].roots);
+            curve.points[k].unstable = ra.roots[k].unstable;
         }
-        if (failed > 0) {
+        if (ra.failed > 0) {
             codim2_ok = false;
-            codim2_message = "the characteristic roots did not converge at " + std::to_string(failed) + " point(s) of the curve";
+            codim2_message = ra.message();
         }
         for (std::size_t k = 0; k + 1 < all.size(); ++k) {
             HopfCurvePoint &a = curve.points[k], &b = curve.points[k + 1];
@@ -721,16 +707,11 @@ HopfCurve hopf_curve(const NonlinearDDE& s, const HopfPoint& start, const HopfCu
 HopfCurves hopf_curves(const NonlinearDDE& s, const Eigen::VectorXd& guess, const HopfCurveOptions& o) {
     std::string why;
     if (!o.is_valid(&why)) throw std::invalid_argument("Hopf curve options: " + why);
-    const int j2 = s.parameter_index(o.parameter2);
-    const double held2 = s.parameter_values()[static_cast<std::size_t>(j2)];
-    const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
-    if (!(held2 >= lo2 && held2 <= hi2))
-        throw std::invalid_argument(o.parameter2 + " = " + detail::format_number(held2) + " (its value in the system): expected a value in [" +
-                                    detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
+    const double held2 = o.held_second(s);  // an unknown parameter2 is refused here
     HopfCurves r;
     r.start = hopf_points(s, guess, o.branch, o.coefficients);
     r.status = r.start.branch.status;
-    const double w1 = std::abs(o.branch.to - o.branch.from), w2 = hi2 - lo2;
+    const double w1 = std::abs(o.branch.to - o.branch.from), w2 = std::abs(o.to2 - o.from2);
     // the index of the traced curve through (p1, p2, omega) (distance to its polyline in the scaled box), or -1
     auto on_curve = [&](double p1, double p2, double omega) {
         const Eigen::Vector3d ph(p1 / w1, p2 / w2, omega);

@@ -5,6 +5,9 @@
 #include <string>
 
 #include <Eigen/Core>
+
+#include "ddemap/core/status.hpp"
+#include "ddemap/solve/continuation.hpp"
 #include <nlohmann/json.hpp>
 
 namespace ddemap::detail {
@@ -24,6 +27,17 @@ inline ojson json_values(const Eigen::VectorXd& x) {
     ojson a = ojson::array();
     for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(json_value(x[i]));
     return a;
+}
+
+/// The head of a two-parameter curve's JSON (Hopf curves, fold curves): {"start", "status",
+/// "message", "stop": [backward, forward]}; the caller adds its points.
+inline ojson curve_json(int start, Status status, const std::string& message, ContinuationStop backward, ContinuationStop forward) {
+    ojson o;
+    o["start"] = start;
+    o["status"] = to_string(status);
+    o["message"] = message;
+    o["stop"] = ojson::array({to_string(backward), to_string(forward)});
+    return o;
 }
 
 }  // namespace ddemap::detail

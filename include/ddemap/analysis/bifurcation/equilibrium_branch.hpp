@@ -193,6 +193,9 @@ struct TwoParameterOptions {
     /// 2 continuation.max_points - 1, p1). It may throw to stop; the exception reaches the caller.
     BranchProgress progress;
     bool is_valid(std::string* why = nullptr) const;
+    /// The system's value of parameter2, checked to lie in [from2, to2] (std::invalid_argument
+    /// naming it otherwise; also for an unknown name).
+    double held_second(const NonlinearDDE& system) const;
 };
 
 /// Newton on the fold system from (x0, p_j = par0).
