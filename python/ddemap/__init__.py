@@ -702,7 +702,7 @@ def simulate(fleet, lead_profile=None, lead=None, on_event="continue", t_end=0.0
 
 @_with_progress
 def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_weight=0.02, lead_noise="auto", model="ovrv", runs=None,
-              data_dir=None, report=None, follower=None, warn=True):
+              data_dir=None, report=None, follower=None, warn=True, lead_noise_correction=True):
     """Fits OVRV to measured car-following traces (``ddemap calibrate``).
 
     ``traces``: each a CSV path (str or ``os.PathLike``), a pandas DataFrame, dict of columns
@@ -713,8 +713,10 @@ def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_we
     the whole file). ``bounds``: a dict ``{"eta": (5, 15), ...}`` (default the paper's k1 0:1,
     k2 0:1, th 0:3, tau 0:1, eta 5:15). The fit minimises ``MSE(speed) + gap_weight * MSE(gap)``
     [gap_weight in 1/s^2] over the simulated follower (RK4 with the delay). ``lead_noise``: the
-    white noise on the measured lead speed [m/s] that the intervals allow for (``"auto"``:
-    estimated from each trace's lead speed; 0: the lead speed is exact), as ``--lead-noise``.
+    white noise on the measured lead speed [m/s] that the fit corrects its bias for and the
+    intervals allow for (``"auto"``: estimated from each trace's lead speed; 0: the lead speed is
+    exact), as ``--lead-noise``; ``lead_noise_correction=False`` fits plain least squares
+    (``--lead-noise-correction off``).
 
     ``runs`` (instead of ``traces``): a run list, CSV with columns car, file, role[, type]: each
     car fitted jointly on its ``role=train`` files and tested on its ``role=test`` files (errors
@@ -760,6 +762,7 @@ def calibrate(*traces, joint=False, car="joint", train=None, bounds=None, gap_we
             raise ValueError("report = %r: expected a folder" % (report,))
         _os.makedirs(report, exist_ok=True)
     r = _result(_ddemap.calibrate(files, follower, bool(joint), car, train, items, _number("gap_weight", gap_weight), lead_noise,
+                                  bool(lead_noise_correction),
                                   "" if runs is None else _os.fspath(runs), "" if data_dir is None else _os.fspath(data_dir),
                                   "" if report is None else report))
     if warn:

@@ -521,11 +521,12 @@ py::tuple py_simulate(const std::string& fleet, const CarTables& tables, const s
 }
 
 std::string py_calibrate(const std::vector<std::pair<std::string, std::string>>& files, int follower, bool joint, const std::string& car, std::optional<std::pair<double, double>> train,
-                      const std::vector<std::tuple<std::string, double, double>>& bounds, double gap_weight, double lead_noise, const std::string& runs,
-                      const std::string& data_dir, const std::string& report) {
+                      const std::vector<std::tuple<std::string, double, double>>& bounds, double gap_weight, double lead_noise, bool lead_noise_correction,
+                      const std::string& runs, const std::string& data_dir, const std::string& report) {
     CalibrationOptions o;
     o.gap_weight = gap_weight;
     o.lead_noise = lead_noise;
+    o.lead_noise_correction = lead_noise_correction;
     if (train) {
         o.train_start = train->first;
         o.train_end = train->second;
@@ -595,6 +596,7 @@ std::string py_calibrate(const std::vector<std::pair<std::string, std::string>>&
     JsonObject in;
     in.json("traces", json_array(traces)).string("model", "ovrv").number("gap_weight", o.gap_weight);
     if (o.lead_noise >= 0.0) in.number("lead_noise", o.lead_noise);
+    if (!o.lead_noise_correction) in.boolean("lead_noise_correction", false);
     if (!runs.empty()) in.string("runs", runs);
     if (joint) in.string("joint", car);
     if (o.train_start >= 0) in.json("train", json_array({json_number(o.train_start), json_number(o.train_end)}));
@@ -1124,7 +1126,7 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("lead_car"), py::arg("on_event"), py::arg("t_end"), py::arg("step"), py::arg("output_dt"), py::arg("noise_speed"),
           py::arg("noise_gap"), py::arg("seed"));
     m.def("calibrate", &py_calibrate, py::arg("files"), py::arg("follower"), py::arg("joint"), py::arg("car"), py::arg("train"), py::arg("bounds"), py::arg("gap_weight"),
-          py::arg("lead_noise"), py::arg("runs"), py::arg("data_dir"), py::arg("report"));
+          py::arg("lead_noise"), py::arg("lead_noise_correction"), py::arg("runs"), py::arg("data_dir"), py::arg("report"));
     m.def("mixed_ring", &py_mixed_ring, py::arg("fleet"), py::arg("tables"), py::arg("is_pattern"), py::arg("ring"), py::arg("speed"), py::arg("length"),
           py::arg("solver"), py::arg("count"), py::arg("degree"));
     m.def("mix", &py_mix, py::arg("x"), py::arg("y"), py::arg("tables"), py::arg("ring"), py::arg("p"), py::arg("draws"), py::arg("seed"),

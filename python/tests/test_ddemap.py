@@ -236,6 +236,10 @@ def test_calibrate():
     r = ddemap.calibrate(trace, bounds={"eta": (5, 20)}, train=(0, 45))
     same_envelope(r, cli_json("calibrate", trace, "--bounds", "eta=5:20", "--train", "0:45"))
     assert len(r["fits"]["status"]) == 1
+    # plain least squares on request, as --lead-noise-correction off
+    plain = ddemap.calibrate(trace, bounds={"eta": (5, 20)}, train=(0, 45), lead_noise_correction=False)
+    same_envelope(plain, cli_json("calibrate", trace, "--bounds", "eta=5:20", "--train", "0:45", "--lead-noise-correction", "off"))
+    assert plain["fits"]["lead_noise_corrected"] == [False] and r["fits"]["lead_noise_corrected"] == [True]
 
 
 def test_calibrate_runs_joint_report(tmp_path):

@@ -529,11 +529,13 @@ std::string calibration_json(const std::vector<std::string>& names, const std::v
         json ln = json::array();
         for (double x : r.lead_noise) ln.push_back(num(x));
         j["lead_noise"] = ln;
+        j["lead_noise_corrected"] = r.lead_noise_corrected;
         json sex = json::object();
         for (int a = 0; a < 5; ++a) sex[r.estimates[static_cast<std::size_t>(a)].name] = num(std::sqrt(std::max(r.covariance_exact_lead(a, a), 0.0)));
         j["standard_errors_exact_lead"] = sex;
         j["warnings"] = r.warnings;
         j["objective"] = num(r.objective);
+        j["minimised_objective"] = num(r.minimised_objective);
         j["starts"] = r.starts;
         j["status"] = r.status;
         j["message"] = r.message;

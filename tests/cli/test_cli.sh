@@ -276,6 +276,8 @@ assert f['starts'] >= 1 and f['objective'] >= 0
 assert len(f['lead_noise']) == 1 and 0 <= f['lead_noise'][0] < 0.01
 se, sx = f['standard_errors'], f['standard_errors_exact_lead']
 assert all(sx[n] <= se[n] * (1 + 1e-12) for n in names if se[n] is not None and sx[n] is not None)
+# the bias correction applied (an evenly sampled run with some lead noise): it lowers what is minimised
+assert f['lead_noise_corrected'] is True and f['minimised_objective'] <= f['objective']
 PY
     "$bin" classify "$tmp/cal.csv" --format csv >/dev/null && ok || bad "calibrate table into classify"
     xmllint --noout "$tmp/cal.svg" && ok || bad "calibrate SVG"
@@ -290,6 +292,10 @@ expect_error "badtrace.csv:3: column 'follower_speed_mps' = 'x'" calibrate "$tmp
 expect_error "--bounds item 'eta=15'" calibrate "$excerpt" --bounds eta=15
 expect_error "--train = '5'" calibrate "$excerpt" --train 5
 expect_error "--lead-noise = -1: expected auto, or 0 to 10 m/s" calibrate "$excerpt" --lead-noise -1
+expect_error "--lead-noise-correction" calibrate "$excerpt" --lead-noise-correction maybe
+"$bin" calibrate "$excerpt" --lead-noise-correction off --format json 2>/dev/null |
+    python3 -c "import json, sys; f = json.load(sys.stdin)['result']['fits'][0]; assert f['lead_noise_corrected'] is False and f['minimised_objective'] == f['objective']" &&
+    ok || bad "calibrate --lead-noise-correction off"
 
 # calibrate on several files: one progress line per finished fit on stderr, always {"fits": [...]}
 cp "$excerpt" "$tmp/run2.csv"

@@ -169,7 +169,7 @@ TEST_CASE("calibration: profile likelihoods of tau and th agree with the interva
         REQUIRE(pl.objective.size() == 15);
         CHECK(std::is_sorted(pl.values.begin(), pl.values.end()));
         // the fit is the minimum of its own profile
-        CHECK(*std::min_element(pl.objective.begin(), pl.objective.end()) >= r.objective * (1.0 - 1e-9));
+        CHECK(*std::min_element(pl.objective.begin(), pl.objective.end()) >= r.minimised_objective * (1.0 - 1e-9));
         CHECK(pl.lower95 < e.value);
         CHECK(pl.upper95 > e.value);
         CHECK(!pl.lower_open);

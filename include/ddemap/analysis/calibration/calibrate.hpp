@@ -113,6 +113,18 @@ struct CalibrationOptions {
     /// robustly); 0: the lead speed is taken as exact.
     double lead_noise = -1.0;
     int lead_noise_draws = 200;  ///< Monte Carlo draws of the lead noise (20 to 100000)
+    /// Corrects the bias the lead speed's noise puts into the fit (corrected least squares,
+    /// docs/mathematics.md section 10): the model is linear in the lead speed, so white lead
+    /// noise of level sigma adds to the expected objective the penalty
+    ///     P(theta) = sigma^2 sum_l N_l (g_v(l)^2 + w_gap g_s(l)^2)
+    /// (g_v, g_s: the follower's speed and gap response to a unit change of one lead sample, at
+    /// lag l samples; N_l: the residual samples l or more after the first), which grows with
+    /// the car's responsiveness and pulls the least-squares fit towards sluggish gains (a car
+    /// with k2 = 0.95, tau = 0.15 s fitted k2 = 0.73, tau = 0.05 s from 0.05 m/s of lead noise).
+    /// The fit minimises |r|^2 - P(theta) instead (Gauss-Newton with the corrected normal
+    /// matrix J^T J - J_P^T J_P), whose expectation is the objective of an exact lead. Needs
+    /// evenly sampled runs (else a warning and no correction); no effect with lead_noise = 0.
+    bool lead_noise_correction = true;
     /// True when validate() would not throw.
     bool is_valid() const;
     /// Throws std::invalid_argument naming the offending option.
@@ -180,6 +192,10 @@ struct CalibrationResult {
     /// over the residuals d_k = v_k - a_k v_(k-1) - b_k v_(k+1) of linear interpolation between
     /// neighbours)
     std::vector<double> lead_noise;
+    /// true when the fit corrected the lead noise's bias (CalibrationOptions::lead_noise_correction,
+    /// some run with lead noise, all runs evenly sampled): the parameters minimise |r|^2 - P(theta),
+    /// the covariance uses the corrected normal matrix
+    bool lead_noise_corrected = false;
     CalibrationMatrix correlation = CalibrationMatrix::Identity();  ///< of `covariance`
     int bandwidth = 0;                ///< L [samples]: 5 times the lag where the residuals' autocorrelation falls below 0.05, at most n/4
     /// q of the 95 % intervals: the fixed-b critical value of the Bartlett-HAC t-statistic,
@@ -200,6 +216,9 @@ struct CalibrationResult {
     double rmse_speed = 0.0, rmse_gap = 0.0;  ///< = all: the whole-file simulation [m/s, m]
     double naive_rmse_speed = 0.0;            ///< = naive.rmse_speed, the same samples as all
     double objective = 0.0;      ///< MSE(speed) + gap_weight MSE(gap) on the training samples
+    /// what the fit minimised, per sample: `objective`, less P(theta) / n when the lead noise's
+    /// bias is corrected (lead_noise_corrected); the profiles are of this objective
+    double minimised_objective = 0.0;
     int starts = 0;              ///< Levenberg-Marquardt starts
     int evaluations = 0;         ///< simulations (with or without sensitivities)
     int jacobian_evaluations = 0;  ///< of which with sensitivities
@@ -268,6 +287,11 @@ std::vector<CarCalibration> calibrate_cars(const std::vector<CarRuns>& cars, con
 /// after t_a + tau_max (tau_max: the upper bound of tau), so fits and other candidates (e.g.
 /// the true parameters of a synthetic trace) compare on the same samples.
 double calibration_objective(const Trace& trace, const ParameterMap& parameters, const CalibrationOptions& options = {});
+/// The lead noise's expected share of calibration_objective at given parameters, P(theta) / n
+/// (CalibrationOptions::lead_noise_correction): for white noise e of level sigma on the lead
+/// speed, E[objective(lead + e)] = objective(lead) + P(theta) / n. sigma is options.lead_noise,
+/// or estimated from the trace when negative; 0 when sigma is 0 or the samples are uneven.
+double lead_noise_penalty(const Trace& trace, const ParameterMap& parameters, const CalibrationOptions& options = {});
 /// The objective `calibrate_joint` minimises: the runs' squared residuals summed over all runs,
 /// divided by the number of samples of all runs.
 double calibration_objective(const std::vector<Trace>& runs, const ParameterMap& parameters, const CalibrationOptions& options = {});
