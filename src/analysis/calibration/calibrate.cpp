@@ -383,13 +383,16 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
         return S;
     };
     // cost, Gauss-Newton matrix and gradient (in z) at theta; false when not finite
-    auto evaluate = [&](const CalibrationVector& th, double& c, Eigen::MatrixXd& AA, Eigen::VectorXd& gg) {
+    // (DD: the diagonal of the plain J^T J, positive, which scales the damping also when the
+    // corrected matrix has a diagonal entry <= 0)
+    auto evaluate = [&](const CalibrationVector& th, double& c, Eigen::MatrixXd& AA, Eigen::VectorXd& gg, Eigen::VectorXd& DD) {
         Eigen::VectorXd r, rho;
         Eigen::MatrixXd Jf, Jrho;
         if (!pb.eval(th, r, &Jf, corrected ? &rho : nullptr, corrected ? &Jrho : nullptr)) return false;
         const Eigen::MatrixXd J = scaled(Jf);
         c = r.squaredNorm();
         AA = J.transpose() * J;
+        DD = AA.diagonal();
         gg = J.transpose() * r;
         if (corrected) {
             const Eigen::MatrixXd Jr = scaled(Jrho);
@@ -401,9 +404,9 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
     };
     res.theta = theta_of(z);
     Eigen::MatrixXd A, A_new;
-    Eigen::VectorXd g, g_new;
+    Eigen::VectorXd g, g_new, D, D_new;
     double cost = kInf;
-    if (!evaluate(res.theta, cost, A, g)) {
+    if (!evaluate(res.theta, cost, A, g, D)) {
         res.message = "the simulation is not finite at the start";
         return res;
     }
@@ -413,7 +416,7 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
         res.message = "no free parameter";
         return res;
     }
-    double mu = 1e-3 * std::max(A.diagonal().maxCoeff(), 1e-300), nu = 2.0;
+    double mu = 1e-3 * std::max(D.maxCoeff(), 1e-300), nu = 2.0;
     res.status = Status::MaxIterations;
     res.message = "the iteration limit (" + std::to_string(o.max_iterations) + ") was reached";
     for (int it = 0; it < o.max_iterations; ++it) {
@@ -438,11 +441,11 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
         }
         Eigen::MatrixXd Aq(q, q);
         Eigen::VectorXd gq(q), dg(q);
-        const double dmax = A.diagonal().maxCoeff();
+        const double dmax = D.maxCoeff();
         for (int i = 0; i < q; ++i) {
             gq[i] = g[act[static_cast<std::size_t>(i)]];
             for (int j = 0; j < q; ++j) Aq(i, j) = A(act[static_cast<std::size_t>(i)], act[static_cast<std::size_t>(j)]);
-            dg[i] = std::max(Aq(i, i), 1e-9 * dmax + 1e-300);
+            dg[i] = std::max(D[act[static_cast<std::size_t>(i)]], 1e-9 * dmax + 1e-300);
         }
         bool accepted = false, stop = false;
         while (!accepted) {
@@ -474,7 +477,7 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
             const double pred = -(g.dot(d) + 0.5 * d.dot(A * d));
             const CalibrationVector th_new = theta_of(z_new);
             double cost_new = kInf;
-            const bool ok = evaluate(th_new, cost_new, A_new, g_new);
+            const bool ok = evaluate(th_new, cost_new, A_new, g_new, D_new);
             if (!ok) cost_new = kInf;
             const double rho = pred > 0.0 ? (cost - cost_new) / pred : -1.0;
             if (ok && cost_new < cost && rho > 1e-4) {
@@ -482,6 +485,7 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
                 z = z_new;
                 A.swap(A_new);
                 g.swap(g_new);
+                D.swap(D_new);
                 cost = cost_new;
                 res.theta = th_new;
                 res.ssr = cost;
