@@ -166,17 +166,25 @@ bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, R
 }
 
 /// Refine candidates, merge duplicates, return sorted rightmost first.
+/// Candidates whose Newton iteration failed go to `failed` (when given): a root there may be
+/// missing from the list. A real candidate is also tried off the axis: rounding splits a nearly
+/// double complex pair (separation ~sqrt(eps)) into two real eigenvalues, and Newton from a real
+/// start stays real (real arithmetic on a real DDE), so it cannot reach the pair.
 std::vector<Root> refine_all(const LinearDDE& dde, const std::vector<cplx>& candidates, const RootOptions& options, int& dropped,
-                             int& iterations) {
+                             int& iterations, std::vector<cplx>* failed = nullptr) {
     const bool real = dde.is_real();
     std::vector<Root> found;
     for (cplx c : candidates) {
         if (real && c.imag() < 0.0) continue;  // the conjugate partner is (or will be) refined instead
         Root r;
-        if (!refine_root(dde, c, options, r, iterations)) {
+        if (!refine_root(dde, c, options, r, iterations) &&
+            !(c.imag() == 0.0 && refine_root(dde, c + cplx(0.0, 1e-4 * scale_of(c)), options, r, iterations))) {
             ++dropped;
+            if (failed) failed->push_back(c);
             continue;
         }
+        r.eigenvalue = c;
+        r.collocation_error = std::abs(r.value - c);
         if (real) {
             if (r.value.imag() < 0.0) r.value = std::conj(r.value);
             if (std::abs(r.value.imag()) <= 1e-12 * scale_of(r.value) && r.value.imag() != 0.0) {
@@ -382,7 +390,9 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         const std::size_t k = std::min<std::size_t>(ev.size(), 2 * options.count + 8);
         ev.resize(k);
         int dropped = 0;
-        std::vector<Root> current = cut_rightmost(refine_all(dde, ev, options, dropped, result.newton_iterations), options.count);
+        std::vector<cplx> failed;
+        std::vector<Root> current = cut_rightmost(refine_all(dde, ev, options, dropped, result.newton_iterations, &failed), options.count);
+
         // Completeness is certified right of sigma: the last of the `count` roots, or, when fewer
         // were found, the floor of the strip Re >= alpha - depth (all roots there are listed).
         const double depth = o.depth > 0.0 ? o.depth : 2.0 / tau;
@@ -410,10 +420,16 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         // Two certificates: the eigenvalues themselves already equal the Newton-refined roots
         // (spectral accuracy reached at this M), or the refined roots agree between two degrees.
         const bool covers = covered >= needed;
+        // a collocation eigenvalue right of sigma that Newton could not refine may be a root the
+        // list misses: no certificate at this degree (a larger M or its neighbour may refine it)
+        cplx lost(std::numeric_limits<double>::quiet_NaN(), 0.0);
+        for (cplx z : failed)
+            if (z.real() >= sigma - 1e-8 * scale_of(z) && !(z.real() <= lost.real())) lost = z;
+        const bool complete = std::isnan(lost.real());
         // (With fewer than `count` roots found only the second certificate applies: a larger M
         // may reveal more roots, so the same set must come out of two degrees.)
-        const bool spectral = full && worst_collocation <= o.spectral_tolerance && covers;
-        const bool agreed = change <= o.agreement_tolerance && collocated && covers;
+        const bool spectral = full && worst_collocation <= o.spectral_tolerance && covers && complete;
+        const bool agreed = change <= o.agreement_tolerance && collocated && covers && complete;
         const bool settled = spectral || agreed;
         // the degree M done (of at most max_degree); may throw Cancelled (caught by rightmost_roots)
         if (options.progress) options.progress(m, max_degree, sigma);
@@ -449,6 +465,7 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
                 os << ", resolved radius " << covered << " of needed ";
                 if (std::isfinite(needed)) os << needed;
                 else os << "an unbounded radius (the root bound is not finite)";
+                if (!complete) os << "; the collocation eigenvalue " << lost.real() << (lost.imag() < 0 ? " - " : " + ") << std::abs(lost.imag()) << "i right of sigma = " << sigma << " could not be refined to a root";
                 os << ")";
             }
             result.message = os.str();

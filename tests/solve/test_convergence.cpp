@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
@@ -57,3 +58,62 @@ TEST_CASE("the adaptive degree reports why it is trusted") {
 }
 
 TEST_SUITE_END();
+
+namespace {
+/// Zeros of f in the rectangle [x0, x1] x [y0, y1] by the argument principle: the change of
+/// arg f along the boundary summed over `steps` equal steps per side. Each step must move arg by
+/// less than pi: true when the steps are short against the distance of every zero from the
+/// boundary (a zero at distance d turns arg by about h / d in a step h).
+int zeros_in_rectangle(const std::function<cplx(cplx)>& f, double x0, double x1, double y0, double y1, int steps) {
+    const cplx corner[5] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}, {x0, y0}};
+    double total = 0.0;
+    for (int side = 0; side < 4; ++side) {
+        const cplx a = corner[side], b = corner[side + 1];
+        cplx fa = f(a);
+        for (int i = 1; i <= steps; ++i) {
+            const cplx fb = f(a + (static_cast<double>(i) / steps) * (b - a));
+            total += std::arg(fb / fa);
+            fa = fb;
+        }
+    }
+    return static_cast<int>(std::lround(total / (2.0 * M_PI)));
+}
+}  // namespace
+
+// D(l) = l^2 + a l + b e^{-l tau}, the plant of an OVRV car (a = k1 th + k2, b = k1, tau = 0.5 s)
+// at gains where its two rightmost roots nearly coincide (a pair -0.859163 -+ 2.6e-6 i, what a
+// minimiser of the spectral abscissa drives them to). Rounding splits the pair into two real
+// collocation eigenvalues at some degrees; Newton from a real start stays real and failed, the
+// two were dropped, and the next roots (-10.73 -+ 9.41 i) were certified as the rightmost. The
+// pair must be listed, and nothing may be certified without it: checked against Newton on the
+// scalar D from a complex start and an argument-principle count right of the answer.
+TEST_CASE("a nearly double complex pair split by rounding into two real eigenvalues is refined, never skipped") {
+    const double k1 = 0.8421560728366616, k2 = 1.5232043282553798, th = 1.0, tau = 0.5;
+    const double a = k1 * th + k2, b = k1;
+    const auto D = [&](cplx l) { return l * l + a * l + b * std::exp(-l * tau); };
+    const auto dD = [&](cplx l) { return 2.0 * l + a - tau * b * std::exp(-l * tau); };
+    cplx z(-0.86, 1e-3);
+    for (int i = 0; i < 100 && std::abs(D(z)) > 1e-15; ++i) z -= D(z) / dD(z);
+    REQUIRE(std::abs(D(z)) < 1e-13);
+    // x = (s, v) as the plant of a car is written: s' = -v, v' = b s(t - tau) - a v
+    MatrixXc a0 = MatrixXc::Zero(2, 2), a1 = MatrixXc::Zero(2, 2);
+    a0(0, 1) = -1.0;
+    a0(1, 1) = -a;
+    a1(1, 0) = b;
+    const LinearDDE dde(a0, {{a1, tau}});
+    for (int count : {1, 2, 4}) {
+        CAPTURE(count);
+        RootOptions ro;
+        ro.count = count;
+        const RootResult r = rightmost_roots(dde, ro);
+        CAPTURE(r.message);
+        REQUIRE(!r.roots.empty());
+        if (r.status != Status::Converged) continue;  // undecided is allowed; a wrong certificate is not
+        CHECK(std::abs(r.roots.front().value.real() - z.real()) < 1e-6);
+        // nothing right of the reported abscissa (|l| <= 10 bounds every root with Re >= -1 here;
+        // steps of 2e-4 against a distance of 1e-3 from the pair), and the pair counted left of it
+        const double x = r.roots.front().value.real();
+        CHECK(zeros_in_rectangle(D, x + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
+        CHECK(zeros_in_rectangle(D, x - 1e-3, 5.0, -10.0, 10.0, 100000) == 2);
+    }
+}
