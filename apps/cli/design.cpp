@@ -21,6 +21,7 @@ namespace ddemap::cli {
 namespace {
 struct DesignArgs {
     std::string car, objective = "sup-gamma", free = "k1,k2", bounds, margin = "0.1", weights, starts = "4";
+    bool robust = false;
     RingArg ring;
     FormatArg format;
     OutArg out;
@@ -65,6 +66,9 @@ void add_design_flags(CLI::App& app) {
                    "from car to car at least as by a first-order lag of this time constant, |Gamma(iw)| <= 1/|1 + i margin w|")
         ->capture_default_str()
         ->type_name("SECONDS");
+    app.add_flag("--robust", design_args.robust,
+                 "ask the margin of every car the fit is consistent with: of the worst point of the fit's 95 % ellipsoid of the held parameters "
+                 "(worst-case iteration; CAR must carry a covariance: a fit file from calibrate)");
     app.add_option("--weights", design_args.weights, "nearest: a weight per free parameter of the relative change, each in [0.001, 1000] (default: all 1)")->type_name("W,...");
     app.add_option("--starts", design_args.starts, "runs of the minimiser: from the car's values and from points of a Halton sequence in the bounds (1..64)")
         ->capture_default_str()
@@ -115,6 +119,11 @@ int run_design() {
     if (car.has_covariance && car.model == "ovrv") {  // a fit: judge the design under its uncertainty too
         o.has_covariance = true;
         o.covariance = car.covariance;
+    }
+    if (design_args.robust) {
+        if (!o.has_covariance)
+            throw BadInput("--robust: the car " + car.name + " has no covariance: expected a fit of calibrate (FILE.json or FILE.csv with cov_ columns)");
+        o.robust = true;
     }
     // sized before the work (one core, measured on the paper's cars): an evaluation of the
     // frequency objectives or the plant's abscissa about 3 ms with its gradient, a run at most a

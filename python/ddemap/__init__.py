@@ -853,7 +853,7 @@ def growth(vehicles=None, followers=15, lead_profile=None, lead=None):
 
 
 @_with_progress
-def design(car, objective="sup-gamma", free=("k1", "k2"), bounds=None, margin=0.1, weights=None, starts=4, speed=None, ring=None):
+def design(car, objective="sup-gamma", free=("k1", "k2"), bounds=None, margin=0.1, weights=None, starts=4, speed=None, ring=None, robust=False):
     """Gains of one car that minimise a stability objective within bounds (``ddemap design``).
 
     ``car``: one car, as :func:`classify` takes cars (``"C_max"``, ``"mycars.csv:Sedan"``, a
@@ -870,6 +870,9 @@ def design(car, objective="sup-gamma", free=("k1", "k2"), bounds=None, margin=0.
     * ``"abscissa"``: the plant's spectral abscissa, or the ring's with ``ring`` (N or "inf").
 
     ``starts``: runs of the minimiser (the car's values and Halton points of the box).
+    ``robust=True`` (a fitted car with its covariance, e.g. a :func:`calibrate` Result): the
+    margin is asked of the worst point of the fit's 95 % ellipsoid of the held parameters
+    (``--robust``; the result's ``robust`` has ``met`` and the designs' ``steps``).
 
     Returns ``gains`` ({name: value}), ``objective``, ``change``, ``attenuation_margin`` [s],
     ``margin_met``, ``infeasibility_proof`` (a proof that no gains of the box are string stable,
@@ -892,7 +895,7 @@ def design(car, objective="sup-gamma", free=("k1", "k2"), bounds=None, margin=0.
     weights = [] if weights is None else [_number("weights", w) for w in weights]
     return _result(_ddemap.design(spec, tables, str(objective), free, bound_list, _number("margin", margin), weights,
                                   _integer("starts", starts, 1, 64), None if speed is None else _number("speed", speed),
-                                  None if ring is None else _ring(ring)))
+                                  None if ring is None else _ring(ring), bool(robust)))
 
 
 def _spec_text(spec):

@@ -728,7 +728,7 @@ std::string py_growth(const std::string& spec, const CarTables& tables, int foll
 /// design: the gains of one car that minimise an objective (analysis/design/design.hpp).
 std::string py_design(const std::string& spec, const CarTables& tables, const std::string& objective, const std::vector<std::string>& free,
                       const std::vector<std::tuple<std::string, double, double>>& bounds, double margin, const std::vector<double>& weights, int starts,
-                      std::optional<double> speed, std::optional<int> cars) {
+                      std::optional<double> speed, std::optional<int> cars, bool robust) {
     const std::vector<CalibratedVehicle> found = distinct_cars(vehicles_spec(spec, tables));
     if (found.size() != 1)
         throw std::invalid_argument("car = '" + spec + "': " + std::to_string(found.size()) + " cars: expected one car (e.g. \"mycars.csv:Sedan\")");
@@ -747,6 +747,9 @@ std::string py_design(const std::string& spec, const CarTables& tables, const st
         o.has_covariance = true;
         o.covariance = car.covariance;
     }
+    if (robust && !o.has_covariance)
+        throw std::invalid_argument("robust: the car " + car.name + " has no covariance: expected a fit of calibrate (its Result, JSON or CSV with cov_ columns)");
+    o.robust = robust;
     o.progress = interruptible();
     const DesignResult r = released([&] { return design_gains(car.model, p, o); });
     const JsonEnvelope e = design_envelope(r, o, spec, car.name);
@@ -1134,7 +1137,7 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("growth", &py_growth, py::arg("vehicles"), py::arg("tables"), py::arg("followers"), py::arg("lead_profile"), py::arg("lead"),
           py::arg("lead_text"), py::arg("lead_car"));
     m.def("design", &py_design, py::arg("car"), py::arg("tables"), py::arg("objective"), py::arg("free"), py::arg("bounds"), py::arg("margin"),
-          py::arg("weights"), py::arg("starts"), py::arg("speed"), py::arg("ring"));
+          py::arg("weights"), py::arg("starts"), py::arg("speed"), py::arg("ring"), py::arg("robust"));
     m.def("chart", &py_chart, py::arg("text"), py::arg("source"), py::arg("prefix"));
     m.def("paper", &py_paper, py::arg("prefix"));
     m.def("atlas", &py_atlas, py::arg("text"), py::arg("source"), py::arg("prefix"), py::arg("allow_large"));

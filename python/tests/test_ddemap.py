@@ -659,3 +659,11 @@ def test_design_of_a_fit_is_judged_under_its_uncertainty_as_the_command(tmp_path
     u = r["uncertainty"]
     assert 0 <= u["design"]["p_string_stable"] <= 1 and u["worst_case"]["design"]["held"] == ["th", "tau"]
     assert u["worst_case"]["design"]["attenuation_margin"] <= r["attenuation_margin"]
+    # robust: the margin of the worst point of the ellipsoid, as --robust; refused without a covariance
+    rr = ddemap.design(path, objective="nearest", robust=True, progress=False)
+    same_envelope(rr, cli_json("design", path, "--objective", "nearest", "--robust"))
+    assert rr["robust"]["met"] is True and len(rr["robust"]["steps"]) >= 1
+    assert rr["uncertainty"]["worst_case"]["design"]["attenuation_margin"] >= 0.1 * (1 - 1e-6)
+    assert r["robust"] is None
+    with pytest.raises(ValueError, match="robust: the car C_max has no covariance"):
+        ddemap.design("C_max", robust=True, progress=False)

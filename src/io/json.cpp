@@ -799,9 +799,22 @@ std::string design_json(const DesignResult& r, double margin) {
                                     .json("initial", prob(r.uncertainty_initial))
                                     .json("worst_case", JsonObject().json("design", worst(r.worst)).json("initial", worst(r.worst_initial)).str())
                                     .str());
+        if (r.robust) {
+            // the worst-case iteration: each design's held values (the car's own first), gains and worst margin
+            std::vector<std::string> steps;
+            for (const auto& st : r.robust_steps) {
+                JsonObject so;
+                so.json("scenario", json_parameters(st.scenario)).json("gains", json_parameters(st.gains));
+                if (std::isfinite(st.worst_margin)) so.number("worst_margin", st.worst_margin);
+                else so.null("worst_margin");
+                steps.push_back(so.str());
+            }
+            res.json("robust", JsonObject().boolean("met", r.robust_met).json("steps", json_array(steps)).str());
+        }
     } else {
         res.null("uncertainty");
     }
+    if (!r.robust) res.null("robust");
     return res.str();
 }
 
@@ -814,6 +827,7 @@ JsonEnvelope design_envelope(const DesignResult& r, const DesignOptions& o, cons
     JsonObject in;
     in.string("car", car).string("name", name).string("model", r.model).json("parameters", json_parameters(r.initial));
     in.string("objective", r.objective).json("free", free + "]").number("margin", o.margin).integer("starts", o.starts);
+    if (o.robust) in.boolean("robust", true);
     if (o.cars >= 0) in.json("ring", json_ring(o.cars));
     e.inputs = in.str();
     e.has_solver = true;

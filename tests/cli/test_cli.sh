@@ -2128,6 +2128,26 @@ for k in ("k1", "k2"):
     assert abs(a["gains"][k] - b["gains"][k]) <= 1e-7 * abs(a["gains"][k]), (a["gains"], b["gains"])
 PY
 expect_error "expected a number of seconds in \[0.001, 1000\]" design C_max --margin 1e-12
+# --robust: refused without a covariance; on a fit with one, the worst margin over its ellipsoid meets --margin
+expect_error "--robust: the car C_max has no covariance" design C_max --robust
+python3 - "$tmp/rfit.csv" <<'PY'
+import sys
+names = ["k1", "k2", "th", "tau", "eta"]
+cols = ["cov_%s_%s" % (names[i], names[j]) for i in range(5) for j in range(i, 5)]
+cov = dict.fromkeys(cols, 0.0)
+cov.update(cov_tau_tau=0.05 ** 2, cov_th_th=0.1 ** 2, cov_th_tau=0.5 * 0.1 * 0.05)
+open(sys.argv[1], "w").write("name,k1,k2,th,tau,eta," + ",".join(cols) + "\nfit,0.05,0.3,1.5,0.4,10," + ",".join(repr(cov[c]) for c in cols) + "\n")
+PY
+"$bin" design "$tmp/rfit.csv" --objective nearest --robust --starts 2 --format json >"$tmp/rob.json" 2>/dev/null && ok || bad "design --robust: exit $?"
+python3 - "$tmp/rob.json" <<'PY' && ok || bad "design --robust: met, the worst margin at least --margin, its steps"
+import json, sys
+d = json.load(open(sys.argv[1]))
+r = d["result"]
+assert d["inputs"]["robust"] is True
+assert r["robust"]["met"] is True and len(r["robust"]["steps"]) >= 2, r["robust"]
+assert r["robust"]["steps"][0]["scenario"] == {} and r["robust"]["steps"][-1]["worst_margin"] >= 0.1 * (1 - 1e-6)
+assert r["uncertainty"]["worst_case"]["design"]["attenuation_margin"] >= 0.1 * (1 - 1e-6)
+PY
 # classify prints the attenuation margin m*: its sign is the string verdict, the design's meets the margin
 "$bin" classify "$(dirname "$0")/../../examples/mycars.csv",A_min,C_max --format json >"$tmp/desc.json" && ok || bad "classify with m*: exit $?"
 python3 - "$tmp/desc.json" <<'PY' && ok || bad "classify: attenuation_margin > 0 exactly for the string-stable cars"

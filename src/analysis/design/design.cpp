@@ -55,6 +55,10 @@ void DesignOptions::validate() const {
     if (starts < 1 || starts > 64) throw std::invalid_argument("design: starts = " + std::to_string(starts) + ": expected 1 to 64");
     optimizer.validate();
     peak.validate();
+    if (robust && !has_covariance)
+        throw std::invalid_argument("design: robust design needs the covariance of a calibrated car (a fit file from calibrate): the car has none");
+    if (robust_iterations < 1 || robust_iterations > 50)
+        throw std::invalid_argument("design: robust_iterations = " + std::to_string(robust_iterations) + ": expected 1 to 50");
     if (uncertainty_samples < 1 || uncertainty_samples > 1000000)
         throw std::invalid_argument("design: uncertainty_samples = " + std::to_string(uncertainty_samples) + ": expected 1 to 1000000");
     validate_bounds(bounds);
@@ -95,6 +99,9 @@ public:
 
     std::string m_model;
     ParameterMap m_base;
+    /// robust design: the held parameters at which the search evaluates (the worst point of the
+    /// ellipsoid); empty: the car's own. The result's verdicts are at the car's own (nominal()).
+    ParameterMap m_scenario;
     const DesignOptions& m_opt;
     std::vector<double> lo, hi, x0, w;
     int evaluations = 0;
@@ -106,7 +113,13 @@ public:
         for (std::size_t j = 0; j < n(); ++j) p[m_opt.free[j]] = x[static_cast<Eigen::Index>(j)];
         return p;
     }
-    Linearisation lin(const Eigen::VectorXd& x) const { return make_model(m_model, params(x))->linearise(); }
+    Linearisation lin(const Eigen::VectorXd& x) const {
+        if (m_scenario.empty()) return make_model(m_model, params(x))->linearise();
+        ParameterMap p = params(x);
+        for (const auto& [k, v] : m_scenario) p[k] = v;
+        return make_model(m_model, p)->linearise();
+    }
+    Linearisation nominal(const Eigen::VectorXd& x) const { return make_model(m_model, params(x))->linearise(); }
     // A difference step of `rel` relative to x_j (to the box's width where x_j = 0)
     double step(std::size_t j, const Eigen::VectorXd& x, double rel = 1e-6) const {
         const double v = std::abs(x[static_cast<Eigen::Index>(j)]);
@@ -639,8 +652,55 @@ WorstMargin worst_attenuation_margin(const ParameterMap& parameters, const Eigen
     return w;
 }
 
+namespace {
+DesignResult design_at(const std::string& model, const ParameterMap& parameters, const DesignOptions& options, const ParameterMap& scenario);
+}  // namespace
+
 DesignResult design_gains(const std::string& model, const ParameterMap& parameters, const DesignOptions& options) {
     options.validate();
+    if (!options.robust) return design_at(model, parameters, options, {});
+    // worst-case iteration: design at the held values where the last design's margin is least
+    DesignOptions o = options;
+    o.robust = false;
+    ParameterMap scenario;
+    DesignResult r;
+    std::vector<DesignResult::RobustStep> steps;
+    for (int it = 0; it < options.robust_iterations; ++it) {
+        r = design_at(model, parameters, o, scenario);
+        steps.push_back({scenario, r.gains, r.worst.margin});
+        // met; or nothing to iterate on: no gains at all (a proof), a design that did not
+        // converge, nothing held, an unstable plant in the ellipsoid, the same worst point again
+        if (r.worst.margin >= options.margin * (1.0 - 1e-6) || !r.infeasibility_proof.empty() || r.status != Status::Converged || r.worst.held.empty() ||
+            r.worst.plant_unstable)
+            break;
+        ParameterMap next;
+        for (const std::string& h : r.worst.held) next[h] = r.worst.at.at(h);
+        if (next == scenario) break;
+        scenario = next;
+    }
+    r.robust = true;
+    r.robust_steps = steps;
+    r.robust_met = r.worst.margin >= options.margin * (1.0 - 1e-6);
+    std::string path;
+    for (const auto& st : steps) path += (path.empty() ? "" : ", ") + detail::significant(st.worst_margin, 4) + " s";
+    if (!r.infeasibility_proof.empty() && !r.robust_met) {
+        if (r.message.find(r.infeasibility_proof) == std::string::npos) r.message += "; " + r.infeasibility_proof;
+        r.message += "; so no robust design either";
+    } else if (r.status == Status::Converged && !r.robust_met) {
+        r.status = Status::MaxIterations;
+        r.message = "robust design: the worst attenuation margin over the fit's 95 % ellipsoid of " + join(r.worst.held, ", ") + " stays below " +
+                    detail::significant(options.margin, 6) + " s after " + std::to_string(steps.size()) + " designs (worst margins " + path +
+                    (r.worst.plant_unstable ? "; the plant is unstable somewhere in the ellipsoid" : "") + "): not a robust design";
+    } else if (r.status == Status::Converged) {
+        r.message += "; robust: the worst attenuation margin over the fit's 95 % ellipsoid of " + join(r.worst.held, ", ") + " is " +
+                     detail::significant(r.worst.margin, 6) + " s >= " + detail::significant(options.margin, 6) + " s after " + std::to_string(steps.size()) +
+                     " design" + (steps.size() == 1 ? "" : "s") + " (worst margins " + path + ")";
+    }
+    return r;
+}
+
+namespace {
+DesignResult design_at(const std::string& model, const ParameterMap& parameters, const DesignOptions& options, const ParameterMap& scenario) {
     const auto car = make_model(model, parameters);  // validates the car itself
     const Linearisation lin0 = car->linearise();
     if (lin0.leaders() > 1) require_single_leader(lin0, "design");
@@ -653,6 +713,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     r.free = options.free;
     r.initial = car->parameters();
     Problem P(model, r.initial, options);
+    P.m_scenario = scenario;
     for (const BoundedParameter& b : options.bounds)
         if (std::find(options.free.begin(), options.free.end(), b.name) == options.free.end())
             throw std::invalid_argument("design: a bound on " + b.name + ", which is not free: expected bounds on the free parameters (" +
@@ -964,7 +1025,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
 
     r.gains = P.free_map(x);
     r.parameters = P.params(x);
-    const Linearisation L = P.lin(x);
+    const Linearisation L = P.nominal(x);
     r.value = P.value(x, nullptr, options.objective);
     if (std::isnan(r.value)) r.value = kInf;
     r.change = P.distance(x, nullptr);
@@ -1051,5 +1112,6 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     }
     return r;
 }
+}  // namespace
 
 }  // namespace ddemap

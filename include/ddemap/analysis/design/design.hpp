@@ -101,6 +101,14 @@ struct DesignOptions {
     bool has_covariance = false;
     Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
     int uncertainty_samples = 1000;  ///< parameter draws for those probabilities (>= 1)
+    /// Robust design (needs the covariance): the attenuation margin is asked of the worst point
+    /// of the fit's 95 % ellipsoid of the held parameters, not of the car's values. Solved by
+    /// worst-case iteration: design at the held values where the current design's margin is
+    /// least (worst_attenuation_margin), until the worst margin over the ellipsoid at the design
+    /// meets `margin` (to 1e-6 relative), at most `robust_iterations` designs; the objective is
+    /// the chosen one at that worst point.
+    bool robust = false;
+    int robust_iterations = 8;  ///< 1 to 50
     /// After each evaluation of a search, and after each run: (work done, work in all), the work
     /// counted in evaluations with each run's budget as its share (an upper bound: a run that
     /// stops early adds the rest of its share). It may throw ddemap::Cancelled to stop.
@@ -181,6 +189,15 @@ struct DesignResult {
     /// parameters, at the car and at the design (the design meets the margin robustly when
     /// worst.margin >= options.margin).
     WorstMargin worst_initial, worst;
+    /// Robust design: each design of the worst-case iteration, at the held values `scenario`
+    /// (empty: the car's own), its gains and the worst margin over the ellipsoid at them.
+    struct RobustStep {
+        ParameterMap scenario, gains;
+        double worst_margin = 0.0;
+    };
+    bool robust = false;
+    bool robust_met = false;  ///< worst.margin >= options.margin (to 1e-6 relative)
+    std::vector<RobustStep> robust_steps;
 };
 
 /// Designs the free parameters of the car `model` with `parameters` (every law parameter and
