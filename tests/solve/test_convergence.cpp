@@ -9,6 +9,7 @@
 
 #include "ddemap/discretize/collocation.hpp"
 #include "ddemap/solve/roots.hpp"
+#include "argument_count.hpp"
 #include "lambert_w.hpp"
 
 TEST_SUITE_BEGIN("fast");
@@ -59,26 +60,6 @@ TEST_CASE("the adaptive degree reports why it is trusted") {
 
 TEST_SUITE_END();
 
-namespace {
-/// Zeros of f in the rectangle [x0, x1] x [y0, y1] by the argument principle: the change of
-/// arg f along the boundary summed over `steps` equal steps per side. Each step must move arg by
-/// less than pi: true when the steps are short against the distance of every zero from the
-/// boundary (a zero at distance d turns arg by about h / d in a step h).
-int zeros_in_rectangle(const std::function<cplx(cplx)>& f, double x0, double x1, double y0, double y1, int steps) {
-    const cplx corner[5] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}, {x0, y0}};
-    double total = 0.0;
-    for (int side = 0; side < 4; ++side) {
-        const cplx a = corner[side], b = corner[side + 1];
-        cplx fa = f(a);
-        for (int i = 1; i <= steps; ++i) {
-            const cplx fb = f(a + (static_cast<double>(i) / steps) * (b - a));
-            total += std::arg(fb / fa);
-            fa = fb;
-        }
-    }
-    return static_cast<int>(std::lround(total / (2.0 * M_PI)));
-}
-}  // namespace
 
 // D(l) = l^2 + a l + b e^{-l tau}, the plant of an OVRV car (a = k1 th + k2, b = k1, tau = 0.5 s)
 // at gains where its two rightmost roots nearly coincide (a pair -0.859163 -+ 2.6e-6 i, what a
@@ -113,7 +94,7 @@ TEST_CASE("a nearly double complex pair split by rounding into two real eigenval
         // nothing right of the reported abscissa (|l| <= 10 bounds every root with Re >= -1 here;
         // steps of 2e-4 against a distance of 1e-3 from the pair), and the pair counted left of it
         const double x = r.roots.front().value.real();
-        CHECK(zeros_in_rectangle(D, x + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
-        CHECK(zeros_in_rectangle(D, x - 1e-3, 5.0, -10.0, 10.0, 100000) == 2);
+        CHECK(test::zeros_in_rectangle(D, x + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
+        CHECK(test::zeros_in_rectangle(D, x - 1e-3, 5.0, -10.0, 10.0, 100000) == 2);
     }
 }

@@ -188,6 +188,10 @@ public:
         if (!is_computable(L)) return std::numeric_limits<double>::quiet_NaN();
         RootOptions ro;
         ro.count = 2;
+        // near its minimum the abscissa is a nearly double root, whose refined value moves by
+        // ~1e-11 between degrees: agreement to 1e-9 (far below the minimiser's resolution) settles
+        // at M of a few dozen instead of a few hundred
+        ro.dense.agreement_tolerance = 1e-9;
         const RootResult r = rightmost_roots(plant_dde(L), ro);
         if (r.status != Status::Converged || r.roots.empty()) return std::numeric_limits<double>::quiet_NaN();
         const cplx lambda = r.roots.front().value;

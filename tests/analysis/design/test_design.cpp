@@ -10,6 +10,7 @@
 #include "ddemap/analysis/stability/attenuation_margin.hpp"
 #include "ddemap/problem/linear_dde.hpp"
 #include "ddemap/solve/roots.hpp"
+#include "argument_count.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
@@ -455,4 +456,21 @@ TEST_CASE("robust design: the margin holds over the fit's ellipsoid (checked by 
     DesignOptions bad = o;
     bad.has_covariance = false;
     CHECK_THROWS_AS(design_gains("ovrv", p, bad), std::invalid_argument);
+}
+
+TEST_CASE("design abscissa with a delay: the value is the plant's rightmost root, a nearly double one at the optimum") {
+    // D = l^2 + (k1 th + k2) l + k1 e^{-l tau}, th = 1, tau = 0.5: the minimiser drives the two
+    // rightmost roots together; the value once skipped that pair (-10.73 reported, -0.859 true).
+    DesignOptions o;
+    o.objective = DesignObjective::Abscissa;
+    o.starts = 2;
+    const DesignResult r = design_gains("ovrv", {{"k1", 0.1}, {"k2", 0.3}, {"th", 1.0}, {"tau", 0.5}, {"eta", 5.0}, {"speed", 20.0}}, o);
+    CAPTURE(r.message);
+    REQUIRE(r.status == Status::Converged);
+    const double a = r.gains.at("k1") * 1.0 + r.gains.at("k2"), b = r.gains.at("k1"), tau = 0.5;
+    const auto D = [&](cplx l) { return l * l + a * l + b * std::exp(-l * tau); };
+    // no root right of the value (|l| <= 10 bounds every root with Re >= -1), two within 1e-3 left of it
+    CHECK(test::zeros_in_rectangle(D, r.value + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
+    CHECK(test::zeros_in_rectangle(D, r.value - 1e-3, 5.0, -10.0, 10.0, 100000) == 2);
+    CHECK(r.value < r.value_initial);
 }
