@@ -560,7 +560,7 @@ def string(model="ovrv", ring=None, **parameters):
 
 
 @_with_progress
-def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", mark=None, out=None, **parameters):
+def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", mark=None, out=None, peak=False, **parameters):
     """A stability chart over two model parameters (``ddemap sweep``).
 
     Give exactly two parameters as ``(LO, HI, COUNT)`` (the axes, COUNT >= 2 grid points from
@@ -569,7 +569,9 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", ma
     axis (default: the alphabetically first). At each grid point the rightmost root of every
     ring mode and of the plant is continued along the rows and certified by the argument
     principle; the string-stability quantities are those of :func:`string`. ``boundaries``:
-    also trace the stability boundaries by continuation; ``ring_curves``: "all" (every ring
+    also trace the stability boundaries by continuation; ``peak=True``: also decide peak
+    (L-infinity) string stability at every L2-stable point (grid keys ``peak_norm``, NaN where not
+    computed, and ``peak_stable``; as ``--peak``); ``ring_curves``: "all" (every ring
     mode's Hopf curve), "envelope" (only the boundary of the ring-stable region, any ring size)
     or "auto" (all up to 64 cars), as ``--ring-curves``. Runs in parallel (OMP_NUM_THREADS);
     the result does not depend on the number of threads.
@@ -596,7 +598,8 @@ def sweep(model="ovrv", ring=22, x=None, boundaries=True, ring_curves="auto", ma
     (xn, xt), (yn, yt) = _axis_text(axes[0], 0), _axis_text(axes[1], 0)
     spec, tables = ("", {}) if mark is None else _cars(mark, "mark")
     prefix = "" if out is None else _prefix(out, "sweep", (".csv", ".json", ".svg", "-boundaries.csv"))
-    envelope, grid, curves = _ddemap.sweep(model, fixed, xn, xt, yn, yt, _ring(ring), bool(boundaries), str(ring_curves), spec, tables, prefix)
+    envelope, grid, curves = _ddemap.sweep(model, fixed, xn, xt, yn, yt, _ring(ring), bool(boundaries), str(ring_curves), spec, tables, prefix,
+                                           bool(peak))
     r = _result(envelope)
     r["grid"] = grid
     r["x"]["values"] = grid["x"]

@@ -337,8 +337,9 @@ py::list curves_arrays(const BoundarySet& b) {
 
 py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const std::string& x_name, const std::string& x_text,
                 const std::string& y_name, const std::string& y_text, int cars, bool boundaries, const std::string& ring_curves_text,
-                const std::string& mark, const CarTables& tables, const std::string& prefix) {
+                const std::string& mark, const CarTables& tables, const std::string& prefix, bool peak) {
     SweepSpec spec = sweep_spec(model, fixed, x_name, x_text, y_name, y_text, cars);
+    spec.peak = peak;
     // the cars to mark, read and checked before the work (their notes as Python warnings)
     std::vector<std::string> notes;
     const std::vector<ChartMarker> marks =
@@ -363,6 +364,7 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     JsonObject in;
     sweep_inputs(spec, in);
     in.boolean("boundaries", boundaries).string("ring_curves", ring_curves_name(ring_curves));
+    if (peak) in.boolean("peak", true);
     if (!mark.empty()) in.string("mark", mark);
     e.inputs = in.str();
     e.has_solver = true;  // the ring method: winding tables, or per mode where boundaries need it
@@ -396,6 +398,10 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     g["plant_stable"] = grid([](const SweepPoint& p) { return p.plant_stable; }, false);
     g["ring_stable"] = grid([](const SweepPoint& p) { return p.ring_stable; }, false);
     g["string_stable"] = grid([](const SweepPoint& p) { return p.string_stable; }, false);
+    if (peak) {  // ||h||_1 (NaN where not computed: L2-unstable points) and the peak verdict
+        g["peak_norm"] = grid([](const SweepPoint& p) { return p.peak_norm > 0.0 ? p.peak_norm : std::numeric_limits<double>::quiet_NaN(); }, 0.0);
+        g["peak_stable"] = grid([](const SweepPoint& p) { return p.peak_stable; }, false);
+    }
     g["abscissa_mode"] = grid([](const SweepPoint& p) { return p.abscissa_mode; }, 0);
     g["plant_abscissa"] = grid([](const SweepPoint& p) { return p.plant_abscissa; }, 0.0);
     g["lowfreq_margin"] = grid([](const SweepPoint& p) { return p.lowfreq_margin; }, 0.0);
@@ -1121,7 +1127,8 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("roots_system", &py_roots_system, py::arg("system"), py::arg("count"), py::arg("degree"), py::arg("solver"));
     m.def("string", &py_string, py::arg("model"), py::arg("parameters"), py::arg("ring"));
     m.def("sweep", &py_sweep, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"), py::arg("y_axis"),
-          py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"), py::arg("mark"), py::arg("tables"), py::arg("prefix"));
+          py::arg("ring"), py::arg("boundaries"), py::arg("ring_curves"), py::arg("mark"), py::arg("tables"), py::arg("prefix"),
+          py::arg("peak"));
     m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
           py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"), py::arg("ring_curves"));
     m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"), py::arg("peak"));

@@ -667,3 +667,14 @@ def test_design_of_a_fit_is_judged_under_its_uncertainty_as_the_command(tmp_path
     assert r["robust"] is None
     with pytest.raises(ValueError, match="robust: the car C_max has no covariance"):
         ddemap.design("C_max", robust=True, progress=False)
+
+
+def test_sweep_peak_as_the_command(tmp_path):
+    # the peak notion in a sweep: the grid's peak_stable implies string_stable, the same envelope as --peak
+    r = ddemap.sweep(k1=(0.005, 0.2, 4), k2=(0.7, 1.1, 4), th=1.5, tau=0.3, boundaries=False, peak=True, progress=False)
+    same_envelope(r, cli_json("sweep", "--k1", "0.005:0.2:4", "--k2", "0.7:1.1:4", "--th", "1.5", "--tau", "0.3", "--no-boundaries", "--peak",
+                              "--out", str(tmp_path / "s")))
+    g = r["grid"]
+    assert (g["peak_stable"] <= g["string_stable"]).all()
+    assert g["peak_stable"].any() and (g["string_stable"] & ~g["peak_stable"]).any()
+    assert r["regions"]["peak_stable"] == int(g["peak_stable"].sum())

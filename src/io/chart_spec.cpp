@@ -56,6 +56,7 @@ Axis read_axis(const std::string& source, const toml::table& root, const char* k
 
 SweepSpec panel_sweep(const ChartSpec& spec, std::size_t panel) {
     SweepSpec s;
+    s.peak = spec.peak;
     s.model = spec.model;
     s.fixed = spec.fixed;
     for (const auto& [k, v] : spec.panels.at(panel).parameters) s.fixed[k] = v;
@@ -119,7 +120,7 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     }
     ChartSpec spec;
     static const char* known[] = {"title", "model", "ring", "fixed", "x", "y", "columns", "panel_width",
-                                  "panel_height", "boundaries", "ring_curves", "panel", "vehicles"};
+                                  "panel_height", "boundaries", "ring_curves", "panel", "vehicles", "peak"};
     for (const auto& [k, v] : root) {
         const std::string key(k.str());
         if (std::find_if(std::begin(known), std::end(known), [&](const char* s) { return key == s; }) == std::end(known)) {
@@ -160,6 +161,11 @@ ChartSpec parse_chart_spec(const std::string& text, const std::string& source) {
     size("panel_width", spec.panel_width);
     size("panel_height", spec.panel_height);
     if (auto b = root["boundaries"].value<bool>()) spec.boundaries = *b;
+    if (const toml::node* pk = root.get("peak")) {
+        const auto v = pk->value<bool>();
+        if (!v) throw std::invalid_argument(where(source, *pk) + ": peak: expected true or false");
+        spec.peak = *v;
+    }
     if (const toml::node* rc = root.get("ring_curves")) {
         const auto v = rc->value<std::string>();
         if (!v || (*v != "all" && *v != "envelope" && *v != "auto"))

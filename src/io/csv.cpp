@@ -36,7 +36,8 @@ std::string sweep_csv(const SweepResult& sw) {
     std::ostringstream s;
     s << parameter_column(sw.spec.x.name) << "," << parameter_column(sw.spec.y.name)
       << ",spectral_abscissa_per_s,unstable_roots,sup_gamma,omega_peak_rad_per_s,plant_stable,ring_stable,string_stable,"
-         "abscissa_mode,plant_abscissa_per_s,lowfreq_margin,peak_gain,certified\n";
+         "abscissa_mode,plant_abscissa_per_s,lowfreq_margin,peak_gain,certified"
+      << (sw.spec.peak ? ",peak_norm,peak_stable" : "") << "\n";
     auto b = [](bool v) { return v ? "true" : "false"; };
     for (const auto& p : sw.points) {
         s << format_exact(p.x) << "," << format_exact(p.y) << "," << format_exact(p.spectral_abscissa) << ",";
@@ -45,7 +46,10 @@ std::string sweep_csv(const SweepResult& sw) {
           << b(p.ring_stable) << "," << b(p.string_stable) << ",";
         if (p.abscissa_mode >= 0) s << p.abscissa_mode;
         s << "," << format_exact(p.plant_abscissa) << "," << format_exact(p.lowfreq_margin) << "," << format_exact(p.peak_gain)
-          << "," << b(p.certified) << "\n";
+          << "," << b(p.certified);
+        // ||h||_1 where it was computed (L2-stable points with a stable plant); empty elsewhere
+        if (sw.spec.peak) s << "," << (p.peak_norm > 0.0 && std::isfinite(p.peak_norm) ? format_exact(p.peak_norm) : std::string()) << "," << b(p.peak_stable);
+        s << "\n";
     }
     return s.str();
 }

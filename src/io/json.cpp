@@ -423,10 +423,14 @@ std::string sweep_json(const SweepResult& sw, const BoundarySet* b) {
     }
     j["ring"] = ring_value(sw.spec.cars);
     j["points"] = sw.points.size();
-    int classes[4] = {0, 0, 0, 0};
+    int classes[5] = {0, 0, 0, 0, 0};
     for (const auto& p : sw.points) ++classes[region_class(p)];
+    // string_stable counts every L2 string-stable point; with the peak notion, peak_stable those of
+    // them whose step response does not overshoot
     j["regions"] = {{"plant_unstable", classes[0]}, {"ring_unstable", classes[1]}, {"string_unstable", classes[2]},
-                    {"string_stable", classes[3]}};
+                    {"string_stable", classes[3] + classes[4]}};
+    if (sw.spec.peak) j["regions"]["peak_stable"] = classes[4];
+    j["peak"] = sw.spec.peak;
     j["method"] =
         "rightmost root of every ring mode and of the plant continued by Newton along grid rows, each certified by an "
         "argument-principle count (no zero right of Re + 1e-10 max(1,|lambda|)); Chebyshev collocation where a "

@@ -13,8 +13,11 @@ namespace ddemap {
 
 namespace {
 
-const char* region_fill[4] = {"#d73027", "#fc8d59", "#fee090", "#91bfdb"};
-const char* region_name[4] = {"plant unstable", "ring unstable", "string unstable", "string stable"};
+// class 4 (peak stable) only where the sweep decided the peak notion; class 3 is then the points
+// that are L2 string stable but whose step response overshoots (||h||_1 > 1)
+const char* region_fill[5] = {"#d73027", "#fc8d59", "#fee090", "#91bfdb", "#4575b4"};
+const char* region_name[5] = {"plant unstable", "ring unstable", "string unstable", "string stable", "string stable (L2 and peak)"};
+const char* kRegionL2Only = "string stable (L2), peak unstable (overshoot)";
 
 /// Text for an SVG (XML 1.0) element or attribute: the five markup characters as entities, and
 /// what XML cannot hold (control characters but tab and line ends, bytes that are not UTF-8) as
@@ -105,6 +108,7 @@ int region_class(const SweepPoint& p) {
     if (!p.plant_stable) return 0;
     if (!p.ring_stable) return 1;
     if (!p.string_stable) return 2;
+    if (p.has_peak && p.peak_stable) return 4;
     return 3;
 }
 
@@ -154,7 +158,8 @@ double condition_margin(const SweepPoint& p, int condition, bool lowfreq) {
     switch (condition) {
         case 0: return -p.plant_abscissa;
         case 1: return -p.spectral_abscissa;
-        default: return lowfreq ? p.lowfreq_margin : 1.0 - p.peak_gain;
+        case 2: return lowfreq ? p.lowfreq_margin : 1.0 - p.peak_gain;
+        default: return 1.0 - p.peak_norm;  // 3: L2 stable, the peak condition ||h||_1 <= 1
     }
 }
 
@@ -177,12 +182,16 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     width = std::max(width, text_width(o.title, 12) + 20);
 
     // what the figure shows: region classes (grid points), boundary kinds, markers, ellipses
-    bool class_shown[4] = {false, false, false, false};
+    bool class_shown[5] = {false, false, false, false, false};
+    bool any_peak = false;  // some panel decided the peak notion: class 3 is then "L2 only"
     bool kind_shown[4] = {false, false, false, false};
     bool any_marker = false, any_ellipse = false, any_outside = false, any_cut = false;
     const BoundaryKind kinds[4] = {BoundaryKind::RingHopf, BoundaryKind::PlantHopf, BoundaryKind::LowFrequency, BoundaryKind::Peak};
     for (const auto& panel : panels) {
-        for (const auto& pt : panel.sweep->points) class_shown[region_class(pt)] = true;
+        for (const auto& pt : panel.sweep->points) {
+            class_shown[region_class(pt)] = true;
+            any_peak = any_peak || pt.has_peak;
+        }
         if (panel.boundaries)
             for (const auto& c : panel.boundaries->curves)
                 for (int k = 0; k < 4; ++k) kind_shown[k] = kind_shown[k] || (c.kind == kinds[k] && c.points.size() >= 2);
@@ -205,8 +214,8 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         std::string text;
     };
     std::vector<Item> items;
-    for (int c = 3; c >= 0; --c)
-        if (class_shown[c]) items.push_back({0, c, region_name[c]});
+    for (int c = 4; c >= 0; --c)
+        if (class_shown[c]) items.push_back({0, c, c == 3 && any_peak ? kRegionL2Only : region_name[c]});
     for (int k = 0; k < 4; ++k)
         if (kind_shown[k]) items.push_back({1, k, curve_style(kinds[k]).name});
     if (any_marker) items.push_back({2, 0, "marked setting (k\u2081, k\u2082)"});
@@ -402,7 +411,7 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         s << "<g id=\"" << id << "-regions\" clip-path=\"url(#" << id << "-clip)\" stroke-linejoin=\"round\" stroke-width=\"0.6\">\n";
         s << "<rect x=\"" << num(ox) << "\" y=\"" << num(oy) << "\" width=\"" << num(pw) << "\" height=\"" << num(ph) << "\" fill=\""
           << region_fill[0] << "\"/>\n";
-        for (int level = 1; level <= 3; ++level) {
+        for (int level = 1; level <= (any_peak ? 4 : 3); ++level) {
             s << "<g class=\"level" << level << "\" fill=\"" << region_fill[level] << "\" stroke=\"" << region_fill[level] << "\">\n";
             auto inside = [&](int i, int j) { return region_class(sw.at(i, j)) >= level; };
             for (int j = 0; j + 1 < ny; ++j) {

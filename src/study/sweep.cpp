@@ -1,4 +1,5 @@
 #include "ddemap/study/sweep.hpp"
+#include "ddemap/analysis/stability/peak_stability.hpp"
 
 #include "study/internal/trackers.hpp"
 
@@ -332,7 +333,7 @@ RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, Pl
 }
 
 void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks,
-                      StringGuess* string) {
+                      StringGuess* string, bool peak) {
     StringOptions so;
     so.grid_points = 120;
     int fb = rs.fallbacks;
@@ -361,6 +362,18 @@ void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTrac
     p.plant_abscissa = sr.plant_abscissa;
     p.plant_stable = sr.plant_stable;
     p.string_stable = sr.string_stable;
+    if (peak) {
+        // ||h||_1 >= sup |Gamma(iw)|: only an L2-stable point can be peak stable
+        p.has_peak = true;
+        p.peak_stable = false;
+        p.peak_norm = sr.plant_stable ? 0.0 : std::numeric_limits<double>::infinity();
+        if (sr.string_stable) {
+            const PeakResult pk = peak_string_stability(lin, sr.plant_abscissa);
+            p.peak_norm = pk.finite ? pk.norm : std::numeric_limits<double>::infinity();
+            p.peak_stable = pk.verdict == Verdict::Stable;
+            if (pk.verdict == Verdict::Undecided) p.certified = false;
+        }
+    }
     if (string) {
         // the next point starts from this maximiser when it is the sup (the only case the shortcut covers)
         string->have = p.peak_gain >= 1.0 && p.peak_omega > 0.0;
@@ -489,13 +502,13 @@ SweepResult run_sweep(const SweepSpec& spec, const ExecutionPolicy& policy) {
                                                                                   row_winding_fallbacks[iy])
                                                    : ring.evaluate(lin);
             int fb = 0;
-            detail::fill_sweep_point(lin, rs, plant, p, fb, &string);
+            detail::fill_sweep_point(lin, rs, plant, p, fb, &string, spec.peak);
             for (int m = 0; m < result.modes && !winding; ++m) {
                 result.mode_roots[(static_cast<std::size_t>(iy) * nx + ix) * result.modes + m] = ring.roots()[m].value_or(cplx(0.0));
             }
             fallbacks += fb;
             degree = std::max(degree, rs.degree);
-            uncertified += !rs.certified;
+            uncertified += !p.certified;
         }
     }, policy);
     for (int iy = 0; iy < ny; ++iy) {

@@ -10,6 +10,8 @@
 #include "ddemap/analysis/stability/string_stability.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "ddemap/study/sweep.hpp"
+#include "ddemap/io/chart_spec.hpp"
+#include "ddemap/io/csv.hpp"
 #include "ddemap/traffic/transfer_function.hpp"
 #include "chart_helpers.hpp"
 
@@ -138,6 +140,45 @@ TEST_CASE("the sweep's plant roots (certified on a wide line first, adapted alon
 TEST_SUITE_END();
 
 TEST_SUITE_BEGIN("fast");
+
+TEST_CASE("sweep with the peak notion: per-point verdicts equal analyse_string's, peak stable points are L2 stable, the chart and CSV show them" * doctest::test_suite("slow")) {
+    // th = 1.5, tau = 0.3: above the L2 boundary a band where the step response still overshoots
+    SweepSpec spec;
+    spec.fixed = {{"th", 1.5}, {"tau", 0.3}};
+    spec.x = parse_axis("k1", "0.005:0.2:7");
+    spec.y = parse_axis("k2", "0.6:1.2:9");
+    spec.cars = 22;
+    spec.peak = true;
+    const SweepResult r = run_sweep(spec);
+    int peak_stable = 0, l2_only = 0;
+    for (const SweepPoint& p : r.points) {
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(p.has_peak);
+        CHECK(!(p.peak_stable && !p.string_stable));  // ||h||_1 >= sup |Gamma|
+        StringOptions so;
+        so.peak = true;
+        const StringResult sr = analyse_string(model_at(spec, p.x, p.y)->linearise(), so);
+        REQUIRE(sr.peak);
+        CHECK(p.peak_stable == (sr.peak->verdict == Verdict::Stable));
+        if (sr.string_stable && sr.peak->finite) CHECK(p.peak_norm == doctest::Approx(sr.peak->norm).epsilon(1e-12));
+        peak_stable += p.peak_stable;
+        l2_only += p.string_stable && !p.peak_stable;
+    }
+    CHECK(peak_stable > 0);
+    CHECK(l2_only > 0);
+    const std::string svg = sweep_chart_svg(spec, r, nullptr, {});
+    CHECK(svg.find("string stable (L2 and peak)") != std::string::npos);
+    CHECK(svg.find("string stable (L2), peak unstable (overshoot)") != std::string::npos);
+    CHECK(svg.find("class=\"level4\"") != std::string::npos);
+    const std::string csv = sweep_csv(r);
+    CHECK(csv.substr(0, csv.find('\n')).find(",peak_norm,peak_stable") != std::string::npos);
+    // without the peak notion: four classes, no peak columns
+    spec.peak = false;
+    const SweepResult plain = run_sweep(spec);
+    CHECK(sweep_chart_svg(spec, plain, nullptr, {}).find("level4") == std::string::npos);
+    CHECK(sweep_csv(plain).find("peak_norm") == std::string::npos);
+}
 
 TEST_CASE("the sweep's plant roots where two real roots meet and leave the real axis: Newton started off the axis, equal to the collocation roots") {
     // th = 1.5, tau = 0.5: along the rows the plant's rightmost root switches between a real root

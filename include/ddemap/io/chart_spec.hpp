@@ -37,6 +37,8 @@ struct ChartSpec {
     int columns = 3;
     double panel_width = 260, panel_height = 220;
     bool boundaries = true;
+    /// key peak = true: every panel also decides peak (L-infinity) string stability (SweepSpec::peak)
+    bool peak = false;
     /// ring Hopf curves of the boundaries (key ring_curves = "all" | "envelope" | "auto",
     /// study/boundary.hpp RingCurves)
     RingCurves ring_curves = RingCurves::Auto;

@@ -40,6 +40,10 @@ struct SweepSpec {
     /// SweepResult::mode_roots, which the boundary continuation needs), or "auto" (winding
     /// when it applies).
     std::string ring_method = "auto";
+    /// Also decide peak (L-infinity) string stability at every point: ||h||_1 <= 1
+    /// (peak_string_stability) where the point is L2 string stable (elsewhere ||h||_1 >=
+    /// sup |Gamma(iw)| > 1); about 0.03 s more per L2-stable point. Region class 4.
+    bool peak = false;
     void validate() const;  ///< builds the model at the four corners
 };
 
@@ -62,6 +66,11 @@ struct SweepPoint {
     cplx plant_root;          ///< rightmost root of the plant (Im >= 0)
     bool plant_stable = false, ring_stable = false, string_stable = false;
     bool certified = true;
+    /// With SweepSpec::peak: ||h||_1 (0 when not computed: an L2-unstable point, where it is
+    /// above sup |Gamma| > 1; inf with an unstable plant), its verdict (a point whose norm is
+    /// undecided counts as not certified and not peak stable).
+    bool has_peak = false, peak_stable = false;
+    double peak_norm = 0.0;
 };
 
 struct SweepResult {

@@ -90,7 +90,8 @@ RingSummary evaluate_sweep_point(const Linearisation& lin, RingTracker& ring, Pl
 /// continuation) the string analysis starts from the previous point's maximiser
 /// (analyse_string_continued) and scans the axis only when that cannot certify; `string` is then
 /// updated to this point's maximiser.
+/// With `peak`, also the peak verdict (SweepPoint::has_peak).
 void fill_sweep_point(const Linearisation& lin, const RingSummary& rs, PlantTracker& plant, SweepPoint& p, int& fallbacks,
-                      StringGuess* string = nullptr);
+                      StringGuess* string = nullptr, bool peak = false);
 
 }  // namespace ddemap::detail
