@@ -353,6 +353,28 @@ std::string design_chart_svg(const DesignResult& d, const std::string& car_name,
     // the ellipse's extent along each axis, sqrt(5.991 C_ii)
     const double ex = covariance ? std::sqrt(5.991464547107979 * std::max(0.0, (*covariance)(0, 0))) : 0.0;
     const double ey = covariance ? std::sqrt(5.991464547107979 * std::max(0.0, (*covariance)(1, 1))) : 0.0;
+    // the path of the run that gave the result (its end at the designed gains), in (k1, k2)
+    std::vector<std::pair<double, double>> path;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const DesignStart& st : d.starts) {
+        if (!st.end.count("k1") || !st.end.count("k2")) continue;
+        const double e = std::hypot((st.end.at("k1") - x1) / std::max(std::abs(x1), 1e-300), (st.end.at("k2") - y1) / std::max(std::abs(y1), 1e-300));
+        if (e < nearest) {
+            nearest = e;
+            path.clear();
+            for (const ParameterMap& q : st.path)
+                if (q.count("k1") && q.count("k2")) path.emplace_back(q.at("k1"), q.at("k2"));
+        }
+    }
+    if (!(nearest <= 1e-9)) path.clear();  // no run ends there (a later stage moved it): no path drawn
+    // the window holds the car, the design, the ellipse and the path
+    double px_lo = std::min(x0, x1), px_hi = std::max(x0, x1), py_lo = std::min(y0, y1), py_hi = std::max(y0, y1);
+    for (const auto& q : path) {
+        px_lo = std::min(px_lo, q.first);
+        px_hi = std::max(px_hi, q.first);
+        py_lo = std::min(py_lo, q.second);
+        py_hi = std::max(py_hi, q.second);
+    }
     auto window = [](double a, double b, double e) {
         double lo = std::min(a, b) - e, hi = std::max(a, b) + e;
         const double span = std::max(hi - lo, 0.1 * std::max(std::abs(a), std::abs(b)));
@@ -362,7 +384,7 @@ std::string design_chart_svg(const DesignResult& d, const std::string& car_name,
         return std::pair<double, double>{lo, hi};
     };
     // (pairs, not structured bindings: clang refuses to capture those in the lambda below)
-    const std::pair<double, double> xr = window(x0, x1, ex), yr = window(y0, y1, ey);
+    const std::pair<double, double> xr = window(px_lo, px_hi, ex), yr = window(py_lo, py_hi, ey);
     auto spec_at = [&](const ParameterMap& params) {
         SweepSpec s;
         s.model = d.model;
@@ -406,7 +428,10 @@ std::string design_chart_svg(const DesignResult& d, const std::string& car_name,
         p.sweep = &sweeps[i];
         p.boundaries = &bounds[i];
         if (i == 0) p.markers.push_back(car);
-        if (i == 0 && !others_changed) p.markers.push_back(designed);
+        if (i == 0 && !others_changed) {
+            p.markers.push_back(designed);
+            p.path = path;
+        }
         if (i == 1) {
             ChartMarker own = car;
             own.label = car_name + " (its k1, k2)";

@@ -749,7 +749,10 @@ std::string design_json(const DesignResult& r, double margin) {
     for (std::size_t i = 0; i < r.starts.size(); ++i) {
         const DesignStart& s = r.starts[i];
         JsonObject o;
+        std::vector<std::string> path;
+        for (const ParameterMap& q : s.path) path.push_back(json_parameters(q));
         o.string("objective_name", s.objective).json("start", json_parameters(s.start)).json("end", json_parameters(s.end)).number("objective", s.value).string("status", to_string(s.status));
+        o.json("path", json_array(path));
         o.string("message", s.message).integer("iterations", s.iterations).integer("evaluations", s.evaluations);
         starts += (i ? "," : "") + o.str();
     }

@@ -209,7 +209,7 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
     }
     // legend items, wrapped to the figure width
     struct Item {
-        int type;  // 0 swatch, 1 line, 2 marker, 3 ellipse, 4 outside marker
+        int type;  // 0 swatch, 1 line, 2 marker, 3 ellipse, 4 outside marker, 5 path
         int index;
         std::string text;
     };
@@ -223,6 +223,9 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
         items.push_back({3, 0, any_cut ? "95 % confidence ellipse of (k\u2081, k\u2082), cut where it leaves the window"
                                        : "95 % confidence ellipse of (k\u2081, k\u2082)"});
     if (any_outside) items.push_back({4, 0, "outside the window (at its edge)"});
+    bool any_path = false;
+    for (const auto& panel : panels) any_path = any_path || panel.path.size() >= 2;
+    if (any_path) items.push_back({5, 0, "the minimiser's path (its iterates)"});
     for (const auto& it : items) width = std::max(width, 36 + text_width(it.text, f_legend) + 20);
     // marker labels: the names beside the markers where every panel's names fit (at most 45 % of
     // the plot width each) and no two labels, or a label and another marker, overlap; otherwise
@@ -506,6 +509,14 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
             s << "\"/>\n";
         }
         s << "</g>\n";
+        if (panel.path.size() >= 2) {
+            s << "<g id=\"" << id << "-path\" clip-path=\"url(#" << id << "-clip)\">\n<polyline fill=\"none\" stroke=\"#252525\" stroke-width=\"1.2\" "
+              << "stroke-dasharray=\"4,2\" points=\"";
+            for (const auto& [px, py] : panel.path) s << num(X(px)) << "," << num(Y(py)) << " ";
+            s << "\"/>\n";
+            for (const auto& [px, py] : panel.path) s << "<circle cx=\"" << num(X(px)) << "\" cy=\"" << num(Y(py)) << "\" r=\"1.8\" fill=\"#252525\"/>\n";
+            s << "</g>\n";
+        }
         // markers: inside the window as a dot with its label; outside it on the nearest edge as
         // an open triangle pointing out of the window, the label saying so
         s << "<g id=\"" << id << "-markers\" font-size=\"" << num(f_tick) << "\">\n";
@@ -584,6 +595,11 @@ std::string render_chart_svg(const std::vector<ChartPanel>& panels, const ChartO
             case 3:
                 s << "<ellipse cx=\"" << num(x + 13) << "\" cy=\"" << num(y + 7.5) << "\" rx=\"12\" ry=\"6\" fill=\"#000\" fill-opacity=\"0.08\" "
                   << "stroke=\"#000\" stroke-width=\"1.3\"/>\n";
+                break;
+            case 5:
+                s << "<line x1=\"" << num(x) << "\" y1=\"" << num(y + 7.5) << "\" x2=\"" << num(x + 26) << "\" y2=\"" << num(y + 7.5)
+                  << "\" stroke=\"#252525\" stroke-width=\"1.2\" stroke-dasharray=\"4,2\"/><circle cx=\"" << num(x + 13) << "\" cy=\"" << num(y + 7.5)
+                  << "\" r=\"1.8\" fill=\"#252525\"/>\n";
                 break;
             default:
                 s << "<polygon points=\"" << num(x + 20) << "," << num(y + 7.5) << " " << num(x + 7) << "," << num(y + 2.5) << " " << num(x + 7)

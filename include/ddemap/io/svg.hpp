@@ -30,6 +30,8 @@ struct ChartPanel {
     const SweepResult* sweep = nullptr;  ///< regions (required)
     const BoundarySet* boundaries = nullptr;  ///< curves (optional)
     std::vector<ChartMarker> markers;
+    /// a minimiser's path (x, y) drawn as a thin polyline with a dot per iterate (e.g. design's)
+    std::vector<std::pair<double, double>> path;
 };
 
 struct ChartOptions {

@@ -342,6 +342,7 @@ public:
         std::string message;
         Eigen::VectorXd x;
         int iterations = 0;
+        std::vector<Eigen::VectorXd> path;  ///< the start and every step's point
     };
 
     // min sum_j M_j (y_j - x0_j)^2 subject to A y >= b, by the KKT conditions of every active set
@@ -398,6 +399,7 @@ public:
             c[static_cast<Eigen::Index>(j)] = x0[j];
         }
         const double target = m_opt.margin * m_opt.margin;
+        out.path.push_back(x);
         std::vector<double> history;  // distances of the iterates that meet the margin
         for (out.iterations = 0; out.iterations < kSqpSteps; ++out.iterations) {
             const Linearisation L = lin(x);
@@ -480,6 +482,7 @@ public:
             if (least >= target * (1.0 - 1e-6)) history.push_back(std::sqrt((x - c).cwiseProduct(M).dot(x - c)));
             else history.clear();
             x = y;
+            out.path.push_back(x);
             // the linearisations come from differences of the law (relative error ~1e-10) at
             // frequencies located to ~1e-12: steps settle at about 1e-10 of the distance
             if (step <= 1e-8 * (1.0 + dist) && least >= target * (1.0 - 1e-6)) {
@@ -830,6 +833,10 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             Eigen::VectorXd z = P.z_of(starts[k]);
             NonsmoothResult nr;
             bool ok = true;
+            // the run's path in the free parameters (every stage's iterates, in order)
+            auto add_z = [&](const std::vector<Eigen::VectorXd>& zs) {
+                for (const Eigen::VectorXd& zz : zs) ds.path.push_back(P.free_map(P.x_of(zz)));
+            };
             // an unstable plant first: lower the plant's abscissa below zero
             if (o != DesignObjective::Abscissa) {
                 const double a = P.value(P.x_of(z), nullptr, DesignObjective::Abscissa);
@@ -837,6 +844,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                     NonsmoothOptions o1 = search;
                     o1.target = -1e-3;
                     nr = minimize_nonsmooth(P.in_z(DesignObjective::Abscissa), z, o1);
+                    add_z(nr.path);
                     if (nr.status == Status::Converged && nr.value < 0.0) {
                         z = nr.x;
                     } else {
@@ -851,6 +859,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             if (ok && o == DesignObjective::Nearest && n <= 4) {
                 int scans = 0;
                 const Problem::Sqp q = P.nearest_sqp(P.x_of(z), scans);
+                for (const Eigen::VectorXd& xx : q.path) ds.path.push_back(P.free_map(xx));
                 P.evaluations += scans;
                 ds.status = q.status;
                 ds.message = q.message;
@@ -863,6 +872,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                     P.rho = 10.0;
                     for (int round = 0; round < 4; ++round) {
                         nr = minimize_nonsmooth(P.in_z(o), z, search);
+                        add_z(nr.path);
                         if (!std::isfinite(nr.value)) break;
                         z = nr.x;
                         if (attenuation_scan(P.lin(P.x_of(z))).margin >= options.margin * (1.0 - 1e-6)) break;
@@ -870,6 +880,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                     }
                 } else {
                     nr = minimize_nonsmooth(P.in_z(o), z, search);
+                    add_z(nr.path);
                 }
                 ds.status = nr.status;
                 ds.message = nr.message;
@@ -879,6 +890,8 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             }
             const Eigen::VectorXd xe = P.x_of(z);
             ds.end = P.free_map(xe);
+            if (ds.path.empty() || ds.path.front() != ds.start) ds.path.insert(ds.path.begin(), ds.start);
+            if (ds.path.back() != ds.end) ds.path.push_back(ds.end);
             ds.evaluations = P.evaluations - ev0;
             // nearest: compare the runs by distance among the feasible ends
             double score = ds.value;

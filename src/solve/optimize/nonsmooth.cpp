@@ -119,6 +119,7 @@ NonsmoothResult minimize_nonsmooth(const NonsmoothFunction& f, const Eigen::Vect
 
     Eigen::VectorXd x = x0, g;
     double fx = eval(x, g);
+    r.path.push_back(x);
     if (!std::isfinite(fx)) {
         r.status = Status::NumericalIssue;
         r.message = "the objective is not finite at the start";
@@ -199,6 +200,7 @@ NonsmoothResult minimize_nonsmooth(const NonsmoothFunction& f, const Eigen::Vect
         }
         if (alpha > 0.0) {
             const Eigen::VectorXd s = x_alpha - x, y = g_alpha - g;
+            r.path.push_back(x_alpha);
             x = x_alpha;
             g = g_alpha;
             fx = f_alpha;
@@ -237,6 +239,7 @@ NonsmoothResult minimize_nonsmooth(const NonsmoothFunction& f, const Eigen::Vect
                 Eigen::VectorXd gs;
                 const double fs = eval(xs, gs);
                 if (fs < fx - c1 * ts * m * m) {
+                    r.path.push_back(xs);
                     x = xs;
                     g = gs;
                     fx = fs;

@@ -11,6 +11,7 @@
 #include "ddemap/problem/linear_dde.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "argument_count.hpp"
+#include "ddemap/io/chart_spec.hpp"
 #include "ddemap/traffic/vehicles.hpp"
 #include "fleet_helpers.hpp"
 #include "tolerances.hpp"
@@ -473,4 +474,22 @@ TEST_CASE("design abscissa with a delay: the value is the plant's rightmost root
     CHECK(test::zeros_in_rectangle(D, r.value + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
     CHECK(test::zeros_in_rectangle(D, r.value - 1e-3, 5.0, -10.0, 10.0, 100000) == 2);
     CHECK(r.value < r.value_initial);
+}
+
+TEST_CASE("design: every run's path starts at its start and ends at its end, and the figure draws the winning run's") {
+    DesignOptions o;
+    o.objective = DesignObjective::Nearest;
+    o.starts = 2;
+    const ParameterMap car{{"k1", 0.018}, {"k2", 0.152}, {"th", 1.986}, {"tau", 0.324}, {"eta", 13.81}, {"speed", 20.0}};
+    const DesignResult r = design_gains("ovrv", car, o);
+    REQUIRE(r.status == Status::Converged);
+    REQUIRE(!r.starts.empty());
+    for (const DesignStart& st : r.starts) {
+        REQUIRE(st.path.size() >= 2);
+        CHECK(st.path.front() == st.start);
+        CHECK(st.path.back() == st.end);
+    }
+    const std::string svg = design_chart_svg(r, "C_max", 22, nullptr, ExecutionPolicy{});
+    CHECK(svg.find("-path\"") != std::string::npos);
+    CHECK(svg.find("the minimiser") != std::string::npos);  // the legend entry
 }

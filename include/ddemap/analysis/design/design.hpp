@@ -122,6 +122,9 @@ struct DesignStart {
     std::string objective;  ///< what this run minimised (sup-gamma runs are followed by nearest runs)
     ParameterMap start;   ///< the free parameters where it started
     ParameterMap end;     ///< where it ended
+    /// the free parameters at start, at every iterate of every stage (plant stabilisation, the
+    /// minimiser or the sequential QP) and at the end, in order
+    std::vector<ParameterMap> path;
     double value = 0.0;   ///< the objective there (nearest: the change, plus the penalty rho (1 - m*/m) where the margin is not met)
     Status status = Status::Converged;
     std::string message;

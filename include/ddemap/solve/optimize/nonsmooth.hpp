@@ -14,6 +14,7 @@
 #include <string>
 
 #include <Eigen/Dense>
+#include <vector>
 
 #include "ddemap/core/status.hpp"
 
@@ -60,6 +61,8 @@ struct NonsmoothResult {
     int iterations = 0;
     int evaluations = 0;
     int sampling_steps = 0;       ///< gradient-sampling steps taken where the line search failed
+    /// the iterates: x0, then every accepted step (line search or gradient sampling), in order
+    std::vector<Eigen::VectorXd> path;
 };
 
 /// Minimises f from x0 (f(x0) must be finite).
