@@ -452,15 +452,18 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
             Eigen::MatrixXd M = Aq;
             M.diagonal() += mu * dg;
             const Eigen::LLT<Eigen::MatrixXd> llt(M);
-            if (llt.info() != Eigen::Success) {  // the corrected matrix is indefinite here: damp more
+            // more damping (Nielsen); false with the status and message given when at its limit
+            auto damp_more = [&](Status at_limit, const char* why) {
                 mu *= nu;
                 nu *= 2.0;
-                if (!(mu < 1e30)) {
-                    res.status = Status::NumericalIssue;
-                    res.message = "the corrected normal matrix stays indefinite at any damping";
-                    stop = true;
-                    break;
-                }
+                if (mu < 1e30) return true;
+                res.status = at_limit;
+                res.message = why;
+                stop = true;
+                return false;
+            };
+            if (llt.info() != Eigen::Success) {  // the corrected matrix is indefinite here: damp more
+                if (!damp_more(Status::NumericalIssue, "the corrected normal matrix stays indefinite at any damping")) break;
                 continue;
             }
             const Eigen::VectorXd dq = llt.solve(-gq);
@@ -497,15 +500,8 @@ LmResult levenberg_marquardt(const LsqProblem& pb, const CalibrationVector& thet
                     res.message = "relative decrease of the objective below tolerance";
                     stop = true;
                 }
-            } else {
-                mu *= nu;
-                nu *= 2.0;
-                if (!(mu < 1e30)) {
-                    res.status = Status::Converged;
-                    res.message = "no descent step left (damping at its limit)";
-                    stop = true;
-                    break;
-                }
+            } else if (!damp_more(Status::Converged, "no descent step left (damping at its limit)")) {
+                break;
             }
         }
         if (stop) break;

@@ -62,4 +62,18 @@ inline ddemap::Trace noisy(ddemap::Trace tr, unsigned seed, double sv = 0.05, do
     return tr;
 }
 
+/// `count` noise draws of `clean` with white noise on all three signals: sv [m/s] on the follower
+/// speed and sg [m] on the gap (seeds 1000 + s), sl [m/s] on the lead speed (seeds 77777 + s)
+inline std::vector<ddemap::Trace> noisy_with_lead(const ddemap::Trace& clean, int count, double sv = 0.05, double sg = 0.2, double sl = 0.05) {
+    std::vector<ddemap::Trace> traces;
+    for (int s = 0; s < count; ++s) {
+        ddemap::Trace tr = noisy(clean, 1000u + static_cast<unsigned>(s), sv, sg, 0.0);
+        std::mt19937 rng(77777u + static_cast<unsigned>(s));
+        std::normal_distribution<double> z(0.0, 1.0);
+        for (double& v : tr.lead) v += sl * z(rng);
+        traces.push_back(std::move(tr));
+    }
+    return traces;
+}
+
 }  // namespace calib_test

@@ -74,14 +74,7 @@ TEST_CASE("calibration intervals cover the truth with noise on the lead speed to
     o.starts = 2;
     const int realisations = 200;
     const double lead_noise = 0.05;
-    std::vector<Trace> traces;
-    for (int s = 0; s < realisations; ++s) {
-        Trace tr = calib_test::noisy(clean, 1000u + static_cast<unsigned>(s), 0.05, 0.2, 0.0);
-        std::mt19937 rng(77777u + static_cast<unsigned>(s));
-        std::normal_distribution<double> z(0.0, 1.0);
-        for (double& v : tr.lead) v += lead_noise * z(rng);
-        traces.push_back(std::move(tr));
-    }
+    const std::vector<Trace> traces = calib_test::noisy_with_lead(clean, realisations, 0.05, 0.2, lead_noise);
     const std::vector<CalibrationResult> fits = calibrate_many(traces, o);
     int covered = 0, covered_exact_lead = 0, total = 0;
     int covered_by[5] = {0, 0, 0, 0, 0}, exact_by[5] = {0, 0, 0, 0, 0};
@@ -246,14 +239,7 @@ TEST_CASE("calibration corrects the lead noise's bias: a quick car's estimates c
     o.set_bounds("k1", 0.0, 3.0);
     o.set_bounds("k2", 0.0, 3.0);
     const int realisations = 200;
-    std::vector<Trace> traces;
-    for (int s = 0; s < realisations; ++s) {
-        Trace tr = calib_test::noisy(clean, 1000u + static_cast<unsigned>(s), 0.05, 0.2, 0.0);
-        std::mt19937 rng(77777u + static_cast<unsigned>(s));
-        std::normal_distribution<double> z(0.0, 1.0);
-        for (double& v : tr.lead) v += 0.05 * z(rng);
-        traces.push_back(std::move(tr));
-    }
+    const std::vector<Trace> traces = calib_test::noisy_with_lead(clean, realisations);
     struct Summary {
         double cover[5] = {0, 0, 0, 0, 0}, mean[5] = {0, 0, 0, 0, 0}, sd[5] = {0, 0, 0, 0, 0};
     };
