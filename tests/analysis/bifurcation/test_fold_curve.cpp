@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "tolerances.hpp"
 #include "two_parameter_box.hpp"
@@ -84,6 +85,35 @@ TEST_CASE("fold curve with a cusp: x' = p1 + p2 x(t - 1) - x^3, the curve (p1, p
     int changes = 0;
     for (std::size_t k = 0; k + 1 < c.points.size(); ++k) changes += (c.points[k].cusp_test < 0) != (c.points[k + 1].cusp_test < 0);
     CHECK(changes == 1);
+}
+
+TEST_CASE("two cusps 0.003 apart in p2 on a box of width 2: both located, against the closed form") {
+    // F(x) = p1 + p2 x + a x^2 - x^4 (a = 0.02): F = F_x = 0 gives p2 = 4 x^3 - 2 a x,
+    // p1 = a x^2 - 3 x^4; the cusps where F_xx = 2 a - 12 x^2 = 0, x = -+sqrt(a/6): p1 = a^2/12,
+    // p2 = -+(4 a/3) sqrt(a/6) = -+0.0015396. The steps are at most 0.05 of the box (0.1 in p2),
+    // 30 times the cusps' distance: a sign test on the step's ends alone would see no change
+    // and both would be missed (the tracer shortens its steps where the curve turns at a cusp).
+    const double a = 0.02;
+    ExpressionSystem sys({"x"}, {"p1", "p2", "a"}, {0.2, 0.5, a}, {"p1 + p2*x(t - 1) + a*x(t - 1)^2 - x^4"});
+    Eigen::VectorXd guess(1);
+    guess << 0.902;
+    const FoldCurves fc = fold_curves(sys, guess, fold_box("p1", 0.2, -0.5, "p2", -1.0, 1.0));
+    INFO(fc.message);
+    REQUIRE(!fc.curves.empty());
+    std::vector<double> p2;
+    for (const FoldCurve& c : fc.curves)
+        for (const FoldCurveSpecialPoint& sp : c.special)
+            if (sp.kind == "cusp") {
+                CHECK(sp.status == Status::Converged);
+                CHECK(std::abs(sp.par - a * a / 12) < tol::special_point);
+                CHECK(std::abs(std::abs(sp.x[0]) - std::sqrt(a / 6)) < tol::special_point);
+                p2.push_back(sp.par2);
+            }
+    REQUIRE(p2.size() == 2);
+    std::sort(p2.begin(), p2.end());
+    const double p2c = 4 * a / 3 * std::sqrt(a / 6);
+    CHECK(std::abs(p2[0] + p2c) < tol::special_point);
+    CHECK(std::abs(p2[1] - p2c) < tol::special_point);
 }
 
 TEST_CASE("fold curve with a Bogdanov-Takens point: x' = p1 + x^2 + p2 x(t - tau), the double root at 0 where p2 = -1/tau") {
