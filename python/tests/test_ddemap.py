@@ -441,7 +441,9 @@ def test_the_gil_is_released_during_a_computation():
 
 def test_ctrl_c_stops_a_long_sweep():
     code = textwrap.dedent("""
-        import sys, ddemap
+        import signal, sys, ddemap
+        # Python's own SIGINT handler even when started with SIGINT ignored (a background job)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         in_call = False
         try:
             print("start", flush=True)
