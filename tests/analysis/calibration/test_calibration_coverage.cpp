@@ -229,7 +229,7 @@ TEST_SUITE_END();
 // would be cut off). th and eta cover about 0.91 here with or without lead noise (measured: 0.93
 // with follower-speed noise alone, 0.96 with gap noise alone): the speed noise also reaches the
 // fit through the history the simulation starts from, which the covariance does not count
-// (docs/guide/calibration.md, "Known limits"); the band for them is the one that shows that.
+// (docs/guide/calibration.md, "Known limit: th and eta of a quick car"); their band shows that.
 TEST_CASE("calibration corrects the lead noise's bias: a quick car's estimates centre on the truth and its intervals cover" * doctest::test_suite("slow")) {
     const double truth[5] = {0.8, 0.95, 0.9, 0.15, 8};
     const Trace clean = calib_test::clean_trace(calib_test::ovrv(truth), calib_test::three_sines(150), 150);
