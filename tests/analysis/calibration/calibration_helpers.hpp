@@ -62,6 +62,15 @@ inline ddemap::Trace noisy(ddemap::Trace tr, unsigned seed, double sv = 0.05, do
     return tr;
 }
 
+/// The coverage tests' fit options: 16 design points and 2 starts (the minimum is easy to find
+/// on these traces; the intervals are the point)
+inline ddemap::CalibrationOptions coverage_options() {
+    ddemap::CalibrationOptions o;
+    o.design_points = 16;
+    o.starts = 2;
+    return o;
+}
+
 /// `count` noise draws of `clean` with white noise on all three signals: sv [m/s] on the follower
 /// speed and sg [m] on the gap (seeds 1000 + s), sl [m/s] on the lead speed (seeds 77777 + s)
 inline std::vector<ddemap::Trace> noisy_with_lead(const ddemap::Trace& clean, int count, double sv = 0.05, double sg = 0.2, double sl = 0.05) {

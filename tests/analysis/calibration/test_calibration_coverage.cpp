@@ -26,9 +26,7 @@ using namespace ddemap;
 TEST_CASE("calibration intervals cover the truth at their level under correlated noise" * doctest::test_suite("slow")) {
     const double truth[5] = {0.05, 0.3, 1.2, 0.43, 8};
     const Trace clean = calib_test::clean_trace(calib_test::ovrv(truth), calib_test::three_sines(150), 150);
-    CalibrationOptions o;
-    o.design_points = 16;  // the minimum is easy to find on this trace; the intervals are the point
-    o.starts = 2;
+    CalibrationOptions o = calib_test::coverage_options();
     o.lead_noise = 0.0;  // the lead speed of this trace is exact (the next case adds noise to it)
     const int realisations = 200;
     int covered = 0, covered_normal = 0, covered_independent = 0, total = 0;
@@ -69,9 +67,7 @@ TEST_CASE("calibration intervals cover the truth at their level under correlated
 TEST_CASE("calibration intervals cover the truth with noise on the lead speed too (errors in variables)" * doctest::test_suite("slow")) {
     const double truth[5] = {0.05, 0.3, 1.2, 0.43, 8};
     const Trace clean = calib_test::clean_trace(calib_test::ovrv(truth), calib_test::three_sines(150), 150);
-    CalibrationOptions o;
-    o.design_points = 16;
-    o.starts = 2;
+    CalibrationOptions o = calib_test::coverage_options();
     const int realisations = 200;
     const double lead_noise = 0.05;
     const std::vector<Trace> traces = calib_test::noisy_with_lead(clean, realisations, 0.05, 0.2, lead_noise);
@@ -145,9 +141,7 @@ TEST_CASE("calibrate: the lead-noise correction is applied on even sampling only
     std::mt19937 rng(99u);
     std::normal_distribution<double> z(0.0, 1.0);
     for (double& v : tr.lead) v += 0.05 * z(rng);
-    CalibrationOptions o;
-    o.design_points = 16;
-    o.starts = 2;
+    CalibrationOptions o = calib_test::coverage_options();
     const CalibrationResult r = calibrate(tr, o);
     CHECK(r.lead_noise_corrected);
     CHECK(r.minimised_objective < r.objective);  // the penalty is positive
@@ -233,9 +227,7 @@ TEST_SUITE_END();
 TEST_CASE("calibration corrects the lead noise's bias: a quick car's estimates centre on the truth and its intervals cover" * doctest::test_suite("slow")) {
     const double truth[5] = {0.8, 0.95, 0.9, 0.15, 8};
     const Trace clean = calib_test::clean_trace(calib_test::ovrv(truth), calib_test::three_sines(150), 150);
-    CalibrationOptions o;
-    o.design_points = 16;
-    o.starts = 2;
+    CalibrationOptions o = calib_test::coverage_options();
     o.set_bounds("k1", 0.0, 3.0);
     o.set_bounds("k2", 0.0, 3.0);
     const int realisations = 200;
