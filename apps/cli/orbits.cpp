@@ -26,6 +26,7 @@ struct OrbitsArgs {
     std::string hopf = "0", degree = "4", intervals = "40", points = "100", variable, svg;
     std::string wave, initial_step, max_step;
     std::string par2, from2, to2;
+    std::string period_doubling;
     CLI::Option* hopf_option = nullptr;
     bool adapt = false;
     bool no_stability = false;
@@ -52,6 +53,10 @@ void add_orbits_flags(CLI::App& app) {
                    "a second parameter: continue every fold of the branch as a curve of folds of periodic orbits in (--par, --par2), "
                    "in the box [--from, --to] x [--from2, --to2] (a curve also ends where it meets the Hopf curve, at a generalised Hopf point)")
         ->type_name("NAME");
+    app.add_option("--period-doubling", orbits_args.period_doubling,
+                   "switch at period doubling K of the branch (from 0, in the order met) onto the branch of orbits of twice the period, "
+                   "and follow it too (its own period doublings are the next of a cascade); PREFIX-doubled.csv, JSON result.period_doubled")
+        ->type_name("K");
     app.add_option("--from2", orbits_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
     app.add_option("--to2", orbits_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     orbits_args.format.add_to(app);
@@ -76,6 +81,8 @@ void add_orbits_flags(CLI::App& app) {
 }
 
 int run_orbits() {
+    if (!orbits_args.wave.empty() && !orbits_args.period_doubling.empty())
+        throw BadInput("--period-doubling: not with --wave (expected the orbits of a system or ring without --wave)");
     if (!orbits_args.wave.empty() && !orbits_args.par2.empty()) throw BadInput("--par2: not with --wave (expected the orbits of a system or ring without --wave)");
     if (!orbits_args.wave.empty())
         return run_orbits_wave({orbits_args.problem, orbits_args.wave, orbits_args.degree, orbits_args.intervals, orbits_args.points, orbits_args.initial_step, orbits_args.svg, orbits_args.variable, orbits_args.adapt,
@@ -90,8 +97,13 @@ int run_orbits() {
     if (orbits_args.stability) throw BadInput("--stability: only with --wave (expected --wave K)");
     const Format format = orbits_args.format.parse();
     const bool two = !orbits_args.par2.empty();
+    const bool doubling = !orbits_args.period_doubling.empty();
+    const int doubling_index =
+        doubling ? static_cast<int>(parse_integer("--period-doubling", orbits_args.period_doubling, 0, 1000000, "an integer >= 0")) : -1;
     const std::string prefix = !orbits_args.out.given() ? std::string()
+                               : two && doubling        ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv", "-doubled.csv"})
                                : two                    ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv"})
+                               : doubling               ? orbits_args.out.prepare("orbits", {".csv", ".json", "-doubled.csv"})
                                                         : orbits_args.out.prepare("orbits", {".csv", ".json"});
     const std::string svg_file = orbits_args.svg.empty() ? std::string() : output_file("--svg", orbits_args.svg);
     PeriodicOrbitOptions o;
@@ -131,9 +143,11 @@ int run_orbits() {
         const double unknowns = static_cast<double>(o.intervals) * o.degree * n;
         const std::string what = "a mesh of " + std::to_string(o.intervals) + " intervals of degree " + std::to_string(o.degree) + " (" +
                                  rounded(unknowns, 3) + " collocation unknowns)";
-        check_size("orbits", what, "memory", 4e4 * unknowns);
-        check_size("orbits", what + " for " + std::to_string(o.max_points) + " orbits", "time",
-                   2e-4 * (o.degree / 4.0) * unknowns * o.max_points);
+        // the doubled branch (--period-doubling) has twice the intervals: twice the memory, about
+        // twice the time per orbit
+        check_size("orbits", what + (doubling ? " and twice that for the doubled branch" : ""), "memory", (doubling ? 2.0 : 1.0) * 4e4 * unknowns);
+        check_size("orbits", what + " for " + std::to_string(o.max_points) + " orbits" + (doubling ? " and as many of twice the period" : ""), "time",
+                   (doubling ? 3.0 : 1.0) * 2e-4 * (o.degree / 4.0) * unknowns * o.max_points);
     }
     OrbitFoldCurveOptions fo;
     if (two) {
@@ -183,6 +197,32 @@ int run_orbits() {
         b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
     }
 
+    // the branch of twice the period from period doubling K (--period-doubling)
+    OrbitBranch doubled;
+    if (doubling) {
+        if (b.period_doublings.empty())
+            throw BadInput("--period-doubling = '" + orbits_args.period_doubling + "': the branch has no period doubling in " + par + " from " +
+                           orbits_args.problem.from + " to " + orbits_args.problem.to + " (expected at least one to switch at)");
+        if (doubling_index >= static_cast<int>(b.period_doublings.size()))
+            throw BadInput("--period-doubling = '" + orbits_args.period_doubling + "': expected an index from 0 to " +
+                           std::to_string(b.period_doublings.size() - 1) + " (the branch has " + counted(static_cast<long long>(b.period_doublings.size()), "period doubling") + ")");
+        const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(doubling_index)];
+        inputs.integer("period_doubling", doubling_index);
+        if (!pd.located) {
+            doubled.status = Status::NumericalIssue;
+            doubled.stop = "first_orbit_failed";
+            doubled.message = "period doubling " + std::to_string(doubling_index) + " was not located: no branch switched onto";
+        } else {
+            o.progress = branch_progress_printer("orbits", "orbits of twice the period", par, false);
+            doubled = orbit_branch_from_period_doubling(*built.system, pd, o);
+            o.progress = nullptr;
+        }
+        if (doubled.status != Status::Converged && b.status == Status::Converged) {
+            b.status = doubled.status;
+            b.message = "the branch of twice the period: " + doubled.message;
+        }
+    }
+
     // the curves of folds in (par, par2): one per fold of the branch that lies on none already traced
     std::vector<OrbitFoldCurve> curves;
     std::vector<int> curve_fold;  // the index of the fold each curve starts from
@@ -225,6 +265,13 @@ int run_orbits() {
     std::string result = orbit_branch_json(b, variables);
     result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
     if (two) result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) + "}";
+    if (doubling) {
+        const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(doubling_index)];
+        JsonObject from;
+        from.integer("index", doubling_index).number("par", pd.par).number("period", pd.period);
+        const std::string branch = orbit_branch_json(doubled, variables);
+        result = result.substr(0, result.size() - 1) + ",\"period_doubled\":{\"from\":" + from.str() + "," + branch.substr(1) + "}";
+    }
     e.result = result;
     const std::string csv = orbit_branch_csv(b, variables, built.units);
     std::vector<std::pair<std::string, std::string>> files;
@@ -232,6 +279,7 @@ int run_orbits() {
         files.push_back({prefix + ".csv", csv});
         files.push_back({prefix + ".json", envelope_json(e)});
         if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables, built.units)});
+        if (doubling) files.push_back({prefix + "-doubled.csv", orbit_branch_csv(doubled, variables, built.units)});
     }
     if (!svg_file.empty()) {
         const std::string punit = built.unit(par);
@@ -239,7 +287,8 @@ int run_orbits() {
         std::ostringstream title;
         title << "Periodic orbits from the Hopf point at " << par << " = " << rounded(h.par, 6);
         title << orbits_args.problem.ring_title();
-        files.push_back({svg_file, bifurcation_svg(&eq, b, variable, variables[static_cast<std::size_t>(variable)], vunit, punit, title.str())});
+        files.push_back({svg_file, bifurcation_svg(&eq, b, variable, variables[static_cast<std::size_t>(variable)], vunit, punit, title.str(),
+                                                   doubling ? &doubled : nullptr)});
     }
     if (!files.empty()) write_files_atomic(files);
     print_output(format, e, csv, [&] {
@@ -248,14 +297,24 @@ int run_orbits() {
             << rounded(6.283185307179586 / h.omega, 8) << " (Hopf point " << hopf_index << " of " << eq.hopf.size() << ")\n";
         out << "branch     " << counted(static_cast<long long>(b.points.size()), "orbit") << ", degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
         const std::string& v = variables[static_cast<std::size_t>(variable)];
-        out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
-        for (const PeriodicOrbit& p : b.points)
-            out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[variable] - p.min[variable], 6), 14)
-                << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12) << pad(p.multipliers.empty() ? "-" : rounded(p.trivial_distance, 2), 12)
-                << (!p.undecided.empty() ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
-        for (const OrbitFold& f : b.folds)
-            out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
-        out << crossing_lines(b);
+        auto table = [&](const OrbitBranch& br) {
+            out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
+            for (const PeriodicOrbit& p : br.points)
+                out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[variable] - p.min[variable], 6), 14)
+                    << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12) << pad(p.multipliers.empty() ? "-" : rounded(p.trivial_distance, 2), 12)
+                    << (!p.undecided.empty() ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
+            for (const OrbitFold& f : br.folds)
+                out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
+            out << crossing_lines(br);
+        };
+        table(b);
+        if (doubling) {
+            const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(doubling_index)];
+            out << "doubled    from the period doubling at " << par << " = " << rounded(pd.par, 10) << " (period " << rounded(pd.period, 8) << "): "
+                << counted(static_cast<long long>(doubled.points.size()), "orbit") << " of twice the period, degree " << doubled.degree << " on "
+                << doubled.intervals << " intervals (ended: " << doubled.stop << ")\n";
+            table(doubled);
+        }
         for (std::size_t k = 0; k < curves.size(); ++k) {
             const OrbitFoldCurve& c = curves[k];
             const OrbitFold& f = b.folds[static_cast<std::size_t>(curve_fold[k])];
@@ -276,10 +335,11 @@ int run_orbits() {
             out << "\n";
         }
         if (!b.points.empty()) {
+            const double trivial = std::max(b.max_trivial_distance, doubled.max_trivial_distance);
             out << "accuracy   ";
             if (std::any_of(b.points.begin(), b.points.end(), [](const PeriodicOrbit& p) { return !p.multipliers.empty(); }))
-                out << "max |mu_trivial - 1| = " << rounded(b.max_trivial_distance, 2) << ", ";
-            out << "max residual = " << rounded(b.max_residual, 2) << "\n";
+                out << "max |mu_trivial - 1| = " << rounded(trivial, 2) << ", ";
+            out << "max residual = " << rounded(std::max(b.max_residual, doubled.max_residual), 2) << (doubling ? " (both branches)" : "") << "\n";
         }
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
         if (!files.empty()) {

@@ -1072,7 +1072,7 @@ def bistability(par, from_, to, par2, from2, to2, system=None, model=None, ring=
 
 @_with_progress
 def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False,
-           max_step=None, **parameters):
+           max_step=None, period_doubling=None, **parameters):
     """The branch of periodic orbits born at a Hopf point (``ddemap orbits``).
 
     The problem as in :func:`equilibria`; the equilibrium branch from ``from_`` to ``to`` gives
@@ -1083,11 +1083,14 @@ def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4,
     same stretch of the branch with fewer orbits (README, orbits).
     Returns ``points`` (``par``, ``period`` [time units of the system], ``min``, ``max`` per
     variable, ``stable``, ``multipliers``: Floquet multipliers as [re, im]), ``folds``,
-    ``period_doublings``, ``tori``: the command's JSON.
+    ``period_doublings``, ``tori``: the command's JSON. ``period_doubling`` (the command's
+    ``--period-doubling``; an index from 0): also the branch of orbits of twice the period
+    switched onto at that period doubling, as ``period_doubled`` (``from``: the doubling's
+    ``par`` and ``period``; then the keys of a branch).
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     step = None if max_step is None else _number("max_step", max_step)
     return _result(_ddemap.orbits(sys_, model_, n, p, par, _number("from_", from_), _number("to", to),
                                   _integer("hopf", hopf, 0, 1000000), _integer("degree", degree, 1, 20),
                                   _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000), bool(adapt),
-                                  step))
+                                  step, None if period_doubling is None else _integer("period_doubling", period_doubling, 0, 1000000)))

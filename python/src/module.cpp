@@ -1050,7 +1050,8 @@ std::string py_bistability(const std::string& system_file, const std::string& mo
 }
 
 std::string py_orbits(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
-                      double from, double to, int hopf, int degree, int intervals, int points, bool adapt, std::optional<double> max_step) {
+                      double from, double to, int hopf, int degree, int intervals, int points, bool adapt, std::optional<double> max_step,
+                      std::optional<int> period_doubling) {
     PeriodicOrbitOptions o;
     if (max_step) {  // as orbits --max-step, checked before any work
         if (!(*max_step >= o.initial_step && *max_step <= 1e6))
@@ -1069,6 +1070,7 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf).integer("degree", o.degree)
         .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
     if (max_step) pb.inputs.number("max_step", o.max_step);  // only when given, as the command's envelope
+    if (period_doubling) pb.inputs.integer("period_doubling", *period_doubling);
     EquilibriumBranchOptions eo;
     eo.parameter = par;
     eo.from = o.from;
@@ -1088,6 +1090,28 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
         b.status = h.status;
         b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
     }
+    // the branch of twice the period (as orbits --period-doubling)
+    OrbitBranch doubled;
+    if (period_doubling) {
+        const int k = *period_doubling;
+        if (b.period_doublings.empty())
+            throw std::invalid_argument("period_doubling = " + std::to_string(k) + ": the branch has no period doubling in " + par + " from " +
+                                        json_number(from) + " to " + json_number(to) + " (expected at least one to switch at)");
+        if (k >= static_cast<int>(b.period_doublings.size()))
+            throw std::invalid_argument("period_doubling = " + std::to_string(k) + ": expected an index from 0 to " + std::to_string(b.period_doublings.size() - 1));
+        const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(k)];
+        if (!pd.located) {
+            doubled.status = Status::NumericalIssue;
+            doubled.stop = "first_orbit_failed";
+            doubled.message = "period doubling " + std::to_string(k) + " was not located: no branch switched onto";
+        } else {
+            doubled = released([&] { return orbit_branch_from_period_doubling(*pb.system, pd, o); });
+        }
+        if (doubled.status != Status::Converged && b.status == Status::Converged) {
+            b.status = doubled.status;
+            b.message = "the branch of twice the period: " + doubled.message;
+        }
+    }
     JsonEnvelope e;
     e.command = "orbits";
     e.inputs = pb.inputs.str();
@@ -1097,6 +1121,13 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     hj.integer("index", hopf).number("par", h.par).number("omega", h.omega).string("status", to_string(h.status));
     const std::string result = orbit_branch_json(b, pb.variables);
     e.result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    if (period_doubling) {
+        const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(*period_doubling)];
+        JsonObject from_j;
+        from_j.integer("index", *period_doubling).number("par", pd.par).number("period", pd.period);
+        const std::string branch = orbit_branch_json(doubled, pb.variables);
+        e.result = e.result.substr(0, e.result.size() - 1) + ",\"period_doubled\":{\"from\":" + from_j.str() + "," + branch.substr(1) + "}";
+    }
     return envelope_json(e);
 }
 
@@ -1156,5 +1187,6 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("from_"), py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("degree"), py::arg("intervals"),
           py::arg("points"), py::arg("rows"));
     m.def("orbits", &py_orbits, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
-          py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"), py::arg("max_step"));
+          py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"), py::arg("max_step"),
+          py::arg("period_doubling"));
 }

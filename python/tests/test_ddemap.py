@@ -345,6 +345,20 @@ def test_orbits():
         ddemap.orbits("headway", 2, 3.5, model="ov", ring=3, hopf=7, points=12)
 
 
+def test_orbits_period_doubling():
+    # the branch of twice the period switched onto at the period doubling of Mackey-Glass: the
+    # command's envelope, and the doubled branch starts at the doubling with twice its period
+    system = os.path.join(SOURCE, "examples", "mackey_glass.json")
+    r = ddemap.orbits("tau", 0.3, 2, system=system, points=200, period_doubling=0)
+    same_envelope(r, cli_json("orbits", "--system", system, "--par", "tau", "--from", 0.3, "--to", 2, "--points", 200,
+                              "--period-doubling", 0))
+    d = r["period_doubled"]
+    assert d["from"]["par"] == r["period_doublings"]["par"][0]
+    assert d["points"]["period"][0] > 1.9 * d["from"]["period"]
+    with pytest.raises(ValueError, match="period_doubling = 3: expected an index from 0 to 0"):
+        ddemap.orbits("tau", 0.3, 1.5, system=system, points=200, period_doubling=3)
+
+
 def _tolerance(name):
     """A tolerance of tests/tolerances.hpp (the one list of them, with why each has its size)."""
     with open(os.path.join(SOURCE, "tests", "tolerances.hpp")) as f:

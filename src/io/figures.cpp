@@ -268,8 +268,9 @@ ChartSpec classification_chart(const ChartSpec& base, const std::vector<Calibrat
 }
 
 std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbits, int variable, const std::string& variable_name,
-                            const std::string& variable_unit, const std::string& parameter_unit, const std::string& title) {
-    const std::string orbit_colour = "#1f77b4", eq_colour = "#000000";
+                            const std::string& variable_unit, const std::string& parameter_unit, const std::string& title,
+                            const OrbitBranch* doubled) {
+    const std::string orbit_colour = "#1f77b4", eq_colour = "#000000", doubled_colour = "#ff7f0e";
     std::vector<PlotSeries> series;
     // consecutive points of one stability form a piece; neighbouring pieces share their end point.
     // States: 1 stable (solid), 0 unstable (dashed), 2 undecided (no multipliers, or an orbit
@@ -296,6 +297,30 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
         st.push_back(!p.undecided.empty() || p.multipliers.empty() ? 2 : p.stable ? 1 : 0);
     }
     if (!x.empty()) pieces(x, y, st, "periodic orbits", orbit_colour);
+    // the branch of twice the period: its own points, states and special points
+    std::vector<double> dx, dy;
+    std::vector<int> dst;
+    if (doubled) {
+        // drawn from the period doubling it starts at (the point of `orbits` nearest its first
+        // orbit): the orbit there traversed twice belongs to both branches
+        if (!doubled->points.empty() && !orbits.period_doublings.empty()) {
+            const PeriodicOrbit& f = doubled->points.front();
+            const OrbitCrossing* start = nullptr;
+            for (const OrbitCrossing& c : orbits.period_doublings)
+                if (c.located && c.orbit.max.size() > variable && (!start || std::abs(c.par - f.par) < std::abs(start->par - f.par))) start = &c;
+            if (start) {
+                dx.push_back(start->par);
+                dy.push_back(start->orbit.max[variable] - start->orbit.min[variable]);
+                dst.push_back(!f.undecided.empty() || f.multipliers.empty() ? 2 : f.stable ? 1 : 0);
+            }
+        }
+        for (const PeriodicOrbit& p : doubled->points) {
+            dx.push_back(p.par);
+            dy.push_back(p.max[variable] - p.min[variable]);
+            dst.push_back(!p.undecided.empty() || p.multipliers.empty() ? 2 : p.stable ? 1 : 0);
+        }
+        if (!dx.empty()) pieces(dx, dy, dst, "orbits of twice the period", doubled_colour);
+    }
     std::vector<PlotMarker> markers;
     if (eq) {
         std::vector<double> ex, ey;
@@ -312,13 +337,24 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
     for (const OrbitCrossing& c : orbits.period_doublings) markers.push_back({c.par, 0.0, "#9467bd", "PD"});
     for (const OrbitCrossing& c : orbits.tori) markers.push_back({c.par, 0.0, "#8c564b", "torus"});
     // the markers of PD and tori are put on the branch by interpolation between its orbits
-    for (PlotMarker& m : markers) {
-        if (m.label != "PD" && m.label != "torus") continue;
-        for (std::size_t i = 0; i + 1 < x.size(); ++i)
-            if ((x[i] - m.x) * (x[i + 1] - m.x) <= 0.0 && x[i] != x[i + 1]) {
-                m.y = y[i] + (m.x - x[i]) / (x[i + 1] - x[i]) * (y[i + 1] - y[i]);
-                break;
-            }
+    auto place = [](std::vector<PlotMarker>& ms, std::size_t from, const std::vector<double>& bx, const std::vector<double>& by) {
+        for (std::size_t k = from; k < ms.size(); ++k) {
+            PlotMarker& m = ms[k];
+            if (m.label != "PD" && m.label != "torus") continue;
+            for (std::size_t i = 0; i + 1 < bx.size(); ++i)
+                if ((bx[i] - m.x) * (bx[i + 1] - m.x) <= 0.0 && bx[i] != bx[i + 1]) {
+                    m.y = by[i] + (m.x - bx[i]) / (bx[i + 1] - bx[i]) * (by[i + 1] - by[i]);
+                    break;
+                }
+        }
+    };
+    place(markers, 0, x, y);
+    if (doubled) {
+        const std::size_t from = markers.size();
+        for (const OrbitFold& f : doubled->folds) markers.push_back({f.par, f.orbit.max[variable] - f.orbit.min[variable], "#2ca02c", "fold"});
+        for (const OrbitCrossing& c : doubled->period_doublings) markers.push_back({c.par, 0.0, "#9467bd", "PD"});
+        for (const OrbitCrossing& c : doubled->tori) markers.push_back({c.par, 0.0, "#8c564b", "torus"});
+        place(markers, from, dx, dy);
     }
     auto label = [](const std::string& name, const std::string& unit) { return unit.empty() ? name : name + " [" + unit_text(unit) + "]"; };
     PlotPanel panel{title, label(parameter_symbol(orbits.parameter), parameter_unit), "amplitude max - min of " + label(variable_name, variable_unit),
@@ -347,6 +383,15 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
         for (const OrbitFold& f : orbits.folds) cuts.push_back(f.par);
         for (const OrbitCrossing& c : orbits.period_doublings) cuts.push_back(c.par);
         for (const OrbitCrossing& c : orbits.tori) cuts.push_back(c.par);
+        if (doubled) {
+            for (const OrbitFold& f : doubled->folds) cuts.push_back(f.par);
+            for (const OrbitCrossing& c : doubled->period_doublings) cuts.push_back(c.par);
+            for (const OrbitCrossing& c : doubled->tori) cuts.push_back(c.par);
+            if (!dx.empty()) {
+                cuts.push_back(*std::min_element(dx.begin(), dx.end()));
+                cuts.push_back(*std::max_element(dx.begin(), dx.end()));
+            }
+        }
         std::sort(cuts.begin(), cuts.end());
         // stable at m: m lies between two neighbouring points that are both stable
         auto stable_at = [](const std::vector<double>& px, const std::vector<int>& ps, double m) {
@@ -366,7 +411,7 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
         for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
             if (!(cuts[i + 1] > cuts[i])) continue;
             const double m = 0.5 * (cuts[i] + cuts[i + 1]);
-            if (!stable_at(x, st, m) || !stable_at(ex, es, m)) continue;
+            if (!(stable_at(x, st, m) || (doubled && stable_at(dx, dst, m))) || !stable_at(ex, es, m)) continue;
             if (!windows.empty() && windows.back().second == cuts[i]) windows.back().second = cuts[i + 1];
             else windows.emplace_back(cuts[i], cuts[i + 1]);
         }
@@ -381,7 +426,8 @@ std::string bifurcation_svg(const EquilibriumBranch* eq, const OrbitBranch& orbi
             po.note = "bistable (stable orbit and stable equilibrium) for " + parameter_symbol(orbits.parameter) + " in " + text +
                       "; crosses: Hopf red, fold green";
     }
-    if (std::count(st.begin(), st.end(), 2) > 0) po.note += "; grey: orbits without a stability verdict";
+    if (doubled) po.note += "; orange: orbits of twice the period";
+    if (std::count(st.begin(), st.end(), 2) + std::count(dst.begin(), dst.end(), 2) > 0) po.note += "; grey: orbits without a stability verdict";
     return render_line_plots_svg({panel}, po);
 }
 

@@ -1202,6 +1202,41 @@ assert d['status'] == 'numerical_issue', d['status']
 assert all(p['stable'] is None and p['multipliers'] == [] and 'no Floquet multipliers' in p['undecided'] for p in d['result']['points'])
 " "$orb/nomu.json" && grep -q "undecided periodic orbits" "$orb/nomu.svg" && ! grep -q ">stable periodic orbits\|>unstable periodic orbits" "$orb/nomu.svg" \
     && ok || bad "orbits without multipliers in the JSON and the figure"
+# switching at a period doubling (Mackey-Glass, examples/mackey_glass.json): the branch of twice the
+# period starts at the located doubling, its orbits have twice the period of the old ones there and
+# are stable past it; the next doubling of the cascade is on it (checked by simulation in
+# tests/analysis/bifurcation/test_periodic_orbit.cpp)
+if "$bin" orbits --system "$(dirname "$0")/../../examples/mackey_glass.json" --par tau --from 0.3 --to 2 --points 200 --period-doubling 0 --format json \
+       --out "$orb/pd" --svg "$orb/pd.svg" --quiet >"$orb/pd.json"; then
+    python3 - "$orb/pd.json" "$orb/pd-doubled.csv" <<'PY' && ok || bad "orbits --period-doubling: the branch of twice the period"
+import json, sys, csv
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "converged" and d["inputs"]["period_doubling"] == 0
+r = d["result"]
+pd = r["period_doublings"][0]
+dbl = r["period_doubled"]
+assert dbl["from"]["par"] == pd["par"] and dbl["from"]["period"] == pd["period"]
+p = dbl["points"]
+assert len(p) > 5 and dbl["intervals"] == 2 * r["intervals"]
+# T(tau) extrapolated from the first two orbits to the doubling: twice the period there
+T = p[0]["period"] + (pd["par"] - p[0]["par"]) * (p[1]["period"] - p[0]["period"]) / (p[1]["par"] - p[0]["par"])
+assert abs(T - 2 * pd["period"]) < 1e-3 * pd["period"], T
+assert p[0]["par"] > pd["par"] and p[1]["stable"]
+assert len(dbl["period_doublings"]) >= 1 and dbl["period_doublings"][0]["par"] > pd["par"]
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert [x["kind"] for x in rows].count("orbit") == len(p) and float(rows[0]["period_s"]) == p[0]["period"]
+PY
+    xmllint --noout "$orb/pd.svg" && grep -q "stable orbits of twice the period" "$orb/pd.svg" && ok || bad "orbits --period-doubling --svg"
+else
+    bad "orbits --period-doubling exit status"
+fi
+expect_error "--period-doubling = '1': expected an index from 0 to 0 (the branch has 1 period doubling)" \
+    orbits --system "$(dirname "$0")/../../examples/mackey_glass.json" --par tau --from 0.3 --to 1.5 --period-doubling 1 --out "$orb/bad4"
+expect_error "--period-doubling = '0': the branch has no period doubling in alpha from 1 to 2" \
+    orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling 0 --out "$orb/bad5"
+expect_error "--period-doubling = '-1': expected an integer >= 0" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling -1
+expect_error "--period-doubling: not with --wave" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --period-doubling 0 --wave 1
+[ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits --period-doubling bad input wrote files: $(ls "$orb")"
 
 fi  # part orbits
 

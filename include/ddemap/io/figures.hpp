@@ -40,8 +40,11 @@ ChartSpec classification_chart(const ChartSpec& base, const std::vector<Calibrat
 /// every orbit against the parameter (stable solid, unstable dashed), the equilibria at
 /// amplitude 0 (stable solid, unstable dashed; `equilibria` may be null), Hopf points and folds
 /// of orbits marked. Labels: "NAME [UNIT]" when a unit is given.
+/// With `doubled` (a branch of twice the period switched onto at a period doubling of `orbits`)
+/// that branch too, orange, with its folds and period doublings.
 std::string bifurcation_svg(const EquilibriumBranch* equilibria, const OrbitBranch& orbits, int variable, const std::string& variable_name,
-                            const std::string& variable_unit, const std::string& parameter_unit, const std::string& title);
+                            const std::string& variable_unit, const std::string& parameter_unit, const std::string& title,
+                            const OrbitBranch* doubled = nullptr);
 
 /// The bistability chart (analysis/bifurcation/bistability.hpp) in (p1, p2) over its box: the
 /// cells shaded by their verdict (orange: a stable periodic orbit and a stable equilibrium;

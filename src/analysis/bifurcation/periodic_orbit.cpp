@@ -1,6 +1,7 @@
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <cmath>
 #include <sstream>
@@ -782,9 +783,30 @@ Eigen::VectorXd resample(const Setup& from, const Setup& to, const Eigen::Vector
     return v;
 }
 
+/// How a branch recognises that it came back to where its orbits are born: the size of an orbit
+/// (0 there) and the name of that end. A branch from a Hopf point: the amplitude max - min, which
+/// falls to 0 at an equilibrium ("hopf"); the period-doubled branch: the distance between the
+/// orbit and itself half a period later, 0 on the orbit of half the period ("period_doubling").
+struct BranchEnd {
+    std::function<double(const PeriodicMesh&, const PeriodicOrbit&)> size;
+    std::string stop;
+};
+
+BranchEnd hopf_end() {
+    return {[](const PeriodicMesh&, const PeriodicOrbit& o) { return amplitude(o); }, "hopf"};
+}
+
+/// max over the mesh points s of max |x(s) - x(s + 1/2)| (the infinity norm over the variables).
+double half_period_distance(const PeriodicMesh& mesh, const PeriodicOrbit& o) {
+    double r = 0.0;
+    for (int i = 0; i < mesh.points(); ++i)
+        r = std::max(r, (o.profile.row(i).transpose() - orbit_value(mesh, o.profile, mesh.point(i) + 0.5)).lpNorm<Eigen::Infinity>());
+    return r;
+}
+
 /// Follows the branch from the corrected first orbit u with unit tangent t.
 void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correction& first, const PeriodicOrbitOptions& o,
-            OrbitBranch& b) {
+            OrbitBranch& b, const BranchEnd& end = hopf_end()) {
     // the mesh of the next orbit (adapted to the last one when o.adapt); Setup refers to it
     std::unique_ptr<PeriodicMesh> mesh;
     std::unique_ptr<Setup> cp = std::make_unique<Setup>(c0);
@@ -810,7 +832,7 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
     };
     b.points.push_back(make_orbit(*cur, u, first, o.floquet));
     report();
-    const double amp0 = amplitude(b.points.front());
+    const double amp0 = end.size(cur->mesh, b.points.front());
     double amp_max = amp0;
     b.newton_iterations += first.iterations;
     b.jacobians += first.jacobians;
@@ -867,9 +889,10 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
         // parameter too, but at an amplitude of the order of the branch's; so a turn with both
         // orbits below a quarter of the largest amplitude seen is taken as the Hopf point: the
         // branch ends there (once it ran on, looped, and listed the Hopf points as folds)
-        amp_max = std::max(amp_max, amplitude(b.points.back()));
-        if (t(N + 1) * tn(N + 1) < 0.0 && std::max(amplitude(b.points.back()), amplitude(orbit)) < 0.25 * amp_max) {
-            b.stop = "hopf";
+        const double size_last = end.size(c.mesh, b.points.back()), size_next = end.size(c.mesh, orbit);
+        amp_max = std::max(amp_max, size_last);
+        if (t(N + 1) * tn(N + 1) < 0.0 && std::max(size_last, size_next) < 0.25 * amp_max) {
+            b.stop = end.stop;
             return;
         }
         const int after = static_cast<int>(b.points.size()) - 1;
@@ -909,11 +932,11 @@ void follow(const Setup& c0, Eigen::VectorXd u, Eigen::VectorXd t, const Correct
             st.par_scale = std::abs(o.to - o.from);
             orbit_continuation::special_points(st, b.points.back(), orbit, o.floquet, "periodic orbits", probe, b);
         }
-        const bool collapsed = amplitude(orbit) < 0.5 * amp0;
+        const bool collapsed = size_next < 0.5 * amp0;
         b.points.push_back(std::move(orbit));
         report();
-        if (collapsed) {  // the amplitude fell back towards 0: the branch ends at an equilibrium (a Hopf point)
-            b.stop = "hopf";
+        if (collapsed) {  // the size fell back towards 0: the branch ends where such orbits are born (a Hopf point, a period doubling)
+            b.stop = end.stop;
             return;
         }
         u = v;
@@ -940,6 +963,30 @@ void finish(OrbitBranch& b) {
         s << b.points.size() << " orbits, ended: " << b.stop;
         b.message = s.str();
     }
+}
+
+/// Starts a branch off a point u0 of another solution set (an equilibrium at a Hopf point, an
+/// orbit traversed twice at a period doubling) along the direction t0 (T and p components 0): the
+/// first orbit corrected from u0 + initial_step t0 with the step condition along t0, then
+/// followed (with `failed`, the message when the first orbit does not converge).
+void branch_off(const Setup& c, const Eigen::VectorXd& u0, Eigen::VectorXd t0, const PeriodicOrbitOptions& options, const std::string& failed,
+                const BranchEnd& end, OrbitBranch& b) {
+    t0 /= c.norm(t0);
+    Eigen::VectorXd u = u0 + options.initial_step * t0;
+    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
+    const Eigen::VectorXd a = c.w.cwiseProduct(t0);
+    const Correction r = correct(c, u, ref, a, a.dot(u), options, nullptr);
+    if (!r.ok) {
+        b.status = Status::MaxIterations;
+        b.stop = "first_orbit_failed";
+        b.message = failed;
+        b.newton_iterations = r.iterations;
+        b.jacobians = r.jacobians;
+        return;
+    }
+    const Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
+    follow(c, u, t, r, options, b, end);
+    finish(b);
 }
 
 std::string method_text(const PeriodicMesh& mesh) {
@@ -1046,22 +1093,7 @@ OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& 
     uh(N) = T0;
     uh(N + 1) = hopf.par;
     t0(N) = t0(N + 1) = 0.0;
-    t0 /= c.norm(t0);
-    Eigen::VectorXd u = uh + options.initial_step * t0;
-    const Eigen::MatrixXd ref = derivative_at_collocation(c, u);
-    const Eigen::VectorXd a = c.w.cwiseProduct(t0);
-    const Correction r = correct(c, u, ref, a, a.dot(u), options, nullptr);
-    if (!r.ok) {
-        b.status = Status::MaxIterations;
-        b.stop = "first_orbit_failed";
-        b.message = "the first orbit from the Hopf point did not converge (try a smaller initial step or a finer mesh)";
-        b.newton_iterations = r.iterations;
-        b.jacobians = r.jacobians;
-        return b;
-    }
-    Eigen::VectorXd t = r.tangent / c.norm(r.tangent);
-    follow(c, u, t, r, options, b);
-    finish(b);
+    branch_off(c, uh, t0, options, "the first orbit from the Hopf point did not converge (try a smaller initial step or a finer mesh)", hopf_end(), b);
     return b;
 }
 
@@ -1107,6 +1139,89 @@ OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess
     if ((t(N + 1) < 0.0) != (options.to < options.from)) t = -t;
     follow(c, u, t, r, options, b);
     finish(b);
+    return b;
+}
+
+OrbitBranch orbit_branch_from_period_doubling(const NonlinearDDE& system, const OrbitCrossing& pd, const PeriodicOrbitOptions& options) {
+    const SingleThreadedEigen single;
+    const PeriodicOrbit& o = pd.orbit;
+    if (!pd.located || o.profile.rows() == 0 || o.breakpoints.size() < 3)
+        throw std::invalid_argument("orbits from a period doubling: expected a located period doubling with its orbit");
+    if (!(std::abs(pd.multiplier.imag()) <= 1e-6) || !(std::abs(pd.multiplier.real() + 1.0) <= 1e-3))
+        throw std::invalid_argument("orbits from a period doubling: expected its crossing multiplier real and near -1");
+    if (o.profile.cols() != system.dimension() || !(o.period > 0.0))
+        throw std::invalid_argument("orbits from a period doubling: the orbit must have the system's dimension and a period > 0");
+    const int L = static_cast<int>(o.breakpoints.size()) - 1;
+    if (o.profile.rows() % L != 0) throw std::invalid_argument("orbits from a period doubling: the orbit's profile does not fit its mesh");
+    const int d = static_cast<int>(o.profile.rows() / L);
+    const PeriodicMesh mesh(d, o.breakpoints);
+    const Setup c1 = make_setup(system, mesh, options, o.period);
+    const int N1 = c1.N(), n = c1.n, P = c1.P;
+    Eigen::VectorXd u1(N1 + 2);
+    for (int i = 0; i < P; ++i) u1.segment(static_cast<Eigen::Index>(i) * n, n) = o.profile.row(i).transpose();
+    u1(N1) = o.period;
+    u1(N1 + 1) = o.par;
+    // the doubled mesh: the orbit's mesh on [0, 1/2] and again on [1/2, 1]
+    std::vector<double> bp;
+    for (int i = 0; i <= L; ++i) bp.push_back(0.5 * o.breakpoints[static_cast<std::size_t>(i)]);
+    for (int i = 1; i <= L; ++i) bp.push_back(0.5 + 0.5 * o.breakpoints[static_cast<std::size_t>(i)]);
+    bp.back() = 1.0;
+    const PeriodicMesh mesh2(d, bp);
+    const Setup c = make_setup(system, mesh2, options, 2.0 * o.period);
+    const int N = c.N();
+    OrbitBranch b;
+    b.parameter = options.parameter;
+    b.degree = d;
+    b.intervals = 2 * L;
+    b.method = method_text(mesh2) + "; started from the period doubling at " + options.parameter + " = " + detail::format_number(o.par) +
+               " along the Floquet eigenfunction of its multiplier -1 (the orbit traversed twice)";
+    // the eigenfunction: the eigenvector v of the monodromy matrix for mu (inverse iteration on
+    // M - mu I), continued over the period by the collocated variational equation, y = Y v
+    Linearization lz;
+    if (linearize(c1, u1, lz) != LinStatus::ok) {
+        b.status = Status::NumericalIssue;
+        b.stop = "first_orbit_failed";
+        b.message = "the Floquet eigenfunction of the period doubling was not computed (its history window is above 4000 values or the collocation matrix is singular)";
+        return b;
+    }
+    const int H = lz.H;
+    Eigen::MatrixXd mono = Eigen::MatrixXd::Zero(H, H);
+    for (long h = 0; h < lz.nh; ++h) {
+        const long g = lz.gmin + h + P;
+        if (g <= 0) mono.block(h * n, (g - lz.gmin) * n, n, n).setIdentity();
+        else mono.middleRows(h * n, n) = lz.Y.block((g - 1) * n, 0, n, H);
+    }
+    const double mu = pd.multiplier.real();
+    Eigen::MatrixXd shifted = mono;
+    shifted.diagonal().array() -= mu;
+    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(shifted);
+    Eigen::VectorXd v = Eigen::VectorXd::Ones(H);
+    for (int it = 0; it < 4; ++it) {
+        v = lu.solve(v);
+        v /= v.norm();
+    }
+    const double eig_residual = (mono * v - mu * v).norm();
+    if (!v.allFinite() || !(eig_residual <= 1e-6 * std::max(1.0, mono.lpNorm<Eigen::Infinity>()))) {
+        b.status = Status::NumericalIssue;
+        b.stop = "first_orbit_failed";
+        b.message = "the Floquet eigenvector of the multiplier " + detail::format_number(mu) + " did not converge (residual " + detail::significant(eig_residual, 3) + ")";
+        return b;
+    }
+    const Eigen::VectorXd y = lz.Y.leftCols(H) * v;  // the values at the points 1..P of the period (M1 order)
+    Eigen::MatrixXd yp(P, n);
+    yp.row(0) = v.segment(-lz.gmin * n, n).transpose();  // point 0 is the window's last point
+    for (int q = 1; q < P; ++q) yp.row(q) = y.segment(static_cast<Eigen::Index>(q - 1) * n, n).transpose();
+    Eigen::VectorXd u0(N + 2), t0(N + 2);
+    for (int q = 0; q < 2 * P; ++q) {
+        u0.segment(static_cast<Eigen::Index>(q) * n, n) = o.profile.row(q % P).transpose();
+        // y(s + 1) = mu y(s) on the second period: the direction is 2-periodic
+        t0.segment(static_cast<Eigen::Index>(q) * n, n) = (q < P ? 1.0 : mu) * yp.row(q % P).transpose();
+    }
+    u0(N) = 2.0 * o.period;
+    u0(N + 1) = o.par;
+    t0(N) = t0(N + 1) = 0.0;
+    branch_off(c, u0, t0, options, "the first orbit of twice the period did not converge from the period doubling (try a smaller initial step)",
+               BranchEnd{half_period_distance, "period_doubling"}, b);
     return b;
 }
 

@@ -169,7 +169,9 @@ struct OrbitBranch {
     std::string message;
     /// why it ended: "bound" (a face of the range), "max_points", "period" (above
     /// max_period_factor), "hopf" (the amplitude fell below half the first orbit's: an
-    /// equilibrium, usually another Hopf point), "step_below_minimum", "first_orbit_failed"
+    /// equilibrium, usually another Hopf point), "period_doubling" (a branch of twice the period
+    /// back on an orbit of the period halved: orbit_branch_from_period_doubling),
+    /// "step_below_minimum", "first_orbit_failed"
     std::string stop;
     std::string method;   ///< the discretisation and solver used
     double max_residual = 0.0;          ///< certificate: max over orbits of max |F|
@@ -200,6 +202,24 @@ OrbitBranch orbit_branch_from_hopf(const NonlinearDDE& system, const HopfPoint& 
 /// The branch through the orbit corrected from `guess` (the parameter fixed at guess.par for
 /// that correction), followed in the direction of increasing p when to > from, else decreasing.
 OrbitBranch orbit_branch_from_guess(const NonlinearDDE& system, const OrbitGuess& guess, const PeriodicOrbitOptions& options);
+
+/// The branch of orbits of twice the period born at a located period doubling `pd` of a branch
+/// (pd.orbit: the orbit of period T where the multiplier mu = -1). On the mesh of pd.orbit
+/// traversed twice (2 L intervals of its degree; options.degree and options.intervals are not
+/// used), the first orbit is corrected from
+///     x(2 s) + eps y(s),  period 2 T,  p = pd.par,
+/// with the step condition along (y, 0, 0): y the Floquet eigenfunction of mu (the eigenvector
+/// of the monodromy matrix by inverse iteration on M - mu I, continued over [0, 1] by the
+/// collocated variational equation, and y(s + 1) = mu y(s) on the second period), eps =
+/// options.initial_step. On the doubled problem the old branch (its orbit traversed twice) goes on
+/// through the point, so this direction (orthogonal to the old branch's tangent) selects the new
+/// one. The branch ends, besides the ends of orbit_branch_from_hopf, when it returns to an orbit
+/// of the period halved (stop "period_doubling"): the distance max_s |x(s) - x(s + 1/2)| falls
+/// below half the first orbit's, or the parameter turns while it is below a quarter of its largest.
+/// Period doublings of this branch are the next ones of a cascade. std::invalid_argument for a
+/// period doubling that is not located or whose multiplier is not real near -1; a failed
+/// eigenvector or first orbit is a status (stop "first_orbit_failed").
+OrbitBranch orbit_branch_from_period_doubling(const NonlinearDDE& system, const OrbitCrossing& pd, const PeriodicOrbitOptions& options);
 
 /// The Floquet multipliers (as in the branch, by decreasing modulus, the trivial one included)
 /// of a given orbit of `system`: its values on `mesh` (points() x n), period and the value `par`
