@@ -27,6 +27,7 @@ struct OrbitsArgs {
     std::string wave, initial_step, max_step;
     std::string par2, from2, to2;
     std::string period_doubling;
+    std::string from_simulation, history, guess;
     CLI::Option* hopf_option = nullptr;
     bool adapt = false;
     bool no_stability = false;
@@ -35,6 +36,53 @@ struct OrbitsArgs {
     OutArg out;
 } orbits_args;
 
+
+/// The orbit of a --guess file: columns t and one per variable (a header row of names allowed,
+/// '#' comments), times increasing, the last row one period after the first.
+struct GuessSamples {
+    std::vector<double> times;
+    Eigen::MatrixXd states;
+};
+
+GuessSamples read_guess(const std::string& path, int n) {
+    const std::string text = read_input_file("--guess", path);
+    std::vector<std::vector<double>> rows;
+    std::istringstream in(text);
+    std::string line;
+    int row = 0;
+    while (std::getline(in, line)) {
+        ++row;
+        const std::size_t hash = line.find('#');
+        if (hash != std::string::npos) line.erase(hash);
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        std::vector<std::string> fields;
+        std::string f;
+        std::istringstream ls(line);
+        while (std::getline(ls, f, ',')) {
+            const std::size_t a = f.find_first_not_of(" \t\r"), z = f.find_last_not_of(" \t\r");
+            fields.push_back(a == std::string::npos ? std::string() : f.substr(a, z - a + 1));
+        }
+        if (static_cast<int>(fields.size()) != n + 1)
+            throw BadInput("--guess = " + path + ", row " + std::to_string(row) + ": expected " + std::to_string(n + 1) + " columns (t and one per variable), found " +
+                           std::to_string(fields.size()));
+        if (rows.empty() && !fields[0].empty() && !(std::isdigit(static_cast<unsigned char>(fields[0][0])) || fields[0][0] == '-' || fields[0][0] == '+' || fields[0][0] == '.'))
+            continue;  // the header
+        std::vector<double> v;
+        for (std::size_t k = 0; k < fields.size(); ++k) v.push_back(parse_number("--guess = " + path + ", row " + std::to_string(row) + ", column " + std::to_string(k + 1), fields[k]));
+        if (!rows.empty() && !(v[0] > rows.back()[0]))
+            throw BadInput("--guess = " + path + ", row " + std::to_string(row) + ": t = " + fields[0] + ": expected times increasing");
+        rows.push_back(std::move(v));
+        if (rows.size() > 1000000) throw BadInput("--guess = " + path + ": more than 1,000,000 rows (expected one period, sampled)");
+    }
+    if (rows.size() < 4) throw BadInput("--guess = " + path + ": " + std::to_string(rows.size()) + " rows of numbers: expected at least 4 covering one period");
+    GuessSamples g;
+    g.states.resize(static_cast<Eigen::Index>(rows.size()), n);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        g.times.push_back(rows[i][0]);
+        for (int k = 0; k < n; ++k) g.states(static_cast<Eigen::Index>(i), k) = rows[i][static_cast<std::size_t>(k) + 1];
+    }
+    return g;
+}
 
 }  // namespace
 
@@ -57,6 +105,18 @@ void add_orbits_flags(CLI::App& app) {
                    "switch at period doubling K of the branch (from 0, in the order met) onto the branch of orbits of twice the period, "
                    "and follow it too (its own period doublings are the next of a cascade); PREFIX-doubled.csv, JSON result.period_doubled")
         ->type_name("K");
+    app.add_option("--from-simulation", orbits_args.from_simulation,
+                   "start from the orbit a simulation at --par = --from settles on (run to time T_END, read off its last third) instead of a "
+                   "Hopf point, and follow the branch from there towards --to")
+        ->type_name("T_END");
+    app.add_option("--history", orbits_args.history,
+                   "--from-simulation: the constant initial state, one value per variable (default: the equilibrium guess with the first "
+                   "variable raised by 10 % of max(1, |x_1|))")
+        ->type_name("V1,V2,..");
+    app.add_option("--guess", orbits_args.guess,
+                   "start from an orbit given as CSV (columns t and one per variable, rows covering one period, the last row one period "
+                   "after the first) at --par = --from, instead of a Hopf point; the branch is followed towards --to")
+        ->type_name("FILE");
     app.add_option("--from2", orbits_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
     app.add_option("--to2", orbits_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     orbits_args.format.add_to(app);
@@ -81,6 +141,13 @@ void add_orbits_flags(CLI::App& app) {
 }
 
 int run_orbits() {
+    const bool from_simulation = !orbits_args.from_simulation.empty(), from_file = !orbits_args.guess.empty();
+    if (!orbits_args.wave.empty() && (from_simulation || from_file))
+        throw BadInput(std::string(from_simulation ? "--from-simulation" : "--guess") + ": not with --wave (expected the orbits of a system or ring without --wave)");
+    if (from_simulation && from_file) throw BadInput("--from-simulation and --guess: expected one start of the orbits");
+    if (!orbits_args.history.empty() && !from_simulation) throw BadInput("--history: only with --from-simulation (expected --from-simulation T_END)");
+    if ((from_simulation || from_file) && orbits_args.hopf_option && orbits_args.hopf_option->count() > 0)
+        throw BadInput("--hopf: not with " + std::string(from_simulation ? "--from-simulation" : "--guess") + " (the orbits start from the simulation or the file)");
     if (!orbits_args.wave.empty() && !orbits_args.period_doubling.empty())
         throw BadInput("--period-doubling: not with --wave (expected the orbits of a system or ring without --wave)");
     if (!orbits_args.wave.empty() && !orbits_args.par2.empty()) throw BadInput("--par2: not with --wave (expected the orbits of a system or ring without --wave)");
@@ -170,9 +237,52 @@ int run_orbits() {
                    "time", 2.0 * 2.0 * 1e-4 * (o.degree / 4.0) * unknowns * o.max_points);
     }
     JsonObject& inputs = built.inputs;
-    inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf_index).integer("degree", o.degree)
-        .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
+    inputs.string("par", par).number("from", o.from).number("to", o.to);
+    if (!from_simulation && !from_file) inputs.integer("hopf", hopf_index);
+    inputs.integer("degree", o.degree).integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
     if (!orbits_args.max_step.empty()) inputs.number("max_step", o.max_step);  // only when given: the Python binding's envelope has no step option yet
+
+    // the starts other than a Hopf point, read and sized before any work: at --par = --from
+    Eigen::VectorXd sim_history;
+    double sim_end = 0.0, sim_step = 0.0;
+    GuessSamples guess_samples;
+    if (from_simulation || from_file) {
+        built.system->set_parameter(par, o.from);
+        inputs.number(from_simulation ? "from_simulation" : "guess_at", o.from);
+    }
+    if (from_simulation) {
+        const int n = built.system->dimension();
+        sim_end = parse_number("--from-simulation", orbits_args.from_simulation);
+        if (!(sim_end > 0.0 && sim_end <= 1e7)) throw BadInput("--from-simulation = '" + orbits_args.from_simulation + "': expected a run time above 0, at most 1e7");
+        if (orbits_args.history.empty()) {
+            sim_history = built.guess;
+            sim_history(0) += 0.1 * std::max(1.0, std::abs(sim_history(0)));
+        } else {
+            std::vector<double> v;
+            std::istringstream hs(orbits_args.history);
+            std::string f;
+            while (std::getline(hs, f, ',')) v.push_back(parse_number("--history", f));
+            if (static_cast<int>(v.size()) != n)
+                throw BadInput("--history = '" + orbits_args.history + "': expected " + std::to_string(n) + " values (one per variable), found " + std::to_string(v.size()));
+            sim_history = Eigen::Map<const Eigen::VectorXd>(v.data(), n);
+        }
+        // the step: 0.01, or a tenth of the shortest positive delay when that is shorter
+        sim_step = 0.01;
+        for (double t : built.system->delays())
+            if (t > 0.0) sim_step = std::min(sim_step, 0.1 * t);
+        const std::vector<double> tau = built.system->delays();
+        // measured about 1.5e-6 s per step and variable-delay pair (ov rings, Mackey-Glass)
+        const double work = (sim_end / sim_step) * n * (static_cast<double>(tau.size()) + 1.0);
+        check_size("orbits", "a simulation of " + rounded(sim_end / sim_step, 3) + " steps of " + std::to_string(n) + " variables", "time", 1.5e-6 * work);
+        check_size("orbits", "a simulation of " + rounded(sim_end / sim_step, 3) + " steps of " + std::to_string(n) + " variables", "memory",
+                   8.0 * 3.0 * n * (sim_end / sim_step));
+        inputs.number("t_end", sim_end);
+        if (!orbits_args.history.empty()) inputs.string("history", orbits_args.history);
+    }
+    if (from_file) {
+        guess_samples = read_guess(orbits_args.guess, built.system->dimension());
+        inputs.string("guess", orbits_args.guess);
+    }
 
     EquilibriumBranchOptions eo;
     eo.parameter = par;
@@ -180,21 +290,63 @@ int run_orbits() {
     eo.to = o.to;
     eo.roots.count = 2;
     eo.progress = branch_progress_printer("orbits", "equilibria", par, true);
-    const EquilibriumBranch eq = equilibrium_branch(*built.system, built.guess, eo);
+    // the equilibria start the orbits at a Hopf point; from a simulation or a file they are only
+    // drawn (--svg), so computed only then (a long ring's branch takes minutes)
+    const bool from_hopf = !from_simulation && !from_file;
+    EquilibriumBranch eq;
+    if (from_hopf || !svg_file.empty()) eq = equilibrium_branch(*built.system, built.guess, eo);
     eo.progress = nullptr;  // ends an open progress line
-    if (eq.hopf.empty())
+    if (from_hopf && eq.hopf.empty())
         throw BadInput("no Hopf point on the equilibrium branch in " + par + " from " + orbits_args.problem.from + " to " + orbits_args.problem.to +
                        " (ended: " + to_string(eq.stop) + "): expected at least one to start the periodic orbits from");
-    if (hopf_index >= static_cast<int>(eq.hopf.size()))
+    if (from_hopf && hopf_index >= static_cast<int>(eq.hopf.size()))
         throw BadInput("--hopf = '" + orbits_args.hopf + "': expected an index from 0 to " + std::to_string(eq.hopf.size() - 1) + " (the branch has " +
                        std::to_string(eq.hopf.size()) + " Hopf point" + (eq.hopf.size() == 1 ? "" : "s") + ")");
-    const HopfPoint& h = eq.hopf[static_cast<std::size_t>(hopf_index)];
-    o.progress = branch_progress_printer("orbits", "orbits", par, false);
-    OrbitBranch b = orbit_branch_from_hopf(*built.system, h, o);
-    o.progress = nullptr;
-    if (h.status != Status::Converged && b.status == Status::Converged) {
-        b.status = h.status;
-        b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
+    const HopfPoint* hp = from_hopf ? &eq.hopf[static_cast<std::size_t>(hopf_index)] : nullptr;
+    OrbitBranch b;
+    JsonObject start;  // result.start of a simulation or a file
+    std::string start_line;
+    if (hp) {
+        o.progress = branch_progress_printer("orbits", "orbits", par, false);
+        b = orbit_branch_from_hopf(*built.system, *hp, o);
+        o.progress = nullptr;
+        if (hp->status != Status::Converged && b.status == Status::Converged) {
+            b.status = hp->status;
+            b.message = "the Hopf point was not located (" + to_string(hp->status) + "); the orbits start from its estimate";
+        }
+    } else {
+        const PeriodicMesh mesh(o.degree, o.intervals);
+        OrbitGuess guess;
+        bool have = true;
+        if (from_simulation) {
+            SimulatedOrbitGuess sg = orbit_guess_from_simulation(*built.system, par, mesh, sim_history, sim_end, sim_step);
+            start.string("kind", "simulation").number("t_end", sim_end).number("step", sim_step).number("period", sg.period)
+                .integer("crossings_per_period", sg.crossings_per_period).number("period_spread", sg.period_spread).string("status", to_string(sg.status))
+                .string("message", sg.message);
+            std::ostringstream sl;
+            sl << "start      simulation at " << par << " = " << rounded(o.from, 10) << " to t = " << rounded(sim_end, 6) << " (step " << rounded(sim_step, 3) << "): " << sg.message << "\n";
+            start_line = sl.str();
+            if (sg.status != Status::Converged) {
+                have = false;
+                b.status = sg.status;
+                b.stop = "first_orbit_failed";
+                b.message = "no orbit from the simulation: " + sg.message;
+            }
+            guess = std::move(sg.guess);
+        } else {
+            try {
+                guess = orbit_guess_from_samples(mesh, guess_samples.times, guess_samples.states, guess_samples.times.back() - guess_samples.times.front(), o.from);
+            } catch (const std::invalid_argument& e) {
+                throw BadInput("--guess = " + orbits_args.guess + ": " + e.what());
+            }
+            start.string("kind", "file").string("file", orbits_args.guess).number("period", guess.period);
+            start_line = "start      " + orbits_args.guess + " at " + par + " = " + rounded(o.from, 10) + ", period " + rounded(guess.period, 8) + "\n";
+        }
+        if (have) {
+            o.progress = branch_progress_printer("orbits", "orbits", par, false);
+            b = orbit_branch_from_guess(*built.system, guess, o);
+            o.progress = nullptr;
+        }
     }
 
     // the branch of twice the period from period doubling K (--period-doubling)
@@ -260,10 +412,14 @@ int run_orbits() {
     e.inputs = inputs.str();
     e.status = to_string(b.status);
     e.message = b.message;
-    JsonObject hj;
-    hj.integer("index", hopf_index).number("par", h.par).number("omega", h.omega).string("status", to_string(h.status));
     std::string result = orbit_branch_json(b, variables);
-    result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    if (hp) {
+        JsonObject hj;
+        hj.integer("index", hopf_index).number("par", hp->par).number("omega", hp->omega).string("status", to_string(hp->status));
+        result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    } else {
+        result = "{\"start\":" + start.str() + "," + result.substr(1);
+    }
     if (two) result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) + "}";
     if (doubling) {
         const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(doubling_index)];
@@ -285,7 +441,8 @@ int run_orbits() {
         const std::string punit = built.unit(par);
         const std::string vunit = built.unit(variables[static_cast<std::size_t>(variable)]);
         std::ostringstream title;
-        title << "Periodic orbits from the Hopf point at " << par << " = " << rounded(h.par, 6);
+        if (hp) title << "Periodic orbits from the Hopf point at " << par << " = " << rounded(hp->par, 6);
+        else title << "Periodic orbits from " << (from_simulation ? "a simulation" : "a given orbit") << " at " << par << " = " << rounded(o.from, 6);
         title << orbits_args.problem.ring_title();
         files.push_back({svg_file, bifurcation_svg(&eq, b, variable, variables[static_cast<std::size_t>(variable)], vunit, punit, title.str(),
                                                    doubling ? &doubled : nullptr)});
@@ -293,8 +450,11 @@ int run_orbits() {
     if (!files.empty()) write_files_atomic(files);
     print_output(format, e, csv, [&] {
         std::ostringstream out;
-        out << "hopf       " << par << " = " << rounded(h.par, 10) << ", omega = " << rounded(h.omega, 10) << ", period 2 pi / omega = "
-            << rounded(6.283185307179586 / h.omega, 8) << " (Hopf point " << hopf_index << " of " << eq.hopf.size() << ")\n";
+        if (hp)
+            out << "hopf       " << par << " = " << rounded(hp->par, 10) << ", omega = " << rounded(hp->omega, 10) << ", period 2 pi / omega = "
+                << rounded(6.283185307179586 / hp->omega, 8) << " (Hopf point " << hopf_index << " of " << eq.hopf.size() << ")\n";
+        else
+            out << start_line;
         out << "branch     " << counted(static_cast<long long>(b.points.size()), "orbit") << ", degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
         const std::string& v = variables[static_cast<std::size_t>(variable)];
         auto table = [&](const OrbitBranch& br) {

@@ -1237,6 +1237,57 @@ expect_error "--period-doubling = '0': the branch has no period doubling in alph
 expect_error "--period-doubling = '-1': expected an integer >= 0" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling -1
 expect_error "--period-doubling: not with --wave" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --period-doubling 0 --wave 1
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits --period-doubling bad input wrote files: $(ls "$orb")"
+# starts other than a Hopf point: the orbit a simulation settles on (--from-simulation), or one
+# given in a file (--guess), at --par = --from. Wright's equation: each is corrected to the orbit
+# that the branch from the Hopf point reaches on its face (alpha = 2 from a simulation, alpha = 1.7
+# from a sine of period 4.1 and amplitude 0.8: near the Hopf point the orbit is nearly one)
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --points 200 --format json --quiet >"$orb/hopf2.json" || bad "orbits to alpha = 2"
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 1.7 --points 200 --format json --quiet >"$orb/hopf17.json" || bad "orbits to alpha = 1.7"
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --points 4 --from-simulation 300 --format json --quiet >"$orb/sim.json" \
+    || bad "orbits --from-simulation exit status"
+python3 -c "
+import math
+with open('$orb/guess.csv', 'w') as f:
+    f.write('t,y\n')
+    for i in range(101):
+        t = 4.1 * i / 100
+        f.write('%r,%r\n' % (t, 0.8 * math.sin(2 * math.pi * t / 4.1)))
+"
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 1.7 --to 2.5 --points 4 --guess "$orb/guess.csv" --format json --quiet >"$orb/file.json" \
+    || bad "orbits --guess exit status"
+python3 - "$orb/hopf2.json" "$orb/sim.json" "$orb/hopf17.json" "$orb/file.json" <<'PY' && ok || bad "orbits --from-simulation and --guess: the orbits of the branch from the Hopf point"
+import json, sys
+h2, s, h17, f = (json.load(open(a)) for a in sys.argv[1:])
+for h, d, kind, at in ((h2, s, "simulation", 2), (h17, f, "file", 1.7)):
+    end = h["result"]["points"][-1]
+    assert end["par"] == at
+    assert d["status"] == "converged" and d["result"]["start"]["kind"] == kind and "hopf" not in d["result"], d["result"].get("start")
+    first = d["result"]["points"][0]
+    assert first["par"] == at and abs(first["period"] - end["period"]) < 1e-9 * end["period"], (first["period"], end["period"])
+    # the same orbit in another phase: max is sampled at 8 d points per interval, so it agrees to
+    # the sampling error (h T / (8 d))^2 |x''| / 8, about 3e-6 here (1.2e-6 and 5.6e-7 measured)
+    assert abs(first["max"][0] - end["max"][0]) < 1e-5 and first["stable"]
+    assert all(p["par"] >= at for p in d["result"]["points"])  # followed towards --to
+assert s["result"]["start"]["crossings_per_period"] == 1 and s["result"]["start"]["period_spread"] < 1e-3
+assert s["inputs"]["t_end"] == 300 and "hopf" not in s["inputs"]
+PY
+# a simulation that settles on the (stable) equilibrium gives no orbit: undecided, exit 4, said why
+"$bin" orbits --system "$orb/wright.json" --par alpha --from 1 --to 1.5 --from-simulation 200 --quiet >"$orb/eqsim.out" 2>"$orb/eqsim.err"
+rc=$?
+[ $rc -eq 4 ] && grep -q "settled on an equilibrium" "$orb/eqsim.err" && ok || bad "orbits --from-simulation on a stable equilibrium: exit $rc, $(cat "$orb/eqsim.err")"
+printf 't,y\n0,1\n1,2\n' >"$orb/short.csv"
+printf 't,y,z\n0,1,1\n' >"$orb/cols.csv"
+printf 't,y\n0,1\n1,2\n0.5,0\n2,1\n' >"$orb/order.csv"
+expect_error "--guess = $orb/short.csv: 2 rows of numbers: expected at least 4 covering one period" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --guess "$orb/short.csv" --out "$orb/bad6"
+expect_error "row 1: expected 2 columns (t and one per variable), found 3" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --guess "$orb/cols.csv"
+expect_error "row 4: t = 0.5: expected times increasing" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --guess "$orb/order.csv"
+expect_error "--history = '1,2': expected 1 values (one per variable), found 2" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --from-simulation 100 --history 1,2
+expect_error "--from-simulation = '-1': expected a run time above 0, at most 1e7" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --from-simulation -1
+expect_error "--hopf: not with --from-simulation" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --from-simulation 100 --hopf 0
+expect_error "--from-simulation and --guess: expected one start of the orbits" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --from-simulation 100 --guess "$orb/guess.csv"
+expect_error "--history: only with --from-simulation" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --history 1
+expect_error "a simulation of 1e+09 steps of 1 variables: estimated run time 50 min is above the limit 10 min" orbits --system "$orb/wright.json" --par alpha --from 2 --to 2.5 --from-simulation 1e7
+[ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits --guess bad input wrote files: $(ls "$orb")"
 
 fi  # part orbits
 

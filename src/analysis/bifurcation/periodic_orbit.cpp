@@ -26,6 +26,7 @@
 #include "analysis/bifurcation/internal/orbit_mesh.hpp"
 #include "core/internal/eigen_threads.hpp"
 #include "core/internal/text.hpp"
+#include "ddemap/solve/integrate.hpp"
 
 namespace ddemap {
 
@@ -1045,6 +1046,104 @@ OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<
         g.profile.row(i) = (1.0 - th) * states.row(static_cast<Eigen::Index>(k)) + th * states.row(static_cast<Eigen::Index>(k + 1));
     }
     return g;
+}
+
+SimulatedOrbitGuess orbit_guess_from_simulation(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
+                                                const Eigen::VectorXd& history, double t_end, double step) {
+    const int n = system.dimension(), m = system.delay_count();
+    if (history.size() != n) throw std::invalid_argument("orbit from a simulation: expected a history of one value per variable");
+    if (!history.allFinite()) throw std::invalid_argument("orbit from a simulation: expected finite history values");
+    if (!(t_end > 0.0) || !std::isfinite(t_end)) throw std::invalid_argument("orbit from a simulation: expected a run time > 0");
+    if (!(step > 0.0) || !(step < t_end)) throw std::invalid_argument("orbit from a simulation: expected a step > 0 below the run time");
+    const int j = system.parameter_index(parameter);  // throws for an unknown name
+    const std::vector<double> tau = system.delays();
+    SimulatedOrbitGuess r;
+    bool finite = true;
+    DdeSolver sol(n, 0.0, [&history](double, double* y) { Eigen::Map<Eigen::VectorXd>(y, history.size()) = history; },
+                  [&](double t, const double* y, const DdeSolver& sv, double* dy) {
+                      Eigen::VectorXd u(static_cast<Eigen::Index>(n) * (m + 1));
+                      for (int i = 0; i < n; ++i) u(i) = y[i];
+                      for (int k = 0; k < m; ++k)
+                          for (int i = 0; i < n; ++i) u((k + 1) * n + i) = sv.value(i, t - tau[static_cast<std::size_t>(k)]);
+                      const Eigen::VectorXd f = system.f(u);
+                      for (int i = 0; i < n; ++i) dy[i] = f(i);
+                  });
+    sol.integrate(t_end, step, {}, [&finite](const DdeSolver& sv) {
+        for (int i = 0; i < sv.dimension(); ++i)
+            if (!std::isfinite(sv.state()[i]) || std::abs(sv.state()[i]) > 1e100) return finite = false;
+        return true;
+    });
+    if (!finite) {
+        r.message = "the simulation left the finite numbers at t = " + detail::format_number(sol.time()) + " (a smaller step, or another history)";
+        return r;
+    }
+    // the last third: the mean level of the first variable and its upward crossings
+    const double t0 = t_end * 2.0 / 3.0, dt = step;
+    double lo = 1e300, hi = -1e300, sum = 0.0;
+    long count = 0;
+    for (double t = t0; t <= t_end; t += dt) {
+        const double x = sol.value(0, t);
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+        sum += x;
+        ++count;
+    }
+    r.amplitude = hi - lo;
+    const double level = sum / static_cast<double>(count);
+    if (!(r.amplitude > 1e-6 * std::max(1.0, std::abs(level)))) {
+        r.message = "the simulation settled on an equilibrium (the first variable varies by " + detail::significant(r.amplitude, 2) +
+                    " over the last third of the run): another history or parameter value";
+        return r;
+    }
+    std::vector<double> up;
+    for (double t = t0; t + dt <= t_end; t += dt) {
+        double a = t, b = t + dt;
+        if (!(sol.value(0, a) < level && sol.value(0, b) >= level)) continue;
+        for (int it = 0; it < 60; ++it) {
+            const double mid = 0.5 * (a + b);
+            (sol.value(0, mid) < level ? a : b) = mid;
+        }
+        up.push_back(0.5 * (a + b));
+    }
+    for (int k = 1; k <= 8 && r.crossings_per_period == 0; ++k) {
+        if (static_cast<int>(up.size()) < 2 * k + 1) break;
+        double mean = 0.0;
+        const std::size_t uk = static_cast<std::size_t>(k);
+        for (std::size_t i = uk; i < up.size(); ++i) mean += up[i] - up[i - uk];
+        mean /= static_cast<double>(up.size() - uk);
+        double spread = 0.0;
+        for (std::size_t i = uk; i < up.size(); ++i) spread = std::max(spread, std::abs(up[i] - up[i - uk] - mean) / mean);
+        if (spread <= 1e-3) {
+            r.crossings_per_period = k;
+            r.period = mean;
+            r.period_spread = spread;
+        } else if (k == 1) {
+            r.period_spread = spread;
+        }
+    }
+    if (r.crossings_per_period == 0) {
+        r.message = up.size() < 3 ? "the simulation crossed its mean level " + std::to_string(up.size()) +
+                                        " times over the last third of the run: a longer run time"
+                                  : "the simulation did not settle on a periodic orbit (the times between crossings of the mean level vary by " +
+                                        detail::significant(r.period_spread * 100.0, 2) + " %, more than 0.1 %): a longer run time, or another history";
+        return r;
+    }
+    // one period ending at the last crossing, sampled at 16 points per mesh point
+    const double t1 = up.back(), ts = t1 - r.period;
+    const int samples = 16 * mesh.points();
+    std::vector<double> times;
+    Eigen::MatrixXd states(samples + 1, n);
+    for (int i = 0; i <= samples; ++i) {
+        const double t = ts + r.period * i / samples;
+        times.push_back(t);
+        for (int v = 0; v < n; ++v) states(i, v) = sol.value(v, t);
+    }
+    r.guess = orbit_guess_from_samples(mesh, times, states, r.period, system.parameter_values()[static_cast<std::size_t>(j)]);
+    r.status = Status::Converged;
+    std::ostringstream msg;
+    msg << "settled on an orbit of period " << detail::significant(r.period, 8) << " (repeats to " << detail::significant(r.period_spread, 2) << ")";
+    r.message = msg.str();
+    return r;
 }
 
 std::vector<cplx> orbit_multipliers(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,

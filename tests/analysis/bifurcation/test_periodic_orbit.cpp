@@ -476,3 +476,36 @@ TEST_CASE("Mackey-Glass (beta = 2, gamma = 1, n = 9.65): the branch switched ont
     // by O(0.01) times the difference of their slopes: 1 % here (0.16 % measured)
     CHECK(std::abs(above.period - 2.0 * T_above) < 0.01 * 2.0 * T_above);
 }
+
+TEST_CASE("orbit_guess_from_simulation: the period read off a run is the collocated orbit's, a doubled orbit is seen as one, an equilibrium is a status") {
+    // Wright's equation at alpha = 2: one crossing of the mean level per period, the period the
+    // collocated orbit's to the integrator's accuracy (RK4, step 0.01)
+    ExpressionSystem w = wright(2.0);
+    const PeriodicMesh mesh(4, 40);
+    const SimulatedOrbitGuess g = orbit_guess_from_simulation(w, "alpha", mesh, Eigen::VectorXd::Constant(1, 0.5), 300.0, 0.01);
+    REQUIRE(g.status == Status::Converged);
+    CHECK(g.crossings_per_period == 1);
+    CHECK(g.guess.par == 2.0);
+    const OrbitBranch b = orbit_branch_from_guess(w, g.guess, options("alpha", 2.0, 2.5, 2));
+    REQUIRE(!b.points.empty());
+    CHECK(std::abs(g.period - b.points.front().period) < 1e-6 * g.period);
+    // Mackey-Glass at tau = 1.5, between its first two period doublings: the simulation settles on
+    // the orbit of twice the period, corrected on the doubled branch's orbit there
+    ExpressionSystem mg = mackey_glass();
+    mg.set_parameter("tau", 1.5);
+    const SimulatedOrbitGuess m = orbit_guess_from_simulation(mg, "tau", mesh, Eigen::VectorXd::Constant(1, 0.5), 3000.0, 0.005);
+    REQUIRE(m.status == Status::Converged);
+    const OrbitBranch mb = orbit_branch_from_guess(mg, m.guess, options("tau", 1.5, 1.6, 2));
+    REQUIRE(!mb.points.empty());
+    CHECK(std::abs(m.period - mb.points.front().period) < 1e-5 * m.period);
+    CHECK(m.period > 8.0);  // twice the old orbit's period (4.3 there), not once
+    CHECK(mb.points.front().stable);
+    // a stable equilibrium (Wright at alpha = 1): a status saying so, no guess
+    ExpressionSystem w1 = wright(1.0);
+    const SimulatedOrbitGuess e = orbit_guess_from_simulation(w1, "alpha", mesh, Eigen::VectorXd::Constant(1, 0.5), 200.0, 0.01);
+    CHECK(e.status == Status::NumericalIssue);
+    CHECK(e.message.find("equilibrium") != std::string::npos);
+    CHECK(e.guess.profile.size() == 0);
+    CHECK_THROWS_AS(orbit_guess_from_simulation(w, "alpha", mesh, Eigen::VectorXd::Constant(2, 0.5), 300.0, 0.01), std::invalid_argument);
+    CHECK_THROWS_AS(orbit_guess_from_simulation(w, "beta", mesh, Eigen::VectorXd::Constant(1, 0.5), 300.0, 0.01), std::invalid_argument);
+}

@@ -194,6 +194,30 @@ struct OrbitGuess {
 OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<double>& times, const Eigen::MatrixXd& states,
                                     double period, double par);
 
+/// A starting orbit found by simulation (orbit_guess_from_simulation).
+struct SimulatedOrbitGuess {
+    OrbitGuess guess;  ///< the last full period of the run on the mesh (empty unless converged)
+    /// Converged: the run settled on a periodic orbit; NumericalIssue: it settled on an
+    /// equilibrium, did not repeat to the tolerance, or left the finite numbers (the message says which)
+    Status status = Status::NumericalIssue;
+    std::string message;
+    double period = 0.0;           ///< mean of the last repeats
+    double period_spread = 0.0;    ///< max |repeat - mean| / mean over the last third of the run
+    int crossings_per_period = 0;  ///< upward crossings of the mean level per period (1 for a simple orbit)
+    double amplitude = 0.0;        ///< max - min of the first variable over the last third
+};
+
+/// Simulates the system at its parameter values (DdeSolver: RK4 with a Hermite continuous
+/// extension, step `step`) from the constant history `history` on [-max tau, 0] to `t_end`, and
+/// reads a periodic orbit off the last third of the run: the upward crossings t_i of the first
+/// variable through its mean level there, the smallest k (1..8) with
+///     |t_{i+k} - t_i - T| <= 1e-3 T  for every i  (T their mean),
+/// and the samples of [t_last - T, t_last] on `mesh` (orbit_guess_from_samples), par the
+/// system's value of `parameter`. std::invalid_argument for sizes that do not fit, t_end or
+/// step not > 0, or an unknown parameter; a run that does not settle is a status.
+SimulatedOrbitGuess orbit_guess_from_simulation(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
+                                                const Eigen::VectorXd& history, double t_end, double step);
+
 /// The branch from a Hopf point of an equilibrium branch (hopf.x, hopf.par, hopf.omega, hopf.q).
 /// std::invalid_argument for invalid options, an unknown parameter, a system without delay
 /// derivatives, or a Hopf point with omega <= 0 or q of the wrong size; non-convergence is a status.
