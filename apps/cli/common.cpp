@@ -76,7 +76,8 @@ void annotate_option_types(CLI::App& app, const std::string& command) {
         {"data-dir", "FOLDER"}, {"report", "FOLDER"}, {"par", "NAME"}, {"from", "NUMBER"}, {"to", "NUMBER"},
         {"samples", "INTEGER"}, {"ring-samples", "INTEGER"}, {"max-points", "INTEGER"}, {"alpha", "NUMBER"},
         {"tau", "NUMBER"}, {"v0", "NUMBER"}, {"h-st", "NUMBER"}, {"headway", "NUMBER"}, {"a", "NUMBER"}, {"b", "NUMBER"},
-        {"delta", "NUMBER"}, {"th", "NUMBER"}, {"eta", "NUMBER"}, {"gap", "NUMBER"}};
+        {"delta", "NUMBER"}, {"th", "NUMBER"}, {"eta", "NUMBER"}, {"gap", "NUMBER"}, {"k1", "NUMBER"}, {"k2", "NUMBER"}, {"a-max", "NUMBER"},
+        {"a-min", "NUMBER"}};
     for (CLI::Option* o : app.get_options()) {
         if (o->get_lnames().empty()) {  // a positional argument: a file
             if (o->get_type_name() == "TEXT") o->type_name("FILE");

@@ -19,8 +19,10 @@ namespace ddemap::cli {
 struct NonlinearProblemArgs {
     std::string system, model, ring, par, from, to;
     // empty: the model's default (ov: alpha 1, tau 1, v0 1, h_st 1, headway 2; idm: a 1, b 1.5,
-    // v0 33.3, delta 4, eta 2, gap 20; th and tau required)
-    std::string alpha, tau, v0, h_st, headway, a, b, delta, th, eta, gap;
+    // v0 33.3, delta 4, eta 2, gap 20; th and tau required; acc: a_max 2, a_min -3, the others
+    // required or from --car)
+    std::string alpha, tau, v0, h_st, headway, a, b, delta, th, eta, gap, k1, k2, a_max, a_min;
+    std::string car;  ///< --model acc: k1, k2, th, tau, eta of a calibrated car (the one car syntax)
     std::vector<CLI::Option*> model_flags;
 
     /// --system, --model, --ring, the model flags, --par, --from, --to (required).

@@ -328,6 +328,8 @@ int run_orbits() {
             start_line = sl.str();
             if (sg.status != Status::Converged) {
                 have = false;
+                b.degree = o.degree;
+                b.intervals = o.intervals;
                 b.status = sg.status;
                 b.stop = "first_orbit_failed";
                 b.message = "no orbit from the simulation: " + sg.message;
@@ -457,12 +459,31 @@ int run_orbits() {
             out << start_line;
         out << "branch     " << counted(static_cast<long long>(b.points.size()), "orbit") << ", degree " << b.degree << " on " << b.intervals << " intervals (ended: " << b.stop << ")\n";
         const std::string& v = variables[static_cast<std::size_t>(variable)];
+        // a built-in ring: orbits in which a gap (or headway) falls below 0 (a collision) or a
+        // speed below 0 (a car reversing) are solutions of the equations but not of traffic
+        std::vector<int> gaps, speeds;
+        if (!orbits_args.problem.model.empty())
+            for (std::size_t k = 0; k < variables.size(); ++k) {
+                const std::string unit = built.unit(variables[k]);
+                if (unit == "m") gaps.push_back(static_cast<int>(k));
+                if (unit == "m/s") speeds.push_back(static_cast<int>(k));
+            }
+        auto physical = [&](const PeriodicOrbit& p) {
+            bool collision = false, reversing = false;
+            for (int k : gaps) collision = collision || p.min[k] < 0.0;
+            for (int k : speeds) reversing = reversing || p.min[k] < 0.0;
+            return collision && reversing ? std::string(" (collision, reversing)") : collision ? std::string(" (collision)") : reversing ? std::string(" (reversing)") : std::string();
+        };
+        bool unphysical = false;
         auto table = [&](const OrbitBranch& br) {
             out << "  " << pad(par, 14) << pad("period", 14) << pad("amp " + v, 14) << pad("max|mu|", 12) << pad("|mu_1 - 1|", 12) << "stable\n";
-            for (const PeriodicOrbit& p : br.points)
+            for (const PeriodicOrbit& p : br.points) {
+                const std::string note = physical(p);
+                unphysical = unphysical || !note.empty();
                 out << "  " << pad(rounded(p.par, 8), 14) << pad(rounded(p.period, 8), 14) << pad(rounded(p.max[variable] - p.min[variable], 6), 14)
                     << pad(p.multipliers.empty() ? "-" : rounded(p.max_nontrivial, 4), 12) << pad(p.multipliers.empty() ? "-" : rounded(p.trivial_distance, 2), 12)
-                    << (!p.undecided.empty() ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << "\n";
+                    << (!p.undecided.empty() ? "undecided" : p.multipliers.empty() ? "not computed" : p.stable ? "yes" : "no") << note << "\n";
+            }
             for (const OrbitFold& f : br.folds)
                 out << "fold       " << par << " = " << rounded(f.par, 10) << ", period " << rounded(f.period, 8) << (f.located ? "" : " (not located)") << "\n";
             out << crossing_lines(br);
@@ -494,6 +515,9 @@ int run_orbits() {
             if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);
             out << "\n";
         }
+        if (unphysical)
+            out << "note       orbits marked (collision) have a gap below 0 somewhere, (reversing) a speed below 0: solutions of the equations, not of "
+                   "traffic (JSON: min of every variable)\n";
         if (!b.points.empty()) {
             const double trivial = std::max(b.max_trivial_distance, doubled.max_trivial_distance);
             out << "accuracy   ";

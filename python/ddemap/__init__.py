@@ -988,7 +988,7 @@ def paper(out):
 def _nonlinear_problem(system, model, ring, parameters):
     """The problem arguments of equilibria, hopf and orbits, checked as the commands check them."""
     if (system is None) == (model is None):
-        raise ValueError("expected one of system=FILE or model='ov'|'idm' (with ring=N)")
+        raise ValueError("expected one of system=FILE or model='ov'|'idm'|'acc' (with ring=N)")
     if system is not None:
         if ring is not None or parameters:
             raise ValueError("system takes the whole problem from the file: expected no ring or model parameters")
@@ -1006,7 +1006,9 @@ def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_
     with ``ring`` N: ``"ov"``, the optimal-velocity ring with reaction delay (``alpha`` [1/s],
     ``tau`` [s], ``v0`` [m/s], ``h_st`` [m], ``headway`` [m]), or ``"idm"``, the intelligent
     driver model ring with sensing delay (``a``, ``b`` [m/s^2], ``v0`` [m/s], ``delta``, ``th``
-    [s], ``eta`` [m], ``tau`` [s], ``gap`` [m]; ``th`` and ``tau`` required). The branch in the
+    [s], ``eta`` [m], ``tau`` [s], ``gap`` [m]; ``th`` and ``tau`` required), or ``"acc"``, the
+    paper's OVRV law with acceleration limits (``k1`` [1/s^2], ``k2`` [1/s], ``th`` [s], ``tau``
+    [s], ``eta`` [m], ``gap`` [m] required; ``a_max``, ``a_min`` [m/s^2], default 2 and -3). The branch in the
     parameter ``par`` starts at ``from_`` (``--from``) and is followed by pseudo-arclength
     continuation (through folds) until the parameter leaves [from_, to] or ``max_points``;
     at every point the ``count`` rightmost roots of the linearisation decide stability; folds

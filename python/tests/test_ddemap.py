@@ -345,6 +345,17 @@ def test_orbits():
         ddemap.orbits("headway", 2, 3.5, model="ov", ring=3, hopf=7, points=12)
 
 
+def test_acc_ring_hopf():
+    # the ACC ring with acceleration limits: the same envelope as the command with the same gains
+    gains = dict(k1=0.052, k2=0.338, th=0.819, tau=0.948, eta=8.03, gap=30)
+    r = ddemap.hopf("k2", 0.2, 1.2, model="acc", ring=8, **gains)
+    same_envelope(r, cli_json("hopf", "--model", "acc", "--ring", 8, "--k1", 0.052, "--k2", 0.338, "--th", 0.819, "--tau", 0.948,
+                              "--eta", 8.03, "--gap", 30, "--par", "k2", "--from", 0.2, "--to", 1.2))
+    assert len(r["hopf"]["par"]) == 2
+    with pytest.raises(ValueError, match="a_min = 1: expected a finite braking limit < 0"):
+        ddemap.hopf("k2", 0.2, 1.2, model="acc", ring=8, a_min=1, **gains)
+
+
 def test_orbits_period_doubling():
     # the branch of twice the period switched onto at the period doubling of Mackey-Glass: the
     # command's envelope, and the doubled branch starts at the doubling with twice its period

@@ -3,18 +3,20 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "ddemap/traffic/acc_ring.hpp"
 #include "ddemap/traffic/idm_ring.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
 #include "core/internal/text.hpp"
 
 namespace ddemap {
 
-std::vector<std::string> nonlinear_ring_models() { return {"ov", "idm"}; }
+std::vector<std::string> nonlinear_ring_models() { return {"ov", "idm", "acc"}; }
 
 std::vector<std::string> nonlinear_ring_parameters(const std::string& model) {
     if (model == "ov") return {"alpha", "tau", "v0", "h_st", "headway"};
     if (model == "idm") return {"a", "b", "v0", "delta", "th", "eta", "tau", "gap"};
-    throw std::invalid_argument("model " + detail::quoted(model) + ": expected ov or idm (other models: write a system file)");
+    if (model == "acc") return {"k1", "k2", "th", "tau", "eta", "a_max", "a_min", "gap"};
+    throw std::invalid_argument("model " + detail::quoted(model) + ": expected ov, idm or acc (other models: write a system file)");
 }
 
 NonlinearRing make_nonlinear_ring(const std::string& model, int cars, const ParameterMap& parameters) {
@@ -46,6 +48,14 @@ NonlinearRing make_nonlinear_ring(const std::string& model, int cars, const Para
         r.system = std::move(ov);
         state = "h";
         r.units = {{"alpha", "1/s"}, {"tau", "s"}, {"v0", "m/s"}, {"h_st", "m"}, {"headway", "m"}};
+    } else if (model == "acc") {
+        for (const char* name : {"k1", "k2", "th", "tau", "eta", "gap"}) required(name);  // named in this order, whatever the compiler's order of arguments
+        auto acc = std::make_unique<AccRing>(cars, required("k1"), required("k2"), required("th"), required("tau"), required("eta"), get("a_max", 2.0),
+                                             get("a_min", -3.0), required("gap"));
+        r.uniform_flow = acc->uniform_flow();
+        r.system = std::move(acc);
+        state = "s";
+        r.units = {{"k1", "1/s^2"}, {"k2", "1/s"}, {"th", "s"}, {"tau", "s"}, {"eta", "m"}, {"a_max", "m/s^2"}, {"a_min", "m/s^2"}, {"gap", "m"}};
     } else {
         auto idm = std::make_unique<IdmRing>(cars, get("a", 1.0), get("b", 1.5), get("v0", 33.3), get("delta", 4.0), required("th"), get("eta", 2.0),
                                              required("tau"), get("gap", 20.0));

@@ -1154,6 +1154,30 @@ expect_error "expected it in \[--from2, --to2\]" bistability --model ov --ring 3
 expect_error "--rows" bistability --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 0.5 --to2 2 --rows 2
 expect_error "--par2 is required" bistability --model ov --ring 3 --par headway --from 1.2 --to 3
 [ -z "$(ls "$fc" | grep bad)" ] && ok || bad "bistability bad input wrote files: $(ls "$fc")"
+# the paper's ACC law with acceleration limits on a ring (--model acc): A_min's gains from --car;
+# its Hopf points in k2 are where the linear OVRV ring (roots, independent code) has a root on the
+# axis, and the upper one is supercritical
+if "$bin" hopf --model acc --ring 8 --car A_min --gap 30 --par k2 --from 0.2 --to 1.2 --format json --quiet >"$tmp/acc.json"; then
+    python3 - "$tmp/acc.json" "$bin" <<'PY' && ok || bad "hopf --model acc: the Hopf points against the linear ring's roots"
+import json, sys, subprocess
+d = json.load(open(sys.argv[1]))
+assert d["inputs"]["car"] == "A_min" and d["inputs"]["model"] == "acc"
+hs = d["result"]["hopf"]
+assert len(hs) == 2 and hs[1]["l1"] < 0, hs
+for h in hs:
+    out = subprocess.run([sys.argv[2], "roots", "--model", "ovrv", "--k1", "0.052", "--k2", repr(h["par"]), "--th", "0.819", "--tau", "0.948",
+                          "--eta", "8.03", "--ring", "8", "--count", "12", "--format", "json"], capture_output=True, text=True, check=True).stdout
+    roots = json.loads(out)["result"]["roots"]
+    assert any(abs(r["re"]) < 1e-8 and abs(abs(r["im"]) - h["omega"]) < 1e-8 for r in roots), (h, roots[:4])
+PY
+else
+    bad "hopf --model acc exit status"
+fi
+expect_error "--car: only with --model acc" hopf --model ov --ring 3 --car A_min --par headway --from 1 --to 2
+expect_error "--model acc needs --gap" hopf --model acc --ring 3 --car A_min --par k2 --from 0.2 --to 1
+expect_error "a_min = 1: expected a finite braking limit < 0" hopf --model acc --ring 3 --car A_min --gap 30 --a-min 1 --par k2 --from 0.2 --to 1
+expect_error "--alpha is not a parameter of --model acc" hopf --model acc --ring 3 --car A_min --gap 30 --alpha 1 --par k2 --from 0.2 --to 1
+
 fi  # part hopf
 
 if part orbits; then

@@ -149,6 +149,6 @@ TEST_CASE("nonlinear rings by name: defaults, required parameters and refusals")
     CHECK(ov.system->parameter("headway") == 1.7);
     CHECK_THROWS_WITH_AS(make_nonlinear_ring("idm", 4, {{"th", 1.2}}), doctest::Contains("the idm ring needs tau"), std::invalid_argument);
     CHECK_THROWS_WITH_AS(make_nonlinear_ring("ov", 4, {{"th", 1.2}}), doctest::Contains("th is not a parameter of the ov ring"), std::invalid_argument);
-    CHECK_THROWS_WITH_AS(make_nonlinear_ring("ccc", 4, {}), doctest::Contains("expected ov or idm"), std::invalid_argument);
+    CHECK_THROWS_WITH_AS(make_nonlinear_ring("ccc", 4, {}), doctest::Contains("expected ov, idm or acc"), std::invalid_argument);
     CHECK_THROWS_AS(make_nonlinear_ring("ov", 1, {}), std::invalid_argument);
 }

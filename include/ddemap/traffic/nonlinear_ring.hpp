@@ -1,8 +1,10 @@
 #pragma once
 /// \file nonlinear_ring.hpp
 /// The built-in nonlinear car-following rings by name, the one place where the command line and
-/// the Python module make them: "ov" (OvRing: alpha, tau, v0, h_st, headway) and "idm" (IdmRing:
-/// a, b, v0, delta, th, eta, tau, gap), with the names of their states and the units.
+/// the Python module make them: "ov" (OvRing: alpha, tau, v0, h_st, headway), "idm" (IdmRing:
+/// a, b, v0, delta, th, eta, tau, gap) and "acc" (AccRing, the seed paper's OVRV law with
+/// acceleration limits: k1, k2, th, tau, eta, a_max, a_min, gap), with the names of their states
+/// and the units.
 
 #include <map>
 #include <memory>
@@ -23,7 +25,7 @@ struct NonlinearRing {
     Eigen::VectorXd uniform_flow;                 ///< the equilibrium at the parameters given
 };
 
-/// The ring names make_nonlinear_ring knows: {"ov", "idm"}.
+/// The ring names make_nonlinear_ring knows: {"ov", "idm", "acc"}.
 std::vector<std::string> nonlinear_ring_models();
 /// The parameter names of a ring model, in the order of its system (std::invalid_argument for
 /// an unknown model).
@@ -31,7 +33,8 @@ std::vector<std::string> nonlinear_ring_parameters(const std::string& model);
 
 /// The ring `model` of `cars` cars (2..2000) with the named parameters; a parameter not given
 /// takes its default (ov: alpha 1, tau 1, v0 1, h_st 1, headway 2; idm: a 1, b 1.5, v0 33.3,
-/// delta 4, eta 2, gap 20; idm's th and tau are required). std::invalid_argument naming the
+/// delta 4, eta 2, gap 20; idm's th and tau are required; acc: a_max 2, a_min -3, the others
+/// required). std::invalid_argument naming the
 /// value for an unknown model, a parameter the model does not have, a missing required one, or
 /// values without a uniform flow (idm: gap <= eta).
 NonlinearRing make_nonlinear_ring(const std::string& model, int cars, const ParameterMap& parameters);
