@@ -98,8 +98,9 @@ void add_orbits_flags(CLI::App& app) {
     app.add_option("--variable", orbits_args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
     app.add_option("--svg", orbits_args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
     app.add_option("--par2", orbits_args.par2,
-                   "a second parameter: continue every fold of the branch as a curve of folds of periodic orbits in (--par, --par2), "
-                   "in the box [--from, --to] x [--from2, --to2] (a curve also ends where it meets the Hopf curve, at a generalised Hopf point)")
+                   "a second parameter: continue every fold of the branch as a curve of folds of periodic orbits, and every period doubling as a "
+                   "curve of period doublings, in (--par, --par2), in the box [--from, --to] x [--from2, --to2] (a fold curve also ends where it "
+                   "meets the Hopf curve, at a generalised Hopf point)")
         ->type_name("NAME");
     app.add_option("--period-doubling", orbits_args.period_doubling,
                    "switch at period doubling K of the branch (from 0, in the order met) onto the branch of orbits of twice the period, "
@@ -120,7 +121,7 @@ void add_orbits_flags(CLI::App& app) {
     app.add_option("--from2", orbits_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
     app.add_option("--to2", orbits_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     orbits_args.format.add_to(app);
-    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json; with --par2 also PREFIX-folds.csv (one row per fold curve point)", false);
+    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json; with --par2 also PREFIX-folds.csv and PREFIX-doublings.csv (one row per point of the curves of folds and of period doublings)", false);
     run_flags().add_to(app, false);
 
     app.add_option("--wave", orbits_args.wave,
@@ -168,8 +169,8 @@ int run_orbits() {
     const int doubling_index =
         doubling ? static_cast<int>(parse_integer("--period-doubling", orbits_args.period_doubling, 0, 1000000, "an integer >= 0")) : -1;
     const std::string prefix = !orbits_args.out.given() ? std::string()
-                               : two && doubling        ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv", "-doubled.csv"})
-                               : two                    ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv"})
+                               : two && doubling        ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv", "-doublings.csv", "-doubled.csv"})
+                               : two                    ? orbits_args.out.prepare("orbits", {".csv", ".json", "-folds.csv", "-doublings.csv"})
                                : doubling               ? orbits_args.out.prepare("orbits", {".csv", ".json", "-doubled.csv"})
                                                         : orbits_args.out.prepare("orbits", {".csv", ".json"});
     const std::string svg_file = orbits_args.svg.empty() ? std::string() : output_file("--svg", orbits_args.svg);
@@ -378,8 +379,18 @@ int run_orbits() {
     }
 
     // the curves of folds in (par, par2): one per fold of the branch that lies on none already traced
-    std::vector<OrbitFoldCurve> curves;
-    std::vector<int> curve_fold;  // the index of the fold each curve starts from
+    std::vector<OrbitFoldCurve> curves, pd_curves;
+    std::vector<int> curve_fold, curve_pd;  // the index of the fold (period doubling) each curve starts from
+    // on a curve already traced: a segment of it crosses par2 = held at p
+    auto on_curve = [&](const std::vector<OrbitFoldCurve>& traced, double held, double p) {
+        for (const OrbitFoldCurve& c : traced)
+            for (std::size_t i = 0; i + 1 < c.points.size(); ++i) {
+                const OrbitFoldCurvePoint &a = c.points[i], &z = c.points[i + 1];
+                if ((a.par2 - held) * (z.par2 - held) > 0.0 || a.par2 == z.par2) continue;
+                if (std::abs(a.par + (z.par - a.par) * (held - a.par2) / (z.par2 - a.par2) - p) <= 1e-6 * std::abs(o.to - o.from)) return true;
+            }
+        return false;
+    };
     if (two) {
         inputs.string("par2", fo.parameter2).number("from2", fo.from2).number("to2", fo.to2);
         fo.orbit = o;
@@ -387,16 +398,7 @@ int run_orbits() {
         for (std::size_t k = 0; k < b.folds.size(); ++k) {
             const OrbitFold& f = b.folds[k];
             if (!f.located) continue;
-            // on a curve already traced: a segment of it crosses par2 = held at this fold's par
-            bool known = false;
-            for (const OrbitFoldCurve& c : curves)
-                for (std::size_t i = 0; i + 1 < c.points.size() && !known; ++i) {
-                    const OrbitFoldCurvePoint &a = c.points[i], &z = c.points[i + 1];
-                    if ((a.par2 - held) * (z.par2 - held) > 0.0 || a.par2 == z.par2) continue;
-                    const double p = a.par + (z.par - a.par) * (held - a.par2) / (z.par2 - a.par2);
-                    known = std::abs(p - f.par) <= 1e-6 * std::abs(o.to - o.from);
-                }
-            if (known) continue;
+            if (on_curve(curves, held, f.par)) continue;
             fo.orbit.progress = branch_progress_printer("orbits", "fold curve points", par, false);
             curves.push_back(orbit_fold_curve(*built.system, f, fo));
             fo.orbit.progress = nullptr;
@@ -405,6 +407,20 @@ int run_orbits() {
             if (c.status != Status::Converged && b.status == Status::Converged) {
                 b.status = c.status;
                 b.message = "the fold curve from the fold at " + par + " = " + rounded(f.par, 10) + ": " + c.message;
+            }
+        }
+        // and one curve of period doublings per located period doubling of the branch
+        for (std::size_t k = 0; k < b.period_doublings.size(); ++k) {
+            const OrbitCrossing& d = b.period_doublings[k];
+            if (!d.located || on_curve(pd_curves, held, d.par)) continue;
+            fo.orbit.progress = branch_progress_printer("orbits", "period doubling curve points", par, false);
+            pd_curves.push_back(orbit_period_doubling_curve(*built.system, d, fo));
+            fo.orbit.progress = nullptr;
+            curve_pd.push_back(static_cast<int>(k));
+            const OrbitFoldCurve& c = pd_curves.back();
+            if (c.status != Status::Converged && b.status == Status::Converged) {
+                b.status = c.status;
+                b.message = "the period doubling curve from the doubling at " + par + " = " + rounded(d.par, 10) + ": " + c.message;
             }
         }
     }
@@ -422,7 +438,9 @@ int run_orbits() {
     } else {
         result = "{\"start\":" + start.str() + "," + result.substr(1);
     }
-    if (two) result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) + "}";
+    if (two)
+        result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) +
+                 ",\"period_doubling_curves\":" + orbit_fold_curves_json(pd_curves, variables) + "}";
     if (doubling) {
         const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(doubling_index)];
         JsonObject from;
@@ -437,6 +455,7 @@ int run_orbits() {
         files.push_back({prefix + ".csv", csv});
         files.push_back({prefix + ".json", envelope_json(e)});
         if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables, built.units)});
+        if (two) files.push_back({prefix + "-doublings.csv", orbit_fold_curves_csv(pd_curves, variables, built.units)});
         if (doubling) files.push_back({prefix + "-doubled.csv", orbit_branch_csv(doubled, variables, built.units)});
     }
     if (!svg_file.empty()) {
@@ -511,6 +530,21 @@ int run_orbits() {
                 if (stop == "hopf")
                     out << "  ends at a generalised Hopf point (the orbits shrink onto the Hopf curve) near " << par << " = " << rounded(end->par, 6) << ", "
                         << c.parameter2 << " = " << rounded(end->par2, 6) << " (amplitude " << rounded(end->orbit.max[variable] - end->orbit.min[variable], 3) << ")\n";
+            out << "  accuracy max |g| = " << rounded(c.max_test, 2) << ", max residual = " << rounded(c.max_residual, 2);
+            if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);
+            out << "\n";
+        }
+        for (std::size_t k = 0; k < pd_curves.size(); ++k) {
+            const OrbitFoldCurve& c = pd_curves[k];
+            const OrbitCrossing& d = b.period_doublings[static_cast<std::size_t>(curve_pd[k])];
+            out << "doubling curve " << k << " from the period doubling at " << par << " = " << rounded(d.par, 10) << ": "
+                << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << c.parameter2 << "), ended: " << c.stop_backward
+                << " and " << c.stop_forward << "\n";
+            out << "  " << pad(par, 14) << pad(c.parameter2, 14) << pad("period", 14) << pad("amp " + v, 12) << pad("|g|", 10) << "min|mu + 1|\n";
+            for (const OrbitFoldCurvePoint& q : c.points)
+                out << "  " << pad(rounded(q.par, 8), 14) << pad(rounded(q.par2, 8), 14) << pad(rounded(q.orbit.period, 8), 14)
+                    << pad(rounded(q.orbit.max[variable] - q.orbit.min[variable], 5), 12) << pad(rounded(q.test, 2), 10)
+                    << (std::isfinite(q.second_distance) ? rounded(q.second_distance, 2) : std::string("-")) << "\n";
             out << "  accuracy max |g| = " << rounded(c.max_test, 2) << ", max residual = " << rounded(c.max_residual, 2);
             if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);
             out << "\n";

@@ -1261,6 +1261,27 @@ expect_error "--period-doubling = '0': the branch has no period doubling in alph
 expect_error "--period-doubling = '-1': expected an integer >= 0" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling -1
 expect_error "--period-doubling: not with --wave" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --period-doubling 0 --wave 1
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits --period-doubling bad input wrote files: $(ls "$orb")"
+# curves of period doublings in two parameters (orbits --par2): Mackey-Glass in (tau, n); the curve
+# passes through the branch's doubling, ends on both faces of n, and every point has a multiplier -1
+mg="$(dirname "$0")/../../examples/mackey_glass.json"
+if "$bin" orbits --system "$mg" --par tau --from 0.3 --to 2 --points 200 --par2 n --from2 9 --to2 10.5 --format json --out "$orb/pdc" --quiet >"$orb/pdc.json"; then
+    python3 - "$orb/pdc.json" "$orb/pdc-doublings.csv" <<'PY' && ok || bad "orbits --par2: the curve of period doublings"
+import json, sys, csv
+d = json.load(open(sys.argv[1]))
+r = d["result"]
+assert d["status"] == "converged" and len(r["period_doubling_curves"]) == 1
+c = r["period_doubling_curves"][0]
+pd = r["period_doublings"][0]
+assert abs(c["points"][c["start"]]["par"] - pd["par"]) < 1e-9 and c["points"][c["start"]]["par2"] == 9.65  # corrected again on the curve: 1.8e-13 apart
+assert c["stop_backward"] == c["stop_forward"] == "bound"
+assert {c["points"][0]["par2"], c["points"][-1]["par2"]} == {9, 10.5}
+assert all(q["second_distance"] < 1e-8 and q["fold_test"] < 1e-10 for q in c["points"])
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert len(rows) == len(c["points"]) and float(rows[0]["tau"]) == c["points"][0]["par"], rows[0]
+PY
+else
+    bad "orbits --par2 (period doublings) exit status"
+fi
 # starts other than a Hopf point: the orbit a simulation settles on (--from-simulation), or one
 # given in a file (--guess), at --par = --from. Wright's equation: each is corrected to the orbit
 # that the branch from the Hopf point reaches on its face (alpha = 2 from a simulation, alpha = 1.7

@@ -1401,6 +1401,37 @@ bool fold_test(const SpD& J, const Eigen::VectorXd& b, const Eigen::VectorXd& c,
     return true;
 }
 
+/// The period-doubling test. `fd` is the problem on the mesh traversed twice (2 L intervals, the
+/// unknowns (X, X, 2T, p1, p2) of the orbit traversed twice, z2 below). A -1 multiplier of the
+/// orbit is a 1 of the doubled orbit with an antiperiodic eigenfunction (v, -v); the Jacobian A2
+/// of the doubled collocation equations in its profile maps (v, -v) to (A_pd v, -A_pd v), with
+///     A_pd = A2[first half rows, first half columns] - A2[first half rows, second half columns],
+/// the collocated variational operator with the antiperiodic wrap y(s + 1) = -y(s). The bordered
+/// [A_pd b; c^T 0] [v; g] = [0; 1] gives g (0 exactly at a multiplier -1). Its gradient
+/// g_z = -w^T A_pd,z v is half the gradient of (w, -w)^T A2 (v, -v) summed over the two copies
+/// of X (and twice the 2T component), and that one is the central difference of A2's transpose
+/// times (w, -w) along (v, -v), a direction in which the doubled orbit stays 2T-periodic.
+Eigen::VectorXd doubled_point(const Eigen::VectorXd& z, int N) {
+    Eigen::VectorXd z2(2 * N + 3);
+    z2.head(N) = z.head(N);
+    z2.segment(N, N) = z.head(N);
+    z2(2 * N) = 2.0 * z(N);
+    z2(2 * N + 1) = z(N + 1);
+    z2(2 * N + 2) = z(N + 2);
+    return z2;
+}
+
+/// A_pd (N x N) from the doubled Jacobian J2 ((2N + 1) x (2N + 3)).
+SpD antiperiodic_block(const SpD& J2, int N) {
+    std::vector<Triplet> t;
+    for (int k = 0; k < 2 * N; ++k)
+        for (SpD::InnerIterator it(J2, k); it; ++it)
+            if (it.row() < N) t.emplace_back(static_cast<int>(it.row()), k < N ? k : k - N, k < N ? it.value() : -it.value());
+    SpD A(N, N);
+    A.setFromTriplets(t.begin(), t.end());
+    return A;
+}
+
 struct FoldCorrection {
     bool ok = false;
     int iterations = 0;
@@ -1412,8 +1443,10 @@ struct FoldCorrection {
 
 /// Newton on [F; g; a . z - beta] = 0 in z = (X, T, p1, p2), a sparse LU of the extended
 /// Jacobian every step; g's row by the central difference of the header.
+/// With `doubled` (the problem on the mesh traversed twice, see antiperiodic_block) the condition
+/// is the period doubling's instead of the fold's.
 FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::MatrixXd& ref, const Eigen::VectorXd& b, const Eigen::VectorXd& c,
-                            const Eigen::VectorXd& a, double beta, const PeriodicOrbitOptions& o) {
+                            const Eigen::VectorXd& a, double beta, const PeriodicOrbitOptions& o, FoldSystem* doubled = nullptr) {
     const int N = fs.N;
     FoldCorrection r;
     Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
@@ -1421,10 +1454,17 @@ FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::Mat
     double last_step = std::numeric_limits<double>::infinity();
     Eigen::VectorXd F, Fp, Fm;
     SpD J, Jp, Jm;
+    const Eigen::MatrixXd ref2 = doubled ? Eigen::MatrixXd::Zero(doubled->c1.P, doubled->c1.n) : Eigen::MatrixXd();  // (its phase row is not used)
     for (int it = 0; it <= o.max_iterations; ++it) {
         if (!fold_assemble(fs, z, ref, F, &J)) return r;
         FoldTest ft;
-        if (!fold_test(J, b, c, ft)) return r;
+        SpD J2;
+        if (doubled) {
+            Eigen::VectorXd F2;
+            if (!fold_assemble(*doubled, doubled_point(z, N), ref2, F2, &J2) || !fold_test(antiperiodic_block(J2, N), b, c, ft)) return r;
+        } else if (!fold_test(J, b, c, ft)) {
+            return r;
+        }
         r.residual = F.lpNorm<Eigen::Infinity>();
         r.test = std::abs(ft.g);
         r.fold = ft;
@@ -1441,11 +1481,28 @@ FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::Mat
         const double vmax = ft.v.lpNorm<Eigen::Infinity>();
         if (!(vmax > 0.0)) return r;
         const double eps = 1e-5 * std::max(1.0, z.head(N + 1).lpNorm<Eigen::Infinity>()) / vmax;
-        Eigen::VectorXd zp = z, zm = z;
-        zp.head(N + 1) += eps * ft.v;
-        zm.head(N + 1) -= eps * ft.v;
-        if (!fold_assemble(fs, zp, ref, Fp, &Jp) || !fold_assemble(fs, zm, ref, Fm, &Jm)) return r;
-        const Eigen::VectorXd grad = -((Jp.transpose() * ft.w) - (Jm.transpose() * ft.w)) / (2.0 * eps);
+        Eigen::VectorXd grad;
+        if (doubled) {
+            Eigen::VectorXd z2 = doubled_point(z, N), v2 = Eigen::VectorXd::Zero(2 * N + 3), w2 = Eigen::VectorXd::Zero(2 * N + 1);
+            v2.head(N) = ft.v;
+            v2.segment(N, N) = -ft.v;
+            w2.head(N) = ft.w;
+            w2.segment(N, N) = -ft.w;
+            const Eigen::VectorXd zp = z2 + eps * v2, zm = z2 - eps * v2;
+            if (!fold_assemble(*doubled, zp, ref2, Fp, &Jp) || !fold_assemble(*doubled, zm, ref2, Fm, &Jm)) return r;
+            const Eigen::VectorXd d = ((Jp.transpose() * w2) - (Jm.transpose() * w2)) / (2.0 * eps);
+            grad.resize(N + 3);
+            grad.head(N) = -0.5 * (d.head(N) + d.segment(N, N));
+            grad(N) = -0.5 * 2.0 * d(2 * N);
+            grad(N + 1) = -0.5 * d(2 * N + 1);
+            grad(N + 2) = -0.5 * d(2 * N + 2);
+        } else {
+            Eigen::VectorXd zp = z, zm = z;
+            zp.head(N + 1) += eps * ft.v;
+            zm.head(N + 1) -= eps * ft.v;
+            if (!fold_assemble(fs, zp, ref, Fp, &Jp) || !fold_assemble(fs, zm, ref, Fm, &Jm)) return r;
+            grad = -((Jp.transpose() * ft.w) - (Jm.transpose() * ft.w)) / (2.0 * eps);
+        }
         std::vector<Triplet> t;
         t.reserve(static_cast<std::size_t>(J.nonZeros()) + 2 * static_cast<std::size_t>(N + 3));
         for (int k = 0; k < J.outerSize(); ++k)
@@ -1485,21 +1542,28 @@ bool OrbitFoldCurveOptions::is_valid(std::string* why) const {
     return w == nullptr;
 }
 
-OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fold, const OrbitFoldCurveOptions& options) {
+namespace {
+
+/// The curve of folds (doubling false) or of period doublings (true) through the orbit `orbit`
+/// at p1 = par (orbit_fold_curve, orbit_period_doubling_curve).
+OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const PeriodicOrbit& orbit, double par, bool doubling,
+                                       const OrbitFoldCurveOptions& options) {
     const SingleThreadedEigen single;
+    const std::string what = doubling ? "period doubling curve" : "fold curve";
+    const std::string kind = doubling ? "period doubling" : "fold";
     std::string why;
-    if (!options.is_valid(&why)) throw std::invalid_argument("fold curve options: " + why);
+    if (!options.is_valid(&why)) throw std::invalid_argument(what + " options: " + why);
     const PeriodicOrbitOptions& o = options.orbit;
     const PeriodicMesh mesh(o.degree, o.intervals);
-    if (fold.orbit.profile.rows() != mesh.points() || fold.orbit.profile.cols() != system.dimension())
-        throw std::invalid_argument("fold curve: the fold's orbit must lie on the uniform mesh of the options' degree and intervals");
-    if (!(fold.orbit.period > 0.0)) throw std::invalid_argument("fold curve: expected a fold with a period > 0");
-    const Setup s1 = make_setup(system, mesh, o, fold.orbit.period);
+    if (orbit.profile.rows() != mesh.points() || orbit.profile.cols() != system.dimension())
+        throw std::invalid_argument(what + ": the " + kind + "'s orbit must lie on the uniform mesh of the options' degree and intervals");
+    if (!(orbit.period > 0.0)) throw std::invalid_argument(what + ": expected a " + kind + " with a period > 0");
+    const Setup s1 = make_setup(system, mesh, o, orbit.period);
     PeriodicOrbitOptions o2 = o;
     o2.parameter = options.parameter2;
     o2.from = options.from2;
     o2.to = options.to2;
-    const Setup s2 = make_setup(system, mesh, o2, fold.orbit.period);
+    const Setup s2 = make_setup(system, mesh, o2, orbit.period);
     FoldSystem fs(s1, s2);
     const int N = s1.N();
     fs.N = N;
@@ -1510,25 +1574,38 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
     const double lo2 = std::min(options.from2, options.to2), hi2 = std::max(options.from2, options.to2);
     const double p20 = system.parameter_values()[static_cast<std::size_t>(s2.j)];
     if (!(p20 >= lo2 && p20 <= hi2))
-        throw std::invalid_argument("fold curve: " + options.parameter2 + " = " + detail::format_number(p20) + " lies outside its range [" +
+        throw std::invalid_argument(what + ": " + options.parameter2 + " = " + detail::format_number(p20) + " lies outside its range [" +
                                     detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
+    // the period doubling's condition lives on the mesh traversed twice (antiperiodic_block)
+    const PeriodicMesh mesh2(o.degree, 2 * o.intervals);
+    std::unique_ptr<FoldSystem> fd;
+    if (doubling) {
+        fd = std::make_unique<FoldSystem>(make_setup(system, mesh2, o, 2.0 * orbit.period), make_setup(system, mesh2, o2, 2.0 * orbit.period));
+        fd->N = 2 * N;
+        fd->w = Eigen::VectorXd::Ones(2 * N + 3);
+    }
+    const Eigen::MatrixXd ref2 = doubling ? Eigen::MatrixXd::Zero(mesh2.points(), system.dimension()) : Eigen::MatrixXd();
 
     OrbitFoldCurve curve;
     curve.parameter = o.parameter;
     curve.parameter2 = options.parameter2;
     curve.degree = o.degree;
     curve.intervals = o.intervals;
-    curve.method = "the minimally augmented fold system (the fold test g of the bordered Jacobian of the collocation and phase "
-                   "conditions appended) on " + method_text(mesh) + "; both parameters free, pseudo-arclength; sparse LU of the extended Jacobian";
+    curve.method = doubling ? "the minimally augmented period doubling system (the test g of the bordered collocated variational operator "
+                              "with the antiperiodic wrap appended) on " + method_text(mesh) + "; both parameters free, pseudo-arclength; "
+                              "sparse LU of the extended Jacobian"
+                            : "the minimally augmented fold system (the fold test g of the bordered Jacobian of the collocation and phase "
+                              "conditions appended) on " + method_text(mesh) + "; both parameters free, pseudo-arclength; sparse LU of the extended Jacobian";
 
     Eigen::VectorXd z(N + 3);
-    for (int i = 0; i < s1.P; ++i) z.segment(static_cast<Eigen::Index>(i) * s1.n, s1.n) = fold.orbit.profile.row(i).transpose();
-    z(N) = fold.orbit.period;
-    z(N + 1) = fold.par;
+    for (int i = 0; i < s1.P; ++i) z.segment(static_cast<Eigen::Index>(i) * s1.n, s1.n) = orbit.profile.row(i).transpose();
+    z(N) = orbit.period;
+    z(N + 1) = par;
     z(N + 2) = p20;
     // the bordering vectors: from fixed pseudo-random ones, two rounds of the bordered solves
-    Eigen::VectorXd bv(N + 1), cv(N + 1);
-    for (int i = 0; i <= N; ++i) {
+    const int M = doubling ? N : N + 1;  // the size of the test's matrix
+    Eigen::VectorXd bv(M), cv(M);
+    for (int i = 0; i < M; ++i) {
         bv(i) = std::sin(1.0 + 0.7 * i);
         cv(i) = std::cos(0.3 + 1.3 * i);
     }
@@ -1543,15 +1620,24 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
         Eigen::VectorXd F;
         SpD J;
         FoldTest ft;
-        if (!fold_assemble(fs, z, ref, F, &J) || !fold_test(J, bv, cv, ft)) return failed("the fold's orbit gives no finite Jacobian");
+        bool ok = fold_assemble(fs, z, ref, F, &J);
+        if (ok && doubling) {
+            SpD J2;
+            Eigen::VectorXd F2;
+            ok = fold_assemble(*fd, doubled_point(z, N), ref2, F2, &J2) && fold_test(antiperiodic_block(J2, N), bv, cv, ft);
+        } else if (ok) {
+            ok = fold_test(J, bv, cv, ft);
+        }
+        if (!ok) return failed("the " + kind + "'s orbit gives no finite Jacobian");
         cv = ft.v / ft.v.norm();
         bv = ft.w / ft.w.norm();
     }
     Eigen::VectorXd e2 = Eigen::VectorXd::Zero(N + 3);
     e2(N + 2) = 1.0;
-    FoldCorrection r0 = correct_fold(fs, z, ref, bv, cv, e2, p20, o);
+    FoldCorrection r0 = correct_fold(fs, z, ref, bv, cv, e2, p20, o, fd.get());
     curve.newton_iterations += r0.iterations;
-    if (!r0.ok) return failed("the fold did not converge as a point of the fold system at " + options.parameter2 + " = " + detail::format_number(p20));
+    if (!r0.ok)
+        return failed("the " + kind + " did not converge as a point of the " + kind + " system at " + options.parameter2 + " = " + detail::format_number(p20));
     Eigen::VectorXd t0 = r0.tangent / fs.norm(r0.tangent);
 
     auto make_point = [&](const Eigen::VectorXd& zz, const FoldCorrection& r) {
@@ -1564,7 +1650,10 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
         q.par = zz(N + 1);
         q.par2 = zz(N + 2);
         q.test = r.test;
-        if (q.orbit.multipliers.size() >= 2) {
+        if (doubling && !q.orbit.multipliers.empty()) {
+            q.second_distance = std::numeric_limits<double>::infinity();
+            for (cplx m : q.orbit.multipliers) q.second_distance = std::min(q.second_distance, std::abs(m + 1.0));
+        } else if (q.orbit.multipliers.size() >= 2) {
             std::vector<double> dist;
             for (cplx m : q.orbit.multipliers) dist.push_back(std::abs(m - 1.0));
             std::sort(dist.begin(), dist.end());
@@ -1590,7 +1679,7 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
             const Eigen::MatrixXd rf = derivative_at_collocation(fs.c1, fs.orbit_part(u));
             Eigen::VectorXd v = u + h * t;
             const Eigen::VectorXd a = fs.w.cwiseProduct(t);
-            FoldCorrection r = correct_fold(fs, v, rf, b, c, a, a.dot(u + h * t), o);
+            FoldCorrection r = correct_fold(fs, v, rf, b, c, a, a.dot(u + h * t), o, fd.get());
             curve.newton_iterations += r.iterations;
             const bool jump = r.ok && step.jumped(fs.norm(v - u));
             if (!r.ok || jump) {
@@ -1598,7 +1687,7 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
                     stop = "step_below_minimum";
                     if (curve.status == Status::Converged) {
                         curve.status = jump ? Status::NumericalIssue : Status::MaxIterations;
-                        curve.message = "the fold curve's corrector failed at (" + o.parameter + ", " + options.parameter2 + ") = (" +
+                        curve.message = "the " + what + "'s corrector failed at (" + o.parameter + ", " + options.parameter2 + ") = (" +
                                         detail::format_number(u(N + 1)) + ", " + detail::format_number(u(N + 2)) + ") with the step below " +
                                         detail::format_number(o.min_step);
                     }
@@ -1621,12 +1710,12 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
                     bound = p2 < lo2 ? lo2 : hi2;
                 }
                 Eigen::VectorXd wz = v;
-                const FoldCorrection rb = correct_fold(fs, wz, rf, b, c, e, bound, o);
+                const FoldCorrection rb = correct_fold(fs, wz, rf, b, c, e, bound, o, fd.get());
                 curve.newton_iterations += rb.iterations;
                 if (rb.ok) out.push_back(make_point(wz, rb));
                 else if (curve.status == Status::Converged) {
                     curve.status = Status::MaxIterations;
-                    curve.message = "the fold curve's point on the face of the box did not converge";
+                    curve.message = "the " + what + "'s point on the face of the box did not converge";
                 }
                 stop = "bound";
                 return out;
@@ -1676,8 +1765,21 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
         if (std::isfinite(q.orbit.trivial_distance)) curve.max_trivial_distance = std::max(curve.max_trivial_distance, q.orbit.trivial_distance);
     }
     if (curve.message.empty())
-        curve.message = std::to_string(curve.points.size()) + " folds of orbits, ended: " + curve.stop_backward + " and " + curve.stop_forward;
+        curve.message = std::to_string(curve.points.size()) + (doubling ? " period doublings" : " folds of orbits") + ", ended: " + curve.stop_backward +
+                        " and " + curve.stop_forward;
     return curve;
+}
+
+}  // namespace
+
+OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fold, const OrbitFoldCurveOptions& options) {
+    return orbit_bifurcation_curve(system, fold.orbit, fold.par, false, options);
+}
+
+OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const OrbitCrossing& pd, const OrbitFoldCurveOptions& options) {
+    if (!pd.located || pd.orbit.profile.size() == 0)
+        throw std::invalid_argument("period doubling curve: expected a located period doubling with its orbit");
+    return orbit_bifurcation_curve(system, pd.orbit, pd.par, true, options);
 }
 
 }  // namespace ddemap

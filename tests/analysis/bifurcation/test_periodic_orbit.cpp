@@ -509,3 +509,38 @@ TEST_CASE("orbit_guess_from_simulation: the period read off a run is the colloca
     CHECK_THROWS_AS(orbit_guess_from_simulation(w, "alpha", mesh, Eigen::VectorXd::Constant(2, 0.5), 300.0, 0.01), std::invalid_argument);
     CHECK_THROWS_AS(orbit_guess_from_simulation(w, "beta", mesh, Eigen::VectorXd::Constant(1, 0.5), 300.0, 0.01), std::invalid_argument);
 }
+
+TEST_CASE("Mackey-Glass: the curve of period doublings in (tau, n) ends on the faces n = 9 and 10.5 where the one-parameter branches there double" * doctest::test_suite("slow")) {
+    ExpressionSystem mg = mackey_glass();
+    const OrbitBranch b = mackey_glass_branch(mg);
+    REQUIRE(!b.period_doublings.empty());
+    OrbitFoldCurveOptions fo;
+    fo.orbit = options("tau", 0.3, 2.0, 40);
+    fo.parameter2 = "n";
+    fo.from2 = 9.0;
+    fo.to2 = 10.5;
+    const OrbitFoldCurve c = orbit_period_doubling_curve(mg, b.period_doublings.front(), fo);
+    REQUIRE(c.status == Status::Converged);
+    CHECK(c.stop_backward == "bound");
+    CHECK(c.stop_forward == "bound");
+    // every point: the test function and, independently, a Floquet multiplier at -1
+    for (const OrbitFoldCurvePoint& q : c.points) {
+        CHECK(q.test < 1e-10);
+        CHECK(q.second_distance < 1e-8);
+    }
+    // a second path: the first period doubling of the branch in tau alone at n = 9 and at n = 10.5
+    for (const OrbitFoldCurvePoint* end : {&c.points.front(), &c.points.back()}) {
+        CAPTURE(end->par2);
+        REQUIRE((end->par2 == 9.0 || end->par2 == 10.5));
+        ExpressionSystem at = mackey_glass();
+        at.set_parameter("n", end->par2);
+        const OrbitBranch bn = mackey_glass_branch(at);
+        REQUIRE(!bn.period_doublings.empty());
+        REQUIRE(bn.period_doublings.front().located);
+        CHECK(std::abs(bn.period_doublings.front().par - end->par) < 1e-8);
+        CHECK(std::abs(bn.period_doublings.front().period - end->orbit.period) < 1e-7);
+    }
+    // a period doubling that was not located is refused
+    OrbitCrossing none;
+    CHECK_THROWS_AS(orbit_period_doubling_curve(mg, none, fo), std::invalid_argument);
+}

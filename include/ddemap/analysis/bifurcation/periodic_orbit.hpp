@@ -321,6 +321,22 @@ struct OrbitFoldCurve {
 /// a fold whose profile does not fit the mesh; non-convergence is a status.
 OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fold, const OrbitFoldCurveOptions& options);
 
+/// The curve of period doublings through the located period doubling `pd` of a branch (its
+/// orbit on the uniform mesh of the options, as for orbit_fold_curve), in (parameter,
+/// parameter2): the same continuation with the period-doubling condition appended instead of the
+/// fold's. A multiplier -1 of the orbit is a multiplier 1 of the orbit traversed twice with an
+/// antiperiodic eigenfunction; with A_pd the collocated variational operator with the
+/// antiperiodic wrap y(s + 1) = -y(s) (N x N: the Jacobian A2 of the collocation on the mesh
+/// traversed twice, first-half rows, its first-half columns minus its second-half columns),
+///     [A_pd b; c^T 0] [v; g] = [0; 1]
+/// defines g, zero exactly where -1 is a multiplier; g_z = -w^T A_pd,z v is half the central
+/// difference of A2^T (w, -w) along (v, -v) (a direction in which the doubled orbit stays
+/// 2T-periodic, so that the symmetry of second derivatives applies), summed over the two copies of
+/// the profile. In the points, `test` is |g| and `second_distance` the independent check
+/// min |mu + 1| over the orbit's Floquet multipliers. std::invalid_argument as orbit_fold_curve,
+/// and for a period doubling that is not located.
+OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const OrbitCrossing& pd, const OrbitFoldCurveOptions& options);
+
 /// x(s) of an orbit on `mesh` at s (any real: taken mod 1), all n components (for an orbit of a
 /// branch: PeriodicMesh(branch.degree, orbit.breakpoints)).
 Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s);
