@@ -267,10 +267,7 @@ int run_orbits() {
                 throw BadInput("--history = '" + orbits_args.history + "': expected " + std::to_string(n) + " values (one per variable), found " + std::to_string(v.size()));
             sim_history = Eigen::Map<const Eigen::VectorXd>(v.data(), n);
         }
-        // the step: 0.01, or a tenth of the shortest positive delay when that is shorter
-        sim_step = 0.01;
-        for (double t : built.system->delays())
-            if (t > 0.0) sim_step = std::min(sim_step, 0.1 * t);
+        sim_step = default_simulation_step(*built.system);
         const std::vector<double> tau = built.system->delays();
         // measured about 1.5e-6 s per step and variable-delay pair (ov rings, Mackey-Glass)
         const double work = (sim_end / sim_step) * n * (static_cast<double>(tau.size()) + 1.0);
@@ -278,7 +275,11 @@ int run_orbits() {
         check_size("orbits", "a simulation of " + rounded(sim_end / sim_step, 3) + " steps of " + std::to_string(n) + " variables", "memory",
                    8.0 * 3.0 * n * (sim_end / sim_step));
         inputs.number("t_end", sim_end);
-        if (!orbits_args.history.empty()) inputs.string("history", orbits_args.history);
+        if (!orbits_args.history.empty()) {
+            std::string list;
+            for (Eigen::Index k = 0; k < sim_history.size(); ++k) list += (k ? "," : "") + format_exact(sim_history(k));
+            inputs.json("history", "[" + list + "]");
+        }
     }
     if (from_file) {
         guess_samples = read_guess(orbits_args.guess, built.system->dimension());
@@ -305,7 +306,7 @@ int run_orbits() {
                        std::to_string(eq.hopf.size()) + " Hopf point" + (eq.hopf.size() == 1 ? "" : "s") + ")");
     const HopfPoint* hp = from_hopf ? &eq.hopf[static_cast<std::size_t>(hopf_index)] : nullptr;
     OrbitBranch b;
-    JsonObject start;  // result.start of a simulation or a file
+    std::string start_json;  // result.start of a simulation or a file
     std::string start_line;
     if (hp) {
         o.progress = branch_progress_printer("orbits", "orbits", par, false);
@@ -320,29 +321,24 @@ int run_orbits() {
         OrbitGuess guess;
         bool have = true;
         if (from_simulation) {
-            SimulatedOrbitGuess sg = orbit_guess_from_simulation(*built.system, par, mesh, sim_history, sim_end, sim_step);
-            start.string("kind", "simulation").number("t_end", sim_end).number("step", sim_step).number("period", sg.period)
-                .integer("crossings_per_period", sg.crossings_per_period).number("period_spread", sg.period_spread).string("status", to_string(sg.status))
-                .string("message", sg.message);
+            const SimulatedOrbitGuess sg = orbit_guess_from_simulation(*built.system, par, mesh, sim_history, sim_end, sim_step);
+            start_json = simulation_start_json(sg, sim_end, sim_step);
             std::ostringstream sl;
             sl << "start      simulation at " << par << " = " << rounded(o.from, 10) << " to t = " << rounded(sim_end, 6) << " (step " << rounded(sim_step, 3) << "): " << sg.message << "\n";
             start_line = sl.str();
-            if (sg.status != Status::Converged) {
-                have = false;
-                b.degree = o.degree;
-                b.intervals = o.intervals;
-                b.status = sg.status;
-                b.stop = "first_orbit_failed";
-                b.message = "no orbit from the simulation: " + sg.message;
-            }
-            guess = std::move(sg.guess);
+            o.progress = branch_progress_printer("orbits", "orbits", par, false);
+            b = orbit_branch_from_simulation(*built.system, sg, o);
+            o.progress = nullptr;
+            have = false;  // done
         } else {
             try {
                 guess = orbit_guess_from_samples(mesh, guess_samples.times, guess_samples.states, guess_samples.times.back() - guess_samples.times.front(), o.from);
             } catch (const std::invalid_argument& e) {
                 throw BadInput("--guess = " + orbits_args.guess + ": " + e.what());
             }
+            JsonObject start;
             start.string("kind", "file").string("file", orbits_args.guess).number("period", guess.period);
+            start_json = start.str();
             start_line = "start      " + orbits_args.guess + " at " + par + " = " + rounded(o.from, 10) + ", period " + rounded(guess.period, 8) + "\n";
         }
         if (have) {
@@ -436,7 +432,7 @@ int run_orbits() {
         hj.integer("index", hopf_index).number("par", hp->par).number("omega", hp->omega).string("status", to_string(hp->status));
         result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
     } else {
-        result = "{\"start\":" + start.str() + "," + result.substr(1);
+        result = "{\"start\":" + start_json + "," + result.substr(1);
     }
     if (two)
         result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) +

@@ -1073,8 +1073,48 @@ def bistability(par, from_, to, par2, from2, to2, system=None, model=None, ring=
 
 
 @_with_progress
+def _guess_rows(guess):
+    """times, states and a label of an orbit given as a CSV file, a table in memory
+    (""" + _TYPES_TABLE + """: the first column t, then one per variable) or a pair (times, states)."""
+    if isinstance(guess, tuple) and len(guess) == 2:
+        times = [float(t) for t in guess[0]]
+        states = [[float(v) for v in (row if hasattr(row, "__len__") else [row])] for row in guess[1]]
+        return times, states, "data"
+    if isinstance(guess, (str, bytes, _os.PathLike)):
+        label = _os.fsdecode(guess)
+        try:
+            with open(label, encoding="utf-8-sig") as f:
+                text = f.read()
+        except OSError as e:
+            raise ValueError("guess = %r: %s" % (label, e.strerror or e)) from None
+    else:
+        text = _table_text(guess, "guess")
+        if text is None:
+            raise ValueError("guess: expected a CSV file, %s or a pair (times, states)" % (_TYPES_TABLE,))
+        label = "data"
+    times, states = [], []
+    for k, line in enumerate(text.splitlines(), 1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        fields = [x.strip() for x in line.split(",")]
+        if not times and fields[0] and not (fields[0][0].isdigit() or fields[0][0] in "+-."):
+            continue  # the header
+        try:
+            values = [float(x) for x in fields]
+        except ValueError:
+            raise ValueError("guess = %s, row %d: expected numbers, found %r" % (label, k, line)) from None
+        if len(values) < 2:
+            raise ValueError("guess = %s, row %d: expected t and one value per variable" % (label, k))
+        if times and not values[0] > times[-1]:
+            raise ValueError("guess = %s, row %d: t = %r: expected times increasing" % (label, k, values[0]))
+        times.append(values[0])
+        states.append(values[1:])
+    return times, states, label
+
+
 def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False,
-           max_step=None, period_doubling=None, **parameters):
+           max_step=None, period_doubling=None, from_simulation=None, history=None, guess=None, **parameters):
     """The branch of periodic orbits born at a Hopf point (``ddemap orbits``).
 
     The problem as in :func:`equilibria`; the equilibrium branch from ``from_`` to ``to`` gives
@@ -1089,10 +1129,24 @@ def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4,
     ``--period-doubling``; an index from 0): also the branch of orbits of twice the period
     switched onto at that period doubling, as ``period_doubled`` (``from``: the doubling's
     ``par`` and ``period``; then the keys of a branch).
+    Instead of a Hopf point the orbits can start (at ``par`` = ``from_``, followed towards ``to``)
+    from the orbit a simulation settles on (``from_simulation`` = the run time T_END, from the
+    constant state ``history``, default the equilibrium guess with the first variable raised by
+    10 %; the command's ``--from-simulation``, ``--history``), or from an orbit ``guess``: a CSV
+    file (t and one column per variable, the rows covering one period), a table in memory with
+    those columns, or a pair (times, states) (``--guess``). Then ``start`` says how instead of
+    ``hopf``.
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     step = None if max_step is None else _number("max_step", max_step)
+    t_end = None if from_simulation is None else _number("from_simulation", from_simulation)
+    hist = None if history is None else [_number("history", v) for v in (history if hasattr(history, "__len__") else [history])]
+    times = states = None
+    label = ""
+    if guess is not None:
+        times, states, label = _guess_rows(guess)
     return _result(_ddemap.orbits(sys_, model_, n, p, par, _number("from_", from_), _number("to", to),
                                   _integer("hopf", hopf, 0, 1000000), _integer("degree", degree, 1, 20),
                                   _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000), bool(adapt),
-                                  step, None if period_doubling is None else _integer("period_doubling", period_doubling, 0, 1000000)))
+                                  step, None if period_doubling is None else _integer("period_doubling", period_doubling, 0, 1000000),
+                                  t_end, hist, times, states, label))

@@ -1051,7 +1051,14 @@ std::string py_bistability(const std::string& system_file, const std::string& mo
 
 std::string py_orbits(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters, const std::string& par,
                       double from, double to, int hopf, int degree, int intervals, int points, bool adapt, std::optional<double> max_step,
-                      std::optional<int> period_doubling) {
+                      std::optional<int> period_doubling, std::optional<double> from_simulation, std::optional<std::vector<double>> history,
+                      std::optional<std::vector<double>> guess_times, std::optional<std::vector<std::vector<double>>> guess_states,
+                      const std::string& guess_label) {
+    const bool from_sim = from_simulation.has_value(), from_data = guess_times.has_value();
+    if (from_sim && from_data) throw std::invalid_argument("from_simulation and guess: expected one start of the orbits");
+    if (history && !from_sim) throw std::invalid_argument("history: only with from_simulation (expected from_simulation=T_END)");
+    if (from_sim && !(*from_simulation > 0.0 && *from_simulation <= 1e7))
+        throw std::invalid_argument("from_simulation = " + json_number(*from_simulation) + ": expected a run time above 0, at most 1e7");
     PeriodicOrbitOptions o;
     if (max_step) {  // as orbits --max-step, checked before any work
         if (!(*max_step >= o.initial_step && *max_step <= 1e6))
@@ -1067,9 +1074,37 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     o.intervals = intervals;
     o.max_points = points;
     o.adapt = adapt;
-    pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("hopf", hopf).integer("degree", o.degree)
-        .integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
+    pb.inputs.string("par", par).number("from", o.from).number("to", o.to);
+    if (!from_sim && !from_data) pb.inputs.integer("hopf", hopf);
+    pb.inputs.integer("degree", o.degree).integer("intervals", o.intervals).integer("points", o.max_points).boolean("adapt", o.adapt);
     if (max_step) pb.inputs.number("max_step", o.max_step);  // only when given, as the command's envelope
+    // the starts other than a Hopf point (as orbits --from-simulation, --guess): at par = from
+    Eigen::VectorXd sim_history;
+    double sim_step = 0.0;
+    if (from_sim || from_data) {
+        pb.system->set_parameter(par, from);
+        pb.inputs.number(from_sim ? "from_simulation" : "guess_at", from);
+    }
+    if (from_sim) {
+        const int n = pb.system->dimension();
+        if (history) {
+            if (static_cast<int>(history->size()) != n)
+                throw std::invalid_argument("history: expected " + std::to_string(n) + " values (one per variable), found " + std::to_string(history->size()));
+            sim_history = Eigen::Map<const Eigen::VectorXd>(history->data(), n);
+            if (!sim_history.allFinite()) throw std::invalid_argument("history: expected finite values");
+        } else {
+            sim_history = pb.guess;
+            sim_history(0) += 0.1 * std::max(1.0, std::abs(sim_history(0)));
+        }
+        sim_step = default_simulation_step(*pb.system);
+        pb.inputs.number("t_end", *from_simulation);
+        if (history) {
+            std::string list;
+            for (double v : *history) list += (list.empty() ? "" : ",") + format_exact(v);
+            pb.inputs.json("history", "[" + list + "]");
+        }
+    }
+    if (from_data) pb.inputs.string("guess", guess_label);
     if (period_doubling) pb.inputs.integer("period_doubling", *period_doubling);
     EquilibriumBranchOptions eo;
     eo.parameter = par;
@@ -1078,17 +1113,51 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     eo.roots.count = 2;
     eo.progress = branch_interruptible();
     o.progress = branch_interruptible();
-    const EquilibriumBranch eq = released([&] { return equilibrium_branch(*pb.system, pb.guess, eo); });
-    if (eq.hopf.empty())
+    const bool from_hopf = !from_sim && !from_data;
+    EquilibriumBranch eq;
+    if (from_hopf) eq = released([&] { return equilibrium_branch(*pb.system, pb.guess, eo); });
+    if (from_hopf && eq.hopf.empty())
         throw std::invalid_argument("no Hopf point on the equilibrium branch in " + par + " from " + json_number(from) + " to " + json_number(to) +
                                     " (ended: " + to_string(eq.stop) + "): expected at least one to start the periodic orbits from");
-    if (hopf >= static_cast<int>(eq.hopf.size()))
+    if (from_hopf && hopf >= static_cast<int>(eq.hopf.size()))
         throw std::invalid_argument("hopf = " + std::to_string(hopf) + ": expected an index from 0 to " + std::to_string(eq.hopf.size() - 1));
-    const HopfPoint& h = eq.hopf[static_cast<std::size_t>(hopf)];
-    OrbitBranch b = released([&] { return orbit_branch_from_hopf(*pb.system, h, o); });
-    if (h.status != Status::Converged && b.status == Status::Converged) {
-        b.status = h.status;
-        b.message = "the Hopf point was not located (" + to_string(h.status) + "); the orbits start from its estimate";
+    const HopfPoint* hp = from_hopf ? &eq.hopf[static_cast<std::size_t>(hopf)] : nullptr;
+    OrbitBranch b;
+    std::string start_json;
+    if (hp) {
+        b = released([&] { return orbit_branch_from_hopf(*pb.system, *hp, o); });
+        if (hp->status != Status::Converged && b.status == Status::Converged) {
+            b.status = hp->status;
+            b.message = "the Hopf point was not located (" + to_string(hp->status) + "); the orbits start from its estimate";
+        }
+    } else {
+        const PeriodicMesh mesh(o.degree, o.intervals);
+        OrbitGuess guess;
+        bool have = true;
+        if (from_sim) {
+            const SimulatedOrbitGuess sg = released([&] { return orbit_guess_from_simulation(*pb.system, par, mesh, sim_history, *from_simulation, sim_step); });
+            start_json = simulation_start_json(sg, *from_simulation, sim_step);
+            b = released([&] { return orbit_branch_from_simulation(*pb.system, sg, o); });
+            have = false;  // done
+        } else {
+            const std::vector<double>& t = *guess_times;
+            const std::vector<std::vector<double>>& x = *guess_states;
+            const int n = pb.system->dimension();
+            if (x.size() != t.size()) throw std::invalid_argument("guess: expected one state per time");
+            Eigen::MatrixXd states(static_cast<Eigen::Index>(t.size()), n);
+            for (std::size_t i = 0; i < t.size(); ++i) {
+                if (static_cast<int>(x[i].size()) != n)
+                    throw std::invalid_argument("guess: row " + std::to_string(i) + ": expected " + std::to_string(n) + " values (one per variable)");
+                for (int k = 0; k < n; ++k) states(static_cast<Eigen::Index>(i), k) = x[i][static_cast<std::size_t>(k)];
+            }
+            if (!states.allFinite()) throw std::invalid_argument("guess: expected finite values");
+            if (t.size() < 4) throw std::invalid_argument("guess: expected at least 4 rows covering one period");
+            guess = orbit_guess_from_samples(mesh, t, states, t.back() - t.front(), from);
+            JsonObject start;
+            start.string("kind", "file").string("file", guess_label).number("period", guess.period);
+            start_json = start.str();
+        }
+        if (have) b = released([&] { return orbit_branch_from_guess(*pb.system, guess, o); });
     }
     // the branch of twice the period (as orbits --period-doubling)
     OrbitBranch doubled;
@@ -1117,10 +1186,14 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     e.inputs = pb.inputs.str();
     e.status = to_string(b.status);
     e.message = b.message;
-    JsonObject hj;
-    hj.integer("index", hopf).number("par", h.par).number("omega", h.omega).string("status", to_string(h.status));
     const std::string result = orbit_branch_json(b, pb.variables);
-    e.result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    if (hp) {
+        JsonObject hj;
+        hj.integer("index", hopf).number("par", hp->par).number("omega", hp->omega).string("status", to_string(hp->status));
+        e.result = "{\"hopf\":" + hj.str() + "," + result.substr(1);
+    } else {
+        e.result = "{\"start\":" + start_json + "," + result.substr(1);
+    }
     if (period_doubling) {
         const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(*period_doubling)];
         JsonObject from_j;
@@ -1188,5 +1261,6 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("points"), py::arg("rows"));
     m.def("orbits", &py_orbits, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"), py::arg("max_step"),
-          py::arg("period_doubling"));
+          py::arg("period_doubling"), py::arg("from_simulation"), py::arg("history"), py::arg("guess_times"), py::arg("guess_states"),
+          py::arg("guess_label"));
 }

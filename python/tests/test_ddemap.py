@@ -370,6 +370,33 @@ def test_orbits_period_doubling():
         ddemap.orbits("tau", 0.3, 1.5, system=system, points=200, period_doubling=3)
 
 
+def test_orbits_from_simulation_and_guess(tmp_path):
+    # the starts other than a Hopf point: the command's envelopes, and the same orbit of Wright's
+    # equation at alpha = 1.7 from a file, a DataFrame and a pair of arrays
+    system = os.path.join(SOURCE, "examples", "wright.json")
+    r = ddemap.orbits("alpha", 2, 2.5, system=system, points=3, from_simulation=300)
+    same_envelope(r, cli_json("orbits", "--system", system, "--par", "alpha", "--from", 2, "--to", 2.5, "--points", 3, "--from-simulation", 300))
+    assert r["start"]["kind"] == "simulation" and r["start"]["crossings_per_period"] == 1
+    r = ddemap.orbits("alpha", 2, 2.5, system=system, points=3, from_simulation=300, history=[0.5])
+    same_envelope(r, cli_json("orbits", "--system", system, "--par", "alpha", "--from", 2, "--to", 2.5, "--points", 3, "--from-simulation", 300,
+                              "--history", 0.5))
+    t = [4.1 * i / 100 for i in range(101)]
+    y = [0.8 * math.sin(2 * math.pi * s / 4.1) for s in t]
+    path = tmp_path / "guess.csv"
+    path.write_text("t,y\n" + "".join("%r,%r\n" % (a, b) for a, b in zip(t, y)))
+    r = ddemap.orbits("alpha", 1.7, 2.5, system=system, points=3, guess=str(path))
+    same_envelope(r, cli_json("orbits", "--system", system, "--par", "alpha", "--from", 1.7, "--to", 2.5, "--points", 3, "--guess", str(path)))
+    pd = pytest.importorskip("pandas")
+    periods = [r["points"]["period"][0]]
+    periods.append(ddemap.orbits("alpha", 1.7, 2.5, system=system, points=3, guess=pd.DataFrame({"t": t, "y": y}))["points"]["period"][0])
+    periods.append(ddemap.orbits("alpha", 1.7, 2.5, system=system, points=3, guess=(t, [[v] for v in y]))["points"]["period"][0])
+    assert periods[0] == periods[1] == periods[2]
+    with pytest.raises(ValueError, match="from_simulation and guess: expected one start"):
+        ddemap.orbits("alpha", 1.7, 2.5, system=system, from_simulation=100, guess=str(path))
+    with pytest.raises(ValueError, match="history: expected 1 values"):
+        ddemap.orbits("alpha", 2, 2.5, system=system, from_simulation=100, history=[1, 2])
+
+
 def _tolerance(name):
     """A tolerance of tests/tolerances.hpp (the one list of them, with why each has its size)."""
     with open(os.path.join(SOURCE, "tests", "tolerances.hpp")) as f:

@@ -615,6 +615,14 @@ std::string orbit_fold_curves_json(const std::vector<OrbitFoldCurve>& curves, co
     return text(all);
 }
 
+std::string simulation_start_json(const SimulatedOrbitGuess& g, double t_end, double step) {
+    JsonObject start;
+    start.string("kind", "simulation").number("t_end", t_end).number("step", step).number("period", g.period)
+        .integer("crossings_per_period", g.crossings_per_period).number("period_spread", g.period_spread).string("status", to_string(g.status))
+        .string("message", g.message);
+    return start.str();
+}
+
 std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers) {
     const auto vec = detail::json_values;
     auto pair = [](cplx z) { return json::array({num(z.real()), num(z.imag())}); };

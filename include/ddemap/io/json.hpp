@@ -149,6 +149,9 @@ std::string mix_json(const std::vector<MixPoint>& points, int cars);
 /// "folds": [{"par", "period", "located"}], "period_doublings" and "tori": [{"par", "period",
 /// "multiplier": [re, im]}], "stop", "method", "certificate": {"max_residual", "max_trivial_distance"}}.
 std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::string>& variables, int multipliers = 10);
+/// result.start of orbits started from a simulation run to t_end with step `step`: {"kind":
+/// "simulation", "t_end", "step", "period", "crossings_per_period", "period_spread", "status", "message"}.
+std::string simulation_start_json(const SimulatedOrbitGuess& g, double t_end, double step);
 /// Curves of folds of periodic orbits in two parameters (orbit_fold_curve), an array: per curve
 /// its parameters, points (par, par2, period, min, max of every variable, fold_test |g|,
 /// second_distance |mu_2 - 1|, trivial_distance, residual), how each end ended, status, message,

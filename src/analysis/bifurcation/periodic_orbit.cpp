@@ -1048,6 +1048,25 @@ OrbitGuess orbit_guess_from_samples(const PeriodicMesh& mesh, const std::vector<
     return g;
 }
 
+OrbitBranch orbit_branch_from_simulation(const NonlinearDDE& system, const SimulatedOrbitGuess& g, const PeriodicOrbitOptions& options) {
+    if (g.status == Status::Converged) return orbit_branch_from_guess(system, g.guess, options);
+    OrbitBranch b;
+    b.parameter = options.parameter;
+    b.degree = options.degree;
+    b.intervals = options.intervals;
+    b.status = g.status;
+    b.stop = "first_orbit_failed";
+    b.message = "no orbit from the simulation: " + g.message;
+    return b;
+}
+
+double default_simulation_step(const NonlinearDDE& system) {
+    double h = 0.01;
+    for (double t : system.delays())
+        if (t > 0.0) h = std::min(h, 0.1 * t);
+    return h;
+}
+
 SimulatedOrbitGuess orbit_guess_from_simulation(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
                                                 const Eigen::VectorXd& history, double t_end, double step) {
     const int n = system.dimension(), m = system.delay_count();

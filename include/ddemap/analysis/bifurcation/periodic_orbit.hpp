@@ -218,6 +218,15 @@ struct SimulatedOrbitGuess {
 SimulatedOrbitGuess orbit_guess_from_simulation(const NonlinearDDE& system, const std::string& parameter, const PeriodicMesh& mesh,
                                                 const Eigen::VectorXd& history, double t_end, double step);
 
+/// The branch through the orbit a simulation settled on (orbit_branch_from_guess from g.guess);
+/// when it did not settle (g.status not Converged) the branch is empty with that status, stop
+/// "first_orbit_failed" and the simulation's message.
+OrbitBranch orbit_branch_from_simulation(const NonlinearDDE& system, const SimulatedOrbitGuess& g, const PeriodicOrbitOptions& options);
+
+/// The step of those simulations by default: 0.01, or a tenth of the shortest positive delay
+/// when that is shorter (at the system's parameter values).
+double default_simulation_step(const NonlinearDDE& system);
+
 /// The branch from a Hopf point of an equilibrium branch (hopf.x, hopf.par, hopf.omega, hopf.q).
 /// std::invalid_argument for invalid options, an unknown parameter, a system without delay
 /// derivatives, or a Hopf point with omega <= 0 or q of the wrong size; non-convergence is a status.
