@@ -27,6 +27,7 @@ struct EquilibriaArgs {
     NonlinearProblemArgs problem;
     std::string count = "4", points = "400";
     std::string par2, from2, to2, svg;
+    std::string branch_point;
     FormatArg format;
     OutArg out;
 } equilibria_args;
@@ -105,6 +106,10 @@ void add_equilibria_flags(CLI::App& app) {
     app.add_option("--from2", equilibria_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
     app.add_option("--to2", equilibria_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     app.add_option("--svg", equilibria_args.svg, "--par2: the two-parameter diagram (fold curves; cusp and Bogdanov-Takens points)")->type_name("FILE");
+    app.add_option("--branch-point", equilibria_args.branch_point,
+                   "switch at branch point K of the branch (from 0, in the order met) onto the other branch of equilibria through it and follow "
+                   "that one towards --to (--from and --to swapped: its other side); PREFIX-switched.csv, JSON result.switched")
+        ->type_name("K");
     equilibria_args.format.add_to(app);
     equilibria_args.out.add_to(app, "PREFIX.csv (one row per point and special point, or per fold-curve point with --par2) and PREFIX.json", false);
     run_flags().add_to(app, false);
@@ -112,7 +117,12 @@ void add_equilibria_flags(CLI::App& app) {
 
 int run_equilibria() {
     const Format format = equilibria_args.format.parse();
-    const std::string prefix = equilibria_args.out.given() ? equilibria_args.out.prepare("equilibria") : std::string();
+    const bool switching = !equilibria_args.branch_point.empty();
+    if (switching && !equilibria_args.par2.empty()) throw BadInput("--branch-point: not with --par2 (expected one branch in --par)");
+    const int bp_index = switching ? static_cast<int>(parse_integer("--branch-point", equilibria_args.branch_point, 0, 1000000, "an integer >= 0")) : -1;
+    const std::string prefix = !equilibria_args.out.given() ? std::string()
+                               : switching              ? equilibria_args.out.prepare("equilibria", {".csv", ".json", "-switched.csv"})
+                                                        : equilibria_args.out.prepare("equilibria");
     NonlinearProblemArgs::Problem pb = equilibria_args.problem.load();
     EquilibriumBranchOptions o;
     o.parameter = equilibria_args.problem.par;
@@ -131,8 +141,36 @@ int run_equilibria() {
     if (two) return run_fold_curves(pb, o, format, prefix);
 
     o.progress = branch_progress_printer("equilibria", "points", equilibria_args.problem.par, true);
-    const EquilibriumBranch b = equilibrium_branch(*system, guess, o);
+    EquilibriumBranch b = equilibrium_branch(*system, guess, o);
     o.progress = nullptr;  // ends an open progress line before the output
+    // the other branch through branch point K (--branch-point)
+    EquilibriumBranch nb;
+    const FoldPoint* bp = nullptr;
+    if (switching) {
+        std::vector<const FoldPoint*> points;
+        for (const FoldPoint& f : b.folds)
+            if (f.kind == "branch_point") points.push_back(&f);
+        if (points.empty())
+            throw BadInput("--branch-point = '" + equilibria_args.branch_point + "': the branch has no branch point in " + equilibria_args.problem.par + " from " +
+                           equilibria_args.problem.from + " to " + equilibria_args.problem.to + " (expected at least one to switch at)");
+        if (bp_index >= static_cast<int>(points.size()))
+            throw BadInput("--branch-point = '" + equilibria_args.branch_point + "': expected an index from 0 to " + std::to_string(points.size() - 1) +
+                           " (the branch has " + counted(static_cast<long long>(points.size()), "branch point") + ")");
+        bp = points[static_cast<std::size_t>(bp_index)];
+        inputs.integer("branch_point", bp_index);
+        if (bp->status != Status::Converged) {
+            nb.status = bp->status;
+            nb.message = "branch point " + std::to_string(bp_index) + " was not located: no branch switched onto";
+        } else {
+            o.progress = branch_progress_printer("equilibria", "points of the other branch", equilibria_args.problem.par, true);
+            nb = equilibrium_branch_from_branch_point(*system, b, *bp, o);
+            o.progress = nullptr;
+        }
+        if (nb.status != Status::Converged && b.status == Status::Converged) {
+            b.status = nb.status;
+            b.message = "the other branch at the branch point: " + nb.message;
+        }
+    }
     JsonEnvelope e;
     e.command = "equilibria";
     e.inputs = inputs.str();
@@ -142,29 +180,48 @@ int run_equilibria() {
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, variables);
+    if (switching) {
+        JsonObject from;
+        from.integer("index", bp_index).number("par", bp->par);
+        const std::string other = equilibrium_branch_json(nb, variables);
+        e.result = e.result.substr(0, e.result.size() - 1) + ",\"switched\":{\"from\":" + from.str() + "," + other.substr(1) + "}";
+    }
     const std::string csv = equilibrium_branch_csv(b, variables, pb.units);
-    if (!prefix.empty()) write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    if (!prefix.empty()) {
+        if (switching)
+            write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}, {prefix + "-switched.csv", equilibrium_branch_csv(nb, variables, pb.units)}});
+        else
+            write_files_atomic({{prefix + ".csv", csv}, {prefix + ".json", envelope_json(e)}});
+    }
     print_output(format, e, csv, [&] {
         std::ostringstream out;
+        auto table = [&](const EquilibriumBranch& br) {
+            const std::size_t shown = std::min<std::size_t>(variables.size(), 3);
+            out << "  " << pad(equilibria_args.problem.par, 14);
+            for (std::size_t i = 0; i < shown; ++i) out << pad(variables[i], 14);
+            out << pad("abscissa", 14) << "unstable  stable\n";
+            for (const EquilibriumPoint& p : br.points) {
+                out << "  " << pad(rounded(p.par, 8), 14);
+                for (std::size_t i = 0; i < shown; ++i) out << pad(rounded(p.x[static_cast<Eigen::Index>(i)], 8), 14);
+                out << pad(rounded(p.abscissa, 6), 14) << pad(std::to_string(p.unstable), 10) << (p.stable ? "yes" : "no") << "\n";
+            }
+            for (const FoldPoint& f : br.folds)
+                out << pad(f.kind + " ", 11) << equilibria_args.problem.par << " = " << rounded(f.par, 12) << " (" << to_string(f.status) << ", residual "
+                    << rounded(f.residual, 2) << ")\n";
+            for (const HopfPoint& h : br.hopf)
+                out << "hopf       " << equilibria_args.problem.par << " = " << rounded(h.par, 12) << ", omega = " << rounded(h.omega, 12) << " (" << to_string(h.status)
+                    << ", residual " << rounded(h.residual, 2) << ")\n";
+        };
         out << "branch     " << counted(static_cast<long long>(b.points.size()), "point") << " in " << equilibria_args.problem.par << " from " << rounded(o.from) << " towards " << rounded(o.to)
             << " (ended: " << to_string(b.stop) << ")\n";
-        const std::size_t shown = std::min<std::size_t>(variables.size(), 3);
-        out << "  " << pad(equilibria_args.problem.par, 14);
-        for (std::size_t i = 0; i < shown; ++i) out << pad(variables[i], 14);
-        out << pad("abscissa", 14) << "unstable  stable\n";
-        for (const EquilibriumPoint& p : b.points) {
-            out << "  " << pad(rounded(p.par, 8), 14);
-            for (std::size_t i = 0; i < shown; ++i) out << pad(rounded(p.x[static_cast<Eigen::Index>(i)], 8), 14);
-            out << pad(rounded(p.abscissa, 6), 14) << pad(std::to_string(p.unstable), 10) << (p.stable ? "yes" : "no") << "\n";
+        table(b);
+        if (switching) {
+            out << "switched   at the branch point " << equilibria_args.problem.par << " = " << rounded(bp->par, 12) << ": the other branch, "
+                << counted(static_cast<long long>(nb.points.size()), "point") << " (ended: " << to_string(nb.stop) << ")\n";
+            table(nb);
         }
-        for (const FoldPoint& f : b.folds)
-            out << pad(f.kind + " ", 11) << equilibria_args.problem.par << " = " << rounded(f.par, 12) << " (" << to_string(f.status) << ", residual " << rounded(f.residual, 2)
-                << ")\n";
-        for (const HopfPoint& h : b.hopf)
-            out << "hopf       " << equilibria_args.problem.par << " = " << rounded(h.par, 12) << ", omega = " << rounded(h.omega, 12) << " (" << to_string(h.status)
-                << ", residual " << rounded(h.residual, 2) << ")\n";
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";
-        if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";
+        if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json" << (switching ? " " + prefix + "-switched.csv" : std::string()) << "\n";
         std::cout << out.str();
     });
     if (b.status != Status::Converged) std::cerr << "ddemap: undecided: " << b.message << "\n";

@@ -980,6 +980,35 @@ rm -rf "$crd/edge" "$crd/edge.csv"
 rc=$?
 [ $rc -eq 0 ] && [ "$(grep -c '^fold ' "$tmp/ov3.out")" -eq 2 ] && grep -q "(ended: hopf)" "$tmp/ov3.out" && ok || bad "ov ring 3 orbits: exit $rc, $(grep -c '^fold ' "$tmp/ov3.out") folds"
 grep -Eq "bistable \(stable orbit and stable equilibrium\) for headway in \[[0-9.]+, [0-9.]+\] and \[[0-9.]+, [0-9.]+\];" "$tmp/ov3.svg" && ok || bad "ov ring 3: two bistable windows"
+# switching at a branch point of equilibria (examples/hutchinson.json, x' = x (p - x(t - 1))):
+# from x = 0 onto x = p at p = 0, and on it the Hopf point p = pi/2 with omega = pi/2
+if "$bin" equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 0 --format json \
+       --out "$tmp/hut" --quiet >"$tmp/hut.json"; then
+    python3 - "$tmp/hut.json" "$tmp/hut-switched.csv" <<'PY' && ok || bad "equilibria --branch-point: the other branch of Hutchinson's equation"
+import json, sys, math, csv
+d = json.load(open(sys.argv[1]))
+assert d["status"] == "converged" and d["inputs"]["branch_point"] == 0
+r = d["result"]
+sw = r["switched"]
+assert sw["from"]["index"] == 0 and abs(sw["from"]["par"]) < 1e-10
+pts = sw["points"]
+assert all(abs(p["x"][0] - p["par"]) < 1e-12 for p in pts) and pts[-1]["par"] == 2
+h = sw["hopf"]
+assert len(h) == 1 and abs(h[0]["par"] - math.pi / 2) < 1e-9 and abs(h[0]["omega"] - math.pi / 2) < 1e-9
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert len([x for x in rows if x["kind"] == "point"]) == len(pts), rows[0]
+PY
+else
+    bad "equilibria --branch-point exit status"
+fi
+expect_error "--branch-point = '1': expected an index from 0 to 0 (the branch has 1 branch point)" \
+    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 1 --out "$tmp/hutbad"
+expect_error "--branch-point = '0': the branch has no branch point in p from 0.5 to 2" \
+    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from 0.5 --to 2 --branch-point 0
+expect_error "--branch-point: not with --par2" \
+    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 0 --par2 p --from2 0 --to2 1
+[ ! -e "$tmp/hutbad.json" ] && ok || bad "equilibria --branch-point bad input wrote files"
+
 fi  # part nonlinear
 
 if part hopf; then

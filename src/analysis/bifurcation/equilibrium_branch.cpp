@@ -399,40 +399,16 @@ double TwoParameterOptions::held_second(const NonlinearDDE& system) const {
     return held;
 }
 
-EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options) {
-    std::string why;
-    if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);
-    const int j = system.parameter_index(options.parameter);
-    check_derivatives(system);
+namespace {
+
+/// The branch's analysis from the continuation's result c (points, fold tests, events): the roots
+/// at every point, folds, branch points and Hopf points located (the body shared by
+/// equilibrium_branch and equilibrium_branch_from_branch_point).
+/// from_branch_point: the first point is a branch point (det Delta(0) = 0 there: the first step's
+/// sign change is that point, not another one).
+EquilibriumBranch analyse_branch(const NonlinearDDE& system, int j, const EquilibriumCurve& curve, const ContinuationResult& c,
+                                 const EquilibriumBranchOptions& options, EquilibriumBranch br, bool from_branch_point = false) {
     const int n = system.dimension();
-    EquilibriumBranch br;
-    br.parameter = options.parameter;
-
-    const std::vector<double> p0 = with(system, j, options.from);
-    const EquilibriumResult e = find_equilibrium(system, guess, options.equilibrium, p0);
-    if (!converged(e.status)) {
-        br.status = e.status;
-        br.message = "no equilibrium at " + options.parameter + " = " + detail::format_number(options.from) + " from the guess: " + e.message;
-        return br;
-    }
-
-    ContinuationOptions co = options.continuation;
-    const double range = std::abs(options.to - options.from);
-    if (co.initial_step == 0.0) co.initial_step = range / 100.0;
-    if (co.max_step == 0.0) co.max_step = range / 20.0;
-    co.initial_step = std::min(co.initial_step, co.max_step);
-    co.min_step = std::min(co.min_step, co.initial_step);
-    co.lower = Eigen::VectorXd::Constant(n + 1, -std::numeric_limits<double>::infinity());
-    co.upper = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::infinity());
-    co.lower[n] = std::min(options.from, options.to);
-    co.upper[n] = std::max(options.from, options.to);
-
-    const EquilibriumCurve curve(system, j);
-    Eigen::VectorXd u0(n + 1), dir = Eigen::VectorXd::Zero(n + 1);
-    u0 << e.x, options.from;
-    dir[n] = options.to > options.from ? 1.0 : -1.0;
-    const std::vector<TestFunction> tests{{"fold", [n](const Eigen::VectorXd&, const Eigen::VectorXd& t) { return t[n]; }, false}};
-    const ContinuationResult c = continue_branch(curve, u0, dir, co, tests);
     br.stop = c.stop;
 
     bool roots_ok = true;
@@ -482,8 +458,10 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
     }
     std::vector<int> real_crossing(br.points.size(), 0);  // +-1 at step k when det Delta(0) changes sign there
     for (std::size_t k = 0; k + 1 < dets.size(); ++k) {
-        if (!(dets[k] * dets[k + 1] < 0.0)) continue;
+        const bool start = from_branch_point && k == 0;  // the branch point itself: a real root leaves 0 here
+        if (!(dets[k] * dets[k + 1] < 0.0) && !start) continue;
         real_crossing[k] = 1;
+        if (start) continue;
         bool fold_here = false;
         for (const FoldPoint& f : br.folds) fold_here = fold_here || f.after == static_cast<int>(k);
         if (fold_here) continue;
@@ -612,4 +590,127 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
     return br;
 }
 
+
+/// The continuation options of a branch of options (steps from the range, the box of the parameter).
+ContinuationOptions branch_continuation(const EquilibriumBranchOptions& options, int n) {
+    ContinuationOptions co = options.continuation;
+    const double range = std::abs(options.to - options.from);
+    if (co.initial_step == 0.0) co.initial_step = range / 100.0;
+    if (co.max_step == 0.0) co.max_step = range / 20.0;
+    co.initial_step = std::min(co.initial_step, co.max_step);
+    co.min_step = std::min(co.min_step, co.initial_step);
+    co.lower = Eigen::VectorXd::Constant(n + 1, -std::numeric_limits<double>::infinity());
+    co.upper = Eigen::VectorXd::Constant(n + 1, std::numeric_limits<double>::infinity());
+    co.lower[n] = std::min(options.from, options.to);
+    co.upper[n] = std::max(options.from, options.to);
+    return co;
+}
+
+}  // namespace
+
+EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options) {
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);
+    const int j = system.parameter_index(options.parameter);
+    check_derivatives(system);
+    const int n = system.dimension();
+    EquilibriumBranch br;
+    br.parameter = options.parameter;
+
+    const std::vector<double> p0 = with(system, j, options.from);
+    const EquilibriumResult e = find_equilibrium(system, guess, options.equilibrium, p0);
+    if (!converged(e.status)) {
+        br.status = e.status;
+        br.message = "no equilibrium at " + options.parameter + " = " + detail::format_number(options.from) + " from the guess: " + e.message;
+        return br;
+    }
+
+    const ContinuationOptions co = branch_continuation(options, n);
+
+    const EquilibriumCurve curve(system, j);
+    Eigen::VectorXd u0(n + 1), dir = Eigen::VectorXd::Zero(n + 1);
+    u0 << e.x, options.from;
+    dir[n] = options.to > options.from ? 1.0 : -1.0;
+    const std::vector<TestFunction> tests{{"fold", [n](const Eigen::VectorXd&, const Eigen::VectorXd& t) { return t[n]; }, false}};
+    const ContinuationResult c = continue_branch(curve, u0, dir, co, tests);
+    return analyse_branch(system, j, curve, c, options, std::move(br));
+}
+
+EquilibriumBranch equilibrium_branch_from_branch_point(const NonlinearDDE& system, const EquilibriumBranch& branch, const FoldPoint& bp,
+                                                       const EquilibriumBranchOptions& options) {
+    std::string why;
+    if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);
+    const int j = system.parameter_index(options.parameter);
+    check_derivatives(system);
+    const int n = system.dimension();
+    if (bp.kind != "branch_point" || !converged(bp.status) || bp.x.size() != n)
+        throw std::invalid_argument("branch switching: expected a located branch point of the system's dimension");
+    if (bp.after < 0 || bp.after + 1 >= static_cast<int>(branch.points.size()))
+        throw std::invalid_argument("branch switching: the branch point must lie between two points of its branch");
+    EquilibriumBranch br;
+    br.parameter = options.parameter;
+    const EquilibriumCurve curve(system, j);
+    Eigen::VectorXd u0(n + 1);
+    u0 << bp.x, bp.par;
+    // the kernel of [Delta(0) f_p] at the point (two dimensions at a branch point), and in it the
+    // direction orthogonal to the old branch (its chord across the point)
+    Eigen::MatrixXd J;
+    if (!curve.jacobian(u0, J)) throw std::invalid_argument("branch switching: no finite Jacobian at the branch point");
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
+    const Eigen::MatrixXd K = svd.matrixV().rightCols(2);
+    const EquilibriumPoint &a = branch.points[static_cast<std::size_t>(bp.after)], &b = branch.points[static_cast<std::size_t>(bp.after) + 1];
+    Eigen::VectorXd t1(n + 1);
+    t1 << b.x - a.x, b.par - a.par;
+    const Eigen::Vector2d c1 = K.transpose() * t1;
+    if (!(c1.norm() > 0.0)) throw std::invalid_argument("branch switching: the old branch does not cross the point");
+    Eigen::VectorXd t2 = K * Eigen::Vector2d(-c1(1), c1(0));
+    t2 /= t2.norm();
+    // the first point: Newton on [F(u); t2 . (u - u0) - h] from u0 + h t2 (the hyperplane meets
+    // the new branch at distance ~h, the old one only at ~sqrt(h)); on the side of t2 whose
+    // tangent there moves the parameter towards `to` (either side when the branch is vertical)
+    const ContinuationOptions co = branch_continuation(options, n);
+    const double h = co.initial_step;
+    auto first_point = [&](const Eigen::VectorXd& dir, Eigen::VectorXd& u) {
+        u = u0 + h * dir;
+        for (int it = 0; it < 30; ++it) {
+            Eigen::VectorXd F;
+            Eigen::MatrixXd Ju;
+            if (!curve.residual(u, F) || !curve.jacobian(u, Ju)) return false;
+            Eigen::VectorXd R(n + 1);
+            R << F, dir.dot(u - u0) - h;
+            Eigen::MatrixXd E(n + 1, n + 1);
+            E << Ju, dir.transpose();
+            const Eigen::VectorXd du = E.partialPivLu().solve(R);
+            if (!du.allFinite()) return false;
+            u -= du;
+            if (du.lpNorm<Eigen::Infinity>() <= 1e-12 * std::max(1.0, u.lpNorm<Eigen::Infinity>()) && R.lpNorm<Eigen::Infinity>() <= 1e-10) return true;
+        }
+        return false;
+    };
+    Eigen::VectorXd u, dir;
+    bool ok = false;
+    for (const double sign : {1.0, -1.0}) {
+        Eigen::VectorXd us, ts;
+        if (!first_point(sign * t2, us) || !tangent(curve, us, sign * t2, ts)) continue;
+        const bool towards = (ts[n] > 0.0) == (options.to > options.from);
+        if (!ok || towards) {
+            u = us;
+            dir = sign * t2;
+            ok = true;
+        }
+        if (towards) break;
+    }
+    if (!ok) {
+        br.status = Status::MaxIterations;
+        br.message = "the first point of the other branch did not converge from the branch point at " + options.parameter + " = " +
+                     detail::format_number(bp.par);
+        return br;
+    }
+    const std::vector<TestFunction> tests{{"fold", [n](const Eigen::VectorXd&, const Eigen::VectorXd& t) { return t[n]; }, false}};
+    ContinuationResult c = continue_branch(curve, u, dir, co, tests);
+    // the branch point itself first: the new branch starts there
+    c.points.insert(c.points.begin(), u0);
+    for (ContinuationEvent& ev : c.events) ++ev.after;
+    return analyse_branch(system, j, curve, c, options, std::move(br), true);
+}
 }  // namespace ddemap

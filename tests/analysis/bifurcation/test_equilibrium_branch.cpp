@@ -499,3 +499,67 @@ TEST_CASE("neuron (DDE-BIFTOOL demo): the branch point a21 = (kappa - beta)^2 / 
         CHECK(br.hopf.size() == (from < 1.0 ? 1u : 0u));
     }
 }
+
+TEST_CASE("branch switching: Hutchinson's x' = x (p - x(t - 1)) from x = 0 onto x = p at the branch point p = 0, its Hopf point at p = pi/2") {
+    ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"x*(p - x(t - 1))"});
+    EquilibriumBranchOptions o;
+    o.parameter = "p";
+    o.from = -1.0;
+    o.to = 2.0;
+    o.roots.count = 2;
+    const EquilibriumBranch b = equilibrium_branch(s, Eigen::VectorXd::Zero(1), o);
+    REQUIRE(b.status == Status::Converged);
+    REQUIRE(b.folds.size() == 1);
+    const FoldPoint& bp = b.folds.front();
+    REQUIRE(bp.kind == "branch_point");
+    CHECK(std::abs(bp.par) < 1e-10);
+    const EquilibriumBranch nb = equilibrium_branch_from_branch_point(s, b, bp, o);
+    REQUIRE(nb.status == Status::Converged);
+    REQUIRE(nb.points.size() > 5);
+    CHECK(nb.points.front().par == bp.par);  // from the branch point
+    CHECK(nb.points.back().par == 2.0);      // towards --to
+    for (const EquilibriumPoint& p : nb.points) {
+        CAPTURE(p.par);
+        CHECK(std::abs(p.x[0] - p.par) < 1e-12);  // the other branch is x = p exactly
+        // its linearisation lambda = -p e^{-lambda}: stable for 0 < p < pi/2, unstable above
+        if (p.par > 1e-6 && p.par < pi / 2 - 1e-3) CHECK(p.stable);
+        if (p.par > pi / 2 + 1e-3) CHECK(!p.stable);
+    }
+    REQUIRE(nb.hopf.size() == 1);
+    CHECK(std::abs(nb.hopf.front().par - pi / 2) < 1e-9);
+    CHECK(std::abs(nb.hopf.front().omega - pi / 2) < 1e-9);
+    CHECK(nb.folds.empty());  // the branch point it starts from is not listed again
+    // the other side (from and to swapped): x = p for p < 0, one real root > 0 (lambda = |p| e^{-lambda})
+    EquilibriumBranchOptions back = o;
+    back.from = 2.0;
+    back.to = -1.0;
+    const EquilibriumBranch other = equilibrium_branch_from_branch_point(s, b, bp, back);
+    REQUIRE(other.status == Status::Converged);
+    CHECK(other.points.back().par == -1.0);
+    for (const EquilibriumPoint& p : other.points) {
+        CHECK(std::abs(p.x[0] - p.par) < 1e-12);
+        if (p.par < -1e-6) CHECK(p.unstable == 1);
+    }
+    // a fold is not a branch point
+    FoldPoint fold = bp;
+    fold.kind = "fold";
+    CHECK_THROWS_AS(equilibrium_branch_from_branch_point(s, b, fold, o), std::invalid_argument);
+}
+
+TEST_CASE("branch switching: two lines of equilibria crossing obliquely, x = 2p and x = p of x' = (x - 2p)(x(t - 1) - p)") {
+    ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"(x - 2*p)*(x(t - 1) - p)"});
+    EquilibriumBranchOptions o;
+    o.parameter = "p";
+    o.from = -1.0;
+    o.to = 1.0;
+    o.roots.count = 2;
+    const EquilibriumBranch b = equilibrium_branch(s, Eigen::VectorXd::Constant(1, -2.0), o);
+    REQUIRE(b.status == Status::Converged);
+    for (const EquilibriumPoint& p : b.points) CHECK(std::abs(p.x[0] - 2.0 * p.par) < 1e-12);
+    REQUIRE(b.folds.size() == 1);
+    REQUIRE(b.folds.front().kind == "branch_point");
+    const EquilibriumBranch nb = equilibrium_branch_from_branch_point(s, b, b.folds.front(), o);
+    REQUIRE(nb.status == Status::Converged);
+    CHECK(nb.points.back().par == 1.0);
+    for (const EquilibriumPoint& p : nb.points) CHECK(std::abs(p.x[0] - p.par) < 1e-12);
+}

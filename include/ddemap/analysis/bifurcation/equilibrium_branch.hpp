@@ -121,6 +121,19 @@ struct EquilibriumBranch {
 /// check the same.
 EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::VectorXd& guess, const EquilibriumBranchOptions& options);
 
+/// The other branch through a located branch point `bp` of `branch` (a point where a real root
+/// crosses 0 without a fold: bp.kind == "branch_point"), in the same parameter and range. At the
+/// point the kernel of [Delta(0) f_p] has two dimensions; the new branch leaves along the kernel
+/// direction t2 orthogonal to the old branch's chord across the point (oriented towards
+/// options.to in the parameter): its first point solves F(u) = 0, t2 . (u - u0) = h (h the first
+/// step; that hyperplane meets a transversal new branch at a distance ~h and the old one only at
+/// ~sqrt(h)), and the branch is followed from there as equilibrium_branch follows one, the branch
+/// point its first point. One side of the new branch: the other side with from and to swapped.
+/// std::invalid_argument for invalid options or a point that is not a located branch point of
+/// `branch`; non-convergence is a status.
+EquilibriumBranch equilibrium_branch_from_branch_point(const NonlinearDDE& system, const EquilibriumBranch& branch, const FoldPoint& bp,
+                                                       const EquilibriumBranchOptions& options);
+
 /// The fold system F(z), z = (x, p_j, v) (2n + 1 unknowns):
 ///     F = (f(x, ..., x; p),  (A_0 + ... + A_m) v,  v0 . v - 1),
 /// and, when J is given, its exact Jacobian: the x and p_j columns of (sum_k A_k) v are
