@@ -999,7 +999,8 @@ def _nonlinear_problem(system, model, ring, parameters):
 
 
 @_with_progress
-def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_points=400, par2=None, from2=None, to2=None, **parameters):
+def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_points=400, par2=None, from2=None, to2=None, branch_point=None,
+               **parameters):
     """A branch of equilibria of a nonlinear DDE in one parameter (``ddemap equilibria``).
 
     ``system``: a JSON file (variables, parameters, equations, equilibrium guess), or ``model``
@@ -1022,12 +1023,17 @@ def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_
     branch in ``par``), ``curves`` (each with ``points``: ``par``, ``par2``, ``x``,
     ``cusp_test``, ``bt_test``; ``special``: ``kind`` ``cusp`` or ``bogdanov_takens``, ``par``,
     ``par2``, ``status``).
+
+    ``branch_point`` K (``equilibria --branch-point K``): also the other branch of equilibria
+    through the branch's branch point K (from 0), followed towards ``to``, as ``switched``
+    (``from``: the point's ``index`` and ``par``; then the keys of a branch).
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     count = _integer("count", count, 1, 100)
     max_points = _integer("max_points", max_points, 2, 100000)
     return _result(_ddemap.equilibria(sys_, model_, n, p, par, _number("from_", from_), _number("to", to), count, max_points, par2 or "",
-                                      None if from2 is None else _number("from2", from2), None if to2 is None else _number("to2", to2)))
+                                      None if from2 is None else _number("from2", from2), None if to2 is None else _number("to2", to2),
+                                      None if branch_point is None else _integer("branch_point", branch_point, 0, 1000000)))
 
 
 @_with_progress

@@ -941,7 +941,7 @@ void second_parameter(NonlinearProblem& pb, const EquilibriumBranchOptions& o, c
 
 std::string py_equilibria(const std::string& system_file, const std::string& model, int ring, const ParameterMap& parameters,
                           const std::string& par, double from, double to, int count, int max_points, const std::string& par2,
-                          std::optional<double> from2, std::optional<double> to2) {
+                          std::optional<double> from2, std::optional<double> to2, std::optional<int> branch_point) {
     NonlinearProblem pb = nonlinear_problem(system_file, model, ring, parameters, par, from, to);
     EquilibriumBranchOptions o;
     o.parameter = par;
@@ -952,6 +952,7 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
     pb.inputs.string("par", par).number("from", o.from).number("to", o.to).integer("count", o.roots.count);
     const bool two = !par2.empty();
     if (!two && (from2 || to2)) throw std::invalid_argument("from2/to2 without par2: expected par2=NAME with them");
+    if (two && branch_point) throw std::invalid_argument("branch_point: not with par2 (expected one branch in par)");
     JsonEnvelope e;
     e.command = "equilibria";
     e.has_solver = true;  // as the CLI: the root method (its names there: shift_invert = sparse, contour = product)
@@ -970,11 +971,41 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
         return envelope_json(e);
     }
     o.progress = branch_interruptible();
-    const EquilibriumBranch b = released([&] { return equilibrium_branch(*pb.system, pb.guess, o); });
+    EquilibriumBranch b = released([&] { return equilibrium_branch(*pb.system, pb.guess, o); });
+    // the other branch through branch point K (as equilibria --branch-point)
+    std::string switched;
+    if (branch_point) {
+        const int k = *branch_point;
+        std::vector<const FoldPoint*> points;
+        for (const FoldPoint& f : b.folds)
+            if (f.kind == "branch_point") points.push_back(&f);
+        if (points.empty())
+            throw std::invalid_argument("branch_point = " + std::to_string(k) + ": the branch has no branch point in " + par + " from " + json_number(from) +
+                                        " to " + json_number(to) + " (expected at least one to switch at)");
+        if (k >= static_cast<int>(points.size()))
+            throw std::invalid_argument("branch_point = " + std::to_string(k) + ": expected an index from 0 to " + std::to_string(points.size() - 1));
+        const FoldPoint& bp = *points[static_cast<std::size_t>(k)];
+        pb.inputs.integer("branch_point", k);
+        EquilibriumBranch nb;
+        if (bp.status != Status::Converged) {
+            nb.status = bp.status;
+            nb.message = "branch point " + std::to_string(k) + " was not located: no branch switched onto";
+        } else {
+            nb = released([&] { return equilibrium_branch_from_branch_point(*pb.system, b, bp, o); });
+        }
+        if (nb.status != Status::Converged && b.status == Status::Converged) {
+            b.status = nb.status;
+            b.message = "the other branch at the branch point: " + nb.message;
+        }
+        JsonObject from_j;
+        from_j.integer("index", k).number("par", bp.par);
+        switched = ",\"switched\":{\"from\":" + from_j.str() + "," + equilibrium_branch_json(nb, pb.variables).substr(1);
+    }
     e.inputs = pb.inputs.str();
     e.status = to_string(b.status);
     e.message = b.message;
     e.result = equilibrium_branch_json(b, pb.variables);
+    if (!switched.empty()) e.result = e.result.substr(0, e.result.size() - 1) + switched + "}";
     return envelope_json(e);
 }
 
@@ -1253,7 +1284,8 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("paper", &py_paper, py::arg("prefix"));
     m.def("atlas", &py_atlas, py::arg("text"), py::arg("source"), py::arg("prefix"), py::arg("allow_large"));
     m.def("equilibria", &py_equilibria, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),
-          py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"), py::arg("par2"), py::arg("from2"), py::arg("to2"));
+          py::arg("from_"), py::arg("to"), py::arg("count"), py::arg("max_points"), py::arg("par2"), py::arg("from2"), py::arg("to2"),
+          py::arg("branch_point"));
     m.def("hopf", &py_hopf, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("par2"), py::arg("from2"), py::arg("to2"), py::arg("max_points"));
     m.def("bistability", &py_bistability, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"),

@@ -370,6 +370,17 @@ def test_orbits_period_doubling():
         ddemap.orbits("tau", 0.3, 1.5, system=system, points=200, period_doubling=3)
 
 
+def test_equilibria_branch_point():
+    # the other branch of Hutchinson's equation through its branch point: the command's envelope, x = p
+    system = os.path.join(SOURCE, "examples", "hutchinson.json")
+    r = ddemap.equilibria("p", -1, 2, system=system, branch_point=0)
+    same_envelope(r, cli_json("equilibria", "--system", system, "--par", "p", "--from", -1, "--to", 2, "--branch-point", 0))
+    sw = r["switched"]
+    assert all(abs(x[0] - p) < 1e-12 for x, p in zip(sw["points"]["x"], sw["points"]["par"]))
+    with pytest.raises(ValueError, match="branch_point = 2: expected an index from 0 to 0"):
+        ddemap.equilibria("p", -1, 2, system=system, branch_point=2)
+
+
 def test_orbits_from_simulation_and_guess(tmp_path):
     # the starts other than a Hopf point: the command's envelopes, and the same orbit of Wright's
     # equation at alpha = 1.7 from a file, a DataFrame and a pair of arrays
