@@ -23,7 +23,8 @@ AccRing acc_test_ring(int n, double k2 = 0.338) { return AccRing(n, 0.052, k2, 0
 }  // namespace
 
 TEST_CASE("acc ring: the saturation passes 0 with slope 1, stays between the limits and has the derivatives of its closed form") {
-    for (const auto& [hi, lo] : {std::pair<double, double>{2.0, -3.0}, {2.0, -2.0}, {1.0, -6.0}}) {
+    for (const std::pair<double, double>& limits : {std::pair<double, double>{2.0, -3.0}, {2.0, -2.0}, {1.0, -6.0}}) {
+        const double hi = limits.first, lo = limits.second;  // (clang 14: no structured bindings inside CAPTURE's lambda)
         CAPTURE(hi);
         CAPTURE(lo);
         CHECK(std::abs(AccRing::saturate(0.0, hi, lo)) < 1e-15);

@@ -460,11 +460,10 @@ TEST_CASE("Mackey-Glass (beta = 2, gamma = 1, n = 9.65): the branch switched ont
     // second, twice that period again
     const double mid = 0.5 * (pd.par + pd2.par);
     const SimulatedOrbit between = mackey_glass_orbit(mg, mid), above = mackey_glass_orbit(mg, pd2.par + 0.01);
-    const auto [T_mid, max_mid] = branch_at(d, mid);
-    const auto [T_old, max_old] = branch_at(b, mid);
-    const auto [T_above, max_above] = branch_at(d, pd2.par + 0.01);
-    (void)max_old;
-    (void)max_above;
+    const std::pair<double, double> at_mid = branch_at(d, mid);
+    const double T_mid = at_mid.first, max_mid = at_mid.second;
+    const double T_old = branch_at(b, mid).first;
+    const double T_above = branch_at(d, pd2.par + 0.01).first;
     MESSAGE("tau = ", mid, ": simulated period ", between.period, " (", between.maxima_per_period, " maxima), doubled branch ", T_mid,
             ", old branch ", T_old, "; tau = ", pd2.par + 0.01, ": simulated ", above.period, ", doubled branch ", T_above);
     REQUIRE(between.period > 0.0);
