@@ -374,52 +374,23 @@ int run_orbits() {
         }
     }
 
-    // the curves of folds in (par, par2): one per fold of the branch that lies on none already traced
-    std::vector<OrbitFoldCurve> curves, pd_curves;
-    std::vector<int> curve_fold, curve_pd;  // the index of the fold (period doubling) each curve starts from
-    // on a curve already traced: a segment of it crosses par2 = held at p
-    auto on_curve = [&](const std::vector<OrbitFoldCurve>& traced, double held, double p) {
-        for (const OrbitFoldCurve& c : traced)
-            for (std::size_t i = 0; i + 1 < c.points.size(); ++i) {
-                const OrbitFoldCurvePoint &a = c.points[i], &z = c.points[i + 1];
-                if ((a.par2 - held) * (z.par2 - held) > 0.0 || a.par2 == z.par2) continue;
-                if (std::abs(a.par + (z.par - a.par) * (held - a.par2) / (z.par2 - a.par2) - p) <= 1e-6 * std::abs(o.to - o.from)) return true;
-            }
-        return false;
-    };
+    // the curves of folds and of period doublings in (par, par2) through the branch's special points
+    OrbitBranchCurves bc;
     if (two) {
         inputs.string("par2", fo.parameter2).number("from2", fo.from2).number("to2", fo.to2);
         fo.orbit = o;
-        const double held = built.system->parameter_values()[static_cast<std::size_t>(built.system->parameter_index(fo.parameter2))];
-        for (std::size_t k = 0; k < b.folds.size(); ++k) {
-            const OrbitFold& f = b.folds[k];
-            if (!f.located) continue;
-            if (on_curve(curves, held, f.par)) continue;
-            fo.orbit.progress = branch_progress_printer("orbits", "fold curve points", par, false);
-            curves.push_back(orbit_fold_curve(*built.system, f, fo));
-            fo.orbit.progress = nullptr;
-            curve_fold.push_back(static_cast<int>(k));
-            const OrbitFoldCurve& c = curves.back();
-            if (c.status != Status::Converged && b.status == Status::Converged) {
-                b.status = c.status;
-                b.message = "the fold curve from the fold at " + par + " = " + rounded(f.par, 10) + ": " + c.message;
-            }
-        }
-        // and one curve of period doublings per located period doubling of the branch
-        for (std::size_t k = 0; k < b.period_doublings.size(); ++k) {
-            const OrbitCrossing& d = b.period_doublings[k];
-            if (!d.located || on_curve(pd_curves, held, d.par)) continue;
-            fo.orbit.progress = branch_progress_printer("orbits", "period doubling curve points", par, false);
-            pd_curves.push_back(orbit_period_doubling_curve(*built.system, d, fo));
-            fo.orbit.progress = nullptr;
-            curve_pd.push_back(static_cast<int>(k));
-            const OrbitFoldCurve& c = pd_curves.back();
-            if (c.status != Status::Converged && b.status == Status::Converged) {
-                b.status = c.status;
-                b.message = "the period doubling curve from the doubling at " + par + " = " + rounded(d.par, 10) + ": " + c.message;
-            }
+        fo.orbit.progress = branch_progress_printer("orbits", "curve points", par, false);
+        bc = orbit_curves_of_branch(*built.system, b, fo);
+        fo.orbit.progress = nullptr;
+        if (bc.status != Status::Converged && b.status == Status::Converged) {
+            b.status = bc.status;
+            b.message = bc.message;
         }
     }
+    const std::vector<OrbitFoldCurve>& curves = bc.folds;
+    const std::vector<OrbitFoldCurve>& pd_curves = bc.period_doublings;
+    const std::vector<int>& curve_fold = bc.fold_index;
+    const std::vector<int>& curve_pd = bc.period_doubling_index;
 
     JsonEnvelope e;
     e.command = "orbits";

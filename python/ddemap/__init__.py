@@ -1120,7 +1120,8 @@ def _guess_rows(guess):
 
 
 def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4, intervals=40, points=100, adapt=False,
-           max_step=None, period_doubling=None, from_simulation=None, history=None, guess=None, **parameters):
+           max_step=None, period_doubling=None, from_simulation=None, history=None, guess=None, par2=None, from2=None, to2=None,
+           **parameters):
     """The branch of periodic orbits born at a Hopf point (``ddemap orbits``).
 
     The problem as in :func:`equilibria`; the equilibrium branch from ``from_`` to ``to`` gives
@@ -1141,7 +1142,9 @@ def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4,
     10 %; the command's ``--from-simulation``, ``--history``), or from an orbit ``guess``: a CSV
     file (t and one column per variable, the rows covering one period), a table in memory with
     those columns, or a pair (times, states) (``--guess``). Then ``start`` says how instead of
-    ``hopf``.
+    ``hopf``. With ``par2``, ``from2``, ``to2`` (``--par2``): every fold of the branch continued
+    as a curve of folds and every period doubling as a curve of period doublings in
+    (par, par2), as ``fold_curves`` and ``period_doubling_curves``.
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     step = None if max_step is None else _number("max_step", max_step)
@@ -1155,4 +1158,5 @@ def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4,
                                   _integer("hopf", hopf, 0, 1000000), _integer("degree", degree, 1, 20),
                                   _integer("intervals", intervals, 2, 10000), _integer("points", points, 2, 100000), bool(adapt),
                                   step, None if period_doubling is None else _integer("period_doubling", period_doubling, 0, 1000000),
-                                  t_end, hist, times, states, label))
+                                  t_end, hist, times, states, label, par2 or "",
+                                  None if from2 is None else _number("from2", from2), None if to2 is None else _number("to2", to2)))

@@ -1084,7 +1084,13 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
                       double from, double to, int hopf, int degree, int intervals, int points, bool adapt, std::optional<double> max_step,
                       std::optional<int> period_doubling, std::optional<double> from_simulation, std::optional<std::vector<double>> history,
                       std::optional<std::vector<double>> guess_times, std::optional<std::vector<std::vector<double>>> guess_states,
-                      const std::string& guess_label) {
+                      const std::string& guess_label, const std::string& par2, std::optional<double> from2, std::optional<double> to2) {
+    const bool two = !par2.empty();
+    if (!two && (from2 || to2)) throw std::invalid_argument("from2/to2 without par2: expected par2=NAME with them");
+    if (two && (!from2 || !to2)) throw std::invalid_argument("par2 needs from2 and to2: expected the box of " + par2);
+    if (two && par2 == par) throw std::invalid_argument("par2 = '" + par2 + "': expected a parameter other than par");
+    if (two && !(*from2 < *to2)) throw std::invalid_argument("from2 = " + json_number(*from2) + ", to2 = " + json_number(*to2) + ": expected from2 < to2");
+    if (two && adapt) throw std::invalid_argument("par2: not with adapt (the curves are computed on the uniform mesh)");
     const bool from_sim = from_simulation.has_value(), from_data = guess_times.has_value();
     if (from_sim && from_data) throw std::invalid_argument("from_simulation and guess: expected one start of the orbits");
     if (history && !from_sim) throw std::invalid_argument("history: only with from_simulation (expected from_simulation=T_END)");
@@ -1212,6 +1218,25 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
             b.message = "the branch of twice the period: " + doubled.message;
         }
     }
+    // the curves of folds and of period doublings in (par, par2) (as orbits --par2)
+    OrbitBranchCurves bc;
+    if (two) {
+        const double held = pb.system->parameter_values()[static_cast<std::size_t>(pb.system->parameter_index(par2))];
+        if (!(held >= *from2 && held <= *to2))
+            throw std::invalid_argument("par2 " + par2 + " = " + json_number(held) + " (its value in the system): expected it in [from2, to2]");
+        pb.inputs.string("par2", par2).number("from2", *from2).number("to2", *to2);
+        OrbitFoldCurveOptions fo;
+        fo.orbit = o;
+        fo.parameter2 = par2;
+        fo.from2 = *from2;
+        fo.to2 = *to2;
+        fo.orbit.progress = branch_interruptible();
+        bc = released([&] { return orbit_curves_of_branch(*pb.system, b, fo); });
+        if (bc.status != Status::Converged && b.status == Status::Converged) {
+            b.status = bc.status;
+            b.message = bc.message;
+        }
+    }
     JsonEnvelope e;
     e.command = "orbits";
     e.inputs = pb.inputs.str();
@@ -1225,6 +1250,9 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     } else {
         e.result = "{\"start\":" + start_json + "," + result.substr(1);
     }
+    if (two)
+        e.result = e.result.substr(0, e.result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(bc.folds, pb.variables) +
+                   ",\"period_doubling_curves\":" + orbit_fold_curves_json(bc.period_doublings, pb.variables) + "}";
     if (period_doubling) {
         const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(*period_doubling)];
         JsonObject from_j;
@@ -1294,5 +1322,5 @@ PYBIND11_MODULE(_ddemap, m) {
     m.def("orbits", &py_orbits, py::arg("system"), py::arg("model"), py::arg("ring"), py::arg("parameters"), py::arg("par"), py::arg("from_"),
           py::arg("to"), py::arg("hopf"), py::arg("degree"), py::arg("intervals"), py::arg("points"), py::arg("adapt"), py::arg("max_step"),
           py::arg("period_doubling"), py::arg("from_simulation"), py::arg("history"), py::arg("guess_times"), py::arg("guess_states"),
-          py::arg("guess_label"));
+          py::arg("guess_label"), py::arg("par2"), py::arg("from2"), py::arg("to2"));
 }

@@ -370,6 +370,17 @@ def test_orbits_period_doubling():
         ddemap.orbits("tau", 0.3, 1.5, system=system, points=200, period_doubling=3)
 
 
+def test_orbits_par2():
+    # the curves of period doublings in two parameters: the command's envelope
+    system = os.path.join(SOURCE, "examples", "mackey_glass.json")
+    r = ddemap.orbits("tau", 0.3, 2, system=system, points=200, par2="n", from2=9, to2=10.5)
+    same_envelope(r, cli_json("orbits", "--system", system, "--par", "tau", "--from", 0.3, "--to", 2, "--points", 200, "--par2", "n",
+                              "--from2", 9, "--to2", 10.5))
+    assert len(r["period_doubling_curves"]["points"]) == 1 and r["fold_curves"] == []  # (a list of curves comes back as columns)
+    with pytest.raises(ValueError, match="par2 needs from2 and to2"):
+        ddemap.orbits("tau", 0.3, 2, system=system, par2="n", from2=9)
+
+
 def test_equilibria_branch_point():
     # the other branch of Hutchinson's equation through its branch point: the command's envelope, x = p
     system = os.path.join(SOURCE, "examples", "hutchinson.json")

@@ -1795,6 +1795,42 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
     return orbit_bifurcation_curve(system, fold.orbit, fold.par, false, options);
 }
 
+OrbitBranchCurves orbit_curves_of_branch(const NonlinearDDE& system, const OrbitBranch& branch, const OrbitFoldCurveOptions& options) {
+    const double held = system.parameter_values()[static_cast<std::size_t>(system.parameter_index(options.parameter2))];
+    const double range = std::abs(options.orbit.to - options.orbit.from);
+    // on a curve already traced: a segment of it crosses parameter2 = held at p
+    auto on_curve = [&](const std::vector<OrbitFoldCurve>& traced, double p) {
+        for (const OrbitFoldCurve& c : traced)
+            for (std::size_t i = 0; i + 1 < c.points.size(); ++i) {
+                const OrbitFoldCurvePoint &a = c.points[i], &z = c.points[i + 1];
+                if ((a.par2 - held) * (z.par2 - held) > 0.0 || a.par2 == z.par2) continue;
+                if (std::abs(a.par + (z.par - a.par) * (held - a.par2) / (z.par2 - a.par2) - p) <= 1e-6 * range) return true;
+            }
+        return false;
+    };
+    OrbitBranchCurves r;
+    auto note = [&](const OrbitFoldCurve& c, const std::string& what, double p) {
+        if (c.status == Status::Converged || r.status != Status::Converged) return;
+        r.status = c.status;
+        r.message = "the " + what + " curve from the " + what + " at " + options.orbit.parameter + " = " + detail::format_number(p) + ": " + c.message;
+    };
+    for (std::size_t k = 0; k < branch.folds.size(); ++k) {
+        const OrbitFold& f = branch.folds[k];
+        if (!f.located || on_curve(r.folds, f.par)) continue;
+        r.folds.push_back(orbit_fold_curve(system, f, options));
+        r.fold_index.push_back(static_cast<int>(k));
+        note(r.folds.back(), "fold", f.par);
+    }
+    for (std::size_t k = 0; k < branch.period_doublings.size(); ++k) {
+        const OrbitCrossing& d = branch.period_doublings[k];
+        if (!d.located || on_curve(r.period_doublings, d.par)) continue;
+        r.period_doublings.push_back(orbit_period_doubling_curve(system, d, options));
+        r.period_doubling_index.push_back(static_cast<int>(k));
+        note(r.period_doublings.back(), "period doubling", d.par);
+    }
+    return r;
+}
+
 OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const OrbitCrossing& pd, const OrbitFoldCurveOptions& options) {
     if (!pd.located || pd.orbit.profile.size() == 0)
         throw std::invalid_argument("period doubling curve: expected a located period doubling with its orbit");

@@ -346,6 +346,21 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
 /// and for a period doubling that is not located.
 OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const OrbitCrossing& pd, const OrbitFoldCurveOptions& options);
 
+/// The curves in two parameters through a branch's special points (orbit_curves_of_branch).
+struct OrbitBranchCurves {
+    std::vector<OrbitFoldCurve> folds, period_doublings;
+    std::vector<int> fold_index, period_doubling_index;  ///< the fold (period doubling) of the branch each curve starts from
+    Status status = Status::Converged;  ///< of the first curve that did not converge, with its message
+    std::string message;
+};
+
+/// Every located fold of `branch` continued as a curve of folds (orbit_fold_curve) and every
+/// located period doubling as a curve of period doublings (orbit_period_doubling_curve), in
+/// (options.orbit.parameter, options.parameter2); a point that lies on a curve of its kind already
+/// traced (a segment of it crosses the held parameter2 within 1e-6 of the first parameter's range
+/// from the point) starts none. options.orbit.progress reports every curve's points.
+OrbitBranchCurves orbit_curves_of_branch(const NonlinearDDE& system, const OrbitBranch& branch, const OrbitFoldCurveOptions& options);
+
 /// x(s) of an orbit on `mesh` at s (any real: taken mod 1), all n components (for an orbit of a
 /// branch: PeriodicMesh(branch.degree, orbit.breakpoints)).
 Eigen::VectorXd orbit_value(const PeriodicMesh& mesh, const Eigen::MatrixXd& profile, double s);
