@@ -51,6 +51,10 @@ bool has_control(const std::string& text) {
 
 std::string quoted(const std::string& text) { return "'" + escaped(text, 80) + "'"; }
 
+void require_value(bool ok, const char* name, double value, const char* expected) {
+    if (!ok) throw std::invalid_argument(std::string(name) + " = " + format_number(value) + ": expected " + expected);
+}
+
 std::string format_number(double v) {
     char buf[40];
     for (int p = 15; p <= 17; ++p) {

@@ -9,22 +9,20 @@
 namespace ddemap {
 
 namespace {
-void require(bool ok, const char* name, double value, const char* expected) {
-    if (!ok) throw std::invalid_argument(std::string(name) + " = " + detail::format_number(value) + ": expected " + expected);
-}
+using detail::require_value;
 }  // namespace
 
 IdmRing::IdmRing(int cars, double a, double b, double v0, double delta, double th, double eta, double tau, double gap)
     : NonlinearDDEOf({"a", "b", "v0", "delta", "th", "eta", "tau", "gap"}, {a, b, v0, delta, th, eta, tau, gap}), m_cars(cars) {
     if (cars < 2) throw std::invalid_argument("a ring needs at least 2 cars, got " + std::to_string(cars));
-    require(std::isfinite(a) && a > 0.0, "a", a, "a finite value > 0 [m/s^2]");
-    require(std::isfinite(b) && b > 0.0, "b", b, "a finite value > 0 [m/s^2]");
-    require(std::isfinite(v0) && v0 > 0.0, "v0", v0, "a finite value > 0 [m/s]");
-    require(std::isfinite(delta) && delta > 0.0, "delta", delta, "a finite value > 0");
-    require(std::isfinite(th) && th >= 0.0, "th", th, "a finite value >= 0 [s]");
-    require(std::isfinite(eta) && eta >= 0.0, "eta", eta, "a finite value >= 0 [m]");
-    require(std::isfinite(tau) && tau >= 0.0, "tau", tau, "a finite value >= 0 [s]");
-    require(std::isfinite(gap) && gap > eta, "gap", gap, "a finite mean gap > eta (a uniform flow exists only then) [m]");
+    require_value(std::isfinite(a) && a > 0.0, "a", a, "a finite value > 0 [m/s^2]");
+    require_value(std::isfinite(b) && b > 0.0, "b", b, "a finite value > 0 [m/s^2]");
+    require_value(std::isfinite(v0) && v0 > 0.0, "v0", v0, "a finite value > 0 [m/s]");
+    require_value(std::isfinite(delta) && delta > 0.0, "delta", delta, "a finite value > 0");
+    require_value(std::isfinite(th) && th >= 0.0, "th", th, "a finite value >= 0 [s]");
+    require_value(std::isfinite(eta) && eta >= 0.0, "eta", eta, "a finite value >= 0 [m]");
+    require_value(std::isfinite(tau) && tau >= 0.0, "tau", tau, "a finite value >= 0 [s]");
+    require_value(std::isfinite(gap) && gap > eta, "gap", gap, "a finite mean gap > eta (a uniform flow exists only then) [m]");
 }
 
 double IdmRing::equilibrium_speed(double gap) const {

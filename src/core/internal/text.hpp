@@ -10,6 +10,9 @@ namespace ddemap::detail {
 /// The shortest of %.15g, %.16g, %.17g that reads back to the same double (for messages).
 std::string format_number(double v);
 
+/// std::invalid_argument "NAME = VALUE: expected EXPECTED" unless `ok` (a model's parameter check).
+void require_value(bool ok, const char* name, double value, const char* expected);
+
 /// v with `digits` significant digits (%g style: "1.49", "6.9e-10"), for human messages.
 std::string significant(double v, int digits);
 
