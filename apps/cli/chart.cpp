@@ -32,7 +32,7 @@ int run_chart() {
     const ChartSpec spec = parse_chart_spec(read_input_file("SPEC", chart_args.spec), chart_args.spec);
     if (!spec.panels.empty()) check_sweep_size(panel_sweep(spec, 0), "chart", false, spec.panels.size());  // panels share the window and ring
     ExecutionPolicy policy;
-    policy.progress = progress_printer("chart", "panels");
+    policy.progress = progress_printer("chart", "grid rows of all panels");
     const RenderedChart r = render_chart(spec, policy);
     const auto files = chart_files(r, prefix);
     // an earlier run's panels beyond this chart's are not left beside it: PREFIX-panelK*.csv, K > panels

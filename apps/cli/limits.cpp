@@ -69,6 +69,21 @@ void check_size(const std::string& command, const std::string& what, const std::
                  what.c_str(), noun.c_str(), show(estimate).c_str(), show(limit).c_str());
 }
 
+void announce_estimate(const std::string& command, const std::string& what, double seconds) {
+    if (seconds > 10.0 && !run_flags().quiet)
+        std::fprintf(stderr, "ddemap: %s: note: %s: estimated run time %s\n", command.c_str(), what.c_str(), human_seconds(seconds).c_str());
+}
+
+std::function<void(const RootWorkEstimate&)> root_size_guard(const std::string& command, const std::string& what) {
+    return [command, what](const RootWorkEstimate& e) {
+        const std::string method = e.method == "shift_invert" ? "sparse" : e.method == "contour" ? "product" : e.method;
+        const std::string full = "the " + method + " root search of " + what + " (" + e.basis + ")";
+        check_size(command, full, "memory", e.bytes);
+        check_size(command, full, "time", e.seconds);
+        announce_estimate(command, full, e.seconds);
+    };
+}
+
 namespace {
 
 /// What the printers share: quiet for the first second (short runs print nothing), on a
@@ -163,11 +178,15 @@ BranchProgress search_progress_printer(const std::string& command, const std::st
     if (run_flags().quiet) return nullptr;
     auto printer = std::make_shared<Printer>(command);
     auto last = std::make_shared<long>(-1);
+    auto last_time = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
     const bool tty = isatty(2) != 0;
     return [=](long done, long total, double value) {
-        // a step repeated from within a long one (the dense eigenvalues): on a terminal the
-        // time is redrawn, otherwise one line per finished step is kept
-        if (!tty && done == *last) return;
+        // a step repeated from within a long one (the dense eigenvalues, the Arnoldi steps of a
+        // shift): on a terminal the time is redrawn, otherwise one line per finished step and,
+        // within a long step, one every 10 s (the log shows the search is alive)
+        const auto now = std::chrono::steady_clock::now();
+        if (!tty && done == *last && std::chrono::duration<double>(now - *last_time).count() < 10.0) return;
+        if (!tty) *last_time = now;
         *last = done;
         char v[32];
         std::snprintf(v, sizeof v, "%.6g", value);

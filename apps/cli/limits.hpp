@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "ddemap/core/execution.hpp"
+#include "ddemap/solve/roots.hpp"
 
 namespace ddemap::cli {
 
@@ -33,6 +34,16 @@ RunFlags& run_flags();
 /// `kind`: "memory", "output" or "time" (bytes, bytes, seconds).
 void check_size(const std::string& command, const std::string& what, const std::string& kind, double estimate);
 
+/// Above 10 s (and without --quiet): `ddemap: COMMAND: note: WHAT: estimated run time 3.6 min`
+/// on stderr, so that long work is sized before it starts. Called when every input has been
+/// checked (an error after it would make the error two lines).
+void announce_estimate(const std::string& command, const std::string& what, double seconds);
+
+/// The size guard of a root search (RootOptions::before): check_size on the predicted memory and
+/// run time of `what` (estimate_root_work, "a ring of 20000 cars"), named with how the prediction
+/// was made.
+std::function<void(const RootWorkEstimate&)> root_size_guard(const std::string& command, const std::string& what);
+
 /// "1.5 GB", "340 MB", "12 kB"; "2.5 min", "3.1 h".
 std::string human_bytes(double bytes);
 std::string human_seconds(double seconds);
@@ -57,7 +68,8 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
 /// steps (the root searches of roots --fleet and --system): the budget is a bound, not the work
 /// to come, so no time left is estimated and the line says so:
 /// `command: step 37 of at most 200000, Re = -0.41 (4.2 s; time left unknown)`. On a terminal
-/// one line redrawn in place; otherwise one line per finished step, at most one a second.
+/// one line redrawn in place; otherwise one line per finished step, at most one a second, and
+/// within a long step one every 10 s.
 BranchProgress search_progress_printer(const std::string& command, const std::string& par);
 
 /// A root search's progress callback with the run-time limit: a search bounded only by its step

@@ -1,4 +1,5 @@
 // mix: the penetration-rate study (study/penetration) on a ring of N cars.
+#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -52,7 +53,9 @@ namespace {
 /// grows only to DenseRootOptions::max_rows = 3000 rows, so above about 50 cars the dense
 /// path may stop undecided, budget_exhausted, rather than use more). The output:
 /// about 600 bytes per fraction (a CSV row, a JSON record and an SVG marker).
-void size_mix(const MixOptions& o) {
+/// Checks the study's size; returns what it is and its estimated run time (announced once the
+/// output is prepared).
+std::pair<std::string, double> size_mix(const MixOptions& o) {
     const double arrangements = static_cast<double>(o.fractions.size()) * (o.draws + 1.0);
     const double cars = o.cars, n = 2.0 * o.cars;
     const std::string& method = o.ring.roots.method;
@@ -73,6 +76,7 @@ void size_mix(const MixOptions& o) {
     check_size("mix", what, "memory", bytes);
     check_size("mix", what, "output", 600.0 * static_cast<double>(o.fractions.size()));
     check_size("mix", what, "time", seconds * arrangements);
+    return {what, seconds * arrangements};
 }
 
 }  // namespace
@@ -98,8 +102,9 @@ int run_mix() {
     o.ring.roots.method = root_method(mix_args.solver);
     o.ring.roots.count = 4;
     o.validate();
-    size_mix(o);
+    const std::pair<std::string, double> size = size_mix(o);
     const std::string prefix = mix_args.out.prepare("mix");
+    announce_estimate("mix", size.first, size.second);
     // one line per arrangement solved: ddemap: mix: arrangements 3/11, p = 0.2 (1.2 s, about 3 s left)
     o.progress = branch_progress_printer("mix", "arrangements", "p", true);
     const std::vector<MixPoint> pts = penetration_study(x, y, o);

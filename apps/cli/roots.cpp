@@ -132,6 +132,7 @@ int run_system(Format format, const std::string& prefix) {
     }
     const LinearDDE& dde = *lin;
     o.progress = root_progress();
+    o.before = root_size_guard("roots", "a " + std::to_string(dde.dimension()) + "-state system");
     const SystemRootResult s = analyse_system(dde, o);
     const RootResult& r = s.roots;
     JsonEnvelope e;
@@ -183,6 +184,7 @@ int run_fleet(Format format, const std::string& prefix) {
     o.roots.count = parse_count();
     o.roots.degree = parse_degree();
     o.roots.progress = root_progress();
+    o.roots.before = root_size_guard("roots", "a ring of " + std::to_string(fleet.size()) + " cars");
     const MixedRingResult r = analyse_mixed_ring(fleet, o);
     const RootResult& rr = r.roots;
     JsonEnvelope e;
@@ -214,7 +216,8 @@ int run_fleet(Format format, const std::string& prefix) {
                             : std::string("not among the rightmost roots"))
         << "\n";
     if (!std::isnan(r.product_residual)) out << "check      max |prod Gamma_i(lambda) - 1| = " << rounded(r.product_residual, 3) << "\n";
-    out << "abscissa   " << rounded(r.spectral_abscissa, 10) << " 1/s\n";
+    // no root computed (a cancelled or failed search): the table says so, never "-inf"
+    out << "abscissa   " << (std::isfinite(r.spectral_abscissa) ? rounded(r.spectral_abscissa, 10) + " 1/s" : std::string("none (no root was computed)")) << "\n";
     if (rr.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(rr.status) << ")\n\n";
     else
         out << "verdict    " << verdict_word(r.verdict) << " ("

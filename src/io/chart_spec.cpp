@@ -36,6 +36,11 @@ Axis read_axis(const std::string& source, const toml::table& root, const char* k
     const toml::node* n = root.get(key);
     if (!n || !n->is_table()) throw std::invalid_argument(source + ": [" + std::string(key) + "] table missing: expected name, lo, hi, count");
     const toml::table& t = *n->as_table();
+    for (const auto& [k, v] : t) {  // a misspelt key (cout = 50) is an error, never ignored
+        const std::string ks(k.str());
+        if (ks != "name" && ks != "lo" && ks != "hi" && ks != "count")
+            throw std::invalid_argument(where(source, v) + ": " + key + ": unknown key " + detail::quoted(ks) + ": expected name, lo, hi, count");
+    }
     Axis a;
     const toml::node* name = t.get("name");
     if (!name || !name->is_string()) throw std::invalid_argument(where(source, *n) + ": " + key + ".name: expected a parameter name");
@@ -250,11 +255,15 @@ RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy)
         out.specs[i].validate();
     }
     for (std::size_t i = 0; i < n; ++i) {
+        // the panel's rows reported as a share of all panels' rows (each panel has the same grid)
+        if (policy.progress)
+            per_panel.progress = [&policy, i, n](long done, long total) {
+                policy.progress(static_cast<long>(i) * total + done, static_cast<long>(n) * total);
+            };
         out.sweeps[i] = run_sweep(out.specs[i], per_panel);
         BoundaryOptions bo;
         bo.ring_curves = spec.ring_curves;
         if (spec.boundaries) out.boundaries[i] = trace_boundaries(out.sweeps[i], bo);
-        if (policy.progress) policy.progress(static_cast<long>(i + 1), static_cast<long>(n));
     }
     std::vector<ChartPanel> panels(n);
     for (std::size_t i = 0; i < n; ++i) {

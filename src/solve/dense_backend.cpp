@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -227,12 +228,50 @@ std::vector<Root> refine_all(const LinearDDE& dde, const std::vector<cplx>& cand
     return found;
 }
 
+/// The first collocation degree and the largest one tried: the largest degree whose
+/// collocation matrix has at most max_rows rows caps them; the first degree is computed whatever
+/// its size (a given degree as asked, an automatic one not above the cap unless M = 8 is), later
+/// ones not beyond the larger of the two.
+std::pair<int, int> dense_degrees(const LinearDDE& dde, const RootOptions& options) {
+    const DenseRootOptions& o = options.dense;
+    const int max_degree = std::max(o.max_degree, options.degree);
+    const int row_degree = o.max_rows / std::max(1, dde.dimension()) - 1;
+    int m = options.degree > 0 ? options.degree : std::clamp(degree_for_radius(dde.root_bound(0.0), dde.max_delay()), 8, max_degree);
+    if (options.degree == 0) m = std::min(m, std::max(row_degree, 8));
+    return {m, std::max(row_degree, m)};
+}
+
 }  // namespace
+
+RootWorkEstimate dense_estimate(const RootProblem& problem, const RootOptions& options) {
+    const LinearDDE& dde = problem.dde;
+    RootWorkEstimate e;
+    const double n = dde.dimension();
+    // Eigen's eigenvalues on one core (measured: 2 s at 1,000 real rows, 19 s at 2,000)
+    const double c = dde.is_real() ? 2e-9 : 8e-9, scalar = dde.is_real() ? 8.0 : 16.0;
+    std::ostringstream os;
+    os.precision(3);
+    if (dde.is_ode()) {
+        e.units = 1;
+        e.seconds = c * n * n * n;
+        e.bytes = 3.0 * scalar * n * n;
+        os << "the eigenvalues of one " << n << "-row matrix";
+    } else {
+        const auto [first, cap] = dense_degrees(dde, options);
+        const double r1 = (first + 1.0) * n, r2 = std::min((cap + 1.0) * n, 1.5 * r1);
+        e.units = 2;
+        e.seconds = c * (r1 * r1 * r1 + r2 * r2 * r2);
+        e.bytes = 3.0 * scalar * std::max(r1, r2) * std::max(r1, r2);
+        os << "the eigenvalues of two collocation degrees, " << r1 << " and " << r2 << " rows";
+    }
+    e.basis = os.str();
+    return e;
+}
 
 std::string dense_why_not(const RootProblem& problem, const RootOptions& /*options*/) {
     if (problem.dde.dimension() > 4000)
         return "method 'dense': " + std::to_string(problem.dde.dimension()) +
-               " states are too many for dense collocation (at most 4000): expected auto or shift_invert";
+               " states are too many for dense collocation (at most 4000): expected auto or shift_invert (the sparse path)";
     return {};
 }
 
@@ -341,13 +380,9 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         }
     }
     const int max_degree = std::max(o.max_degree, options.degree);
-    // the largest degree whose collocation matrix has at most max_rows rows; the first degree is
-    // computed whatever its size (a given degree as asked, an automatic one not above the cap
-    // unless M = 8 is), later ones not beyond the larger of the two
-    const int row_degree = o.max_rows / std::max(1, dde.dimension()) - 1;
-    int m = options.degree > 0 ? options.degree : std::clamp(degree_for_radius(dde.root_bound(0.0), tau), 8, max_degree);
-    if (options.degree == 0) m = std::min(m, std::max(row_degree, 8));
-    const int cap_degree = std::max(row_degree, m);
+    const std::pair<int, int> degrees = dense_degrees(dde, options);
+    int m = degrees.first;
+    const int cap_degree = degrees.second;
     std::vector<Root> previous;
     std::size_t previous_in_strip = 0;
     int previous_degree = 0;

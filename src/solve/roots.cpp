@@ -15,9 +15,9 @@ namespace {
 
 /// THE registry: every backend of rightmost_roots, in one place.
 const detail::RootBackend kBackends[] = {
-    {"dense", detail::dense_why_not, detail::dense_roots},
-    {"shift_invert", detail::shift_invert_why_not, detail::shift_invert_roots},
-    {"contour", detail::contour_why_not, detail::contour_roots},
+    {"dense", detail::dense_why_not, detail::dense_roots, detail::dense_estimate},
+    {"shift_invert", detail::shift_invert_why_not, detail::shift_invert_roots, detail::shift_invert_estimate},
+    {"contour", detail::contour_why_not, detail::contour_roots, detail::contour_estimate},
 };
 
 const detail::RootBackend* find_backend(const std::string& name) {
@@ -115,6 +115,9 @@ bool RootOptions::is_valid(std::string* why) const {
     } else if (shift_invert.max_shifts < 1) {
         os << "shift_invert.max_shifts = " << shift_invert.max_shifts << ": expected an integer >= 1";
         ok = false;
+    } else if (!(std::isfinite(shift_invert.expected_shifts) && shift_invert.expected_shifts >= 0.0)) {
+        os << "shift_invert.expected_shifts = " << shift_invert.expected_shifts << ": expected a finite number >= 0 (0 = automatic)";
+        ok = false;
     } else if (shift_invert.arnoldi != "compact" && shift_invert.arnoldi != "spectra") {
         os << "shift_invert.arnoldi = '" << shift_invert.arnoldi << "': expected compact or spectra";
         ok = false;
@@ -174,8 +177,20 @@ std::string choose_root_method(const RootProblem& problem, const RootOptions& op
     return "shift_invert";
 }
 
+RootWorkEstimate estimate_root_work(const RootProblem& problem, const RootOptions& options) {
+    const std::string method = choose_root_method(problem, options);
+    RootWorkEstimate e = find_backend(method)->estimate(problem, options);
+    e.method = method;
+    return e;
+}
+
 RootResult rightmost_roots(const RootProblem& problem, const RootOptions& options) {
     const std::string method = choose_root_method(problem, options);
+    if (options.before) {
+        RootWorkEstimate e = find_backend(method)->estimate(problem, options);
+        e.method = method;
+        options.before(e);
+    }
     RootResult r;
     long units = 0;
     try {

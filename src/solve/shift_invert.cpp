@@ -63,6 +63,15 @@ public:
     }
     double flops() const { return m_flops; }
     double nonzeros() const { return m_nonzeros; }
+    /// After analyzePattern: UMFPACK's symbolic estimates of the factorisation (upper bounds):
+    /// its flops, the nonzeros of L and U, and the bytes of the numeric object.
+    double flops_estimate() const { return std::max(0.0, m_umfpackInfo[UMFPACK_FLOPS_ESTIMATE]); }
+    double nonzeros_estimate() const {
+        return std::max(0.0, m_umfpackInfo[UMFPACK_LNZ_ESTIMATE]) + std::max(0.0, m_umfpackInfo[UMFPACK_UNZ_ESTIMATE]);
+    }
+    double bytes_estimate() const {
+        return std::max(0.0, m_umfpackInfo[UMFPACK_NUMERIC_SIZE_ESTIMATE]) * std::max(0.0, m_umfpackInfo[UMFPACK_SIZE_OF_UNIT]);
+    }
 
 private:
     double m_flops = 0.0, m_nonzeros = 0.0;
@@ -292,7 +301,8 @@ public:
     /// The run described above; `first_check`: steps before Ritz values are first computed.
     /// `goal` > 0: also stop once the converged prefix's disc |z - sigma| < 1/|theta_last|
     /// (shrunk by the same 1e-6 margin as the covering's) reaches that radius.
-    /// `between` (may be empty) is called before every restart (it may throw, e.g. Cancelled).
+    /// `between` (may be empty) is called after every step and before every restart (it may
+    /// throw, e.g. Cancelled: a long shift reports, and can be stopped, while it runs).
     /// `costly` (may be empty): asked at a check where something converged but not yet nev,
     /// with the steps taken, those up to the next check and the converged count; true stops the
     /// run there (its disc is then the converged prefix's, as at any other stop).
@@ -306,6 +316,7 @@ public:
         for (;;) {
             step();
             ++out.steps;
+            if (between) between();
             out.max_rank = std::max(out.max_rank, m_r);
             if (m_k < check && !m_invariant && m_k < m_kmax) continue;
             ritz(tol, out);
@@ -912,7 +923,7 @@ public:
             const bool factored = compact_arnoldi(m_op, sigma, nev, static_cast<int>(std::min<Eigen::Index>(ncv, kmax)), kmax,
                                                   m_o.compact_restarts, keep, m_o.arnoldi_tolerance,
                                                   m_o.compact_restarts > 0 ? goal : 0.0, probe, [&] {
-                                                      // a long run reports again (same count) before each restart
+                                                      // a long run reports again (same count) after each step
                                                       if (m_progress && *m_progress)
                                                           (*m_progress)(m_before + m_shifts - 1, m_o.max_shifts, sigma.real());
                                                   }, costly, rz);
@@ -1075,6 +1086,8 @@ public:
                 // is the smaller the farther right it holds
                 const double h = 0.5 * std::hypot(cw, ch);
                 const double x0 = std::max(m_floor, mx - h);
+                // a test costs an LU of Delta: it reports (the shifts done so far) and may be cancelled
+                if (m_progress && *m_progress) (*m_progress)(m_before + m_shifts, m_o.max_shifts, mx);
                 const double r = m_res->free_radius(cplx(mx, my), x0, h);
                 if (r >= h) {
                     ++m_excluded;
@@ -1345,6 +1358,69 @@ std::string shift_invert_why_not(const RootProblem& problem, const RootOptions& 
     return {};
 }
 
+namespace {
+
+/// The first collocation degree: the given one, or the one resolving the first strip's cells
+/// (compact: those covered by Arnoldi discs, so a huge root bound of a stiff system does not set
+/// it). The first strip is deep, Re >= min(0, beta) - 1 / tau.
+int first_shift_invert_degree(const LinearDDE& dde, const RootOptions& options) {
+    const ShiftInvertRootOptions& so = options.shift_invert;
+    const double tau = dde.max_delay(), beta = dde.bounds().right_bound();
+    const double first_radius = dde.bounds().radius(std::min(0.0, beta) - 1.0 / tau);
+    const bool compact = so.arnoldi == "compact";
+    return options.degree > 0 ? options.degree
+                              : std::clamp(degree_for_radius(compact ? std::min(first_radius, std::abs(beta) + 8.0 * M_PI / tau) : first_radius, tau), 8,
+                                           std::max(so.max_degree, options.degree));
+}
+
+}  // namespace
+
+RootWorkEstimate shift_invert_estimate(const RootProblem& problem, const RootOptions& options) {
+    const LinearDDE dde = problem.dde.to_sparse();
+    const ShiftInvertRootOptions& so = options.shift_invert;
+    const double n = dde.dimension(), m = first_shift_invert_degree(dde, options);
+    UmfLU lu;
+    no_refinement(lu);
+    const SpC pattern = union_pattern(dde).cast<cplx>();
+    lu.analyzePattern(pattern);
+    // UMFPACK's symbolic estimates are upper bounds (3 times the flops and 2 times the nonzeros of
+    // random systems, 30 times the flops of a 2-D grid): when they promise an LU of under 20 s,
+    // Delta is factorised once at the right bound of the roots and its true size is used (a
+    // fraction of the 4 LUs per shift the search itself makes)
+    // (otherwise a third of the bound's flops: the ratio on random systems, the worst for fill)
+    double lu_flops = lu.flops_estimate() / 3.0, lu_nonzeros = lu.nonzeros_estimate(), lu_bytes = lu.bytes_estimate();
+    bool measured = false;
+    if (lu.flops_estimate() / 4.5e9 < 20.0) {
+        const double beta = dde.bounds().right_bound();
+        SpC d = dde.sparse_characteristic_matrix(cplx(std::isfinite(beta) ? std::max(beta, 0.0) + 0.5 : 1.0, 0.0)) + cplx(0.0) * pattern;
+        d.makeCompressed();
+        lu.factorize_counted(d);
+        if (lu.info() == Eigen::Success && lu.nonzeros() > 0.0) {
+            lu_flops = lu.flops();
+            lu_bytes *= lu.nonzeros() / std::max(1.0, lu_nonzeros);
+            lu_nonzeros = lu.nonzeros();
+            measured = true;
+        }
+    }
+    // one shift, as measured (BENCHMARKS.md): about 4 LU factorisations (the shift's and the
+    // resolvent tests', at about 4.5e9 flops per second), 100 solves (Arnoldi and Lanczos
+    // steps; 8 flops per nonzero of L and U) and 30 Arnoldi steps on the (M+1) n blocks with the
+    // orthogonalisation; memory: two LUs, the compact basis (its rank stayed below 80), the blocks
+    const double steps = std::min(30.0, static_cast<double>(so.compact_max_steps));
+    const double per_shift = 4.0 * lu_flops / 4.5e9 + (100.0 * 8.0 * lu_nonzeros + steps * (m + 1.0) * n * 20.0 + steps * steps * n * 8.0) / 1e9;
+    const double shifts = std::min(so.expected_shifts > 0.0 ? so.expected_shifts : 6.0, static_cast<double>(so.max_shifts));
+    RootWorkEstimate e;
+    e.units = shifts;
+    e.seconds = shifts * per_shift;
+    e.bytes = 2.0 * lu_bytes + 16.0 * n * (std::min(80.0, static_cast<double>(so.compact_max_steps)) + 2.0 * (m + 1.0)) + 3e7;
+    std::ostringstream os;
+    os.precision(3);
+    os << "about " << std::ceil(shifts) << " Arnoldi shifts of " << per_shift << " s each: sparse LU of " << lu_nonzeros << " nonzeros and "
+       << lu_flops << " flops (" << (measured ? "one factorised" : "a third of UMFPACK's symbolic upper bound") << "), M = " << m;
+    e.basis = os.str();
+    return e;
+}
+
 RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& options) {
     const SingleThreadedEigen single;  // the Krylov products are too small for OpenMP's threads
     const LinearDDE dde = problem.dde.to_sparse();
@@ -1359,12 +1435,7 @@ RootResult shift_invert_roots(const RootProblem& problem, const RootOptions& opt
     // a deep first strip: the floor rises as soon as `count` eigenvalues are known
     double alpha = std::min(0.0, beta) - 1.0 / tau;
     const bool compact = so.arnoldi == "compact";
-    // compact: the degree need only resolve the cells covered by Arnoldi discs (raised below),
-    // so a huge root bound (stiff systems) does not set it
-    const double first_radius = bounds.radius(std::min(0.0, beta) - 1.0 / tau);
-    int m = options.degree > 0 ? options.degree
-                               : std::clamp(degree_for_radius(compact ? std::min(first_radius, std::abs(beta) + 8.0 * M_PI / tau) : first_radius, tau),
-                                            8, max_degree);
+    int m = first_shift_invert_degree(dde, options);
     const Gershgorin gersh(dde);
     ResolventExclusion resolvent(dde);
     int max_rank = 0;

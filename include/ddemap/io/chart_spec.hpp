@@ -65,7 +65,7 @@ struct RenderedChart {
 };
 
 /// Panels run one after the other (each sweep in parallel under `policy`); the policy's
-/// progress counts finished panels.
+/// progress counts the grid rows swept, over all panels (rows done, rows of every panel).
 RenderedChart render_chart(const ChartSpec& spec, const ExecutionPolicy& policy = {});
 
 /// The files of a rendered chart: PREFIX.svg, and for panel K its grid PREFIX-panelK.csv (as

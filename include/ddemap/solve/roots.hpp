@@ -78,6 +78,10 @@ struct ShiftInvertRootOptions {
     bool refine = true;                ///< Newton refinement on Delta(lambda) (off: eigenvalues only)
     double collocation_tolerance = 1e-8; ///< |eigenvalue - root| / max(1, |lambda|) accepted
     NewtonOptions newton{30, 1e-14};
+    /// For estimate_root_work only: the shifts the search is expected to take; 0 = 6 (a system
+    /// whose rightmost roots are few and apart: 3 to 5 shifts measured on random sparse systems).
+    /// A ring sets 1.2 sqrt(n): its roots crowd the imaginary axis as it grows (measured).
+    double expected_shifts = 0.0;
 };
 
 /// Options of the contour backend.
@@ -86,6 +90,29 @@ struct ContourRootOptions {
     int max_cells = 200000;             ///< give up (BudgetExhausted) after this many cell counts
     double max_type_evaluations = 2e9;  ///< or after this many evaluations (times evaluation_cost)
     NewtonOptions newton{60, 1e-14};    ///< Newton on D; a root is accepted at |step| <= 1e-8 max(1,|lambda|)
+};
+
+/// The predicted cost of rightmost_roots(problem, options), computed before it runs so that a
+/// caller can refuse work that would take too long (the CLI's size guard). Cheap: at most the symbolic
+/// analysis of one sparse LU and one factorisation that the analysis promises short.
+///  - dense: the eigenvalues of the first two collocation degrees, c r^3 seconds each for r =
+///    (M+1) n rows (c = 2e-9 real, 8e-9 complex; Eigen's solver on one core, measured), memory
+///    3 r^2 scalars;
+///  - shift_invert: shift_invert.expected_shifts x (4 sparse LU factorisations + 100 solves + 30
+///    Arnoldi steps); the LU's flops and nonzeros from one factorisation of Delta at the right
+///    bound of the roots when UMFPACK's symbolic analysis (an upper bound, up to 30 times the
+///    true flops) promises it in under 20 s, else a third of that bound (the ratio on random
+///    systems, the worst for fill); LUs at 4.5e9 flops per
+///    second, the rest at 1e9; memory: two LUs, the compact Krylov basis and the (M+1) n blocks;
+///  - contour: about 100 rectangle counts and 7e5 evaluations of D for 7 roots (more for more),
+///    0.3 us per evaluation and unit of evaluation_cost (measured on rings; independent of N).
+/// An estimate, not a bound: BENCHMARKS.md compares it with measured runs.
+struct RootWorkEstimate {
+    std::string method;      ///< the backend that would run (choose_root_method)
+    double seconds = 0.0;    ///< predicted run time on one core
+    double bytes = 0.0;      ///< predicted peak memory
+    double units = 0.0;      ///< predicted units of work: degrees (dense), shifts (shift_invert), counts (contour)
+    std::string basis;       ///< how the prediction was made, one clause ("about 170 shifts of 0.35 s each")
 };
 
 /// The options of rightmost_roots: what is asked (shared) and how each backend works.
@@ -104,10 +131,15 @@ struct RootOptions {
     /// (M+1) n >= 200 states also between its stages (collocation_eigenvalues), the last call
     /// repeated (the previous degree and its sigma; 0 and NaN within the first degree) so that
     /// Cancelled stops it there (a real one is not interrupted); shift_invert:
-    /// before each Arnoldi shift, (shifts done, max_shifts, Re sigma); contour: after each
+    /// before each Arnoldi shift, (shifts done, max_shifts, Re sigma), repeated after each of its
+    /// Arnoldi steps and before each resolvent test (Re of its centre); contour: after each
     /// rectangle count, (counts done, max_cells, its left edge). May be empty. Throwing ddemap::Cancelled
     /// (core/execution.hpp) stops the work: rightmost_roots then returns Status::Cancelled.
     BranchProgress progress;
+    /// Called by rightmost_roots with estimate_root_work's prediction before any work starts,
+    /// when set: it may throw (a size guard refusing the work; the exception leaves
+    /// rightmost_roots) or announce the estimate. May be empty (then nothing is estimated).
+    std::function<void(const RootWorkEstimate&)> before;
     /// True when the options are usable; otherwise `why` (if given) names the field, e.g.
     /// "count = 0: expected an integer >= 1", "dense.max_degree: ...".
     bool is_valid(std::string* why = nullptr) const;
@@ -175,6 +207,10 @@ RootResult rightmost_roots(const LinearDDE& dde, const RootOptions& options = {}
 /// The backend "auto" would choose for this problem (or the forced one, checked); throws
 /// std::invalid_argument when options.method does not apply to the problem.
 std::string choose_root_method(const RootProblem& problem, const RootOptions& options);
+
+/// The predicted cost of rightmost_roots(problem, options) (RootWorkEstimate); throws
+/// std::invalid_argument as choose_root_method does.
+RootWorkEstimate estimate_root_work(const RootProblem& problem, const RootOptions& options);
 
 /// The registered backend names ("dense", "shift_invert", "contour").
 std::vector<std::string> root_methods();

@@ -43,6 +43,9 @@ MixedRingResult analyse_mixed_ring(const Fleet& fleet, const MixedRingOptions& o
     RootOptions ro = options.roots;
     ro.count = options.roots.count + 1;  // room for the trivial root
     const RootProblem problem = ring_root_problem(lins);
+    // the sparse path's size guard (estimate_root_work): a ring's roots crowd the imaginary axis
+    // as it grows, the shifts grew like 1.2 sqrt(n) (measured, BENCHMARKS.md)
+    if (ro.shift_invert.expected_shifts == 0.0) ro.shift_invert.expected_shifts = std::max(16.0, 1.2 * std::sqrt(static_cast<double>(problem.dde.dimension())));
     const bool one_leader = std::all_of(lins.begin(), lins.end(), [](const Linearisation& l) { return l.leaders() == 1; });
     // the facade chooses (auto: contour for one-leader rings unless a degree is asked) or checks the forced method
     RootResult r = rightmost_roots(problem, ro);

@@ -1,5 +1,5 @@
 // The progress callback of the root backends (RootOptions::progress) and its cancellation: one
-// call per unit of work (contour counts, Arnoldi shifts, dense degrees, counted independently by
+// call per unit of work (contour counts, Arnoldi shifts and their steps, dense degrees, counted independently by
 // the result's own counters), and a callback that throws ddemap::Cancelled stops the work with
 // Status::Cancelled, no roots and an undecided verdict (how Ctrl-C stops roots --system and
 // mixed_ring from Python); any other exception reaches the caller as it is.
@@ -79,17 +79,27 @@ TEST_CASE("mixed ring, product path: one progress call per contour count, Cancel
     CHECK(cancelled.roots.message.find("cancelled") != std::string::npos);
 }
 
-TEST_CASE("mixed ring, sparse path: one progress call per Arnoldi shift, Cancelled gives Status::Cancelled") {
+TEST_CASE("mixed ring, sparse path: a progress call per Arnoldi shift and step, Cancelled gives Status::Cancelled") {
     const Fleet fleet = fleet_from_pattern("A_min,C_max", 20);
     MixedRingOptions o = ring_options("shift_invert");
     Seen seen;
     o.roots.progress = recorder(seen);
     const MixedRingResult r = analyse_mixed_ring(fleet, o);
     REQUIRE(r.roots.status == Status::Converged);
-    CHECK(static_cast<long>(seen.done.size()) == r.roots.shifts);
-    for (std::size_t i = 0; i < seen.done.size(); ++i) CHECK(seen.done[i] == static_cast<long>(i));  // shifts done before each
+    // each shift reports the shifts done before it, then again (the same count) after every
+    // Arnoldi step within it, and each resolvent test between shifts the shifts done: the counts
+    // never decrease and take every value 0 .. shifts - 1 (and shifts, after the last one)
+    std::vector<long> distinct;
+    for (std::size_t i = 0; i < seen.done.size(); ++i) {
+        if (i > 0) CHECK(seen.done[i] >= seen.done[i - 1]);
+        if (distinct.empty() || distinct.back() != seen.done[i]) distinct.push_back(seen.done[i]);
+    }
+    CHECK(static_cast<long>(distinct.size()) >= r.roots.shifts);
+    CHECK(static_cast<long>(distinct.size()) <= r.roots.shifts + 1);
+    for (std::size_t i = 0; i < distinct.size(); ++i) CHECK(distinct[i] == static_cast<long>(i));
+    CHECK(static_cast<long>(seen.done.size()) >= r.roots.shifts + r.roots.arnoldi_steps);
     REQUIRE(r.roots.shifts >= 1);
-    // cancelled at the last shift's call (this ring needs one shift)
+    // cancelled within the last shift's Arnoldi steps
     const long last = static_cast<long>(seen.done.size());
     Seen stopped;
     o.roots.progress = recorder(stopped, last);
@@ -165,4 +175,46 @@ TEST_CASE("ring N = inf: the search stopped within its one long dense degree sto
     CHECK_THROWS_AS(analyse_ring(lin, 0, o), Cancelled);
     REQUIRE(done.size() == 2);
     CHECK(done[0] > 0);  // the first degree finished, then a call from within the next one
+}
+
+TEST_CASE("estimate_root_work: the predicted shifts of a ring against the run's, and the before callback refuses before any work") {
+    // a ring's shifts grow like 1.2 sqrt(n) (n = 2 N states): the prediction is within a factor
+    // of 1.6 of the shifts the search then takes (16 at 200 cars, 54 at 1000: BENCHMARKS.md)
+    for (int cars : {200, 1000}) {
+        CAPTURE(cars);
+        const Fleet fleet = fleet_from_pattern("A_min,B_min", cars);
+        MixedRingOptions o = ring_options("shift_invert");
+        RootWorkEstimate seen;
+        int calls = 0;
+        o.roots.before = [&seen, &calls](const RootWorkEstimate& e) {
+            seen = e;
+            ++calls;
+        };
+        const MixedRingResult r = analyse_mixed_ring(fleet, o);
+        REQUIRE(r.roots.status == Status::Converged);
+        CHECK(calls == 1);
+        CHECK(seen.method == "shift_invert");
+        CHECK(seen.units <= 1.6 * r.roots.shifts);
+        CHECK(seen.units >= r.roots.shifts / 1.6);
+        CHECK(seen.seconds > 0.0);
+        CHECK(seen.bytes > 0.0);
+        CHECK(seen.basis.find("Arnoldi shifts") != std::string::npos);
+    }
+    // the callback throws: nothing else runs (no progress call), the exception reaches the caller
+    const Fleet fleet = fleet_from_pattern("A_min,B_min", 200);
+    MixedRingOptions o = ring_options("shift_invert");
+    Seen seen;
+    o.roots.progress = recorder(seen);
+    o.roots.before = [](const RootWorkEstimate&) { throw std::invalid_argument("too large"); };
+    CHECK_THROWS_WITH_AS(analyse_mixed_ring(fleet, o), "too large", std::invalid_argument);
+    CHECK(seen.done.empty());
+    // the method is the one the facade would choose
+    o.roots.method = "auto";
+    o.roots.before = nullptr;
+    const RootProblem p{LinearDDE(MatrixXc::Zero(1, 1), {{MatrixXc::Constant(1, 1, -1.0), 1.0}}), nullptr};
+    RootOptions ro;
+    CHECK(estimate_root_work(p, ro).method == choose_root_method(p, ro));
+    CHECK(estimate_root_work(p, ro).method == "dense");
+    ro.shift_invert.expected_shifts = -1.0;
+    CHECK_THROWS_AS(estimate_root_work(p, ro), std::invalid_argument);
 }
