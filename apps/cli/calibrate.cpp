@@ -89,7 +89,7 @@ void add_calibrate_flags(CLI::App& app) {
     app.add_option("--train", calibrate_args.train, "training window T0:T1 [s] (default: the whole file; the rest is the test part)");
     app.add_option("--model", calibrate_args.model, "the model to fit (ovrv)")->capture_default_str();
     app.add_option("--bounds", calibrate_args.bounds, "bounds NAME=LO:HI,... (default: the paper's k1=0:1,k2=0:1,th=0:3,tau=0:1,eta=5:15)");
-    app.add_option("--gap-weight", calibrate_args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2]")->capture_default_str();
+    app.add_option("--gap-weight", calibrate_args.gap_weight, "objective = MSE(speed) + W * MSE(gap) [W in 1/s^2, 0 to 1e6]")->capture_default_str();
     app.add_option("--lead-noise", calibrate_args.lead_noise,
                    "white noise on the measured lead speed that the fit corrects its bias for and the intervals allow for [m/s]: auto "
                    "estimates it from each trace's lead speed (its second differences), 0 takes the lead speed as exact")

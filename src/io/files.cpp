@@ -496,6 +496,11 @@ std::string read_text_file(const std::string& path) {
     if (::stat(path.c_str(), &st) != 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
     if (S_ISDIR(st.st_mode)) throw std::invalid_argument("'" + path + "' is a folder, expected a file");
     if (S_ISREG(st.st_mode)) inputs_read().emplace_back(st.st_dev, st.st_ino);
+    // a bound on what is read: a regular file by its size, a stream (a device such as /dev/zero,
+    // a pipe) while it is read, so that an endless one is refused instead of read for ever
+    constexpr std::size_t kMaxInputBytes = std::size_t(1) << 30;
+    const std::string too_large = "'" + path + "': more than 1 GB of text: expected an input file of at most 1 GB";
+    if (S_ISREG(st.st_mode) && static_cast<unsigned long long>(st.st_size) > kMaxInputBytes) throw std::invalid_argument(too_large);
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw std::invalid_argument("'" + path + "': cannot open the file (" + reason(errno) + ")");
     std::string text;
@@ -509,6 +514,10 @@ std::string read_text_file(const std::string& path) {
             throw std::invalid_argument("'" + path + "': cannot read the file (" + reason(err) + ")");
         }
         if (n == 0) break;
+        if (text.size() + static_cast<std::size_t>(n) > kMaxInputBytes) {
+            ::close(fd);
+            throw std::invalid_argument(too_large);
+        }
         text.append(buf, static_cast<std::size_t>(n));
     }
     ::close(fd);

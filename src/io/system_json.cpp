@@ -274,6 +274,9 @@ NonlinearSystemFile read_nonlinear_system_json(const std::string& text, const st
             if (!it.value().is_number()) fail(source, "parameters." + it.key(), "expected a number");
             const double v = it.value().get<double>();
             if (!std::isfinite(v)) fail(source, "parameters." + it.key(), "expected a finite number");
+            // a subnormal parameter (a delay of 1e-320) overflows 1 / tau: the coefficients' range
+            if (v != 0.0 && (std::abs(v) < 1e-100 || std::abs(v) > 1e100))
+                fail(source, "parameters." + it.key(), detail::format_number(v) + ": expected 0 or a finite magnitude from 1e-100 to 1e100");
             names.push_back(it.key());
             values.push_back(v);
         }

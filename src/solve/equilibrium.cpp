@@ -53,15 +53,17 @@ EquilibriumResult find_equilibrium(const NonlinearDDE& system, const Eigen::Vect
     }
     r.status = s.status;
     if (converged(s.status) && !(r.residual <= options.residual_tolerance)) r.status = Status::NumericalIssue;
+    // (a message never shows "inf" or "nan": the equations may be undefined at the point)
+    const std::string residual = std::isfinite(r.residual) ? detail::format_number(r.residual) : std::string("not finite (an equation is infinite or undefined there)");
     if (converged(r.status))
         r.message = "Newton converged in " + std::to_string(r.iterations) + " iterations, residual " + detail::format_number(r.residual);
     else if (s.status == Status::NumericalIssue)
         r.message = "Newton stopped after " + std::to_string(r.iterations) +
-                    " iterations: singular or non-finite Jacobian or residual " + detail::format_number(r.residual);
+                    " iterations: singular or non-finite Jacobian or residual " + residual;
     else if (s.status == Status::MaxIterations)
-        r.message = "Newton did not converge in " + std::to_string(r.iterations) + " iterations (residual " + detail::format_number(r.residual) + ")";
+        r.message = "Newton did not converge in " + std::to_string(r.iterations) + " iterations (residual " + residual + ")";
     else
-        r.message = "Newton converged in step but the residual " + detail::format_number(r.residual) + " exceeds " + detail::format_number(options.residual_tolerance);
+        r.message = "Newton converged in step but the residual " + residual + " exceeds " + detail::format_number(options.residual_tolerance);
     return r;
 }
 

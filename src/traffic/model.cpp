@@ -87,6 +87,8 @@ ParameterMap resolve(const std::string& model, const std::vector<ParameterSpec>&
         if (std::abs(v) > kMaxParameterMagnitude)
             throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected at most 1e12 [" +
                                         s.unit + "] in magnitude");
+        if (v != 0.0 && std::abs(v) < kMinParameterMagnitude)
+            throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected 0 or a magnitude of at least 2.2e-308 (a subnormal number overflows 1 / x) [" + s.unit + "]");
         if (s.lower_open ? !(v > s.lower) : !(v >= s.lower)) {
             throw std::invalid_argument(s.name + " = " + detail::format_number(v) + ": expected a value " + (s.lower_open ? "> " : ">= ") +
                                         detail::format_number(s.lower) + " [" + s.unit + "]");

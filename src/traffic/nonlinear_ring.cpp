@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <cmath>
 
 #include "ddemap/traffic/acc_ring.hpp"
 #include "ddemap/traffic/idm_ring.hpp"
+#include "ddemap/traffic/model.hpp"
 #include "ddemap/traffic/ov_ring.hpp"
 #include "core/internal/text.hpp"
 
@@ -30,6 +32,9 @@ NonlinearRing make_nonlinear_ring(const std::string& model, int cars, const Para
             for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
             throw std::invalid_argument(name + " is not a parameter of the " + model + " ring (" + list + ")");
         }
+        // a subnormal value (a delay of 1e-320) overflows 1 / tau in the analyses
+        if (value != 0.0 && std::abs(value) < kMinParameterMagnitude)
+            throw std::invalid_argument(name + " = " + detail::format_number(value) + ": expected 0 or a magnitude of at least 2.2e-308 (a subnormal number overflows 1 / x)");
     }
     auto get = [&](const std::string& name, double fallback) {
         const auto it = parameters.find(name);

@@ -2104,9 +2104,11 @@ expect_error "latin1.csv:2: byte 3 (0xEB) is not UTF-8" simulate --fleet "$ch/la
 # the same byte in an inline name is shown escaped: the message itself stays valid UTF-8
 "$bin" classify "$(printf 'ovrv:k1=0.1,k2=0.2,th=1.5,tau=0.3,name=Zo\xeb')" 2>"$ch/lat.err"; rc=$?
 [ $rc -eq 2 ] && grep -q 'name=Zo\\xeb' "$ch/lat.err" && iconv -f UTF-8 -t UTF-8 "$ch/lat.err" >/dev/null 2>&1 && ok || bad "inline non-UTF-8 name: exit $rc, $(cat -v "$ch/lat.err")"
-# numbers that underflow (1e-310) are finite: judged by their range, not called non-finite; overflow is named
+# numbers that underflow (1e-310) are finite: judged by their range (0 or a normal magnitude of
+# at least 2.2e-308: a subnormal overflows 1 / x), not called non-finite; overflow is named
 expect_error "expected a finite number (beyond the range of doubles" string --k1 1e999 --k2 0.2 --th 1.5 --tau 0.2
-"$bin" string --k1 0.2 --k2 1e-310 --th 1.5 --tau 0.2 >/dev/null 2>&1 && ok || bad "string --k2 1e-310 refused"
+expect_error "k2 = 9.99999999999997e-311: expected 0 or a magnitude of at least 2.2e-308 (a subnormal number overflows 1 / x) \[1/s\]" string --k1 0.2 --k2 1e-310 --th 1.5 --tau 0.2
+"$bin" string --k1 0.2 --k2 1e-300 --th 1.5 --tau 0.2 >/dev/null 2>&1 && ok || bad "string --k2 1e-300 refused"
 [ ! -e "$ch/lat.csv" ] && ok || bad "an output after a refused input"
 expect_error "expected a name without control characters" classify "ovrv:name=a$(printf '\001')b,k1=0.1,k2=0.2,th=1.5,tau=0.3"
 printf 'name,k1,k2,th,tau\nZo\xc3\xab,0.1,0.2,1.5,0.3\n' >"$ch/utf8.csv"
@@ -2150,6 +2152,33 @@ DDEMAP_TEST_TIME_LIMIT=1 "$bin" roots --fleet-pattern A_min,B_min --ring 20000 -
 rc=$?
 [ $rc -eq 4 ] && grep -q "stopped at the run-time limit of 1 s after step [0-9]* of at most [0-9]* (--allow-large lets it run on)" "$ch/tl.err" \
     && grep -q '"status": "cancelled"' "$ch/tl.json" && ok || bad "the run-time limit of a root search: exit $rc, $(cat "$ch/tl.err")"
+# ... and was sized before it started: its estimate (minutes) is announced first
+head -1 "$ch/tl.err" | grep -q "^ddemap: roots: note: the sparse root search of a ring of 20000 cars (about [0-9]* Arnoldi shifts of .* s each: sparse LU of .*): estimated run time .* min$" \
+    && ok || bad "the root search's estimate before it starts: $(head -1 "$ch/tl.err")"
+# a search predicted above the limit is refused at once (exit 2): 10^5 cars on the sparse path,
+# about 40 min (BENCHMARKS.md compares the prediction with measured runs)
+start_ns=$(date +%s%N)
+"$bin" roots --fleet-pattern A_min,B_min --ring 100000 --solver sparse >/dev/null 2>"$ch/big.err"; rc=$?
+[ $rc -eq 2 ] && [ "$(wc -l <"$ch/big.err")" -eq 1 ] &&
+    grep -q "^ddemap: error: the sparse root search of a ring of 100000 cars (about [0-9]* Arnoldi shifts of .*): estimated run time .* is above the limit 10 min (--allow-large runs it anyway)$" "$ch/big.err" &&
+    [ $(( ($(date +%s%N) - start_ns) / 1000000 )) -lt 10000 ] && ok || bad "the 10^5-car sparse ring: exit $rc, $(cat "$ch/big.err")"
+# the second fuzzing run's findings (issue: hostile input): a subnormal delay (1/tau overflows)
+# is refused wherever a parameter is read, never an internal error
+expect_error "tau = 9.99988867182683e-321: expected 0 or a magnitude of at least 2.2e-308 (a subnormal number overflows 1 / x) \[s\]" string --k1 0.2 --k2 0.3 --th 1.5 --tau 1e-320
+expect_error "tau = 4.94065645841247e-324: expected 0 or a magnitude of at least 2.2e-308" classify ovrv:k1=0.2,k2=0.6,th=2,tau=4.9e-324,eta=8
+expect_error "tau = 9.99988867182683e-321: expected 0 or a magnitude of at least 2.2e-308" hopf --model ov --ring 3 --tau 1e-320 --par headway --from 1.2 --to 3
+printf '{"variables": ["x"], "parameters": {"beta": 2, "gamma": 1, "n": 9.65, "tau": 1e-320}, "equations": ["beta*x(t - tau)/(1 + x(t - tau)^n) - gamma*x"], "equilibrium": [1]}' >"$ch/subnormal.json"
+expect_error "subnormal.json: parameters.tau: 9.99988867182683e-321: expected 0 or a finite magnitude from 1e-100 to 1e100" equilibria --system "$ch/subnormal.json" --par beta --from 1 --to 3
+# an endless stream is refused after 1 GB, not read for ever
+expect_error "'/dev/zero': more than 1 GB of text: expected an input file of at most 1 GB" roots --system /dev/zero
+# a gap weight that overflows the objective; a misspelt key of a chart axis
+expect_error "gap weight = 1e+308: expected a number from 0 to 1e6" calibrate "$(dirname "$0")/../../examples/openacc_runs.csv" --gap-weight 1e308
+printf 'title = "t"\n[x]\nname = "k1"\nlo = 0.1\nhi = 1\ncount = 5\ncout = 7\n[y]\nname = "k2"\nlo = 0.1\nhi = 1\ncount = 5\n[[panel]]\nth = 1.5\ntau = 0.1\n' >"$ch/axis.toml"
+expect_error "axis.toml:7: x: unknown key 'cout': expected name, lo, hi, count" chart "$ch/axis.toml" --out "$ch/axis"
+# a chart reports its grid rows (not only finished panels): a one-panel chart of 1.1 million
+# points once ran 25 s without a line
+DDEMAP_TEST_PROGRESS_AT_ONCE=1 "$bin" chart "$(dirname "$0")/../../maps/classification.toml" --out "$ch/rows" >/dev/null 2>"$ch/rows.err"
+grep -q "^ddemap: chart: grid rows of all panels 1/" "$ch/rows.err" && ok || bad "chart progress by rows: $(head -2 "$ch/rows.err")"
 # an output that is a link into /proc is found unwritable before the work (once: after it; access()
 # says yes to root there, a file made and dropped in the folder says no)
 ln -s /proc/self/status "$ch/proc.csv"

@@ -23,7 +23,8 @@ std::string normalize_input_text(std::string text);
 /// The whole file `path` as normalized text (normalize_input_text). std::invalid_argument
 /// "'PATH' is a folder, expected a file" or "'PATH': cannot open the file (REASON)"; a file
 /// that is not UTF-8 (e.g. a Latin-1 name) is refused naming its first bad byte:
-/// "PATH:LINE: byte K (0xNN) is not UTF-8: expected UTF-8 text".
+/// "PATH:LINE: byte K (0xNN) is not UTF-8: expected UTF-8 text". At most 1 GB is read (a
+/// larger file, or an endless stream such as /dev/zero, is refused).
 std::string read_text_file(const std::string& path);
 
 /// The file that writing `path` changes: `path` with every symbolic link followed (a link to a

@@ -62,6 +62,10 @@ struct ParameterSpec {
 /// analyses form (k1 (1 + th), eta + th v, N (eta + th v) for a ring) leave double range or mean
 /// nothing physical; refused with the value and the unit.
 constexpr double kMaxParameterMagnitude = 1e12;
+/// The smallest magnitude of a nonzero law parameter, the smallest normal double (2.2e-308):
+/// below it (a subnormal delay such as 1e-320) 1 / tau and the root bounds overflow to
+/// infinity; refused, 0 itself is allowed (tau = 1e-300 is computed, tests/analysis/stability/test_verdicts.cpp).
+constexpr double kMinParameterMagnitude = 2.2250738585072014e-308;
 
 /// The car-following law. Implementations validate their parameters on construction and
 /// throw std::invalid_argument with a one-line message naming the value and what was expected.

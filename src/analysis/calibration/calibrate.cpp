@@ -186,7 +186,9 @@ void CalibrationOptions::validate() const {
                                         ": expected lower >= 0");
     const double tau_max = bound("tau").upper;
     if (tau_max > 5.0) throw std::invalid_argument("bounds for 'tau': upper = " + detail::format_number(tau_max) + ": expected at most 5 s");
-    if (!(gap_weight >= 0.0 && std::isfinite(gap_weight))) throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected >= 0");
+    // W MSE(gap) must stay a finite number for gaps of kilometres: W at most 1e6 (the default 0.02)
+    if (!(gap_weight >= 0.0 && gap_weight <= 1e6))
+        throw std::invalid_argument("gap weight = " + detail::format_number(gap_weight) + ": expected a number from 0 to 1e6 [1/s^2]");
     if (!(step > 0.0 && step <= 0.5)) throw std::invalid_argument("step = " + detail::format_number(step) + ": expected 0 < step <= 0.5 s");
     if (design_points < 1) throw std::invalid_argument("design points = " + std::to_string(design_points) + ": expected at least 1");
     if (starts < 1 || starts > design_points)
@@ -1028,8 +1030,10 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
                                    fmt(upper ? pb.hi[i] : pb.lo[i]) + "): the best fit may lie outside the bounds; its interval is not reliable");
         }
         if (!e.fixed && finite && !(e.upper95 - e.lower95 <= pb.hi[i] - pb.lo[i]))
-            res.warnings.push_back(e.name + " is not determined by this trace: its 95 % interval [" + fmt3(e.lower95) + ", " + fmt3(e.upper95) +
-                                   "] is wider than its bounds [" + fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) + "]");
+            res.warnings.push_back(e.name + " is not determined by this trace: its 95 % interval " +
+                                   (std::isfinite(e.lower95) && std::isfinite(e.upper95) ? "[" + fmt3(e.lower95) + ", " + fmt3(e.upper95) + "]"
+                                                                                          : std::string("(unbounded: the trace does not inform it)")) +
+                                   " is wider than its bounds [" + fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) + "]");
         else if (!e.fixed && finite && !e.at_bound && (e.lower95 < pb.lo[i] || e.upper95 > pb.hi[i]))
             res.warnings.push_back(e.name + "'s 95 % interval [" + fmt3(e.lower95) + ", " + fmt3(e.upper95) + "] reaches beyond its bounds [" +
                                    fmt(pb.lo[i]) + ", " + fmt(pb.hi[i]) +

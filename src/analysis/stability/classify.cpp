@@ -154,8 +154,10 @@ VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eig
     std::string box;
     for (int i = 0; i < 5; ++i)
         if (std::isfinite(lo[i]) || std::isfinite(hi[i]))
-            box += std::string(box.empty() ? "" : ", ") + kNames[i] + " in [" + detail::format_number(lo[i]) + ", " +
-                   (std::isfinite(hi[i]) ? detail::format_number(hi[i]) + "]" : std::string("inf)"));
+            box += std::string(box.empty() ? "" : ", ") + kNames[i] +
+                   (!std::isfinite(hi[i])   ? " >= " + detail::format_number(lo[i])  // (no "inf" in a message)
+                    : !std::isfinite(lo[i]) ? " <= " + detail::format_number(hi[i])
+                                            : " in [" + detail::format_number(lo[i]) + ", " + detail::format_number(hi[i]) + "]");
 
     VerdictUncertainty out;
     out.domain = options.domain;
