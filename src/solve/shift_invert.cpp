@@ -1384,13 +1384,15 @@ RootWorkEstimate shift_invert_estimate(const RootProblem& problem, const RootOpt
     const SpC pattern = union_pattern(dde).cast<cplx>();
     lu.analyzePattern(pattern);
     // UMFPACK's symbolic estimates are upper bounds (3 times the flops and 2 times the nonzeros of
-    // random systems, 30 times the flops of a 2-D grid): when they promise an LU of under 20 s,
+    // random systems, 30 times the flops of a 2-D grid): when they promise a small LU of under 20 s,
     // Delta is factorised once at the right bound of the roots and its true size is used (a
     // fraction of the 4 LUs per shift the search itself makes)
     // (otherwise a third of the bound's flops: the ratio on random systems, the worst for fill)
     double lu_flops = lu.flops_estimate() / 3.0, lu_nonzeros = lu.nonzeros_estimate(), lu_bytes = lu.bytes_estimate();
     bool measured = false;
-    if (lu.flops_estimate() / 4.5e9 < 20.0) {
+    // (and at most 2e6 nonzeros: UMFPACK's time is not all flops, the ring of 10^6 cars, 1e7
+    // nonzeros and 5e7 flops by the bound, took over a minute to factorise)
+    if (lu.flops_estimate() / 4.5e9 < 20.0 && lu.nonzeros_estimate() <= 2e6) {
         const double beta = dde.bounds().right_bound();
         SpC d = dde.sparse_characteristic_matrix(cplx(std::isfinite(beta) ? std::max(beta, 0.0) + 0.5 : 1.0, 0.0)) + cplx(0.0) * pattern;
         d.makeCompressed();

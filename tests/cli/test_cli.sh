@@ -2162,6 +2162,12 @@ start_ns=$(date +%s%N)
 [ $rc -eq 2 ] && [ "$(wc -l <"$ch/big.err")" -eq 1 ] &&
     grep -q "^ddemap: error: the sparse root search of a ring of 100000 cars (about [0-9]* Arnoldi shifts of .*): estimated run time .* is above the limit 10 min (--allow-large runs it anyway)$" "$ch/big.err" &&
     [ $(( ($(date +%s%N) - start_ns) / 1000000 )) -lt 10000 ] && ok || bad "the 10^5-car sparse ring: exit $rc, $(cat "$ch/big.err")"
+# 10^6 cars: the estimate takes UMFPACK's bound instead of factorising (one LU of it ran over a
+# minute inside the estimate) and refuses on memory
+start_ns=$(date +%s%N)
+"$bin" roots --fleet-pattern A_min,B_min --ring 1000000 --solver sparse >/dev/null 2>"$ch/big6.err"; rc=$?
+[ $rc -eq 2 ] && grep -q "^ddemap: error: the sparse root search of a ring of 1000000 cars (.*UMFPACK's symbolic upper bound.*): estimated memory .* GB is above the limit 2 GB" "$ch/big6.err" &&
+    [ $(( ($(date +%s%N) - start_ns) / 1000000 )) -lt 30000 ] && ok || bad "the 10^6-car sparse ring: exit $rc, $(cat "$ch/big6.err")"
 # the second fuzzing run's findings (issue: hostile input): a subnormal delay (1/tau overflows)
 # is refused wherever a parameter is read, never an internal error
 expect_error "tau = 9.99988867182683e-321: expected 0 or a magnitude of at least 2.2e-308 (a subnormal number overflows 1 / x) \[s\]" string --k1 0.2 --k2 0.3 --th 1.5 --tau 1e-320

@@ -101,7 +101,7 @@ struct ContourRootOptions {
 ///  - shift_invert: shift_invert.expected_shifts x (4 sparse LU factorisations + 100 solves + 30
 ///    Arnoldi steps); the LU's flops and nonzeros from one factorisation of Delta at the right
 ///    bound of the roots when UMFPACK's symbolic analysis (an upper bound, up to 30 times the
-///    true flops) promises it in under 20 s, else a third of that bound (the ratio on random
+///    true flops) promises it in under 20 s with at most 2e6 nonzeros, else a third of that bound (the ratio on random
 ///    systems, the worst for fill); LUs at 4.5e9 flops per
 ///    second, the rest at 1e9; memory: two LUs, the compact Krylov basis and the (M+1) n blocks;
 ///  - contour: about 100 rectangle counts and 7e5 evaluations of D for 7 roots (more for more),

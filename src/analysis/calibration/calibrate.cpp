@@ -1054,7 +1054,8 @@ CalibrationResult fit_problem(const LsqProblem& pb, const CalibrationOptions& o)
         std::string which;
         for (int i = 0; i < 5; ++i)
             if (undetermined[static_cast<std::size_t>(i)]) which += (which.empty() ? "" : ", ") + std::string(names[i]);
-        res.warnings.push_back("J^T J is nearly singular (condition number " + fmt3(res.condition_number) + ")" +
+        res.warnings.push_back("J^T J is nearly singular (condition number " +
+                               (std::isfinite(res.condition_number) ? fmt3(res.condition_number) : std::string("beyond double range: singular")) + ")" +
                                (which.empty() ? std::string(": the parameters are strongly correlated") : ": " + which + " not determined by this trace"));
     }
     res.evaluations = pb.evaluations;
