@@ -387,4 +387,12 @@ constexpr double fold_curve_vs_branch = 1e-8;
 /// ring): the orbit's collocation error at small amplitude (degree 4, 40 intervals: ~1e-8) and the
 /// generalised Hopf point's location (1e-13 of L1's scale); 1e-6.
 constexpr double fold_curve_floor = 1e-6;
+/// The distance to the other string verdict (verdict_distance): the flip point is bisected on
+/// the segment from the car to 1e-6 of the distance, so the closed-form low-frequency coefficient
+/// B there is within ~1e-6 |grad B . (x - x0)| (~0.1 for the car tested; measured 1.7e-8) of 0; 1e-6.
+constexpr double verdict_flip_b = 1e-6;
+/// Its optimality (KKT: M (x - x0) parallel to grad B, M = diag(1 / x0^2)): the projection settles
+/// to steps of 1e-10 of the distance with gradients by differences (~1e-10); the bisection moves
+/// the point along the segment, not across the direction; 1 - cos(angle) below 1e-8.
+constexpr double verdict_flip_kkt = 1e-8;
 }  // namespace ddemap::test::tol

@@ -10,6 +10,7 @@
 #include "sweep_flags.hpp"
 #include "tables.hpp"
 #include "ddemap/analysis/calibration/calibrate.hpp"
+#include "ddemap/analysis/design/verdict_distance.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/io/cars.hpp"
 #include "ddemap/io/chart_spec.hpp"
@@ -22,7 +23,7 @@ namespace ddemap::cli {
 namespace {
 struct ClassifyArgs {
     std::string file, svg, samples = "4000", ring_samples = "200", seed = "1";
-    bool peak = false;
+    bool peak = false, distance = false;
     RingArg ring;
     FormatArg format;
     OutArg out;
@@ -41,6 +42,9 @@ void add_classify_flags(CLI::App& app) {
     app.add_option("--ring-samples", classify_args.ring_samples, "of these, how many are also classified as rings (a ring costs 30-400 string verdicts)")
         ->capture_default_str();
     app.add_option("--seed", classify_args.seed, "seed of the parameter samples")->capture_default_str();
+    app.add_flag("--distance", classify_args.distance,
+                 "also find the distance to the other string verdict: the smallest relative change of (k1, k2, th, tau), "
+                 "sqrt(sum ((x - x0) / x0)^2), that turns a string-stable car unstable or an unstable one stable (about 0.2 s more per car)");
     app.add_flag("--peak", classify_args.peak,
                  "also decide peak (L-infinity) string stability: ||h||_1 <= 1 for the impulse response h of Gamma (about 0.03 s more per car)");
     classify_args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
@@ -78,7 +82,7 @@ int run_classify() {
     {
         double seconds = 0.0;
         for (const auto& v : vehicles) {
-            seconds += (cars == 0 ? 0.08 : 0.011) + (classify_args.peak ? 0.03 : 0.0);
+            seconds += (cars == 0 ? 0.08 : 0.011) + (classify_args.peak ? 0.03 : 0.0) + (classify_args.distance ? 0.2 : 0.0);
             if (v.has_covariance) seconds += 0.0005 * uo.samples + (cars == 0 ? 0.09 : 0.008) * uo.ring_samples;
         }
         check_size("classify", counted(static_cast<long long>(vehicles.size()), "car"), "time", seconds / std::max(1, thread_count()));
@@ -93,12 +97,18 @@ int run_classify() {
     policy.progress = progress_printer("classify", "cars");  // one line per car classified
     StringOptions so;
     so.peak = classify_args.peak;
-    const auto rows = classify(vehicles, cars, uo, policy, so);
+    auto rows = classify(vehicles, cars, uo, policy, so);
+    if (classify_args.distance) {
+        ExecutionPolicy dp;
+        dp.progress = progress_printer("classify", "verdict distances");
+        add_verdict_distances(rows, {}, dp);
+    }
     JsonEnvelope e;
     e.command = "classify";
     JsonObject inputs;
     inputs.string("vehicles", source).json("ring", json_ring(cars));
     if (classify_args.peak) inputs.boolean("peak", true);
+    if (classify_args.distance) inputs.boolean("distance", true);
     for (const auto& r : rows)
         if (r.has_uncertainty) {
             inputs.integer("samples", uo.samples).integer("ring_samples", uo.ring_samples).integer("seed", static_cast<long long>(uo.seed));
@@ -126,6 +136,7 @@ int run_classify() {
         report_undecided(r.ring.status, "classify: " + r.vehicle.name + ": ring", r.ring.reason);
         if (r.string.peak && r.string.peak->verdict == Verdict::Undecided)
             report_undecided(r.string.peak->status, "classify: " + r.vehicle.name + ": peak", r.string.peak->message);
+        if (r.has_distance) report_undecided(r.distance.status, "classify: " + r.vehicle.name + ": verdict distance", r.distance.message);
     }
     return exit_code(status);
 }

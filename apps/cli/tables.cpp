@@ -31,6 +31,8 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
         std::snprintf(header, sizeof header, "   %-9s %10s", "peak", "||h||_1");
         out << header;
     }
+    const bool dist = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.has_distance; });
+    if (dist) out << "   flip at";
     out << "\n";
     // the units under their columns (c2: the w^2 coefficient of |D(i w)|^2 - |N(i w)|^2)
     std::snprintf(header, sizeof header, " %6s %6s %6s %6s %6s   %-9s %-9s %-9s %10s %7s %9s %7s", "1/s^2", "1/s", "s", "s", "m", "", "", "", "1",
@@ -40,6 +42,7 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
         std::snprintf(header, sizeof header, "   %-9s %10s", "", "1");
         out << header;
     }
+    if (dist) out << "  change";
     out << "\n";
     for (const auto& row : rows) {
         char line[256];
@@ -61,7 +64,17 @@ std::string classification_table(const std::vector<Classification>& rows, int ca
             else std::snprintf(line, sizeof line, "   %-9s %10s", pk ? word(pk->verdict).c_str() : "", pk && pk->verdict != Verdict::Undecided ? "inf" : "");
             out << line;
         }
+        if (dist) {
+            // the relative change of (k1, k2, th, tau) that flips the string verdict
+            if (row.has_distance && row.distance.status == Status::Converged) std::snprintf(line, sizeof line, " %8.1f %%", 100.0 * row.distance.distance);
+            else std::snprintf(line, sizeof line, " %10s", row.has_distance ? "undecided" : "-");
+            out << line;
+        }
         out << "\n";
+    }
+    if (dist) {
+        out << "\nflip at: the smallest relative change of (k1, k2, th, tau), sqrt(sum ((x - x0) / x0)^2), found to turn a string-stable car\n"
+               "unstable or an unstable one stable (certified verdicts on either side; a local search, docs/reference/outputs.md)\n";
     }
     bool any = false;
     for (const auto& row : rows) any = any || row.has_uncertainty;

@@ -30,6 +30,7 @@
 
 #include "ddemap/analysis/calibration/calibrate.hpp"
 #include "ddemap/analysis/design/design.hpp"
+#include "ddemap/analysis/design/verdict_distance.hpp"
 #include "ddemap/analysis/stability/classify.hpp"
 #include "ddemap/analysis/bifurcation/bistability.hpp"
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
@@ -438,7 +439,7 @@ py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const
 }
 
 std::string py_classify(const std::string& spec, const CarTables& tables, int cars, int samples, int ring_samples, unsigned long long seed,
-                        bool peak) {
+                        bool peak, bool distance) {
     std::vector<CalibratedVehicle> vehicles;
     std::string source = "the paper's calibration table (built in)";
     if (spec.empty()) {
@@ -456,12 +457,17 @@ std::string py_classify(const std::string& spec, const CarTables& tables, int ca
     policy.progress = interruptible();
     StringOptions so;
     so.peak = peak;
-    const auto rows = released([&] { return classify(vehicles, cars, uo, policy, so); });
+    const auto rows = released([&] {
+        auto out = classify(vehicles, cars, uo, policy, so);
+        if (distance) add_verdict_distances(out, {}, policy);
+        return out;
+    });
     JsonEnvelope e;
     e.command = "classify";
     JsonObject inputs;
     inputs.string("vehicles", source).json("ring", json_ring(cars));
     if (peak) inputs.boolean("peak", true);
+    if (distance) inputs.boolean("distance", true);
     for (const auto& r : rows)
         if (r.has_uncertainty) {
             inputs.integer("samples", uo.samples).integer("ring_samples", uo.ring_samples).integer("seed", static_cast<long long>(uo.seed));
@@ -1294,7 +1300,7 @@ PYBIND11_MODULE(_ddemap, m) {
           py::arg("peak"));
     m.def("boundary", &py_boundary, py::arg("model"), py::arg("fixed"), py::arg("x_name"), py::arg("x_axis"), py::arg("y_name"),
           py::arg("y_axis"), py::arg("ring"), py::arg("seed_grid"), py::arg("ring_curves"));
-    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"), py::arg("peak"));
+    m.def("classify", &py_classify, py::arg("vehicles"), py::arg("tables"), py::arg("ring"), py::arg("samples"), py::arg("ring_samples"), py::arg("seed"), py::arg("peak"), py::arg("distance"));
     m.def("simulate", &py_simulate, py::arg("fleet"), py::arg("tables"), py::arg("lead_profile"), py::arg("lead"), py::arg("lead_text"),
           py::arg("lead_car"), py::arg("on_event"), py::arg("t_end"), py::arg("step"), py::arg("output_dt"), py::arg("noise_speed"),
           py::arg("noise_gap"), py::arg("seed"));

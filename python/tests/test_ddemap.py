@@ -216,6 +216,17 @@ def test_classify():
     assert all(x == "unstable" for x in v["peak_verdict"]) and (np.asarray(v["sup_gamma"]) <= np.asarray(v["peak_norm"])).all()
     with pytest.raises(ValueError, match="peak = 1: expected True or False"):
         ddemap.classify(peak=1)
+    # the distance to the other verdict: as the command's, and a stable car of a DataFrame-like
+    # dict turns unstable at the parameters reported
+    r = ddemap.classify("C_max", distance=True)
+    same_envelope(r, cli_json("classify", "C_max", "--distance"))
+    r = ddemap.classify({"name": ["mine"], "k1": [0.2], "k2": [0.6], "th": [2.0], "tau": [0.2]}, distance=True)
+    d = r["vehicles"]["verdict_distance"]  # columns, one entry per vehicle
+    assert r["vehicles"]["string_stable"][0] and d["to"][0] == "string unstable" and 0 < d["distance"][0] < 1, d
+    flipped = ddemap.classify([dict(name="flip", **{k: float(v[0]) for k, v in d["at"].items()})])
+    assert not flipped["vehicles"]["string_stable"][0]
+    with pytest.raises(ValueError, match="distance = 'yes': expected True or False"):
+        ddemap.classify(distance="yes")
 
 
 def test_simulate(tmp_path):

@@ -221,6 +221,9 @@ std::string classification_csv(const std::vector<Classification>& rows) {
     // peak (L-infinity) string stability, when it was asked (classify --peak): the last columns
     const bool peak = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.string.peak.has_value(); });
     if (peak) out << ",peak_verdict,peak_norm,peak_norm_error";
+    // the distance to the other verdict, when it was asked (classify --distance)
+    const bool dist = std::any_of(rows.begin(), rows.end(), [](const Classification& r) { return r.has_distance; });
+    if (dist) out << ",verdict_distance,verdict_distance_boundary,verdict_distance_omega_rad_per_s";
     out << "\n";
     for (const auto& row : rows) {
         out << csv_field(row.vehicle.name);
@@ -242,6 +245,11 @@ std::string classification_csv(const std::vector<Classification>& rows) {
             out << ",,,,,,,,,,,";
         }
         if (peak) out << (row.string.peak ? peak_fields(*row.string.peak) : std::string(",,,"));
+        if (dist) {
+            const bool ok = row.has_distance && row.distance.status == Status::Converged;
+            out << "," << (ok ? format_exact(row.distance.distance) : std::string()) << "," << (ok ? row.distance.boundary : std::string()) << ","
+                << (ok && std::isfinite(row.distance.omega) ? format_exact(row.distance.omega) : std::string());
+        }
         out << "\n";
     }
     return out.str();

@@ -314,6 +314,7 @@ std::string classification_message(const std::vector<Classification>& rows) {
         if (r.string.plant_roots.status != Status::Converged) return r.vehicle.name + ": plant roots: " + r.string.plant_roots.message;
         if (r.ring.status != Status::Converged) return r.vehicle.name + ": ring: " + r.ring.reason;
         if (r.has_uncertainty && r.uncertainty.status != Status::Converged) return r.vehicle.name + ": " + r.uncertainty.message;
+        if (r.has_distance && r.distance.status != Status::Converged) return r.vehicle.name + ": verdict distance: " + r.distance.message;
     }
     if (rows.empty()) return "";
     return std::to_string(rows.size()) + (rows.size() == 1 ? " car" : " cars") +
@@ -377,6 +378,22 @@ std::string classification_json(const std::vector<Classification>& rows, int car
         o["spectral_abscissa"] = num(row.ring.spectral_abscissa);
         o["plant_abscissa"] = num(row.string.plant_abscissa);
         o["attenuation_margin"] = num(row.attenuation_margin);  // null when the plant is not stable
+        if (row.has_distance) {
+            // the distance to the other L2 string verdict (classify --distance)
+            const VerdictDistance& d = row.distance;
+            json at = json::object();
+            for (const auto& name : d.over)
+                if (d.at.count(name)) at[name] = num(d.at.at(name));
+            o["verdict_distance"] = {{"distance", num(d.distance)},
+                                     {"to", d.from_stable ? "string unstable" : "string stable"},
+                                     {"over", d.over},
+                                     {"at", d.status == Status::Converged ? at : json(nullptr)},
+                                     {"boundary", d.boundary.empty() ? json(nullptr) : json(d.boundary)},
+                                     {"omega", num(d.omega)},
+                                     {"status", to_string(d.status)},
+                                     {"method", d.method},
+                                     {"message", d.message}};
+        }
         if (row.has_uncertainty) {
             // the verdicts under the calibration's parameter uncertainty (classify_with_uncertainty)
             const VerdictUncertainty& u = row.uncertainty;

@@ -102,4 +102,19 @@ AttenuationScan attenuation_scan(const Linearisation& lin, double weight, int gr
     return s;
 }
 
+double attenuation_piece(const Linearisation& lin, double omega, double m2) {
+    // at w = 0 for ovrv: 2 B - m2 k1 with B of the design's infeasibility proof, linear in
+    // (k1, k2), where mu = c2 / k1^2 itself is far from linear
+    if (omega == 0.0) {
+        const LowFrequency lf = low_frequency_expansion(lin);
+        return (lf.c2 - m2 * lf.d0 * lf.d0) / std::abs(lf.d0);
+    }
+    const TransferFunction tf(lin);
+    double q = 0.0;
+    tf.attenuation(omega, &q);
+    const double nn = std::abs(tf.numerator(cplx(0.0, omega)));
+    if (!(nn > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    return (q - m2 * nn * nn) / nn;
+}
+
 }  // namespace ddemap

@@ -297,6 +297,7 @@ Status classification_status(const std::vector<Classification>& rows) {
         if (r.ring.status != Status::Converged) status = r.ring.status;
         if (r.string.plant_roots.status != Status::Converged) status = r.string.plant_roots.status;
         if (r.has_uncertainty && r.uncertainty.status != Status::Converged) status = r.uncertainty.status;
+        if (r.has_distance && r.distance.status != Status::Converged) status = r.distance.status;
         if (r.string.peak && r.string.peak->verdict == Verdict::Undecided) status = r.string.peak->status;
     }
     return status;

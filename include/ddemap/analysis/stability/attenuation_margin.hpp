@@ -50,4 +50,12 @@ struct AttenuationScan {
 /// `weight` m >= 0 (s) of the weighted norm sup |Gamma(i w)| |1 + i m w|.
 AttenuationScan attenuation_scan(const Linearisation& lin, double weight = 0.0, int grid = 800);
 
+/// One piece of the margin condition mu >= m2 at a fixed frequency w >= 0, smooth in the law's
+/// parameters:
+///     g = (q(w) - m2 |N(i w)|^2) / |N(i w)|         (w > 0),
+///     g = (c2 - m2 D(0)^2) / |D(0)|                  (w = 0, the limit),
+/// so that mu >= m2 exactly when g >= 0 at every w (q as in mu above). With m2 = 0 its sign is
+/// that of 1 - |Gamma(i w)|^2 (w > 0) or of c2 (w = 0). NaN where N(i w) = 0.
+double attenuation_piece(const Linearisation& lin, double omega, double m2);
+
 }  // namespace ddemap

@@ -105,6 +105,31 @@ struct VerdictUncertainty {
 VerdictUncertainty classify_with_uncertainty(const ParameterMap& ovrv, const Eigen::Matrix<double, 5, 5>& covariance, int cars,
                                              const UncertaintyOptions& options = {}, const ExecutionPolicy& policy = {});
 
+/// How far a car is from the other L2 string verdict: the smallest weighted relative change
+///     d = sqrt(sum_j ((x_j - x0_j) / x0_j)^2)
+/// of its parameters x = (k1, k2, th, tau) (x0 the car's own) that flips the verdict: for a
+/// string-stable car the nearest point of the string-unstable set (|Gamma(i w)| reaches 1 at
+/// some w >= 0, or a plant root reaches the axis), for a string-unstable one the nearest
+/// string-stable point. Computed by analysis/design/verdict_distance.hpp (verdict_distance);
+/// certified along the segment from x0 to `at`: the certified verdict (analyse_string) is the
+/// car's own at (1 - 1e-6) d and the other at `at` itself or just beyond it. A distance is local
+/// (each search converges to a nearest point of its own piece of the boundary); the smallest of
+/// every piece searched is reported.
+struct VerdictDistance {
+    Status status = Status::NumericalIssue;
+    std::string message;
+    std::string method;
+    bool from_stable = false;   ///< the car is string stable: the distance to instability (else to stability)
+    double distance = std::numeric_limits<double>::quiet_NaN();  ///< d (0.25 = a change of 25 %)
+    std::vector<std::string> over;  ///< the parameters changed
+    ParameterMap at;            ///< every parameter at the flip (the others as the car's)
+    /// The piece of the boundary reached: "low-frequency" (|Gamma| reaches 1 as w -> 0: c2 = 0),
+    /// "frequency" (|Gamma(i omega)| = 1 at omega > 0) or "plant" (a root of the plant reaches
+    /// the imaginary axis)
+    std::string boundary;
+    double omega = std::numeric_limits<double>::quiet_NaN();  ///< rad/s of the boundary (0: w -> 0)
+};
+
 /// Verdicts of one vehicle setting.
 struct Classification {
     CalibratedVehicle vehicle;
@@ -114,6 +139,9 @@ struct Classification {
     /// (> 0) or outside (< 0) the string-stable set, as the time constant of the slowest lag that
     /// still bounds |Gamma(i w)|. NaN when the plant is not stable.
     double attenuation_margin = std::numeric_limits<double>::quiet_NaN();
+    /// Only when asked (add_verdict_distances, analysis/design/verdict_distance.hpp).
+    bool has_distance = false;
+    VerdictDistance distance;
     /// Only when the vehicle carries a covariance (vehicle.has_covariance) and uncertainty was asked.
     bool has_uncertainty = false;
     VerdictUncertainty uncertainty;
