@@ -914,12 +914,19 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     // end, by bisection; false when no run ended feasible
     auto crossing = [&](const Outcome& out, Eigen::VectorXd& x) {
         if (!std::isfinite(out.best) || out.best >= 1e6) return false;
-        auto in_box = [&](const Eigen::VectorXd& y) {
-            for (std::size_t j = 0; j < n; ++j)
-                if (y[static_cast<Eigen::Index>(j)] < P.lo[j] || y[static_cast<Eigen::Index>(j)] > P.hi[j]) return false;
+        // x0 + t (x_end - x0) at t = 1 differs from x_end by rounding: an end on a bound (the
+        // relative metric often takes the delay to its lower bound) is snapped back onto it
+        auto in_box = [&](Eigen::VectorXd& y) {
+            for (std::size_t j = 0; j < n; ++j) {
+                const auto J = static_cast<Eigen::Index>(j);
+                const double slack = 1e-12 * (std::abs(P.lo[j]) + std::abs(P.hi[j]));
+                if (y[J] < P.lo[j] && y[J] >= P.lo[j] - slack) y[J] = P.lo[j];
+                if (y[J] > P.hi[j] && y[J] <= P.hi[j] + slack) y[J] = P.hi[j];
+                if (y[J] < P.lo[j] || y[J] > P.hi[j]) return false;
+            }
             return true;
         };
-        auto feasible = [&](const Eigen::VectorXd& y) {
+        auto feasible = [&](Eigen::VectorXd y) {
             if (!in_box(y)) return false;
             const Linearisation L = P.lin(y);
             return P.plant(y, L, nullptr) < 0.0 && attenuation_scan(L).margin >= options.margin;
@@ -930,7 +937,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         }
         double t_in = -1.0;
         for (double t = 1.0; t <= 1.0 + 1e-2; t = 1.0 + 2.0 * (t - 1.0) + 1e-9) {
-            const Eigen::VectorXd y = x0 + t * (out.x - x0);
+            Eigen::VectorXd y = x0 + t * (out.x - x0);
             if (!in_box(y)) break;
             if (feasible(y)) {
                 t_in = t;
@@ -945,6 +952,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             else a = m;
         }
         x = x0 + b * (out.x - x0);
+        in_box(x);  // onto a bound it lies on
         return true;
     };
 

@@ -1,5 +1,6 @@
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -8,6 +9,8 @@
 
 #include "ddemap/analysis/design/design.hpp"
 #include "ddemap/analysis/stability/attenuation_margin.hpp"
+#include "ddemap/analysis/stability/string_stability.hpp"
+#include "ddemap/traffic/model.hpp"
 #include "ddemap/problem/linear_dde.hpp"
 #include "ddemap/solve/roots.hpp"
 #include "argument_count.hpp"
@@ -220,6 +223,33 @@ TEST_CASE("design sup-gamma: where the weighted norm reaches 1 the result is the
     bad = DesignOptions{};
     bad.free = {"k1", "k1"};
     CHECK_THROWS_AS(design_gains("ovrv", car, bad), std::invalid_argument);
+}
+
+TEST_CASE("design nearest from an unstable plant whose nearest gains lie on a bound: converged, no feasible run end nearer") {
+    // k1 = 1 with a 1.5 s delay: the plant is unstable; the relative metric takes tau to its
+    // lower bound tau0 / 10, where x0 + 1 (x_end - x0) != x_end in rounding (the crossing test
+    // found the run's own end outside the box and fell back to a point three times as far)
+    const ParameterMap car = {{"k1", 1.0}, {"k2", 0.1}, {"th", 0.5}, {"tau", 1.5}, {"eta", 10.0}, {"speed", 20.0}};
+    DesignOptions o = options_for(DesignObjective::Nearest, 4);
+    o.free = {"k1", "k2", "th", "tau"};
+    o.margin = 0.001;
+    const DesignResult r = design_gains("ovrv", car, o);
+    INFO(r.message);
+    CHECK(r.status == Status::Converged);
+    CHECK(r.margin_met);
+    CHECK(r.string.string_stable);
+    CHECK(std::find(r.at_bound.begin(), r.at_bound.end(), "tau") != r.at_bound.end());
+    // every run that ended meeting the margin (checked here with its own scan) is not nearer
+    for (const DesignStart& s : r.starts) {
+        ParameterMap p = car;
+        double d2 = 0.0;
+        for (const auto& [k, v] : s.end) {
+            p[k] = v;
+            d2 += std::pow((v - car.at(k)) / car.at(k), 2);
+        }
+        const Linearisation L = make_model("ovrv", p)->linearise();
+        if (is_computable(L) && analyse_string(L).plant_stable && attenuation_scan(L).margin >= o.margin) CHECK(r.change <= std::sqrt(d2) * (1.0 + 1e-9));
+    }
 }
 
 TEST_SUITE_END();
