@@ -106,7 +106,10 @@ struct DesignOptions {
     /// worst-case iteration: design at the held values where the current design's margin is
     /// least (worst_attenuation_margin), until the worst margin over the ellipsoid at the design
     /// meets `margin` (to 1e-6 relative), at most `robust_iterations` designs; the objective is
-    /// the chosen one at that worst point.
+    /// the chosen one at that worst point. When it stops with the margin met, the last design
+    /// (the nearest gains meeting the margin at one point p, a relaxation of the robust problem)
+    /// is robust, hence the least robust change (up to the local search and the worst-case
+    /// search over the ellipsoid, which is sampled, not certified).
     bool robust = false;
     int robust_iterations = 8;  ///< 1 to 50
     /// After each evaluation of a search, and after each run: (work done, work in all), the work
