@@ -395,4 +395,8 @@ constexpr double verdict_flip_b = 1e-6;
 /// to steps of 1e-10 of the distance with gradients by differences (~1e-10); the bisection moves
 /// the point along the segment, not across the direction; 1 - cos(angle) below 1e-8.
 constexpr double verdict_flip_kkt = 1e-8;
+/// A root against a value a peer tool prints with 16 digits (TDS-CONTROL via tdcpy): both
+/// Newton-corrected in double precision from different discretisations, agreeing to a few ulps
+/// of the residual's conditioning (measured 3.6e-13 for example 2.1); 1e-11.
+constexpr double peer_root = 1e-11;
 }  // namespace ddemap::test::tol
