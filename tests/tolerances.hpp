@@ -399,4 +399,10 @@ constexpr double verdict_flip_kkt = 1e-8;
 /// Newton-corrected in double precision from different discretisations, agreeing to a few ulps
 /// of the residual's conditioning (measured 3.6e-13 for example 2.1); 1e-11.
 constexpr double peer_root = 1e-11;
+/// Normal-form coefficients at an exact codimension-two point against their closed forms: a few
+/// small dense solves and exact (dual-number) derivatives, O(1) values; 1e-12.
+constexpr double normal_form_exact = 1e-12;
+/// The same at a located point (special_point away from the exact one; the coefficients move by
+/// O(1) times that); 1e-7.
+constexpr double normal_form_located = 1e-7;
 }  // namespace ddemap::test::tol

@@ -84,7 +84,9 @@ int run_fold_curves(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOp
                         : p.kind == "bogdanov_takens" ? std::string("Bogdanov-Takens (a double root at 0; a Hopf curve ends here)")
                                                       : "zero-Hopf (a pair +-i " + rounded(p.omega, 8) + " on the axis; a Hopf curve crosses here)")
                     << ": " << par << " = " << rounded(p.par, 10) << ", " << a.par2 << " = " << rounded(p.par2, 10) << " (" << to_string(p.status)
-                    << ", residual " << rounded(p.residual, 2) << ")\n";
+                    << ", residual " << rounded(p.residual, 2) << ")"
+                    << (p.kind == "bogdanov_takens" && std::isfinite(p.nf_a) ? "; normal form a = " + rounded(p.nf_a, 8) + ", b = " + rounded(p.nf_b, 8) : std::string())
+                    << (p.kind == "cusp" && std::isfinite(p.nf_c) ? "; normal form c = " + rounded(p.nf_c, 8) : std::string()) << "\n";
         }
         if (fc.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(fc.status) << "): " << fc.message << "\n";
         if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";

@@ -106,7 +106,7 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
 std::string fold_curves_csv(const FoldCurves& c, const std::string& parameter2, const std::vector<std::string>& variables, const ColumnUnits& units) {
     std::string out = "curve,kind," + named_column(c.start.parameter, units) + "," + named_column(parameter2, units);
     for (const auto& v : variables) out += "," + named_column(v, units);
-    out += ",cusp_test,bt_test,unstable,omega_rad_per_s,residual,status\n";
+    out += ",cusp_test,bt_test,unstable,omega_rad_per_s,residual,status,nf_a,nf_b,nf_c\n";
     auto finite = [](double v) { return std::isfinite(v) ? format_exact(v) : std::string(); };
     auto xs = [&](const Eigen::VectorXd& x) {
         std::string s;
@@ -116,10 +116,11 @@ std::string fold_curves_csv(const FoldCurves& c, const std::string& parameter2, 
     for (std::size_t k = 0; k < c.curves.size(); ++k) {
         for (const FoldCurvePoint& p : c.curves[k].points)
             out += std::to_string(k) + ",point," + format_exact(p.par) + "," + format_exact(p.par2) + xs(p.x) + "," + finite(p.cusp_test) + "," +
-                   finite(p.bt_test) + "," + (p.unstable >= 0 ? std::to_string(p.unstable) : std::string()) + ",," + finite(p.residual) + ",\n";
+                   finite(p.bt_test) + "," + (p.unstable >= 0 ? std::to_string(p.unstable) : std::string()) + ",," + finite(p.residual) + ",,,,\n";
         for (const FoldCurveSpecialPoint& p : c.curves[k].special)
             out += std::to_string(k) + "," + p.kind + "," + format_exact(p.par) + "," + format_exact(p.par2) + xs(p.x) + ",,,," +
-                   (p.kind == "zero_hopf" ? finite(p.omega) : std::string()) + "," + finite(p.residual) + "," + to_string(p.status) + "\n";
+                   (p.kind == "zero_hopf" ? finite(p.omega) : std::string()) + "," + finite(p.residual) + "," + to_string(p.status) + "," +
+                   finite(p.nf_a) + "," + finite(p.nf_b) + "," + finite(p.nf_c) + "\n";
     }
     return out;
 }

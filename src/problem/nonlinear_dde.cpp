@@ -176,30 +176,42 @@ void check_direction(const Eigen::VectorXd& d, Eigen::Index size, const char* wh
 }  // namespace
 
 Eigen::VectorXd NonlinearDDE::second_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b) const {
+    return second_derivative(stacked, m_values, a, b);
+}
+
+Eigen::VectorXd NonlinearDDE::third_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                               const Eigen::VectorXd& c) const {
+    return third_derivative(stacked, m_values, a, b, c);
+}
+
+Eigen::VectorXd NonlinearDDE::second_derivative(const Eigen::VectorXd& stacked, const std::vector<double>& pv, const Eigen::VectorXd& a,
+                                                const Eigen::VectorXd& b) const {
     check_stacked(stacked, "the stacked argument");
     check_direction(a, stacked.size(), "direction a");
     check_direction(b, stacked.size(), "direction b");
-    std::vector<Dual2> u(stacked.size()), p(m_values.size()), out(dimension());
+    if (pv.size() != m_values.size()) throw std::invalid_argument("second_derivative: expected " + std::to_string(m_values.size()) + " parameter values");
+    std::vector<Dual2> u(stacked.size()), p(pv.size()), out(dimension());
     for (Eigen::Index i = 0; i < stacked.size(); ++i) u[i] = Dual2(Dual<double>(stacked[i], a[i]), Dual<double>(b[i], 0.0));
-    for (std::size_t j = 0; j < m_values.size(); ++j) p[j] = Dual2(m_values[j]);
+    for (std::size_t j = 0; j < pv.size(); ++j) p[j] = Dual2(pv[j]);
     evaluate(u.data(), p.data(), out.data());
     Eigen::VectorXd d(dimension());
     for (int r = 0; r < dimension(); ++r) d[r] = out[r].deriv.deriv;
     return d;
 }
 
-Eigen::VectorXd NonlinearDDE::third_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
-                                               const Eigen::VectorXd& c) const {
+Eigen::VectorXd NonlinearDDE::third_derivative(const Eigen::VectorXd& stacked, const std::vector<double>& pv, const Eigen::VectorXd& a,
+                                               const Eigen::VectorXd& b, const Eigen::VectorXd& c) const {
     check_stacked(stacked, "the stacked argument");
     check_direction(a, stacked.size(), "direction a");
     check_direction(b, stacked.size(), "direction b");
     check_direction(c, stacked.size(), "direction c");
+    if (pv.size() != m_values.size()) throw std::invalid_argument("third_derivative: expected " + std::to_string(m_values.size()) + " parameter values");
     using D1 = Dual<double>;
-    std::vector<Dual3> u(stacked.size()), p(m_values.size()), out(dimension());
+    std::vector<Dual3> u(stacked.size()), p(pv.size()), out(dimension());
     // x + a e1 + b e2 + c e3: value part (x + a e1) + b e2, derivative part (c + 0 e1) + 0 e2
     for (Eigen::Index i = 0; i < stacked.size(); ++i)
         u[i] = Dual3(Dual2(D1(stacked[i], a[i]), D1(b[i], 0.0)), Dual2(D1(c[i], 0.0), D1(0.0, 0.0)));
-    for (std::size_t j = 0; j < m_values.size(); ++j) p[j] = Dual3(m_values[j]);
+    for (std::size_t j = 0; j < pv.size(); ++j) p[j] = Dual3(pv[j]);
     evaluate(u.data(), p.data(), out.data());
     Eigen::VectorXd d(dimension());
     for (int r = 0; r < dimension(); ++r) d[r] = out[r].deriv.deriv.deriv;

@@ -867,8 +867,13 @@ assert abs(k[0]["special"][0]["par"]) < 1e-8 and abs(k[0]["special"][0]["par2"])
 rows = list(csv.DictReader(open(sys.argv[3])))
 assert [r["kind"] for r in rows].count("point") == len(c[0]["points"]) and [r for r in rows if r["kind"] == "bogdanov_takens"]
 assert float([r for r in rows if r["kind"] == "bogdanov_takens"][0]["p2"]) == s[0]["par2"]  # round trip exact
+# the normal forms against their closed forms: BT a = 2/tau = 1, b = 4/3; cusp c = -1
+assert abs(s[0]["normal_form"]["a"] - 1) < 1e-7 and abs(s[0]["normal_form"]["b"] - 4 / 3) < 1e-7, s[0]["normal_form"]
+assert abs(k[0]["special"][0]["normal_form"]["c"] + 1) < 1e-7, k[0]["special"][0]["normal_form"]
+r = [r for r in rows if r["kind"] == "bogdanov_takens"][0]
+assert float(r["nf_a"]) == s[0]["normal_form"]["a"] and float(r["nf_b"]) == s[0]["normal_form"]["b"] and r["nf_c"] == ""
 PY
-"$bin" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 -1.5 --to2 1.5 | grep -q "Bogdanov-Takens (a double root at 0; a Hopf curve ends here): p1 = 0.0625, p2 = -0.5 (converged" &&
+"$bin" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 -1.5 --to2 1.5 | grep -q "Bogdanov-Takens (a double root at 0; a Hopf curve ends here): p1 = 0.0625, p2 = -0.5 (converged, residual 0); normal form a = 1, b = 1.3333333$" &&
     ok || bad "equilibria --par2 table"
 # the two-parameter diagrams: the fold curve with its BT point; the Hopf curves of the 3-car ov ring with its GH points
 "$bin" equilibria --system "$tmp/bt.json" --par p1 --from -0.5 --to 2 --par2 p2 --from2 -1.5 --to2 1.5 --svg "$tmp/two/bt.svg" >/dev/null &&

@@ -90,6 +90,11 @@ public:
     /// D^3_u f(u; p)[a, b, c], exact (one evaluation in three nested levels).
     Eigen::VectorXd third_derivative(const Eigen::VectorXd& stacked, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                                      const Eigen::VectorXd& c) const;
+    /// The same two at parameter values p (in the order of parameter_names()), not the held ones.
+    Eigen::VectorXd second_derivative(const Eigen::VectorXd& stacked, const std::vector<double>& p, const Eigen::VectorXd& a,
+                                      const Eigen::VectorXd& b) const;
+    Eigen::VectorXd third_derivative(const Eigen::VectorXd& stacked, const std::vector<double>& p, const Eigen::VectorXd& a,
+                                     const Eigen::VectorXd& b, const Eigen::VectorXd& c) const;
 
 protected:
     void check_stacked(const Eigen::VectorXd& stacked, const char* what) const;

@@ -1,4 +1,5 @@
 #include "ddemap/analysis/bifurcation/fold_curve.hpp"
+#include "ddemap/analysis/bifurcation/normal_forms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -293,6 +294,22 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
             sp.other = tz.ok ? (which == 0 ? tz.bt : tz.cusp) : std::numeric_limits<double>::quiet_NaN();
             sp.residual = fold_residual(pr, z.u);
             if (converged(sp.status) && !(sp.residual <= o.branch.special_residual)) sp.status = Status::NumericalIssue;
+            if (converged(sp.status)) {
+                // the normal form at the located point (DDE-BIFTOOL's normalisation)
+                if (which == 0) {
+                    const CuspNormalForm nf = cusp_normal_form(s, sp.x, pr.values(z.u));
+                    if (nf.status == Status::Converged) {
+                        sp.nf_b = nf.b;
+                        sp.nf_c = nf.c;
+                    }
+                } else {
+                    const BogdanovTakensNormalForm nf = bogdanov_takens_normal_form(s, sp.x, pr.values(z.u));
+                    if (nf.status == Status::Converged) {
+                        sp.nf_a = nf.a;
+                        sp.nf_b = nf.b;
+                    }
+                }
+            }
             special_ok = special_ok && converged(sp.status);
             curve.special.push_back(std::move(sp));
         }

@@ -81,6 +81,10 @@ TEST_CASE("fold curve with a cusp: x' = p1 + p2 x(t - 1) - x^3, the curve (p1, p
     CHECK(std::abs(cusp.par) < tol::special_point);
     CHECK(std::abs(cusp.par2) < tol::special_point);
     CHECK(std::abs(std::abs(cusp.other) - 1.0) < tol::special_point);  // b = 1 + p2 there: not a BT point
+    // the normal form w' = b w^2 + c w^3 there: q = p = 1 (Delta'(0) = 1 + p2 = 1), c = F_xxx / 6 = -1
+    CHECK(std::abs(cusp.nf_b) < tol::normal_form_located);
+    CHECK(std::abs(cusp.nf_c + 1.0) < tol::normal_form_located);
+    CHECK(std::isnan(cusp.nf_a));
     // the sign of a changes at the cusp and nowhere else (w carried continuously)
     int changes = 0;
     for (std::size_t k = 0; k + 1 < c.points.size(); ++k) changes += (c.points[k].cusp_test < 0) != (c.points[k + 1].cusp_test < 0);
@@ -137,6 +141,11 @@ TEST_CASE("fold curve with a Bogdanov-Takens point: x' = p1 + x^2 + p2 x(t - tau
         CHECK(std::abs(bt.par - 1 / (4 * tau * tau)) < tol::special_point);
         CHECK(std::abs(bt.x[0] - 1 / (2 * tau)) < tol::special_point);
         CHECK(std::abs(std::abs(bt.other) - 2.0) < 1e-8);  // a = w F'' v^2 = 2 (|v| = |w| = 1): not a cusp
+        // the normal form at the located point against its closed form (test_normal_forms.cpp):
+        // a = 2 / tau, b = 4 / 3
+        CHECK(std::abs(bt.nf_a - 2.0 / tau) < tol::normal_form_located);
+        CHECK(std::abs(bt.nf_b - 4.0 / 3.0) < tol::normal_form_located);
+        CHECK(std::isnan(bt.nf_c));
     }
 }
 

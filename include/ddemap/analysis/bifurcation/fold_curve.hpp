@@ -70,6 +70,13 @@ struct FoldCurveSpecialPoint {
     Eigen::VectorXd x;
     double test = 0.0;      ///< the test function at the located point
     double other = 0.0;     ///< the other test function there (b at a cusp, a at a Bogdanov-Takens point)
+    /// Normal-form coefficients at the located point (normal_forms.hpp, DDE-BIFTOOL's
+    /// normalisation): Bogdanov-Takens a (nf_a) and b (nf_b), w1' = a w0^2 + b w0 w1; cusp b (nf_b,
+    /// ~0) and c (nf_c), w' = b w^2 + c w^3. NaN where not computed (zero-Hopf points; a point not
+    /// located).
+    double nf_a = std::numeric_limits<double>::quiet_NaN();
+    double nf_b = std::numeric_limits<double>::quiet_NaN();
+    double nf_c = std::numeric_limits<double>::quiet_NaN();
     Status status = Status::MaxIterations;
     double residual = std::numeric_limits<double>::infinity();  ///< of the fold system
     int after = 0;          ///< index of the curve point before it
