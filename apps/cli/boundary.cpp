@@ -42,13 +42,14 @@ int run_boundary() {
     SweepSpec spec = sweep_spec(boundary_args.model, boundary_args.ring, "", false, grid);
     const RingCurves ring_curves = parse_ring_curves_flag(boundary_args.ring_curves, spec);
     if (ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";  // every mode's curve needs every mode's root
-    check_sweep_size(spec, "boundary", false);
+    check_sweep_size(spec, "boundary", false, 1, ring_curves == RingCurves::All);
     const std::string prefix = boundary_args.out.prepare("boundary", {".csv", ".json"});
     ExecutionPolicy policy;
     policy.progress = progress_printer("boundary", "seed-grid rows");
     const SweepResult sw = run_sweep(spec, policy);
     BoundaryOptions bo;
     bo.ring_curves = ring_curves;
+    bo.progress = progress_printer("boundary", "seeds");
     const BoundarySet b = trace_boundaries(sw, bo);
     JsonEnvelope e;
     e.command = "boundary";

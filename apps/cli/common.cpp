@@ -1,5 +1,6 @@
 #include <cctype>
 #include "common.hpp"
+#include "limits.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -296,8 +297,8 @@ Fleet fleet_argument(const std::string& flag, const std::string& list, int cars)
         throw BadInput("--ring " + std::to_string(cars) + ": fewer cars than " + flag + " has (" + std::to_string(unit.size()) +
                        "): expected at least " + std::to_string(unit.size()) + " (the fleet repeated to N cars), or no --ring for the fleet once");
     if (static_cast<std::size_t>(cars) % unit.size() != 0)
-        std::cerr << "ddemap: note: --ring " << cars << " is not a multiple of the fleet's " << unit.size() << " cars: the last repetition has only its first "
-                  << static_cast<std::size_t>(cars) % unit.size() << "\n";
+        defer_note("--ring " + std::to_string(cars) + " is not a multiple of the fleet's " + std::to_string(unit.size()) +
+                   " cars: the last repetition has only its first " + std::to_string(static_cast<std::size_t>(cars) % unit.size()));
     Fleet out;
     out.reserve(static_cast<std::size_t>(cars));
     for (int i = 0; i < cars; ++i) out.push_back(unit[static_cast<std::size_t>(i) % unit.size()]);

@@ -203,7 +203,7 @@ int run_design() {
             std::snprintf(line, sizeof line, "%-24s %-18s %s\n", "P(string stable)", pcell(r.uncertainty_initial).c_str(), pcell(r.uncertainty).c_str());
             out << line << "  (under the fit's uncertainty of the held parameters, " << r.uncertainty.samples
                 << " draws; 95 % Wilson intervals)\n";
-            auto wcell = [](const WorstMargin& w) { return std::isfinite(w.margin) ? rounded(w.margin, 4) : std::string("-inf (plant unstable)"); };
+            auto wcell = [](const WorstMargin& w) { return std::isfinite(w.margin) ? rounded(w.margin, 4) : std::string("none (plant unstable)"); };
             std::snprintf(line, sizeof line, "%-24s %-18s %s\n", "worst m* [s]", wcell(r.worst_initial).c_str(), wcell(r.worst).c_str());
             std::string held;
             for (const auto& h : r.worst.held) held += (held.empty() ? "" : ", ") + h;

@@ -205,7 +205,10 @@ int run_equilibria() {
             for (const EquilibriumPoint& p : br.points) {
                 out << "  " << pad(rounded(p.par, 8), 14);
                 for (std::size_t i = 0; i < shown; ++i) out << pad(rounded(p.x[static_cast<Eigen::Index>(i)], 8), 14);
-                out << pad(rounded(p.abscissa, 6), 14) << pad(std::to_string(p.unstable), 10) << (p.stable ? "yes" : "no") << "\n";
+                // where the roots did not converge there is no verdict: "-" and "undecided"
+                const bool decided = p.roots_status == Status::Converged && std::isfinite(p.abscissa);
+                out << pad(decided ? rounded(p.abscissa, 6) : "-", 14) << pad(decided ? std::to_string(p.unstable) : "-", 10)
+                    << (!decided ? "undecided" : p.stable ? "yes" : "no") << "\n";
             }
             for (const FoldPoint& f : br.folds)
                 out << pad(f.kind + " ", 11) << equilibria_args.problem.par << " = " << rounded(f.par, 12) << " (" << to_string(f.status) << ", residual "

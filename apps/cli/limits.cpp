@@ -69,7 +69,22 @@ void check_size(const std::string& command, const std::string& what, const std::
                  what.c_str(), noun.c_str(), show(estimate).c_str(), show(limit).c_str());
 }
 
+namespace {
+std::vector<std::string>& pending_notes() {
+    static std::vector<std::string> notes;
+    return notes;
+}
+}  // namespace
+
+void defer_note(const std::string& text) { pending_notes().push_back(text); }
+
+void flush_notes() {
+    for (const std::string& n : pending_notes()) std::fprintf(stderr, "ddemap: note: %s\n", n.c_str());
+    pending_notes().clear();
+}
+
 void announce_estimate(const std::string& command, const std::string& what, double seconds) {
+    flush_notes();
     if (seconds > 10.0 && !run_flags().quiet)
         std::fprintf(stderr, "ddemap: %s: note: %s: estimated run time %s\n", command.c_str(), what.c_str(), human_seconds(seconds).c_str());
 }
@@ -118,6 +133,7 @@ public:
         if (!m_tty && m_shown && done != total &&
             (elapsed - m_last_line < interval || (unknown_left ? elapsed - m_last_line < m_delay : percent == m_last_percent)))
             return;
+        flush_notes();
         m_last_percent = percent;
         m_last_line = elapsed;
         m_shown = true;
@@ -164,13 +180,18 @@ LabelledProgress labelled_progress_printer(const std::string& command, const std
 BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total) {
     if (run_flags().quiet) return nullptr;
     auto printer = std::make_shared<Printer>(command);
+    auto last = std::make_shared<long>(-1);
     return [=](long done, long total, double value) {
         char v[32];
         std::snprintf(v, sizeof v, "%.6g", value);
         const std::string count = exact_total ? unit + " " + std::to_string(done) + "/" + std::to_string(total)
                                               : std::to_string(done) + " " + (done == 1 && unit.size() > 1 && unit.back() == 's' ? unit.substr(0, unit.size() - 1) : unit) +
                                                     " (at most " + std::to_string(total) + ")";
-        (*printer)(done, total, count + ", " + par + " = " + v, exact_total);
+        // the same count again: a report from within a long unit (bistability's stages), shown
+        // every few seconds like a search's, so that the log shows the work is alive
+        const bool within = done == *last;
+        *last = done;
+        (*printer)(done, total, count + ", " + par + " = " + v, exact_total && !within, within);
     };
 }
 

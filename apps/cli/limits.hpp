@@ -39,6 +39,14 @@ void check_size(const std::string& command, const std::string& what, const std::
 /// checked (an error after it would make the error two lines).
 void announce_estimate(const std::string& command, const std::string& what, double seconds);
 
+/// A note about the input found while parsing it ("ddemap: note: TEXT" on stderr), held back
+/// until the input has passed every check: printed before the first progress line or estimate,
+/// or when the command returns; dropped when it ends with an error (whose one line is then the
+/// only one).
+void defer_note(const std::string& text);
+/// Prints the notes held back (main, the progress printers and announce_estimate call it).
+void flush_notes();
+
 /// The size guard of a root search (RootOptions::before): check_size on the predicted memory and
 /// run time of `what` (estimate_root_work, "a ring of 20000 cars"), named with how the prediction
 /// was made.

@@ -19,6 +19,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "limits.hpp"
 #include "ddemap/io/svg.hpp"
 
 using namespace ddemap::cli;
@@ -207,7 +208,11 @@ int main(int argc, char** argv) {
         const char* fault = std::getenv("DDEMAP_TEST_FAULT");
         if (fault && std::strcmp(fault, "internal") == 0) throw std::logic_error("DDEMAP_TEST_FAULT=internal");
         for (const auto& [sub, command] : commands)
-            if (sub->parsed()) return finish_stdout(command->run());
+            if (sub->parsed()) {
+                const int code = command->run();
+                ddemap::cli::flush_notes();  // notes about the input not yet shown (none on an error)
+                return finish_stdout(code);
+            }
         throw std::logic_error("no command was parsed");
     } catch (const ddemap::WriteError& e) {
         std::cerr << "ddemap: error: " << one_line(e.what()) << "\n";

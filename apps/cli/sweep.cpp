@@ -77,7 +77,7 @@ int run_sweep() {
     const RingCurves ring_curves = parse_ring_curves_flag(sweep_args.ring_curves, spec);
     // every mode's curve needs every mode's root; the envelope is seeded from the winding sweep
     if (!sweep_args.no_boundaries && ring_curves == RingCurves::All && spec.cars > 0) spec.ring_method = "modes";
-    check_sweep_size(spec, "sweep", true);
+    check_sweep_size(spec, "sweep", true, 1, !sweep_args.no_boundaries && ring_curves == RingCurves::All);
     const std::vector<ChartMarker> marks = sweep_args.mark.empty() ? std::vector<ChartMarker>{} : mark_cars(spec);
     const std::string prefix = sweep_args.out.prepare("sweep", {".csv", ".json", ".svg", "-boundaries.csv"});
     ExecutionPolicy policy;
@@ -86,6 +86,7 @@ int run_sweep() {
     BoundarySet b;
     BoundaryOptions bo;
     bo.ring_curves = ring_curves;
+    bo.progress = progress_printer("sweep", "boundary seeds");
     if (!sweep_args.no_boundaries) b = trace_boundaries(sw, bo);
     const BoundarySet* bp = sweep_args.no_boundaries ? nullptr : &b;
     JsonEnvelope e;

@@ -40,7 +40,7 @@ SweepSpec sweep_spec(const ModelArgs& margs, const RingArg& ring, const std::str
     return spec;
 }
 
-void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels) {
+void check_sweep_size(const SweepSpec& spec, const std::string& command, bool writes_grid, std::size_t panels, bool ring_curves_all) {
     if (spec.cars > kModesMaxCars && sweep_ring_method(spec) == "modes")
         throw BadInput("--ring = " + std::to_string(spec.cars) + ": expected at most " + std::to_string(kModesMaxCars) + " cars for " +
                        (command == "boundary" ? std::string("boundary --ring-curves all (its seeds need every mode's root, one by one; --ring-curves envelope takes up to ") +
@@ -55,7 +55,10 @@ void check_sweep_size(const SweepSpec& spec, const std::string& command, bool wr
     check_size(command, what, "memory", points * (600.0 + 16.0 * modes));
     if (writes_grid) check_size(command, what, "output", points * 180.0);
     // the peak notion: at most 0.03 s more per point (only L2-stable points need ||h||_1)
-    check_size(command, what, "time", points * (modes * 5e-5 + (spec.peak ? 0.03 : 0.0)) / std::max(1, thread_count()));
+    const double seconds = points * (modes * 5e-5 + (spec.peak ? 0.03 : 0.0)) / std::max(1, thread_count()) +
+                           (ring_curves_all && spec.cars > 0 ? 1e-3 * modes : 0.0);  // the curves are traced on one core
+    check_size(command, what, "time", seconds);
+    announce_estimate(command, what, seconds);
 }
 
 RingCurves parse_ring_curves_flag(const std::string& text, const SweepSpec& spec) {

@@ -353,6 +353,7 @@ py::tuple py_sweep(const std::string& model, const ParameterMap& fixed, const st
     bo.ring_curves = ring_curves;
     ExecutionPolicy policy;
     policy.progress = interruptible();
+    bo.progress = interruptible();
     BoundarySet b;
     const SweepResult sw = released([&] {
         SweepResult r = run_sweep(spec, policy);
@@ -427,6 +428,7 @@ py::tuple py_boundary(const std::string& model, const ParameterMap& fixed, const
     bo.ring_curves = ring_curves;
     ExecutionPolicy policy;
     policy.progress = interruptible();
+    bo.progress = interruptible();
     const BoundarySet b = released([&] { return trace_boundaries(run_sweep(spec, policy), bo); });
     JsonEnvelope e;
     e.command = "boundary";

@@ -72,6 +72,12 @@ std::vector<RunListEntry> read_run_list_csv(const std::string& text, const std::
         if (e.file.empty()) csv.fail("column 'file' is empty: expected a trace file");
         if (e.role != "train" && e.role != "test") csv.fail("column 'role' = " + detail::quoted(e.role) + ": expected train or test");
         if (e.type.empty()) e.type = "test";
+        // each run once: a repeated one would fit (and write its report figures) twice, and a
+        // run both trained on and tested against is no test
+        for (const RunListEntry& o : out)
+            if (o.car == e.car && o.file == e.file)
+                csv.fail("car " + detail::quoted(e.car) + " with file " + detail::quoted(e.file) + " is listed before (role " + o.role +
+                         "): expected each run once, as train or as test");
         out.push_back(e);
     }
     if (out.empty()) throw std::invalid_argument(source + ": no runs listed: expected lines car,file,role[,type]");

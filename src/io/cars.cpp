@@ -211,6 +211,9 @@ std::vector<CalibratedVehicle> read_calibration_json(const std::string& text, co
             if (!ok) throw std::invalid_argument(where + " (" + v.name + "): the covariance is not a 5 x 5 matrix of numbers");
             for (int a = 0; a < 5; ++a)
                 if (!(v.covariance(a, a) >= 0.0)) throw std::invalid_argument(where + " (" + v.name + "): a negative variance of " + names[a]);
+            if (!(v.covariance.cwiseAbs().maxCoeff() <= kMaxCovarianceEntry))
+                throw std::invalid_argument(where + " (" + v.name + "): a covariance entry of magnitude " + detail::significant(v.covariance.cwiseAbs().maxCoeff(), 6) +
+                                            ": expected at most 1e6 (a standard deviation of 1000)");
             v.has_covariance = true;
         }
         const nlohmann::json* bounds = f.contains("bounds") ? &f["bounds"] : result->contains("bounds") ? &(*result)["bounds"] : nullptr;

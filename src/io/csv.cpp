@@ -94,9 +94,13 @@ std::string equilibrium_branch_csv(const EquilibriumBranch& b, const std::vector
         for (Eigen::Index i = 0; i < x.size(); ++i) s += "," + format_exact(x[i]);
         return s;
     };
-    for (const EquilibriumPoint& p : b.points)
-        out += "point," + format_exact(p.par) + xs(p.x) + "," + format_exact(p.abscissa) + "," + std::to_string(p.unstable) + "," +
-               (p.stable ? "true" : "false") + ",," + to_string(p.roots_status) + "\n";
+    for (const EquilibriumPoint& p : b.points) {
+        // where the roots did not converge there is no verdict: empty abscissa, count and stability
+        const bool decided = p.roots_status == Status::Converged && std::isfinite(p.abscissa);
+        out += "point," + format_exact(p.par) + xs(p.x) + "," + (decided ? format_exact(p.abscissa) : std::string()) + "," +
+               (decided ? std::to_string(p.unstable) : std::string()) + "," + (!decided ? "" : p.stable ? "true" : "false") + ",," +
+               to_string(p.roots_status) + "\n";
+    }
     for (const FoldPoint& f : b.folds) out += f.kind + "," + format_exact(f.par) + xs(f.x) + ",,,,," + to_string(f.status) + "\n";
     for (const HopfPoint& h : b.hopf)
         out += "hopf," + format_exact(h.par) + xs(h.x) + ",,,," + format_exact(h.omega) + "," + to_string(h.status) + "\n";

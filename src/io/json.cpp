@@ -149,9 +149,11 @@ std::string equilibrium_branch_json(const EquilibriumBranch& b, const std::vecto
         json o;
         o["par"] = num(p.par);
         o["x"] = vec(p.x);
-        o["abscissa"] = num(p.abscissa);
-        o["unstable"] = p.unstable;
-        o["stable"] = p.stable;
+        // no verdict where the roots did not converge: null
+        const bool decided = p.roots_status == Status::Converged && std::isfinite(p.abscissa);
+        o["abscissa"] = decided ? num(p.abscissa) : json(nullptr);
+        o["unstable"] = decided ? json(p.unstable) : json(nullptr);
+        o["stable"] = decided ? json(p.stable) : json(nullptr);
         o["roots_status"] = to_string(p.roots_status);
         json roots = json::array();
         for (const cplx& r : p.roots) roots.push_back(json::array({num(r.real()), num(r.imag())}));

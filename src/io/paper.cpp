@@ -18,13 +18,16 @@ PaperJob run_paper_job(const std::string& paper_toml, const std::string& paper_s
     const ChartSpec classes = classification_chart(parse_chart_spec(classification_toml, classification_source), paper_calibration_table(), options.cars);
     job.figure_spec = parse_chart_spec(paper_toml, paper_source);
     const long total = 1 + static_cast<long>(classes.panels.size() + job.figure_spec.panels.size());
-    long before = 0;
+    long before = 0, panels = 0;
     ExecutionPolicy charts;
-    if (progress) charts.progress = [&](long done, long) { progress(before + done, total); };
+    // a chart reports its grid rows (done of t over all its panels): scaled to its panels
+    if (progress) charts.progress = [&](long done, long t) { progress(before + (t > 0 ? done * panels / t : 0), total); };
     job.study = run_paper_study(options);
     if (progress) progress(++before, total);
+    panels = static_cast<long>(classes.panels.size());
     job.classification = render_chart(classes, charts);
-    before += static_cast<long>(classes.panels.size());
+    before += panels;
+    panels = static_cast<long>(job.figure_spec.panels.size());
     job.figure = render_chart(job.figure_spec, charts);
     job.seconds = job.figure.seconds + job.classification.seconds;
     return job;

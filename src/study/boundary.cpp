@@ -1,6 +1,7 @@
 #include "ddemap/study/boundary.hpp"
 
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -540,14 +541,19 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
     set.seeds = static_cast<int>(seeds.size());
 
     const double cell = 1.0 / std::min(nx - 1, ny - 1);
-    std::vector<int> traced_mode;  // the seed's mode of every curve (before relabelling)
+    // the curves traced so far by (kind, the seed's mode before relabelling): a seed is compared
+    // with its own kind and mode only (a ring of 10^5 cars has 5 10^4 modes' curves)
+    std::map<std::pair<int, int>, std::vector<std::size_t>> traced;
+    long done = 0;
     for (const Seed& sd : seeds) {
+        if (options.progress) options.progress(done, static_cast<long>(seeds.size()));
+        ++done;
         Problem p(spec, sd.kind, sd.mode);
         // already on a traced curve of the same kind and mode?
         bool known = false;
-        for (std::size_t ci = 0; ci < set.curves.size(); ++ci) {
+        const auto key = std::make_pair(static_cast<int>(sd.kind), sd.mode);
+        for (std::size_t ci : traced[key]) {
             const auto& c = set.curves[ci];
-            if (c.kind != sd.kind || traced_mode[ci] != sd.mode) continue;
             for (std::size_t i = 0; i + 1 < c.points.size() && !known; ++i)
                 known = segment_distance(sd.u(0), sd.u(1), c.points[i], c.points[i + 1], p) < 0.75 * cell;
             if (c.points.size() == 1) known = known || segment_distance(sd.u(0), sd.u(1), c.points[0], c.points[0], p) < 0.75 * cell;
@@ -587,9 +593,10 @@ BoundarySet trace_boundaries(const SweepResult& sweep, const BoundaryOptions& op
             curve.mode = spec.cars - curve.mode;
             for (auto& bp : curve.points) bp.omega = -bp.omega;
         }
+        traced[key].push_back(set.curves.size());
         set.curves.push_back(std::move(curve));
-        traced_mode.push_back(sd.mode);
     }
+    if (options.progress && !seeds.empty()) options.progress(static_cast<long>(seeds.size()), static_cast<long>(seeds.size()));
     if (envelope) trace_envelope(sweep, options, set);
     set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return set;

@@ -229,6 +229,8 @@ std::vector<CalibratedVehicle> read_car_table(const std::string& text, const std
                     for (int b = a; b < 5; ++b, ++k) {
                         const double x = csv.number(c_cov[k], cov_names[k]);
                         if (a == b && x < 0.0) csv.fail("column '" + cov_names[k] + "' = " + field(c_cov[k]) + ": expected a variance >= 0");
+                        if (!(std::abs(x) <= kMaxCovarianceEntry))
+                            csv.fail("column '" + cov_names[k] + "' = " + field(c_cov[k]) + ": expected a magnitude at most 1e6 (a standard deviation of 1000)");
                         v.covariance(a, b) = v.covariance(b, a) = x;
                     }
                 v.has_covariance = true;

@@ -2219,6 +2219,21 @@ for cmd in "classify A_min" "simulate --fleet A_min" "growth --fleet A_min --fol
     expect_error "--out = '': expected an output prefix" $cmd --out ''
 done
 rm -rf "$ch"
+# the third fuzzing run (13,264 cases): a delay of 2^31 leaves the roots undecided: no -inf in
+# any output, "undecided" in the table, exit 4 (it was an internal error); a covariance of 1e308
+# and a repeated run are bad input; a note about the input is not printed before an error;
+# rings too long for classify and for every mode's curves are sized and refused up front
+echo '{"variables":["y"],"parameters":{"alpha":1},"equations":["-alpha*y(t - 2147483648)*(1 + y)"]}' >"$tmp/bigdelay.json"
+"$bin" equilibria --system "$tmp/bigdelay.json" --par alpha --from 0.5 --to 0.6 --format csv >"$tmp/bd.csv" 2>/dev/null; rc=$?
+[ $rc -eq 4 ] && grep -q '^point,0.5,0,,,,,max_degree_reached$' "$tmp/bd.csv" && ! grep -qi 'inf' "$tmp/bd.csv" && ok || bad "equilibria with a 2^31 delay: rc $rc $(head -3 "$tmp/bd.csv")"
+"$bin" equilibria --system "$tmp/bigdelay.json" --par alpha --from 0.5 --to 0.6 2>/dev/null | grep -q '^  0.5  *0  *-  *-  *undecided$' && ok || bad "equilibria table: undecided points"
+printf 'name,k1,k2,th,tau,eta,cov_k1_k1,cov_k1_k2,cov_k1_th,cov_k1_tau,cov_k1_eta,cov_k2_k2,cov_k2_th,cov_k2_tau,cov_k2_eta,cov_th_th,cov_th_tau,cov_th_eta,cov_tau_tau,cov_tau_eta,cov_eta_eta\ns,0.05,0.3,1.5,0.4,8,1e308,0,0,0,0,1e-4,0,0,0,1e-4,0,0,1e-4,0,1e-2\n' >"$tmp/cov1e308.csv"
+expect_error "cov1e308.csv:2: column 'cov_k1_k1' = 1e308: expected a magnitude at most 1e6" classify "$tmp/cov1e308.csv" --out "$tmp/cov"
+printf 'car,file,role\nCarA,t1.csv,train\nCarA,t1.csv,test\n' >"$tmp/dupruns.csv"
+expect_error "dupruns.csv:3: car 'CarA' with file 't1.csv' is listed before (role train): expected each run once" calibrate --runs "$tmp/dupruns.csv" --report "$tmp/rep"
+expect_error "length = 10000000 m: expected at least" roots --fleet A_min,C_max --ring 999999 --length 1e7
+expect_error "14 cars in rings of 1000000 cars: estimated run time" classify --ring 1000000
+expect_error "a 3 x 3 grid of a 1000000-car ring: estimated run time" sweep --ring 1000000 --k1 0.01:1:3 --k2 0.01:1:3 --th 1.5 --tau 0.1 --ring-curves all --out "$tmp/sw"
 fi  # part chain
 
 if part killset; then

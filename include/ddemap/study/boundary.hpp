@@ -75,6 +75,9 @@ struct BoundaryOptions {
     double max_step = 0.02;
     double min_step = 1e-8;
     int max_points = 20000;      ///< per branch
+    /// Before each seed is traced and at the end: (seeds done, seeds). May throw
+    /// ddemap::Cancelled to stop.
+    Progress progress;
     void validate() const;
 };
 

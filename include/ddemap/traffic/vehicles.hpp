@@ -13,6 +13,11 @@
 
 namespace ddemap {
 
+/// The largest magnitude of a covariance entry a car file may carry: a standard deviation of
+/// 1000 in the parameter's units (1/s^2, 1/s, s, s, m) is far beyond any fit; larger entries
+/// (1e308 once overflowed the 95 % ellipses into NaN) are refused.
+constexpr double kMaxCovarianceEntry = 1e6;
+
 /// A car with its law and parameters: a setting of the paper's table, a row of a user's table, a
 /// fit that `calibrate` wrote, or a car given inline (io/cars.hpp reads every kind).
 struct CalibratedVehicle {

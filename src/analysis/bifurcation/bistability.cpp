@@ -137,6 +137,11 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     auto report = [&](double p) {
         if (o.progress) o.progress(++stages, stage_bound, p);
     };
+    // within a stage: every point of its curves and branches reports the stages done so far and
+    // where it is (the printer shows a line every few seconds), so a long stage is not silent
+    const BranchProgress beat = [&](long, long, double p) {
+        if (o.progress) o.progress(stages, stage_bound, p);
+    };
     auto fail = [&](Status s, const std::string& m) {
         if (chart.status == Status::Converged) {
             chart.status = s;
@@ -153,6 +158,10 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     ho.from2 = o.from2;
     ho.to2 = o.to2;
     ho.continuation.max_points = o.max_points;
+    if (o.progress) {
+        ho.progress = beat;
+        ho.branch.progress = beat;
+    }
     chart.hopf = hopf_curves(system, guess, ho);
     if (chart.hopf.status != Status::Converged) fail(chart.hopf.status, "the Hopf curves: " + chart.hopf.message);
     report(o.from);
@@ -164,6 +173,7 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     po.degree = o.degree;
     po.intervals = o.intervals;
     po.max_points = o.max_points;
+    if (o.progress) po.progress = beat;
     OrbitFoldCurveOptions fo;
     fo.orbit = po;
     // the fold curves only bound the cells: their points' multipliers (a certificate of `orbits
@@ -184,6 +194,7 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
         eo.from = o.from;
         eo.to = o.to;
         eo.roots.count = 2;
+        if (o.progress) eo.progress = beat;
         s.eq = equilibrium_branch(system, guess, eo);
         if (s.eq.status != Status::Converged) {
             s.status = s.eq.status;
