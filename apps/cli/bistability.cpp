@@ -81,7 +81,7 @@ int run_bistability() {
     inputs.string("par", o.parameter).number("from", o.from).number("to", o.to).string("par2", o.parameter2).number("from2", o.from2).number("to2", o.to2)
         .integer("degree", o.degree).integer("intervals", o.intervals).integer("points", o.max_points).integer("rows", o.rows);
 
-    o.progress = branch_progress_printer("bistability", "stages", o.parameter, false);
+    o.progress = branch_progress_printer("bistability", "stages", o.parameter, false, true);
     const BistabilityChart chart = bistability_chart(system, pb.guess, o);
     o.progress = nullptr;
 

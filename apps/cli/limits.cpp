@@ -177,7 +177,7 @@ LabelledProgress labelled_progress_printer(const std::string& command, const std
     };
 }
 
-BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total) {
+BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total, bool heartbeat) {
     if (run_flags().quiet) return nullptr;
     auto printer = std::make_shared<Printer>(command);
     auto last = std::make_shared<long>(-1);
@@ -187,9 +187,9 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
         const std::string count = exact_total ? unit + " " + std::to_string(done) + "/" + std::to_string(total)
                                               : std::to_string(done) + " " + (done == 1 && unit.size() > 1 && unit.back() == 's' ? unit.substr(0, unit.size() - 1) : unit) +
                                                     " (at most " + std::to_string(total) + ")";
-        // the same count again: a report from within a long unit (bistability's stages), shown
-        // every few seconds like a search's, so that the log shows the work is alive
-        const bool within = done == *last;
+        // with `heartbeat`, the same count again: a report from within a long unit (bistability's
+        // stages), shown every few seconds like a search's, so that the log shows the work is alive
+        const bool within = heartbeat && done == *last;
         *last = done;
         (*printer)(done, total, count + ", " + par + " = " + v, exact_total && !within, within);
     };

@@ -70,7 +70,10 @@ LabelledProgress labelled_progress_printer(const std::string& command, const std
 /// The same printer for a branch (a continuation), one line per finished point:
 /// `command: 37 orbits (at most 100), headway = 2.81 (4.2 s)`, or with `exact_total` (the
 /// number of points is known) `command: points 37/80, gap = 12.5 (4.2 s, about 3 s left)`.
-BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total);
+/// `heartbeat`: a call that repeats the last count (a report from within a long unit, as
+/// bistability's stages make) is shown every few seconds ("time left unknown") instead of dropped.
+BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total,
+                                       bool heartbeat = false);
 
 /// The printer of a search that ends when it has found what it looks for, within a budget of
 /// steps (the root searches of roots --fleet and --system): the budget is a bound, not the work

@@ -1023,10 +1023,11 @@ PY
 else
     bad "equilibria --branch-point exit status"
 fi
+# (checked once the branch is computed: --quiet keeps a slow build's progress lines out)
 expect_error "--branch-point = '1': expected an index from 0 to 0 (the branch has 1 branch point)" \
-    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 1 --out "$tmp/hutbad"
+    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 1 --out "$tmp/hutbad" --quiet
 expect_error "--branch-point = '0': the branch has no branch point in p from 0.5 to 2" \
-    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from 0.5 --to 2 --branch-point 0
+    equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from 0.5 --to 2 --branch-point 0 --quiet
 expect_error "--branch-point: not with --par2" \
     equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 0 --par2 p --from2 0 --to2 1
 [ ! -e "$tmp/hutbad.json" ] && ok || bad "equilibria --branch-point bad input wrote files"
@@ -1305,10 +1306,12 @@ PY
 else
     bad "orbits --period-doubling exit status"
 fi
+# (these indices can only be checked once the branch is computed: --quiet, so that a slow build's
+# progress lines, which may come first, do not count as a second line of the error)
 expect_error "--period-doubling = '1': expected an index from 0 to 0 (the branch has 1 period doubling)" \
-    orbits --system "$(dirname "$0")/../../examples/mackey_glass.json" --par tau --from 0.3 --to 1.5 --period-doubling 1 --out "$orb/bad4"
+    orbits --system "$(dirname "$0")/../../examples/mackey_glass.json" --par tau --from 0.3 --to 1.5 --period-doubling 1 --out "$orb/bad4" --quiet
 expect_error "--period-doubling = '0': the branch has no period doubling in alpha from 1 to 2" \
-    orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling 0 --out "$orb/bad5"
+    orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling 0 --out "$orb/bad5" --quiet
 expect_error "--period-doubling = '-1': expected an integer >= 0" orbits --system "$orb/wright.json" --par alpha --from 1 --to 2 --period-doubling -1
 expect_error "--period-doubling: not with --wave" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --period-doubling 0 --wave 1
 [ -z "$(ls "$orb" | grep bad)" ] && ok || bad "orbits --period-doubling bad input wrote files: $(ls "$orb")"
