@@ -81,6 +81,9 @@ int run_bistability() {
     inputs.string("par", o.parameter).number("from", o.from).number("to", o.to).string("par2", o.parameter2).number("from2", o.from2).number("to2", o.to2)
         .integer("degree", o.degree).integer("intervals", o.intervals).integer("points", o.max_points).integer("rows", o.rows);
 
+    // the equilibria: the first branch's roots sized before they start, the slices (about ten,
+    // as above) alike
+    o.before_roots = branch_roots_guard("bistability", "the equilibrium branch and about 10 slices like it", 11.0);
     o.progress = branch_progress_printer("bistability", "stages", o.parameter, false, true);
     const BistabilityChart chart = bistability_chart(system, pb.guess, o);
     o.progress = nullptr;

@@ -40,7 +40,7 @@ int run_fold_curves(NonlinearProblemArgs::Problem& pb, const EquilibriumBranchOp
     second_parameter(pb, o, a.par2, a.from2, a.to2, co);
     const std::string svg_file = a.svg.empty() ? std::string() : output_file("--svg", a.svg);
 
-    co.branch.progress = branch_progress_printer("equilibria", "points", a.problem.par, true);
+    co.branch.progress = branch_progress_printer("equilibria", "points", a.problem.par, true, true);
     co.progress = branch_progress_printer("equilibria", "fold-curve points", a.problem.par, false);
     const FoldCurves fc = fold_curves(system, pb.guess, co);
     co.branch.progress = nullptr;  // ends an open progress line before the output
@@ -132,6 +132,7 @@ int run_equilibria() {
     o.to = pb.to;
     o.roots.count = static_cast<int>(parse_integer("--count", equilibria_args.count, 1, 100, "an integer between 1 and 100"));
     o.continuation.max_points = static_cast<int>(parse_integer("--max-points", equilibria_args.points, 2, 100000, "an integer between 2 and 100000"));
+    o.before_roots = branch_roots_guard("equilibria");
     std::unique_ptr<NonlinearDDE>& system = pb.system;
     const std::vector<std::string>& variables = pb.variables;
     const Eigen::VectorXd& guess = pb.guess;
@@ -142,7 +143,7 @@ int run_equilibria() {
     if (!two && !equilibria_args.svg.empty()) throw BadInput("--svg = '" + equilibria_args.svg + "' draws the curves of --par2: expected --par2 NAME with it");
     if (two) return run_fold_curves(pb, o, format, prefix);
 
-    o.progress = branch_progress_printer("equilibria", "points", equilibria_args.problem.par, true);
+    o.progress = branch_progress_printer("equilibria", "points", equilibria_args.problem.par, true, true);
     EquilibriumBranch b = equilibrium_branch(*system, guess, o);
     o.progress = nullptr;  // ends an open progress line before the output
     // the other branch through branch point K (--branch-point)
@@ -164,7 +165,7 @@ int run_equilibria() {
             nb.status = bp->status;
             nb.message = "branch point " + std::to_string(bp_index) + " was not located: no branch switched onto";
         } else {
-            o.progress = branch_progress_printer("equilibria", "points of the other branch", equilibria_args.problem.par, true);
+            o.progress = branch_progress_printer("equilibria", "points of the other branch", equilibria_args.problem.par, true, true);
             nb = equilibrium_branch_from_branch_point(*system, b, *bp, o);
             o.progress = nullptr;
         }

@@ -60,6 +60,7 @@ int run_hopf() {
     o.to = pb.to;
     const int max_points = static_cast<int>(parse_integer("--max-points", hopf_args.points, 2, 100000, "an integer between 2 and 100000"));
     o.continuation.max_points = max_points;
+    o.before_roots = branch_roots_guard("hopf");
     const NonlinearDDE& system = *pb.system;
     JsonObject& inputs = pb.inputs;
     inputs.string("par", hopf_args.problem.par).number("from", o.from).number("to", o.to);
@@ -79,7 +80,7 @@ int run_hopf() {
     HopfCurves curves;
     HopfAnalysis points;
     if (two) {
-        co.branch.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true);
+        co.branch.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true, true);
         co.progress = branch_progress_printer("hopf", "curve points", hopf_args.problem.par, false);
         curves = hopf_curves(system, pb.guess, co);
         co.branch.progress = nullptr;  // ends an open progress line before the output
@@ -89,7 +90,7 @@ int run_hopf() {
         e.result = hopf_curves_json(curves, hopf_args.par2, pb.variables);
         csv = hopf_curves_csv(curves, hopf_args.par2, pb.units);
     } else {
-        o.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true);
+        o.progress = branch_progress_printer("hopf", "equilibria", hopf_args.problem.par, true, true);
         points = hopf_points(system, pb.guess, o);
         o.progress = nullptr;
         status = points.status;

@@ -99,6 +99,49 @@ std::function<void(const RootWorkEstimate&)> root_size_guard(const std::string& 
     };
 }
 
+void check_repeated_roots(const std::string& command, const std::string& what, double units, double runs, const RootWorkEstimate& one) {
+    const std::string method = one.method == "shift_invert" ? "sparse" : one.method == "contour" ? "product" : one.method;
+    const std::string full = what + " (" + method + " root searches of about " + human_seconds(runs * one.seconds) + " each: " + one.basis + ")";
+    check_size(command, full, "memory", one.bytes);
+    check_size(command, full, "time", units * runs * one.seconds);
+    announce_estimate(command, full, units * runs * one.seconds);
+}
+
+std::function<void(long, const RootWorkEstimate&)> ring_modes_guard(const std::string& command, int cars) {
+    return [command, cars](long modes, const RootWorkEstimate& one) {
+        // a mode's search ran in 0.31 of its prediction (the modes of rings of 2 x 10^4 and
+        // 4 x 10^4 ovrv, idm and ccc cars: 0.43 ms against 1.4 ms; small complex collocation
+        // matrices, where Eigen's solver beats the c r^3 fitted on large ones)
+        check_repeated_roots(command, "the " + std::to_string(modes) + " modes of a ring of " + std::to_string(cars) + " cars", static_cast<double>(modes), 0.35, one);
+    };
+}
+
+std::function<void(long, const RootWorkEstimate&, int)> branch_roots_guard(const std::string& command, const std::string& stage, double branches) {
+    auto announced = std::make_shared<double>(0.0);  // the run time announced so far (0: none)
+    return [command, stage, branches, announced](long points, const RootWorkEstimate& one, int measured) {
+        const std::string what = "the roots at " + std::to_string(points) + " points of " + (stage.empty() ? "the branch" : stage);
+        const double units = branches * static_cast<double>(points);
+        if (!measured) {
+            // predicted from the first point's root problem: refused above the limit, announced
+            const std::string method = one.method == "shift_invert" ? "sparse" : one.method == "contour" ? "product" : one.method;
+            const std::string full = what + " (" + method + " root searches of about " + human_seconds(one.seconds) + " each, one or two per point: " + one.basis + ")";
+            const double seconds = units * 2.0 * one.seconds;
+            check_size(command, full, "memory", one.bytes);
+            check_size(command, full, "time", seconds);
+            announce_estimate(command, full, seconds);
+            if (seconds > 10.0) *announced = seconds;
+            return;
+        }
+        // measured at the pilot points: refused above the limit; announced at the last pilot when
+        // above 10 s and not within a factor 2 of the prediction announced before
+        const std::string full = what + " (about " + human_seconds(one.seconds) + " each: " + one.basis + ")";
+        const double seconds = units * one.seconds;
+        check_size(command, full, "time", seconds);
+        if (measured == std::min(5L, points) && (*announced == 0.0 || seconds > 2.0 * *announced || 2.0 * seconds < *announced))
+            announce_estimate(command, *announced == 0.0 ? full : full + ", revised", seconds);
+    };
+}
+
 namespace {
 
 /// What the printers share: quiet for the first second (short runs print nothing), on a
@@ -180,8 +223,15 @@ LabelledProgress labelled_progress_printer(const std::string& command, const std
 BranchProgress branch_progress_printer(const std::string& command, const std::string& unit, const std::string& par, bool exact_total, bool heartbeat) {
     if (run_flags().quiet) return nullptr;
     auto printer = std::make_shared<Printer>(command);
-    auto last = std::make_shared<long>(-1);
+    // with `heartbeat`, a call before the first unit is finished (0 done) is a repeat too
+    auto last = std::make_shared<long>(heartbeat ? 0 : -1);
+    auto changed = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
     return [=](long done, long total, double value) {
+        const auto now = std::chrono::steady_clock::now();
+        // a repeat within a unit is shown only once the unit has run 3 s (the regular lines,
+        // with their time left, are not crowded out by a unit's many short repeats)
+        if (heartbeat && done == *last && std::chrono::duration<double>(now - *changed).count() < 3.0) return;
+        if (done != *last) *changed = now;
         char v[32];
         std::snprintf(v, sizeof v, "%.6g", value);
         const std::string count = exact_total ? unit + " " + std::to_string(done) + "/" + std::to_string(total)

@@ -52,6 +52,25 @@ void flush_notes();
 /// was made.
 std::function<void(const RootWorkEstimate&)> root_size_guard(const std::string& command, const std::string& what);
 
+/// The size guard of work made of `units` root searches alike (the points of an equilibrium
+/// branch, the modes of a ring), each predicted by `one` (estimate_root_work of the first) and
+/// made `runs` times at most on average: check_size on the memory of one and on units x runs x
+/// its time, then announce_estimate. `what`: "the roots at 24 points of the branch".
+void check_repeated_roots(const std::string& command, const std::string& what, double units, double runs, const RootWorkEstimate& one);
+
+/// RingOptions::before of `command` (the per-mode path of a ring of `cars` cars): check_repeated_roots
+/// on the modes, each predicted by the first nonzero mode's estimate times 0.35 (measured on
+/// rings of 2 x 10^4 and 4 x 10^4 cars: 0.31).
+std::function<void(long, const RootWorkEstimate&)> ring_modes_guard(const std::string& command, int cars);
+
+/// EquilibriumBranchOptions::before_roots of `command`: before any root, check_size on the
+/// branch's points x 2 searches (equilibrium_roots asks again when the first did not certify the
+/// strip it needs) x the predicted one, and announce_estimate; after each pilot point check_size
+/// on the points x their mean measured time (refused above the limit), announced after the last
+/// pilot ("revised") when it is off the first announcement by more than a factor 2. `stage` names the branch in the note ("" = "the
+/// branch"), `branches` the number of branches like it (bistability's slices).
+std::function<void(long, const RootWorkEstimate&, int)> branch_roots_guard(const std::string& command, const std::string& stage = "", double branches = 1.0);
+
 /// "1.5 GB", "340 MB", "12 kB"; "2.5 min", "3.1 h".
 std::string human_bytes(double bytes);
 std::string human_seconds(double seconds);

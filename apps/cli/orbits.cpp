@@ -291,7 +291,8 @@ int run_orbits() {
     eo.from = o.from;
     eo.to = o.to;
     eo.roots.count = 2;
-    eo.progress = branch_progress_printer("orbits", "equilibria", par, true);
+    eo.progress = branch_progress_printer("orbits", "equilibria", par, true, true);
+    eo.before_roots = branch_roots_guard("orbits", "the equilibrium branch");
     // the equilibria start the orbits at a Hopf point; from a simulation or a file they are only
     // drawn (--svg), so computed only then (a long ring's branch takes minutes)
     const bool from_hopf = !from_simulation && !from_file;

@@ -240,7 +240,7 @@ int run_ring(Format format, const std::string& prefix) {
     const int count = parse_count();
     // N = inf: the wave numbers of the scan, then the steps of the search for --count roots at the abscissa's
     const FastRing fast = analyse_ring_fast(lin, cars, method, count, progress_printer("roots", cars == 0 ? "wave numbers" : "modes"),
-                                            cars == 0 ? search_progress_printer("roots", "Re") : nullptr);
+                                            cars == 0 ? search_progress_printer("roots", "Re") : nullptr, ring_modes_guard("roots", cars));
     const RingResult& r = fast.ring;
     JsonEnvelope e;
     e.command = "roots";

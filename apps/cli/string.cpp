@@ -58,7 +58,7 @@ int run_string() {
     std::optional<RingResult> ring;
     std::optional<FastRing> fast;
     if (cars) {
-        fast = analyse_ring_fast(lin, *cars, method, 0, progress_printer("string", *cars == 0 ? "wave numbers" : "modes"));
+        fast = analyse_ring_fast(lin, *cars, method, 0, progress_printer("string", *cars == 0 ? "wave numbers" : "modes"), nullptr, ring_modes_guard("string", *cars));
         ring = fast->ring;
     }
     const RingResult* rp = ring ? &*ring : nullptr;

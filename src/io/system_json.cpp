@@ -287,6 +287,18 @@ NonlinearSystemFile read_nonlinear_system_json(const std::string& text, const st
     } catch (const std::invalid_argument& e) {
         throw std::invalid_argument(source + ": " + detail::escaped(e.what(), 400));
     }
+    // a delay written as a number in an equation (x(t - 1e308)) has the range of a linear file's
+    // delays: at most 1e100 (beyond, 1 / tau is subnormal and the dense eigenvalues crawl)
+    {
+        std::vector<double> tau;
+        try {
+            tau = out.system->delays();
+        } catch (const std::invalid_argument&) {
+            tau.clear();  // a delay that cannot be evaluated at the file's values: reported where it is used
+        }
+        for (const double t : tau)
+            if (std::isfinite(t) && t > 1e100) fail(source, "equations", "a delay of " + detail::format_number(t) + ": expected a delay of at most 1e100");
+    }
     const std::size_t n = variables.size();
     out.equilibrium = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
     if (j.contains("equilibrium")) {

@@ -2237,6 +2237,21 @@ expect_error "dupruns.csv:3: car 'CarA' with file 't1.csv' is listed before (rol
 expect_error "length = 10000000 m: expected at least" roots --fleet A_min,C_max --ring 999999 --length 1e7
 expect_error "14 cars in rings of 1000000 cars: estimated run time" classify --ring 1000000
 expect_error "a 3 x 3 grid of a 1000000-car ring: estimated run time" sweep --ring 1000000 --k1 0.01:1:3 --k2 0.01:1:3 --th 1.5 --tau 0.1 --ring-curves all --out "$tmp/sw"
+# the fourth run's timeouts: a delay written in an equation has a linear file's range (1e308 made
+# the dense eigenvalues crawl on subnormal numbers, 9 s a point); the continuations' roots and
+# the per-mode ring path are sized before they start: refused above the limit, else announced
+echo '{"variables":["x"],"parameters":{"p":-1},"equations":["x*(p - x(t - 1e308))"]}' >"$tmp/hu308.json"
+expect_error "hu308.json: equations: a delay of 1e+308: expected a delay of at most 1e100" equilibria --system "$tmp/hu308.json" --par p --from -1 --to 3
+printf '{"variables": ["x1", "x2"], "parameters": {"kappa": 0.5, "beta": -1, "a12": 1, "a21": 1e5, "tau1": 0.2, "tau2": 0.2, "taus": 1.5}, "equations": ["-kappa*x1 + beta*tanh(x1(t - taus)) + a12*tanh(x2(t - tau2))", "-kappa*x2 + beta*tanh(x2(t - taus)) + a21*tanh(x1(t - tau1))"]}' >"$tmp/coupled.json"
+expect_error "the roots at 24 points of the equilibrium branch and about 10 slices like it (dense root searches of about .* each, one or two per point: the eigenvalues of two collocation degrees, 802 and 1.2e+03 rows): estimated run time .* min is above the limit 10 min (--allow-large runs it anyway)" \
+    bistability --system "$tmp/coupled.json" --par kappa --from 0.1 --to 2 --par2 beta --from2 -2 --to2 0 --points 50 --rows 8 --out "$tmp/bi"
+printf '{"variables": ["x1", "x2"], "parameters": {"a": 0.5, "b": 0.6, "d": 0.05, "tau": 1e19}, "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"]}' >"$tmp/duffing19.json"
+timeout 3 "$bin" hopf --system "$tmp/duffing19.json" --par a --from 0.1 --to 2 >/dev/null 2>"$tmp/duffing19.err"
+head -1 "$tmp/duffing19.err" | grep -q "^ddemap: hopf: note: the roots at 24 points of the branch (dense root searches of about .* each, one or two per point: .*): estimated run time .* min$" &&
+    ok || bad "hopf sized before its roots: $(head -1 "$tmp/duffing19.err")"
+timeout 3 "$bin" string --ring 1000000 --k1 0.2 --k2 0.3 --th 1.5 --tau 0.2 --ring-method modes >/dev/null 2>"$tmp/modes.err"
+head -1 "$tmp/modes.err" | grep -q "^ddemap: string: note: the 500001 modes of a ring of 1000000 cars (dense root searches of about .* each: .*): estimated run time .* min$" &&
+    ok || bad "the per-mode ring path sized before it starts: $(head -1 "$tmp/modes.err")"
 fi  # part chain
 
 if part killset; then

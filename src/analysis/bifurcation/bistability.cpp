@@ -158,6 +158,7 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     ho.from2 = o.from2;
     ho.to2 = o.to2;
     ho.continuation.max_points = o.max_points;
+    ho.branch.before_roots = o.before_roots;
     if (o.progress) {
         ho.progress = beat;
         ho.branch.progress = beat;

@@ -83,10 +83,11 @@ std::vector<RingRoot> neighbour_roots(const Linearisation& lin, int cars, const 
 }  // namespace
 
 FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress,
-                           const BranchProgress& search) {
+                           const BranchProgress& search, const std::function<void(long, const RootWorkEstimate&)>& before) {
     FastRing f;
     RingOptions opt;
     opt.progress = progress;
+    opt.before = before;
     if (cars == 0) opt.roots.progress = search;  // N finite: every mode's search would call it
     if (count > 0) opt.roots.count = count;
     if (method == "modes") {

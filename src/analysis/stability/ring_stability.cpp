@@ -72,6 +72,12 @@ RingResult analyse_ring(const Linearisation& lin, int cars, const RingOptions& o
             per_mode[m] = solve_mode(dde, o, true);
             asked[m] = std::max(asked[m], static_cast<int>(per_mode[m].roots.size()));
         };
+        if (options.before) {
+            RootOptions o = options.roots;
+            o.count = std::min(count, 2);
+            const LinearDDE one = modes > 1 ? ring_mode_dde(lin, ring_zeta(1, cars)) : ring_mode0_dde(lin);
+            options.before(modes, estimate_root_work(RootProblem{one, nullptr}, o));
+        }
         for (int m = 0; m < modes; ++m) {
             solve(m);
             if (options.progress) options.progress(m + 1, modes);

@@ -3,6 +3,7 @@
 // after that point with its exception reaching the caller (how Ctrl-C stops them from Python).
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <vector>
 
@@ -29,6 +30,21 @@ struct Seen {
     std::vector<double> par;
 };
 
+/// The calls that report a newly finished unit (the count changed): a branch repeats the last
+/// count from within a point's root search (a heartbeat), and those repeats are dropped here.
+Seen finished(const Seen& all) {
+    Seen s;
+    long last = 0;
+    for (std::size_t k = 0; k < all.done.size(); ++k) {
+        if (all.done[k] == last) continue;
+        last = all.done[k];
+        s.done.push_back(all.done[k]);
+        s.total.push_back(all.total[k]);
+        s.par.push_back(all.par[k]);
+    }
+    return s;
+}
+
 /// Records every call; throws `Stop` at the call with done == stop_at (never when 0).
 struct Stop : std::runtime_error {
     Stop() : std::runtime_error("stopped by the caller") {}
@@ -38,7 +54,7 @@ BranchProgress recorder(Seen& seen, long stop_at = 0) {
         seen.done.push_back(done);
         seen.total.push_back(total);
         seen.par.push_back(par);
-        if (done == stop_at) throw Stop();
+        if (stop_at > 0 && done == stop_at) throw Stop();
     };
 }
 
@@ -51,21 +67,92 @@ TEST_CASE("equilibrium branch: one progress call per point after its roots, and 
     o.parameter = "p";
     o.from = 0.9;
     o.to = -1.0;
-    Seen seen;
-    o.progress = recorder(seen);
+    Seen all;
+    o.progress = recorder(all);
     const EquilibriumBranch b = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.9), o);
-    REQUIRE(b.points.size() > 5);
-    REQUIRE(seen.done.size() == b.points.size());
-    for (std::size_t k = 0; k < b.points.size(); ++k) {
+    const std::size_t n = b.points.size();
+    REQUIRE(n > 5);
+    const Seen seen = finished(all);
+    REQUIRE(seen.done.size() == n);
+    // the pilot points first (the ends, the middle, the quarters), then the others in order
+    std::vector<std::size_t> order = {0, n - 1, n / 2, n / 4, (3 * n) / 4};
+    for (std::size_t k = 1; k + 1 < n; ++k)
+        if (k != n / 2 && k != n / 4 && k != (3 * n) / 4) order.push_back(k);
+    REQUIRE(order.size() == n);
+    for (std::size_t k = 0; k < n; ++k) {
         CHECK(seen.done[k] == static_cast<long>(k + 1));
-        CHECK(seen.total[k] == static_cast<long>(b.points.size()));  // known: the continuation ran first
-        CHECK(seen.par[k] == b.points[k].par);
+        CHECK(seen.total[k] == static_cast<long>(n));  // known: the continuation ran first
+        CHECK(seen.par[k] == b.points[order[k]].par);
     }
+    // the repeats come from within a point: the count of the points finished before it
+    for (std::size_t k = 0; k < all.done.size(); ++k) CHECK((all.done[k] >= 0 && all.done[k] <= static_cast<long>(n)));
 
     Seen stopped;
     o.progress = recorder(stopped, 3);
     CHECK_THROWS_AS(equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.9), o), Stop);
-    CHECK(stopped.done == std::vector<long>{1, 2, 3});  // nothing after the throwing call
+    CHECK(finished(stopped).done == std::vector<long>{1, 2, 3});
+    CHECK(stopped.done.back() == 3);  // nothing after the throwing call
+}
+
+TEST_CASE("equilibrium branch: the size guard sees the points before any root and the pilots' measured time, and may refuse") {
+    const ExpressionSystem sys({"x"}, {"p"}, {0.9}, {"p - x(t - 1)^2"});
+    EquilibriumBranchOptions o;
+    o.parameter = "p";
+    o.from = 0.9;
+    o.to = -1.0;
+    std::vector<int> measured;
+    std::vector<long> points;
+    std::vector<double> seconds;
+    long progress_calls = 0;
+    o.progress = [&](long, long, double) { ++progress_calls; };
+    o.before_roots = [&](long n, const RootWorkEstimate& one, int m) {
+        if (m == 0) CHECK(progress_calls == 0);  // before any root
+        measured.push_back(m);
+        points.push_back(n);
+        seconds.push_back(one.seconds);
+    };
+    const EquilibriumBranch b = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.9), o);
+    REQUIRE(b.points.size() > 5);
+    CHECK(measured == std::vector<int>{0, 1, 2, 3, 4, 5});
+    for (const long n : points) CHECK(n == static_cast<long>(b.points.size()));
+    for (const double s : seconds) CHECK((std::isfinite(s) && s > 0.0));
+
+    // the same branch with and without the guard (the order of the roots changes nothing)
+    EquilibriumBranchOptions plain = o;
+    plain.before_roots = nullptr;
+    plain.progress = nullptr;
+    const EquilibriumBranch c = equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.9), plain);
+    REQUIRE(c.points.size() == b.points.size());
+    for (std::size_t k = 0; k < b.points.size(); ++k) {
+        CHECK(c.points[k].par == b.points[k].par);
+        CHECK(c.points[k].unstable == b.points[k].unstable);
+        CHECK(c.points[k].abscissa == b.points[k].abscissa);
+    }
+
+    // a guard that refuses before the roots: no point's roots computed
+    progress_calls = 0;
+    o.before_roots = [](long, const RootWorkEstimate&, int) { throw Stop(); };
+    CHECK_THROWS_AS(equilibrium_branch(sys, Eigen::VectorXd::Constant(1, 0.9), o), Stop);
+    CHECK(progress_calls == 0);
+}
+
+TEST_CASE("ring: the size guard of the per-mode path sees N/2 + 1 modes before any is solved") {
+    const Linearisation lin = test::ovrv(0.2, 0.2, 1.5, 0.1);  // the paper's example
+    RingOptions o;
+    long modes = -1, progress_calls = 0;
+    o.progress = [&](long, long) { ++progress_calls; };
+    o.before = [&](long m, const RootWorkEstimate& one) {
+        CHECK(progress_calls == 0);
+        CHECK((std::isfinite(one.seconds) && one.seconds > 0.0));
+        modes = m;
+    };
+    const RingResult r = analyse_ring(lin, 9, o);
+    CHECK(modes == 5);
+    CHECK(progress_calls >= 5);
+    o.before = [](long, const RootWorkEstimate&) { throw Stop(); };
+    progress_calls = 0;
+    CHECK_THROWS_AS(analyse_ring(lin, 9, o), Stop);
+    CHECK(progress_calls == 0);
 }
 
 TEST_CASE("Hopf curve: one progress call per traced point, and a throwing callback stops the continuation") {
@@ -84,7 +171,7 @@ TEST_CASE("Hopf curve: one progress call per traced point, and a throwing callba
     const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(1), o);
     REQUIRE(hc.curves.size() == 1);
     const HopfCurve& c = hc.curves[0];
-    CHECK(branch.done.size() == hc.start.branch.points.size());
+    CHECK(finished(branch).done.size() == hc.start.branch.points.size());
     // every point but the start (a Hopf point of the branch) is reported, numbered from 2
     REQUIRE(curve.done.size() + 1 == c.points.size());
     for (std::size_t k = 0; k < curve.done.size(); ++k) {

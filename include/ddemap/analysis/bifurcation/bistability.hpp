@@ -27,6 +27,7 @@
 /// has orbits of two stabilities, seen only at its representative point.
 /// The system's parameter p2 is changed during the call and restored before it returns.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,9 @@ struct BistabilityOptions {
     /// After each stage (the Hopf curves, each orbit branch, fold curve and cell slice):
     /// (stages done, an upper bound of the stages, p1 of the stage). It may throw to stop.
     BranchProgress progress;
+    /// The first equilibrium branch's EquilibriumBranchOptions::before_roots (the one at the held
+    /// p2, before its roots; the slices' branches are like it): a size guard may throw there.
+    std::function<void(long points, const RootWorkEstimate& one, int measured)> before_roots;
     bool is_valid(std::string* why = nullptr) const;
 };
 

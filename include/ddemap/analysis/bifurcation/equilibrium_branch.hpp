@@ -19,6 +19,7 @@
 ///    (fold_system, hopf_system: blocks from second derivatives of f in nested dual numbers), so
 ///    Newton converges quadratically.
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -59,8 +60,22 @@ struct EquilibriumBranchOptions {
     double special_residual = 1e-9;    ///< accept a fold/Hopf point with residual at most this
     /// After the roots of every point of the branch: (points done, points of the branch, p).
     /// The continuation (Newton only) runs first, then the roots point by point (most of the
-    /// time); the callback may throw to stop, and that exception reaches the caller.
+    /// time: the pilot points of before_roots first, then the others in order); within a point's root search the last call is repeated (the points done so far,
+    /// after every unit of that search's work: RootOptions::progress) so that a printer can show
+    /// that a long point is still running and a Cancelled thrown there stops it. The callback may
+    /// throw to stop, and that exception reaches the caller.
     BranchProgress progress;
+    /// The size guard of the roots (the long part), called twice with the number of points whose
+    /// roots are to be computed: after the continuation and before any root, with
+    /// estimate_root_work's prediction for one root search at the first point (measured = 0;
+    /// each point makes one to a few searches: equilibrium_roots), then after the roots of each of
+    /// the pilot points, computed first (the ends, the middle and the quarters of the branch:
+    /// min(5, points) of them), with the mean of their measured times as `one.seconds` (measured
+    /// = the pilots done; the last call, measured = min(5, points), is the final prediction):
+    /// points x one.seconds predicts the whole (the cost of a point changes along a branch with
+    /// the roots near the axis). It may throw (a guard refusing the work; the exception reaches
+    /// the caller). May be empty.
+    std::function<void(long points, const RootWorkEstimate& one, int measured)> before_roots;
     bool is_valid(std::string* why = nullptr) const;
 };
 

@@ -32,8 +32,9 @@ struct FastRing {
 /// the per-mode path needs cars <= kModesMaxCars (checked by the caller). `progress`: the per-mode
 /// path's (RingOptions::progress; it may throw to stop); the winding pass does not report.
 /// `search`: N = infinity, the steps of the search for the `count` roots at the abscissa's
-/// wave number (RingOptions::roots.progress).
+/// wave number (RingOptions::roots.progress). `before`: the per-mode path's size guard
+/// (RingOptions::before), called only when that path runs.
 FastRing analyse_ring_fast(const Linearisation& lin, int cars, const std::string& method, int count, const Progress& progress = {},
-                           const BranchProgress& search = {});
+                           const BranchProgress& search = {}, const std::function<void(long, const RootWorkEstimate&)>& before = {});
 
 }  // namespace ddemap

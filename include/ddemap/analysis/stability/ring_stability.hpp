@@ -3,6 +3,7 @@
 /// Rightmost roots and the stability verdict of a ring of N identical cars, mode by mode
 /// (traffic/ring.hpp); N = infinity over every wave number theta.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,11 @@ struct RingOptions {
     /// the exception reaches the caller; so does a ddemap::Cancelled thrown by roots.progress
     /// (which is also called within a long dense degree of that search: solve/roots.hpp).
     Progress progress;
+    /// N finite: called once before the modes are solved, with their number (N/2 + 1) and
+    /// estimate_root_work's prediction for the first nonzero mode's root search (the modes are
+    /// alike in size); it may throw (a size guard refusing the work; the exception reaches the
+    /// caller). May be empty.
+    std::function<void(long modes, const RootWorkEstimate& one)> before;
     void validate() const;
 };
 
