@@ -110,7 +110,8 @@ void add_equilibria_flags(CLI::App& app) {
     app.add_option("--svg", equilibria_args.svg, "--par2: the two-parameter diagram (fold curves; cusp and Bogdanov-Takens points)")->type_name("FILE");
     app.add_option("--branch-point", equilibria_args.branch_point,
                    "switch at branch point K of the branch (from 0, in the order met) onto the other branch of equilibria through it and follow "
-                   "that one towards --to (--from and --to swapped: its other side); PREFIX-switched.csv, JSON result.switched")
+                   "that one on both sides of the point (the half away from --to, then the half towards it, joined; at a pitchfork both sides of the "
+                   "broken symmetry); PREFIX-switched.csv, JSON result.switched")
         ->type_name("K");
     equilibria_args.format.add_to(app);
     equilibria_args.out.add_to(app, "PREFIX.csv (one row per point and special point, or per fold-curve point with --par2) and PREFIX.json", false);
@@ -166,7 +167,7 @@ int run_equilibria() {
             nb.message = "branch point " + std::to_string(bp_index) + " was not located: no branch switched onto";
         } else {
             o.progress = branch_progress_printer("equilibria", "points of the other branch", equilibria_args.problem.par, true, true);
-            nb = equilibrium_branch_from_branch_point(*system, b, *bp, o);
+            nb = equilibrium_branch_from_branch_point(*system, b, *bp, o, BranchSide::Both);
             o.progress = nullptr;
         }
         if (nb.status != Status::Converged && b.status == Status::Converged) {
@@ -223,7 +224,7 @@ int run_equilibria() {
         table(b);
         if (switching) {
             out << "switched   at the branch point " << equilibria_args.problem.par << " = " << rounded(bp->par, 12) << ": the other branch, "
-                << counted(static_cast<long long>(nb.points.size()), "point") << " (ended: " << to_string(nb.stop) << ")\n";
+                << counted(static_cast<long long>(nb.points.size()), "point") << ", both halves through the point (ended: " << to_string(nb.stop) << ")\n";
             table(nb);
         }
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";

@@ -1030,7 +1030,8 @@ def equilibria(par, from_, to, system=None, model=None, ring=None, count=4, max_
     ``par2``, ``status``).
 
     ``branch_point`` K (``equilibria --branch-point K``): also the other branch of equilibria
-    through the branch's branch point K (from 0), followed towards ``to``, as ``switched``
+    through the branch's branch point K (from 0), both halves joined through the point (the half
+    away from ``to`` from its far end, then the half towards ``to``), as ``switched``
     (``from``: the point's ``index`` and ``par``; then the keys of a branch).
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)

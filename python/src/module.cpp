@@ -999,7 +999,7 @@ std::string py_equilibria(const std::string& system_file, const std::string& mod
             nb.status = bp.status;
             nb.message = "branch point " + std::to_string(k) + " was not located: no branch switched onto";
         } else {
-            nb = released([&] { return equilibrium_branch_from_branch_point(*pb.system, b, bp, o); });
+            nb = released([&] { return equilibrium_branch_from_branch_point(*pb.system, b, bp, o, BranchSide::Both); });
         }
         if (nb.status != Status::Converged && b.status == Status::Converged) {
             b.status = nb.status;

@@ -1015,6 +1015,7 @@ sw = r["switched"]
 assert sw["from"]["index"] == 0 and abs(sw["from"]["par"]) < 1e-10
 pts = sw["points"]
 assert all(abs(p["x"][0] - p["par"]) < 1e-12 for p in pts) and pts[-1]["par"] == 2
+assert pts[0]["par"] == -1  # both halves: the one towards --from first, from its far end
 h = sw["hopf"]
 assert len(h) == 1 and abs(h[0]["par"] - math.pi / 2) < 1e-9 and abs(h[0]["omega"] - math.pi / 2) < 1e-9
 rows = list(csv.DictReader(open(sys.argv[2])))
@@ -1023,6 +1024,20 @@ PY
 else
     bad "equilibria --branch-point exit status"
 fi
+# a pitchfork: both halves x = +-sqrt(p) of x' = x (p - x(t - 1)^2), each with its Hopf point p = pi/4
+echo '{"variables":["x"],"parameters":{"p":-1},"equations":["x*(p - x(t - 1)^2)"]}' >"$tmp/pitchfork.json"
+"$bin" equilibria --system "$tmp/pitchfork.json" --par p --from -1 --to 1 --branch-point 0 --format json --quiet >"$tmp/pf.json" &&
+    python3 - "$tmp/pf.json" <<'PY' && ok || bad "equilibria --branch-point at a pitchfork: both halves"
+import json, sys, math
+sw = json.load(open(sys.argv[1]))["result"]["switched"]
+pts = sw["points"]
+assert pts[0]["par"] == 1 and pts[-1]["par"] == 1
+assert all(abs(p["x"][0] ** 2 - p["par"]) < 1e-10 for p in pts)
+assert any(p["x"][0] > 0.5 for p in pts) and any(p["x"][0] < -0.5 for p in pts)
+h = sw["hopf"]
+assert len(h) == 2 and all(abs(x["par"] - math.pi / 4) < 1e-9 and abs(x["omega"] - math.pi / 2) < 1e-9 for x in h)
+assert h[0]["x"][0] * h[1]["x"][0] < 0
+PY
 # (checked once the branch is computed: --quiet keeps a slow build's progress lines out)
 expect_error "--branch-point = '1': expected an index from 0 to 0 (the branch has 1 branch point)" \
     equilibria --system "$(dirname "$0")/../../examples/hutchinson.json" --par p --from -1 --to 2 --branch-point 1 --out "$tmp/hutbad" --quiet

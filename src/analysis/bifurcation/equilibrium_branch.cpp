@@ -680,8 +680,47 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
     return analyse_branch(system, j, curve, c, options, std::move(br));
 }
 
+namespace {
+
+/// The two halves of a switched branch joined through their common first point (the branch
+/// point): `away` reversed, then `towards` after its first point.
+EquilibriumBranch join_halves(EquilibriumBranch away, const EquilibriumBranch& towards) {
+    EquilibriumBranch j;
+    j.parameter = towards.parameter;
+    const int m = static_cast<int>(away.points.size());
+    j.points.assign(away.points.rbegin(), away.points.rend());
+    j.points.insert(j.points.end(), towards.points.begin() + (towards.points.empty() ? 0 : 1), towards.points.end());
+    // a special point between points k and k + 1 of the away half lies between m - 2 - k and
+    // m - 1 - k of the reversed one; one of the towards half after point k after m - 1 + k
+    auto join = [m](auto away_points, const auto& towards_points, auto& out) {
+        for (auto& x : away_points) x.after = m - 2 - x.after;
+        out = std::move(away_points);
+        for (auto x : towards_points) {
+            x.after += m - 1;
+            out.push_back(std::move(x));
+        }
+        std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.after < b.after; });
+    };
+    join(away.folds, towards.folds, j.folds);
+    join(away.hopf, towards.hopf, j.hopf);
+    j.stop = towards.stop;
+    j.status = towards.status != Status::Converged ? towards.status : away.status;
+    j.message = std::to_string(j.points.size()) + " points, " + std::to_string(j.folds.size()) + " folds, " + std::to_string(j.hopf.size()) +
+                " Hopf points (both halves through the branch point); the half towards the end: " + towards.message + "; the other half: " + away.message;
+    return j;
+}
+
+}  // namespace
+
 EquilibriumBranch equilibrium_branch_from_branch_point(const NonlinearDDE& system, const EquilibriumBranch& branch, const FoldPoint& bp,
-                                                       const EquilibriumBranchOptions& options) {
+                                                       const EquilibriumBranchOptions& options, BranchSide side) {
+    if (side == BranchSide::Both) {
+        const EquilibriumBranch towards = equilibrium_branch_from_branch_point(system, branch, bp, options, BranchSide::Towards);
+        const EquilibriumBranch away = equilibrium_branch_from_branch_point(system, branch, bp, options, BranchSide::Away);
+        if (towards.points.empty()) return away;
+        if (away.points.empty()) return towards;
+        return join_halves(away, towards);
+    }
     std::string why;
     if (!options.is_valid(&why)) throw std::invalid_argument("equilibrium branch options: " + why);
     const int j = system.parameter_index(options.parameter);
@@ -744,10 +783,16 @@ EquilibriumBranch equilibrium_branch_from_branch_point(const NonlinearDDE& syste
         }
         if (towards) break;
     }
+    if (ok && side == BranchSide::Away) {
+        // the opposite half: its first point along -dir
+        const Eigen::VectorXd back = -dir;
+        ok = first_point(back, u);
+        dir = back;
+    }
     if (!ok) {
         br.status = Status::MaxIterations;
         br.message = "the first point of the other branch did not converge from the branch point at " + options.parameter + " = " +
-                     detail::format_number(bp.par);
+                     detail::format_number(bp.par) + (side == BranchSide::Away ? " (the half away from the end)" : "");
         return br;
     }
     const std::vector<TestFunction> tests{{"fold", [n](const Eigen::VectorXd&, const Eigen::VectorXd& t) { return t[n]; }, false}};

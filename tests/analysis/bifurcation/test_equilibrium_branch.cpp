@@ -546,6 +546,60 @@ TEST_CASE("branch switching: Hutchinson's x' = x (p - x(t - 1)) from x = 0 onto 
     CHECK_THROWS_AS(equilibrium_branch_from_branch_point(s, b, fold, o), std::invalid_argument);
 }
 
+TEST_CASE("branch switching at a pitchfork: both halves x = +-sqrt(p) of x' = x (p - x(t - 1)^2), joined through the point, each with its Hopf point") {
+    // x = 0 loses stability at p = 0 (lambda = p), where x = +-sqrt(p) branch off towards p > 0;
+    // on them lambda = -2 p e^{-lambda}: stable for p < pi/4, a Hopf point at p = pi/4, omega = pi/2
+    ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"x*(p - x(t - 1)^2)"});
+    EquilibriumBranchOptions o;
+    o.parameter = "p";
+    o.from = -1.0;
+    o.to = 1.0;
+    o.roots.count = 2;
+    const EquilibriumBranch b = equilibrium_branch(s, Eigen::VectorXd::Zero(1), o);
+    REQUIRE(b.status == Status::Converged);
+    REQUIRE(b.folds.size() == 1);
+    const FoldPoint& bp = b.folds.front();
+    REQUIRE(bp.kind == "branch_point");
+    CHECK(std::abs(bp.par) < 1e-10);
+    // one half only (the default): every point on one side, x = +sqrt(p) or -sqrt(p)
+    const EquilibriumBranch one = equilibrium_branch_from_branch_point(s, b, bp, o);
+    REQUIRE(one.status == Status::Converged);
+    const double sign = one.points.back().x[0] > 0.0 ? 1.0 : -1.0;
+    for (const EquilibriumPoint& p : one.points) CHECK(std::abs(p.x[0] - sign * std::sqrt(std::max(0.0, p.par))) < 1e-10);
+    // swapping from and to cannot reach the other half; BranchSide::Away does
+    const EquilibriumBranch away = equilibrium_branch_from_branch_point(s, b, bp, o, BranchSide::Away);
+    REQUIRE(away.status == Status::Converged);
+    CHECK(away.points.back().par == 1.0);
+    for (const EquilibriumPoint& p : away.points) CHECK(std::abs(p.x[0] + sign * std::sqrt(std::max(0.0, p.par))) < 1e-10);
+    // both: the away half reversed, the point, the default half
+    const EquilibriumBranch both = equilibrium_branch_from_branch_point(s, b, bp, o, BranchSide::Both);
+    REQUIRE(both.status == Status::Converged);
+    REQUIRE(both.points.size() == one.points.size() + away.points.size() - 1);
+    const std::size_t mid = away.points.size() - 1;
+    CHECK(both.points[mid].par == bp.par);
+    CHECK(both.points.front().par == 1.0);
+    CHECK(both.points.back().par == 1.0);
+    for (std::size_t k = 0; k < both.points.size(); ++k) {
+        const EquilibriumPoint& p = both.points[k];
+        CAPTURE(p.par);
+        const double branch_sign = k < mid ? -sign : sign;
+        if (k != mid) CHECK(std::abs(p.x[0] - branch_sign * std::sqrt(p.par)) < 1e-10);
+        if (p.par > 1e-6 && p.par < pi / 4 - 1e-3) CHECK(p.stable);
+        if (p.par > pi / 4 + 1e-3) CHECK(!p.stable);
+    }
+    // a Hopf point on each half, at p = pi/4 with omega = pi/2, between the points it lies between
+    REQUIRE(both.hopf.size() == 2);
+    for (const HopfPoint& h : both.hopf) {
+        CHECK(std::abs(h.par - pi / 4) < 1e-9);
+        CHECK(std::abs(h.omega - pi / 2) < 1e-9);
+        REQUIRE((h.after >= 0 && h.after + 1 < static_cast<int>(both.points.size())));
+        const double p0 = both.points[static_cast<std::size_t>(h.after)].par, p1 = both.points[static_cast<std::size_t>(h.after) + 1].par;
+        CHECK((std::min(p0, p1) <= h.par && h.par <= std::max(p0, p1)));
+    }
+    CHECK(both.hopf[0].x[0] * both.hopf[1].x[0] < 0.0);  // one on each half
+    CHECK(both.folds.empty());
+}
+
 TEST_CASE("branch switching: two lines of equilibria crossing obliquely, x = 2p and x = p of x' = (x - 2p)(x(t - 1) - p)") {
     ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"(x - 2*p)*(x(t - 1) - p)"});
     EquilibriumBranchOptions o;

@@ -146,8 +146,17 @@ EquilibriumBranch equilibrium_branch(const NonlinearDDE& system, const Eigen::Ve
 /// point its first point. One side of the new branch: the other side with from and to swapped.
 /// std::invalid_argument for invalid options or a point that is not a located branch point of
 /// `branch`; non-convergence is a status.
+///
+/// `side`: Towards (the default) follows the half described above; Away the opposite half (-t2:
+/// at a transcritical point the part towards options.from, at a pitchfork, where both halves
+/// leave towards the same side of the parameter, the other half, which swapping from and to
+/// cannot reach); Both follows the two halves and joins them into one branch through the point:
+/// the Away half reversed (its far end first, the branch point last), then the Towards half
+/// after the point; special points keep their place (`after` renumbered), the status is the
+/// worse of the two, `stop` the Towards half's and the message names both ends.
+enum class BranchSide { Towards, Away, Both };
 EquilibriumBranch equilibrium_branch_from_branch_point(const NonlinearDDE& system, const EquilibriumBranch& branch, const FoldPoint& bp,
-                                                       const EquilibriumBranchOptions& options);
+                                                       const EquilibriumBranchOptions& options, BranchSide side = BranchSide::Towards);
 
 /// The fold system F(z), z = (x, p_j, v) (2n + 1 unknowns):
 ///     F = (f(x, ..., x; p),  (A_0 + ... + A_m) v,  v0 . v - 1),
