@@ -1180,6 +1180,21 @@ PY
 else
     bad "orbits --par2 exit status"
 fi
+# knut's traffic demo: the folds of orbits of the 3-car ring (alpha = 0.6, v0 = 0.8) in (headway,
+# alpha); on the face alpha = 1.2 the curves end where the branch in the headway at alpha = 1.2 folds
+if "$bin" orbits --model ov --ring 3 --alpha 0.6 --v0 0.8 --tau 1 --par headway --from 1.2 --to 3 --par2 alpha --from2 0.3 --to2 1.2 --format json --quiet >"$fc/knut.json" &&
+   "$bin" orbits --model ov --ring 3 --alpha 1.2 --v0 0.8 --tau 1 --par headway --from 1.2 --to 3 --format json --quiet >"$fc/knut12.json"; then
+    python3 - "$fc/knut.json" "$fc/knut12.json" <<'PY' && ok || bad "orbits --par2 alpha: knut's demo against the folds at alpha = 1.2"
+import json, sys
+curves = json.load(open(sys.argv[1]))["result"]["fold_curves"]
+folds = sorted(f["par"] for f in json.load(open(sys.argv[2]))["result"]["folds"])
+ends = sorted(p["par"] for c in curves for p in c["points"] if p["par2"] == 1.2)
+assert len(curves) == 2 and len(folds) == 2 and len(ends) == 2, (len(curves), folds, ends)
+assert all(abs(a - b) < 1e-8 for a, b in zip(ends, folds)), (ends, folds)
+PY
+else
+    bad "orbits --par2 alpha exit status"
+fi
 expect_error "--par2 needs --from2 and --to2" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --out "$fc/bad1"
 expect_error "--par2 = 'headway': expected a parameter other than --par" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 headway --from2 1 --to2 2
 expect_error "expected it in \[--from2, --to2\]" orbits --model ov --ring 3 --par headway --from 1.2 --to 3 --par2 tau --from2 1.5 --to2 2 --out "$fc/bad2"
