@@ -224,7 +224,9 @@ int run_equilibria() {
         table(b);
         if (switching) {
             out << "switched   at the branch point " << equilibria_args.problem.par << " = " << rounded(bp->par, 12) << ": the other branch, "
-                << counted(static_cast<long long>(nb.points.size()), "point") << ", both halves through the point (ended: " << to_string(nb.stop) << ")\n";
+                << counted(static_cast<long long>(nb.points.size()), "point")
+                << (nb.message.rfind("one half only", 0) == 0 ? ", one half only (the other did not start)" : ", both halves through the point")
+                << " (ended: " << to_string(nb.stop) << ")\n";
             table(nb);
         }
         if (b.status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(b.status) << "): " << b.message << "\n";

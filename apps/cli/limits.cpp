@@ -83,9 +83,9 @@ void flush_notes() {
     pending_notes().clear();
 }
 
-void announce_estimate(const std::string& command, const std::string& what, double seconds) {
+void announce_estimate(const std::string& command, const std::string& what, double seconds, bool always) {
     flush_notes();
-    if (seconds > 10.0 && !run_flags().quiet)
+    if ((seconds > 10.0 || always) && !run_flags().quiet)
         std::fprintf(stderr, "ddemap: %s: note: %s: estimated run time %s\n", command.c_str(), what.c_str(), human_seconds(seconds).c_str());
 }
 
@@ -129,7 +129,7 @@ std::function<void(long, const RootWorkEstimate&, int)> branch_roots_guard(const
             check_size(command, full, "memory", one.bytes);
             check_size(command, full, "time", seconds);
             announce_estimate(command, full, seconds);
-            if (seconds > 10.0) *announced = seconds;
+            *announced = seconds > 10.0 ? seconds : 0.0;  // this branch's (a command may follow several)
             return;
         }
         // measured at the pilot points: refused above the limit; announced at the last pilot when
@@ -137,8 +137,9 @@ std::function<void(long, const RootWorkEstimate&, int)> branch_roots_guard(const
         const std::string full = what + " (about " + human_seconds(one.seconds) + " each: " + one.basis + ")";
         const double seconds = units * one.seconds;
         check_size(command, full, "time", seconds);
-        if (measured == std::min(5L, points) && (*announced == 0.0 || seconds > 2.0 * *announced || 2.0 * seconds < *announced))
-            announce_estimate(command, *announced == 0.0 ? full : full + ", revised", seconds);
+        if (measured != std::min(5L, points)) return;
+        if (*announced == 0.0) announce_estimate(command, full, seconds);
+        else if (seconds > 2.0 * *announced || 2.0 * seconds < *announced) announce_estimate(command, full + ", revised", seconds, true);
     };
 }
 
@@ -167,14 +168,18 @@ public:
     /// `estimate`: the time left follows from done / total; otherwise with `unknown_left` the
     /// line says "time left unknown" (a search whose total is only a budget), and off a
     /// terminal lines come at most once a second instead of once per percent of the budget.
-    void operator()(long done, long total, const std::string& what, bool estimate, bool unknown_left = false) {
+    /// `repeat`: a report from within a unit (the count unchanged): off a terminal shown at most
+    /// every 3 s whatever the percent, never once the count is complete.
+    void operator()(long done, long total, const std::string& what, bool estimate, bool unknown_left = false, bool repeat = false) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
         if (elapsed < m_delay && !m_shown) return;
+        if (repeat && done >= total) return;
         const long percent = total > 0 ? done * 100 / total : 100;
         // off a terminal (a log file): at most one line every 3 s, and one per percent at most
         const double interval = m_delay > 0.0 ? 3.0 : 0.0;
         if (!m_tty && m_shown && done != total &&
-            (elapsed - m_last_line < interval || (unknown_left ? elapsed - m_last_line < m_delay : percent == m_last_percent)))
+            (elapsed - m_last_line < interval ||
+             (repeat ? false : unknown_left ? elapsed - m_last_line < m_delay : percent == m_last_percent)))
             return;
         flush_notes();
         m_last_percent = percent;
@@ -241,7 +246,8 @@ BranchProgress branch_progress_printer(const std::string& command, const std::st
         // stages), shown every few seconds like a search's, so that the log shows the work is alive
         const bool within = heartbeat && done == *last;
         *last = done;
-        (*printer)(done, total, count + ", " + par + " = " + v, exact_total && !within, within);
+        // a repeat keeps the time left where the count is exact (and one unit is done)
+        (*printer)(done, total, count + ", " + par + " = " + v, exact_total, within && !(exact_total && done > 0), within);
     };
 }
 

@@ -37,7 +37,8 @@ void check_size(const std::string& command, const std::string& what, const std::
 /// Above 10 s (and without --quiet): `ddemap: COMMAND: note: WHAT: estimated run time 3.6 min`
 /// on stderr, so that long work is sized before it starts. Called when every input has been
 /// checked (an error after it would make the error two lines).
-void announce_estimate(const std::string& command, const std::string& what, double seconds);
+/// `always`: whatever the time (a revision of an estimate announced before).
+void announce_estimate(const std::string& command, const std::string& what, double seconds, bool always = false);
 
 /// A note about the input found while parsing it ("ddemap: note: TEXT" on stderr), held back
 /// until the input has passed every check: printed before the first progress line or estimate,

@@ -428,13 +428,15 @@ EquilibriumBranch analyse_branch(const NonlinearDDE& system, int j, const Equili
         // Re = -24 and the dense degree grew to its cap for them: the request starts at the
         // options' count and grows only while the strip does not reach below the axis.)
         RootOptions ro = options.roots;
-        if (options.progress && !ro.progress) {
+        if (options.progress && !ro.progress && done < static_cast<long>(c.points.size())) {
             // within the point's search: the count of points done repeated (a heartbeat)
             const long total = static_cast<long>(c.points.size());
             const double par = u[n];
             ro.progress = [&options, done, total, par](long, long, double) { options.progress(done, total, par); };
         }
         const EquilibriumRoots er = equilibrium_roots(system, pt.x, curve.values(u), ro);
+        // a progress callback's Cancelled ends in the roots' status: it stops the branch too
+        if (er.status == Status::Cancelled) throw Cancelled();
         pt.roots_status = er.status;
         roots_ok = roots_ok && converged(er.status);
         pt.abscissa = er.abscissa;
@@ -693,6 +695,7 @@ EquilibriumBranch join_halves(EquilibriumBranch away, const EquilibriumBranch& t
     // a special point between points k and k + 1 of the away half lies between m - 2 - k and
     // m - 1 - k of the reversed one; one of the towards half after point k after m - 1 + k
     auto join = [m](auto away_points, const auto& towards_points, auto& out) {
+        std::reverse(away_points.begin(), away_points.end());  // in the order met along the reversed half
         for (auto& x : away_points) x.after = m - 2 - x.after;
         out = std::move(away_points);
         for (auto x : towards_points) {
@@ -717,8 +720,15 @@ EquilibriumBranch equilibrium_branch_from_branch_point(const NonlinearDDE& syste
     if (side == BranchSide::Both) {
         const EquilibriumBranch towards = equilibrium_branch_from_branch_point(system, branch, bp, options, BranchSide::Towards);
         const EquilibriumBranch away = equilibrium_branch_from_branch_point(system, branch, bp, options, BranchSide::Away);
-        if (towards.points.empty()) return away;
-        if (away.points.empty()) return towards;
+        // a half without points (its first point did not converge): the other alone, undecided
+        // with the reason
+        if (towards.points.empty() || away.points.empty()) {
+            EquilibriumBranch r = towards.points.empty() ? away : towards;
+            const EquilibriumBranch& failed = towards.points.empty() ? towards : away;
+            r.status = failed.status != Status::Converged ? failed.status : Status::NumericalIssue;
+            r.message = "one half only: " + r.message + "; the other half: " + failed.message;
+            return r;
+        }
         return join_halves(away, towards);
     }
     std::string why;
