@@ -144,7 +144,12 @@ int run_hopf() {
                         << ", residual " << rounded(d.residual, 2) << ")\n";
                 for (const ZeroHopfPoint& z : c.zero_hopf)
                     out << "  zero-Hopf (a real root at 0): " << par << " = " << rounded(z.par, 10) << ", " << hopf_args.par2 << " = " << rounded(z.par2, 10)
-                        << ", omega = " << rounded(z.omega, 8) << " (" << to_string(z.status) << ")\n";
+                        << ", omega = " << rounded(z.omega, 8) << " (" << to_string(z.status) << ")"
+                        << (z.normal_form.status == Status::Converged
+                                ? ", normal form s = " + rounded(z.normal_form.s, 6) +
+                                      (std::isfinite(z.normal_form.theta) ? ", theta = " + rounded(z.normal_form.theta, 6) : std::string()) +
+                                      (std::isfinite(z.normal_form.e) ? ", e = " + rounded(z.normal_form.e, 6) : ", " + z.normal_form.message)
+                                : std::string()) << "\n";
             }
         if (status != Status::Converged) out << "verdict    UNDECIDED (" << to_string(status) << "): " << message << "\n";
         if (!prefix.empty()) out << "wrote      " << prefix << ".csv " << prefix << ".json\n";

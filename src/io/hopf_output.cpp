@@ -132,6 +132,8 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
             q["det_delta0"] = num(z.det);
             q["residual"] = num(z.residual);
             q["status"] = to_string(z.status);
+            q["normal_form"] = detail::zero_hopf_normal_form_json(z.normal_form);
+            if (z.normal_form.status != Status::Converged) q["normal_form_message"] = z.normal_form.message;
             zh.push_back(q);
         }
         o["zero_hopf"] = zh;

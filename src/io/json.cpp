@@ -220,7 +220,7 @@ std::string fold_curves_json(const FoldCurves& c, const std::string& parameter2,
             // normal-form coefficients (normal_forms.hpp): a, b at a Bogdanov-Takens point, b, c at a cusp
             if (p.kind == "bogdanov_takens") q["normal_form"] = {{"a", num(p.nf_a)}, {"b", num(p.nf_b)}};
             else if (p.kind == "cusp") q["normal_form"] = {{"b", num(p.nf_b)}, {"c", num(p.nf_c)}};
-            else q["normal_form"] = nullptr;
+            else q["normal_form"] = detail::zero_hopf_normal_form_json(p.zero_hopf);  // null when not formed
             q["test"] = num(p.test);
             q["other"] = num(p.other);
             q["status"] = to_string(p.status);

@@ -198,6 +198,7 @@ FoldCurveSpecialPoint locate_zero_hopf(const NonlinearDDE& s, const FoldCurvePro
         if (r.imag() > 1e-8 && std::abs(r.real()) < re_min) re_min = std::abs(r.real()), z.omega = r.imag();
     Eigen::VectorXd f;
     z.residual = pr.residual(best, f) ? f.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+    if (converged(z.status) && z.omega > 0.0) z.zero_hopf = zero_hopf_normal_form(s, z.x, pr.values(best), z.omega);
     if (converged(z.status) && !(z.residual <= residual_tolerance && z.omega > 0.0)) z.status = Status::NumericalIssue;
     return z;
 }

@@ -1,5 +1,7 @@
 #include "ddemap/analysis/bifurcation/normal_forms.hpp"
 
+#include "analysis/bifurcation/internal/multilinear.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -152,6 +154,177 @@ CuspNormalForm cusp_normal_form(const NonlinearDDE& system, const Eigen::VectorX
     }
     r.status = Status::Converged;
     r.message = "cusp normal form w' = b w^2 + c w^3 (DDE-BIFTOOL's nmfm_cusp normalisation; b = 0 at the cusp)";
+    return r;
+}
+
+}  // namespace ddemap
+
+namespace ddemap {
+
+namespace {
+
+using namespace detail::multilinear;
+
+/// A history function sum_k v_k theta^{t_k} e^{lambda_k theta} (t_k = 0 or 1), the form of the
+/// eigenfunctions and the centre manifold's coefficients.
+struct History {
+    struct Term {
+        VectorXc v;
+        cplx lambda;
+        int t = 0;
+    };
+    std::vector<Term> terms;
+    /// (h(0), h(-tau_1), ...) stacked
+    VectorXc stacked(const std::vector<double>& tau0) const {
+        const Eigen::Index n = terms.empty() ? 0 : terms.front().v.size();
+        VectorXc r = VectorXc::Zero(n * static_cast<Eigen::Index>(tau0.size()));
+        for (std::size_t k = 0; k < tau0.size(); ++k)
+            for (const Term& term : terms) {
+                const double theta = -tau0[k];
+                r.segment(static_cast<Eigen::Index>(k) * n, n) += term.v * (std::pow(theta, term.t) * std::exp(term.lambda * theta));
+            }
+        return r;
+    }
+    History conj() const {
+        History h = *this;
+        for (Term& t : h.terms) {
+            t.v = t.v.conjugate();
+            t.lambda = std::conj(t.lambda);
+        }
+        return h;
+    }
+};
+
+/// Delta''(lambda) = -sum_k tau_k^2 A_k e^{-lambda tau_k}.
+MatrixXc delta2(const std::vector<Eigen::MatrixXd>& a, const std::vector<double>& tau0, cplx lambda) {
+    const Eigen::Index n = a[0].rows();
+    MatrixXc m = MatrixXc::Zero(n, n);
+    for (std::size_t k = 0; k < a.size(); ++k) m -= tau0[k] * tau0[k] * std::exp(-lambda * tau0[k]) * a[k].cast<cplx>();
+    return m;
+}
+
+/// The unit null vector of m (complex), its largest component real and positive; `residual`
+/// sigma_min / sigma_max.
+VectorXc null_vector_c(const MatrixXc& m, double& residual) {
+    Eigen::JacobiSVD<MatrixXc> svd(m, Eigen::ComputeFullV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    const Eigen::Index last = sv.size() - 1;
+    residual = sv[0] > 0.0 ? sv[last] / sv[0] : 0.0;
+    VectorXc v = svd.matrixV().col(last);
+    Eigen::Index i = 0;
+    v.cwiseAbs().maxCoeff(&i);
+    return v * (std::abs(v[i]) / v[i]);
+}
+
+}  // namespace
+
+ZeroHopfNormalForm zero_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega) {
+    if (!system.has_higher_derivatives()) throw std::invalid_argument("normal form: the system has no second and third derivatives");
+    const int n = system.dimension();
+    if (x.size() != n) throw std::invalid_argument("normal form: expected an equilibrium of " + std::to_string(n) + " entries");
+    if (!(std::isfinite(omega) && omega > 0.0)) throw std::invalid_argument("zero-Hopf normal form: omega = " + std::to_string(omega) + ": expected a value > 0");
+    ZeroHopfNormalForm r;
+    const Eigen::VectorXd u = system.stack_constant(x);
+    const std::vector<Eigen::MatrixXd> a = system.jacobians(u, p);
+    std::vector<double> tau0{0.0};
+    for (const double t : system.delays(p)) tau0.push_back(t);
+    const cplx l0(0.0, 0.0), l1(0.0, omega);
+    const MatrixXc D0 = delta(a, tau0, l0), D1 = delta(a, tau0, l1);
+    const MatrixXc dD0 = delta(a, tau0, l0, true), dD1 = delta(a, tau0, l1, true);
+
+    double left = 0.0;
+    VectorXc q0 = null_vector_c(D0, r.kernel_residual), q1 = null_vector_c(D1, r.hopf_residual);
+    q0 = q0.real().cast<cplx>();  // Delta(0) is real: its null vector too (the phase made it so)
+    q0 /= q0.norm();
+    VectorXc p0 = null_vector_c(D0.transpose(), left).conjugate(), p1 = null_vector_c(D1.transpose(), left);
+    p0 = p0.real().cast<cplx>();
+    const cplx n0 = p0.transpose() * dD0 * q0, n1 = p1.transpose() * dD1 * q1;
+    if (!(std::abs(n0) > 0.0) || !(std::abs(n1) > 0.0)) {
+        r.message = "the eigenvectors cannot be normalised (p Delta'(lambda) q = 0: the root is not simple)";
+        return r;
+    }
+    p0 /= n0;
+    p1 /= n1;
+
+    // the bordered inverse (the header's binv)
+    bool ok = true;
+    auto binv = [&](cplx lambda, const VectorXc& q, const VectorXc& pv, const VectorXc& zeta, cplx kappa) {
+        const MatrixXc D = delta(a, tau0, lambda), dD = delta(a, tau0, lambda, true), ddD = delta2(a, tau0, lambda);
+        MatrixXc k = MatrixXc::Zero(n + 1, n + 1);
+        k.topLeftCorner(n, n) = D;
+        k.topRightCorner(n, 1) = q;
+        k.bottomLeftCorner(1, n) = pv.transpose();
+        VectorXc rhs = VectorXc::Zero(n + 1);
+        rhs.head(n) = zeta + kappa * (dD * q);
+        const Eigen::FullPivLU<MatrixXc> lu(k);
+        if (lu.rank() < n + 1) ok = false;
+        const VectorXc xi = lu.solve(rhs).head(n);
+        const cplx gamma = -cplx(pv.transpose() * dD * xi) + 0.5 * kappa * cplx(pv.transpose() * ddD * q);
+        History h;
+        h.terms.push_back({xi + gamma * q, lambda, 0});
+        h.terms.push_back({-kappa * q, lambda, 1});
+        return h;
+    };
+    auto B = [&](const History& f, const History& g) { return b_complex(system, u, p, f.stacked(tau0), g.stacked(tau0)); };
+    auto C = [&](const History& f, const History& g, const History& h) { return c_complex(system, u, p, f.stacked(tau0), g.stacked(tau0), h.stacked(tau0)); };
+    auto dot = [](const VectorXc& pv, const VectorXc& v) { return cplx(pv.transpose() * v); };
+
+    History phi0, phi1;
+    phi0.terms.push_back({q0, l0, 0});
+    phi1.terms.push_back({q1, l1, 0});
+    const History phi1b = phi1.conj();
+    const VectorXc B00 = B(phi0, phi0), B01 = B(phi0, phi1);
+    const VectorXc B11b = B(phi1, phi1b).real().cast<cplx>();  // real up to rounding
+    const cplx g200 = 0.5 * dot(p0, B00), g110 = dot(p1, B01), g011 = dot(p0, B11b);
+    const History h200 = binv(l0, q0, p0, B00, -dot(p0, B00));
+    const History h011 = binv(l0, q0, p0, B11b, -dot(p0, B11b));
+    const History h110 = binv(l1, q1, p1, B01, -dot(p1, B01));
+    const History h110b = h110.conj();
+    History h020;
+    {
+        const Eigen::FullPivLU<MatrixXc> lu(delta(a, tau0, 2.0 * l1));
+        if (lu.rank() < n) ok = false;
+        h020.terms.push_back({lu.solve(B(phi1, phi1)), 2.0 * l1, 0});
+    }
+    if (!ok) {
+        r.message = "a bordered system of the centre manifold is singular (a kernel is not one-dimensional, or 2 i omega is a root too)";
+        return r;
+    }
+    const cplx g300 = dot(p0, 3.0 * B(phi0, h200) + C(phi0, phi0, phi0)) / 6.0;
+    const cplx g111 = dot(p0, B(phi0, h011) + B(phi1b, h110) + B(phi1, h110b) + C(phi0, phi1, phi1b));
+    const cplx g210 = 0.5 * dot(p1, B(phi1, h200) + 2.0 * B(phi0, h110) + C(phi0, phi0, phi1));
+    const cplx g021 = 0.5 * dot(p1, B(phi1b, h020) + 2.0 * B(phi1, h011) + C(phi1, phi1, phi1b));
+
+    r.g200 = g200.real();
+    r.g011 = g011.real();
+    r.g300 = g300.real();
+    r.g111 = g111.real();
+    r.g110 = g110;
+    r.g210 = g210;
+    r.g021 = g021;
+    r.b = r.g200;
+    r.c = r.g011;
+    r.d = g110 - l1 * r.g300 / r.g200;
+    r.e = (g210 + g110 * (g021.real() / r.g011 - 1.5 * r.g300 / r.g200 + r.g111 / (2.0 * r.g011)) - g021 * r.g200 / r.g011).real();
+    r.s = r.b * r.c + 0.0;  // no -0
+    r.theta = g110.real() / r.g200;
+    r.q0 = q0.real();
+    r.p0 = p0.real();
+    r.q1 = q1;
+    r.p1 = p1;
+    const double all[] = {r.g200, r.g011, r.g300, r.g111, std::abs(g110), std::abs(g210), std::abs(g021)};
+    for (const double v : all)
+        if (!std::isfinite(v)) {
+            r.message = "a coefficient g is not finite";
+            return r;
+        }
+    // a degenerate point (g200 = 0 or g011 = 0, e.g. a system whose fold variable does not feel
+    // the oscillation at second order): the g are the result; what divides by zero is NaN (null)
+    if (!(r.g200 != 0.0)) r.d = cplx(std::numeric_limits<double>::quiet_NaN(), 0.0), r.theta = std::numeric_limits<double>::quiet_NaN();
+    if (!(r.g200 != 0.0) || !(r.g011 != 0.0)) r.e = std::numeric_limits<double>::quiet_NaN();
+    r.status = Status::Converged;
+    r.message = std::isfinite(r.e) ? "s = " + std::to_string(r.s) + ", theta = " + std::to_string(r.theta)
+                                   : std::string("degenerate: ") + (r.g200 != 0.0 ? "g011 = 0 (e undefined)" : "g200 = 0 (d, e, theta undefined)");
     return r;
 }
 

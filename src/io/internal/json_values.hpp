@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "ddemap/analysis/bifurcation/normal_forms.hpp"
 #include "ddemap/core/status.hpp"
 #include "ddemap/solve/continuation.hpp"
 #include <nlohmann/json.hpp>
@@ -27,6 +28,28 @@ inline ojson json_values(const Eigen::VectorXd& x) {
     ojson a = ojson::array();
     for (Eigen::Index i = 0; i < x.size(); ++i) a.push_back(json_value(x[i]));
     return a;
+}
+
+/// A zero-Hopf point's normal form (analysis/bifurcation/normal_forms.hpp): {"g200", "g110", ...,
+/// "theta"}, complex coefficients as {"re", "im"}; null when it was not formed.
+inline ojson zero_hopf_normal_form_json(const ZeroHopfNormalForm& nf) {
+    if (nf.status != Status::Converged) return ojson(nullptr);
+    auto complex = [](cplx v) { return ojson{{"re", json_value(v.real())}, {"im", json_value(v.imag())}}; };
+    ojson g;
+    g["g200"] = json_value(nf.g200);
+    g["g110"] = complex(nf.g110);
+    g["g011"] = json_value(nf.g011);
+    g["g300"] = json_value(nf.g300);
+    g["g111"] = json_value(nf.g111);
+    g["g210"] = complex(nf.g210);
+    g["g021"] = complex(nf.g021);
+    g["b"] = json_value(nf.b);
+    g["c"] = json_value(nf.c);
+    g["d"] = complex(nf.d);
+    g["e"] = json_value(nf.e);
+    g["s"] = json_value(nf.s);
+    g["theta"] = json_value(nf.theta);
+    return g;
 }
 
 /// The head of a two-parameter curve's JSON (Hopf curves, fold curves): {"start", "status",

@@ -181,6 +181,22 @@ TEST_CASE("a fold curve with a Bogdanov-Takens and a zero-Hopf point: the root c
     CHECK(std::abs(zh->par - 0.25) < tol::special_point);
     CHECK(std::abs(zh->x[0] - 0.5) < tol::special_point);
     CHECK(std::abs(zh->omega - 1.0) < 1e-8);
+    // its normal form: with u = x - 1/2 the system is u' = u - u(t - 2) + u^2, y' = J y + u y
+    // (test_normal_forms.cpp's reduction with a = 1, tau = 2, so k = 1/(1 - a tau) = -1, beta = 1,
+    // c = 0, delta = 1, sigma = 0): g200 = -1, g110 = 1, g011 = 0 (degenerate: e undefined),
+    // g300 = beta k H200 = 4 (H200 = -beta a tau^2 k^2 = -4), g111 = 0, g210 = H200 / 2 = -2,
+    // g021 = 0, theta = -1, d = g110 - i g300 / g200 = 1 + 4i
+    const ZeroHopfNormalForm& nf = zh->zero_hopf;
+    REQUIRE(nf.status == Status::Converged);
+    CHECK(std::abs(nf.g200 + 1.0) < tol::special_point);
+    CHECK(std::abs(nf.g110 - cplx(1.0, 0.0)) < tol::special_point);
+    CHECK(std::abs(nf.g011) < tol::special_point);
+    CHECK(std::abs(nf.g300 - 4.0) < tol::special_point);
+    CHECK(std::abs(nf.g111) < tol::special_point);
+    CHECK(std::abs(nf.g210 - cplx(-2.0, 0.0)) < tol::special_point);
+    CHECK(std::abs(nf.g021) < tol::special_point);
+    CHECK(std::abs(nf.theta + 1.0) < tol::special_point);
+    CHECK(std::abs(nf.d - cplx(1.0, 4.0)) < tol::special_point);
 }
 
 TEST_CASE("the Hopf curve of x' = p1 + x^2 + p2 x(t - 2) ends at the Bogdanov-Takens point of its fold curve (omega -> 0)") {

@@ -590,6 +590,19 @@ TEST_CASE("zero-Hopf point: the Hopf curve passes the fold of the equilibria, wh
     CHECK(std::abs(z.x[1]) < 1e-6);  // y2 = sqrt(b): the square root of the parameter error
     CHECK(z.residual < 1e-9);
     CHECK(c.double_hopf.empty());
+    // its normal form by hand: the fold variable y2 (q0 = e2, p0 = e2: Delta'(0) = 1 there),
+    // g200 = p0 B[phi0, phi0] / 2 = -1 (from -y2^2); the pair of y1' = -(pi/2) y1(t - 1):
+    // q1 = e1, p1 = e1 / Delta1'(i pi/2) = e1 / (1 + i pi/2); B[phi0, phi1] from -y2 y1(t - 1):
+    // -(1 e^{-i pi/2}) = i, so g110 = i / (1 + i pi/2); g011 = 0 (y2 does not see y1 at second
+    // order: a degenerate point, e undefined); theta = Re g110 / g200
+    const ZeroHopfNormalForm& nf = z.normal_form;
+    REQUIRE(nf.status == Status::Converged);
+    const cplx g110 = cplx(0.0, 1.0) / cplx(1.0, pi / 2);
+    CHECK(std::abs(nf.g200 + 1.0) < tol::special_point);
+    CHECK(std::abs(nf.g110 - g110) < tol::special_point);
+    CHECK(std::abs(nf.g011) < tol::special_point);
+    CHECK(std::abs(nf.theta + g110.real()) < tol::special_point);
+    CHECK(!std::isfinite(nf.e));
     // the count of roots right of the axis besides the pair: 0 on the y2 > 0 side, 1 on the other
     int zeros = 0, ones = 0;
     for (const HopfCurvePoint& p : c.points) {

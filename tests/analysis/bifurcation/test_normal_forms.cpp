@@ -79,3 +79,57 @@ TEST_CASE("cusp normal form where the centre manifold bends: x1' = -x1 + x2^2, x
 }
 
 TEST_SUITE_END();
+
+TEST_CASE("zero-Hopf normal form of a fold and a Hopf pair coupled through delays: every g against its reduction by hand") {
+    // u' = a (u - u(t - tau)) + beta u^2 + c (y1^2 + y2^2) + e3 u^3,
+    // y' = omega J y + delta u(t - sigma) y + rho |y|^2 y   (J the rotation by pi/2),
+    // at 0: the root 0 of u (Delta_u'(0) = 1 - a tau = 1/k) and +-i omega of y. q0 = e_u, p0 = k e_u,
+    // q1 = (0, 1, -i)/sqrt2, p1 = (0, 1, i)/sqrt2; the centre manifold's u-parts
+    // h200(theta) = H200 + 2 beta k theta, h011(theta) = H011 + 2 c k theta with H = -(coefficient) a tau^2 k^2
+    // (the bordered inverse's gamma term: Delta_u''(0) = a tau^2), h110 = delta theta e^{i omega theta} q1,
+    // h020 = 0, so that
+    //   g200 = beta k, g011 = 2 c k, g110 = delta, g300 = beta k H200 + e3 k, g111 = 2 beta k H011,
+    //   g210 = delta (H200 - 2 beta k sigma) / 2, g021 = delta (H011 - 2 c k sigma) + 2 rho
+    // (rho: y = w1 q1 + conj, |y|^2 = 2 |w1|^2, projected by p1: 2 rho w1 |w1|^2).
+    const double a = 0.5, tau = 0.8, beta = 0.7, c = -0.3, delta = 1.3, omega = 1.1, sigma = 0.6, e3 = 0.4, rho = -0.25;
+    const ExpressionSystem sys({"u", "y1", "y2"}, {"a", "tau", "beta", "c", "delta", "omega", "sigma", "e3", "rho"},
+                               {a, tau, beta, c, delta, omega, sigma, e3, rho},
+                               {"a*(u - u(t - tau)) + beta*u^2 + c*(y1^2 + y2^2) + e3*u^3",
+                                "-omega*y2 + delta*u(t - sigma)*y1 + rho*(y1^2 + y2^2)*y1",
+                                "omega*y1 + delta*u(t - sigma)*y2 + rho*(y1^2 + y2^2)*y2"});
+    const ZeroHopfNormalForm nf = zero_hopf_normal_form(sys, Eigen::VectorXd::Zero(3), sys.parameter_values(), omega);
+    REQUIRE(nf.status == Status::Converged);
+    CHECK(nf.kernel_residual < 1e-14);
+    CHECK(nf.hopf_residual < 1e-14);
+    const double k = 1.0 / (1.0 - a * tau);
+    const double H200 = -beta * a * tau * tau * k * k, H011 = -c * a * tau * tau * k * k;
+    const double g200 = beta * k, g011 = 2.0 * c * k, g300 = beta * k * H200 + e3 * k, g111 = 2.0 * beta * k * H011;
+    const cplx g110(delta, 0.0), g210(delta * (H200 - 2.0 * beta * k * sigma) / 2.0, 0.0), g021(delta * (H011 - 2.0 * c * k * sigma) + 2.0 * rho, 0.0);
+    CHECK(std::abs(nf.g200 - g200) < tol::normal_form_exact);
+    CHECK(std::abs(nf.g011 - g011) < tol::normal_form_exact);
+    CHECK(std::abs(nf.g110 - g110) < tol::normal_form_exact);
+    CHECK(std::abs(nf.g300 - g300) < tol::normal_form_exact);
+    CHECK(std::abs(nf.g111 - g111) < tol::normal_form_exact);
+    CHECK(std::abs(nf.g210 - g210) < tol::normal_form_exact);
+    CHECK(std::abs(nf.g021 - g021) < tol::normal_form_exact);
+    // Gavrilov's coefficients from these, as DDE-BIFTOOL forms them
+    const cplx I(0.0, 1.0);
+    CHECK(std::abs(nf.d - (g110 - I * omega * g300 / g200)) < tol::normal_form_exact);
+    CHECK(std::abs(nf.e - (g210 + g110 * (g021.real() / g011 - 1.5 * g300 / g200 + g111 / (2.0 * g011)) - g021 * g200 / g011).real()) <
+          tol::normal_form_exact);
+    CHECK(std::abs(nf.s - g200 * g011) < tol::normal_form_exact);
+    CHECK(std::abs(nf.theta - delta / g200) < tol::normal_form_exact);
+    // s and theta do not depend on the sign of q0: the system mirrored in u (u -> -u) has
+    // g200, g011, g110 of the other sign and the same s and theta
+    const ExpressionSystem mirrored({"u", "y1", "y2"}, {"a", "tau", "beta", "c", "delta", "omega", "sigma", "e3", "rho"},
+                                    {a, tau, beta, c, delta, omega, sigma, e3, rho},
+                                    {"a*(u - u(t - tau)) - beta*u^2 - c*(y1^2 + y2^2) + e3*u^3",
+                                     "-omega*y2 - delta*u(t - sigma)*y1 + rho*(y1^2 + y2^2)*y1",
+                                     "omega*y1 - delta*u(t - sigma)*y2 + rho*(y1^2 + y2^2)*y2"});
+    const ZeroHopfNormalForm m = zero_hopf_normal_form(mirrored, Eigen::VectorXd::Zero(3), mirrored.parameter_values(), omega);
+    REQUIRE(m.status == Status::Converged);
+    CHECK(std::abs(m.s - nf.s) < tol::normal_form_exact);
+    CHECK(std::abs(m.theta - nf.theta) < tol::normal_form_exact);
+    CHECK(std::abs(std::abs(m.g200) - std::abs(nf.g200)) < tol::normal_form_exact);
+    CHECK_THROWS_AS(zero_hopf_normal_form(sys, Eigen::VectorXd::Zero(3), sys.parameter_values(), 0.0), std::invalid_argument);
+}

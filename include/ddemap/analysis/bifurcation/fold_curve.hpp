@@ -36,6 +36,7 @@
 
 #include <Eigen/Core>
 
+#include "ddemap/analysis/bifurcation/normal_forms.hpp"
 #include "ddemap/core/types.hpp"
 
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
@@ -77,6 +78,8 @@ struct FoldCurveSpecialPoint {
     double nf_a = std::numeric_limits<double>::quiet_NaN();
     double nf_b = std::numeric_limits<double>::quiet_NaN();
     double nf_c = std::numeric_limits<double>::quiet_NaN();
+    /// zero_hopf: its normal form (status NumericalIssue where not formed)
+    ZeroHopfNormalForm zero_hopf;
     Status status = Status::MaxIterations;
     double residual = std::numeric_limits<double>::infinity();  ///< of the fold system
     int after = 0;          ///< index of the curve point before it

@@ -36,6 +36,7 @@
 #include <Eigen/Core>
 
 #include "ddemap/analysis/bifurcation/equilibrium_branch.hpp"
+#include "ddemap/analysis/bifurcation/normal_forms.hpp"
 #include "ddemap/core/status.hpp"
 #include "ddemap/core/types.hpp"
 #include "ddemap/problem/nonlinear_dde.hpp"
@@ -163,6 +164,8 @@ struct ZeroHopfPoint {
     double residual = std::numeric_limits<double>::infinity();  ///< of the Hopf system
     double det = 0.0;  ///< the scaled det Delta(0) at the located point
     int after = 0;
+    /// at a located point: the normal-form coefficients (normal_forms.hpp, DDE-BIFTOOL's nmfm_zeho)
+    ZeroHopfNormalForm normal_form;
 };
 
 struct GeneralisedHopfPoint {
