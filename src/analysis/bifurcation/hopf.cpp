@@ -275,6 +275,42 @@ bool scaled_det0(const NonlinearDDE& s, const Eigen::VectorXd& x, const std::vec
     }
 }
 
+/// The zero of det Delta(0) along the chord from ua to ub by Illinois regula falsi, every trial
+/// corrected onto the curve by Newton with minimum-norm steps (a complete orthogonal
+/// decomposition of the bordered Jacobian, rank threshold 1e-10) until the residual is at
+/// rounding. Where the equilibrium is itself a branch point (the trivial equilibrium of a
+/// symmetric system at its pitchfork: f(0, p) = 0 for all p) the curve system is singular exactly
+/// at the zero-Hopf point (the equilibrium equations lose a rank), and plain Newton fails near it
+/// (DDE-BIFTOOL's two-layer neuron demo); the minimum-norm steps leave the undetermined direction
+/// alone and converge.
+detail::ChordZero chord_zero_minimum_norm(const NonlinearDDE& s, const HopfCurveProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub,
+                                          double fa, double fb) {
+    const int n = s.dimension();
+    auto correct_mn = [&](Eigen::VectorXd& u, const Eigen::VectorXd& dir, double b) {
+        const Eigen::Index m = u.size();
+        Eigen::VectorXd f, rhs(m);
+        Eigen::MatrixXd j, bordered(m, m);
+        for (int it = 0; it < 100; ++it) {
+            if (!pr.residual(u, f) || !pr.jacobian(u, j)) return Status::NumericalIssue;
+            rhs.head(m - 1) = f;
+            rhs(m - 1) = dir.dot(u) - b;
+            if (rhs.lpNorm<Eigen::Infinity>() <= 1e-14 * std::max(1.0, u.lpNorm<Eigen::Infinity>())) return Status::Converged;
+            bordered.topRows(m - 1) = j;
+            bordered.row(m - 1) = dir.transpose();
+            Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(bordered);
+            cod.setThreshold(1e-10);
+            const Eigen::VectorXd du = cod.solve(rhs);
+            if (!du.allFinite()) return Status::NumericalIssue;
+            u -= du;
+            if (du.lpNorm<Eigen::Infinity>() <= 1e-15 * std::max(1.0, u.lpNorm<Eigen::Infinity>())) break;
+        }
+        return pr.residual(u, f) && f.lpNorm<Eigen::Infinity>() <= 1e-12 ? Status::Converged : Status::MaxIterations;
+    };
+    return detail::chord_zero_with(
+        ua, ub, fa, fb, correct_mn, [&](const Eigen::VectorXd& u, double& value) { return scaled_det0(s, u.head(n), pr.values(u), value); },
+        [](const Eigen::VectorXd&, double value) { return std::abs(value) <= 1e-13; });
+}
+
 ZeroHopfPoint locate_zero_hopf(const NonlinearDDE& s, const HopfCurveProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub,
                                const HopfCurveOptions& o) {
     const int n = s.dimension();
@@ -285,10 +321,12 @@ ZeroHopfPoint locate_zero_hopf(const NonlinearDDE& s, const HopfCurveProblem& pr
         zh.x = ua.head(n), zh.par = ua[n], zh.omega = ua[3 * n + 1], zh.par2 = ua[3 * n + 2];
         return zh;
     }
-    const detail::ChordZero z = detail::chord_zero(
+    const detail::ChordZero first = detail::chord_zero(
         pr, ua, ub, fa, fb, o.continuation.newton,
         [&](const Eigen::VectorXd& u, double& value) { return scaled_det0(s, u.head(n), pr.values(u), value); },
         [&](const Eigen::VectorXd&, double value) { return std::abs(value) <= 1e-13; });
+    detail::ChordZero z = first;
+    if (!converged(first.status)) z = chord_zero_minimum_norm(s, pr, ua, ub, fa, fb);
     zh.status = z.status;
     zh.x = z.u.head(n), zh.par = z.u[n], zh.omega = z.u[3 * n + 1], zh.par2 = z.u[3 * n + 2];
     scaled_det0(s, zh.x, pr.values(z.u), zh.det);
@@ -508,6 +546,15 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
         ua.segment(2 * n + 1, n) = qn.imag();
         GeneralisedHopfPoint g = locate_generalised(s, j1, pr, ua, all[k + 1].u, a.l1, b.l1, o);
         g.after = static_cast<int>(k);
+        // where a real root crosses 0 in the same step (a zero-Hopf point, located below) L1 has
+        // a pole (its centre-manifold term Delta(0)^-1 B[phi, conj phi] blows up) and changes sign
+        // through it: a search that fails or ends where |L1| is not below both ends found the
+        // pole, not a generalised Hopf point (on DDE-BIFTOOL's two-layer neuron demo L1 reaches
+        // 740 there)
+        double da = 0.0, db = 0.0;
+        const bool real_crossing = scaled_det0(s, ua.head(n), pr.values(ua), da) && scaled_det0(s, all[k + 1].u.head(n), pr.values(all[k + 1].u), db) &&
+                                   (da < 0.0) != (db < 0.0);
+        if (real_crossing && (!converged(g.status) || !(std::abs(g.l1) < std::min(std::abs(a.l1), std::abs(b.l1))))) continue;
         genh_ok = genh_ok && converged(g.status);
         curve.generalised.push_back(std::move(g));
     }

@@ -662,3 +662,55 @@ TEST_CASE("ov ring (N = 5) in (headway, tau): the root counts along every Hopf c
     CHECK(compared > 50);
     MESSAGE("root counts compared with the closed form at " << compared << " Hopf-curve points");
 }
+
+TEST_CASE("DDE-BIFTOOL's normal-form demo (two layers of neurons): the zero-Hopf point where the trivial equilibrium is a pitchfork, its normal form, no generalised Hopf point at L1's pole") {
+    // x1' = -x1 - a g(b x1(t - tau1)) + c g(d x2(t - tau2)) and symmetrically, g(z) = (tanh(z - 1) +
+    // tanh 1) cosh(1)^2 (g(0) = 0, g'(0) = 1), b = 2, d = 1.2, tau1 = 12.7, tau2 = 20.2. At x = 0 the
+    // symmetric mode has Delta_s(lambda) = lambda + 1 + 2 a e^{-12.7 lambda} - 1.2 c e^{-20.2 lambda}: a
+    // real root crosses 0 where 1 + 2a - 1.2c = 0 (a pitchfork of the symmetric equilibrium, where
+    // the curve system is singular). The demo (nmfm_demo, its published output) prints the
+    // zero-Hopf point a = 0.0133327150, c = 0.8554382654 (where 1 + 2a - 1.2c = 1.4e-4: located to
+    // its secant tolerance) with s = 0.0000803411 and theta = 2.0969328059, its generalised Hopf point
+    // a = 0.2518504300, c = 0.5812203535.
+    const double C2 = 2.3810978455418157, T1 = 0.7615941559557649;  // cosh(1)^2, tanh(1)
+    char c2[64];
+    std::snprintf(c2, sizeof c2, "%.17g", C2);
+    char t1[64];
+    std::snprintf(t1, sizeof t1, "%.17g", T1);
+    auto g = [&](const std::string& var, const std::string& gain, const std::string& tau) {
+        return std::string("(tanh(") + gain + "*" + var + "(t - " + tau + ") - 1) + " + t1 + ")*" + c2;
+    };
+    const ExpressionSystem sys({"x1", "x2"}, {"a", "b", "c", "d", "tau1", "tau2"}, {0.25, 2.0, 15.0 / 29.0, 1.2, 12.7, 20.2},
+                               {"-x1 - a*" + g("x1", "b", "tau1") + " + c*" + g("x2", "d", "tau2"),
+                                "-x2 - a*" + g("x2", "b", "tau1") + " + c*" + g("x1", "d", "tau2")});
+    HopfCurveOptions o = curve_box("a", 0.0, 0.55, "c", 0.3, 1.0);
+    const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(2), o);
+    REQUIRE(!hc.curves.empty());
+    const HopfCurve& c = hc.curves[0];
+    INFO(c.message);
+    CHECK(c.status == Status::Converged);
+    REQUIRE(c.zero_hopf.size() == 1);
+    const ZeroHopfPoint& z = c.zero_hopf[0];
+    REQUIRE(z.status == Status::Converged);
+    // the closed form: the fold condition of the symmetric mode and its pair +-i omega
+    const double a = z.par, cc = z.par2, w = z.omega;
+    CHECK(std::abs(1.0 + 2.0 * a - 1.2 * cc) < 1e-7);
+    const cplx l(0.0, w);
+    CHECK(std::abs(l + 1.0 + 2.0 * a * std::exp(-12.7 * l) - 1.2 * cc * std::exp(-20.2 * l)) < 1e-7);
+    // the demo's point, located to its tolerance
+    CHECK(std::abs(a - 0.0133327150) < 1e-4);
+    CHECK(std::abs(cc - 0.8554382654) < 1e-4);
+    CHECK(std::abs(w - 0.2958015628) < 1e-5);
+    // its normal form: theta as printed; s in the demo's normalisation of that version (q1 scaled by
+    // 1/sqrt(p1 Delta'(i omega) q1) from unit vectors, which divides s by |Delta_s'(i omega)|)
+    const ZeroHopfNormalForm& nf = z.normal_form;
+    REQUIRE(nf.status == Status::Converged);
+    const cplx ds = 1.0 - 2.0 * a * 12.7 * std::exp(-12.7 * l) + 1.2 * cc * 20.2 * std::exp(-20.2 * l);
+    CHECK(std::abs(nf.theta - 2.0969328059) < 5e-4 * 2.0969328059);
+    CHECK(std::abs(nf.s / std::abs(ds) - 0.0000803411) < 5e-4 * 0.0000803411);
+    // L1's pole at the zero-Hopf point is not a generalised Hopf point: the one there is the demo's
+    REQUIRE(c.generalised.size() == 1);
+    CHECK(c.generalised[0].status == Status::Converged);
+    CHECK(std::abs(c.generalised[0].par - 0.2518504300) < 5e-5);
+    CHECK(std::abs(c.generalised[0].par2 - 0.5812203535) < 5e-5);
+}

@@ -17,9 +17,11 @@ struct ChordZero {
     Eigen::VectorXd u;
     Status status = Status::MaxIterations;
 };
-template <class G, class Done>
-ChordZero chord_zero(const ContinuationProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub, double fa, double fb,
-                     const NewtonOptions& newton, G g, Done done) {
+/// The same with the corrector given: correct(u, dir, b) moves u onto the curve within the
+/// hyperplane dir . u = b and returns its status (hopf.cpp's minimum-norm steps where the curve
+/// system is singular at the point sought).
+template <class Correct, class G, class Done>
+ChordZero chord_zero_with(const Eigen::VectorXd& ua, const Eigen::VectorXd& ub, double fa, double fb, Correct correct_onto, G g, Done done) {
     ChordZero z;
     z.u = ua;
     const Eigen::VectorXd d = ub - ua;
@@ -30,9 +32,9 @@ ChordZero chord_zero(const ContinuationProblem& pr, const Eigen::VectorXd& ua, c
         const double sm = (slo * fhi - shi * flo) / (fhi - flo);
         const Eigen::VectorXd v = ua + sm * d;
         Eigen::VectorXd u = v;
-        const CorrectorResult cr = correct(pr, u, dir, dir.dot(v), newton);
-        if (!converged(cr.status)) {
-            z.status = cr.status;
+        const Status cs = correct_onto(u, dir, dir.dot(v));
+        if (!converged(cs)) {
+            z.status = cs;
             break;
         }
         double value = 0.0;
@@ -57,6 +59,13 @@ ChordZero chord_zero(const ContinuationProblem& pr, const Eigen::VectorXd& ua, c
         }
     }
     return z;
+}
+
+template <class G, class Done>
+ChordZero chord_zero(const ContinuationProblem& pr, const Eigen::VectorXd& ua, const Eigen::VectorXd& ub, double fa, double fb,
+                     const NewtonOptions& newton, G g, Done done) {
+    return chord_zero_with(
+        ua, ub, fa, fb, [&](Eigen::VectorXd& u, const Eigen::VectorXd& dir, double b) { return correct(pr, u, dir, b, newton).status; }, g, done);
 }
 
 }  // namespace ddemap::detail
