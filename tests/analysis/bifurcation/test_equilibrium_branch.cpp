@@ -500,19 +500,30 @@ TEST_CASE("neuron (DDE-BIFTOOL demo): the branch point a21 = (kappa - beta)^2 / 
     }
 }
 
+namespace {
+
+/// The branch x = 0 of a scalar system in p from `from` to `to` (o set to it, 2 roots asked),
+/// converged, with its one branch point located at p = 0.
+EquilibriumBranch trivial_branch_with_branch_point(const ExpressionSystem& s, double from, double to, EquilibriumBranchOptions& o) {
+    o.parameter = "p";
+    o.from = from;
+    o.to = to;
+    o.roots.count = 2;
+    EquilibriumBranch b = equilibrium_branch(s, Eigen::VectorXd::Zero(1), o);
+    REQUIRE(b.status == Status::Converged);
+    REQUIRE(b.folds.size() == 1);
+    REQUIRE(b.folds.front().kind == "branch_point");
+    CHECK(std::abs(b.folds.front().par) < 1e-10);
+    return b;
+}
+
+}  // namespace
+
 TEST_CASE("branch switching: Hutchinson's x' = x (p - x(t - 1)) from x = 0 onto x = p at the branch point p = 0, its Hopf point at p = pi/2") {
     ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"x*(p - x(t - 1))"});
     EquilibriumBranchOptions o;
-    o.parameter = "p";
-    o.from = -1.0;
-    o.to = 2.0;
-    o.roots.count = 2;
-    const EquilibriumBranch b = equilibrium_branch(s, Eigen::VectorXd::Zero(1), o);
-    REQUIRE(b.status == Status::Converged);
-    REQUIRE(b.folds.size() == 1);
+    const EquilibriumBranch b = trivial_branch_with_branch_point(s, -1.0, 2.0, o);
     const FoldPoint& bp = b.folds.front();
-    REQUIRE(bp.kind == "branch_point");
-    CHECK(std::abs(bp.par) < 1e-10);
     const EquilibriumBranch nb = equilibrium_branch_from_branch_point(s, b, bp, o);
     REQUIRE(nb.status == Status::Converged);
     REQUIRE(nb.points.size() > 5);
@@ -551,16 +562,8 @@ TEST_CASE("branch switching at a pitchfork: both halves x = +-sqrt(p) of x' = x 
     // on them lambda = -2 p e^{-lambda}: stable for p < pi/4, a Hopf point at p = pi/4, omega = pi/2
     ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"x*(p - x(t - 1)^2)"});
     EquilibriumBranchOptions o;
-    o.parameter = "p";
-    o.from = -1.0;
-    o.to = 1.0;
-    o.roots.count = 2;
-    const EquilibriumBranch b = equilibrium_branch(s, Eigen::VectorXd::Zero(1), o);
-    REQUIRE(b.status == Status::Converged);
-    REQUIRE(b.folds.size() == 1);
+    const EquilibriumBranch b = trivial_branch_with_branch_point(s, -1.0, 1.0, o);
     const FoldPoint& bp = b.folds.front();
-    REQUIRE(bp.kind == "branch_point");
-    CHECK(std::abs(bp.par) < 1e-10);
     // one half only (the default): every point on one side, x = +sqrt(p) or -sqrt(p)
     const EquilibriumBranch one = equilibrium_branch_from_branch_point(s, b, bp, o);
     REQUIRE(one.status == Status::Converged);

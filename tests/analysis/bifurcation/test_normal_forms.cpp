@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <string>
 
 #include "ddemap/analysis/bifurcation/normal_forms.hpp"
 #include "ddemap/problem/expression_system.hpp"
@@ -92,11 +93,15 @@ TEST_CASE("zero-Hopf normal form of a fold and a Hopf pair coupled through delay
     //   g210 = delta (H200 - 2 beta k sigma) / 2, g021 = delta (H011 - 2 c k sigma) + 2 rho
     // (rho: y = w1 q1 + conj, |y|^2 = 2 |w1|^2, projected by p1: 2 rho w1 |w1|^2).
     const double a = 0.5, tau = 0.8, beta = 0.7, c = -0.3, delta = 1.3, omega = 1.1, sigma = 0.6, e3 = 0.4, rho = -0.25;
-    const ExpressionSystem sys({"u", "y1", "y2"}, {"a", "tau", "beta", "c", "delta", "omega", "sigma", "e3", "rho"},
-                               {a, tau, beta, c, delta, omega, sigma, e3, rho},
-                               {"a*(u - u(t - tau)) + beta*u^2 + c*(y1^2 + y2^2) + e3*u^3",
-                                "-omega*y2 + delta*u(t - sigma)*y1 + rho*(y1^2 + y2^2)*y1",
-                                "omega*y1 + delta*u(t - sigma)*y2 + rho*(y1^2 + y2^2)*y2"});
+    // sign -1: the system mirrored in u (u -> -u flips the terms even in u)
+    auto system = [&](const std::string& sign) {
+        return ExpressionSystem({"u", "y1", "y2"}, {"a", "tau", "beta", "c", "delta", "omega", "sigma", "e3", "rho"},
+                                {a, tau, beta, c, delta, omega, sigma, e3, rho},
+                                {"a*(u - u(t - tau)) " + sign + " beta*u^2 " + sign + " c*(y1^2 + y2^2) + e3*u^3",
+                                 "-omega*y2 " + sign + " delta*u(t - sigma)*y1 + rho*(y1^2 + y2^2)*y1",
+                                 "omega*y1 " + sign + " delta*u(t - sigma)*y2 + rho*(y1^2 + y2^2)*y2"});
+    };
+    const ExpressionSystem sys = system("+");
     const ZeroHopfNormalForm nf = zero_hopf_normal_form(sys, Eigen::VectorXd::Zero(3), sys.parameter_values(), omega);
     REQUIRE(nf.status == Status::Converged);
     CHECK(nf.kernel_residual < 1e-14);
@@ -121,11 +126,7 @@ TEST_CASE("zero-Hopf normal form of a fold and a Hopf pair coupled through delay
     CHECK(std::abs(nf.theta - delta / g200) < tol::normal_form_exact);
     // s and theta do not depend on the sign of q0: the system mirrored in u (u -> -u) has
     // g200, g011, g110 of the other sign and the same s and theta
-    const ExpressionSystem mirrored({"u", "y1", "y2"}, {"a", "tau", "beta", "c", "delta", "omega", "sigma", "e3", "rho"},
-                                    {a, tau, beta, c, delta, omega, sigma, e3, rho},
-                                    {"a*(u - u(t - tau)) - beta*u^2 - c*(y1^2 + y2^2) + e3*u^3",
-                                     "-omega*y2 - delta*u(t - sigma)*y1 + rho*(y1^2 + y2^2)*y1",
-                                     "omega*y1 - delta*u(t - sigma)*y2 + rho*(y1^2 + y2^2)*y2"});
+    const ExpressionSystem mirrored = system("-");
     const ZeroHopfNormalForm m = zero_hopf_normal_form(mirrored, Eigen::VectorXd::Zero(3), mirrored.parameter_values(), omega);
     REQUIRE(m.status == Status::Converged);
     CHECK(std::abs(m.s - nf.s) < tol::normal_form_exact);
