@@ -78,7 +78,7 @@ TEST_CASE("system coefficients outside 1e-100..1e100 in magnitude are bad input 
 
 TEST_SUITE_END();
 
-TEST_CASE("a nonlinear system file: expressions, parameter order, equilibrium guess, errors naming the file and field") {
+TEST_CASE("a nonlinear system file: expressions, parameter order, equilibrium guess, errors naming the file and field" * doctest::test_suite("fast")) {
     const std::string text = R"J({ "variables": ["x1", "x2"],
       "parameters": {"tau": 2.0, "a": 0.5, "b": 0.6, "d": 0.05},
       "equations": ["x2", "-d*x2 - a*x1 - x1^3 - b*(x1 - x1(t - tau))"],

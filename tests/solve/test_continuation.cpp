@@ -283,7 +283,7 @@ public:
 
 }  // namespace
 
-TEST_CASE("continuation: a branch reaches a face of the box where the problem ends (one-sided differences)") {
+TEST_CASE("continuation: a branch reaches a face of the box where the problem ends (one-sided differences)" * doctest::test_suite("fast")) {
     const HalfParabola p;
     // within h = 1e-7 of x = 0 the central difference would evaluate F at x < 0
     Eigen::MatrixXd j;

@@ -68,7 +68,7 @@ TEST_SUITE_END();
 // two were dropped, and the next roots (-10.73 -+ 9.41 i) were certified as the rightmost. The
 // pair must be listed, and nothing may be certified without it: checked against Newton on the
 // scalar D from a complex start and an argument-principle count right of the answer.
-TEST_CASE("a nearly double complex pair split by rounding into two real eigenvalues is refined, never skipped") {
+TEST_CASE("a nearly double complex pair split by rounding into two real eigenvalues is refined, never skipped" * doctest::test_suite("fast")) {
     const double k1 = 0.8421560728366616, k2 = 1.5232043282553798, th = 1.0, tau = 0.5;
     const double a = k1 * th + k2, b = k1;
     const auto D = [&](cplx l) { return l * l + a * l + b * std::exp(-l * tau); };

@@ -14,7 +14,7 @@
 
 using namespace ddemap;
 
-TEST_CASE("growth: a platoon whose simulation diverged is undecided (its status and message), the others converged") {
+TEST_CASE("growth: a platoon whose simulation diverged is undecided (its status and message), the others converged" * doctest::test_suite("fast")) {
     const std::vector<CalibratedVehicle> vehicles = paper_calibration_table();
     const LeadProfile lead = LeadProfile::builtin("dip");  // 22.4 -> 19.7 -> 22.4 m/s
     SimOptions o;

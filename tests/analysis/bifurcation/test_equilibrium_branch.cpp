@@ -392,7 +392,7 @@ double quadratic_constant(const std::vector<double>& r, int& steps) {
 
 }  // namespace
 
-TEST_CASE("fold and Hopf systems: the exact Jacobian agrees with central differences of the residuals") {
+TEST_CASE("fold and Hopf systems: the exact Jacobian agrees with central differences of the residuals" * doctest::test_suite("fast")) {
     // two delays tau and 2 tau that move with tau, so the parameter column has the tau_k' terms;
     // every parameter in turn is the free one; z is an arbitrary point (not a solution)
     ExpressionSystem sys({"x1", "x2"}, {"a", "b", "c", "tau"}, {0.7, 1.3, 0.4, 0.9},
@@ -439,7 +439,7 @@ TEST_CASE("fold and Hopf systems: the exact Jacobian agrees with central differe
     }
 }
 
-TEST_CASE("fold and Hopf points: Newton with the exact Jacobian converges quadratically") {
+TEST_CASE("fold and Hopf points: Newton with the exact Jacobian converges quadratically" * doctest::test_suite("fast")) {
     // Hopf of x' = -a sin(x(t - tau)) + x^3 in a (a = pi/2, omega = pi/2 at tau = 1), from afar
     ExpressionSystem s1({"x"}, {"a", "tau"}, {1.0, 1.0}, {"-a*sin(x(t - tau)) + x^3"});
     const HopfPoint h1 = correct_hopf(s1, 0, Eigen::VectorXd::Constant(1, 0.05), 1.3, 1.3);
@@ -474,7 +474,7 @@ TEST_CASE("fold and Hopf points: Newton with the exact Jacobian converges quadra
     }
 }
 
-TEST_CASE("neuron (DDE-BIFTOOL demo): the branch point a21 = (kappa - beta)^2 / a12 is a branch point, not a Hopf point") {
+TEST_CASE("neuron (DDE-BIFTOOL demo): the branch point a21 = (kappa - beta)^2 / a12 is a branch point, not a Hopf point" * doctest::test_suite("fast")) {
     // Shayer and Campbell's two-neuron model at x = 0 (tanh'(0) = 1): Delta(0) = [kappa - beta, -a12;
     // -a21, kappa - beta], det Delta(0) = (kappa - beta)^2 - a12 a21: a real root crosses 0 at
     // a21 = (kappa - beta)^2 / a12 = 2.25. The unstable complex pair of the Hopf point at
@@ -519,7 +519,7 @@ EquilibriumBranch trivial_branch_with_branch_point(const ExpressionSystem& s, do
 
 }  // namespace
 
-TEST_CASE("branch switching: Hutchinson's x' = x (p - x(t - 1)) from x = 0 onto x = p at the branch point p = 0, its Hopf point at p = pi/2") {
+TEST_CASE("branch switching: Hutchinson's x' = x (p - x(t - 1)) from x = 0 onto x = p at the branch point p = 0, its Hopf point at p = pi/2" * doctest::test_suite("fast")) {
     ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"x*(p - x(t - 1))"});
     EquilibriumBranchOptions o;
     const EquilibriumBranch b = trivial_branch_with_branch_point(s, -1.0, 2.0, o);
@@ -557,7 +557,7 @@ TEST_CASE("branch switching: Hutchinson's x' = x (p - x(t - 1)) from x = 0 onto 
     CHECK_THROWS_AS(equilibrium_branch_from_branch_point(s, b, fold, o), std::invalid_argument);
 }
 
-TEST_CASE("branch switching at a pitchfork: both halves x = +-sqrt(p) of x' = x (p - x(t - 1)^2), joined through the point, each with its Hopf point") {
+TEST_CASE("branch switching at a pitchfork: both halves x = +-sqrt(p) of x' = x (p - x(t - 1)^2), joined through the point, each with its Hopf point" * doctest::test_suite("fast")) {
     // x = 0 loses stability at p = 0 (lambda = p), where x = +-sqrt(p) branch off towards p > 0;
     // on them lambda = -2 p e^{-lambda}: stable for p < pi/4, a Hopf point at p = pi/4, omega = pi/2
     ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"x*(p - x(t - 1)^2)"});
@@ -603,7 +603,7 @@ TEST_CASE("branch switching at a pitchfork: both halves x = +-sqrt(p) of x' = x 
     CHECK(both.folds.empty());
 }
 
-TEST_CASE("branch switching: two lines of equilibria crossing obliquely, x = 2p and x = p of x' = (x - 2p)(x(t - 1) - p)") {
+TEST_CASE("branch switching: two lines of equilibria crossing obliquely, x = 2p and x = p of x' = (x - 2p)(x(t - 1) - p)" * doctest::test_suite("fast")) {
     ExpressionSystem s({"x"}, {"p"}, {-1.0}, {"(x - 2*p)*(x(t - 1) - p)"});
     EquilibriumBranchOptions o;
     o.parameter = "p";

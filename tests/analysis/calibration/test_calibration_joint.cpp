@@ -90,7 +90,7 @@ TEST_CASE("joint calibration: the stacked objective is the sample-weighted mean 
 
 TEST_SUITE_END();
 
-TEST_CASE("joint calibration: a run stacked with itself halves the covariance (no lags across runs)") {
+TEST_CASE("joint calibration: a run stacked with itself halves the covariance (no lags across runs)" * doctest::test_suite("fast")) {
     const Trace tr = calib_test::noisy(calib_test::clean_trace(calib_test::ovrv(kTruth), calib_test::three_sines(90), 90), 41u, 0.05, 0.2, 0.9);
     const CalibrationOptions o;
     const CalibrationResult one = calibrate(tr, o), twice = calibrate_joint({tr, tr}, o);

@@ -166,7 +166,7 @@ TEST_CASE("one minimum ACC speed rule for built-in and CSV vehicles (platoon_fro
 
 TEST_SUITE_END();
 
-TEST_CASE("a diverging platoon stops with a status and the time, and outputs only finite values") {
+TEST_CASE("a diverging platoon stops with a status and the time, and outputs only finite values" * doctest::test_suite("fast")) {
     // k1 = k2 = 1000 with tau = 0.5: the delayed speed feedback alone, v' = -k2 v(t - tau), is
     // unstable for k2 tau > pi/2 (here 500), so the solution grows without bound (the speeds
     // overflow to inf within seconds). The linear analysis refuses these gains (c tau = 2250 is
@@ -192,7 +192,7 @@ TEST_CASE("a diverging platoon stops with a status and the time, and outputs onl
     for (const auto& c : r.cars) CHECK((std::isfinite(c.min_speed) && std::isfinite(c.min_gap)));
 }
 
-TEST_CASE("the simulation estimate bounds the steps the run takes and counts its output samples") {
+TEST_CASE("the simulation estimate bounds the steps the run takes and counts its output samples" * doctest::test_suite("fast")) {
     const auto& a_min = paper_calibration_table()[0];
     SimOptions o;
     o.step = 0.05;

@@ -287,7 +287,7 @@ void check_sign(const Linearisation& lin, int cars) {
 
 }  // namespace
 
-TEST_CASE("on huge rings the verdict and the abscissa agree in sign within rounding of the boundary") {
+TEST_CASE("on huge rings the verdict and the abscissa agree in sign within rounding of the boundary" * doctest::test_suite("fast")) {
     // two points where they did not: a count of roots right of the axis with a located rightmost
     // root left of it (N = 10^6), and a listed root's real part of the wrong sign (N = 10^9)
     check_sign(ovrv(0.48136463760710274, 0.46374907192550308, 1.5, 0.2), 1000000);

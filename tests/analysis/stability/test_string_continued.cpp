@@ -42,7 +42,7 @@ void check_same(const StringResult& c, const StringResult& full) {
 
 }  // namespace
 
-TEST_CASE("continued string analysis: the same sup |Gamma| and verdicts as the scan at random points seeded by a neighbour") {
+TEST_CASE("continued string analysis: the same sup |Gamma| and verdicts as the scan at random points seeded by a neighbour" * doctest::test_suite("fast")) {
     std::mt19937 rng(13);
     std::uniform_real_distribution<double> u(0.02, 1.0);
     int used = 0;
@@ -67,7 +67,7 @@ TEST_CASE("continued string analysis: the same sup |Gamma| and verdicts as the s
     CHECK(used >= 30);  // the shortcut applies to most points of this window
 }
 
-TEST_CASE("continued string analysis: a neighbour's maximiser on the lower of two peaks never yields the lower peak") {
+TEST_CASE("continued string analysis: a neighbour's maximiser on the lower of two peaks never yields the lower peak" * doctest::test_suite("fast")) {
     // tau 1.2, th 1.5: peaks near w = 0.030 (|Gamma| 1.0017) and w = 0.507 (1.285)
     const Linearisation lin = ovrv_car(0.65, 0.8, 1.5, 1.2);
     const RootResult plant = plant_of(lin);
@@ -90,7 +90,7 @@ TEST_CASE("continued string analysis: a neighbour's maximiser on the lower of tw
     check_same(*d, full);
 }
 
-TEST_CASE("continued string analysis: the verdict next to the string-stability boundary") {
+TEST_CASE("continued string analysis: the verdict next to the string-stability boundary" * doctest::test_suite("fast")) {
     // along k2 at k1 = 0.5 the sup of |Gamma| falls to 1 (th 1.5, tau 0.5): bisect the scan's verdict
     const double k1 = 0.5;
     double lo = 0.05, hi = 1.0;  // string unstable at lo, stable at hi
@@ -120,7 +120,7 @@ TEST_CASE("continued string analysis: the verdict next to the string-stability b
     check_same(*c, seeded);
 }
 
-TEST_CASE("continued string analysis: the exclusion bound against a dense scan of the axis") {
+TEST_CASE("continued string analysis: the exclusion bound against a dense scan of the axis" * doctest::test_suite("fast")) {
     for (const auto& [k1, k2, th, tau] : {std::array<double, 4>{0.3, 0.2, 1.5, 0.5}, std::array<double, 4>{0.9, 0.4, 1.5, 0.5},
                                           std::array<double, 4>{0.65, 0.8, 1.5, 1.2}, std::array<double, 4>{0.5, 0.2, 2.5, 0.8}}) {
         const Linearisation lin = ovrv_car(k1, k2, th, tau);
