@@ -136,12 +136,19 @@ int run_hopf() {
                 }
                 for (const GeneralisedHopfPoint& g : c.generalised)
                     out << "  generalised Hopf (L1 = 0): " << par << " = " << rounded(g.par, 10) << ", " << hopf_args.par2 << " = " << rounded(g.par2, 10)
-                        << ", omega = " << rounded(g.omega, 8) << " (" << to_string(g.status) << ")\n";
+                        << ", omega = " << rounded(g.omega, 8) << " (" << to_string(g.status) << ")"
+                        << (g.normal_form.status == Status::Converged ? ", L2 = " + rounded(g.normal_form.l2, 6) : std::string()) << "\n";
                 for (const DoubleHopfPoint& d : c.double_hopf)
                     out << (d.resonant ? "  double Hopf, 1:1 resonant: " : "  double Hopf: ") << par << " = " << rounded(d.par, 10) << ", " << hopf_args.par2 << " = " << rounded(d.par2, 10) << ", omega = "
                         << rounded(d.omega1, 8) << " and " << rounded(d.omega2, 8)
                         << (d.other_curve >= 0 ? " (crossing curve " + std::to_string(d.other_curve) + ")" : std::string()) << " (" << to_string(d.status)
-                        << ", residual " << rounded(d.residual, 2) << ")\n";
+                        << ", residual " << rounded(d.residual, 2) << ")"
+                        << (d.normal_form.status == Status::Converged
+                                ? (std::isfinite(d.normal_form.theta) && std::isfinite(d.normal_form.delta)
+                                       ? ", normal form theta = " + rounded(d.normal_form.theta, 6) + ", delta = " + rounded(d.normal_form.delta, 6)
+                                       : ", normal form " + d.normal_form.message)
+                                : std::string())
+                        << "\n";
                 for (const ZeroHopfPoint& z : c.zero_hopf)
                     out << "  zero-Hopf (a real root at 0): " << par << " = " << rounded(z.par, 10) << ", " << hopf_args.par2 << " = " << rounded(z.par2, 10)
                         << ", omega = " << rounded(z.omega, 8) << " (" << to_string(z.status) << ")"

@@ -104,7 +104,10 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
             q["par2"] = num(g.par2);
             q["omega"] = num(g.omega);
             q["l1"] = num(g.l1);
+            q["l2"] = g.normal_form.status == Status::Converged ? num(g.normal_form.l2) : json(nullptr);
             q["status"] = to_string(g.status);
+            q["normal_form"] = detail::generalised_hopf_normal_form_json(g.normal_form);
+            if (converged(g.status) && g.normal_form.status != Status::Converged) q["normal_form_message"] = g.normal_form.message;
             gh.push_back(q);
         }
         o["generalised_hopf"] = gh;
@@ -120,6 +123,8 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
             q["resonant_1_1"] = d.resonant;
             q["status"] = to_string(d.status);
             q["message"] = d.message;
+            q["normal_form"] = detail::double_hopf_normal_form_json(d.normal_form);
+            if (converged(d.status) && !d.resonant && d.normal_form.status != Status::Converged) q["normal_form_message"] = d.normal_form.message;
             dh.push_back(q);
         }
         o["double_hopf"] = dh;

@@ -167,6 +167,14 @@ void NonlinearDDE::evaluate(const Dual3*, const Dual3*, Dual3*) const {
     throw std::logic_error("this system has no third derivatives: expected a system built on NonlinearDDEOf");
 }
 
+void NonlinearDDE::evaluate(const Dual4*, const Dual4*, Dual4*) const {
+    throw std::logic_error("this system has no fourth derivatives: expected a system built on NonlinearDDEOf");
+}
+
+void NonlinearDDE::evaluate(const Dual5*, const Dual5*, Dual5*) const {
+    throw std::logic_error("this system has no fifth derivatives: expected a system built on NonlinearDDEOf");
+}
+
 namespace {
 void check_direction(const Eigen::VectorXd& d, Eigen::Index size, const char* what) {
     if (d.size() != size)

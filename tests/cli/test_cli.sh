@@ -1119,6 +1119,17 @@ assert [abs(x['l1'] / p - 1) < 5e-5 for x, p in zip(h, (0.12631, 0.13109, -0.480
 assert [x['criticality'] for x in h] == ['subcritical', 'subcritical', 'supercritical'], h
 " && ok || bad "hopf: DDE-BIFTOOL minimal demo L1 values"
 
+# its generalised Hopf point in (tau, b) carries L2 (c1 real part 0 there) in JSON and the table
+"$bin" hopf --system "$(dirname "$0")/../../examples/duffing.json" --par tau --from 0 --to 20 --par2 b --from2 0 --to2 0.6 --quiet --out "$tmp/dgh" >"$tmp/dgh.txt" &&
+    grep -q "generalised Hopf (L1 = 0): tau = 14.8348.*L2 = " "$tmp/dgh.txt" && python3 - "$tmp/dgh.json" <<'PY' && ok || bad "hopf --par2: L2 at the generalised Hopf point"
+import json, sys
+g = [g for c in json.load(open(sys.argv[1]))['result']['curves'] for g in c['generalised_hopf'] if abs(g['par'] - 14.83483) < 1e-4]
+assert len(g) == 1, g
+nf = g[0]['normal_form']
+assert g[0]['l2'] == nf['l2'] and abs(nf['c1']['re']) < 1e-9 * abs(nf['c1']['im']) + 1e-12, nf
+assert nf['l2'] * g[0]['omega'] == nf['c2']['re'] or abs(nf['l2'] * g[0]['omega'] / nf['c2']['re'] - 1) < 1e-15, nf
+PY
+
 # the IDM ring (--model idm): the branch in the mean gap; its Hopf point is where the linear ring analysis
 # (roots --model idm --ring 5 at the uniform-flow speed of that gap) puts a root on the axis
 "$bin" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --a 1.1 --b 1.6 --v0 32 --par gap --from 6 --to 40 --format json >"$tmp/hidm.json" &&

@@ -1,9 +1,11 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <type_traits>
 #include <stdexcept>
 
 #include "ddemap/core/dual.hpp"
+#include "ddemap/problem/expression_system.hpp"
 #include "ddemap/problem/nonlinear_dde.hpp"
 #include "ddemap/solve/roots.hpp"
 
@@ -84,6 +86,35 @@ TEST_CASE("nested dual numbers give second and third derivatives") {
     using D3 = Dual<D2>;
     const D3 e(D2(Dual<double>(x, 1.0), Dual<double>(1.0, 0.0)), D2(Dual<double>(1.0, 0.0), Dual<double>(0.0, 0.0)));
     CHECK(exp(2.0 * e).deriv.deriv.deriv == doctest::Approx(8 * std::exp(2 * x)).epsilon(1e-14));
+    // fourth and fifth through a system (NonlinearDDE::Dual4, Dual5, the levels the second
+    // Lyapunov coefficient needs): f = exp(2 x) tanh(x), mixed partials d^k/dx^k along x in every
+    // direction, against the Leibniz sums of the closed-form derivatives
+    const ExpressionSystem sys({"x"}, {}, {}, {"exp(2*x)*tanh(x)"});
+    using D4 = NonlinearDDE::Dual4;
+    using D5 = NonlinearDDE::Dual5;
+    auto seeded = [&](auto level) {
+        using T = decltype(level);
+        if constexpr (std::is_same_v<T, D4>) return D4(D3(D2(Dual<double>(x, 1.0), Dual<double>(1.0, 0.0)), D2(Dual<double>(1.0, 0.0), Dual<double>(0.0, 0.0))), D3(1.0));
+        else return D5(D4(D3(D2(Dual<double>(x, 1.0), Dual<double>(1.0, 0.0)), D2(Dual<double>(1.0, 0.0), Dual<double>(0.0, 0.0))), D3(1.0)), D4(1.0));
+    };
+    // t = tanh x: t' = 1 - t^2, t'' = -2 t t', t''' = -2 (t'^2 + t t''), t'''' = -2 (3 t' t'' + t t''')
+    const double t = std::tanh(x), t1 = 1 - t * t, t2 = -2 * t * t1, t3 = -2 * (t1 * t1 + t * t2), t4 = -2 * (3 * t1 * t2 + t * t3);
+    const double t5 = -2 * (3 * t2 * t2 + 4 * t1 * t3 + t * t4);
+    const double ts[] = {t, t1, t2, t3, t4, t5};
+    auto leibniz = [&](int k) {
+        double sum = 0.0, binom = 1.0;
+        for (int j = 0; j <= k; ++j) {
+            sum += binom * std::pow(2.0, k - j) * std::exp(2 * x) * ts[j];
+            binom = binom * (k - j) / (j + 1);
+        }
+        return sum;
+    };
+    D4 u4 = seeded(D4()), o4;
+    sys.evaluate(&u4, nullptr, &o4);
+    CHECK(o4.deriv.deriv.deriv.deriv == doctest::Approx(leibniz(4)).epsilon(1e-13));
+    D5 u5 = seeded(D5()), o5;
+    sys.evaluate(&u5, nullptr, &o5);
+    CHECK(o5.deriv.deriv.deriv.deriv.deriv == doctest::Approx(leibniz(5)).epsilon(1e-13));
 }
 
 TEST_CASE("Mackey-Glass: linearisation at the positive equilibrium is the analytic one") {

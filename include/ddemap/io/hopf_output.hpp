@@ -25,7 +25,11 @@ std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string
 
 /// {"parameter", "parameter2", "hopf": [the starting points as above], "curves": [{"start",
 /// "status", "message", "stop": [backward, forward], "points": [{"par", "par2", "omega", "l1",
-/// "criticality", "dre_dpar"}], "generalised_hopf": [{"par", "par2", "omega", "l1", "status"}]}]}
+/// "criticality", "dre_dpar"}], "generalised_hopf": [{"par", "par2", "omega", "l1", "l2", "status",
+/// "normal_form": {"c1", "c2", "l2"}}], "double_hopf": [{"par", "par2", "omega1", "omega2", "residual",
+/// "other_curve", "resonant_1_1", "status", "message", "normal_form": {"g2100", "g1011", "g1110",
+/// "g0021", "theta", "delta"}}], "zero_hopf": [{..., "normal_form"}]}]} (a normal form null where it
+/// was not formed, with "normal_form_message" saying why at a located point)
 std::string hopf_curves_json(const HopfCurves& c, const std::string& parameter2, const std::vector<std::string>& variables);
 /// curve,kind,PAR,PAR2,omega_rad_per_s,l1,criticality,status (kind: point, generalised_hopf,
 /// double_hopf or zero_hopf; PAR and PAR2 the parameters' names with their units from `units`)

@@ -27,6 +27,8 @@ class NonlinearDDE {
 public:
     using Dual2 = Dual<Dual<double>>;
     using Dual3 = Dual<Dual<Dual<double>>>;
+    using Dual4 = Dual<Dual3>;
+    using Dual5 = Dual<Dual4>;
 
     NonlinearDDE(std::vector<std::string> names, std::vector<double> values);
     virtual ~NonlinearDDE() = default;
@@ -77,10 +79,13 @@ public:
     virtual void evaluate(const double* u, const double* p, double* out) const = 0;
     /// The same in dual numbers (derivatives along the seeded direction).
     virtual void evaluate(const Dual<double>* u, const Dual<double>* p, Dual<double>* out) const = 0;
-    /// Nested dual numbers (second and third derivatives). Systems built on NonlinearDDEOf have
-    /// them; the default throws std::logic_error (see has_higher_derivatives()).
+    /// Nested dual numbers (derivatives of order 2 to 5; the fourth and fifth for the second
+    /// Lyapunov coefficient). Systems built on NonlinearDDEOf have them; the default throws
+    /// std::logic_error (see has_higher_derivatives()).
     virtual void evaluate(const Dual2* u, const Dual2* p, Dual2* out) const;
     virtual void evaluate(const Dual3* u, const Dual3* p, Dual3* out) const;
+    virtual void evaluate(const Dual4* u, const Dual4* p, Dual4* out) const;
+    virtual void evaluate(const Dual5* u, const Dual5* p, Dual5* out) const;
     /// True when the nested evaluate() overloads are implemented.
     virtual bool has_higher_derivatives() const { return false; }
 
@@ -120,6 +125,8 @@ public:
     }
     void evaluate(const Dual2* u, const Dual2* p, Dual2* out) const override { static_cast<const Derived*>(this)->rhs(u, p, out); }
     void evaluate(const Dual3* u, const Dual3* p, Dual3* out) const override { static_cast<const Derived*>(this)->rhs(u, p, out); }
+    void evaluate(const Dual4* u, const Dual4* p, Dual4* out) const override { static_cast<const Derived*>(this)->rhs(u, p, out); }
+    void evaluate(const Dual5* u, const Dual5* p, Dual5* out) const override { static_cast<const Derived*>(this)->rhs(u, p, out); }
     bool has_higher_derivatives() const override { return true; }
 };
 

@@ -256,6 +256,7 @@ GeneralisedHopfPoint locate_generalised(const NonlinearDDE& s, int j1, const Hop
     g.par = z.u[n];
     g.omega = z.u[3 * n + 1];
     g.par2 = z.u[3 * n + 2];
+    if (converged(g.status) && g.omega > 0.0 && s.has_higher_derivatives()) g.normal_form = generalised_hopf_normal_form(s, g.x, pr.values(z.u), g.omega);
     return g;
 }
 
@@ -430,6 +431,10 @@ DoubleHopfPoint locate_double_hopf(const NonlinearDDE& s, int j1, int j2, const 
                          detail::format_number(dh.residual);
         } else {
             dh.message = "two pairs on the imaginary axis, residual " + detail::format_number(dh.residual);
+            std::vector<double> pv = p;
+            pv[static_cast<std::size_t>(j1)] = dh.par;
+            pv[static_cast<std::size_t>(j2)] = dh.par2;
+            if (s.has_higher_derivatives()) dh.normal_form = double_hopf_normal_form(s, dh.x, pv, dh.omega1, dh.omega2);
         }
     }
     return dh;

@@ -3,6 +3,7 @@
 #include "analysis/bifurcation/internal/multilinear.hpp"
 
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 
 #include <Eigen/Dense>
@@ -216,77 +217,127 @@ VectorXc null_vector_c(const MatrixXc& m, double& residual) {
     return v * (std::abs(v[i]) / v[i]);
 }
 
-}  // namespace
-
-ZeroHopfNormalForm zero_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega) {
-    if (!system.has_higher_derivatives()) throw std::invalid_argument("normal form: the system has no second and third derivatives");
-    const int n = system.dimension();
-    if (x.size() != n) throw std::invalid_argument("normal form: expected an equilibrium of " + std::to_string(n) + " entries");
-    if (!(std::isfinite(omega) && omega > 0.0)) throw std::invalid_argument("zero-Hopf normal form: omega = " + std::to_string(omega) + ": expected a value > 0");
-    ZeroHopfNormalForm r;
-    const Eigen::VectorXd u = system.stack_constant(x);
-    const std::vector<Eigen::MatrixXd> a = system.jacobians(u, p);
-    std::vector<double> tau0{0.0};
-    for (const double t : system.delays(p)) tau0.push_back(t);
-    const cplx l0(0.0, 0.0), l1(0.0, omega);
-    const MatrixXc D0 = delta(a, tau0, l0), D1 = delta(a, tau0, l1);
-    const MatrixXc dD0 = delta(a, tau0, l0, true), dD1 = delta(a, tau0, l1, true);
-
-    double left = 0.0;
-    VectorXc q0 = null_vector_c(D0, r.kernel_residual), q1 = null_vector_c(D1, r.hopf_residual);
-    q0 = q0.real().cast<cplx>();  // Delta(0) is real: its null vector too (the phase made it so)
-    q0 /= q0.norm();
-    VectorXc p0 = null_vector_c(D0.transpose(), left).conjugate(), p1 = null_vector_c(D1.transpose(), left);
-    p0 = p0.real().cast<cplx>();
-    const cplx n0 = p0.transpose() * dD0 * q0, n1 = p1.transpose() * dD1 * q1;
-    if (!(std::abs(n0) > 0.0) || !(std::abs(n1) > 0.0)) {
-        r.message = "the eigenvectors cannot be normalised (p Delta'(lambda) q = 0: the root is not simple)";
-        return r;
+/// The pieces every normal form of this file is built from, at one equilibrium: the
+/// characteristic matrix and its derivatives, the eigenvector pairs of a root, the multilinear
+/// forms on history functions and the inverses that give the centre manifold's coefficients.
+class CentreForms {
+public:
+    CentreForms(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, int order) : m_s(system), m_p(p) {
+        if (!system.has_higher_derivatives())
+            throw std::invalid_argument("normal form: the system has no derivatives of order 2 to " + std::to_string(order));
+        const int n = system.dimension();
+        if (x.size() != n) throw std::invalid_argument("normal form: expected an equilibrium of " + std::to_string(n) + " entries");
+        m_u = system.stack_constant(x);
+        m_a = system.jacobians(m_u, p);
+        m_tau0.push_back(0.0);
+        for (const double t : system.delays(p)) m_tau0.push_back(t);
     }
-    p0 /= n0;
-    p1 /= n1;
+    int n() const { return m_s.dimension(); }
+    MatrixXc D(cplx lambda) const { return delta(m_a, m_tau0, lambda); }
+    MatrixXc dD(cplx lambda) const { return delta(m_a, m_tau0, lambda, true); }
+    MatrixXc ddD(cplx lambda) const { return delta2(m_a, m_tau0, lambda); }
 
-    // the bordered inverse (the header's binv)
-    bool ok = true;
-    auto binv = [&](cplx lambda, const VectorXc& q, const VectorXc& pv, const VectorXc& zeta, cplx kappa) {
-        const MatrixXc D = delta(a, tau0, lambda), dD = delta(a, tau0, lambda, true), ddD = delta2(a, tau0, lambda);
-        MatrixXc k = MatrixXc::Zero(n + 1, n + 1);
-        k.topLeftCorner(n, n) = D;
-        k.topRightCorner(n, 1) = q;
-        k.bottomLeftCorner(1, n) = pv.transpose();
-        VectorXc rhs = VectorXc::Zero(n + 1);
-        rhs.head(n) = zeta + kappa * (dD * q);
+    /// Delta(lambda) q = 0, |q| = 1; p Delta(lambda) = 0 (a row, no conjugation) with
+    /// p Delta'(lambda) q = 1; false when the root is not simple (the normalisation vanishes).
+    bool pair(cplx lambda, VectorXc& q, VectorXc& p, double& residual) const {
+        double left = 0.0;
+        q = null_vector_c(D(lambda), residual);
+        p = null_vector_c(D(lambda).transpose(), left);
+        if (lambda.imag() == 0.0) {  // a real root: real vectors (the phase made them so)
+            q = q.real().cast<cplx>();
+            q /= q.norm();
+            p = p.real().cast<cplx>();
+        }
+        const cplx norm = p.transpose() * dD(lambda) * q;
+        if (!(std::abs(norm) > 0.0)) return false;
+        p /= norm;
+        return true;
+    }
+
+    /// The history v e^{lambda theta}.
+    static History exp(const VectorXc& v, cplx lambda) { return History{{{v, lambda, 0}}}; }
+    /// theta -> e^{lambda theta} Delta(lambda)^-1 rhs (lambda not a root); `ok` false when singular.
+    History solve(cplx lambda, const VectorXc& rhs) {
+        const Eigen::FullPivLU<MatrixXc> lu(D(lambda));
+        if (lu.rank() < n()) m_ok = false;
+        return exp(lu.solve(rhs), lambda);
+    }
+    /// The bordered inverse binv(lambda, q, p, zeta, kappa) of normal_forms.hpp (lambda a simple root).
+    History binv(cplx lambda, const VectorXc& q, const VectorXc& pv, const VectorXc& zeta, cplx kappa) {
+        const int m = n();
+        MatrixXc k = MatrixXc::Zero(m + 1, m + 1);
+        k.topLeftCorner(m, m) = D(lambda);
+        k.topRightCorner(m, 1) = q;
+        k.bottomLeftCorner(1, m) = pv.transpose();
+        VectorXc rhs = VectorXc::Zero(m + 1);
+        rhs.head(m) = zeta + kappa * (dD(lambda) * q);
         const Eigen::FullPivLU<MatrixXc> lu(k);
-        if (lu.rank() < n + 1) ok = false;
-        const VectorXc xi = lu.solve(rhs).head(n);
-        const cplx gamma = -cplx(pv.transpose() * dD * xi) + 0.5 * kappa * cplx(pv.transpose() * ddD * q);
+        if (lu.rank() < m + 1) m_ok = false;
+        const VectorXc xi = lu.solve(rhs).head(m);
+        const cplx gamma = -cplx(pv.transpose() * dD(lambda) * xi) + 0.5 * kappa * cplx(pv.transpose() * ddD(lambda) * q);
         History h;
         h.terms.push_back({xi + gamma * q, lambda, 0});
         h.terms.push_back({-kappa * q, lambda, 1});
         return h;
-    };
-    auto B = [&](const History& f, const History& g) { return b_complex(system, u, p, f.stacked(tau0), g.stacked(tau0)); };
-    auto C = [&](const History& f, const History& g, const History& h) { return c_complex(system, u, p, f.stacked(tau0), g.stacked(tau0), h.stacked(tau0)); };
-    auto dot = [](const VectorXc& pv, const VectorXc& v) { return cplx(pv.transpose() * v); };
+    }
+    /// False when an inverse above met a singular matrix.
+    bool ok() const { return m_ok; }
 
-    History phi0, phi1;
-    phi0.terms.push_back({q0, l0, 0});
-    phi1.terms.push_back({q1, l1, 0});
+    VectorXc B(const History& f, const History& g) const { return form<2>({&f, &g}); }
+    VectorXc C(const History& f, const History& g, const History& h) const { return form<3>({&f, &g, &h}); }
+    VectorXc D4(const History& f, const History& g, const History& h, const History& k) const { return form<4>({&f, &g, &h, &k}); }
+    VectorXc E5(const History& f, const History& g, const History& h, const History& k, const History& l) const {
+        return form<5>({&f, &g, &h, &k, &l});
+    }
+    static cplx dot(const VectorXc& pv, const VectorXc& v) { return cplx(pv.transpose() * v); }
+
+private:
+    template <int K>
+    VectorXc form(std::initializer_list<const History*> h) const {
+        VectorXc stacked[K];
+        const VectorXc* ptr[K];
+        int k = 0;
+        for (const History* f : h) {
+            stacked[k] = f->stacked(m_tau0);
+            ptr[k] = &stacked[k];
+            ++k;
+        }
+        return dk_complex<K>(m_s, m_u, m_p, ptr);
+    }
+    const NonlinearDDE& m_s;
+    std::vector<double> m_p;
+    Eigen::VectorXd m_u;
+    std::vector<Eigen::MatrixXd> m_a;
+    std::vector<double> m_tau0;
+    bool m_ok = true;
+};
+
+}  // namespace
+
+ZeroHopfNormalForm zero_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega) {
+    if (!(std::isfinite(omega) && omega > 0.0)) throw std::invalid_argument("zero-Hopf normal form: omega = " + std::to_string(omega) + ": expected a value > 0");
+    CentreForms f(system, x, p, 3);
+    ZeroHopfNormalForm r;
+    const cplx l0(0.0, 0.0), l1(0.0, omega);
+    VectorXc q0, p0, q1, p1;
+    if (!f.pair(l0, q0, p0, r.kernel_residual) || !f.pair(l1, q1, p1, r.hopf_residual)) {
+        r.message = "the eigenvectors cannot be normalised (p Delta'(lambda) q = 0: the root is not simple)";
+        return r;
+    }
+    auto B = [&](const History& a, const History& b) { return f.B(a, b); };
+    auto C = [&](const History& a, const History& b, const History& c) { return f.C(a, b, c); };
+    auto dot = CentreForms::dot;
+    const History phi0 = CentreForms::exp(q0, l0), phi1 = CentreForms::exp(q1, l1);
     const History phi1b = phi1.conj();
     const VectorXc B00 = B(phi0, phi0), B01 = B(phi0, phi1);
     const VectorXc B11b = B(phi1, phi1b).real().cast<cplx>();  // real up to rounding
     const cplx g200 = 0.5 * dot(p0, B00), g110 = dot(p1, B01), g011 = dot(p0, B11b);
-    const History h200 = binv(l0, q0, p0, B00, -dot(p0, B00));
-    const History h011 = binv(l0, q0, p0, B11b, -dot(p0, B11b));
-    const History h110 = binv(l1, q1, p1, B01, -dot(p1, B01));
+    const History h200 = f.binv(l0, q0, p0, B00, -dot(p0, B00));
+    const History h011 = f.binv(l0, q0, p0, B11b, -dot(p0, B11b));
+    const History h110 = f.binv(l1, q1, p1, B01, -dot(p1, B01));
     const History h110b = h110.conj();
-    History h020;
-    {
-        const Eigen::FullPivLU<MatrixXc> lu(delta(a, tau0, 2.0 * l1));
-        if (lu.rank() < n) ok = false;
-        h020.terms.push_back({lu.solve(B(phi1, phi1)), 2.0 * l1, 0});
-    }
-    if (!ok) {
+    const History h020 = f.solve(2.0 * l1, B(phi1, phi1));
+    if (!f.ok()) {
         r.message = "a bordered system of the centre manifold is singular (a kernel is not one-dimensional, or 2 i omega is a root too)";
         return r;
     }
@@ -325,6 +376,104 @@ ZeroHopfNormalForm zero_hopf_normal_form(const NonlinearDDE& system, const Eigen
     r.status = Status::Converged;
     r.message = std::isfinite(r.e) ? "s = " + std::to_string(r.s) + ", theta = " + std::to_string(r.theta)
                                    : std::string("degenerate: ") + (r.g200 != 0.0 ? "g011 = 0 (e undefined)" : "g200 = 0 (d, e, theta undefined)");
+    return r;
+}
+
+DoubleHopfNormalForm double_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega1,
+                                             double omega2) {
+    if (!(std::isfinite(omega1) && omega1 > 0.0 && std::isfinite(omega2) && omega2 > 0.0 && omega1 != omega2))
+        throw std::invalid_argument("double Hopf normal form: omega1 = " + std::to_string(omega1) + ", omega2 = " + std::to_string(omega2) +
+                                    ": expected two different values > 0");
+    CentreForms f(system, x, p, 3);
+    DoubleHopfNormalForm r;
+    const cplx l1(0.0, omega1), l2(0.0, omega2);
+    VectorXc q1, p1, q2, p2;
+    if (!f.pair(l1, q1, p1, r.hopf1_residual) || !f.pair(l2, q2, p2, r.hopf2_residual)) {
+        r.message = "the eigenvectors cannot be normalised (p Delta'(i omega) q = 0: a pair is not simple)";
+        return r;
+    }
+    auto B = [&](const History& a, const History& b) { return f.B(a, b); };
+    auto C = [&](const History& a, const History& b, const History& c) { return f.C(a, b, c); };
+    auto dot = CentreForms::dot;
+    const History phi1 = CentreForms::exp(q1, l1), phi1b = phi1.conj(), phi2 = CentreForms::exp(q2, l2), phi2b = phi2.conj();
+    const History h1100 = f.solve(0.0, B(phi1, phi1b)), h2000 = f.solve(2.0 * l1, B(phi1, phi1));
+    const History h1010 = f.solve(l1 + l2, B(phi1, phi2)), h1001 = f.solve(l1 - l2, B(phi1, phi2b)), h1001b = h1001.conj();
+    const History h0020 = f.solve(2.0 * l2, B(phi2, phi2)), h0011 = f.solve(0.0, B(phi2, phi2b));
+    if (!f.ok()) {
+        r.message = "an inverse of the centre manifold is singular (0, 2 i omega_j or i (omega1 +- omega2) is a root too: a resonance)";
+        return r;
+    }
+    r.g2100 = 0.5 * dot(p1, 2.0 * B(h1100, phi1) + B(h2000, phi1b) + C(phi1, phi1, phi1b));
+    r.g1011 = dot(p1, B(h0011, phi1) + B(h1001, phi2) + B(h1010, phi2b) + C(phi1, phi2, phi2b));
+    r.g1110 = dot(p2, B(h1001b, phi1) + B(h1010, phi1b) + B(h1100, phi2) + C(phi1, phi1b, phi2));
+    r.g0021 = 0.5 * dot(p2, 2.0 * B(h0011, phi2) + B(h0020, phi2b) + C(phi2, phi2, phi2b));
+    r.q1 = q1, r.p1 = p1, r.q2 = q2, r.p2 = p2;
+    for (const cplx g : {r.g2100, r.g1011, r.g1110, r.g0021})
+        if (!std::isfinite(std::abs(g))) {
+            r.message = "a coefficient g is not finite";
+            return r;
+        }
+    if (r.g0021.real() != 0.0) r.theta = r.g1011.real() / r.g0021.real();
+    if (r.g2100.real() != 0.0) r.delta = r.g1110.real() / r.g2100.real();
+    r.status = Status::Converged;
+    r.message = std::isfinite(r.theta) && std::isfinite(r.delta)
+                    ? "theta = " + std::to_string(r.theta) + ", delta = " + std::to_string(r.delta)
+                    : std::string("degenerate: ") + (std::isfinite(r.theta) ? "Re g2100 = 0 (delta undefined)" : "Re g0021 = 0 (theta undefined)");
+    return r;
+}
+
+GeneralisedHopfNormalForm generalised_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p,
+                                                       double omega) {
+    if (!(std::isfinite(omega) && omega > 0.0))
+        throw std::invalid_argument("generalised Hopf normal form: omega = " + std::to_string(omega) + ": expected a value > 0");
+    CentreForms f(system, x, p, 5);
+    GeneralisedHopfNormalForm r;
+    const cplx l(0.0, omega);
+    VectorXc q, pv;
+    if (!f.pair(l, q, pv, r.hopf_residual)) {
+        r.message = "the eigenvectors cannot be normalised (p Delta'(i omega) q = 0: the pair is not simple)";
+        return r;
+    }
+    auto B = [&](const History& a, const History& b) { return f.B(a, b); };
+    auto C = [&](const History& a, const History& b, const History& c) { return f.C(a, b, c); };
+    auto D = [&](const History& a, const History& b, const History& c, const History& d) { return f.D4(a, b, c, d); };
+    auto dot = CentreForms::dot;
+    const History phi = CentreForms::exp(q, l), phib = phi.conj();
+    const VectorXc B20 = B(phi, phi);
+    const History h20 = f.solve(2.0 * l, B20), h20b = h20.conj(), h11 = f.solve(0.0, B(phi, phib));
+    const VectorXc r21 = B(phib, h20) + 2.0 * B(phi, h11) + C(phi, phi, phib);
+    const cplx c1 = 0.5 * dot(pv, r21);
+    const History h30 = f.solve(3.0 * l, 3.0 * B(phi, h20) + C(phi, phi, phi));
+    const History h21 = f.binv(l, q, pv, r21, -2.0 * c1), h21b = h21.conj();
+    // h31: the particular solution of the theta-dependent equation (nmfm_genh's devlt)
+    const VectorXc y20 = h20.terms.front().v;  // Delta(2 lambda)^-1 B(phi, phi)
+    const VectorXc r31 = B(phib, h30) + 3.0 * B(phi, h21) + 3.0 * B(h20, h11) + 3.0 * C(phi, phib, h20) + 3.0 * C(phi, phi, h11) +
+                         D(phi, phi, phi, phib);
+    History h31 = f.solve(2.0 * l, r31 - 6.0 * c1 * (f.dD(2.0 * l) * y20));
+    h31.terms.push_back({6.0 * c1 * y20, 2.0 * l, 1});
+    const History h22 = f.solve(0.0, 2.0 * B(phib, h21) + 2.0 * B(h11, h11) + 2.0 * B(phi, h21b) + B(h20, h20b) + C(phib, phib, h20) +
+                                         C(phi, phi, h20b) + 4.0 * C(phi, phib, h11) + D(phi, phi, phib, phib));
+    if (!f.ok()) {
+        r.message = "an inverse of the centre manifold is singular (0, 2 i omega or 3 i omega is a root too, or the pair is not simple)";
+        return r;
+    }
+    const cplx c2 = dot(pv, 6.0 * B(h11, h21) + 3.0 * B(h21b, h20) + B(h20b, h30) + 3.0 * B(phi, h22) + 2.0 * B(phib, h31) +
+                                6.0 * C(phib, h20, h11) + 6.0 * C(phi, h11, h11) + 3.0 * C(phi, h20, h20b) + 6.0 * C(phi, phib, h21) +
+                                3.0 * C(phi, phi, h21b) + C(phib, phib, h30) + 6.0 * D(phi, phi, phib, h11) + 3.0 * D(phi, phib, phib, h20) +
+                                D(phi, phi, phi, h20b) + f.E5(phi, phi, phi, phib, phib)) /
+                    12.0;
+    r.c1 = c1;
+    r.c2 = c2;
+    r.l1 = c1.real() / omega;
+    r.l2 = c2.real() / omega;
+    r.q = q;
+    r.p = pv;
+    if (!std::isfinite(std::abs(c1)) || !std::isfinite(std::abs(c2))) {
+        r.message = "a coefficient is not finite";
+        return r;
+    }
+    r.status = Status::Converged;
+    r.message = "L2 = " + std::to_string(r.l2);
     return r;
 }
 

@@ -52,6 +52,23 @@ inline ojson zero_hopf_normal_form_json(const ZeroHopfNormalForm& nf) {
     return g;
 }
 
+/// A double Hopf point's normal form: {"g2100", "g1011", "g1110", "g0021" (as {"re", "im"}),
+/// "theta", "delta"}; null when it was not formed.
+inline ojson double_hopf_normal_form_json(const DoubleHopfNormalForm& nf) {
+    if (nf.status != Status::Converged) return ojson(nullptr);
+    auto complex = [](cplx v) { return ojson{{"re", json_value(v.real())}, {"im", json_value(v.imag())}}; };
+    return ojson{{"g2100", complex(nf.g2100)}, {"g1011", complex(nf.g1011)}, {"g1110", complex(nf.g1110)},
+                 {"g0021", complex(nf.g0021)}, {"theta", json_value(nf.theta)}, {"delta", json_value(nf.delta)}};
+}
+
+/// A generalised Hopf point's normal form: {"c1", "c2" (as {"re", "im"}), "l2"}; null when it was
+/// not formed.
+inline ojson generalised_hopf_normal_form_json(const GeneralisedHopfNormalForm& nf) {
+    if (nf.status != Status::Converged) return ojson(nullptr);
+    auto complex = [](cplx v) { return ojson{{"re", json_value(v.real())}, {"im", json_value(v.imag())}}; };
+    return ojson{{"c1", complex(nf.c1)}, {"c2", complex(nf.c2)}, {"l2", json_value(nf.l2)}};
+}
+
 /// The head of a two-parameter curve's JSON (Hopf curves, fold curves): {"start", "status",
 /// "message", "stop": [backward, forward]}; the caller adds its points.
 inline ojson curve_json(int start, Status status, const std::string& message, ContinuationStop backward, ContinuationStop forward) {

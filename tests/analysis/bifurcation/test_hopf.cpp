@@ -8,6 +8,7 @@
 #include "two_parameter_box.hpp"
 #include "tolerances.hpp"
 #include "ddemap/analysis/bifurcation/hopf.hpp"
+#include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 #include "ddemap/io/hopf_output.hpp"
 #include "ddemap/problem/expression_system.hpp"
 #include "ddemap/solve/integrate.hpp"
@@ -663,15 +664,12 @@ TEST_CASE("ov ring (N = 5) in (headway, tau): the root counts along every Hopf c
     MESSAGE("root counts compared with the closed form at " << compared << " Hopf-curve points");
 }
 
-TEST_CASE("DDE-BIFTOOL's normal-form demo (two layers of neurons): the zero-Hopf point where the trivial equilibrium is a pitchfork, its normal form, no generalised Hopf point at L1's pole") {
-    // x1' = -x1 - a g(b x1(t - tau1)) + c g(d x2(t - tau2)) and symmetrically, g(z) = (tanh(z - 1) +
-    // tanh 1) cosh(1)^2 (g(0) = 0, g'(0) = 1), b = 2, d = 1.2, tau1 = 12.7, tau2 = 20.2. At x = 0 the
-    // symmetric mode has Delta_s(lambda) = lambda + 1 + 2 a e^{-12.7 lambda} - 1.2 c e^{-20.2 lambda}: a
-    // real root crosses 0 where 1 + 2a - 1.2c = 0 (a pitchfork of the symmetric equilibrium, where
-    // the curve system is singular). The demo (nmfm_demo, its published output) prints the
-    // zero-Hopf point a = 0.0133327150, c = 0.8554382654 (where 1 + 2a - 1.2c = 1.4e-4: located to
-    // its secant tolerance) with s = 0.0000803411 and theta = 2.0969328059, its generalised Hopf point
-    // a = 0.2518504300, c = 0.5812203535.
+namespace {
+
+/// DDE-BIFTOOL's normal-form demo (nmfm_demo): two layers of neurons,
+/// x1' = -x1 - a g(b x1(t - tau1)) + c g(d x2(t - tau2)) and symmetrically, g(z) = (tanh(z - 1) +
+/// tanh 1) cosh(1)^2 (g(0) = 0, g'(0) = 1), b = 2, d = 1.2, tau1 = 12.7, tau2 = 20.2.
+ExpressionSystem two_layers(double a, double c) {
     const double C2 = 2.3810978455418157, T1 = 0.7615941559557649;  // cosh(1)^2, tanh(1)
     char c2[64];
     std::snprintf(c2, sizeof c2, "%.17g", C2);
@@ -680,9 +678,33 @@ TEST_CASE("DDE-BIFTOOL's normal-form demo (two layers of neurons): the zero-Hopf
     auto g = [&](const std::string& var, const std::string& gain, const std::string& tau) {
         return std::string("(tanh(") + gain + "*" + var + "(t - " + tau + ") - 1) + " + t1 + ")*" + c2;
     };
-    const ExpressionSystem sys({"x1", "x2"}, {"a", "b", "c", "d", "tau1", "tau2"}, {0.25, 2.0, 15.0 / 29.0, 1.2, 12.7, 20.2},
-                               {"-x1 - a*" + g("x1", "b", "tau1") + " + c*" + g("x2", "d", "tau2"),
-                                "-x2 - a*" + g("x2", "b", "tau1") + " + c*" + g("x1", "d", "tau2")});
+    return ExpressionSystem({"x1", "x2"}, {"a", "b", "c", "d", "tau1", "tau2"}, {a, 2.0, c, 1.2, 12.7, 20.2},
+                            {"-x1 - a*" + g("x1", "b", "tau1") + " + c*" + g("x2", "d", "tau2"),
+                             "-x2 - a*" + g("x2", "b", "tau1") + " + c*" + g("x1", "d", "tau2")});
+}
+
+/// The root of the symmetric mode's Delta_s(lambda) = lambda + 1 + 2 a e^{-12.7 lambda} -
+/// 1.2 c e^{-20.2 lambda} near `start` (complex Newton).
+cplx two_layers_root(double a, double c, cplx start) {
+    cplx l = start;
+    for (int it = 0; it < 60; ++it) {
+        const cplx e1 = std::exp(-12.7 * l), e2 = std::exp(-20.2 * l);
+        l -= (l + 1.0 + 2.0 * a * e1 - 1.2 * c * e2) / (1.0 - 25.4 * a * e1 + 24.24 * c * e2);
+    }
+    return l;
+}
+
+}  // namespace
+
+TEST_CASE("DDE-BIFTOOL's normal-form demo (two layers of neurons): the zero-Hopf point where the trivial equilibrium is a pitchfork, its normal form, no generalised Hopf point at L1's pole") {
+    // (two_layers). At x = 0 the
+    // symmetric mode has Delta_s(lambda) = lambda + 1 + 2 a e^{-12.7 lambda} - 1.2 c e^{-20.2 lambda}: a
+    // real root crosses 0 where 1 + 2a - 1.2c = 0 (a pitchfork of the symmetric equilibrium, where
+    // the curve system is singular). The demo (nmfm_demo, its published output) prints the
+    // zero-Hopf point a = 0.0133327150, c = 0.8554382654 (where 1 + 2a - 1.2c = 1.4e-4: located to
+    // its secant tolerance) with s = 0.0000803411 and theta = 2.0969328059, its generalised Hopf point
+    // a = 0.2518504300, c = 0.5812203535.
+    const ExpressionSystem sys = two_layers(0.25, 15.0 / 29.0);
     HopfCurveOptions o = curve_box("a", 0.0, 0.55, "c", 0.3, 1.0);
     const HopfCurves hc = hopf_curves(sys, Eigen::VectorXd::Zero(2), o);
     REQUIRE(!hc.curves.empty());
@@ -713,4 +735,85 @@ TEST_CASE("DDE-BIFTOOL's normal-form demo (two layers of neurons): the zero-Hopf
     CHECK(c.generalised[0].status == Status::Converged);
     CHECK(std::abs(c.generalised[0].par - 0.2518504300) < 5e-5);
     CHECK(std::abs(c.generalised[0].par2 - 0.5812203535) < 5e-5);
+    // its second Lyapunov coefficient: checked against the folds of orbits in the test below; the
+    // demo prints L2 = 0.0011029849 in the normalisation of its s (which divides L2 by
+    // |Delta_s'(i omega)|^2): 1.9 % below ddemap's (see the guide)
+    const GeneralisedHopfNormalForm& gnf = c.generalised[0].normal_form;
+    REQUIRE(gnf.status == Status::Converged);
+    CHECK(std::abs(gnf.l1) < 1e-8);
+    const cplx lg(0.0, c.generalised[0].omega);
+    const cplx dsg = 1.0 - 2.0 * c.generalised[0].par * 12.7 * std::exp(-12.7 * lg) + 1.2 * c.generalised[0].par2 * 20.2 * std::exp(-20.2 * lg);
+    CHECK(std::abs(gnf.l2 / std::norm(dsg) - 0.0011029849) < 0.03 * 0.0011029849);
+    // the double Hopf point where the curve of the pair omega ~ 0.29 crosses that of omega ~ 0.156:
+    // the demo prints theta(0) = 1.6984018466, delta(0) = 1.5254221873 at a = 0.0900149247,
+    // c = 0.7736041399 (1.2e-4 off its second pair's equation); theta and delta are ratios, free of
+    // the normalisation. At ddemap's point they agree to 6e-4, at the demo's point to 4.3e-4.
+    const DoubleHopfPoint* dh = nullptr;
+    for (const HopfCurve& cv : hc.curves)
+        for (const DoubleHopfPoint& d : cv.double_hopf)
+            if (std::abs(d.par - 0.09) < 1e-3 && d.omega1 > d.omega2) dh = &d;
+    REQUIRE(dh != nullptr);
+    REQUIRE(dh->normal_form.status == Status::Converged);
+    CHECK(std::abs(dh->par - 0.0900149247) < 5e-4);
+    CHECK(std::abs(dh->par2 - 0.7736041399) < 5e-4);
+    CHECK(std::abs(dh->normal_form.theta - 1.6984018466) < 1e-3 * 1.6984018466);
+    CHECK(std::abs(dh->normal_form.delta - 1.5254221873) < 1e-3 * 1.5254221873);
+    std::vector<double> at_demo = sys.parameter_values();
+    at_demo[0] = 0.0900149247, at_demo[2] = 0.7736041399;
+    const DoubleHopfNormalForm demo = double_hopf_normal_form(sys, Eigen::VectorXd::Zero(2), at_demo, dh->omega1, dh->omega2);
+    REQUIRE(demo.status == Status::Converged);
+    CHECK(std::abs(demo.theta - 1.6984018466) < 5e-4 * 1.6984018466);
+    CHECK(std::abs(demo.delta - 1.5254221873) < 5e-4 * 1.5254221873);
+}
+
+TEST_CASE("second Lyapunov coefficient of DDE-BIFTOOL's normal-form demo against the folds of periodic orbits near its generalised Hopf point" *
+          doctest::test_suite("slow")) {
+    // Near a generalised Hopf point the radial normal form rho' = rho (mu + omega L1 rho^2 +
+    // omega L2 rho^4) has a fold of orbits where its discriminant vanishes: mu = omega L1^2 / (4 L2)
+    // (mu the real part of the critical root at the fold's parameter), up to O(L1) relative. On
+    // lines c = const at four distances, the Hopf point in a gives omega and L1, the orbit branch
+    // from it (collocation, a different computation) its fold a_F, the characteristic equation mu at
+    // a_F; the estimates omega L1^2 / (4 mu) extrapolated to L1 = 0 by a quadratic must give L2.
+    const ExpressionSystem at_gh = two_layers(0.25, 15.0 / 29.0);
+    HopfCurveOptions o = curve_box("a", 0.0, 0.55, "c", 0.3, 1.0);
+    const HopfCurves hc = hopf_curves(at_gh, Eigen::VectorXd::Zero(2), o);
+    REQUIRE(!hc.curves.empty());
+    REQUIRE(hc.curves[0].generalised.size() == 1);
+    const GeneralisedHopfPoint& gh = hc.curves[0].generalised[0];
+    REQUIRE(gh.normal_form.status == Status::Converged);
+    std::vector<double> l1s, estimates;
+    for (const double c : {0.57, 0.5725, 0.575, 0.5775}) {
+        const ExpressionSystem sys = two_layers(0.2, c);
+        EquilibriumBranchOptions eo;
+        eo.parameter = "a";
+        eo.from = 0.2;
+        eo.to = 0.28;
+        const HopfAnalysis h = hopf_points(sys, Eigen::VectorXd::Zero(2), eo);
+        REQUIRE(h.points.size() == 1);
+        const HopfCoefficients& hp = h.points[0];
+        REQUIRE(hp.status == Status::Converged);
+        REQUIRE(hp.l1 < 0.0);  // the side of the generalised Hopf point where the fold exists (L2 > 0)
+        PeriodicOrbitOptions po;
+        po.parameter = "a";
+        po.from = 0.2;
+        po.to = 0.28;
+        po.degree = 5;
+        po.intervals = 60;
+        const OrbitBranch b = orbit_branch_from_hopf(sys, h.branch.hopf[0], po);
+        REQUIRE(!b.folds.empty());
+        REQUIRE(b.folds[0].located);
+        const double mu = two_layers_root(b.folds[0].par, c, cplx(0.0, hp.omega)).real();
+        REQUIRE(mu > 0.0);
+        l1s.push_back(hp.l1);
+        estimates.push_back(hp.omega * hp.l1 * hp.l1 / (4.0 * mu));
+    }
+    // the quadratic through the last three estimates, at L1 = 0 (Lagrange)
+    const double x0 = l1s[1], x1 = l1s[2], x2 = l1s[3];
+    const double extrapolated = estimates[1] * x1 * x2 / ((x0 - x1) * (x0 - x2)) + estimates[2] * x0 * x2 / ((x1 - x0) * (x1 - x2)) +
+                                estimates[3] * x0 * x1 / ((x2 - x0) * (x2 - x1));
+    MESSAGE("L2 at the generalised Hopf point " << gh.normal_form.l2 << "; from the folds of orbits " << estimates[0] << ", " << estimates[1]
+                                                << ", " << estimates[2] << ", " << estimates[3] << ", extrapolated " << extrapolated);
+    // the estimates alone are 5 to 17 % off (first order in L1); the extrapolation removes that
+    CHECK(std::abs(estimates[3] - gh.normal_form.l2) > 0.01 * gh.normal_form.l2);
+    CHECK(std::abs(extrapolated - gh.normal_form.l2) < 1e-4 * gh.normal_form.l2);
 }

@@ -152,6 +152,9 @@ struct DoubleHopfPoint {
     /// omega1 = omega2 (to 1e-6): a 1:1 resonance, the pair +-i omega double (as at a21 = 0 of
     /// DDE-BIFTOOL's neuron demo, which calls it spurious); no second curve starts there.
     bool resonant = false;
+    /// at a located, non-resonant point: the normal-form coefficients (normal_forms.hpp,
+    /// DDE-BIFTOOL's nmfm_hoho; omega1 the first pair's)
+    DoubleHopfNormalForm normal_form;
 };
 
 /// A zero-Hopf (fold-Hopf) point: a real root crosses 0 on the Hopf curve (det Delta(0) changes
@@ -175,6 +178,9 @@ struct GeneralisedHopfPoint {
     double l1 = 0.0;       ///< at the located point (|l1| <= 1e-13 of its scale, or the chord bracket at rounding, when converged)
     double residual = std::numeric_limits<double>::infinity();  ///< of the Hopf system
     int after = 0;         ///< index of the curve point before it
+    /// at a located point: c1, c2 and the second Lyapunov coefficient L2 = Re c2 / omega
+    /// (normal_forms.hpp, DDE-BIFTOOL's nmfm_genh)
+    GeneralisedHopfNormalForm normal_form;
 };
 
 struct HopfCurve {

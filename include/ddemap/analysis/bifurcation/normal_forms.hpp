@@ -1,7 +1,7 @@
 #pragma once
 /// \file normal_forms.hpp
-/// Normal-form coefficients of the codimension-two points of equilibria on fold curves, in
-/// DDE-BIFTOOL's normalisation (nmfm_bt, nmfm_cusp), so that the numbers compare.
+/// Normal-form coefficients of the codimension-two points of equilibria, in DDE-BIFTOOL's
+/// normalisation (nmfm_bt, nmfm_cusp, nmfm_zeho, nmfm_hoho, nmfm_genh), so that the numbers compare.
 ///
 /// At an equilibrium x* of x'(t) = f(x(t), x(t - tau_1), ..., x(t - tau_m); p), with
 /// A_k = D_{u_k} f and the characteristic matrix Delta(lambda) = lambda I - A_0 - sum_k A_k
@@ -52,6 +52,42 @@
 /// d = g110 - i omega g300 / g200, e = Re(g210 + g110 (Re g021 / g011 - 3 g300 / (2 g200) +
 /// g111 / (2 g011)) - g021 g200 / g011), s = b c and theta = Re g110 / g200 (s and theta decide the
 /// unfolding's type: s = +1 or -1, theta's sign; they do not depend on the sign of q0).
+///
+/// Double Hopf (two simple pairs +-i omega1, +-i omega2, no resonance 1:1, 1:2, 1:3), as
+/// DDE-BIFTOOL's nmfm_hoho: the pairs (q_j, p_j) normalised as above, phi_j = e^{i omega_j theta} q_j,
+/// lambda_j = i omega_j; with h_lambda[v] = theta -> e^{lambda theta} Delta(lambda)^-1 v,
+///     h1100 = h_0[B(phi1, conj phi1)],  h2000 = h_{2 lambda1}[B(phi1, phi1)],
+///     h1010 = h_{lambda1 + lambda2}[B(phi1, phi2)],  h1001 = h_{lambda1 - lambda2}[B(phi1, conj phi2)],
+///     h0020 = h_{2 lambda2}[B(phi2, phi2)],  h0011 = h_0[B(phi2, conj phi2)],
+///     g2100 = p1 (2 B(h1100, phi1) + B(h2000, conj phi1) + C(phi1, phi1, conj phi1)) / 2,
+///     g1011 = p1 (B(h0011, phi1) + B(h1001, phi2) + B(h1010, conj phi2) + C(phi1, phi2, conj phi2)),
+///     g1110 = p2 (B(conj h1001, phi1) + B(h1010, conj phi1) + B(h1100, phi2) + C(phi1, conj phi1, phi2)),
+///     g0021 = p2 (2 B(h0011, phi2) + B(h0020, conj phi2) + C(phi2, phi2, conj phi2)) / 2,
+/// the coefficients of w1' = i omega1 w1 + g2100 w1 |w1|^2 + g1011 w1 |w2|^2,
+/// w2' = i omega2 w2 + g1110 w2 |w1|^2 + g0021 w2 |w2|^2; theta = Re g1011 / Re g0021 and
+/// delta = Re g1110 / Re g2100 (with the signs of Re g2100, Re g0021 they decide the unfolding's
+/// type: simple or difficult case, and which tori and three-tori it has).
+///
+/// Generalised Hopf (Bautin: a simple pair +-i omega where L1 = 0), as DDE-BIFTOOL's nmfm_genh
+/// (Kuznetsov's formulas for the centre manifold of a DDE): with (q, p) and phi = e^{i omega theta} q,
+/// lambda = i omega and D, E the fourth and fifth derivatives of f as multilinear forms,
+///     h20 = h_{2 lambda}[B(phi, phi)],  h11 = h_0[B(phi, conj phi)],
+///     c1 = p (B(conj phi, h20) + 2 B(phi, h11) + C(phi, phi, conj phi)) / 2,
+///     h30 = h_{3 lambda}[3 B(phi, h20) + C(phi, phi, phi)],
+///     h21 = binv(lambda, q, p, B(conj phi, h20) + 2 B(phi, h11) + C(phi, phi, conj phi), -2 c1),
+///     h31 = theta -> e^{2 lambda theta} (Delta(2 lambda)^-1 (R31 - 6 c1 Delta'(2 lambda) y20) + 6 c1 theta y20),
+///       y20 = Delta(2 lambda)^-1 B(phi, phi),
+///       R31 = B(conj phi, h30) + 3 B(phi, h21) + 3 B(h20, h11) + 3 C(phi, conj phi, h20) + 3 C(phi, phi, h11)
+///             + D(phi, phi, phi, conj phi),
+///     h22 = h_0[2 B(conj phi, h21) + 2 B(h11, h11) + 2 B(phi, conj h21) + B(h20, conj h20)
+///             + C(conj phi, conj phi, h20) + C(phi, phi, conj h20) + 4 C(phi, conj phi, h11) + D(phi, phi, conj phi, conj phi)],
+///     c2 = p (6 B(h11, h21) + 3 B(conj h21, h20) + B(conj h20, h30) + 3 B(phi, h22) + 2 B(conj phi, h31)
+///             + 6 C(conj phi, h20, h11) + 6 C(phi, h11, h11) + 3 C(phi, h20, conj h20) + 6 C(phi, conj phi, h21)
+///             + 3 C(phi, phi, conj h21) + C(conj phi, conj phi, h30) + 6 D(phi, phi, conj phi, h11)
+///             + 3 D(phi, conj phi, conj phi, h20) + D(phi, phi, phi, conj h20) + E(phi, phi, phi, conj phi, conj phi)) / 12,
+/// the coefficients of w' = i omega w + c1 w |w|^2 + c2 w |w|^4; L1 = Re c1 / omega and the second
+/// Lyapunov coefficient L2 = Re c2 / omega (defined where L1 = 0; its sign says whether the fold of
+/// periodic orbits born there lies on the side where the equilibrium is stable, L2 < 0, or not).
 
 #include <limits>
 #include <string>
@@ -104,6 +140,28 @@ struct ZeroHopfNormalForm {
     double hopf_residual = std::numeric_limits<double>::quiet_NaN();
 };
 
+struct DoubleHopfNormalForm {
+    Status status = Status::NumericalIssue;
+    std::string message;
+    cplx g2100{std::numeric_limits<double>::quiet_NaN(), 0.0}, g1011{std::numeric_limits<double>::quiet_NaN(), 0.0},
+        g1110{std::numeric_limits<double>::quiet_NaN(), 0.0}, g0021{std::numeric_limits<double>::quiet_NaN(), 0.0};
+    double theta = std::numeric_limits<double>::quiet_NaN(), delta = std::numeric_limits<double>::quiet_NaN();
+    VectorXc q1, p1, q2, p2;
+    /// sigma_min / sigma_max of Delta(i omega1) and of Delta(i omega2) (both ~0 at the point)
+    double hopf1_residual = std::numeric_limits<double>::quiet_NaN();
+    double hopf2_residual = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct GeneralisedHopfNormalForm {
+    Status status = Status::NumericalIssue;
+    std::string message;
+    cplx c1{std::numeric_limits<double>::quiet_NaN(), 0.0}, c2{std::numeric_limits<double>::quiet_NaN(), 0.0};
+    double l1 = std::numeric_limits<double>::quiet_NaN();  ///< Re c1 / omega (0 at the point)
+    double l2 = std::numeric_limits<double>::quiet_NaN();  ///< Re c2 / omega
+    VectorXc q, p;
+    double hopf_residual = std::numeric_limits<double>::quiet_NaN();  ///< sigma_min / sigma_max of Delta(i omega)
+};
+
 /// The Bogdanov-Takens coefficients (a, b) at the equilibrium x of `system` at parameter values p
 /// (the system's second derivatives are needed: has_higher_derivatives(), else
 /// std::invalid_argument). Status NumericalIssue when the Jordan chain cannot be formed (the
@@ -120,5 +178,19 @@ CuspNormalForm cusp_normal_form(const NonlinearDDE& system, const Eigen::VectorX
 /// degenerate point (g200 = 0 or g011 = 0) the status is Converged, the g are given and what
 /// divides by them (d, theta; e) is NaN, the message says which.
 ZeroHopfNormalForm zero_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega);
+
+/// The double Hopf coefficients at the equilibrium x at parameter values p with the pairs
+/// +-i omega1, +-i omega2 (0 < omega1 != omega2; second and third derivatives needed); status
+/// NumericalIssue when a kernel is not one-dimensional, an inverse is singular (a resonance:
+/// 2 omega_j or omega1 +- omega2 a root frequency too) or a g is not finite. Where Re g2100 or
+/// Re g0021 is 0, delta or theta is NaN and the message says so (status Converged).
+DoubleHopfNormalForm double_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega1,
+                                             double omega2);
+
+/// c1, c2, L1 and L2 at the equilibrium x at parameter values p with the pair +-i omega (omega > 0;
+/// derivatives of order 2 to 5 needed: has_higher_derivatives()); status NumericalIssue when the
+/// root is not simple, 2 i omega or 3 i omega is a root too, or a coefficient is not finite.
+GeneralisedHopfNormalForm generalised_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p,
+                                                       double omega);
 
 }  // namespace ddemap

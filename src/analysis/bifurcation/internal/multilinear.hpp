@@ -47,6 +47,69 @@ inline Eigen::VectorXd d3(const NonlinearDDE& s, const Eigen::VectorXd& u, const
     return r;
 }
 
+/// Dual numbers nested K levels deep (K = 0: double).
+template <int K> struct Nested { using type = Dual<typename Nested<K - 1>::type>; };
+template <> struct Nested<0> { using type = double; };
+
+/// u + d_0 e_1 + ... + d_{K-1} e_K: level j carries direction d_{j-1} (as d2 and d3 seed).
+template <int K> typename Nested<K>::type seed(double u, const double* d) {
+    if constexpr (K == 0) return u;
+    else return typename Nested<K>::type(seed<K - 1>(u, d), typename Nested<K - 1>::type(d[K - 1]));
+}
+template <int K> double mixed_part(const typename Nested<K>::type& v) {
+    if constexpr (K == 0) return v;
+    else return mixed_part<K - 1>(v.deriv);
+}
+
+/// D^K f(u; p)[d_0, ..., d_{K-1}] for real stacked directions (K = 1..5), one evaluation in K
+/// nested levels of dual numbers.
+template <int K>
+Eigen::VectorXd dk(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const Eigen::VectorXd* const* d) {
+    using T = typename Nested<K>::type;
+    const int n = s.dimension();
+    std::vector<T> U(static_cast<std::size_t>(u.size())), P(p.size()), out(static_cast<std::size_t>(n));
+    double dirs[K];
+    for (Eigen::Index i = 0; i < u.size(); ++i) {
+        for (int k = 0; k < K; ++k) dirs[k] = (*d[k])[i];
+        U[static_cast<std::size_t>(i)] = seed<K>(u[i], dirs);
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) P[i] = T(p[i]);
+    s.evaluate(U.data(), P.data(), out.data());
+    Eigen::VectorXd r(n);
+    for (int i = 0; i < n; ++i) r[i] = mixed_part<K>(out[static_cast<std::size_t>(i)]);
+    return r;
+}
+
+/// D^K f[a_0, ..., a_{K-1}] for complex directions (multilinear, no conjugation): the 2^K real
+/// terms of the expansion a_k = Re a_k + i Im a_k, zero parts skipped.
+template <int K>
+VectorXc dk_complex(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const VectorXc* const* a) {
+    Eigen::VectorXd parts[K][2];
+    bool zero[K][2];
+    for (int k = 0; k < K; ++k) {
+        parts[k][0] = a[k]->real();
+        parts[k][1] = a[k]->imag();
+        zero[k][0] = parts[k][0].isZero(0.0);
+        zero[k][1] = parts[k][1].isZero(0.0);
+    }
+    VectorXc r = VectorXc::Zero(s.dimension());
+    for (int mask = 0; mask < (1 << K); ++mask) {
+        const Eigen::VectorXd* d[K];
+        int imag = 0;
+        bool skip = false;
+        for (int k = 0; k < K; ++k) {
+            const int b = (mask >> k) & 1;
+            skip = skip || zero[k][b];
+            imag += b;
+            d[k] = &parts[k][b];
+        }
+        if (skip) continue;
+        static const cplx powers[4] = {cplx(1, 0), cplx(0, 1), cplx(-1, 0), cplx(0, -1)};
+        r += powers[imag % 4] * dk<K>(s, u, p, d).template cast<cplx>();
+    }
+    return r;
+}
+
 /// B(a, b) for complex stacked directions (bilinear, not sesquilinear).
 inline VectorXc b_complex(const NonlinearDDE& s, const Eigen::VectorXd& u, const std::vector<double>& p, const VectorXc& a, const VectorXc& b) {
     const Eigen::VectorXd ar = a.real(), ai = a.imag(), br = b.real(), bi = b.imag();
