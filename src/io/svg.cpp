@@ -74,13 +74,13 @@ double nice_step(double range) {
 }
 
 /// XML declaration, the svg element (width x height px), a white background and the title.
-void svg_preamble(std::ostringstream& s, double width, double height, const std::string& title) {
+void svg_preamble(std::ostringstream& s, double width, double height, const std::string& title, double title_size = 15) {
     s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
     s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width) << "\" height=\"" << num(height)
       << "\" viewBox=\"0 0 " << num(width) << " " << num(height) << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
     s << "<rect id=\"background\" x=\"0\" y=\"0\" width=\"" << num(width) << "\" height=\"" << num(height) << "\" fill=\"#ffffff\"/>\n";
     if (!title.empty()) {
-        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">"
+        s << "<text id=\"title\" x=\"" << num(width / 2) << "\" y=\"22\" text-anchor=\"middle\" font-size=\"" << num(title_size) << "\" font-weight=\"bold\">"
           << esc(title) << "</text>\n";
     }
 }
@@ -633,7 +633,8 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     const double ml = 70, mr = 18, mt = 36, mb = 54;  // type as in the charts: readable at a column width
     const double cw = o.panel_width + ml + mr, ch = o.panel_height + mt + mb;
     const double header = o.title.empty() ? 10 : 34;
-    const double width = cols * cw + 10;
+    // as wide as the panels, or wider where the title needs it at 12 px (long names are not cut off)
+    const double width = std::max(cols * cw + 10, text_width(o.title, 12) + 20);
     // legend entries: the series names of the first panel
     std::vector<std::pair<std::string, std::string>> entries;
     std::vector<bool> dashed_entries;
@@ -681,7 +682,7 @@ std::string render_line_plots_svg(const std::vector<PlotPanel>& panels, const Pl
     const double note_h = 18.0 * static_cast<double>(note_lines.size()) + (note_lines.empty() ? 0 : 4);
     const double height = header + rows * ch + legend_h + note_h;
     std::ostringstream s;
-    svg_preamble(s, width, height, o.title);
+    svg_preamble(s, width, height, o.title, fitted_size(o.title, 15, width - 20, 12));
     for (std::size_t pi = 0; pi < panels.size(); ++pi) {
         const PlotPanel& p = panels[pi];
         double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
