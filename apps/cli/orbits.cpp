@@ -96,11 +96,12 @@ void add_orbits_flags(CLI::App& app) {
     app.add_flag("--adapt", orbits_args.adapt,
                  "move the mesh after every orbit to equidistribute |x^(d+1)|^(1/(d+1)) (more accurate orbits, less accurate multipliers; see README)");
     app.add_option("--variable", orbits_args.variable, "the variable whose amplitude max - min the figure shows (default: the first)")->type_name("NAME");
-    app.add_option("--svg", orbits_args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers)");
+    app.add_option("--svg", orbits_args.svg, "the bifurcation diagram (amplitude against the parameter, equilibria, Hopf and fold markers); with --par2 the curves in the plane (--par, --par2)");
     app.add_option("--par2", orbits_args.par2,
-                   "a second parameter: continue every fold of the branch as a curve of folds of periodic orbits, and every period doubling as a "
-                   "curve of period doublings, in (--par, --par2), in the box [--from, --to] x [--from2, --to2] (a fold curve also ends where it "
-                   "meets the Hopf curve, at a generalised Hopf point)")
+                   "a second parameter: continue every fold of the branch as a curve of folds of periodic orbits, every period doubling as a "
+                   "curve of period doublings and every torus bifurcation as a curve of tori, in (--par, --par2), in the box [--from, --to] x "
+                   "[--from2, --to2] (a fold curve also ends where it meets the Hopf curve, at a generalised Hopf point; a torus curve at a "
+                   "double Hopf point)")
         ->type_name("NAME");
     app.add_option("--period-doubling", orbits_args.period_doubling,
                    "switch at period doubling K of the branch (from 0, in the order met) onto the branch of orbits of twice the period, "
@@ -121,7 +122,7 @@ void add_orbits_flags(CLI::App& app) {
     app.add_option("--from2", orbits_args.from2, "--par2: the lower end of its box (its value in the system must lie in [from2, to2])")->type_name("NUMBER");
     app.add_option("--to2", orbits_args.to2, "--par2: the upper end of its box")->type_name("NUMBER");
     orbits_args.format.add_to(app);
-    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json; with --par2 also PREFIX-folds.csv and PREFIX-doublings.csv (one row per point of the curves of folds and of period doublings)", false);
+    orbits_args.out.add_to(app, "PREFIX.csv (one row per orbit and special point) and PREFIX.json; with --par2 also PREFIX-folds.csv, PREFIX-doublings.csv and PREFIX-tori.csv (one row per point of the curves of folds, of period doublings and of tori)", false);
     run_flags().add_to(app, false);
 
     app.add_option("--wave", orbits_args.wave,
@@ -392,6 +393,8 @@ int run_orbits() {
     const std::vector<OrbitFoldCurve>& pd_curves = bc.period_doublings;
     const std::vector<int>& curve_fold = bc.fold_index;
     const std::vector<int>& curve_pd = bc.period_doubling_index;
+    const std::vector<OrbitFoldCurve>& torus_curves = bc.tori;
+    const std::vector<int>& curve_torus = bc.torus_index;
 
     JsonEnvelope e;
     e.command = "orbits";
@@ -408,7 +411,8 @@ int run_orbits() {
     }
     if (two)
         result = result.substr(0, result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(curves, variables) +
-                 ",\"period_doubling_curves\":" + orbit_fold_curves_json(pd_curves, variables) + "}";
+                 ",\"period_doubling_curves\":" + orbit_fold_curves_json(pd_curves, variables) +
+                 ",\"torus_curves\":" + orbit_fold_curves_json(torus_curves, variables) + "}";
     if (doubling) {
         const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(doubling_index)];
         JsonObject from;
@@ -424,9 +428,17 @@ int run_orbits() {
         files.push_back({prefix + ".json", envelope_json(e)});
         if (two) files.push_back({prefix + "-folds.csv", orbit_fold_curves_csv(curves, variables, built.units)});
         if (two) files.push_back({prefix + "-doublings.csv", orbit_fold_curves_csv(pd_curves, variables, built.units)});
+        if (two) files.push_back({prefix + "-tori.csv", orbit_fold_curves_csv(torus_curves, variables, built.units)});
         if (doubling) files.push_back({prefix + "-doubled.csv", orbit_branch_csv(doubled, variables, built.units)});
     }
-    if (!svg_file.empty()) {
+    if (!svg_file.empty() && two) {
+        // with --par2 the figure is the plane (par, par2) with the curves
+        std::ostringstream title;
+        title << "Bifurcation curves of periodic orbits in (" << par << ", " << fo.parameter2 << ")" << orbits_args.problem.ring_title();
+        files.push_back({svg_file, two_parameter_svg(nullptr, nullptr, par, fo.parameter2, std::min(o.from, o.to), std::max(o.from, o.to),
+                                                     std::min(fo.from2, fo.to2), std::max(fo.from2, fo.to2), built.unit(par), built.unit(fo.parameter2),
+                                                     title.str(), &bc)});
+    } else if (!svg_file.empty()) {
         const std::string punit = built.unit(par);
         const std::string vunit = built.unit(variables[static_cast<std::size_t>(variable)]);
         std::ostringstream title;
@@ -513,6 +525,28 @@ int run_orbits() {
                 out << "  " << pad(rounded(q.par, 8), 14) << pad(rounded(q.par2, 8), 14) << pad(rounded(q.orbit.period, 8), 14)
                     << pad(rounded(q.orbit.max[variable] - q.orbit.min[variable], 5), 12) << pad(rounded(q.test, 2), 10)
                     << (std::isfinite(q.second_distance) ? rounded(q.second_distance, 2) : std::string("-")) << "\n";
+            out << "  accuracy max |g| = " << rounded(c.max_test, 2) << ", max residual = " << rounded(c.max_residual, 2);
+            if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);
+            out << "\n";
+        }
+        for (std::size_t k = 0; k < torus_curves.size(); ++k) {
+            const OrbitFoldCurve& c = torus_curves[k];
+            const OrbitCrossing& d = b.tori[static_cast<std::size_t>(curve_torus[k])];
+            out << "torus curve " << k << " from the torus bifurcation at " << par << " = " << rounded(d.par, 10) << ": "
+                << counted(static_cast<long long>(c.points.size()), "point") << " in (" << par << ", " << c.parameter2 << "), ended: " << c.stop_backward
+                << " and " << c.stop_forward << "\n";
+            out << "  " << pad(par, 14) << pad(c.parameter2, 14) << pad("period", 14) << pad("amp " + v, 12) << pad("phi [rad]", 12) << pad("|g|", 10)
+                << "min|mu - e^(i phi)|\n";
+            for (const OrbitFoldCurvePoint& q : c.points)
+                out << "  " << pad(rounded(q.par, 8), 14) << pad(rounded(q.par2, 8), 14) << pad(rounded(q.orbit.period, 8), 14)
+                    << pad(rounded(q.orbit.max[variable] - q.orbit.min[variable], 5), 12) << pad(rounded(q.rotation, 6), 12) << pad(rounded(q.test, 2), 10)
+                    << (std::isfinite(q.second_distance) ? rounded(q.second_distance, 2) : std::string("-")) << "\n";
+            for (const auto& [end, stop] : {std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.front(), c.stop_backward},
+                                            std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.back(), c.stop_forward}})
+                if (stop == "hopf")
+                    out << "  ends at a double Hopf point (the orbits shrink onto an equilibrium with two pairs on the axis) near " << par << " = "
+                        << rounded(end->par, 6) << ", " << c.parameter2 << " = " << rounded(end->par2, 6) << " (amplitude "
+                        << rounded(end->orbit.max[variable] - end->orbit.min[variable], 3) << ")\n";
             out << "  accuracy max |g| = " << rounded(c.max_test, 2) << ", max residual = " << rounded(c.max_residual, 2);
             if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);
             out << "\n";

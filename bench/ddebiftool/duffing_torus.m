@@ -14,15 +14,8 @@
 %
 % Run: DDEBIFTOOL_DIR=/path/to/DDE-Biftool octave --no-gui --quiet duffing_torus.m
 % Prints one line "ddebiftool torus L <L> tau <tau> period <T> omega <rotation/pi> ..." per mesh.
-ddir = getenv('DDEBIFTOOL_DIR');
-if isempty(ddir)
-    disp('DDEBIFTOOL_DIR is not set: skipped');
-    exit(0);
-end
-addpath(fullfile(ddir, 'ddebiftool'), fullfile(ddir, 'ddebiftool_extra_psol'), ...
-        fullfile(ddir, 'ddebiftool_extra_nmfm'), fullfile(ddir, 'ddebiftool_utilities'), ...
-        fullfile(ddir, 'demos', 'minimal_demo'));
-warning('off', 'all');
+addpath(fileparts(mfilename('fullpath')));  % ddebiftool_paths.m, duffing_orbit_branch.m
+if ~ddebiftool_paths({fullfile('demos', 'minimal_demo')}), exit(0); end
 format long
 function [g, mu] = crossing_g(funcs, method, orbit)
     % |mu| - 1 of the complex multiplier (|Im mu| > 1e-6) nearest the unit circle
@@ -32,40 +25,12 @@ function [g, mu] = crossing_g(funcs, method, orbit)
     [~, k] = min(abs(abs(c) - 1));
     g = abs(c(k)) - 1;
 end
-indp = struct('tau', 1, 'a', 2, 'b', 3, 'd', 4);
-funcs = set_symfuncs(@sym_minimal_demo, 'sys_tau', @() indp.tau);
-par = [0, 0.5, 0.6, 0.05];
-br_args = {'max_bound', [indp.tau, 20], 'min_bound', [indp.tau, 0], 'max_step', [0, 2; indp.tau, 0.2]};
-[eqs, suc] = SetupStst(funcs, 'x', [0; 0], 'parameter', par, 'contpar', indp.tau, br_args{:}, 'minimal_real_part', -1);
-eqs.method.continuation.plot = 0;
-eqs = br_contn(funcs, eqs, 60);
-[eqs, ~, ind_hopf] = LocateSpecialPoints(funcs, eqs);
-hopf_taus = arrayfun(@(i) eqs.point(i).parameter(indp.tau), ind_hopf);
-[~, ih] = min(abs(hopf_taus - 7.3195));
-fprintf('Hopf point used: tau = %.10f\n', eqs.point(ind_hopf(ih)).parameter(indp.tau));
 meshes = [20, 30, 40, 60, 80];
 s = getenv('MESHES');
 if ~isempty(s), meshes = str2num(s); end
 for L = meshes
-    [per, suc] = SetupPsol(funcs, eqs, ind_hopf(ih), 'intervals', L, 'degree', 4, 'max_bound', [indp.tau, 20], ...
-                           'min_bound', [indp.tau, 0], 'max_step', [0, 0.1; indp.tau, 0.02], 'print_residual_info', 0);
-    if ~suc
-        fprintf('L = %d: the first orbit did not converge\n', L);
-        continue;
-    end
-    per.method.continuation.adapt_mesh_before_correct = 0;
-    per.method.continuation.adapt_mesh_after_correct = 0;
-    per.method.continuation.plot = 0;
-    per = br_contn(funcs, per, 40);
-    [nunst, ~, triv, per.point] = GetStability(per, 'exclude_trivial', true, 'funcs', funcs);
-    taus = arrayfun(@(p) p.parameter(indp.tau), per.point);
-    ich = find(diff(nunst(:)) ~= 0 & taus(2:end)' < 7.2, 1);
-    if isempty(ich)
-        fprintf('L = %d: no change of stability on %d orbits (tau %.4f..%.4f)\n', L, numel(taus), min(taus), max(taus));
-        continue;
-    end
-    fprintf('L = %d: unstable multipliers %d -> %d between tau = %.8f and %.8f\n', L, nunst(ich), nunst(ich + 1), ...
-            taus(ich), taus(ich + 1));
+    [funcs, per, indp, ich] = duffing_orbit_branch(L);
+    if isempty(ich), continue; end
     % locate |mu| = 1 of the complex pair that crosses by Illinois regula falsi in tau, every trial
     % orbit corrected at fixed tau (period free, DDE-BIFTOOL's phase condition) from the nearer
     % branch orbit and its multipliers computed by p_stabil

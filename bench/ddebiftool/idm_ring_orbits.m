@@ -12,14 +12,8 @@
 % Optional: ORBITS=<n> (default 100); DDEBIFTOOL_POINTS=<file.csv> writes every orbit (gap, period,
 % number of unstable nontrivial multipliers, |mu_trivial - 1|, the 6 largest nontrivial |mu|) for
 % the point-by-point stability comparison with `ddemap orbits` (not timed).
-ddir = getenv('DDEBIFTOOL_DIR');
-if isempty(ddir)
-    disp('DDEBIFTOOL_DIR is not set: skipped');
-    exit(0);
-end
-addpath(fullfile(ddir, 'ddebiftool'), fullfile(ddir, 'ddebiftool_extra_psol'), ...
-        fullfile(ddir, 'ddebiftool_extra_nmfm'), fullfile(ddir, 'ddebiftool_utilities'));
-warning('off', 'all');
+addpath(fileparts(mfilename('fullpath')));  % ddebiftool_paths.m
+if ~ddebiftool_paths(), exit(0); end
 npoints = 100;
 s = getenv('ORBITS');
 if ~isempty(s), npoints = str2double(s); end

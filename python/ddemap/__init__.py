@@ -1149,8 +1149,10 @@ def orbits(par, from_, to, system=None, model=None, ring=None, hopf=0, degree=4,
     file (t and one column per variable, the rows covering one period), a table in memory with
     those columns, or a pair (times, states) (``--guess``). Then ``start`` says how instead of
     ``hopf``. With ``par2``, ``from2``, ``to2`` (``--par2``): every fold of the branch continued
-    as a curve of folds and every period doubling as a curve of period doublings in
-    (par, par2), as ``fold_curves`` and ``period_doubling_curves``.
+    as a curve of folds, every period doubling as a curve of period doublings and every torus
+    bifurcation as a curve of tori in (par, par2), as ``fold_curves``, ``period_doubling_curves``
+    and ``torus_curves`` (their points with ``rotation``, the angle of the multipliers on the
+    unit circle).
     """
     sys_, model_, n, p = _nonlinear_problem(system, model, ring, parameters)
     step = None if max_step is None else _number("max_step", max_step)

@@ -1260,7 +1260,8 @@ std::string py_orbits(const std::string& system_file, const std::string& model, 
     }
     if (two)
         e.result = e.result.substr(0, e.result.size() - 1) + ",\"fold_curves\":" + orbit_fold_curves_json(bc.folds, pb.variables) +
-                   ",\"period_doubling_curves\":" + orbit_fold_curves_json(bc.period_doublings, pb.variables) + "}";
+                   ",\"period_doubling_curves\":" + orbit_fold_curves_json(bc.period_doublings, pb.variables) +
+                   ",\"torus_curves\":" + orbit_fold_curves_json(bc.tori, pb.variables) + "}";
     if (period_doubling) {
         const OrbitCrossing& pd = b.period_doublings[static_cast<std::size_t>(*period_doubling)];
         JsonObject from_j;

@@ -390,6 +390,14 @@ def test_orbits_par2():
     assert len(r["period_doubling_curves"]["points"]) == 1 and r["fold_curves"] == []  # (a list of curves comes back as columns)
     with pytest.raises(ValueError, match="par2 needs from2 and to2"):
         ddemap.orbits("tau", 0.3, 2, system=system, par2="n", from2=9)
+    assert r["torus_curves"] == []
+    # the curve of torus bifurcations of DDE-BIFTOOL's minimal demo in (tau, b)
+    duffing = os.path.join(SOURCE, "examples", "duffing.json")
+    t = ddemap.orbits("tau", 0, 20, system=duffing, hopf=1, points=12, intervals=30, par2="b", from2=0.3, to2=0.9)
+    same_envelope(t, cli_json("orbits", "--system", duffing, "--par", "tau", "--from", 0, "--to", 20, "--hopf", 1, "--points", 12,
+                              "--intervals", 30, "--par2", "b", "--from2", 0.3, "--to2", 0.9))
+    curve = t["torus_curves"]
+    assert curve["stop_backward"] == ["hopf"] and len(curve["points"][0]["par"]) > 10, curve["points"][0].keys()
 
 
 def test_equilibria_branch_point():

@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cstdio>
 #include <stdexcept>
+#include <limits>
 #include <string>
 #include <sstream>
 
@@ -154,6 +155,8 @@ std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, con
     if (curves.empty()) return "curve\n";
     std::string out = "curve," + named_column(curves.front().parameter, units) + "," + named_column(curves.front().parameter2, units) +
                       ",period_s,fold_test,second_distance";
+    const bool torus = std::isfinite(curves.front().points.empty() ? std::numeric_limits<double>::quiet_NaN() : curves.front().points.front().rotation);
+    if (torus) out += ",rotation_rad";
     for (const auto& v : variables) out += "," + named_column("min_" + v, units, v);
     for (const auto& v : variables) out += "," + named_column("max_" + v, units, v);
     out += "\n";
@@ -161,6 +164,7 @@ std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, con
         for (const OrbitFoldCurvePoint& q : curves[k].points) {
             out += std::to_string(k) + "," + format_exact(q.par) + "," + format_exact(q.par2) + "," + format_exact(q.orbit.period) + "," +
                    format_exact(q.test) + "," + (std::isfinite(q.second_distance) ? format_exact(q.second_distance) : std::string());
+            if (torus) out += "," + format_exact(q.rotation);
             for (Eigen::Index i = 0; i < q.orbit.min.size(); ++i) out += "," + format_exact(q.orbit.min[i]);
             for (Eigen::Index i = 0; i < q.orbit.max.size(); ++i) out += "," + format_exact(q.orbit.max[i]);
             out += "\n";

@@ -530,7 +530,7 @@ std::string bistability_svg(const BistabilityChart& chart, const std::string& un
 
 std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, const std::string& parameter, const std::string& parameter2,
                               double from, double to, double from2, double to2, const std::string& unit, const std::string& unit2,
-                              const std::string& title) {
+                              const std::string& title, const OrbitBranchCurves* orbit_curves) {
     PlotPanel panel;
     auto label = [](const std::string& name, const std::string& u) { return u.empty() ? name : name + " [" + unit_text(u) + "]"; };
     panel.x_label = label(parameter_symbol(parameter), unit);
@@ -552,6 +552,30 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
                 if (q.status == Status::Converged)
                     panel.markers.push_back({q.par, q.par2, "#000000", q.kind == "cusp" ? "CP" : q.kind == "bogdanov_takens" ? "BT" : "ZH"});
         }
+    bool gh = false, dh = false;
+    if (orbit_curves) {
+        struct Kind {
+            const std::vector<OrbitFoldCurve>* curves;
+            const char* name;
+            const char* colour;
+            const char* end;  // the marker where a curve ends on the orbits' shrinking (stop "hopf")
+        };
+        for (const Kind& k : {Kind{&orbit_curves->folds, "fold of periodic orbits", "#2ca02c", "GH"},
+                              Kind{&orbit_curves->period_doublings, "period doubling", "#9467bd", ""},
+                              Kind{&orbit_curves->tori, "torus bifurcation", "#8c564b", "DH"}})
+            for (const OrbitFoldCurve& c : *k.curves) {
+                PlotSeries sr{k.name, {}, {}, k.colour, false};
+                for (const OrbitFoldCurvePoint& q : c.points) {
+                    sr.x.push_back(q.par);
+                    sr.y.push_back(q.par2);
+                }
+                panel.series.push_back(std::move(sr));
+                if (c.points.empty() || !*k.end) continue;
+                if (c.stop_backward == "hopf") panel.markers.push_back({c.points.front().par, c.points.front().par2, "#000000", k.end});
+                if (c.stop_forward == "hopf") panel.markers.push_back({c.points.back().par, c.points.back().par2, "#000000", k.end});
+                if (c.stop_backward == "hopf" || c.stop_forward == "hopf") (std::string(k.end) == "GH" ? gh : dh) = true;
+            }
+    }
     PlotOptions po;
     po.title = title;
     po.columns = 1;
@@ -560,6 +584,8 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
     std::string note;
     if (hopf) note = "GH: generalised Hopf (L1 = 0), DH: double Hopf, ZH: zero-Hopf";
     if (folds) note += std::string(note.empty() ? "" : "; ") + "CP: cusp, BT: Bogdanov-Takens (a Hopf curve ends there)" + (hopf ? "" : ", ZH: zero-Hopf");
+    if (!hopf && (gh || dh))
+        note += std::string(note.empty() ? "" : "; ") + "curves of orbits end where the orbits shrink onto an equilibrium: GH generalised Hopf, DH double Hopf";
     po.note = note;
     return render_line_plots_svg({panel}, po);
 }

@@ -1377,6 +1377,32 @@ PY
 else
     bad "orbits --par2 (period doublings) exit status"
 fi
+# the curve of torus bifurcations (orbits --par2): DDE-BIFTOOL's minimal demo in (tau, b), from the
+# torus of the branch born at tau = 7.3195; it ends on the face b = 0.9 and where the orbits
+# shrink onto the double Hopf point that hopf --par2 locates (tau = 8.728742694, b = 0.3544448049)
+duff="$(dirname "$0")/../../examples/duffing.json"
+if "$bin" orbits --system "$duff" --par tau --from 0 --to 20 --hopf 1 --points 12 --intervals 30 --par2 b --from2 0.3 --to2 0.9 --format json \
+    --out "$orb/tor" --svg "$orb/tor.svg" --quiet >"$orb/tor.json"; then
+    # the figure with --par2: the plane (tau, b), the torus curve and its end at the double Hopf point marked
+    grep -q ">torus bifurcation<" "$orb/tor.svg" && grep -q ">DH<" "$orb/tor.svg" && ok || bad "orbits --par2 --svg: the torus curve in the plane"
+    python3 - "$orb/tor.json" "$orb/tor-tori.csv" <<'PY' && ok || bad "orbits --par2: the curve of torus bifurcations"
+import json, sys, csv, math
+d = json.load(open(sys.argv[1]))
+r = d["result"]
+assert d["status"] == "converged" and len(r["torus_curves"]) == 1 and len(r["tori"]) == 1
+c = r["torus_curves"][0]
+s = c["points"][c["start"]]
+assert abs(s["par"] - r["tori"][0]["par"]) < 1e-8 and s["par2"] == 0.6
+assert c["stop_backward"] == "hopf" and c["stop_forward"] == "bound"
+end = c["points"][0]
+assert abs(end["par"] - 8.728742694) < 1e-4 and abs(end["par2"] - 0.3544448049) < 1e-4, end
+assert all(q["second_distance"] < 1e-9 and q["fold_test"] < 1e-10 and 0 < q["rotation"] < math.pi for q in c["points"])
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert len(rows) == len(c["points"]) and float(rows[0]["rotation_rad"]) == c["points"][0]["rotation"], rows[0]
+PY
+else
+    bad "orbits --par2 (tori) exit status"
+fi
 # starts other than a Hopf point: the orbit a simulation settles on (--from-simulation), or one
 # given in a file (--guess), at --par = --from. Wright's equation: each is corrected to the orbit
 # that the branch from the Hopf point reaches on its face (alpha = 2 from a simulation, alpha = 1.7

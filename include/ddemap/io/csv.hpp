@@ -69,8 +69,9 @@ std::string fold_curves_csv(const FoldCurves& c, const std::string& parameter2, 
 /// with their units from `units`.
 std::string orbit_branch_csv(const OrbitBranch& b, const std::vector<std::string>& variables, const ColumnUnits& units = {});
 /// Curves of folds of periodic orbits: one row per point, curve (index), the two parameters (named),
-/// period_s, fold_test |g|, second_distance |mu_2 - 1| (empty without multipliers), min_ and max_
-/// of every variable; names with their units from `units`.
+/// period_s, fold_test |g|, second_distance |mu_2 - 1| (empty without multipliers), on torus
+/// curves rotation_rad (phi of the multipliers e^{+-i phi}), min_ and max_ of every variable; names
+/// with their units from `units`.
 std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables,
                                   const ColumnUnits& units = {});
 

@@ -57,9 +57,12 @@ std::string bistability_svg(const BistabilityChart& chart, const std::string& un
 /// Hopf curves (`hopf`, may be null; red, solid where supercritical, dashed where subcritical,
 /// grey where L1 is not decided) with their generalised Hopf (GH), double Hopf (DH) and
 /// zero-Hopf (ZH) points, and the fold curves of equilibria (`folds`, may be null; blue) with their
-/// cusp (CP) and Bogdanov-Takens (BT) points. Units in the axis labels when given.
+/// cusp (CP) and Bogdanov-Takens (BT) points, and the curves of periodic orbits' folds (green),
+/// period doublings (purple) and tori (brown) (`orbit_curves`, may be null) with the points where
+/// they end on the orbits' shrinking marked (GH: a fold curve at a generalised Hopf point, DH: a
+/// torus curve at a double Hopf point). Units in the axis labels when given.
 std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, const std::string& parameter, const std::string& parameter2,
                               double from, double to, double from2, double to2, const std::string& unit, const std::string& unit2,
-                              const std::string& title);
+                              const std::string& title, const OrbitBranchCurves* orbit_curves = nullptr);
 
 }  // namespace ddemap

@@ -154,8 +154,9 @@ std::string orbit_branch_json(const OrbitBranch& b, const std::vector<std::strin
 std::string simulation_start_json(const SimulatedOrbitGuess& g, double t_end, double step);
 /// Curves of folds of periodic orbits in two parameters (orbit_fold_curve), an array: per curve
 /// its parameters, points (par, par2, period, min, max of every variable, fold_test |g|,
-/// second_distance |mu_2 - 1|, trivial_distance, residual), how each end ended, status, message,
-/// method and certificate.
+/// second_distance |mu_2 - 1|, trivial_distance, residual; on torus curves also rotation, the
+/// angle phi of the multipliers e^{+-i phi}), how each end ended, status, message, method and
+/// certificate.
 std::string orbit_fold_curves_json(const std::vector<OrbitFoldCurve>& curves, const std::vector<std::string>& variables);
 
 /// A branch of travelling waves (analysis/travelling_wave.hpp): the keys of orbit_branch_json

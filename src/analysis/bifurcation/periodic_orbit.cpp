@@ -1,7 +1,9 @@
 #include "ddemap/analysis/bifurcation/periodic_orbit.hpp"
 
 #include <algorithm>
+#include <complex>
 #include <functional>
+#include <map>
 #include <memory>
 #include <cmath>
 #include <sstream>
@@ -1549,6 +1551,231 @@ FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::Mat
     return r;
 }
 
+using VectorXcd = Eigen::VectorXcd;
+using SpC = Eigen::SparseMatrix<std::complex<double>>;
+
+/// The torus condition. A multiplier mu = e^{i phi} of the orbit is one whose Floquet
+/// eigenfunction wraps as y(s + 1) = mu y(s): the collocated variational operator with that wrap,
+///     A_mu = sum_q mu^q A^(q),
+/// A^(q) the part of the Jacobian of the collocation equations (in the profile) whose values lie q
+/// periods after the collocation point's (q = 1: the end point of the last interval; q < 0: the
+/// delayed values, q >= -ceil(tau_max / T)). On the mesh traversed M = ceil(tau_max / T) + 2 times
+/// these parts are separate column blocks of the first copy's rows: copy 0 (q = 0), copy 1
+/// (q = 1), copy j >= 2 (q = j - M). The bordered [A_mu b; c^H 0] [v; g] = [0; 1] gives the
+/// complex g, zero exactly where mu is a multiplier; with w from the adjoint system
+/// g_z = -w^H A_mu,z v and g_phi = -w^H (sum_q i q mu^q A^(q)) v. A_mu,z v is the derivative of the
+/// M-fold Jacobian's first-copy rows along the M-fold direction V = (mu^q(j) v)_j, and by the
+/// symmetry of second derivatives w^H (d_e J) V = w^H (d_V J) E for the M-fold lift E of e: the
+/// central difference of J^T conj(w) along Re V and Im V, summed back over the copies.
+struct TorusCondition {
+    TorusCondition(const NonlinearDDE& s, const PeriodicOrbitOptions& a, const PeriodicOrbitOptions& b, int n) : sys(s), o1(a), o2(b), N(n) {}
+    const NonlinearDDE& sys;
+    PeriodicOrbitOptions o1, o2;
+    int N;
+    struct Copies {
+        std::unique_ptr<PeriodicMesh> mesh;
+        std::unique_ptr<FoldSystem> fs;
+    };
+    std::map<int, Copies> cache;
+    /// M for the point z = (X, T, p1, p2, phi); 0 when the delays are not defined there
+    int copies(const FoldSystem& fs, const Eigen::VectorXd& z) const {
+        std::vector<double> pv = fs.c1.base;
+        pv[static_cast<std::size_t>(fs.c1.j)] = z(N + 1);
+        pv[static_cast<std::size_t>(fs.c2.j)] = z(N + 2);
+        double tmax = 0.0;
+        try {
+            for (const double t : sys.delays(pv)) tmax = std::max(tmax, t);
+        } catch (const std::exception&) {
+            return 0;
+        }
+        if (!(z(N) > 0.0) || !std::isfinite(tmax)) return 0;
+        return static_cast<int>(std::ceil(tmax / z(N))) + 2;
+    }
+    FoldSystem* get(int M, const FoldSystem& one) {
+        Copies& c = cache[M];
+        if (!c.fs) {
+            c.mesh = std::make_unique<PeriodicMesh>(one.c1.d, M * one.c1.L);
+            c.fs = std::make_unique<FoldSystem>(make_setup(sys, *c.mesh, o1, M), make_setup(sys, *c.mesh, o2, M));
+            c.fs->N = M * N;
+            c.fs->w = Eigen::VectorXd::Ones(M * N + 3);
+        }
+        return c.fs.get();
+    }
+};
+
+/// (X, ..., X, M T, p1, p2): the orbit z traversed M times.
+Eigen::VectorXd repeated_point(const Eigen::VectorXd& z, int N, int M) {
+    Eigen::VectorXd zm(M * N + 3);
+    for (int j = 0; j < M; ++j) zm.segment(static_cast<Eigen::Index>(j) * N, N) = z.head(N);
+    zm(M * N) = M * z(N);
+    zm(M * N + 1) = z(N + 1);
+    zm(M * N + 2) = z(N + 2);
+    return zm;
+}
+
+/// mu^q of copy j of M (see TorusCondition), and its derivative in phi (mu = e^{i phi}).
+std::complex<double> copy_factor(int j, int M, std::complex<double> mu, bool d_phi = false) {
+    const int q = j == 0 ? 0 : (j == 1 ? 1 : j - M);
+    const std::complex<double> f = std::pow(mu, q);
+    return d_phi ? std::complex<double>(0.0, q) * f : f;
+}
+
+/// A_mu (or its phi derivative) from the M-fold Jacobian JM.
+SpC floquet_operator(const SpD& JM, int N, int M, std::complex<double> mu, bool d_phi) {
+    std::vector<Eigen::Triplet<std::complex<double>>> t;
+    t.reserve(static_cast<std::size_t>(JM.nonZeros()) / static_cast<std::size_t>(M) + 16);
+    for (int k = 0; k < M * N; ++k) {
+        const int j = k / N;
+        const std::complex<double> f = copy_factor(j, M, mu, d_phi);
+        if (f == 0.0) continue;
+        for (SpD::InnerIterator it(JM, k); it; ++it)
+            if (it.row() < N) t.emplace_back(static_cast<int>(it.row()), k - j * N, f * it.value());
+    }
+    SpC A(N, N);
+    A.setFromTriplets(t.begin(), t.end());
+    return A;
+}
+
+struct TorusTest {
+    VectorXcd v, w;
+    std::complex<double> g{std::numeric_limits<double>::quiet_NaN(), 0.0};
+};
+
+/// v, g from [A b; c^H 0] [v; g] = [0; 1] and w from the adjoint system.
+bool torus_test(const SpC& A, const VectorXcd& b, const VectorXcd& c, TorusTest& out) {
+    const int M = static_cast<int>(A.rows());
+    std::vector<Eigen::Triplet<std::complex<double>>> t;
+    t.reserve(static_cast<std::size_t>(A.nonZeros()) + 2 * static_cast<std::size_t>(M));
+    for (int k = 0; k < M; ++k)
+        for (SpC::InnerIterator it(A, k); it; ++it) t.emplace_back(static_cast<int>(it.row()), k, it.value());
+    for (int i = 0; i < M; ++i) {
+        if (b(i) != 0.0) t.emplace_back(i, M, b(i));
+        if (c(i) != 0.0) t.emplace_back(M, i, std::conj(c(i)));
+    }
+    SpC K(M + 1, M + 1);
+    K.setFromTriplets(t.begin(), t.end());
+    K.makeCompressed();
+    Eigen::SparseLU<SpC, Eigen::COLAMDOrdering<int>> lu;
+    lu.compute(K);
+    if (lu.info() != Eigen::Success) return false;
+    VectorXcd e = VectorXcd::Zero(M + 1);
+    e(M) = 1.0;
+    const VectorXcd x = lu.solve(e);
+    const VectorXcd y = lu.adjoint().solve(e);
+    if (!x.allFinite() || !y.allFinite()) return false;
+    out.v = x.head(M);
+    out.g = x(M);
+    out.w = y.head(M);
+    return true;
+}
+
+/// The torus test at y = (X, T, p1, p2, phi) and, with `grad`, its gradient (2 rows: Re g, Im g).
+bool torus_at(TorusCondition& tc, FoldSystem& fs, const Eigen::VectorXd& y, const VectorXcd& b, const VectorXcd& c, TorusTest& out,
+              Eigen::MatrixXd* grad) {
+    const int N = fs.N;
+    const int M = tc.copies(fs, y);
+    if (M < 2) return false;
+    FoldSystem& fm = *tc.get(M, fs);
+    const std::complex<double> mu = std::polar(1.0, y(N + 3));
+    const Eigen::MatrixXd ref = Eigen::MatrixXd::Zero(fm.c1.P, fm.c1.n);  // (its phase row is not used)
+    const Eigen::VectorXd Z = repeated_point(y, N, M);
+    Eigen::VectorXd F;
+    SpD JM;
+    if (!fold_assemble(fm, Z, ref, F, &JM) || !torus_test(floquet_operator(JM, N, M, mu, false), b, c, out)) return false;
+    if (!grad) return true;
+    // g_phi
+    const std::complex<double> gphi = -out.w.dot(floquet_operator(JM, N, M, mu, true) * out.v);  // dot: w^H (.)
+    // g_z by the central differences of J^T conj(w) along Re V and Im V
+    VectorXcd V = VectorXcd::Zero(M * N + 3);
+    for (int j = 0; j < M; ++j) V.segment(static_cast<Eigen::Index>(j) * N, N) = copy_factor(j, M, mu) * out.v;
+    Eigen::VectorXd Wr = Eigen::VectorXd::Zero(M * N + 1), Wi = Eigen::VectorXd::Zero(M * N + 1);
+    Wr.head(N) = out.w.real();
+    Wi.head(N) = -out.w.imag();  // conj(w)
+    const double vmax = V.cwiseAbs().maxCoeff();
+    if (!(vmax > 0.0)) return false;
+    const double eps = 1e-5 * std::max(1.0, y.head(N + 1).lpNorm<Eigen::Infinity>()) / vmax;
+    VectorXcd gz = VectorXcd::Zero(M * N + 3);
+    for (int part = 0; part < 2; ++part) {
+        const Eigen::VectorXd dir = part == 0 ? Eigen::VectorXd(V.real()) : Eigen::VectorXd(V.imag());
+        if (dir.isZero(0.0)) continue;
+        Eigen::VectorXd Fp, Fm;
+        SpD Jp, Jm;
+        if (!fold_assemble(fm, Z + eps * dir, ref, Fp, &Jp) || !fold_assemble(fm, Z - eps * dir, ref, Fm, &Jm)) return false;
+        const Eigen::VectorXd dr = (Jp.transpose() * Wr - Jm.transpose() * Wr) / (2.0 * eps);
+        const Eigen::VectorXd di = (Jp.transpose() * Wi - Jm.transpose() * Wi) / (2.0 * eps);
+        const std::complex<double> unit = part == 0 ? std::complex<double>(1.0, 0.0) : std::complex<double>(0.0, 1.0);
+        gz -= unit * (dr.cast<std::complex<double>>() + std::complex<double>(0.0, 1.0) * di.cast<std::complex<double>>());
+    }
+    VectorXcd g(N + 4);
+    g.head(N).setZero();
+    for (int j = 0; j < M; ++j) g.head(N) += gz.segment(static_cast<Eigen::Index>(j) * N, N);
+    g(N) = static_cast<double>(M) * gz(M * N);
+    g(N + 1) = gz(M * N + 1);
+    g(N + 2) = gz(M * N + 2);
+    g(N + 3) = gphi;
+    grad->resize(2, N + 4);
+    grad->row(0) = g.real().transpose();
+    grad->row(1) = g.imag().transpose();
+    return true;
+}
+
+/// Newton on [F; Re g; Im g; a . y - beta] = 0 in y = (X, T, p1, p2, phi) (the torus condition
+/// appended), as correct_fold.
+FoldCorrection correct_torus(FoldSystem& fs, TorusCondition& tc, Eigen::VectorXd& y, const Eigen::MatrixXd& ref, const VectorXcd& b,
+                             const VectorXcd& c, const Eigen::VectorXd& a, double beta, const PeriodicOrbitOptions& o, TorusTest& last) {
+    const int N = fs.N;
+    FoldCorrection r;
+    Eigen::SparseLU<SpD, Eigen::COLAMDOrdering<int>> lu;
+    bool factored = false;
+    double last_step = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd F;
+    SpD J;
+    Eigen::MatrixXd grad;
+    for (int it = 0; it <= o.max_iterations; ++it) {
+        TorusTest tt;
+        const bool want = !(it > 0 && last_step <= o.tolerance * std::max(1.0, y.lpNorm<Eigen::Infinity>()));
+        if (!fold_assemble(fs, y, ref, F, &J) || !torus_at(tc, fs, y, b, c, tt, want && it < o.max_iterations ? &grad : nullptr)) return r;
+        r.residual = F.lpNorm<Eigen::Infinity>();
+        r.test = std::abs(tt.g);
+        last = tt;
+        if (!want) {
+            r.ok = r.residual <= o.residual_tolerance && factored;
+            Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 4);
+            e(N + 3) = 1.0;
+            r.tangent = lu.solve(e);
+            if (!r.tangent.allFinite()) r.ok = false;
+            return r;
+        }
+        if (it == o.max_iterations) break;
+        std::vector<Triplet> t;
+        t.reserve(static_cast<std::size_t>(J.nonZeros()) + 3 * static_cast<std::size_t>(N + 4));
+        for (int k = 0; k < J.outerSize(); ++k)
+            for (SpD::InnerIterator q(J, k); q; ++q) t.emplace_back(static_cast<int>(q.row()), k, q.value());
+        for (int k = 0; k < N + 4; ++k) {
+            if (grad(0, k) != 0.0) t.emplace_back(N + 1, k, grad(0, k));
+            if (grad(1, k) != 0.0) t.emplace_back(N + 2, k, grad(1, k));
+            if (a(k) != 0.0) t.emplace_back(N + 3, k, a(k));
+        }
+        SpD E(N + 4, N + 4);
+        E.setFromTriplets(t.begin(), t.end());
+        E.makeCompressed();
+        lu.compute(E);
+        if (lu.info() != Eigen::Success) return r;
+        factored = true;
+        Eigen::VectorXd rhs(N + 4);
+        rhs.head(N + 1) = F;
+        rhs(N + 1) = tt.g.real();
+        rhs(N + 2) = tt.g.imag();
+        rhs(N + 3) = a.dot(y) - beta;
+        const Eigen::VectorXd dy = lu.solve(rhs);
+        if (!dy.allFinite()) return r;
+        y -= dy;
+        ++r.iterations;
+        last_step = dy.lpNorm<Eigen::Infinity>();
+    }
+    return r;
+}
+
 }  // namespace
 
 bool OrbitFoldCurveOptions::is_valid(std::string* why) const {
@@ -1563,13 +1790,17 @@ bool OrbitFoldCurveOptions::is_valid(std::string* why) const {
 
 namespace {
 
-/// The curve of folds (doubling false) or of period doublings (true) through the orbit `orbit`
-/// at p1 = par (orbit_fold_curve, orbit_period_doubling_curve).
-OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const PeriodicOrbit& orbit, double par, bool doubling,
-                                       const OrbitFoldCurveOptions& options) {
+enum class CurveKind { Fold, PeriodDoubling, Torus };
+
+/// The curve of folds, period doublings or tori through the orbit `orbit` at p1 = par
+/// (orbit_fold_curve, orbit_period_doubling_curve, orbit_torus_curve); `multiplier` the torus's
+/// e^{i phi} (Im > 0).
+OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const PeriodicOrbit& orbit, double par, CurveKind curve_kind,
+                                       const OrbitFoldCurveOptions& options, std::complex<double> multiplier = 1.0) {
     const SingleThreadedEigen single;
-    const std::string what = doubling ? "period doubling curve" : "fold curve";
-    const std::string kind = doubling ? "period doubling" : "fold";
+    const bool doubling = curve_kind == CurveKind::PeriodDoubling, torus = curve_kind == CurveKind::Torus;
+    const std::string what = doubling ? "period doubling curve" : (torus ? "torus curve" : "fold curve");
+    const std::string kind = doubling ? "period doubling" : (torus ? "torus bifurcation" : "fold");
     std::string why;
     if (!options.is_valid(&why)) throw std::invalid_argument(what + " options: " + why);
     const PeriodicOrbitOptions& o = options.orbit;
@@ -1604,29 +1835,45 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
         fd->w = Eigen::VectorXd::Ones(2 * N + 3);
     }
     const Eigen::MatrixXd ref2 = doubling ? Eigen::MatrixXd::Zero(mesh2.points(), system.dimension()) : Eigen::MatrixXd();
+    TorusCondition tc(system, o, o2, N);
+    // the unknowns: (X, T, p1, p2), and for a torus phi (weighted as (phi / pi)^2 in the norm)
+    const int K = N + 3 + (torus ? 1 : 0);
+    Eigen::VectorXd wk(K);
+    wk.head(N + 3) = fs.w;
+    if (torus) wk(N + 3) = 1.0 / (M_PI * M_PI);
+    auto knorm = [&](const Eigen::VectorXd& v) { return std::sqrt((wk.array() * v.array().square()).sum()); };
 
     OrbitFoldCurve curve;
     curve.parameter = o.parameter;
     curve.parameter2 = options.parameter2;
     curve.degree = o.degree;
     curve.intervals = o.intervals;
-    curve.method = doubling ? "the minimally augmented period doubling system (the test g of the bordered collocated variational operator "
+    curve.method = torus ? "the minimally augmented torus system (the complex test g of the bordered collocated variational operator with "
+                           "the Floquet wrap y(s + 1) = e^{i phi} y(s) appended, phi free) on " + method_text(mesh) +
+                               "; both parameters free, pseudo-arclength; sparse LU of the extended Jacobian"
+                   : doubling ? "the minimally augmented period doubling system (the test g of the bordered collocated variational operator "
                               "with the antiperiodic wrap appended) on " + method_text(mesh) + "; both parameters free, pseudo-arclength; "
                               "sparse LU of the extended Jacobian"
                             : "the minimally augmented fold system (the fold test g of the bordered Jacobian of the collocation and phase "
                               "conditions appended) on " + method_text(mesh) + "; both parameters free, pseudo-arclength; sparse LU of the extended Jacobian";
 
-    Eigen::VectorXd z(N + 3);
+    Eigen::VectorXd z(K);
     for (int i = 0; i < s1.P; ++i) z.segment(static_cast<Eigen::Index>(i) * s1.n, s1.n) = orbit.profile.row(i).transpose();
     z(N) = orbit.period;
     z(N + 1) = par;
     z(N + 2) = p20;
+    if (torus) z(N + 3) = std::arg(multiplier);
     // the bordering vectors: from fixed pseudo-random ones, two rounds of the bordered solves
     const int M = doubling ? N : N + 1;  // the size of the test's matrix
     Eigen::VectorXd bv(M), cv(M);
     for (int i = 0; i < M; ++i) {
         bv(i) = std::sin(1.0 + 0.7 * i);
         cv(i) = std::cos(0.3 + 1.3 * i);
+    }
+    VectorXcd bt(N), ct(N);  // the torus's (complex)
+    for (int i = 0; i < N; ++i) {
+        bt(i) = std::complex<double>(std::sin(1.0 + 0.7 * i), std::cos(2.0 + 0.4 * i));
+        ct(i) = std::complex<double>(std::cos(0.3 + 1.3 * i), std::sin(0.5 + 0.9 * i));
     }
     Eigen::MatrixXd ref = derivative_at_collocation(fs.c1, fs.orbit_part(z));
     auto failed = [&](const std::string& m) {
@@ -1640,6 +1887,13 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
         SpD J;
         FoldTest ft;
         bool ok = fold_assemble(fs, z, ref, F, &J);
+        if (ok && torus) {
+            TorusTest tt;
+            if (!torus_at(tc, fs, z, bt, ct, tt, nullptr)) return failed("the " + kind + "'s orbit gives no finite Jacobian");
+            ct = tt.v / tt.v.norm();
+            bt = tt.w / tt.w.norm();
+            continue;
+        }
         if (ok && doubling) {
             SpD J2;
             Eigen::VectorXd F2;
@@ -1651,13 +1905,20 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
         cv = ft.v / ft.v.norm();
         bv = ft.w / ft.w.norm();
     }
-    Eigen::VectorXd e2 = Eigen::VectorXd::Zero(N + 3);
+    // one corrector for the three kinds; a torus's borders (complex) are renewed from its last test
+    auto correct = [&](Eigen::VectorXd& y, const Eigen::MatrixXd& rf, const Eigen::VectorXd& b, const Eigen::VectorXd& c, const VectorXcd& tb,
+                       const VectorXcd& tcv, const Eigen::VectorXd& a, double beta, TorusTest& tt) {
+        if (torus) return correct_torus(fs, tc, y, rf, tb, tcv, a, beta, o, tt);
+        return correct_fold(fs, y, rf, b, c, a, beta, o, fd.get());
+    };
+    Eigen::VectorXd e2 = Eigen::VectorXd::Zero(K);
     e2(N + 2) = 1.0;
-    FoldCorrection r0 = correct_fold(fs, z, ref, bv, cv, e2, p20, o, fd.get());
+    TorusTest tt0;
+    FoldCorrection r0 = correct(z, ref, bv, cv, bt, ct, e2, p20, tt0);
     curve.newton_iterations += r0.iterations;
     if (!r0.ok)
         return failed("the " + kind + " did not converge as a point of the " + kind + " system at " + options.parameter2 + " = " + detail::format_number(p20));
-    Eigen::VectorXd t0 = r0.tangent / fs.norm(r0.tangent);
+    Eigen::VectorXd t0 = r0.tangent / knorm(r0.tangent);
 
     auto make_point = [&](const Eigen::VectorXd& zz, const FoldCorrection& r) {
         OrbitFoldCurvePoint q;
@@ -1669,7 +1930,13 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
         q.par = zz(N + 1);
         q.par2 = zz(N + 2);
         q.test = r.test;
-        if (doubling && !q.orbit.multipliers.empty()) {
+        if (torus) {
+            q.rotation = zz(N + 3);
+            if (!q.orbit.multipliers.empty()) {
+                q.second_distance = std::numeric_limits<double>::infinity();
+                for (cplx m : q.orbit.multipliers) q.second_distance = std::min(q.second_distance, std::abs(m - std::polar(1.0, q.rotation)));
+            }
+        } else if (doubling && !q.orbit.multipliers.empty()) {
             q.second_distance = std::numeric_limits<double>::infinity();
             for (cplx m : q.orbit.multipliers) q.second_distance = std::min(q.second_distance, std::abs(m + 1.0));
         } else if (q.orbit.multipliers.size() >= 2) {
@@ -1690,6 +1957,7 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
     auto follow_fold = [&](double sign, std::string& stop) {
         std::vector<OrbitFoldCurvePoint> out;
         Eigen::VectorXd u = z, t = sign * t0, b = bv, c = cv;
+        VectorXcd tb = bt, tcv = ct;
         StepControl step(orbit_continuation::step_control_options(o));
         double amp_max = amplitude(first.orbit);
         stop = "max_points";
@@ -1697,10 +1965,11 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
             const double h = step.h();
             const Eigen::MatrixXd rf = derivative_at_collocation(fs.c1, fs.orbit_part(u));
             Eigen::VectorXd v = u + h * t;
-            const Eigen::VectorXd a = fs.w.cwiseProduct(t);
-            FoldCorrection r = correct_fold(fs, v, rf, b, c, a, a.dot(u + h * t), o, fd.get());
+            const Eigen::VectorXd a = wk.cwiseProduct(t);
+            TorusTest tt;
+            FoldCorrection r = correct(v, rf, b, c, tb, tcv, a, a.dot(u + h * t), tt);
             curve.newton_iterations += r.iterations;
-            const bool jump = r.ok && step.jumped(fs.norm(v - u));
+            const bool jump = r.ok && step.jumped(knorm(v - u));
             if (!r.ok || jump) {
                 if (!step.reject()) {
                     stop = "step_below_minimum";
@@ -1714,12 +1983,12 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
                 }
                 continue;
             }
-            Eigen::VectorXd tn = r.tangent / fs.norm(r.tangent);
-            if (tn.dot(fs.w.cwiseProduct(t)) < 0.0) tn = -tn;
+            Eigen::VectorXd tn = r.tangent / knorm(r.tangent);
+            if (tn.dot(wk.cwiseProduct(t)) < 0.0) tn = -tn;
             const double p1 = v(N + 1), p2 = v(N + 2);
             if (p1 < lo1 || p1 > hi1 || p2 < lo2 || p2 > hi2) {
                 // the point on the face it crossed (the first parameter's, else the second's)
-                Eigen::VectorXd e = Eigen::VectorXd::Zero(N + 3);
+                Eigen::VectorXd e = Eigen::VectorXd::Zero(K);
                 double bound = 0.0;
                 if (p1 < lo1 || p1 > hi1) {
                     e(N + 1) = 1.0;
@@ -1729,7 +1998,8 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
                     bound = p2 < lo2 ? lo2 : hi2;
                 }
                 Eigen::VectorXd wz = v;
-                const FoldCorrection rb = correct_fold(fs, wz, rf, b, c, e, bound, o, fd.get());
+                TorusTest tb2;
+                const FoldCorrection rb = correct(wz, rf, b, c, tb, tcv, e, bound, tb2);
                 curve.newton_iterations += rb.iterations;
                 if (rb.ok) out.push_back(make_point(wz, rb));
                 else if (curve.status == Status::Converged) {
@@ -1754,6 +2024,9 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
                 return out;
             }
             amp_max = std::max(amp_max, amp);
+            // a torus curve ends where its multipliers e^{+-i phi} meet at 1 or -1 (a 1:1 or 1:2
+            // resonance, on a fold or period doubling curve): the pair turns real there
+            const bool resonant = torus && std::abs(std::sin(v(N + 3))) < 1e-2;
             out.push_back(std::move(next));
             if (o.progress) o.progress(++done, total, out.back().par);
             if (amp < 0.02 * amp_max) {
@@ -1764,10 +2037,19 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
                 stop = "period";
                 return out;
             }
+            if (resonant) {
+                stop = "resonance";
+                return out;
+            }
             u = v;
             t = tn;
-            c = r.fold.v / r.fold.v.norm();
-            b = r.fold.w / r.fold.w.norm();
+            if (torus) {
+                tcv = tt.v / tt.v.norm();
+                tb = tt.w / tt.w.norm();
+            } else {
+                c = r.fold.v / r.fold.v.norm();
+                b = r.fold.w / r.fold.w.norm();
+            }
             step.accept(r.iterations <= 3);
         }
         return out;
@@ -1784,7 +2066,7 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
         if (std::isfinite(q.orbit.trivial_distance)) curve.max_trivial_distance = std::max(curve.max_trivial_distance, q.orbit.trivial_distance);
     }
     if (curve.message.empty())
-        curve.message = std::to_string(curve.points.size()) + (doubling ? " period doublings" : " folds of orbits") + ", ended: " + curve.stop_backward +
+        curve.message = std::to_string(curve.points.size()) + (doubling ? " period doublings" : (torus ? " torus bifurcations" : " folds of orbits")) + ", ended: " + curve.stop_backward +
                         " and " + curve.stop_forward;
     return curve;
 }
@@ -1792,7 +2074,7 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
 }  // namespace
 
 OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fold, const OrbitFoldCurveOptions& options) {
-    return orbit_bifurcation_curve(system, fold.orbit, fold.par, false, options);
+    return orbit_bifurcation_curve(system, fold.orbit, fold.par, CurveKind::Fold, options);
 }
 
 OrbitBranchCurves orbit_curves_of_branch(const NonlinearDDE& system, const OrbitBranch& branch, const OrbitFoldCurveOptions& options) {
@@ -1828,13 +2110,29 @@ OrbitBranchCurves orbit_curves_of_branch(const NonlinearDDE& system, const Orbit
         r.period_doubling_index.push_back(static_cast<int>(k));
         note(r.period_doublings.back(), "period doubling", d.par);
     }
+    for (std::size_t k = 0; k < branch.tori.size(); ++k) {
+        const OrbitCrossing& d = branch.tori[k];
+        if (!d.located || on_curve(r.tori, d.par)) continue;
+        r.tori.push_back(orbit_torus_curve(system, d, options));
+        r.torus_index.push_back(static_cast<int>(k));
+        note(r.tori.back(), "torus", d.par);
+    }
     return r;
 }
 
 OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const OrbitCrossing& pd, const OrbitFoldCurveOptions& options) {
     if (!pd.located || pd.orbit.profile.size() == 0)
         throw std::invalid_argument("period doubling curve: expected a located period doubling with its orbit");
-    return orbit_bifurcation_curve(system, pd.orbit, pd.par, true, options);
+    return orbit_bifurcation_curve(system, pd.orbit, pd.par, CurveKind::PeriodDoubling, options);
+}
+
+OrbitFoldCurve orbit_torus_curve(const NonlinearDDE& system, const OrbitCrossing& torus, const OrbitFoldCurveOptions& options) {
+    if (!torus.located || torus.orbit.profile.size() == 0) throw std::invalid_argument("torus curve: expected a located torus bifurcation with its orbit");
+    const std::complex<double> mu = torus.multiplier.imag() < 0.0 ? std::conj(torus.multiplier) : torus.multiplier;
+    if (!(std::abs(std::sin(std::arg(mu))) >= 1e-2))
+        throw std::invalid_argument("torus curve: the multiplier " + detail::format_number(mu.real()) + " + " + detail::format_number(mu.imag()) +
+                                    " i is (nearly) real: expected a complex pair on the unit circle");
+    return orbit_bifurcation_curve(system, torus.orbit, torus.par, CurveKind::Torus, options, mu);
 }
 
 }  // namespace ddemap

@@ -130,3 +130,78 @@ TEST_CASE("Duffing oscillator: the torus point converges as the mesh is refined,
     // error of both at 40 intervals is below 1e-9)
     CHECK(std::abs(taus[2] - ddebiftool_l40.tau) <= tol::torus_vs_ddebiftool);
 }
+
+TEST_CASE("torus curve in (tau, b) of DDE-BIFTOOL's minimal demo: Floquet multipliers on it, its end at the double Hopf point, and a one-parameter branch's torus on it" *
+          doctest::test_suite("slow")) {
+    const ExpressionSystem sys = duffing();
+    const OrbitBranch b = duffing_orbits(sys, 30);
+    REQUIRE(b.tori.size() == 1);
+    OrbitFoldCurveOptions fo;
+    fo.orbit.parameter = "tau";
+    fo.orbit.from = 0.0;
+    fo.orbit.to = 20.0;
+    fo.orbit.degree = 4;
+    fo.orbit.intervals = 30;
+    fo.orbit.max_points = 30;
+    fo.parameter2 = "b";
+    fo.from2 = 0.3;
+    fo.to2 = 0.9;
+    const OrbitFoldCurve c = orbit_torus_curve(sys, b.tori.front(), fo);
+    INFO(c.message);
+    REQUIRE(c.status == Status::Converged);
+    REQUIRE(c.points.size() > 10);
+    CHECK(c.stop_backward == "hopf");
+    CHECK(c.stop_forward == "bound");
+    // 1. every point: the orbit's Floquet multipliers (the monodromy matrix's eigenvalues, not the
+    // bordered test) have e^{i phi} on the unit circle
+    for (const OrbitFoldCurvePoint& q : c.points) {
+        CHECK(q.test < 1e-10);
+        CHECK(q.second_distance < 1e-9);
+        CHECK(q.rotation > 0.0);
+        CHECK(q.rotation < M_PI);
+    }
+    // 2. it ends where the orbits shrink onto the double Hopf point of the trivial equilibrium
+    // (the Hopf curves of hopf_curves cross at tau = 8.728742694, b = 0.3544448049 with omega
+    // 0.70836009 and 1.0975498): the orbits there have period 2 pi / 1.0975498 and the other pair's
+    // multiplier e^{i 2 pi 0.70836009 / 1.0975498}
+    const OrbitFoldCurvePoint& end = c.points.front();
+    const double w_orbit = 1.0975498, w_other = 0.70836009;
+    CHECK(std::abs(end.par - 8.728742694) < 1e-4);
+    CHECK(std::abs(end.par2 - 0.3544448049) < 1e-4);
+    CHECK(std::abs(end.orbit.period - 2.0 * M_PI / w_orbit) < 1e-3);
+    CHECK(std::abs(end.rotation - std::abs(std::remainder(2.0 * M_PI * w_other / w_orbit, 2.0 * M_PI))) < 1e-3);
+    // 3. a second path: at the b of a point of the curve, the branch in tau alone has its torus
+    // bifurcation at that point's tau (the same mesh)
+    auto torus_in_tau = [&](double bval, double near) {
+        ExpressionSystem sys2 = duffing();
+        sys2.set_parameter("b", bval);
+        EquilibriumBranchOptions eo;
+        eo.parameter = "tau";
+        eo.from = 0.0;
+        eo.to = 20.0;
+        const EquilibriumBranch eq = equilibrium_branch(sys2, Eigen::VectorXd::Zero(2), eo);
+        const HopfPoint* start = nullptr;
+        for (const HopfPoint& h : eq.hopf)  // the second of the pair omega ~ 1.25, as at b = 0.6
+            if (h.omega > 1.0 && (!start || std::abs(h.par - near) < std::abs(start->par - near))) start = &h;
+        REQUIRE(start != nullptr);
+        PeriodicOrbitOptions o = fo.orbit;
+        o.max_points = 40;
+        const OrbitBranch b2 = orbit_branch_from_hopf(sys2, *start, o);
+        REQUIRE(!b2.tori.empty());
+        REQUIRE(b2.tori.front().located);
+        return b2.tori.front();
+    };
+    const OrbitFoldCurvePoint* q = nullptr;
+    for (const OrbitFoldCurvePoint& p : c.points)
+        if (!q || std::abs(p.par2 - 0.52) < std::abs(q->par2 - 0.52)) q = &p;
+    const OrbitCrossing t2 = torus_in_tau(q->par2, q->par);
+    MESSAGE("curve point tau = " << q->par << " at b = " << q->par2 << "; the branch in tau: torus at " << t2.par << " (difference "
+                                    << t2.par - q->par << ")");
+    CHECK(std::abs(t2.par - q->par) < 1e-8);
+    CHECK(std::abs(std::arg(t2.multiplier) - q->rotation) < 1e-7);
+    // 4. DDE-BIFTOOL's torus curve (SetupTorusBifurcation from the same torus, the same mesh:
+    // bench/ddebiftool/duffing_torus_curve.m) passes (b, tau) = (0.526247199475, 7.448995471658)
+    // and (0.856384049708, 6.046997638618); ddemap's torus points at those b (3.4e-9 and 9.9e-10)
+    CHECK(std::abs(torus_in_tau(0.526247199475, 7.45).par - 7.448995471658) < 1e-8);
+    CHECK(std::abs(torus_in_tau(0.856384049708, 6.05).par - 6.046997638618) < 1e-8);
+}

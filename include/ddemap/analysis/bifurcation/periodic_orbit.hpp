@@ -287,6 +287,10 @@ struct OrbitFoldCurvePoint {
     /// without multipliers). The collocation splits the double multiplier like the square root
     /// of its error, so it is of the order of sqrt(trivial_distance)
     double second_distance = std::numeric_limits<double>::quiet_NaN();
+    /// a torus curve's point: phi of its multipliers e^{+-i phi} on the unit circle, in (0, pi)
+    /// (NaN on fold and period doubling curves); second_distance is then min |mu - e^{i phi}| over
+    /// the orbit's Floquet multipliers
+    double rotation = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A curve of folds of periodic orbits in (parameter, parameter2), ordered along the curve.
@@ -298,8 +302,9 @@ struct OrbitFoldCurve {
     /// why each end ended: "bound" (a face of the box), "max_points", "period" (above
     /// max_period_factor times the start's: towards a homoclinic orbit), "hopf" (the amplitude fell
     /// below 2 % of the largest on the curve, or the curve turned back in (p1, p2) below a quarter of
-    /// it: at a generalised Hopf point, where the curve
-    /// meets the Hopf curve), "step_below_minimum"; first the end before `start`, then the end after
+    /// it: at a generalised Hopf point, where a fold curve meets the Hopf curve; a torus curve ends
+    /// so at a double Hopf point), "resonance" (a torus curve's phi within 0.01 of 0 or pi),
+    /// "step_below_minimum"; first the end before `start`, then the end after
     std::string stop_backward, stop_forward;
     Status status = Status::Converged;
     std::string message;
@@ -346,16 +351,35 @@ OrbitFoldCurve orbit_fold_curve(const NonlinearDDE& system, const OrbitFold& fol
 /// and for a period doubling that is not located.
 OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const OrbitCrossing& pd, const OrbitFoldCurveOptions& options);
 
+/// The curve of torus (Neimark-Sacker) bifurcations through the located torus bifurcation `torus`
+/// of a branch (its orbit on the uniform mesh of the options), in (parameter, parameter2): the
+/// same continuation with the torus condition appended and the angle phi of the multipliers
+/// e^{+-i phi} as one more unknown. With A_mu the collocated variational operator with the
+/// Floquet wrap y(s + 1) = mu y(s), mu = e^{i phi} (the profile Jacobian's parts that reach q
+/// periods away weighted by mu^q; they are read off the collocation on the mesh traversed
+/// ceil(tau_max / T) + 2 times),
+///     [A_mu b; c^H 0] [v; g] = [0; 1]
+/// defines the complex g, zero exactly where mu is a multiplier; Re g = Im g = 0 are the two
+/// appended equations; g_z = -w^H A_mu,z v by central differences as for the period doubling,
+/// g_phi exactly. A curve also ends ("resonance") where phi comes within 0.01 of 0 or pi (the
+/// pair meets at 1 or -1: a fold or period doubling curve). In the points, `test` is |g|,
+/// `rotation` phi and `second_distance` the independent check min |mu - e^{i phi}| over the
+/// orbit's Floquet multipliers. std::invalid_argument as orbit_fold_curve, and for a torus
+/// bifurcation that is not located or whose multiplier is (nearly) real.
+OrbitFoldCurve orbit_torus_curve(const NonlinearDDE& system, const OrbitCrossing& torus, const OrbitFoldCurveOptions& options);
+
 /// The curves in two parameters through a branch's special points (orbit_curves_of_branch).
 struct OrbitBranchCurves {
-    std::vector<OrbitFoldCurve> folds, period_doublings;
-    std::vector<int> fold_index, period_doubling_index;  ///< the fold (period doubling) of the branch each curve starts from
+    std::vector<OrbitFoldCurve> folds, period_doublings, tori;
+    /// the fold (period doubling, torus bifurcation) of the branch each curve starts from
+    std::vector<int> fold_index, period_doubling_index, torus_index;
     Status status = Status::Converged;  ///< of the first curve that did not converge, with its message
     std::string message;
 };
 
-/// Every located fold of `branch` continued as a curve of folds (orbit_fold_curve) and every
-/// located period doubling as a curve of period doublings (orbit_period_doubling_curve), in
+/// Every located fold of `branch` continued as a curve of folds (orbit_fold_curve), every
+/// located period doubling as a curve of period doublings (orbit_period_doubling_curve) and every
+/// located torus bifurcation as a curve of tori (orbit_torus_curve), in
 /// (options.orbit.parameter, options.parameter2); a point that lies on a curve of its kind already
 /// traced (a segment of it crosses the held parameter2 within 1e-6 of the first parameter's range
 /// from the point) starts none. options.orbit.progress reports every curve's points.
