@@ -505,6 +505,7 @@ int run_orbits() {
                 out << "  " << pad(rounded(q.par, 8), 14) << pad(rounded(q.par2, 8), 14) << pad(rounded(q.orbit.period, 8), 14)
                     << pad(rounded(q.orbit.max[variable] - q.orbit.min[variable], 5), 12) << pad(rounded(q.test, 2), 10)
                     << (std::isfinite(q.second_distance) ? rounded(q.second_distance, 2) : std::string("-")) << "\n";
+            if (!c.points.empty())  // (a curve whose first point failed has none)
             for (const auto& [end, stop] : {std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.front(), c.stop_backward},
                                             std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.back(), c.stop_forward}})
                 if (stop == "hopf")
@@ -541,11 +542,13 @@ int run_orbits() {
                 out << "  " << pad(rounded(q.par, 8), 14) << pad(rounded(q.par2, 8), 14) << pad(rounded(q.orbit.period, 8), 14)
                     << pad(rounded(q.orbit.max[variable] - q.orbit.min[variable], 5), 12) << pad(rounded(q.rotation, 6), 12) << pad(rounded(q.test, 2), 10)
                     << (std::isfinite(q.second_distance) ? rounded(q.second_distance, 2) : std::string("-")) << "\n";
+            if (!c.points.empty())
             for (const auto& [end, stop] : {std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.front(), c.stop_backward},
                                             std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.back(), c.stop_forward}})
                 if (stop == "hopf")
-                    out << "  ends at a double Hopf point (the orbits shrink onto an equilibrium with two pairs on the axis) near " << par << " = "
-                        << rounded(end->par, 6) << ", " << c.parameter2 << " = " << rounded(end->par2, 6) << " (amplitude "
+                    out << "  ends at " << (orbit_curve_end_point(*end) == "ZH" ? "a zero-Hopf point (phi -> 0: the orbits shrink onto an equilibrium with a pair and a real root on the axis)"
+                                                                                 : "a double Hopf point (the orbits shrink onto an equilibrium with two pairs on the axis)")
+                        << " near " << par << " = " << rounded(end->par, 6) << ", " << c.parameter2 << " = " << rounded(end->par2, 6) << " (amplitude "
                         << rounded(end->orbit.max[variable] - end->orbit.min[variable], 3) << ")\n";
             out << "  accuracy max |g| = " << rounded(c.max_test, 2) << ", max residual = " << rounded(c.max_residual, 2);
             if (c.max_trivial_distance > 0.0) out << ", max |mu_trivial - 1| = " << rounded(c.max_trivial_distance, 2);

@@ -155,7 +155,9 @@ std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, con
     if (curves.empty()) return "curve\n";
     std::string out = "curve," + named_column(curves.front().parameter, units) + "," + named_column(curves.front().parameter2, units) +
                       ",period_s,fold_test,second_distance";
-    const bool torus = std::isfinite(curves.front().points.empty() ? std::numeric_limits<double>::quiet_NaN() : curves.front().points.front().rotation);
+    bool torus = false;  // torus curves (any point with a rotation)
+    for (const OrbitFoldCurve& c : curves)
+        for (const OrbitFoldCurvePoint& q : c.points) torus = torus || std::isfinite(q.rotation);
     if (torus) out += ",rotation_rad";
     for (const auto& v : variables) out += "," + named_column("min_" + v, units, v);
     for (const auto& v : variables) out += "," + named_column("max_" + v, units, v);
@@ -164,7 +166,7 @@ std::string orbit_fold_curves_csv(const std::vector<OrbitFoldCurve>& curves, con
         for (const OrbitFoldCurvePoint& q : curves[k].points) {
             out += std::to_string(k) + "," + format_exact(q.par) + "," + format_exact(q.par2) + "," + format_exact(q.orbit.period) + "," +
                    format_exact(q.test) + "," + (std::isfinite(q.second_distance) ? format_exact(q.second_distance) : std::string());
-            if (torus) out += "," + format_exact(q.rotation);
+            if (torus) out += "," + (std::isfinite(q.rotation) ? format_exact(q.rotation) : std::string());
             for (Eigen::Index i = 0; i < q.orbit.min.size(); ++i) out += "," + format_exact(q.orbit.min[i]);
             for (Eigen::Index i = 0; i < q.orbit.max.size(); ++i) out += "," + format_exact(q.orbit.max[i]);
             out += "\n";

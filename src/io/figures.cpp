@@ -552,7 +552,7 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
                 if (q.status == Status::Converged)
                     panel.markers.push_back({q.par, q.par2, "#000000", q.kind == "cusp" ? "CP" : q.kind == "bogdanov_takens" ? "BT" : "ZH"});
         }
-    bool gh = false, dh = false;
+    bool gh = false, dh = false, zh = false;
     if (orbit_curves) {
         struct Kind {
             const std::vector<OrbitFoldCurve>* curves;
@@ -571,9 +571,13 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
                 }
                 panel.series.push_back(std::move(sr));
                 if (c.points.empty() || !*k.end) continue;
-                if (c.stop_backward == "hopf") panel.markers.push_back({c.points.front().par, c.points.front().par2, "#000000", k.end});
-                if (c.stop_forward == "hopf") panel.markers.push_back({c.points.back().par, c.points.back().par2, "#000000", k.end});
-                if (c.stop_backward == "hopf" || c.stop_forward == "hopf") (std::string(k.end) == "GH" ? gh : dh) = true;
+                for (const auto& [end, stop] : {std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.front(), c.stop_backward},
+                                                std::pair<const OrbitFoldCurvePoint*, std::string>{&c.points.back(), c.stop_forward}}) {
+                    if (stop != "hopf") continue;
+                    const std::string label = std::string(k.end) == "GH" ? "GH" : orbit_curve_end_point(*end);
+                    panel.markers.push_back({end->par, end->par2, "#000000", label});
+                    (label == "GH" ? gh : label == "DH" ? dh : zh) = true;
+                }
             }
     }
     PlotOptions po;
@@ -584,8 +588,12 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
     std::string note;
     if (hopf) note = "GH: generalised Hopf (L1 = 0), DH: double Hopf, ZH: zero-Hopf";
     if (folds) note += std::string(note.empty() ? "" : "; ") + "CP: cusp, BT: Bogdanov-Takens (a Hopf curve ends there)" + (hopf ? "" : ", ZH: zero-Hopf");
-    if (!hopf && (gh || dh))
-        note += std::string(note.empty() ? "" : "; ") + "curves of orbits end where the orbits shrink onto an equilibrium: GH generalised Hopf, DH double Hopf";
+    if (!hopf && (gh || dh || zh)) {
+        std::string ends;
+        for (const auto& [shown, text] : {std::pair<bool, const char*>{gh, "GH generalised Hopf"}, {dh, "DH double Hopf"}, {zh, "ZH zero-Hopf"}})
+            if (shown) ends += std::string(ends.empty() ? "" : ", ") + text;
+        note += std::string(note.empty() ? "" : "; ") + "curves of orbits end where the orbits shrink onto an equilibrium: " + ends;
+    }
     po.note = note;
     return render_line_plots_svg({panel}, po);
 }

@@ -625,8 +625,8 @@ std::string orbit_fold_curves_json(const std::vector<OrbitFoldCurve>& curves, co
             points.push_back({{"par", num(q.par)}, {"par2", num(q.par2)}, {"period", num(q.orbit.period)}, {"min", vec(q.orbit.min)},
                               {"max", vec(q.orbit.max)}, {"fold_test", num(q.test)}, {"second_distance", num(q.second_distance)},
                               {"trivial_distance", num(q.orbit.trivial_distance)}, {"residual", num(q.orbit.residual)}});
-        if (!c.points.empty() && std::isfinite(c.points.front().rotation))
-            for (std::size_t i = 0; i < c.points.size(); ++i) points[i]["rotation"] = num(c.points[i].rotation);
+        for (std::size_t i = 0; i < c.points.size(); ++i)
+            if (std::isfinite(c.points[i].rotation)) points[i]["rotation"] = num(c.points[i].rotation);
         j["points"] = points;
         j["stop_backward"] = c.stop_backward;
         j["stop_forward"] = c.stop_forward;

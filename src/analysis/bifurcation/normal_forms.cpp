@@ -386,6 +386,18 @@ DoubleHopfNormalForm double_hopf_normal_form(const NonlinearDDE& system, const E
                                     ": expected two different values > 0");
     CentreForms f(system, x, p, 3);
     DoubleHopfNormalForm r;
+    // the strong resonances 1:2 and 1:3 (omega2 = k omega1 or omega1 = k omega2) have another
+    // normal form (resonant terms at second and third order); near them these coefficients grow
+    std::string near;
+    for (const int k : {2, 3}) {
+        const double off = std::min(std::abs(omega2 - k * omega1), std::abs(omega1 - k * omega2)) / std::max(omega1, omega2);
+        if (off <= 1e-6) {
+            r.message = "a 1:" + std::to_string(k) + " resonance (one frequency " + std::to_string(k) +
+                        " times the other): the normal form of a non-resonant double Hopf point does not apply";
+            return r;
+        }
+        if (off <= 1e-2) near = " (near a 1:" + std::to_string(k) + " resonance: the coefficients may be large)";
+    }
     const cplx l1(0.0, omega1), l2(0.0, omega2);
     VectorXc q1, p1, q2, p2;
     if (!f.pair(l1, q1, p1, r.hopf1_residual) || !f.pair(l2, q2, p2, r.hopf2_residual)) {
@@ -416,9 +428,10 @@ DoubleHopfNormalForm double_hopf_normal_form(const NonlinearDDE& system, const E
     if (r.g0021.real() != 0.0) r.theta = r.g1011.real() / r.g0021.real();
     if (r.g2100.real() != 0.0) r.delta = r.g1110.real() / r.g2100.real();
     r.status = Status::Converged;
-    r.message = std::isfinite(r.theta) && std::isfinite(r.delta)
-                    ? "theta = " + std::to_string(r.theta) + ", delta = " + std::to_string(r.delta)
-                    : std::string("degenerate: ") + (std::isfinite(r.theta) ? "Re g2100 = 0 (delta undefined)" : "Re g0021 = 0 (theta undefined)");
+    r.message = (std::isfinite(r.theta) && std::isfinite(r.delta)
+                     ? "theta = " + std::to_string(r.theta) + ", delta = " + std::to_string(r.delta)
+                     : std::string("degenerate: ") + (std::isfinite(r.theta) ? "Re g2100 = 0 (delta undefined)" : "Re g0021 = 0 (theta undefined)")) +
+                near;
     return r;
 }
 

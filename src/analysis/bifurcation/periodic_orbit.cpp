@@ -1931,7 +1931,7 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
         q.par2 = zz(N + 2);
         q.test = r.test;
         if (torus) {
-            q.rotation = zz(N + 3);
+            q.rotation = std::abs(std::remainder(zz(N + 3), 2.0 * M_PI));  // in [0, pi]
             if (!q.orbit.multipliers.empty()) {
                 q.second_distance = std::numeric_limits<double>::infinity();
                 for (cplx m : q.orbit.multipliers) q.second_distance = std::min(q.second_distance, std::abs(m - std::polar(1.0, q.rotation)));
@@ -2014,6 +2014,13 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
             // same folds phase-shifted: the direction in (p1, p2) turns back within the step at a
             // small amplitude. Such a step ends the curve (once it ran back along itself); a cusp
             // of the fold curve turns too, but at the amplitude of its orbits
+            // a torus curve whose phi crossed 0 or pi within the step passed a 1:1 or 1:2 resonance
+            // (the pair met at 1 or -1 and turned real): beyond it the equations hold for the
+            // conjugate pair, the same curve traced back; the curve ends before the crossing
+            if (torus && std::sin(u(N + 3)) * std::sin(v(N + 3)) <= 0.0) {
+                stop = "resonance";
+                return out;
+            }
             OrbitFoldCurvePoint next = make_point(v, r);
             const double amp = amplitude(next.orbit), amp_prev = out.empty() ? amplitude(first.orbit) : amplitude(out.back().orbit);
             const double turn = fs.w(N + 1) * t(N + 1) * tn(N + 1) + fs.w(N + 2) * t(N + 2) * tn(N + 2);
@@ -2113,7 +2120,21 @@ OrbitBranchCurves orbit_curves_of_branch(const NonlinearDDE& system, const Orbit
     for (std::size_t k = 0; k < branch.tori.size(); ++k) {
         const OrbitCrossing& d = branch.tori[k];
         if (!d.located || on_curve(r.tori, d.par)) continue;
-        r.tori.push_back(orbit_torus_curve(system, d, options));
+        try {
+            r.tori.push_back(orbit_torus_curve(system, d, options));
+        } catch (const std::invalid_argument& e) {
+            // a torus whose pair is (nearly) real (|sin phi| < 0.01: at a resonance) starts no
+            // curve; the other curves stand, this one is undecided with the reason
+            OrbitFoldCurve c;
+            c.parameter = options.orbit.parameter;
+            c.parameter2 = options.parameter2;
+            c.degree = options.orbit.degree;
+            c.intervals = options.orbit.intervals;
+            c.status = Status::NumericalIssue;
+            c.message = e.what();
+            c.stop_backward = c.stop_forward = "first_point_failed";
+            r.tori.push_back(std::move(c));
+        }
         r.torus_index.push_back(static_cast<int>(k));
         note(r.tori.back(), "torus", d.par);
     }
@@ -2133,6 +2154,10 @@ OrbitFoldCurve orbit_torus_curve(const NonlinearDDE& system, const OrbitCrossing
         throw std::invalid_argument("torus curve: the multiplier " + detail::format_number(mu.real()) + " + " + detail::format_number(mu.imag()) +
                                     " i is (nearly) real: expected a complex pair on the unit circle");
     return orbit_bifurcation_curve(system, torus.orbit, torus.par, CurveKind::Torus, options, mu);
+}
+
+std::string orbit_curve_end_point(const OrbitFoldCurvePoint& end) {
+    return std::abs(std::sin(end.rotation)) < std::sin(0.1) ? "ZH" : "DH";
 }
 
 }  // namespace ddemap

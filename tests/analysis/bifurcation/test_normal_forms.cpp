@@ -269,6 +269,11 @@ TEST_CASE("double Hopf normal form of two oscillators coupled through delays aga
     CHECK(std::abs(sw.g2100 - nf.g0021) < tol::normal_form_exact);
     CHECK(std::abs(sw.g1011 - nf.g1110) < tol::normal_form_exact);
     CHECK_THROWS_AS(double_hopf_normal_form(sys, Eigen::VectorXd::Zero(5), sys.parameter_values(), w1, w1), std::invalid_argument);
+    // a strong resonance (omega2 = 2 omega1 or 3 omega1) has another normal form: refused, with the reason
+    const DoubleHopfNormalForm r2 = double_hopf_normal_form(sys, Eigen::VectorXd::Zero(5), sys.parameter_values(), w1, 2.0 * w1);
+    CHECK(r2.status == Status::NumericalIssue);
+    CHECK(r2.message.find("1:2 resonance") != std::string::npos);
+    CHECK(double_hopf_normal_form(sys, Eigen::VectorXd::Zero(5), sys.parameter_values(), 3.0 * w2, w2).message.find("1:3 resonance") != std::string::npos);
     REQUIRE(nf.status == Status::Converged);
 }
 

@@ -53,7 +53,7 @@
 /// g111 / (2 g011)) - g021 g200 / g011), s = b c and theta = Re g110 / g200 (s and theta decide the
 /// unfolding's type: s = +1 or -1, theta's sign; they do not depend on the sign of q0).
 ///
-/// Double Hopf (two simple pairs +-i omega1, +-i omega2, no resonance 1:1, 1:2, 1:3), as
+/// Double Hopf (two simple pairs +-i omega1, +-i omega2, no resonance 1:1, 1:2, 1:3: refused), as
 /// DDE-BIFTOOL's nmfm_hoho: the pairs (q_j, p_j) normalised as above, phi_j = e^{i omega_j theta} q_j,
 /// lambda_j = i omega_j; with h_lambda[v] = theta -> e^{lambda theta} Delta(lambda)^-1 v,
 ///     h1100 = h_0[B(phi1, conj phi1)],  h2000 = h_{2 lambda1}[B(phi1, phi1)],
@@ -181,8 +181,9 @@ ZeroHopfNormalForm zero_hopf_normal_form(const NonlinearDDE& system, const Eigen
 
 /// The double Hopf coefficients at the equilibrium x at parameter values p with the pairs
 /// +-i omega1, +-i omega2 (0 < omega1 != omega2; second and third derivatives needed); status
-/// NumericalIssue when a kernel is not one-dimensional, an inverse is singular (a resonance:
-/// 2 omega_j or omega1 +- omega2 a root frequency too) or a g is not finite. Where Re g2100 or
+/// NumericalIssue at a 1:2 or 1:3 resonance (omega2 = k omega1 or omega1 = k omega2 to 1e-6
+/// relative; within 1e-2 the message warns), when a kernel is not one-dimensional, an inverse is
+/// singular (2 omega_j or omega1 +- omega2 a root frequency too) or a g is not finite. Where Re g2100 or
 /// Re g0021 is 0, delta or theta is NaN and the message says so (status Converged).
 DoubleHopfNormalForm double_hopf_normal_form(const NonlinearDDE& system, const Eigen::VectorXd& x, const std::vector<double>& p, double omega1,
                                              double omega2);

@@ -303,7 +303,8 @@ struct OrbitFoldCurve {
     /// max_period_factor times the start's: towards a homoclinic orbit), "hopf" (the amplitude fell
     /// below 2 % of the largest on the curve, or the curve turned back in (p1, p2) below a quarter of
     /// it: at a generalised Hopf point, where a fold curve meets the Hopf curve; a torus curve ends
-    /// so at a double Hopf point), "resonance" (a torus curve's phi within 0.01 of 0 or pi),
+    /// so at a double Hopf or zero-Hopf point: orbit_curve_end_point), "resonance" (a torus curve's
+    /// phi within 0.01 of 0 or pi, or across them within a step),
     /// "step_below_minimum"; first the end before `start`, then the end after
     std::string stop_backward, stop_forward;
     Status status = Status::Converged;
@@ -367,6 +368,11 @@ OrbitFoldCurve orbit_period_doubling_curve(const NonlinearDDE& system, const Orb
 /// orbit's Floquet multipliers. std::invalid_argument as orbit_fold_curve, and for a torus
 /// bifurcation that is not located or whose multiplier is (nearly) real.
 OrbitFoldCurve orbit_torus_curve(const NonlinearDDE& system, const OrbitCrossing& torus, const OrbitFoldCurveOptions& options);
+
+/// Where a torus curve that ended on its orbits' shrinking ("hopf") ends, from the point `end`:
+/// "ZH" (a zero-Hopf point, where the torus's phi tends to 0 or pi: within 0.1) or "DH" (a double
+/// Hopf point, phi tending to 2 pi omega2 / omega1 mod 2 pi).
+std::string orbit_curve_end_point(const OrbitFoldCurvePoint& end);
 
 /// The curves in two parameters through a branch's special points (orbit_curves_of_branch).
 struct OrbitBranchCurves {
