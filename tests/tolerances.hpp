@@ -369,6 +369,10 @@ constexpr double design_abscissa_value = 1e-6;
 /// Its gains: the square-root side makes them known only to about the square root of the value's
 /// error; 1e-3.
 constexpr double design_abscissa_gains = 1e-3;
+/// The least plant abscissa with a delay on a face of the box (a double real root of
+/// l^2 + a l + k1 e^{-l tau}): the same sampling radius (5e-6 in k2 on a box 5 wide) and the
+/// square-root side; measured 1.6e-6; 1e-5.
+constexpr double design_abscissa_delay_value = 1e-5;
 /// The nearest gains against the closed form: the sequential QP stops at steps of 1e-8 of the
 /// distance, then the crossing is bisected to 1e-13; 1e-7.
 constexpr double design_nearest_rel = 1e-7;

@@ -166,15 +166,70 @@ bool refine_root(const LinearDDE& dde, cplx guess, const RootOptions& options, R
     return (s.status == Status::Converged || s.last_step <= 1e-6 * scale_of(lambda)) && out.residual <= options.residual_tolerance;
 }
 
+/// Schroeder's iteration (Newton on u = g / g') for g(lambda) = det Delta(lambda) / prod_k
+/// (lambda - r_k), the roots r_k already found deflated (Maehly), from `start`: quadratic at a
+/// root of any multiplicity, where Newton on det Delta is only linear and stalls near
+/// eps^(1/m). With X = Delta^-1 Delta', Y = Delta^-1 Delta'' and T = g'/g = tr X - sum 1/(lambda -
+/// r_k), T' = tr Y - tr X^2 + sum 1/(lambda - r_k)^2 and the step is -T / T'. True when it
+/// converged (a step below 1e-14 of the root's scale, or Delta singular to machine precision)
+/// with a residual below the tolerance; `out` then holds the root.
+bool refine_deflated(const LinearDDE& dde, cplx start, const std::vector<cplx>& deflate, const RootOptions& options, Root& out,
+                     int& iterations) {
+    cplx lambda = start;
+    double last = std::numeric_limits<double>::infinity();
+    bool converged = false;
+    for (int it = 0; it < 60; ++it) {
+        MatrixXc d2 = MatrixXc::Zero(dde.dimension(), dde.dimension());
+        for (const auto& t : dde.delayed()) d2 -= (t.delay * t.delay * std::exp(-lambda * t.delay)) * t.matrix;
+        const Eigen::PartialPivLU<MatrixXc> lu(dde.characteristic_matrix(lambda));
+        const MatrixXc X = lu.solve(dde.characteristic_derivative(lambda));
+        cplx T = X.trace(), dT = lu.solve(d2).trace() - (X * X).trace();
+        for (const cplx r : deflate) {
+            const cplx q = 1.0 / (lambda - r);
+            T -= q;
+            dT += q * q;
+        }
+        ++iterations;
+        if (!std::isfinite(std::abs(T)) || !std::isfinite(std::abs(dT))) {
+            converged = true;  // Delta singular to machine precision: lambda is the root
+            break;
+        }
+        if (dT == cplx(0.0)) break;
+        const cplx step = -T / dT;
+        if (!std::isfinite(std::abs(step))) break;
+        lambda -= step;
+        last = std::abs(step);
+        if (last <= 1e-14 * scale_of(lambda)) {
+            converged = true;
+            break;
+        }
+    }
+    if (!converged) return false;
+    out.value = lambda;
+    out.eigenvalue = start;
+    out.newton_step = std::isfinite(last) ? last : 0.0;
+    out.residual = relative_residual(dde, lambda);
+    return out.residual <= options.residual_tolerance;
+}
+
 /// Refine candidates, merge duplicates, return sorted rightmost first.
 /// Candidates whose Newton iteration failed go to `failed` (when given): a root there may be
 /// missing from the list. A real candidate is also tried off the axis: rounding splits a nearly
 /// double complex pair (separation ~sqrt(eps)) into two real eigenvalues, and Newton from a real
 /// start stays real (real arithmetic on a real DDE), so it cannot reach the pair.
+///
+/// Several candidates whose Newton iterations end within 1e-5 of each other (relative) meet a
+/// multiple root, where Newton stalls up to eps^(1/m) away, or a cluster of distinct roots, of
+/// which Newton may find one from every start (a missed root): on a real DDE a value within that
+/// of the real axis counts with its conjugate. Such a group of k members is refined again: k
+/// deflated Schroeder iterations (refine_deflated), the i-th from the i-th member's eigenvalue
+/// with the i - 1 roots before it deflated, find every distinct root of the cluster to full
+/// accuracy (a multiple root comes back, and is listed once); if one fails, the group's Newton
+/// values stand.
 std::vector<Root> refine_all(const LinearDDE& dde, const std::vector<cplx>& candidates, const RootOptions& options, int& dropped,
                              int& iterations, std::vector<cplx>* failed = nullptr) {
     const bool real = dde.is_real();
-    std::vector<Root> found;
+    std::vector<Root> refined;
     for (cplx c : candidates) {
         if (real && c.imag() < 0.0) continue;  // the conjugate partner is (or will be) refined instead
         Root r;
@@ -197,21 +252,110 @@ std::vector<Root> refine_all(const LinearDDE& dde, const std::vector<cplx>& cand
                 }
             }
         }
-        bool dup = false;
+        refined.push_back(r);
+    }
+    // groups of refined values within `cluster` of each other (single linkage)
+    const double cluster = 1e-5;
+    auto close = [&](cplx a, cplx b) { return std::abs(a - b) <= cluster * std::max(scale_of(a), scale_of(b)); };
+    std::vector<int> group(refined.size(), -1);
+    int groups = 0;
+    for (std::size_t i = 0; i < refined.size(); ++i) {
+        if (group[i] >= 0) continue;
+        group[i] = groups;
+        for (std::size_t k = i; k < refined.size(); ++k) {  // grow the group from its members
+            if (group[k] != groups) continue;
+            for (std::size_t j = i + 1; j < refined.size(); ++j)
+                if (group[j] < 0 && close(refined[k].value, refined[j].value)) group[j] = groups;
+        }
+        ++groups;
+    }
+    std::vector<Root> found;
+    auto add = [&](const Root& r) {  // merge exact duplicates (1e-9)
         for (auto& f : found) {
             if (std::abs(f.value - r.value) <= 1e-9 * scale_of(r.value)) {
-                dup = true;
                 ++dropped;
                 f.collocation_error = std::min(f.collocation_error, r.collocation_error);
+                const int mult = std::max(f.multiplicity, r.multiplicity);
                 if (r.residual < f.residual) {
                     const double ce = f.collocation_error;
                     f = r;
                     f.collocation_error = ce;
                 }
-                break;
+                f.multiplicity = mult;
+                return;
             }
         }
-        if (!dup) found.push_back(r);
+        found.push_back(r);
+    };
+    for (int g = 0; g < groups; ++g) {
+        std::vector<const Root*> members;
+        std::vector<cplx> starts;
+        for (std::size_t i = 0; i < refined.size(); ++i)
+            if (group[i] == g) {
+                members.push_back(&refined[i]);
+                starts.push_back(refined[i].eigenvalue);
+                // on a real DDE a value next to the real axis, from a value or a start off it: its
+                // conjugate (the skipped partner of the eigenvalue) is a member too
+                const bool near_axis = std::abs(refined[i].value.imag()) <= cluster * scale_of(refined[i].value);
+                if (real && near_axis && (refined[i].value.imag() != 0.0 || refined[i].eigenvalue.imag() > 0.0))
+                    starts.push_back(std::conj(refined[i].eigenvalue) + cplx(0.0, refined[i].eigenvalue.imag() == 0.0 ? -1e-6 * scale_of(refined[i].value) : 0.0));
+            }
+        if (starts.size() == 1) {
+            add(*members.front());
+            continue;
+        }
+        double ce = std::numeric_limits<double>::infinity();
+        for (const Root* m : members) ce = std::min(ce, m->collocation_error);
+        // the deflated sequence from `from`; false when one iteration fails
+        auto sequence = [&](const std::vector<cplx>& from, std::vector<Root>& out) {
+            std::vector<cplx> roots;
+            for (const cplx s0 : from) {
+                Root r;
+                // (a start exactly on a root already found would divide by zero: moved off it)
+                cplx s = s0;
+                for (const cplx x : roots)
+                    if (s == x) s += cplx(1e-8 * scale_of(x), 0.0);
+                if (!refine_deflated(dde, s, roots, options, r, iterations)) return false;
+                roots.push_back(r.value);
+                r.collocation_error = ce;
+                out.push_back(r);
+            }
+            return true;
+        };
+        std::vector<Root> out;
+        bool ok = false;
+        if (real && starts.size() > members.size()) {
+            // a group at the real axis of a real DDE (a double real root, or real roots closer than
+            // Newton resolves): from real starts the iterations stay real and list them real; a
+            // complex pair this close to the axis (they fail then) is looked for from the complex starts
+            std::vector<cplx> on_axis;
+            for (const cplx z : starts) on_axis.push_back(cplx(z.real(), 0.0));
+            ok = sequence(on_axis, out);
+            if (!ok) out.clear();
+        }
+        if (!ok) ok = sequence(starts, out);
+        if (!ok) {
+            for (const Root* m : members) add(*m);
+            continue;
+        }
+        // roots of the sequence within 1e-7 (relative) of each other are one multiple root (the
+        // deflated iteration found it again): listed once, with its multiplicity
+        std::vector<Root> distinct;
+        for (Root& r : out) {
+            if (real) {
+                if (std::abs(r.value.imag()) <= 1e-12 * scale_of(r.value)) r.value = cplx(r.value.real(), 0.0);
+                if (r.value.imag() < 0.0) r.value = std::conj(r.value), r.eigenvalue = std::conj(r.eigenvalue);  // listed by its partner
+            }
+            bool same = false;
+            for (Root& d : distinct)
+                if (std::abs(d.value - r.value) <= 1e-7 * scale_of(r.value)) {
+                    ++d.multiplicity;
+                    same = true;
+                    break;
+                }
+            if (!same) distinct.push_back(r);
+        }
+        for (const Root& r : distinct) add(r);
     }
     if (real) {
         const std::size_t n = found.size();
@@ -440,10 +584,26 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         const double needed = dde.root_bound(sigma);
         double change = std::numeric_limits<double>::infinity();
         bool collocated = true;
+        // a root within d (relative) of another is determined only to about eps / d (a cluster or
+        // a multiple root, d ~ sqrt(eps) for a double one): its change between degrees is measured
+        // against 1e3 eps / d where that exceeds the agreement tolerance
+        bool conditioned = false;  // every change within its own allowance
+        double close_roots = std::numeric_limits<double>::infinity();  // the least such d
         if (previous_degree > 0 && previous_in_strip == in_strip) {
             change = 0.0;
+            conditioned = true;
             for (std::size_t i = 0; i < in_strip; ++i) {
-                change = std::max(change, std::abs(current[i].value - previous[i].value) / scale_of(current[i].value));
+                double d = std::numeric_limits<double>::infinity();
+                for (std::size_t j = 0; j < current.size(); ++j)
+                    if (j != i) d = std::min(d, std::abs(current[i].value - current[j].value) / scale_of(current[i].value));
+                // (a root of multiplicity m: to about eps^(1/m))
+                const int mult = std::max(current[i].multiplicity, previous[i].multiplicity);
+                const double allowed = std::max({o.agreement_tolerance, 1e3 * std::numeric_limits<double>::epsilon() / d,
+                                                 mult > 1 ? 1e2 * std::pow(std::numeric_limits<double>::epsilon(), 1.0 / mult) : 0.0});
+                const double c = std::abs(current[i].value - previous[i].value) / scale_of(current[i].value);
+                if (c > allowed) conditioned = false;
+                if (allowed > o.agreement_tolerance) close_roots = std::min(close_roots, mult > 1 ? 0.0 : d);
+                change = std::max(change, c);
             }
         }
         double worst_collocation = 0.0;
@@ -464,7 +624,7 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
         // (With fewer than `count` roots found only the second certificate applies: a larger M
         // may reveal more roots, so the same set must come out of two degrees.)
         const bool spectral = full && worst_collocation <= o.spectral_tolerance && covers && complete;
-        const bool agreed = change <= o.agreement_tolerance && collocated && covers && complete;
+        const bool agreed = conditioned && collocated && covers && complete;
         const bool settled = spectral || agreed;
         // the degree M done (of at most max_degree); may throw Cancelled (caught by rightmost_roots)
         if (options.progress) options.progress(m, max_degree, sigma);
@@ -486,8 +646,12 @@ RootResult dense_roots(const RootProblem& problem, const RootOptions& options) {
                     os << " equal collocation eigenvalues at M=" << m << " to " << worst_collocation
                        << " (relative; spectral accuracy reached)";
                 } else {
-                    os << " agree between M=" << previous_degree << " and M=" << m << " (max relative change " << change
-                       << "; eigenvalues within " << worst_collocation << ")";
+                    os << " agree between M=" << previous_degree << " and M=" << m << " (max relative change " << change;
+                    if (close_roots == 0.0)
+                        os << ", within 100 eps^(1/m) for a root of multiplicity m, determined to about that";
+                    else if (std::isfinite(close_roots))
+                        os << ", within 1e3 eps / d for roots a relative d >= " << close_roots << " apart (a cluster, determined to about eps / d)";
+                    os << "; eigenvalues within " << worst_collocation << ")";
                 }
                 os << ", and M resolves |lambda| <= " << covered << ", beyond the bound " << needed
                    << " on any root with Re >= " << sigma;

@@ -89,12 +89,70 @@ TEST_CASE("a nearly double complex pair split by rounding into two real eigenval
         const RootResult r = rightmost_roots(dde, ro);
         CAPTURE(r.message);
         REQUIRE(!r.roots.empty());
-        if (r.status != Status::Converged) continue;  // undecided is allowed; a wrong certificate is not
+        // (once undecided at some counts: the pair's Newton values moved by 1e-6 between degrees)
+        REQUIRE(r.status == Status::Converged);
         CHECK(std::abs(r.roots.front().value.real() - z.real()) < 1e-6);
         // nothing right of the reported abscissa (|l| <= 10 bounds every root with Re >= -1 here;
         // steps of 2e-4 against a distance of 1e-3 from the pair), and the pair counted left of it
         const double x = r.roots.front().value.real();
         CHECK(test::zeros_in_rectangle(D, x + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
         CHECK(test::zeros_in_rectangle(D, x - 1e-3, 5.0, -10.0, 10.0, 100000) == 2);
+    }
+}
+
+namespace {
+
+/// The plant of an OVRV car, s' = -v, v' = b s(t - tau) - a v: D(l) = l^2 + a l + b e^{-l tau}.
+LinearDDE ovrv_plant(double a, double b, double tau) {
+    MatrixXc a0 = MatrixXc::Zero(2, 2), a1 = MatrixXc::Zero(2, 2);
+    a0(0, 1) = -1.0;
+    a0(1, 1) = -a;
+    a1(1, 0) = b;
+    return LinearDDE(a0, {{a1, tau}});
+}
+
+}  // namespace
+
+TEST_CASE("a double real root and two real roots 1.3e-6 apart are certified, each root listed" * doctest::test_suite("fast")) {
+    const double tau = 0.5;
+    // 1. D = D' = 0 at l0 = -1.5: b e^{-l0 tau} = (2 l0 + a) / tau and l0^2 + a l0 + (2 l0 + a) / tau = 0,
+    // so a = 7.5, b = 9 e^{-0.75}: a double root at -1.5 exactly. Newton stalls 1e-8 from it, and
+    // the values it stalled at moved between degrees: the roots were undecided
+    {
+        const double a = 7.5, b = 9.0 * std::exp(-0.75);
+        const auto D = [&](cplx l) { return l * l + a * l + b * std::exp(-l * tau); };
+        for (int count : {1, 2, 4}) {
+            CAPTURE(count);
+            RootOptions ro;
+            ro.count = count;
+            const RootResult r = rightmost_roots(ovrv_plant(a, b, tau), ro);
+            CAPTURE(r.message);
+            REQUIRE(r.status == Status::Converged);
+            CHECK(std::abs(r.roots.front().value - cplx(-1.5, 0.0)) < 1e-7);  // a double root: sqrt(eps) accuracy
+            // the argument principle: two zeros within 1e-3 of -1.5, none right of it
+            CHECK(test::zeros_in_rectangle(D, -1.5 - 1e-3, -1.5 + 1e-3, -1e-3, 1e-3, 4000) == 2);
+            CHECK(test::zeros_in_rectangle(D, -1.5 + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
+        }
+    }
+    // 2. the minimum of the spectral abscissa that design_gains found at k1 = 5 (its bound),
+    // th = 1: two real roots 2e-6 apart. Newton from both eigenvalues met one of them, and which
+    // one changed with the degree: the plant was undecided (max degree reached) and so was the
+    // design's verdict. Both must be listed, each where D changes sign on the real axis.
+    {
+        const double k1 = 4.999991689748873, a = k1 + 3.5518626863260914, b = k1;
+        const auto D = [&](double l) { return l * l + a * l + b * std::exp(-l * tau); };
+        RootOptions ro;
+        ro.count = 2;
+        const RootResult r = rightmost_roots(ovrv_plant(a, b, tau), ro);
+        CAPTURE(r.message);
+        REQUIRE(r.status == Status::Converged);
+        REQUIRE(r.roots.size() >= 2);
+        const double r1 = r.roots[0].value.real(), r2 = r.roots[1].value.real();
+        CHECK(r.roots[0].value.imag() == 0.0);
+        CHECK(r.roots[1].value.imag() == 0.0);
+        CHECK(r1 - r2 > 1e-6);
+        CHECK(r1 - r2 < 3e-6);
+        for (const double x : {r1, r2}) CHECK(D(x - 1e-9) * D(x + 1e-9) < 0.0);
+        CHECK(test::zeros_in_rectangle([&](cplx l) { return l * l + a * l + b * std::exp(-l * tau); }, r1 + 1e-3, 5.0, -10.0, 10.0, 100000) == 0);
     }
 }

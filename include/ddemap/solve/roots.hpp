@@ -160,6 +160,9 @@ struct Root {
     double newton_step = 0.0;   ///< size of the last Newton step (an error estimate)
     double collocation_error = 0.0;  ///< |eigenvalue - refined root| (0 for the contour backend)
     cplx eigenvalue;            ///< the estimate it was refined from (a collocation eigenvalue; contour: the root)
+    /// dense backend: how many roots were found at this value (within 1e-7 relative): 2 for a
+    /// double root, which is located only to about sqrt(eps); listed once
+    int multiplicity = 1;
 };
 
 /// What rightmost_roots did (cf. Ceres' Summary).

@@ -160,6 +160,31 @@ TEST_CASE("design abscissa: OVRV without delay reaches the double root of the cl
     CHECK(r.string.plant_abscissa == doctest::Approx(r.value).epsilon(1e-9));
 }
 
+TEST_CASE("design abscissa with a delay: on the face k1 = 5 the minimum is the double real root of the closed form, and its verdict is decided") {
+    // D = l^2 + a l + k1 e^{-l tau}, a = k1 th + k2, th = 1, tau = 0.5. Over a at fixed k1 the
+    // least abscissa is where the two rightmost real roots meet: D = D' = 0 gives
+    // l^2 = k1 e^{-l tau} (1 + tau l) and a = tau k1 e^{-l tau} - 2 l; it decreases with k1, so
+    // the minimum lies on the face k1 = 5. There the plant's roots are nearly double (1.3e-6
+    // apart), which left the certified verdict at the design undecided (max degree reached).
+    DesignOptions o;
+    o.objective = DesignObjective::Abscissa;
+    o.bounds = {{"k1", 0.01, 5.0}, {"k2", 0.01, 5.0}};
+    const DesignResult r = design_gains("ovrv", {{"k1", 0.5}, {"k2", 0.5}, {"th", 1.0}, {"tau", 0.5}, {"eta", 10.0}, {"speed", 20.0}}, o);
+    CAPTURE(r.message);
+    REQUIRE(r.status == Status::Converged);
+    const double k1 = 5.0, tau = 0.5;
+    double l = -1.5;
+    for (int i = 0; i < 50; ++i) {
+        const double e = k1 * std::exp(-l * tau);
+        l -= (-l * l + e * (1.0 + tau * l)) / (-2.0 * l + e * (tau - tau * (1.0 + tau * l)));
+    }
+    const double a = tau * k1 * std::exp(-l * tau) - 2.0 * l;
+    CHECK(std::abs(r.gains.at("k1") - k1) < tol::design_abscissa_gains);
+    CHECK(std::abs(r.gains.at("k2") - (a - k1)) < tol::design_abscissa_gains);
+    CHECK(std::abs(r.value - l) < tol::design_abscissa_delay_value);
+    CHECK(r.string.plant_verdict == Verdict::Stable);
+}
+
 TEST_CASE("design nearest: C_max reaches the closed-form nearest point of its low-frequency condition, and the margin flips across it") {
     // ovrv, th and tau held: mu_0 = c2 / k1^2 >= m^2 is 2 B - m^2 k1 >= 0, linear in (k1, k2):
     // a1 k1 + a2 k2 >= 2, a1 = 2 th (th/2 - tau) - m^2, a2 = 2 (th - tau). In relative changes
