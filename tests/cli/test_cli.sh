@@ -1148,6 +1148,27 @@ r = json.loads(subprocess.run([sys.argv[2], 'roots', '--model', 'idm', '--ring',
 assert abs(r['spectral_abscissa']) < 1e-8, r['spectral_abscissa']
 assert any(abs(abs(x['im']) - h[0]['omega']) < 1e-8 for x in r['roots'] if abs(x['re']) < 1e-8), r['roots']
 PY
+# its Hopf curve in (gap, tau) across the box, in a few dozen points (the equilibrium's speeds
+# and gaps of 20-30 are scaled in the step: unscaled, 543 points reached a fifth of the box), and
+# its end on the face tau = 1 against the linear ring analysis there
+"$bin" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --a 1.1 --b 1.6 --v0 32 --par gap --from 6 --to 40 --par2 tau --from2 0.3 --to2 1 --format json \
+    --quiet >"$tmp/hidm2.json" && python3 - "$tmp/hidm2.json" "$bin" <<'PY' && ok || bad "hopf --model idm --par2: the Hopf curve across the box, its end against the linear ring analysis"
+import json, math, subprocess, sys
+d = json.load(open(sys.argv[1]))
+c = d['result']['curves']
+assert d['status'] == 'converged' and len(c) == 1 and c[0]['stop'] == ['bound', 'bound'] and len(c[0]['points']) < 150, (d['status'], c[0]['stop'], len(c[0]['points']))
+end = max(c[0]['points'], key=lambda p: p['par2'])
+assert end['par2'] == 1, end
+gap = end['par']
+lo, hi = 0.0, 32.0
+for _ in range(200):
+    mid = 0.5 * (lo + hi)
+    lo, hi = (mid, hi) if (2 + 1.2 * mid) / math.sqrt(1 - (mid / 32) ** 4) < gap else (lo, mid)
+r = json.loads(subprocess.run([sys.argv[2], 'roots', '--model', 'idm', '--ring', '5', '--th', '1.2', '--tau', '1', '--a', '1.1', '--b', '1.6',
+                               '--v0', '32', '--speed', repr(lo), '--format', 'json'], capture_output=True, text=True, check=True).stdout)['result']
+assert abs(r['spectral_abscissa']) < 1e-8, r['spectral_abscissa']
+assert any(abs(abs(x['im']) - end['omega']) < 1e-8 for x in r['roots'] if abs(x['re']) < 1e-8), r['roots']
+PY
 expect_error "--model idm needs --tau" equilibria --model idm --ring 5 --th 1.2 --par gap --from 6 --to 40
 expect_error "--alpha is not a parameter of --model idm" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --alpha 2 --par gap --from 6 --to 40
 expect_error "gap = 1: expected a finite mean gap > eta" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --par gap --from 1 --to 40

@@ -212,7 +212,7 @@ FoldCurve trace_fold_curve(const NonlinearDDE& s, const FoldPoint& start, double
     const double lo2 = std::min(o.from2, o.to2), hi2 = std::max(o.from2, o.to2);
 
     const int N = 2 * n + 2;
-    ContinuationOptions co = detail::curve_options(o.continuation, N, n, lo1, hi1, 2 * n + 1, lo2, hi2);
+    ContinuationOptions co = detail::curve_options(o.continuation, N, n, lo1, hi1, 2 * n + 1, lo2, hi2, start.x);
     const int budget = o.continuation.max_points;
 
     // the null vector at the start

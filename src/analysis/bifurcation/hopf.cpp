@@ -498,7 +498,7 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
                                     detail::format_number(lo2) + ", " + detail::format_number(hi2) + "]");
 
     const int N = 3 * n + 3;
-    ContinuationOptions co = detail::curve_options(o.continuation, N, n, lo1, hi1, 3 * n + 2, lo2, hi2);
+    ContinuationOptions co = detail::curve_options(o.continuation, N, n, lo1, hi1, 3 * n + 2, lo2, hi2, start.x);
     const int budget = o.continuation.max_points;
 
     VectorXc q = start.q / start.q.norm();
