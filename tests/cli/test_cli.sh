@@ -1132,42 +1132,40 @@ PY
 
 # the IDM ring (--model idm): the branch in the mean gap; its Hopf point is where the linear ring analysis
 # (roots --model idm --ring 5 at the uniform-flow speed of that gap) puts a root on the axis
+# (idm_ring_axis.py: that check for a Hopf point (gap, tau, omega), shared with the curve below)
+cat >"$tmp/idm_ring_axis.py" <<'PY'
+import json, math, subprocess
+
+def check(bin_, gap, tau, omega):
+    # the uniform-flow speed of this gap: s*(v) = (eta + th v) / sqrt(1 - (v/v0)^4) = gap, by bisection
+    lo, hi = 0.0, 32.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if (2 + 1.2 * mid) / math.sqrt(1 - (mid / 32) ** 4) < gap else (lo, mid)
+    r = json.loads(subprocess.run([bin_, 'roots', '--model', 'idm', '--ring', '5', '--th', '1.2', '--tau', repr(tau), '--a', '1.1', '--b', '1.6',
+                                   '--v0', '32', '--speed', repr(lo), '--format', 'json'], capture_output=True, text=True, check=True).stdout)['result']
+    assert abs(r['spectral_abscissa']) < 1e-8, r['spectral_abscissa']
+    assert any(abs(abs(x['im']) - omega) < 1e-8 for x in r['roots'] if abs(x['re']) < 1e-8), r['roots']
+PY
 "$bin" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --a 1.1 --b 1.6 --v0 32 --par gap --from 6 --to 40 --format json >"$tmp/hidm.json" &&
-    python3 - "$tmp/hidm.json" "$bin" <<'PY' && ok || bad "hopf --model idm: the Hopf point against the linear ring analysis"
-import json, math, subprocess, sys
+    PYTHONPATH="$tmp" python3 - "$tmp/hidm.json" "$bin" <<'PY' && ok || bad "hopf --model idm: the Hopf point against the linear ring analysis"
+import json, sys, idm_ring_axis
 h = json.load(open(sys.argv[1]))['result']['hopf']
 assert len(h) == 1 and h[0]['status'] == 'converged', h
-gap = h[0]['par']
-# the uniform-flow speed of this gap: s*(v) = (eta + th v) / sqrt(1 - (v/v0)^4) = gap, by bisection
-lo, hi = 0.0, 32.0
-for _ in range(200):
-    mid = 0.5 * (lo + hi)
-    lo, hi = (mid, hi) if (2 + 1.2 * mid) / math.sqrt(1 - (mid / 32) ** 4) < gap else (lo, mid)
-r = json.loads(subprocess.run([sys.argv[2], 'roots', '--model', 'idm', '--ring', '5', '--th', '1.2', '--tau', '0.6', '--a', '1.1', '--b', '1.6',
-                               '--v0', '32', '--speed', repr(lo), '--format', 'json'], capture_output=True, text=True, check=True).stdout)['result']
-assert abs(r['spectral_abscissa']) < 1e-8, r['spectral_abscissa']
-assert any(abs(abs(x['im']) - h[0]['omega']) < 1e-8 for x in r['roots'] if abs(x['re']) < 1e-8), r['roots']
+idm_ring_axis.check(sys.argv[2], h[0]['par'], 0.6, h[0]['omega'])
 PY
 # its Hopf curve in (gap, tau) across the box, in a few dozen points (the equilibrium's speeds
 # and gaps of 20-30 are scaled in the step: unscaled, 543 points reached a fifth of the box), and
 # its end on the face tau = 1 against the linear ring analysis there
 "$bin" hopf --model idm --ring 5 --th 1.2 --tau 0.6 --a 1.1 --b 1.6 --v0 32 --par gap --from 6 --to 40 --par2 tau --from2 0.3 --to2 1 --format json \
-    --quiet >"$tmp/hidm2.json" && python3 - "$tmp/hidm2.json" "$bin" <<'PY' && ok || bad "hopf --model idm --par2: the Hopf curve across the box, its end against the linear ring analysis"
-import json, math, subprocess, sys
+    --quiet >"$tmp/hidm2.json" && PYTHONPATH="$tmp" python3 - "$tmp/hidm2.json" "$bin" <<'PY' && ok || bad "hopf --model idm --par2: the Hopf curve across the box, its end against the linear ring analysis"
+import json, sys, idm_ring_axis
 d = json.load(open(sys.argv[1]))
 c = d['result']['curves']
 assert d['status'] == 'converged' and len(c) == 1 and c[0]['stop'] == ['bound', 'bound'] and len(c[0]['points']) < 150, (d['status'], c[0]['stop'], len(c[0]['points']))
 end = max(c[0]['points'], key=lambda p: p['par2'])
 assert end['par2'] == 1, end
-gap = end['par']
-lo, hi = 0.0, 32.0
-for _ in range(200):
-    mid = 0.5 * (lo + hi)
-    lo, hi = (mid, hi) if (2 + 1.2 * mid) / math.sqrt(1 - (mid / 32) ** 4) < gap else (lo, mid)
-r = json.loads(subprocess.run([sys.argv[2], 'roots', '--model', 'idm', '--ring', '5', '--th', '1.2', '--tau', '1', '--a', '1.1', '--b', '1.6',
-                               '--v0', '32', '--speed', repr(lo), '--format', 'json'], capture_output=True, text=True, check=True).stdout)['result']
-assert abs(r['spectral_abscissa']) < 1e-8, r['spectral_abscissa']
-assert any(abs(abs(x['im']) - end['omega']) < 1e-8 for x in r['roots'] if abs(x['re']) < 1e-8), r['roots']
+idm_ring_axis.check(sys.argv[2], end['par'], 1.0, end['omega'])
 PY
 expect_error "--model idm needs --tau" equilibria --model idm --ring 5 --th 1.2 --par gap --from 6 --to 40
 expect_error "--alpha is not a parameter of --model idm" equilibria --model idm --ring 5 --th 1.2 --tau 0.6 --alpha 2 --par gap --from 6 --to 40
