@@ -149,6 +149,12 @@ int run_hopf() {
                                        : ", normal form " + d.normal_form.message)
                                 : std::string())
                         << "\n";
+                for (const HopfCurveBogdanovTakens& b : c.bogdanov_takens)
+                    out << "  Bogdanov-Takens (omega -> 0 at its " << (b.forward ? "forward" : "backward") << " end): " << par << " = " << rounded(b.par, 10)
+                        << ", " << hopf_args.par2 << " = " << rounded(b.par2, 10) << " (" << to_string(b.status) << ")"
+                        << (b.normal_form.status == Status::Converged ? ", normal form a = " + rounded(b.normal_form.a, 6) + ", b = " + rounded(b.normal_form.b, 6)
+                                                                       : std::string())
+                        << "\n";
                 for (const ZeroHopfPoint& z : c.zero_hopf)
                     out << "  zero-Hopf (a real root at 0): " << par << " = " << rounded(z.par, 10) << ", " << hopf_args.par2 << " = " << rounded(z.par2, 10)
                         << ", omega = " << rounded(z.omega, 8) << " (" << to_string(z.status) << ")"

@@ -462,6 +462,8 @@ void add_hopf_curves(PlotPanel& panel, const HopfCurves& curves, bool codim2) {
             if (d.status == Status::Converged) panel.markers.push_back({d.par, d.par2, "#000000", "DH"});
         for (const ZeroHopfPoint& z : c.zero_hopf)
             if (z.status == Status::Converged) panel.markers.push_back({z.par, z.par2, "#000000", "ZH"});
+        for (const HopfCurveBogdanovTakens& b : c.bogdanov_takens)
+            if (b.status == Status::Converged) panel.markers.push_back({b.par, b.par2, "#000000", "BT"});
     }
 }
 }  // namespace
@@ -586,7 +588,7 @@ std::string two_parameter_svg(const HopfCurves* hopf, const FoldCurves* folds, c
     po.panel_width = 560.0;
     po.panel_height = 420.0;
     std::string note;
-    if (hopf) note = "GH: generalised Hopf (L1 = 0), DH: double Hopf, ZH: zero-Hopf";
+    if (hopf) note = "GH: generalised Hopf (L1 = 0), DH: double Hopf, ZH: zero-Hopf, BT: Bogdanov-Takens";
     if (folds) note += std::string(note.empty() ? "" : "; ") + "CP: cusp, BT: Bogdanov-Takens (a Hopf curve ends there)" + (hopf ? "" : ", ZH: zero-Hopf");
     if (!hopf && (gh || dh || zh)) {
         std::string ends;

@@ -142,6 +142,19 @@ std::string hopf_curves_json(const HopfCurves& hc, const std::string& parameter2
             zh.push_back(q);
         }
         o["zero_hopf"] = zh;
+        json bts = json::array();
+        for (const HopfCurveBogdanovTakens& b : c.bogdanov_takens) {
+            json q;
+            q["par"] = num(b.par);
+            q["par2"] = num(b.par2);
+            q["end"] = b.forward ? "forward" : "backward";
+            q["residual"] = num(b.residual);
+            q["status"] = to_string(b.status);
+            q["message"] = b.message;
+            q["normal_form"] = b.normal_form.status == Status::Converged ? json{{"a", num(b.normal_form.a)}, {"b", num(b.normal_form.b)}} : json(nullptr);
+            bts.push_back(q);
+        }
+        o["bogdanov_takens"] = bts;
         json unstable = json::array();
         for (const HopfCurvePoint& p : c.points) unstable.push_back(p.unstable);
         o["unstable_beside_pair"] = unstable;
@@ -168,6 +181,8 @@ std::string hopf_curves_csv(const HopfCurves& hc, const std::string& parameter2,
             out += std::to_string(k) + ",double_hopf," + exact(d.par) + "," + exact(d.par2) + "," + exact(d.omega2) + ",,," + to_string(d.status) + "\n";
         for (const ZeroHopfPoint& z : c.zero_hopf)
             out += std::to_string(k) + ",zero_hopf," + exact(z.par) + "," + exact(z.par2) + "," + exact(z.omega) + ",,," + to_string(z.status) + "\n";
+        for (const HopfCurveBogdanovTakens& b : c.bogdanov_takens)
+            out += std::to_string(k) + ",bogdanov_takens," + exact(b.par) + "," + exact(b.par2) + ",0,,," + to_string(b.status) + "\n";
     }
     return out;
 }

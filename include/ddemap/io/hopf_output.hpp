@@ -28,11 +28,12 @@ std::string hopf_points_csv(const HopfAnalysis& a, const std::vector<std::string
 /// "criticality", "dre_dpar"}], "generalised_hopf": [{"par", "par2", "omega", "l1", "l2", "status",
 /// "normal_form": {"c1", "c2", "l2"}}], "double_hopf": [{"par", "par2", "omega1", "omega2", "residual",
 /// "other_curve", "resonant_1_1", "status", "message", "normal_form": {"g2100", "g1011", "g1110",
-/// "g0021", "theta", "delta"}}], "zero_hopf": [{..., "normal_form"}]}]} (a normal form null where it
-/// was not formed, with "normal_form_message" saying why at a located point)
+/// "g0021", "theta", "delta"}}], "zero_hopf": [{..., "normal_form"}], "bogdanov_takens": [{"par",
+/// "par2", "end", "residual", "status", "message", "normal_form": {"a", "b"}}]}]} (a normal form
+/// null where it was not formed, with "normal_form_message" saying why at a located point)
 std::string hopf_curves_json(const HopfCurves& c, const std::string& parameter2, const std::vector<std::string>& variables);
 /// curve,kind,PAR,PAR2,omega_rad_per_s,l1,criticality,status (kind: point, generalised_hopf,
-/// double_hopf or zero_hopf; PAR and PAR2 the parameters' names with their units from `units`)
+/// double_hopf, zero_hopf or bogdanov_takens (omega 0); PAR and PAR2 the parameters' names with their units from `units`)
 std::string hopf_curves_csv(const HopfCurves& c, const std::string& parameter2, const ColumnUnits& units = {});
 
 /// The criticality word of a point: to_string(criticality), or "undecided" when its

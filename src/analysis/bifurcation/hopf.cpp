@@ -337,6 +337,111 @@ ZeroHopfPoint locate_zero_hopf(const NonlinearDDE& s, const HopfCurveProblem& pr
     return zh;
 }
 
+/// The Bogdanov-Takens system of HopfCurveBogdanovTakens at z = (x, p1, p2, v0, v1); false when it
+/// cannot be evaluated there.
+bool bogdanov_takens_system(const NonlinearDDE& s, int j1, int j2, const Eigen::VectorXd& c, const Eigen::VectorXd& z, Eigen::VectorXd& g) {
+    const int n = s.dimension();
+    std::vector<double> p = s.parameter_values();
+    p[static_cast<std::size_t>(j1)] = z[n];
+    p[static_cast<std::size_t>(j2)] = z[n + 1];
+    try {
+        const Eigen::VectorXd x = z.head(n), v0 = z.segment(n + 2, n), v1 = z.segment(2 * n + 2, n);
+        const Eigen::VectorXd u = s.stack_constant(x);
+        const std::vector<Eigen::MatrixXd> a = s.jacobians(u, p);
+        const std::vector<double> tau = s.delays(p);
+        Eigen::MatrixXd d0 = -a[0], d1 = Eigen::MatrixXd::Identity(n, n);
+        for (std::size_t k = 1; k < a.size(); ++k) d0 -= a[k], d1 += tau[k - 1] * a[k];
+        g.resize(3 * n + 2);
+        g.head(n) = s.f(u, p);
+        g.segment(n, n) = d0 * v0;
+        g.segment(2 * n, n) = d0 * v1 + d1 * v0;
+        g[3 * n] = c.dot(v0) - 1.0;
+        g[3 * n + 1] = c.dot(v1);
+    } catch (const std::invalid_argument&) {
+        return false;
+    }
+    return g.allFinite();
+}
+
+/// Newton (central-difference Jacobian) on the Bogdanov-Takens system from the end of a Hopf
+/// curve: the equilibrium x, (p1, p2) and omega -> 0 there, v0 from Re q.
+HopfCurveBogdanovTakens locate_bogdanov_takens(const NonlinearDDE& s, int j1, int j2, const HopfCurvePoint& end) {
+    const int n = s.dimension();
+    HopfCurveBogdanovTakens bt;
+    bt.x = end.x, bt.par = end.par, bt.par2 = end.par2;
+    std::vector<double> p = s.parameter_values();
+    p[static_cast<std::size_t>(j1)] = end.par;
+    p[static_cast<std::size_t>(j2)] = end.par2;
+    Eigen::VectorXd z(3 * n + 2);
+    try {
+        const std::vector<Eigen::MatrixXd> a = s.jacobians(s.stack_constant(end.x), p);
+        const std::vector<double> tau = s.delays(p);
+        Eigen::MatrixXd d0 = -a[0], d1 = Eigen::MatrixXd::Identity(n, n);
+        for (std::size_t k = 1; k < a.size(); ++k) d0 -= a[k], d1 += tau[k - 1] * a[k];
+        Eigen::JacobiSVD<Eigen::MatrixXd> svd(d0, Eigen::ComputeFullV);
+        Eigen::VectorXd v0 = svd.matrixV().col(n - 1);
+        // v1: [Delta(0); v0^T] v1 = [-Delta'(0) v0; 0] in the least-squares sense
+        Eigen::MatrixXd m(n + 1, n);
+        m.topRows(n) = d0;
+        m.row(n) = v0.transpose();
+        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + 1);
+        rhs.head(n) = -d1 * v0;
+        const Eigen::VectorXd v1 = m.completeOrthogonalDecomposition().solve(rhs);
+        z << end.x, end.par, end.par2, v0, v1;
+    } catch (const std::invalid_argument&) {
+        bt.status = Status::NumericalIssue;
+        bt.message = "the linearisation is not defined at the curve's end";
+        return bt;
+    }
+    const Eigen::VectorXd c = z.segment(n + 2, n);
+    const int N = 3 * n + 2;
+    Eigen::VectorXd g, gp, gm;
+    Eigen::MatrixXd J(N, N);
+    bt.status = Status::MaxIterations;
+    for (int it = 0; it < 40; ++it) {
+        if (!bogdanov_takens_system(s, j1, j2, c, z, g)) {
+            bt.status = Status::NumericalIssue;
+            bt.message = "the Bogdanov-Takens system is not defined at an iterate";
+            break;
+        }
+        bt.residual = g.cwiseAbs().maxCoeff();
+        for (int k = 0; k < N; ++k) {
+            const double h = 1e-7 * std::max(1.0, std::abs(z[k]));
+            Eigen::VectorXd zp = z, zm = z;
+            zp[k] += h, zm[k] -= h;
+            if (!bogdanov_takens_system(s, j1, j2, c, zp, gp) || !bogdanov_takens_system(s, j1, j2, c, zm, gm)) {
+                bt.status = Status::NumericalIssue;
+                bt.message = "the Bogdanov-Takens system is not defined next to an iterate";
+                break;
+            }
+            J.col(k) = (gp - gm) / (2.0 * h);
+        }
+        if (bt.status == Status::NumericalIssue) break;
+        const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+        if (!lu.isInvertible()) {
+            bt.status = Status::NumericalIssue;
+            bt.message = "the Bogdanov-Takens system is singular (a degenerate point)";
+            break;
+        }
+        const Eigen::VectorXd step = lu.solve(g);
+        z -= step;
+        if (step.cwiseAbs().maxCoeff() <= 1e-13 * std::max(1.0, z.cwiseAbs().maxCoeff())) {
+            if (bogdanov_takens_system(s, j1, j2, c, z, g)) bt.residual = g.cwiseAbs().maxCoeff();
+            bt.status = bt.residual <= 1e-10 ? Status::Converged : Status::NumericalIssue;
+            bt.message = bt.residual <= 1e-10 ? "located" : "Newton stalled with residual " + detail::format_number(bt.residual);
+            break;
+        }
+    }
+    bt.x = z.head(n), bt.par = z[n], bt.par2 = z[n + 1];
+    if (converged(bt.status) && s.has_higher_derivatives()) {
+        p[static_cast<std::size_t>(j1)] = bt.par;
+        p[static_cast<std::size_t>(j2)] = bt.par2;
+        bt.normal_form = bogdanov_takens_normal_form(s, bt.x, p);
+    }
+    if (bt.message.empty()) bt.message = "Newton did not converge in 40 iterations";
+    return bt;
+}
+
 /// The stacked double Hopf system in v = (x, p1, Re q1, Im q1, omega1, p2, Re q2, Im q2, omega2).
 bool double_hopf_system(const NonlinearDDE& s, int j1, int j2, const VectorXc& q01, const VectorXc& q02, const Eigen::VectorXd& v,
                         Eigen::VectorXd& g, Eigen::MatrixXd* jac) {
@@ -654,15 +759,20 @@ HopfCurve trace_hopf_curve(const NonlinearDDE& s, const HopfPoint& start, double
     curve.message = std::to_string(curve.points.size()) + " points, " + std::to_string(curve.generalised.size()) + " generalised Hopf, " +
                     std::to_string(curve.double_hopf.size()) + " double Hopf, " + std::to_string(curve.zero_hopf.size()) +
                     " zero-Hopf points; " + traced_curve.end_text();
-    // a curve that leaves the domain as omega falls to 0 ends near a Bogdanov-Takens point (not located)
+    // a curve that leaves the domain as omega falls to 0 (its last point's omega below a tenth of
+    // the largest on it) ends at a Bogdanov-Takens point: located from its last point
     double wmax = 0.0;
     for (const HopfCurvePoint& p : curve.points) wmax = std::max(wmax, p.omega);
     for (int d = 0; d < 2; ++d) {
         if (stops[d] != ContinuationStop::LeftDomain || curve.points.empty()) continue;
         const HopfCurvePoint& end = d == 0 ? curve.points.back() : curve.points.front();
-        if (end.omega <= 0.01 * wmax)
-            curve.message += "; near a Bogdanov-Takens point at its " + std::string(d == 0 ? "forward" : "backward") + " end (omega " +
-                             detail::format_number(end.omega) + " -> 0; located on the fold curve of the equilibria there, fold_curves)";
+        if (!(end.omega <= 0.1 * wmax)) continue;  // (the domain is omega > 0: a curve leaves it only there)
+        HopfCurveBogdanovTakens bt = locate_bogdanov_takens(s, j1, s.parameter_index(o.parameter2), end);
+        bt.forward = d == 0;
+        curve.message += "; at its " + std::string(d == 0 ? "forward" : "backward") + " end (omega " + detail::format_number(end.omega) +
+                         " -> 0) a Bogdanov-Takens point" +
+                         (converged(bt.status) ? " (located, residual " + detail::format_number(bt.residual) + ")" : " not located: " + bt.message);
+        curve.bogdanov_takens.push_back(std::move(bt));
     }
     if (!coefficients_ok) curve.message += "; L1 not computed at some points";
     if (!genh_ok) curve.message += "; a generalised Hopf point was not located";

@@ -227,6 +227,20 @@ TEST_CASE("the Hopf curve of x' = p1 + x^2 + p2 x(t - 2) ends at the Bogdanov-Ta
     CHECK(std::abs(last->par - bt.par) < w2);
     CHECK(std::abs(last->par2 - bt.par2) < w2);
     CHECK(std::abs(last->x[0] - bt.x[0]) < w2);
+    // the Hopf curve locates the point itself: the closed form p2 = -1/tau, x = -p2/2, p1 = -x^2 -
+    // p2 x (the fold 2 x + p2 = 0 and Delta'(0) = 1 + tau p2 = 0), and its normal form a = 2/tau,
+    // b = 4/3 (normal_forms' test), as the fold curve's
+    REQUIRE(c.bogdanov_takens.size() == 1);
+    const HopfCurveBogdanovTakens& hb = c.bogdanov_takens[0];
+    INFO(hb.message);
+    REQUIRE(hb.status == Status::Converged);
+    CHECK(std::abs(hb.par2 + 0.5) < 1e-10);
+    CHECK(std::abs(hb.x[0] - 0.25) < 1e-10);
+    CHECK(std::abs(hb.par - 0.0625) < 1e-10);
+    REQUIRE(hb.normal_form.status == Status::Converged);
+    CHECK(std::abs(hb.normal_form.a - 1.0) < tol::normal_form_exact);
+    CHECK(std::abs(hb.normal_form.b - 4.0 / 3.0) < tol::normal_form_exact);
+    CHECK(std::abs(hb.normal_form.a - bt.nf_a) < tol::normal_form_exact);
 }
 
 TEST_CASE("fold curves: bad options are refused naming the field") {

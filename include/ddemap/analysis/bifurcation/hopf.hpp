@@ -183,12 +183,30 @@ struct GeneralisedHopfPoint {
     GeneralisedHopfNormalForm normal_form;
 };
 
+/// A Bogdanov-Takens point where a Hopf curve ends (omega -> 0: the pair +-i omega becomes a double
+/// root 0). Located by Newton on the Jordan-chain system in (x, p1, p2, v0, v1), 3n + 2 unknowns:
+///     f(x; p) = 0,  Delta(0) v0 = 0,  Delta(0) v1 + Delta'(0) v0 = 0,  c . v0 = 1,  c . v1 = 0
+/// (c the first v0), its Jacobian by central differences, from the curve's last point; the
+/// residual of the system at the result (exact) must be below 1e-10. With its normal form (a, b)
+/// in DDE-BIFTOOL's normalisation (normal_forms.hpp), as on fold curves.
+struct HopfCurveBogdanovTakens {
+    double par = 0.0, par2 = 0.0;
+    Eigen::VectorXd x;
+    Status status = Status::MaxIterations;
+    std::string message;
+    double residual = std::numeric_limits<double>::infinity();
+    bool forward = true;  ///< at the forward end of the curve (else the backward one)
+    BogdanovTakensNormalForm normal_form;
+};
+
 struct HopfCurve {
     int start = 0;  ///< the index of the Hopf point of the branch it starts from (-1: from a double Hopf point of another curve)
     std::vector<HopfCurvePoint> points;  ///< in order along the curve
     std::vector<GeneralisedHopfPoint> generalised;
     std::vector<DoubleHopfPoint> double_hopf;  ///< where the count of roots right of the axis changed by 2
     std::vector<ZeroHopfPoint> zero_hopf;      ///< where it changed by 1
+    /// where the curve ends as omega falls to 0 (below 1 % of its largest on the curve)
+    std::vector<HopfCurveBogdanovTakens> bogdanov_takens;
     ContinuationStop stop_backward = ContinuationStop::MaxPoints, stop_forward = ContinuationStop::MaxPoints;
     Status status = Status::Converged;
     std::string message;
