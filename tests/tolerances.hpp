@@ -391,6 +391,14 @@ constexpr double fold_curve_vs_branch = 1e-8;
 /// ring): the orbit's collocation error at small amplitude (degree 4, 40 intervals: ~1e-8) and the
 /// generalised Hopf point's location (1e-13 of L1's scale); 1e-6.
 constexpr double fold_curve_floor = 1e-6;
+/// A fold curve of periodic orbits against exact rotating waves (their fold in closed form but
+/// for one scalar root): the orbits are sinusoids, which collocation of degree 4 on 40 intervals
+/// reproduces to its O(h^8) error (~1e-11 here), and the curve's points are Newton's to 1e-10 of
+/// max |u|. At a fold p1 is quadratic along the branch, so p1 is fixed to that (measured 1.6e-10;
+/// 1e-8), the orbit along the branch only to the square root of the fold test's accuracy (|g| ~
+/// 1e-15): the period to ~3e-8 relative (measured 1.2e-8; 1e-7).
+constexpr double fold_curve_exact_waves = 1e-8;
+constexpr double fold_curve_exact_waves_period = 1e-7;
 /// The distance to the other string verdict (verdict_distance): the flip point is bisected on
 /// the segment from the car to 1e-6 of the distance, so the closed-form low-frequency coefficient
 /// B there is within ~1e-6 |grad B . (x - x0)| (~0.1 for the car tested; measured 1.7e-8) of 0; 1e-6.

@@ -512,6 +512,18 @@ std::string bistability_svg(const BistabilityChart& chart, const std::string& un
     for (PlotFill* f : {&bistable, &unstable, &undecided})
         if (!f->polygons.empty()) panel.fills.push_back(std::move(*f));
     add_hopf_curves(panel, chart.hopf, false);
+    // a bistable cell narrower than 0.5 % of the box on its widest line (as beside a generalised
+    // Hopf point with a small L2) would not show: marked at its representative point
+    bool thin = false;
+    for (const BistabilityCell& c : chart.cells) {
+        if (!c.bistable || c.status != Status::Converged) continue;
+        double widest = 0.0;
+        for (const auto& iv : c.intervals) widest = std::max(widest, iv.hi - iv.lo);
+        if (widest < 0.005 * (chart.to - chart.from)) {
+            panel.markers.push_back({c.par, c.par2, "#c05800", "B"});
+            thin = true;
+        }
+    }
     for (const OrbitFoldCurve& c : chart.folds) {
         PlotSeries sr{"fold of periodic orbits", {}, {}, "#2ca02c", false};
         for (const OrbitFoldCurvePoint& q : c.points) {
@@ -526,7 +538,8 @@ std::string bistability_svg(const BistabilityChart& chart, const std::string& un
     po.panel_width = 560.0;
     po.panel_height = 420.0;
     po.note = "shading: the verdict of each cell of the box cut by the curves, from a slice in " + parameter_symbol(chart.parameter) +
-              " at one point of it (orbits born at a Hopf point; isolas not seen); GH: generalised Hopf point (L1 = 0)";
+              " at one point of it (orbits born at a Hopf point; isolas not seen); GH: generalised Hopf point (L1 = 0)" +
+              (thin ? std::string("; B: a bistable cell too thin to see (below 0.5 % of the box wide)") : std::string());
     return render_line_plots_svg({panel}, po);
 }
 

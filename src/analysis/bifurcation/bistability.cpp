@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <numeric>
+#include <set>
+#include <tuple>
 #include <stdexcept>
 #include <utility>
 
@@ -35,6 +38,7 @@ struct Slice {
     double par2 = 0.0;
     EquilibriumBranch eq;
     std::vector<OrbitBranch> orbits;
+    std::vector<double> orbit_start;  ///< p1 of the Hopf point each orbit branch starts from
     Status status = Status::Converged;
     std::string message;
 };
@@ -98,6 +102,34 @@ struct UnionFind {
     }
     void unite(int a, int b) { parent[static_cast<std::size_t>(find(a))] = find(b); }
 };
+
+/// A point of a branch in order along it: a regular point with its verdict, or a special point
+/// (a Hopf point, a fold, a period doubling, a torus bifurcation) where the verdict may change.
+struct BranchNode {
+    double order = 0.0;  ///< position along the branch (a special point after point i: i + 0.5)
+    double par = 0.0;
+    enum Kind { Stable, Unstable, Undecided, Special } kind = Special;
+};
+
+/// Whether the branch has a stable part over p1 = m: 1 when some piece between consecutive nodes
+/// around m is stable (its regular ends stable; a special end bounds the piece and takes the
+/// verdict of the other, since between a regular point and the next special point nothing
+/// changes: every crossing of a step is a located special point), 0 when none is, -1 when none is
+/// stable and some piece around m has no verdict (an undecided end, or two special ends: two
+/// changes within one step, the verdict between them unknown).
+int stable_over(std::vector<BranchNode> nodes, double m) {
+    std::stable_sort(nodes.begin(), nodes.end(), [](const BranchNode& a, const BranchNode& b) { return a.order < b.order; });
+    bool unknown = false;
+    for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+        const BranchNode &a = nodes[i], &b = nodes[i + 1];
+        if ((a.par - m) * (b.par - m) > 0.0) continue;
+        if (a.kind == BranchNode::Undecided || b.kind == BranchNode::Undecided || (a.kind == BranchNode::Special && b.kind == BranchNode::Special))
+            unknown = true;
+        else if (a.kind != BranchNode::Unstable && b.kind != BranchNode::Unstable)
+            return 1;
+    }
+    return unknown ? -1 : 0;
+}
 
 }  // namespace
 
@@ -181,6 +213,10 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     // --par2`, one dense monodromy eigenproblem per point, most of the time on longer rings) are
     // not computed; |g| and the residual certify them
     fo.orbit.floquet = false;
+    // and their steps are measured in units of the state's size (the norm measures the profile in
+    // the system's units: the fold curve of a ring of speeds and gaps of 20-30 m, whose waves swing
+    // by 10-40 m/s, took 400 points of 0.1 m/s for a tenth of its box)
+    fo.orbit.max_step *= std::max(1.0, guess.cwiseAbs().maxCoeff());
     fo.parameter2 = o.parameter2;
     fo.from2 = o.from2;
     fo.to2 = o.to2;
@@ -216,6 +252,7 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
                 reached = reached || (b.stop == "hopf" && !b.points.empty() && std::abs(b.points.back().par - h.par) < 0.02 * width);
             if (reached) continue;
             s.orbits.push_back(orbit_branch_from_hopf(system, h, so));
+            s.orbit_start.push_back(h.par);
             report(h.par);
             const OrbitBranch& b = s.orbits.back();
             const bool outside = !b.points.empty() && (b.points.back().par < o.from || b.points.back().par > o.to);
@@ -238,11 +275,29 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
         }
         return out;
     };
+    // an end of a fold curve at a generalised Hopf point (stop "hopf": its orbits shrink, and its
+    // last point lies within the fold system's reach of the point, ~a^2 away) is joined to the
+    // located point within 2 % of the box, so that the curve meets the Hopf curve there
+    auto generalised_near = [&](double p1, double p2, std::pair<double, double>& at) {
+        double best = 0.02;
+        for (const HopfCurve& h : chart.hopf.curves)
+            for (const GeneralisedHopfPoint& g : h.generalised) {
+                const double d = std::hypot((g.par - p1) / width, (g.par2 - p2) / height);
+                if (g.status == Status::Converged && d < best) {
+                    best = d;
+                    at = {g.par, g.par2};
+                }
+            }
+        return best < 0.02;
+    };
     auto fold_lines = [&] {
         std::vector<Polyline> out;
         for (const OrbitFoldCurve& c : chart.folds) {
             Polyline l;
             for (const OrbitFoldCurvePoint& q : c.points) l.emplace_back(q.par, q.par2);
+            std::pair<double, double> g;
+            if (!l.empty() && c.stop_backward == "hopf" && generalised_near(l.front().first, l.front().second, g)) l.insert(l.begin(), g);
+            if (!l.empty() && c.stop_forward == "hopf" && generalised_near(l.back().first, l.back().second, g)) l.push_back(g);
             out.push_back(std::move(l));
         }
         return out;
@@ -254,6 +309,56 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
         for (double v : x)
             if (std::abs(v - p1) <= 0.01 * width) return true;
         return false;
+    };
+    // whether the fold f of an orbit branch at p2 lies on a traced fold curve: a crossing of p2
+    // within 1 % of the box's width in p1 and 1 % in the period (two folds of one branch can be
+    // closer in p1 than that, as near a cusp of folds, but differ in their orbits)
+    auto on_fold_curve = [&](const OrbitFold& f, double p2) {
+        for (const OrbitFoldCurve& c : chart.folds)
+            for (std::size_t i = 0; i + 1 < c.points.size(); ++i) {
+                const OrbitFoldCurvePoint &a = c.points[i], &b = c.points[i + 1];
+                if ((a.par2 <= p2) == (b.par2 <= p2)) continue;
+                const double t = (p2 - a.par2) / (b.par2 - a.par2);
+                const double p1 = a.par + t * (b.par - a.par), period = a.orbit.period + t * (b.orbit.period - a.orbit.period);
+                if (std::abs(p1 - f.par) <= 0.01 * width && std::abs(period - f.period) <= 0.01 * f.period) return true;
+            }
+        return false;
+    };
+    auto trace_fold = [&](const OrbitFold& f, double p2) {
+        system.set_parameter(o.parameter2, p2);
+        chart.folds.push_back(orbit_fold_curve(system, f, fo));
+        report(f.par);
+        if (chart.folds.back().status != Status::Converged)
+            fail(chart.folds.back().status,
+                 "the fold curve through " + o.parameter + " = " + detail::format_number(f.par) + ": " + chart.folds.back().message);
+    };
+    // where Hopf curve k crosses the line p2 = y: the chord's crossing corrected onto the curve (the
+    // Hopf point in p1 at that p2, Newton from the chord's x, p1 and omega; the chord itself where
+    // that fails or moves by more than 1 % of the box). A chord of a curve with steps of a few % of
+    // the box is off it by ~1e-4 of the box, wider than a band between the Hopf curve and a fold
+    // curve born at a generalised Hopf point with a small L2 (7e-5 on the acc ring): the order of
+    // the crossings on the line, so the cells, would be wrong. Cached by (curve, segment, line).
+    const int p1_index = system.parameter_index(o.parameter);
+    std::map<std::tuple<std::size_t, std::size_t, double>, double> hopf_cache;
+    auto hopf_crossings = [&](std::size_t k, double y, std::vector<std::pair<double, int>>& out) {
+        const std::vector<HopfCurvePoint>& pts = chart.hopf.curves[k].points;
+        for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+            const HopfCurvePoint &a = pts[i], &b = pts[i + 1];
+            if ((a.par2 <= y) == (b.par2 <= y)) continue;
+            auto found = hopf_cache.find({k, i, y});
+            if (found == hopf_cache.end()) {
+                const double t = (y - a.par2) / (b.par2 - a.par2);
+                const double chord = a.par + t * (b.par - a.par);
+                double p1 = chord;
+                if (a.x.size() == b.x.size() && a.x.size() > 0) {
+                    system.set_parameter(o.parameter2, y);
+                    const HopfPoint h = correct_hopf(system, p1_index, a.x + t * (b.x - a.x), chord, a.omega + t * (b.omega - a.omega));
+                    if (h.status == Status::Converged && std::abs(h.par - chord) <= 0.01 * width) p1 = h.par;
+                }
+                found = hopf_cache.emplace(std::make_tuple(k, i, y), p1).first;
+            }
+            out.emplace_back(found->second, static_cast<int>(k));
+        }
     };
     // traces the curves through the folds and Hopf points of a slice that lie on none traced;
     // returns whether it traced any
@@ -271,20 +376,70 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
         }
         for (const OrbitBranch& b : s.orbits)
             for (const OrbitFold& f : b.folds) {
-                if (!f.located || f.par < o.from || f.par > o.to || on_lines(fold_lines(), f.par, s.par2)) continue;  // (the slices' orbits run beyond the box)
-                system.set_parameter(o.parameter2, s.par2);
-                chart.folds.push_back(orbit_fold_curve(system, f, fo));
-                report(f.par);
-                if (chart.folds.back().status != Status::Converged)
-                    fail(chart.folds.back().status, "the fold curve through " + o.parameter + " = " + detail::format_number(f.par) + ": " +
-                                                        chart.folds.back().message);
+                if (!f.located || f.par < o.from || f.par > o.to || on_fold_curve(f, s.par2)) continue;  // (the slices' orbits run beyond the box)
+                trace_fold(f, s.par2);
                 any = true;
+            }
+        return any;
+    };
+    // the fold curves born at the generalised Hopf points: where L2 != 0 a curve of folds of
+    // orbits starts at the point, on the side of the Hopf curve where L1 L2 < 0 (the orbits from a
+    // Hopf point there turn back at an amplitude ~ sqrt(-L1 / (2 L2)), in p1 ~ L1^2 / (4 L2) from
+    // it): a band along the Hopf curve too thin for slices to meet. From the Hopf curve's points on
+    // that side (both sides when L2 has no value), nearest first but at least 1 % of the box from
+    // the point (so that the fold lies beyond the branch's first orbit), up to 3 of them: the orbit
+    // branch from the Hopf point there (at most 150 orbits) and the curves through its folds. A
+    // side where none of them finds a fold although L2 says there is one leaves the chart
+    // undecided. Returns whether it traced any.
+    std::set<std::pair<std::size_t, std::size_t>> seeded;  // (curve, generalised Hopf point)
+    auto seed_generalised = [&] {
+        bool any = false;
+        for (std::size_t ci = 0; ci < chart.hopf.curves.size(); ++ci)
+            for (std::size_t gi = 0; gi < chart.hopf.curves[ci].generalised.size(); ++gi) {
+                if (!seeded.insert({ci, gi}).second) continue;
+                const HopfCurve c = chart.hopf.curves[ci];  // a copy: tracing adds curves
+                const GeneralisedHopfPoint& g = c.generalised[gi];
+                if (g.status != Status::Converged) continue;
+                const double l2 = g.normal_form.status == Status::Converged ? g.normal_form.l2 : std::numeric_limits<double>::quiet_NaN();
+                const bool known = std::isfinite(l2) && l2 != 0.0;
+                for (int side : {-1, 1}) {
+                    int tried = 0;
+                    bool found = false;
+                    for (int j = side < 0 ? g.after : g.after + 1; j >= 0 && j < static_cast<int>(c.points.size()) && tried < 3 && !found; j += side) {
+                        const HopfCurvePoint& q = c.points[static_cast<std::size_t>(j)];
+                        if (q.coefficients.status != Status::Converged) continue;
+                        if (known && !(q.coefficients.l1 * l2 < 0.0)) break;  // the side without the fold curve
+                        if (std::hypot((q.par - g.par) / width, (q.par2 - g.par2) / height) < 0.01) continue;
+                        ++tried;
+                        system.set_parameter(o.parameter2, q.par2);
+                        const HopfPoint h = correct_hopf(system, p1_index, q.x, q.par, q.omega);
+                        if (h.status != Status::Converged) continue;
+                        PeriodicOrbitOptions so = po;
+                        so.from = o.from - 0.5 * width;
+                        so.to = o.to + 0.5 * width;
+                        so.max_points = std::min(o.max_points, 150);
+                        const OrbitBranch b = orbit_branch_from_hopf(system, h, so);
+                        report(h.par);
+                        for (const OrbitFold& f : b.folds) {
+                            if (!f.located) continue;
+                            found = true;
+                            if (f.par < o.from || f.par > o.to || on_fold_curve(f, q.par2)) continue;
+                            trace_fold(f, q.par2);
+                            any = true;
+                        }
+                    }
+                    if (known && tried > 0 && !found)
+                        fail(Status::NumericalIssue, "no fold of orbits found beside the generalised Hopf point at " + o.parameter + " = " +
+                                                         detail::format_number(g.par) + ", " + o.parameter2 + " = " + detail::format_number(g.par2) +
+                                                         " although L2 = " + detail::format_number(l2) + " implies a curve of them there");
+                }
             }
         return any;
     };
 
     // 2. the fold curves through the folds of the orbits at the held p2
     trace_new(slice_at(held));
+    seed_generalised();
 
     // 3. and 4. cells and their verdicts, again while a slice meets a curve not traced
     std::map<int, Slice> slices;  // by line
@@ -297,20 +452,44 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
             int line, id;
             double lo, hi;
             int left, right;  // the curves (or faces, -1 and -2) that bound it
+            /// per curve: the parity of its crossings of the line left of the piece
+            std::vector<bool> side;
         };
         std::vector<Piece> pieces, previous;
         for (int r = 0; r < o.rows; ++r) {
             const double y = o.from2 + (r + 0.5) * height / o.rows;
             std::vector<std::pair<double, int>> x;
-            for (std::size_t k = 0; k < lines.size(); ++k) crossings(lines[k], y, x, static_cast<int>(k));
+            for (std::size_t k = 0; k < lines.size(); ++k) {
+                if (k < chart.hopf.curves.size()) hopf_crossings(k, y, x);
+                else crossings(lines[k], y, x, static_cast<int>(k));
+            }
+            // (crossings left of the box count in the pieces' sides: a curve that leaves the box
+            // through its left face does not change the side of the pieces right of it)
+            // and so does a curve that ends on the left face, continued outside along the ray of
+            // its last step (it was followed in the box only)
+            std::vector<bool> side(lines.size(), false);
+            for (const auto& v : x)
+                if (!(v.first > o.from)) side[static_cast<std::size_t>(v.second)] = !side[static_cast<std::size_t>(v.second)];
+            for (std::size_t k = 0; k < lines.size(); ++k) {
+                const Polyline& l = lines[k];
+                if (l.size() < 2) continue;
+                for (int end = 0; end < 2; ++end) {
+                    const auto& e = end == 0 ? l.front() : l.back();
+                    const auto& before = end == 0 ? l[1] : l[l.size() - 2];
+                    const double dy = e.second - before.second;
+                    if (std::abs(e.first - o.from) <= 1e-9 * width && e.first < before.first && dy != 0.0 && (y - e.second) * dy > 0.0)
+                        side[k] = !side[k];
+                }
+            }
             x.erase(std::remove_if(x.begin(), x.end(), [&](const std::pair<double, int>& v) { return !(v.first > o.from && v.first < o.to); }), x.end());
             x.emplace_back(o.from, -1);
             x.emplace_back(o.to, -2);
             std::sort(x.begin(), x.end());
             std::vector<Piece> row;
             for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+                if (x[i].second >= 0) side[static_cast<std::size_t>(x[i].second)] = !side[static_cast<std::size_t>(x[i].second)];
                 if (!(x[i + 1].first > x[i].first)) continue;
-                Piece p{r, uf.add(), x[i].first, x[i + 1].first, x[i].second, x[i + 1].second};
+                Piece p{r, uf.add(), x[i].first, x[i + 1].first, x[i].second, x[i + 1].second, side};
                 // one cell with an overlapping piece of the line below when both are bounded by
                 // the same two curves, or when a path between them crosses no curve: the vertical
                 // segment in the middle of the overlap, or the segment between the two pieces'
@@ -320,15 +499,21 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
                 // never one of two
                 // (a thin slanted cell, as between a fold curve and the Hopf curve it touches,
                 // moves by more than its width from line to line: its pieces need not overlap, so
-                // the piece of the line below between the same two curves nearest it is joined)
+                // the piece of the line below between the same two curves nearest it is joined).
+                // Two pieces are joined only on the same side of every curve (the parity of its
+                // crossings left of them): where two curves cross between the lines, the pieces
+                // before and after the crossing between them lie on opposite sides of both, and
+                // the thin cells there (a bistable band where a fold curve crosses the Hopf curve)
+                // are not joined across it. A curve's turn in p2 keeps the parity; one that ends
+                // between the lines splits a cell in two (each decided on its own)
                 const Piece* same = nullptr;
                 for (const Piece& q : previous)
-                    if (q.left == p.left && q.right == p.right &&
+                    if (q.left == p.left && q.right == p.right && q.side == p.side &&
                         (!same || std::abs(q.lo + q.hi - p.lo - p.hi) < std::abs(same->lo + same->hi - p.lo - p.hi)))
                         same = &q;
                 if (same) uf.unite(p.id, same->id);
                 for (const Piece& q : previous) {
-                    if (!(q.lo < p.hi && p.lo < q.hi)) continue;
+                    if (!(q.lo < p.hi && p.lo < q.hi) || q.side != p.side) continue;
                     const double xm = 0.5 * (std::max(p.lo, q.lo) + std::min(p.hi, q.hi)), yq = y - height / o.rows;
                     if (!crosses_vertical(lines, xm, yq, y) || !crosses_segment(lines, 0.5 * (q.lo + q.hi), yq, 0.5 * (p.lo + p.hi), y))
                         uf.unite(p.id, q.id);
@@ -371,30 +556,50 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
             }
             const Slice& s = found->second;
             const double m = c.par;
-            // the equilibrium: both branch points around m stable
-            for (std::size_t i = 0; i + 1 < s.eq.points.size(); ++i) {
-                const EquilibriumPoint &a = s.eq.points[i], &b = s.eq.points[i + 1];
-                if ((a.par - m) * (b.par - m) <= 0.0 && a.stable && b.stable) c.equilibrium_stable = true;
+            // the equilibrium: a stable piece of the branch over m (between two branch points,
+            // or a branch point and a Hopf point or fold next to it: a thin cell beside a curve
+            // lies within one step of the branch)
+            std::vector<BranchNode> nodes;
+            for (std::size_t i = 0; i < s.eq.points.size(); ++i) {
+                const EquilibriumPoint& a = s.eq.points[i];
+                nodes.push_back({static_cast<double>(i), a.par,
+                                 a.roots_status != Status::Converged ? BranchNode::Undecided : a.stable ? BranchNode::Stable : BranchNode::Unstable});
             }
-            // a stable orbit: two neighbouring orbits of a branch around m, both stable
-            bool undecided = false;
-            for (const OrbitBranch& b : s.orbits)
-                for (std::size_t i = 0; i + 1 < b.points.size(); ++i) {
-                    const PeriodicOrbit &a = b.points[i], &z = b.points[i + 1];
-                    if ((a.par - m) * (z.par - m) > 0.0) continue;
-                    if (!a.undecided.empty() || !z.undecided.empty()) undecided = true;
-                    else if (a.stable && z.stable) c.stable_orbit = true;
-                }
+            for (const HopfPoint& h : s.eq.hopf) nodes.push_back({h.after + 0.5, h.par, BranchNode::Special});
+            for (const FoldPoint& f : s.eq.folds) nodes.push_back({f.after + 0.5, f.par, BranchNode::Special});
+            const int eq = stable_over(nodes, m);
+            c.equilibrium_stable = eq == 1;
+            bool orbit_undecided = false;
+            // a stable orbit: a stable piece of an orbit branch over m (its Hopf point, folds,
+            // period doublings and tori bound the pieces)
+            for (std::size_t k = 0; k < s.orbits.size(); ++k) {
+                const OrbitBranch& b = s.orbits[k];
+                nodes.clear();
+                nodes.push_back({-0.5, s.orbit_start[k], BranchNode::Special});
+                for (std::size_t i = 0; i < b.points.size(); ++i)
+                    nodes.push_back({static_cast<double>(i), b.points[i].par,
+                                     !b.points[i].undecided.empty() ? BranchNode::Undecided : b.points[i].stable ? BranchNode::Stable : BranchNode::Unstable});
+                for (const OrbitFold& f : b.folds) nodes.push_back({f.after + 0.5, f.par, BranchNode::Special});
+                for (const OrbitCrossing& x : b.period_doublings) nodes.push_back({x.after + 0.5, x.par, BranchNode::Special});
+                for (const OrbitCrossing& x : b.tori) nodes.push_back({x.after + 0.5, x.par, BranchNode::Special});
+                const int v = stable_over(nodes, m);
+                if (v == 1) c.stable_orbit = true;
+                else if (v < 0) orbit_undecided = true;
+            }
+            // no verdict: the equilibrium's, or no stable orbit found beside a piece without one
+            const bool undecided = eq < 0 || (orbit_undecided && !c.stable_orbit);
             c.bistable = c.equilibrium_stable && c.stable_orbit;
             if (s.status != Status::Converged) {
                 c.status = s.status;
                 c.message = s.message;
             } else if (undecided) {
                 c.status = Status::NumericalIssue;
-                c.message = "an orbit at " + o.parameter + " = " + detail::format_number(m) + ", " + o.parameter2 + " = " + detail::format_number(c.par2) +
-                            " has no stability verdict";
+                c.message = std::string(eq < 0 ? "the equilibrium" : "an orbit") + " at " + o.parameter + " = " + detail::format_number(m) + ", " +
+                            o.parameter2 + " = " + detail::format_number(c.par2) +
+                            " has no stability verdict (its roots or multipliers undecided, or two changes of stability within one step)";
             }
         }
+        traced = seed_generalised() || traced;
         if (!traced) break;
         if (round == 3) fail(Status::MaxIterations, "slices still met curves not traced after 4 rounds: the cells may be cut wrongly");
     }

@@ -1547,6 +1547,7 @@ FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::Mat
         z -= dz;
         ++r.iterations;
         last_step = dz.lpNorm<Eigen::Infinity>();
+
     }
     return r;
 }
@@ -1972,6 +1973,19 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
             const bool jump = r.ok && step.jumped(knorm(v - u));
             if (!r.ok || jump) {
                 if (!step.reject()) {
+                    // a fold curve coming to a generalised Hopf point: the fold system degenerates
+                    // as the amplitude a -> 0 (the fold's position is fixed only to ~1e-8 where
+                    // a is a few % of the curve's largest, and Newton stalls there); a corrector
+                    // that fails after the amplitude fell over the last 3 points to below a
+                    // quarter of the largest ends the curve there, as a regular end
+                    if (!torus && !doubling && out.size() >= 3) {
+                        const std::size_t k = out.size();
+                        const double a0 = amplitude(out[k - 3].orbit), a1 = amplitude(out[k - 2].orbit), a2 = amplitude(out[k - 1].orbit);
+                        if (a2 < a1 && a1 < a0 && a2 < 0.25 * amp_max) {
+                            stop = "hopf";
+                            return out;
+                        }
+                    }
                     stop = "step_below_minimum";
                     if (curve.status == Status::Converged) {
                         curve.status = jump ? Status::NumericalIssue : Status::MaxIterations;

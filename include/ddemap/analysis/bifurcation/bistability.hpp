@@ -8,16 +8,28 @@
 /// criticality changes) and the curves of folds of periodic orbits (orbit_fold_curve). The chart:
 ///  1. the Hopf curves through the Hopf points of the equilibrium branch in p1 at the held p2;
 ///  2. the orbit branches in p1 from every Hopf point at the held p2, and the fold curve through
-///     every fold on them (without the Floquet multipliers of its points: |g| certifies them);
+///     every fold on them (without the Floquet multipliers of its points: |g| certifies them; its
+///     steps in units of max(1, max |guess|), the state's size); and the fold curves born at the
+///     generalised Hopf points: where L2 != 0 a curve of folds of orbits starts at the point, on
+///     the side of the Hopf curve where L1 L2 < 0, in a band along it as thin as L1^2 / (4 L2) that
+///     slices rarely meet. From the Hopf curve's points on that side (nearest first, at least 1 %
+///     of the box away, up to 3), the orbit branch from the Hopf point there (at most 150 orbits)
+///     and the curves through its folds; none found although L2 says there is one: undecided;
 ///  3. the cells: the box cut by these curves. Each of `rows` horizontal lines p2 = const is cut at
-///     the curves' crossings (linear between curve points) into intervals; intervals of
-///     neighbouring lines that overlap belong to one cell (union-find);
+///     the curves' crossings into intervals (linear between a fold curve's points; a Hopf curve's
+///     crossing corrected onto the curve by Newton, since a chord is off it by more than such a
+///     band is wide; a fold curve's end at a generalised Hopf point joined to the point);
+///     intervals of neighbouring lines that overlap, or lie between the same two curves, belong
+///     to one cell (union-find) when they lie on the same side of every curve (the parity of its
+///     crossings left of them: two curves crossing between the lines separate the pieces);
 ///  4. one verdict per cell, at the middle of its widest interval, from a one-parameter slice at
-///     that p2: the equilibrium branch in p1 (stable there: both neighbouring branch points
-///     stable) and the orbit branches from its Hopf points, followed in p1 beyond the box by half
+///     that p2: the equilibrium branch in p1 (stable there: a piece of the branch over that p1
+///     stable, between two branch points or a branch point and the Hopf point or fold next to it)
+///     and the orbit branches from its Hopf points, followed in p1 beyond the box by half
 ///     its width on either side (a branch may leave the box and come back after a fold outside
-///     it; a failure outside the box leaves the slice decided), a stable orbit there: two
-///     neighbouring orbits of a branch that bracket p1 are both stable. Inside a cell nothing
+///     it; a failure outside the box leaves the slice decided), a stable orbit there: a piece of a
+///     branch over p1, between two orbits or an orbit and the Hopf point, fold, period doubling
+///     or torus next to it, with its orbits stable. Inside a cell nothing
 ///     changes (no curve crosses it), so one point decides it; a fold or a Hopf point met on a
 ///     slice that lies on no traced curve (more than 1 % of the box from each) is traced too and
 ///     the cells are cut again (up to 4 rounds), so that a curve that misses the held p2 is found

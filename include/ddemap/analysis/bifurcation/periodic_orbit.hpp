@@ -302,7 +302,9 @@ struct OrbitFoldCurve {
     /// why each end ended: "bound" (a face of the box), "max_points", "period" (above
     /// max_period_factor times the start's: towards a homoclinic orbit), "hopf" (the amplitude fell
     /// below 2 % of the largest on the curve, or the curve turned back in (p1, p2) below a quarter of
-    /// it: at a generalised Hopf point, where a fold curve meets the Hopf curve; a torus curve ends
+    /// it, or a fold curve's corrector failed after the amplitude fell over its last 3 points to
+    /// below a quarter of it: the fold system degenerates as a -> 0 and Newton stalls at ~1e-8
+    /// of the fold's position: at a generalised Hopf point, where a fold curve meets the Hopf curve; a torus curve ends
     /// so at a double Hopf or zero-Hopf point: orbit_curve_end_point), "resonance" (a torus curve's
     /// phi within 0.01 of 0 or pi, or across them within a step),
     /// "step_below_minimum"; first the end before `start`, then the end after
