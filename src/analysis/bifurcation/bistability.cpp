@@ -116,14 +116,22 @@ struct BranchNode {
 /// verdict of the other, since between a regular point and the next special point nothing
 /// changes: every crossing of a step is a located special point), 0 when none is, -1 when none is
 /// stable and some piece around m has no verdict (an undecided end, or two special ends: two
-/// changes within one step, the verdict between them unknown).
+/// changes within one step, the verdict between them unknown; so is a piece ending at one of
+/// several special points of one step, whose order along it is not known).
 int stable_over(std::vector<BranchNode> nodes, double m) {
     std::stable_sort(nodes.begin(), nodes.end(), [](const BranchNode& a, const BranchNode& b) { return a.order < b.order; });
+    // several special points within one step: their order along it is not known, so no piece
+    // that ends at one of them has a verdict
+    auto crowded = [&](std::size_t i) {
+        return nodes[i].kind != BranchNode::Stable && nodes[i].kind != BranchNode::Unstable &&
+               ((i > 0 && nodes[i - 1].order == nodes[i].order) || (i + 1 < nodes.size() && nodes[i + 1].order == nodes[i].order));
+    };
     bool unknown = false;
     for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
         const BranchNode &a = nodes[i], &b = nodes[i + 1];
         if ((a.par - m) * (b.par - m) > 0.0) continue;
-        if (a.kind == BranchNode::Undecided || b.kind == BranchNode::Undecided || (a.kind == BranchNode::Special && b.kind == BranchNode::Special))
+        if (a.kind == BranchNode::Undecided || b.kind == BranchNode::Undecided || (a.kind == BranchNode::Special && b.kind == BranchNode::Special) ||
+            crowded(i) || crowded(i + 1))
             unknown = true;
         else if (a.kind != BranchNode::Unstable && b.kind != BranchNode::Unstable)
             return 1;
@@ -328,9 +336,19 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
         system.set_parameter(o.parameter2, p2);
         chart.folds.push_back(orbit_fold_curve(system, f, fo));
         report(f.par);
-        if (chart.folds.back().status != Status::Converged)
-            fail(chart.folds.back().status,
-                 "the fold curve through " + o.parameter + " = " + detail::format_number(f.par) + ": " + chart.folds.back().message);
+        const OrbitFoldCurve& c = chart.folds.back();
+        if (c.status != Status::Converged)
+            fail(c.status, "the fold curve through " + o.parameter + " = " + detail::format_number(f.par) + ": " + c.message);
+        // an end where the orbits shrank must be at a located generalised Hopf point (joined to it
+        // below): else the curve's rest, and the cells it bounds, are unknown
+        std::pair<double, double> g;
+        for (int end = 0; end < 2 && !c.points.empty(); ++end) {
+            const OrbitFoldCurvePoint& q = end == 0 ? c.points.front() : c.points.back();
+            if ((end == 0 ? c.stop_backward : c.stop_forward) == "hopf" && !generalised_near(q.par, q.par2, g))
+                fail(Status::NumericalIssue, "the fold curve through " + o.parameter + " = " + detail::format_number(f.par) + " ends at (" +
+                                                 detail::format_number(q.par) + ", " + detail::format_number(q.par2) +
+                                                 ") where its orbits shrink, but no generalised Hopf point was located there");
+        }
     };
     // where Hopf curve k crosses the line p2 = y: the chord's crossing corrected onto the curve (the
     // Hopf point in p1 at that p2, Newton from the chord's x, p1 and omega; the chord itself where
@@ -353,7 +371,9 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
                 if (a.x.size() == b.x.size() && a.x.size() > 0) {
                     system.set_parameter(o.parameter2, y);
                     const HopfPoint h = correct_hopf(system, p1_index, a.x + t * (b.x - a.x), chord, a.omega + t * (b.omega - a.omega));
-                    if (h.status == Status::Converged && std::abs(h.par - chord) <= 0.01 * width) p1 = h.par;
+                    // (the same curve: omega as interpolated, not a neighbouring mode's)
+                    const double omega = a.omega + t * (b.omega - a.omega);
+                    if (h.status == Status::Converged && std::abs(h.par - chord) <= 0.01 * width && std::abs(h.omega - omega) <= 0.01 * omega) p1 = h.par;
                 }
                 found = hopf_cache.emplace(std::make_tuple(k, i, y), p1).first;
             }
@@ -387,52 +407,81 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
     // Hopf point there turn back at an amplitude ~ sqrt(-L1 / (2 L2)), in p1 ~ L1^2 / (4 L2) from
     // it): a band along the Hopf curve too thin for slices to meet. From the Hopf curve's points on
     // that side (both sides when L2 has no value), nearest first but at least 1 % of the box from
-    // the point (so that the fold lies beyond the branch's first orbit), up to 3 of them: the orbit
-    // branch from the Hopf point there (at most 150 orbits) and the curves through its folds. A
-    // side where none of them finds a fold although L2 says there is one leaves the chart
-    // undecided. Returns whether it traced any.
+    // the point (so that the fold lies beyond the branch's first orbit; the farthest one when none
+    // is), up to 3 of them: the orbit branch from the Hopf point there (at most 150 orbits), whose
+    // first fold must lie in the box, and the curves through its folds. Where the Hopf curve goes
+    // on beyond the point but none of them finds that fold, the chart is undecided. Returns
+    // whether it traced any.
     std::set<std::pair<std::size_t, std::size_t>> seeded;  // (curve, generalised Hopf point)
     auto seed_generalised = [&] {
         bool any = false;
         for (std::size_t ci = 0; ci < chart.hopf.curves.size(); ++ci)
             for (std::size_t gi = 0; gi < chart.hopf.curves[ci].generalised.size(); ++gi) {
                 if (!seeded.insert({ci, gi}).second) continue;
-                const HopfCurve c = chart.hopf.curves[ci];  // a copy: tracing adds curves
+                const HopfCurve& c = chart.hopf.curves[ci];  // (only fold curves are added below)
                 const GeneralisedHopfPoint& g = c.generalised[gi];
                 if (g.status != Status::Converged) continue;
                 const double l2 = g.normal_form.status == Status::Converged ? g.normal_form.l2 : std::numeric_limits<double>::quiet_NaN();
                 const bool known = std::isfinite(l2) && l2 != 0.0;
+                bool candidates = false, found = false;
+                std::string why;  // what went wrong at the points tried
                 for (int side : {-1, 1}) {
-                    int tried = 0;
-                    bool found = false;
-                    for (int j = side < 0 ? g.after : g.after + 1; j >= 0 && j < static_cast<int>(c.points.size()) && tried < 3 && !found; j += side) {
+                    // the side's points with a decided L1 of the fold side's sign, in order from
+                    // the point: those at least 1 % of the box away first, else the farthest
+                    std::vector<std::size_t> far, near;
+                    for (int j = side < 0 ? g.after : g.after + 1; j >= 0 && j < static_cast<int>(c.points.size()); j += side) {
                         const HopfCurvePoint& q = c.points[static_cast<std::size_t>(j)];
                         if (q.coefficients.status != Status::Converged) continue;
-                        if (known && !(q.coefficients.l1 * l2 < 0.0)) break;  // the side without the fold curve
-                        if (std::hypot((q.par - g.par) / width, (q.par2 - g.par2) / height) < 0.01) continue;
-                        ++tried;
+                        if (known && !(q.coefficients.l1 * l2 < 0.0)) break;  // the side without the fold curve (or past another such point)
+                        (std::hypot((q.par - g.par) / width, (q.par2 - g.par2) / height) < 0.01 ? near : far).push_back(static_cast<std::size_t>(j));
+                    }
+                    if (far.empty() && !near.empty()) far.push_back(near.back());
+                    if (far.size() > 3) far.resize(3);
+                    candidates = candidates || !far.empty();
+                    for (std::size_t j : far) {
+                        if (found) break;
+                        const HopfCurvePoint& q = c.points[j];
                         system.set_parameter(o.parameter2, q.par2);
                         const HopfPoint h = correct_hopf(system, p1_index, q.x, q.par, q.omega);
-                        if (h.status != Status::Converged) continue;
+                        if (h.status != Status::Converged) {
+                            why = "the Hopf point at " + o.parameter2 + " = " + detail::format_number(q.par2) + " did not converge";
+                            continue;
+                        }
                         PeriodicOrbitOptions so = po;
                         so.from = o.from - 0.5 * width;
                         so.to = o.to + 0.5 * width;
                         so.max_points = std::min(o.max_points, 150);
                         const OrbitBranch b = orbit_branch_from_hopf(system, h, so);
                         report(h.par);
+                        // the branch's first fold is the one born at the generalised Hopf point
+                        // (later ones may belong to other curves); it must lie in the box
+                        const OrbitFold* first = nullptr;
+                        for (const OrbitFold& f : b.folds)
+                            if (!first || f.after < first->after) first = &f;
+                        if (!first || !first->located || first->par < o.from || first->par > o.to) {
+                            why = "the orbits from the Hopf point at " + o.parameter2 + " = " + detail::format_number(q.par2) +
+                                  (b.status != Status::Converged ? " failed: " + b.message
+                                   : !first                     ? " did not fold within " + std::to_string(so.max_points) + " orbits"
+                                   : !first->located            ? " folded, but the fold was not located"
+                                                                : " folded outside the box");
+                            continue;
+                        }
+                        found = true;
                         for (const OrbitFold& f : b.folds) {
-                            if (!f.located) continue;
-                            found = true;
-                            if (f.par < o.from || f.par > o.to || on_fold_curve(f, q.par2)) continue;
+                            if (!f.located || f.par < o.from || f.par > o.to || on_fold_curve(f, q.par2)) continue;
                             trace_fold(f, q.par2);
                             any = true;
                         }
                     }
-                    if (known && tried > 0 && !found)
-                        fail(Status::NumericalIssue, "no fold of orbits found beside the generalised Hopf point at " + o.parameter + " = " +
-                                                         detail::format_number(g.par) + ", " + o.parameter2 + " = " + detail::format_number(g.par2) +
-                                                         " although L2 = " + detail::format_number(l2) + " implies a curve of them there");
                 }
+                // a generic generalised Hopf point (L2 != 0, also when its value failed) has a fold
+                // curve on one side: not finding it where the Hopf curve goes on is no verdict
+                if (candidates && !found)
+                    fail(Status::NumericalIssue, "no fold of orbits found beside the generalised Hopf point at " + o.parameter + " = " +
+                                                     detail::format_number(g.par) + ", " + o.parameter2 + " = " + detail::format_number(g.par2) +
+                                                     (known ? " although L2 = " + detail::format_number(l2) + " implies a curve of them there"
+                                                            : " (L2 not computed), where a curve of them starts") +
+                                                     (why.empty() ? std::string() : ": " + why));
             }
         return any;
     };
@@ -565,8 +614,10 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
                 nodes.push_back({static_cast<double>(i), a.par,
                                  a.roots_status != Status::Converged ? BranchNode::Undecided : a.stable ? BranchNode::Stable : BranchNode::Unstable});
             }
-            for (const HopfPoint& h : s.eq.hopf) nodes.push_back({h.after + 0.5, h.par, BranchNode::Special});
-            for (const FoldPoint& f : s.eq.folds) nodes.push_back({f.after + 0.5, f.par, BranchNode::Special});
+            for (const HopfPoint& h : s.eq.hopf)
+                nodes.push_back({h.after + 0.5, h.par, h.status == Status::Converged ? BranchNode::Special : BranchNode::Undecided});
+            for (const FoldPoint& f : s.eq.folds)
+                nodes.push_back({f.after + 0.5, f.par, f.status == Status::Converged ? BranchNode::Special : BranchNode::Undecided});
             const int eq = stable_over(nodes, m);
             c.equilibrium_stable = eq == 1;
             bool orbit_undecided = false;
@@ -576,12 +627,21 @@ BistabilityChart bistability_chart(NonlinearDDE& system, const Eigen::VectorXd& 
                 const OrbitBranch& b = s.orbits[k];
                 nodes.clear();
                 nodes.push_back({-0.5, s.orbit_start[k], BranchNode::Special});
+                // a branch that ended at another Hopf point: that point bounds its last piece
+                if (b.stop == "hopf" && !b.points.empty())
+                    for (const HopfPoint& h : s.eq.hopf)
+                        if (h.status == Status::Converged && std::abs(b.points.back().par - h.par) < 0.02 * width) {
+                            nodes.push_back({b.points.size() - 0.5, h.par, BranchNode::Special});
+                            break;
+                        }
                 for (std::size_t i = 0; i < b.points.size(); ++i)
                     nodes.push_back({static_cast<double>(i), b.points[i].par,
                                      !b.points[i].undecided.empty() ? BranchNode::Undecided : b.points[i].stable ? BranchNode::Stable : BranchNode::Unstable});
-                for (const OrbitFold& f : b.folds) nodes.push_back({f.after + 0.5, f.par, BranchNode::Special});
-                for (const OrbitCrossing& x : b.period_doublings) nodes.push_back({x.after + 0.5, x.par, BranchNode::Special});
-                for (const OrbitCrossing& x : b.tori) nodes.push_back({x.after + 0.5, x.par, BranchNode::Special});
+                // (a special point not located: its place is not known, its pieces have no verdict)
+                for (const OrbitFold& f : b.folds) nodes.push_back({f.after + 0.5, f.par, f.located ? BranchNode::Special : BranchNode::Undecided});
+                for (const OrbitCrossing& x : b.period_doublings)
+                    nodes.push_back({x.after + 0.5, x.par, x.located ? BranchNode::Special : BranchNode::Undecided});
+                for (const OrbitCrossing& x : b.tori) nodes.push_back({x.after + 0.5, x.par, x.located ? BranchNode::Special : BranchNode::Undecided});
                 const int v = stable_over(nodes, m);
                 if (v == 1) c.stable_orbit = true;
                 else if (v < 0) orbit_undecided = true;

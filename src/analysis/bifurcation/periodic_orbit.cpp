@@ -1547,7 +1547,6 @@ FoldCorrection correct_fold(FoldSystem& fs, Eigen::VectorXd& z, const Eigen::Mat
         z -= dz;
         ++r.iterations;
         last_step = dz.lpNorm<Eigen::Infinity>();
-
     }
     return r;
 }
@@ -1978,7 +1977,7 @@ OrbitFoldCurve orbit_bifurcation_curve(const NonlinearDDE& system, const Periodi
                     // a is a few % of the curve's largest, and Newton stalls there); a corrector
                     // that fails after the amplitude fell over the last 3 points to below a
                     // quarter of the largest ends the curve there, as a regular end
-                    if (!torus && !doubling && out.size() >= 3) {
+                    if (!r.ok && !torus && !doubling && out.size() >= 3) {
                         const std::size_t k = out.size();
                         const double a0 = amplitude(out[k - 3].orbit), a1 = amplitude(out[k - 2].orbit), a2 = amplitude(out[k - 1].orbit);
                         if (a2 < a1 && a1 < a0 && a2 < 0.25 * amp_max) {

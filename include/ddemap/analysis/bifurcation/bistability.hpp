@@ -14,14 +14,19 @@
 ///     the side of the Hopf curve where L1 L2 < 0, in a band along it as thin as L1^2 / (4 L2) that
 ///     slices rarely meet. From the Hopf curve's points on that side (nearest first, at least 1 %
 ///     of the box away, up to 3), the orbit branch from the Hopf point there (at most 150 orbits)
-///     and the curves through its folds; none found although L2 says there is one: undecided;
+///     and the curves through its folds (its first fold must lie in the box); none found where
+///     the Hopf curve goes on beyond the point: undecided;
 ///  3. the cells: the box cut by these curves. Each of `rows` horizontal lines p2 = const is cut at
 ///     the curves' crossings into intervals (linear between a fold curve's points; a Hopf curve's
 ///     crossing corrected onto the curve by Newton, since a chord is off it by more than such a
 ///     band is wide; a fold curve's end at a generalised Hopf point joined to the point);
 ///     intervals of neighbouring lines that overlap, or lie between the same two curves, belong
 ///     to one cell (union-find) when they lie on the same side of every curve (the parity of its
-///     crossings left of them: two curves crossing between the lines separate the pieces);
+///     crossings left of them, a curve that leaves through the left face continued along its last
+///     step: two curves crossing between the lines separate the pieces, and so does a curve's end
+///     inside the box for the pieces right of it, which may cut a region into two cells, never
+///     join two); a fold curve's end where its orbits shrink away from a located generalised
+///     Hopf point: undecided;
 ///  4. one verdict per cell, at the middle of its widest interval, from a one-parameter slice at
 ///     that p2: the equilibrium branch in p1 (stable there: a piece of the branch over that p1
 ///     stable, between two branch points or a branch point and the Hopf point or fold next to it)
