@@ -968,6 +968,22 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             const Outcome l2 = run(DesignObjective::Nearest);
             Eigen::VectorXd xn;
             if (crossing(l2, xn)) starts.insert(starts.begin(), xn);
+            // a run that reaches ||h||_1 = 1 ends the search (a global minimum), and a run costs
+            // up to kPeakEvaluations gradients of 1 + 2n norms: the starts are run in the order
+            // of their norm (one norm each; where it cannot be computed within the search's
+            // step budget, last, in the order given)
+            const auto tick = P.tick;
+            P.tick = nullptr;
+            std::vector<std::pair<double, std::size_t>> order;
+            for (std::size_t k = 0; k < starts.size(); ++k) {
+                const double v = P.value(starts[k], nullptr, DesignObjective::Peak);
+                order.emplace_back(std::isfinite(v) ? v : kInf, k);
+            }
+            P.tick = tick;
+            std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+            std::vector<Eigen::VectorXd> sorted;
+            for (const auto& [v, k] : order) sorted.push_back(starts[k]);
+            starts = std::move(sorted);
         }
     }
     const Outcome first = skipped ? Outcome{} : run(options.objective);
@@ -1017,6 +1033,40 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             x = xn;
             best_status = second.status;
             best_message = second.message;
+        }
+    } else if (options.objective == DesignObjective::Peak && !skipped && first.best <= 1.0 + std::max(options.peak.tolerance, 1e-6)) {
+        // peak reached its least value 1 (no overshoot), on a plateau of such gains; the runs are
+        // ordered by their start's norm, so the point may lie far from the car: of the gains
+        // on the segment from the car's own values to it, the nearest that is peak stable by
+        // the result's own verdict (bisection on that verdict; the point itself is kept where
+        // that verdict does not confirm it)
+        auto stable_at = [&](const Eigen::VectorXd& y) {
+            const Linearisation Ly = P.lin(y);
+            const double a = P.plant(y, Ly, nullptr);
+            if (!(a < 0.0)) return false;
+            return peak_string_stability(Ly, a, options.peak).verdict == Verdict::Stable;
+        };
+        if (stable_at(x)) {
+            double lo_t = 0.0, hi_t = 1.0;  // x0 + lo_t d not (or not shown) peak stable, x0 + hi_t d peak stable
+            if (stable_at(x0)) hi_t = 0.0;
+            for (int it = 0; it < 30 && hi_t - lo_t > 1e-6; ++it) {
+                const double m = 0.5 * (lo_t + hi_t);
+                if (stable_at(x0 + m * (x - x0))) hi_t = m;
+                else lo_t = m;
+            }
+            if (hi_t < 1.0) {
+                // recorded as a stage of its own, so that the path drawn ends at the result
+                DesignStart walk;
+                walk.objective = "peak";
+                walk.start = P.free_map(x);
+                x = x0 + hi_t * (x - x0);
+                walk.end = P.free_map(x);
+                walk.path = {walk.start, walk.end};
+                walk.value = P.value(x, nullptr, DesignObjective::Peak);
+                walk.message = "bisection on the peak verdict toward the car's own values";
+                r.starts.push_back(walk);
+                best_message += "; of the gains on the segment from the car's own values to that point, the nearest with no overshoot (bisection on the peak verdict)";
+            }
         }
     }
     if (options.progress && done < total) options.progress(total, total);

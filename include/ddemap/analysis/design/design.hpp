@@ -38,7 +38,11 @@
 /// its gradient is a difference of ||h||_1 (step 1e-3 of the value, the norm computed to 1e-6
 /// with at most 200,000 integrator steps during the search), at most 40 evaluations per run, so
 /// `peak` is slower and less precise than the others. sup-gamma and peak are at least 1: a run
-/// that reaches 1 has found a global minimum, and the remaining starts are skipped.
+/// that reaches 1 has found a global minimum, and the remaining starts are skipped. peak runs
+/// its starts in the order of their norm (one norm each; the nearest L2 design among them), and
+/// a point it reaches with ||h||_1 = 1 is walked back toward the car: the result is the point
+/// x0 + t (x - x0) of least t in [0, 1] found by bisection (to 1e-6 in t) on the certified peak
+/// verdict, a stage of its own in `starts`.
 /// The minimiser: solve/optimize/nonsmooth.hpp, in the coordinates z_j with
 /// x_j = lo_j + (hi_j - lo_j)(1 - cos z_j)/2 (the bounds reached at z_j = 0, pi), from the car's
 /// own values (moved a millionth of the box inside it when they lie outside or on a bound) and
