@@ -673,8 +673,22 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     std::string path;
     for (const auto& st : steps) path += (path.empty() ? "" : ", ") + detail::significant(st.worst_margin, 4) + " s";
     if (!r.infeasibility_proof.empty() && !r.robust_met) {
-        if (r.message.find(r.infeasibility_proof) == std::string::npos) r.message += "; " + r.infeasibility_proof;
-        r.message += "; so no robust design either";
+        const ParameterMap& at = steps.back().scenario;
+        if (at.empty()) {
+            if (r.message.find(r.infeasibility_proof) == std::string::npos) r.message += "; " + r.infeasibility_proof;
+            r.message += "; so no robust design either";
+        } else {
+            // the proof holds at a point of the ellipsoid: no gains of the box are robust
+            std::string point;
+            for (const auto& [k, v] : at) {
+                std::string unit;
+                for (const ParameterSpec& sp : model_parameters(model))
+                    if (sp.name == k && !sp.unit.empty() && sp.unit != "1") unit = " " + sp.unit;
+                point += (point.empty() ? "" : ", ") + k + " = " + detail::significant(v, 6) + unit;
+            }
+            r.message = "no robust design within the bounds: at " + point + ", a point of the fit's 95 % ellipsoid of " + join(r.worst.held, ", ") +
+                        " (the worst for the design before), " + r.infeasibility_proof;
+        }
     } else if (r.status == Status::Converged && !r.robust_met) {
         r.status = Status::MaxIterations;
         r.message = "robust design: the worst attenuation margin over the fit's 95 % ellipsoid of " + join(r.worst.held, ", ") + " stays below " +
@@ -703,6 +717,9 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     r.initial = car->parameters();
     Problem P(model, r.initial, options);
     P.m_scenario = scenario;
+    // the held parameters the search works at (robust design: a point of the ellipsoid)
+    ParameterMap held = r.initial;
+    for (const auto& [k, v] : scenario) held[k] = v;
     for (const BoundedParameter& b : options.bounds)
         if (std::find(options.free.begin(), options.free.end(), b.name) == options.free.end())
             throw std::invalid_argument("design: a bound on " + b.name + ", which is not free: expected bounds on the free parameters (" +
@@ -959,7 +976,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     // peak: peak stability implies L2 stability. Without L2-stable gains in the box (proved)
     // there is nothing to search; else the search starts also from the nearest L2 design (a
     // cheap sequential QP), inside the set where ||h||_1 can reach 1.
-    const std::string l2_proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+    const std::string l2_proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
     bool skipped = options.objective == DesignObjective::Nearest && !l2_proof.empty();  // nothing to find
     if (options.objective == DesignObjective::Peak) {
         if (!l2_proof.empty()) {
@@ -1072,7 +1089,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     if (options.progress && done < total) options.progress(total, total);
     if (infeasible) {
         x = x0;  // nothing found: the car's own values, unchanged
-        const std::string proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+        const std::string proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
         best_status = proof.empty() ? Status::BudgetExhausted : Status::Converged;
         best_message = proof.empty() ? "no gains with an attenuation margin of at least " + detail::significant(options.margin, 6) +
                                            " s found within the bounds from " + std::to_string(n_starts) +
@@ -1135,7 +1152,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         r.has_uncertainty = true;
     }
     r.evaluations = P.evaluations;
-    r.infeasibility_proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+    r.infeasibility_proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
     r.status = best_status;
     r.message = best_message;
     const PeakResult& pk = *r.string.peak;
@@ -1158,7 +1175,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                                                   detail::significant(options.margin, 6) + " s: a relative change of ") +
                         detail::significant(r.change, 6) + " (" + std::to_string(r.starts.size()) + " runs of the minimisers)";
         } else if (options.objective != DesignObjective::Abscissa && !r.string.string_stable) {
-            const std::string proof = ovrv_infeasibility(model, r.initial, options.free, P.lo, P.hi);
+            const std::string proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
             r.message = proof.empty() ? "no string-stable gains found within the bounds from " + std::to_string(n_starts) +
                                             " starts (not a proof that none exist): the least objective found is " + detail::significant(r.value, 8) +
                                             " (" + best_message + ")"

@@ -561,6 +561,40 @@ TEST_CASE("robust design: the margin holds over the fit's ellipsoid (checked by 
     CHECK_THROWS_AS(design_gains("ovrv", p, bad), std::invalid_argument);
 }
 
+TEST_CASE("robust design where a point of the ellipse has no string-stable gains in the box: decided, with the proof at that point") {
+    // F_max with 5 % on th and 10 % on tau (correlation 0.5): the nominal design's worst point
+    // has th - tau too small for any (k1, k2) of the box. The iteration used to stop there
+    // undecided (max_iterations, 'not a robust design'); the proof at that point decides it.
+    const ParameterMap p = car_params("F_max");
+    const double sth = 0.05 * p.at("th"), stau = 0.1 * p.at("tau");
+    for (DesignObjective objective : {DesignObjective::Nearest, DesignObjective::SupGamma}) {
+        DesignOptions o = options_for(objective);
+        o.has_covariance = true;
+        o.covariance(2, 2) = sth * sth;
+        o.covariance(3, 3) = stau * stau;
+        o.covariance(2, 3) = o.covariance(3, 2) = 0.5 * sth * stau;
+        o.uncertainty_samples = 50;
+        o.robust = true;
+        const DesignResult r = design_gains("ovrv", p, o);
+        CAPTURE(r.message);
+        CHECK(r.status == Status::Converged);
+        CHECK_FALSE(r.robust_met);
+        CHECK(!r.infeasibility_proof.empty());
+        REQUIRE(r.robust_steps.size() >= 2);
+        CHECK(r.message.find("no robust design within the bounds") == 0);
+        // independently: the point lies in the ellipse, and B < 0 at every corner of the box there
+        const ParameterMap& at = r.robust_steps.back().scenario;
+        const double dth = at.at("th") - p.at("th"), dtau = at.at("tau") - p.at("tau");
+        Eigen::Matrix2d C;
+        C << sth * sth, 0.5 * sth * stau, 0.5 * sth * stau, stau * stau;
+        const Eigen::Vector2d d(dth, dtau);
+        CHECK(d.dot(C.inverse() * d) <= 5.991464547107979 * (1.0 + 1e-9));
+        const double th = at.at("th"), tau = at.at("tau");
+        for (double k1 : {0.1 * p.at("k1"), 10.0 * p.at("k1")})
+            for (double k2 : {0.1 * p.at("k2"), 10.0 * p.at("k2")}) CHECK(k1 * th * (th / 2.0 - tau) + k2 * (th - tau) - 1.0 < 0.0);
+    }
+}
+
 TEST_CASE("robust design is the least change: every gain pair nearer the car fails the margin somewhere in the ellipse") {
     // The relaxation argument: the last design is the nearest gains meeting the margin at one
     // point p of the ellipse (a relaxation of the robust problem, whose least change can only be

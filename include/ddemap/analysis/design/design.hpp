@@ -182,7 +182,9 @@ struct DesignResult {
     bool margin_met = false;     ///< attenuation margin m* >= options.margin at the result (to 1e-9 relative)
     /// A proof that no gains within the bounds are string stable, when one is known (the ovrv law
     /// with th and tau held: its low-frequency coefficient is negative at every corner of the
-    /// (k1, k2) box, and linear there); empty otherwise.
+    /// (k1, k2) box, and linear there); empty otherwise. Robust design: the proof at the held
+    /// values of the last design (a point of the ellipsoid, named in the message), so that no
+    /// gains of the box are robust.
     std::string infeasibility_proof;
     StringResult string_initial; ///< certified plant, L2 and peak verdicts at the car's own values
     StringResult string;         ///< the same at the result
