@@ -68,7 +68,7 @@ void add_design_flags(CLI::App& app) {
         ->type_name("SECONDS");
     app.add_flag("--robust", design_args.robust,
                  "ask the margin of every car the fit is consistent with: of the worst point of the fit's 95 % ellipsoid of the held parameters "
-                 "(worst-case iteration; CAR must carry a covariance: a fit file from calibrate)");
+                 "(an exchange method over its worst points; CAR must carry a covariance: a fit file from calibrate)");
     app.add_option("--weights", design_args.weights, "nearest: a weight per free parameter of the relative change, each in [0.001, 1000] (default: all 1)")->type_name("W,...");
     app.add_option("--starts", design_args.starts, "runs of the minimiser: from the car's values and from points of a Halton sequence in the bounds (1..64)")
         ->capture_default_str()

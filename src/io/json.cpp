@@ -840,7 +840,7 @@ std::string design_json(const DesignResult& r, double margin) {
                                     .json("worst_case", JsonObject().json("design", worst(r.worst)).json("initial", worst(r.worst_initial)).str())
                                     .str());
         if (r.robust) {
-            // the worst-case iteration: each design's held values (the car's own first), gains and worst margin
+            // the exchange method: the held values each design added (the car's own first), its gains and worst margin
             std::vector<std::string> steps;
             for (const auto& st : r.robust_steps) {
                 JsonObject so;

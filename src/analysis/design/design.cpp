@@ -100,9 +100,12 @@ public:
 
     std::string m_model;
     ParameterMap m_base;
-    /// robust design: the held parameters at which the search evaluates (the worst point of the
-    /// ellipsoid); empty: the car's own. The result's verdicts are at the car's own (nominal()).
-    ParameterMap m_scenario;
+    /// robust design: the held parameters at which the search evaluates (the car's own and the
+    /// worst points of the ellipsoid met so far; an empty map: the car's own), every objective
+    /// taken as its worst over them. The result's verdicts are at the car's own (nominal()).
+    std::vector<ParameterMap> m_scenarios{ParameterMap{}};
+    /// the scenario that lin() evaluates (set by the loops over scenarios, 0 otherwise)
+    std::size_t m_active = 0;
     const DesignOptions& m_opt;
     std::vector<double> lo, hi, x0, w;
     int evaluations = 0;
@@ -115,10 +118,33 @@ public:
         return p;
     }
     Linearisation lin(const Eigen::VectorXd& x) const {
-        if (m_scenario.empty()) return make_model(m_model, params(x))->linearise();
+        const ParameterMap& sc = m_scenarios[m_active];
+        if (sc.empty()) return make_model(m_model, params(x))->linearise();
         ParameterMap p = params(x);
-        for (const auto& [k, v] : m_scenario) p[k] = v;
+        for (const auto& [k, v] : sc) p[k] = v;
         return make_model(m_model, p)->linearise();
+    }
+    // f() evaluated with lin() at every scenario in turn
+    template <class F>
+    void for_each_scenario(const F& f) {
+        for (m_active = 0; m_active < m_scenarios.size(); ++m_active) f();
+        m_active = 0;
+    }
+    // every scenario's plant stable (abscissa below 0) and, when asked, its margin at least m
+    bool meets(const Eigen::VectorXd& x, double m, bool with_margin = true) {
+        bool ok = true;
+        for_each_scenario([&] {
+            if (!ok) return;
+            const Linearisation L = lin(x);
+            ok = plant(x, L, nullptr) < 0.0 && (!with_margin || attenuation_scan(L).margin >= m);
+        });
+        return ok;
+    }
+    // the least attenuation margin m* over the scenarios (no plant check)
+    double least_margin(const Eigen::VectorXd& x) {
+        double m = kInf;
+        for_each_scenario([&] { m = std::min(m, attenuation_scan(lin(x)).margin); });
+        return m;
     }
     Linearisation nominal(const Eigen::VectorXd& x) const { return make_model(m_model, params(x))->linearise(); }
     // A difference step of `rel` relative to x_j (to the box's width where x_j = 0)
@@ -291,6 +317,29 @@ public:
     double value(const Eigen::VectorXd& x, Eigen::VectorXd* grad, DesignObjective o) {
         ++evaluations;
         if (tick) tick();
+        if (m_scenarios.size() == 1) return value_at(x, grad, o);
+        // robust: the worst scenario's value and its gradient (a maximum of smooth pieces, as the
+        // objectives themselves are: the minimiser is made for that)
+        double worst = -kInf;
+        Eigen::VectorXd g, gw;
+        bool undefined = false;
+        for_each_scenario([&] {
+            if (undefined) return;
+            const double v = value_at(x, grad ? &g : nullptr, o);
+            if (std::isnan(v) || v == kInf) {
+                undefined = true;
+                worst = v;
+                return;
+            }
+            if (v > worst) {
+                worst = v;
+                gw = g;
+            }
+        });
+        if (grad && !undefined) *grad = gw;
+        return worst;
+    }
+    double value_at(const Eigen::VectorXd& x, Eigen::VectorXd* grad, DesignObjective o) {
         const Linearisation L = lin(x);
         if (!is_computable(L)) return kInf;  // outside the analyses' range: outside the search's domain
         if (o == DesignObjective::Abscissa) return m_opt.cars < 0 ? plant(x, L, grad) : ring(x, L, grad);
@@ -331,12 +380,11 @@ public:
     bool solve_qp(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& M, const Eigen::VectorXd& c, Eigen::VectorXd& y) const {
         const int k = static_cast<int>(A.rows()), nn = static_cast<int>(A.cols());
         double best = kInf;
-        for (unsigned mask = 0; mask < (1u << k); ++mask) {
-            const int size = __builtin_popcount(mask);
-            if (size > nn) continue;
-            std::vector<int> S;
-            for (int i = 0; i < k; ++i)
-                if (mask & (1u << i)) S.push_back(i);
+        // every active set S of at most n constraints (n <= 4; the robust design's scenarios
+        // add rows, so the sets are enumerated as combinations, not as bit masks of all rows)
+        std::vector<int> S;
+        auto consider = [&] {
+            const int size = static_cast<int>(S.size());
             Eigen::VectorXd cand = c, lambda;
             if (size > 0) {
                 Eigen::MatrixXd As(size, nn);
@@ -348,22 +396,30 @@ public:
                 const Eigen::MatrixXd AMi = As * M.cwiseInverse().asDiagonal();
                 const Eigen::MatrixXd K = AMi * As.transpose();
                 Eigen::FullPivLU<Eigen::MatrixXd> lu(K);
-                if (lu.rank() < size) continue;
+                if (lu.rank() < size) return;
                 lambda = lu.solve(bs - As * c);
-                if ((lambda.array() < -1e-12 * (1.0 + lambda.cwiseAbs().maxCoeff())).any()) continue;
+                if ((lambda.array() < -1e-12 * (1.0 + lambda.cwiseAbs().maxCoeff())).any()) return;
                 cand = c + M.cwiseInverse().asDiagonal() * (As.transpose() * lambda);
             }
             const Eigen::VectorXd slack = A * cand - b;
-            bool ok = true;
             for (int i = 0; i < k; ++i)
-                if (!(slack[i] >= -1e-10 * (std::abs(b[i]) + A.row(i).cwiseAbs().dot(cand.cwiseAbs()) + 1e-300))) ok = false;  // NaN too
-            if (!ok) continue;
+                if (!(slack[i] >= -1e-10 * (std::abs(b[i]) + A.row(i).cwiseAbs().dot(cand.cwiseAbs()) + 1e-300))) return;  // NaN too
             const double obj = (cand - c).cwiseProduct(M).dot(cand - c);
             if (obj < best) {
                 best = obj;
                 y = cand;
             }
-        }
+        };
+        std::function<void(int)> extend = [&](int from) {
+            consider();
+            if (static_cast<int>(S.size()) == nn) return;
+            for (int i = from; i < k; ++i) {
+                S.push_back(i);
+                extend(i + 1);
+                S.pop_back();
+            }
+        };
+        extend(0);
         return std::isfinite(best);
     }
 
@@ -384,46 +440,62 @@ public:
         out.path.push_back(x);
         std::vector<double> history;  // distances of the iterates that meet the margin
         for (out.iterations = 0; out.iterations < kSqpSteps; ++out.iterations) {
-            const Linearisation L = lin(x);
-            if (!(plant(x, L, nullptr) < 0.0)) {
+            // the constraints of every scenario: each piece of its margin, linearised at its
+            // frequency, and its plant kept stable, -alpha(x) - kPlantMargin >= 0 linearised with
+            // the root sensitivity (the margin is not defined where it is not)
+            std::vector<Eigen::VectorXd> rows;
+            std::vector<double> rhs;
+            std::vector<bool> is_piece;
+            double least = kInf;
+            bool unstable = false;
+            for_each_scenario([&] {
+                if (unstable) return;
+                const Linearisation L = lin(x);
+                Eigen::VectorXd ga;
+                const double alpha = plant(x, L, &ga);
+                if (!(alpha < 0.0)) {
+                    unstable = true;
+                    return;
+                }
+                const AttenuationScan sc = attenuation_scan(L);
+                ++scans;
+                for (const auto& piece : sc.mu_minima) {
+                    const double om = piece.omega;
+                    const Eigen::VectorXd g = partials(x, [om, target](const Linearisation& l) { return margin_piece(l, om, target); });
+                    const double gv = margin_piece(L, om, target);
+                    if (!g.allFinite() || !std::isfinite(gv)) continue;  // a piece that cannot be linearised: left out of this step
+                    rows.push_back(g);
+                    rhs.push_back(-gv + g.dot(x));
+                    is_piece.push_back(true);
+                    least = std::min(least, piece.mu);
+                }
+                rows.push_back(-ga);
+                rhs.push_back(alpha + kPlantMargin - ga.dot(x));
+                is_piece.push_back(false);
+            });
+            if (unstable) {
                 out.status = Status::NumericalIssue;
                 out.message = "an iterate has an unstable plant";
                 out.x = x;
                 return out;
             }
-            const AttenuationScan sc = attenuation_scan(L);
-            ++scans;
-            const auto& pieces = sc.mu_minima;
-            // one more constraint: the plant stays stable, -alpha(x) - kPlantMargin >= 0 linearised
-            // with the root sensitivity (the margin is not defined where it is not)
-            Eigen::VectorXd ga;
-            const double alpha = plant(x, L, &ga);
-            const int k = static_cast<int>(pieces.size()) + 2 * static_cast<int>(nn) + 1;
-            Eigen::MatrixXd A = Eigen::MatrixXd::Zero(k, nn);
-            Eigen::VectorXd b(k);
-            double least = kInf;
-            for (std::size_t i = 0; i < pieces.size(); ++i) {
-                const double om = pieces[i].omega;
-                const Eigen::VectorXd g = partials(x, [om, target](const Linearisation& l) { return margin_piece(l, om, target); });
-                const double gv = margin_piece(L, om, target);
-                if (!g.allFinite() || !std::isfinite(gv)) {  // a piece that cannot be linearised: left out of this step
-                    A.row(static_cast<Eigen::Index>(i)).setZero();
-                    b[static_cast<Eigen::Index>(i)] = 0.0;
-                    continue;
-                }
-                A.row(static_cast<Eigen::Index>(i)) = g.transpose();
-                b[static_cast<Eigen::Index>(i)] = -gv + g.dot(x);
-                least = std::min(least, pieces[i].mu);
-            }
             for (Eigen::Index j = 0; j < nn; ++j) {
-                const auto r = static_cast<Eigen::Index>(pieces.size()) + 2 * j;
-                A(r, j) = 1.0;
-                b[r] = lo[static_cast<std::size_t>(j)];
-                A(r + 1, j) = -1.0;
-                b[r + 1] = -hi[static_cast<std::size_t>(j)];
+                Eigen::VectorXd e = Eigen::VectorXd::Zero(nn);
+                e[j] = 1.0;
+                rows.push_back(e);
+                rhs.push_back(lo[static_cast<std::size_t>(j)]);
+                is_piece.push_back(false);
+                rows.push_back(-e);
+                rhs.push_back(-hi[static_cast<std::size_t>(j)]);
+                is_piece.push_back(false);
             }
-            A.row(k - 1) = -ga.transpose();
-            b[k - 1] = alpha + kPlantMargin - ga.dot(x);
+            const int k = static_cast<int>(rows.size());
+            Eigen::MatrixXd A(k, nn);
+            Eigen::VectorXd b(k);
+            for (int i = 0; i < k; ++i) {
+                A.row(i) = rows[static_cast<std::size_t>(i)].transpose();
+                b[i] = rhs[static_cast<std::size_t>(i)];
+            }
             Eigen::VectorXd y;
             bool solved = solve_qp(A, b, M, c, y);
             // far from the boundary the linearised pieces may contradict each other within the
@@ -432,8 +504,8 @@ public:
             if (!solved) {
                 std::size_t worst = 0;
                 double wv = kInf;
-                for (std::size_t i = 0; i < pieces.size(); ++i)
-                    if (A.row(static_cast<Eigen::Index>(i)).squaredNorm() > 0.0) {
+                for (std::size_t i = 0; i < is_piece.size(); ++i)
+                    if (is_piece[i]) {
                         const double gi = A.row(static_cast<Eigen::Index>(i)).dot(x) - b[static_cast<Eigen::Index>(i)];  // g_i(x)
                         if (gi < wv) {
                             wv = gi;
@@ -456,7 +528,7 @@ public:
             }
             // a step into the region of unstable plants is halved (the margin is not defined there)
             for (int half = 0; half < 30; ++half) {
-                if (plant(y, lin(y), nullptr) < 0.0) break;
+                if (meets(y, 0.0, false)) break;
                 y = x + 0.5 * (y - x);
             }
             const double step = std::sqrt((y - x).cwiseProduct(M).dot(y - x));
@@ -642,30 +714,34 @@ WorstMargin worst_attenuation_margin(const ParameterMap& parameters, const Eigen
 }
 
 namespace {
-DesignResult design_at(const std::string& model, const ParameterMap& parameters, const DesignOptions& options, const ParameterMap& scenario);
+DesignResult design_at(const std::string& model, const ParameterMap& parameters, const DesignOptions& options,
+                       const std::vector<ParameterMap>& scenarios, ParameterMap* proof_at = nullptr);
 }  // namespace
 
 DesignResult design_gains(const std::string& model, const ParameterMap& parameters, const DesignOptions& options) {
     options.validate();
-    if (!options.robust) return design_at(model, parameters, options, {});
-    // worst-case iteration: design at the held values where the last design's margin is least
+    if (!options.robust) return design_at(model, parameters, options, {ParameterMap{}});
+    // worst-case iteration (an exchange method): design for the car's own held values and every
+    // worst point met so far at once, add the new design's worst point of the ellipsoid, repeat
     DesignOptions o = options;
     o.robust = false;
-    ParameterMap scenario;
+    std::vector<ParameterMap> scenarios{ParameterMap{}};
+    ParameterMap proof_at;
     DesignResult r;
     std::vector<DesignResult::RobustStep> steps;
     for (int it = 0; it < options.robust_iterations; ++it) {
-        r = design_at(model, parameters, o, scenario);
-        steps.push_back({scenario, r.gains, r.worst.margin});
+        r = design_at(model, parameters, o, scenarios, &proof_at);
+        steps.push_back({scenarios.back(), r.gains, r.worst.margin});
         // met; or nothing to iterate on: no gains at all (a proof), a design that did not
-        // converge, nothing held, an unstable plant in the ellipsoid, the same worst point again
+        // converge, nothing held, an unstable plant in the ellipsoid, a worst point already in
+        // the set (the design does not meet the margin there)
         if (r.worst.margin >= options.margin * (1.0 - 1e-6) || !r.infeasibility_proof.empty() || r.status != Status::Converged || r.worst.held.empty() ||
             r.worst.plant_unstable)
             break;
         ParameterMap next;
         for (const std::string& h : r.worst.held) next[h] = r.worst.at.at(h);
-        if (next == scenario) break;
-        scenario = next;
+        if (std::find(scenarios.begin(), scenarios.end(), next) != scenarios.end()) break;
+        scenarios.push_back(next);
     }
     r.robust = true;
     r.robust_steps = steps;
@@ -673,7 +749,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
     std::string path;
     for (const auto& st : steps) path += (path.empty() ? "" : ", ") + detail::significant(st.worst_margin, 4) + " s";
     if (!r.infeasibility_proof.empty() && !r.robust_met) {
-        const ParameterMap& at = steps.back().scenario;
+        const ParameterMap& at = proof_at;
         if (at.empty()) {
             if (r.message.find(r.infeasibility_proof) == std::string::npos) r.message += "; " + r.infeasibility_proof;
             r.message += "; so no robust design either";
@@ -687,7 +763,7 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
                 point += (point.empty() ? "" : ", ") + k + " = " + detail::significant(v, 6) + unit;
             }
             r.message = "no robust design within the bounds: at " + point + ", a point of the fit's 95 % ellipsoid of " + join(r.worst.held, ", ") +
-                        " (the worst for the design before), " + r.infeasibility_proof;
+                        " (the worst for an earlier design), " + r.infeasibility_proof;
         }
     } else if (r.status == Status::Converged && !r.robust_met) {
         r.status = Status::MaxIterations;
@@ -703,7 +779,8 @@ DesignResult design_gains(const std::string& model, const ParameterMap& paramete
 }
 
 namespace {
-DesignResult design_at(const std::string& model, const ParameterMap& parameters, const DesignOptions& options, const ParameterMap& scenario) {
+DesignResult design_at(const std::string& model, const ParameterMap& parameters, const DesignOptions& options,
+                       const std::vector<ParameterMap>& scenarios, ParameterMap* proof_at) {
     const auto car = make_model(model, parameters);  // validates the car itself
     const Linearisation lin0 = car->linearise();
     if (lin0.leaders() > 1) require_single_leader(lin0, "design");
@@ -716,10 +793,21 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     r.free = options.free;
     r.initial = car->parameters();
     Problem P(model, r.initial, options);
-    P.m_scenario = scenario;
-    // the held parameters the search works at (robust design: a point of the ellipsoid)
-    ParameterMap held = r.initial;
-    for (const auto& [k, v] : scenario) held[k] = v;
+    P.m_scenarios = scenarios;
+    // a proof that no gains of the box are string stable at one of the held values the search
+    // works at (robust design: the car's own and points of the ellipsoid); where it holds
+    auto proof_any = [&] {
+        for (const ParameterMap& sc : P.m_scenarios) {
+            ParameterMap held = r.initial;
+            for (const auto& [k, v] : sc) held[k] = v;
+            std::string proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
+            if (!proof.empty()) {
+                if (proof_at) *proof_at = sc;
+                return proof;
+            }
+        }
+        return std::string();
+    };
     for (const BoundedParameter& b : options.bounds)
         if (std::find(options.free.begin(), options.free.end(), b.name) == options.free.end())
             throw std::invalid_argument("design: a bound on " + b.name + ", which is not free: expected bounds on the free parameters (" +
@@ -864,8 +952,9 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                 ds.message = q.message;
                 ds.iterations = q.iterations;
                 z = P.z_of(q.x);
-                const Linearisation L = P.lin(q.x);
-                ds.value = P.nearest_objective(attenuation_scan(L, options.margin), q.x, nullptr);  // the distance where feasible
+                // the distance where feasible (the worst scenario's penalty added where not)
+                const double viol = 1.0 - P.least_margin(q.x) / options.margin;
+                ds.value = P.distance(q.x, nullptr) + (viol > 0.0 ? P.rho * viol : 0.0);
             } else if (ok) {
                 if (o == DesignObjective::Nearest) {
                     P.rho = 10.0;
@@ -874,7 +963,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                         add_z(nr.path);
                         if (!std::isfinite(nr.value)) break;
                         z = nr.x;
-                        if (attenuation_scan(P.lin(P.x_of(z))).margin >= options.margin * (1.0 - 1e-6)) break;
+                        if (P.least_margin(P.x_of(z)) >= options.margin * (1.0 - 1e-6)) break;
                         P.rho *= 10.0;  // the penalty was too weak: the end is outside the set
                     }
                 } else {
@@ -895,8 +984,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             // nearest: compare the runs by distance among the feasible ends
             double score = ds.value;
             if (o == DesignObjective::Nearest && std::isfinite(score)) {
-                const Linearisation L = P.lin(xe);
-                const bool feasible = P.plant(xe, L, nullptr) < 0.0 && attenuation_scan(L).margin >= options.margin * (1.0 - 1e-6);
+                const bool feasible = P.meets(xe, options.margin * (1.0 - 1e-6));
                 score = feasible ? P.distance(xe, nullptr) : 1e6 + score;
             }
             // ties (the plateau of peak: every non-overshooting design) go to the run that ended
@@ -945,8 +1033,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         };
         auto feasible = [&](Eigen::VectorXd y) {
             if (!in_box(y)) return false;
-            const Linearisation L = P.lin(y);
-            return P.plant(y, L, nullptr) < 0.0 && attenuation_scan(L).margin >= options.margin;
+            return P.meets(y, options.margin);
         };
         if (feasible(x0)) {
             x = x0;
@@ -976,7 +1063,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     // peak: peak stability implies L2 stability. Without L2-stable gains in the box (proved)
     // there is nothing to search; else the search starts also from the nearest L2 design (a
     // cheap sequential QP), inside the set where ||h||_1 can reach 1.
-    const std::string l2_proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
+    const std::string l2_proof = proof_any();
     bool skipped = options.objective == DesignObjective::Nearest && !l2_proof.empty();  // nothing to find
     if (options.objective == DesignObjective::Peak) {
         if (!l2_proof.empty()) {
@@ -1058,10 +1145,14 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         // the result's own verdict (bisection on that verdict; the point itself is kept where
         // that verdict does not confirm it)
         auto stable_at = [&](const Eigen::VectorXd& y) {
-            const Linearisation Ly = P.lin(y);
-            const double a = P.plant(y, Ly, nullptr);
-            if (!(a < 0.0)) return false;
-            return peak_string_stability(Ly, a, options.peak).verdict == Verdict::Stable;
+            bool ok = true;
+            P.for_each_scenario([&] {
+                if (!ok) return;
+                const Linearisation Ly = P.lin(y);
+                const double a = P.plant(y, Ly, nullptr);
+                ok = a < 0.0 && peak_string_stability(Ly, a, options.peak).verdict == Verdict::Stable;
+            });
+            return ok;
         };
         if (stable_at(x)) {
             double lo_t = 0.0, hi_t = 1.0;  // x0 + lo_t d not (or not shown) peak stable, x0 + hi_t d peak stable
@@ -1089,7 +1180,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
     if (options.progress && done < total) options.progress(total, total);
     if (infeasible) {
         x = x0;  // nothing found: the car's own values, unchanged
-        const std::string proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
+        const std::string proof = proof_any();
         best_status = proof.empty() ? Status::BudgetExhausted : Status::Converged;
         best_message = proof.empty() ? "no gains with an attenuation margin of at least " + detail::significant(options.margin, 6) +
                                            " s found within the bounds from " + std::to_string(n_starts) +
@@ -1152,7 +1243,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         r.has_uncertainty = true;
     }
     r.evaluations = P.evaluations;
-    r.infeasibility_proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
+    r.infeasibility_proof = proof_any();
     r.status = best_status;
     r.message = best_message;
     const PeakResult& pk = *r.string.peak;
@@ -1175,7 +1266,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                                                   detail::significant(options.margin, 6) + " s: a relative change of ") +
                         detail::significant(r.change, 6) + " (" + std::to_string(r.starts.size()) + " runs of the minimisers)";
         } else if (options.objective != DesignObjective::Abscissa && !r.string.string_stable) {
-            const std::string proof = ovrv_infeasibility(model, held, options.free, P.lo, P.hi);
+            const std::string proof = proof_any();
             r.message = proof.empty() ? "no string-stable gains found within the bounds from " + std::to_string(n_starts) +
                                             " starts (not a proof that none exist): the least objective found is " + detail::significant(r.value, 8) +
                                             " (" + best_message + ")"

@@ -106,12 +106,13 @@ struct DesignOptions {
     Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
     int uncertainty_samples = 1000;  ///< parameter draws for those probabilities (>= 1)
     /// Robust design (needs the covariance): the attenuation margin is asked of the worst point
-    /// of the fit's 95 % ellipsoid of the held parameters, not of the car's values. Solved by
-    /// worst-case iteration: design at the held values where the current design's margin is
-    /// least (worst_attenuation_margin), until the worst margin over the ellipsoid at the design
-    /// meets `margin` (to 1e-6 relative), at most `robust_iterations` designs; the objective is
-    /// the chosen one at that worst point. When it stops with the margin met, the last design
-    /// (the nearest gains meeting the margin at one point p, a relaxation of the robust problem)
+    /// of the fit's 95 % ellipsoid of the held parameters, not of the car's values. Solved by an
+    /// exchange method: each design asks the margin at the car's own held values and at every
+    /// held values where an earlier design's margin was least (worst_attenuation_margin), the
+    /// objective being its worst over them; the new design's worst point is added until the
+    /// worst margin over the ellipsoid at the design meets `margin` (to 1e-6 relative), at most
+    /// `robust_iterations` designs. When it stops with the margin met, the last design (the
+    /// nearest gains meeting the margin at finitely many points, a relaxation of the robust problem)
     /// is robust, hence the least robust change (up to the local search and the worst-case
     /// search over the ellipsoid, which is sampled, not certified).
     bool robust = false;
@@ -201,8 +202,9 @@ struct DesignResult {
     /// parameters, at the car and at the design (the design meets the margin robustly when
     /// worst.margin >= options.margin).
     WorstMargin worst_initial, worst;
-    /// Robust design: each design of the worst-case iteration, at the held values `scenario`
-    /// (empty: the car's own), its gains and the worst margin over the ellipsoid at them.
+    /// Robust design: each design of the exchange method, with the held values `scenario` it
+    /// added (empty: the car's own; each design asks the margin at its own and every earlier
+    /// step's), its gains and the worst margin over the ellipsoid at them.
     struct RobustStep {
         ParameterMap scenario, gains;
         double worst_margin = 0.0;
