@@ -352,6 +352,11 @@ constexpr double nonsmooth_smooth_x = 1e-6;
 /// A kink of absolute values (slopes 1 and 2) minimised to stationarity: the error in x is the
 /// error in f divided by the slope, and f is resolved to about 1e-10; 1e-6 leaves a margin.
 constexpr double nonsmooth_kink_x = 1e-6;
+/// The least spectral abscissa of delayed PD control of a double integrator, a triple root
+/// (located to about eps^(1/3) = 6e-6 by the root solver): the minimiser reaches it to 4.9e-7 in
+/// the abscissa and 4.3e-7 in the gains (measured).
+constexpr double abscissa_triple_root = 1e-5;
+constexpr double abscissa_triple_root_gains = 1e-5;
 /// mu of OVRV without delay against its closed form: the limit w -> 0 is exact, the asymptote
 /// 1/k2^2 is approached at the scan's last frequency (1e5 times the natural one) to ~1e-10
 /// relative, interior minima are refined by golden sections to 1e-12 in log w; 1e-8.
