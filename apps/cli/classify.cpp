@@ -23,7 +23,7 @@ namespace ddemap::cli {
 namespace {
 struct ClassifyArgs {
     std::string file, svg, samples = "4000", ring_samples = "200", seed = "1";
-    bool peak = false, distance = false;
+    bool peak = true, peak_flag = false, no_peak = false, distance = false;
     RingArg ring;
     FormatArg format;
     OutArg out;
@@ -45,8 +45,10 @@ void add_classify_flags(CLI::App& app) {
     app.add_flag("--distance", classify_args.distance,
                  "also find the distance to the other string verdict: the smallest relative change of (k1, k2, th, tau), "
                  "sqrt(sum ((x - x0) / x0)^2), that turns a string-stable car unstable or an unstable one stable (about 0.2 s more per car)");
-    app.add_flag("--peak", classify_args.peak,
-                 "also decide peak (L-infinity) string stability: ||h||_1 <= 1 for the impulse response h of Gamma (about 0.03 s more per car)");
+    app.add_flag("--no-peak", classify_args.no_peak,
+                 "skip peak (L-infinity) string stability, which is decided by default: ||h||_1 <= 1 for the impulse response h of Gamma "
+                 "(about 0.03 s per car)");
+    app.add_flag("--peak", classify_args.peak_flag, "the peak verdict (the default; kept for old scripts)");
     classify_args.ring.add_to(app, "22", "ring size N >= 2 or inf for the ring verdict");
     classify_args.format.add_to(app);
     classify_args.out.add_to(app, "PREFIX.csv, PREFIX.json and PREFIX.svg (one (k1, k2) chart per vehicle, vehicle marked)", false);
@@ -55,6 +57,8 @@ void add_classify_flags(CLI::App& app) {
 }
 
 int run_classify() {
+    if (classify_args.no_peak && classify_args.peak_flag) throw BadInput("--peak and --no-peak: expected one of them");
+    classify_args.peak = !classify_args.no_peak;
     const int cars = classify_args.ring.parse();
     const Format format = classify_args.format.parse();
     if (classify_args.out.given() && !classify_args.svg.empty()) throw BadInput("--out and --svg: expected only --out (--svg is its old spelling)");
@@ -112,7 +116,7 @@ int run_classify() {
     e.command = "classify";
     JsonObject inputs;
     inputs.string("vehicles", source).json("ring", json_ring(cars));
-    if (classify_args.peak) inputs.boolean("peak", true);
+    inputs.boolean("peak", classify_args.peak);
     if (classify_args.distance) inputs.boolean("distance", true);
     for (const auto& r : rows)
         if (r.has_uncertainty) {

@@ -640,7 +640,7 @@ def boundary(model="ovrv", ring=22, seed_grid=41, ring_curves="auto", **paramete
 
 
 @_with_progress
-def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1, peak=False, distance=False):
+def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1, peak=True, distance=False):
     """Plant, ring and string verdicts of calibrated OVRV vehicles (``ddemap classify``).
 
     ``vehicles``: None (the paper's calibration table, 14 settings) or cars, as everywhere: a car
@@ -651,9 +651,9 @@ def classify(vehicles=None, ring=22, samples=4000, ring_samples=200, seed=1, pea
     :func:`calibrate`, or a list of these. Each distinct car is classified once. With the
     covariance of a fit the verdicts come with probabilities from ``samples`` parameter draws
     (seed ``seed``; the first ``ring_samples`` also classified as rings). ``ring``: N or "inf".
-    ``peak=True`` also decides peak (L-infinity) string stability (``peak_verdict``,
-    ``peak_stable``, ``peak_norm`` = ||h||_1, ``peak_norm_error``, ``peak_overshoot`` per vehicle;
-    see :func:`string`). ``distance=True`` also finds the distance to the other string verdict
+    ``peak`` (default True; False skips it, ``--no-peak``) decides peak (L-infinity) string
+    stability too (``peak_verdict``, ``peak_stable``, ``peak_norm`` = ||h||_1, ``peak_norm_error``,
+    ``peak_overshoot`` per vehicle; see :func:`string`). ``distance=True`` also finds the distance to the other string verdict
     (``verdict_distance`` per vehicle: the smallest relative change of (k1, k2, th, tau),
     sqrt(sum ((x - x0) / x0)^2), found to turn a string-stable car unstable or an unstable one
     stable, the parameters ``at`` the flip and the ``boundary`` reached; ``ddemap classify --distance``).

@@ -178,7 +178,9 @@ printf 'name,k1,k2,th,tau\nover,0.05,0.3,3.0,0.1\nmono,0.05,0.8,2.0,0.1\nwild,1,
 import json,sys; v={r['name']: r for r in json.load(sys.stdin)['result']['vehicles']}
 assert v['wild']['peak_norm'] is None and v['mono']['peak_stable'] is True and v['over']['peak_stable'] is False and v['over']['string_stable'] is True, v" &&
     ok || bad "classify --peak json"
-"$bin" classify "$tmp/pk.csv" --format csv | head -1 | grep -q 'peak_verdict' && bad "classify without --peak has peak columns" || ok
+"$bin" classify "$tmp/pk.csv" --no-peak --format csv | head -1 | grep -q 'peak_verdict' && bad "classify --no-peak has peak columns" || ok
+"$bin" classify "$tmp/pk.csv" --format csv | head -1 | grep -q ',peak_verdict,peak_norm,peak_norm_error$' && ok || bad "classify: peak columns by default"
+expect_error "--peak and --no-peak: expected one of them" classify --peak --no-peak
 # --distance: the relative change that flips the verdict; the parameters at the flip, written
 # back as a car, get the other verdict (a second run of the certified verdicts)
 "$bin" classify "$tmp/pk.csv" --distance --format json >"$tmp/dist.json" && python3 - "$tmp/dist.json" "$tmp/flip.csv" <<'PY' && ok || bad "classify --distance json: $(head -c 600 "$tmp/dist.json")"
@@ -192,7 +194,7 @@ assert w["status"] == "converged" and w["to"] == "string stable" and 1 < w["dist
 rows = "".join("%s,%r,%r,%r,%r\n" % (name, x["at"]["k1"], x["at"]["k2"], x["at"]["th"], x["at"]["tau"]) for name, x in (("flipover", o), ("flipwild", w)))
 open(sys.argv[2], "w").write("name,k1,k2,th,tau\n" + rows)
 PY
-"$bin" classify "$tmp/flip.csv" --format csv >"$tmp/flip.out" && grep -q '^flipover,.*,false,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*$' "$tmp/flip.out" &&
+"$bin" classify "$tmp/flip.csv" --no-peak --format csv >"$tmp/flip.out" && grep -q '^flipover,.*,false,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*$' "$tmp/flip.out" &&
     grep -q '^flipwild,.*,true,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*,[^,]*$' "$tmp/flip.out" && ok || bad "classify: the flip points have the other verdicts: $(cat "$tmp/flip.out")"
 "$bin" classify "$tmp/pk.csv" --distance 2>/dev/null | grep -q '^over .* 5\.1 %$' && ok || bad "classify --distance table"
 "$bin" classify "$tmp/pk.csv" --distance --format csv 2>/dev/null | head -1 | grep -q ',verdict_distance,verdict_distance_boundary,verdict_distance_omega_rad_per_s$' && ok || bad "classify --distance csv header"
