@@ -302,13 +302,57 @@ public:
     // ||h||_1 during the search, with at most kSearchPeakSteps steps per run: a design whose step
     // response needs more (a plant that settles slowly) is outside the search's domain, so that
     // no evaluation takes seconds; the result's own verdict uses the full options.
-    double peak_value(const Linearisation& L, double abscissa) const {
+    // With `directions`, its derivatives along them into `gradient` (the sensitivity equations
+    // of the step response, peak_stability.hpp).
+    double peak_value(const Linearisation& L, double abscissa, const std::vector<Linearisation>& directions = {},
+                      std::vector<double>* gradient = nullptr) const {
         PeakOptions o = m_opt.peak;
         o.max_steps = std::min(o.max_steps, kSearchPeakSteps);
-        o.tolerance = std::max(o.tolerance, 1e-6);  // the differences of the gradient need no more
-        const PeakResult p = peak_string_stability(L, abscissa, o);
+        o.tolerance = std::max(o.tolerance, 1e-6);  // the search needs no more
+        std::vector<double> g;
+        const PeakResult p = peak_string_stability(L, abscissa, o, directions, g);
         if (p.verdict == Verdict::Undecided || !p.finite) return std::numeric_limits<double>::quiet_NaN();
+        if (gradient) *gradient = g;
         return p.norm;
+    }
+    // d lin / d x_j as a direction of peak_string_stability: the coefficients' central
+    // differences (forward at the box's lower side) at the delays of `base`; false when a delay
+    // moves with x_j (then the norm itself is differenced)
+    bool lin_direction(const Eigen::VectorXd& x, std::size_t j, const Linearisation& base, Linearisation& out) const {
+        const double h = step(j, x);
+        Eigen::VectorXd xp = x, xm = x;
+        xp[static_cast<Eigen::Index>(j)] += h;
+        const bool forward = x[static_cast<Eigen::Index>(j)] - h < lo[j];
+        if (!forward) xm[static_cast<Eigen::Index>(j)] -= h;
+        const Linearisation Lp = lin(xp), Lm = lin(xm);
+        const double width = forward ? h : 2.0 * h;
+        out = Linearisation{};
+        const ExpPoly* bases[3] = {&base.gap, &base.own, &base.lead};
+        const ExpPoly* plus[3] = {&Lp.gap, &Lp.own, &Lp.lead};
+        const ExpPoly* minus[3] = {&Lm.gap, &Lm.own, &Lm.lead};
+        ExpPoly* outs[3] = {&out.gap, &out.own, &out.lead};
+        for (int k = 0; k < 3; ++k) {
+            std::vector<double> delays;
+            for (const ExpPoly* e : {bases[k], plus[k], minus[k]})
+                for (const auto& t : e->terms()) delays.push_back(t.delay);
+            std::sort(delays.begin(), delays.end());
+            delays.erase(std::unique(delays.begin(), delays.end()), delays.end());
+            auto coef = [](const ExpPoly& e, double d) {
+                for (const auto& t : e.terms())
+                    if (t.delay == d) return t.coef;
+                return 0.0;
+            };
+            auto has = [](const ExpPoly& e, double d) {
+                return std::any_of(e.terms().begin(), e.terms().end(), [d](const auto& t) { return t.delay == d; });
+            };
+            for (double d : delays) {
+                const double dc = (coef(*plus[k], d) - coef(*minus[k], d)) / width;
+                if (dc == 0.0) continue;
+                if (!has(*bases[k], d)) return false;  // a delay that moves, or a term born at x
+                outs[k]->add(dc, d);
+            }
+        }
+        return true;
     }
 
     // The objective in x (gradient in x when asked); +inf / NaN where undefined.
@@ -346,7 +390,22 @@ public:
         const double a = plant(x, L, nullptr);
         if (!(a < 0.0)) return kInf;
         if (o == DesignObjective::Peak) {
-            const double v = peak_value(L, a);
+            // the gradient from the sensitivity equations where every free parameter moves only
+            // coefficients (k1, k2, th of ovrv); else differences of the norm
+            std::vector<Linearisation> directions;
+            bool exact = grad != nullptr;
+            for (std::size_t j = 0; exact && j < n(); ++j) {
+                Linearisation d;
+                exact = lin_direction(x, j, L, d);
+                directions.push_back(d);
+            }
+            if (!exact) directions.clear();
+            std::vector<double> g;
+            const double v = peak_value(L, a, directions, exact ? &g : nullptr);
+            if (exact && std::isfinite(v) && g.size() == n()) {
+                *grad = Eigen::Map<const Eigen::VectorXd>(g.data(), static_cast<Eigen::Index>(n()));
+                return v;
+            }
             if (grad && std::isfinite(v)) {
                 *grad = Eigen::VectorXd(static_cast<Eigen::Index>(n()));
                 for (std::size_t j = 0; j < n(); ++j) {

@@ -34,22 +34,46 @@ std::string num(double x) { return detail::significant(x, 4); }
 struct Run {
     double norm = 0.0, overshoot = 0.0, tail = 0.0, rounding = 0.0;
     long steps = 0;
+    std::vector<double> gradient;  ///< d norm / d direction_k (with directions)
 };
+
+/// The derivative of one term list along a direction: the direction's coefficients at the same
+/// delays (a delay of the direction that `base` does not have: false).
+bool matched(const Terms& base, const Terms& direction, Terms& out) {
+    out.clear();
+    for (const auto& [c, d] : direction) {
+        const bool found = std::any_of(base.begin(), base.end(), [d = d](const auto& t) { return t.second == d; });
+        if (!found) return false;
+        out.emplace_back(c, d);
+    }
+    return true;
+}
 
 class StepResponse {
 public:
     /// Delays below `zero_below` are taken as 0 (a step no longer than each delay would make the
     /// run endless): x(t - d) - x(t) is at most d max|x'|, and short_error() estimates the effect.
-    StepResponse(const Linearisation& lin, double zero_below)
+    StepResponse(const Linearisation& lin, double zero_below, const std::vector<Linearisation>& directions = {})
         : m_gap(terms_of(lin.gap)), m_own(terms_of(lin.own)), m_lead(terms_of(lin.lead)) {
-        for (Terms* t : {&m_gap, &m_own, &m_lead})
-            for (auto& [c, d] : *t) {
+        for (const Linearisation& dl : directions) {
+            Direction dir;
+            if (!matched(m_gap, terms_of(dl.gap), dir.gap) || !matched(m_own, terms_of(dl.own), dir.own) ||
+                !matched(m_lead, terms_of(dl.lead), dir.lead))
+                throw std::invalid_argument("peak string stability: a direction has a delay the linearisation does not (only coefficients may change)");
+            m_dir.push_back(std::move(dir));
+        }
+        auto shorten = [&](Terms& t, bool count) {
+            for (auto& [c, d] : t) {
                 if (d > 0.0 && d < zero_below) {
-                    m_short += std::abs(c) * d;
+                    if (count) m_short += std::abs(c) * d;
                     d = 0.0;
                 }
-                if (d > 0.0) m_delays.push_back(d);
+                if (count && d > 0.0) m_delays.push_back(d);
             }
+        };
+        for (Terms* t : {&m_gap, &m_own, &m_lead}) shorten(*t, true);
+        for (Direction& dir : m_dir)
+            for (Terms* t : {&dir.gap, &dir.own, &dir.lead}) shorten(*t, false);
         std::sort(m_delays.begin(), m_delays.end());
         m_delays.erase(std::unique(m_delays.begin(), m_delays.end()), m_delays.end());
     }
@@ -67,22 +91,51 @@ public:
     }
 
     Run run(double h, double T, double alpha) const {
+        // states 0-3: s_a, v_a, s_b, v_b; with directions, 4 more per direction k (at 4 + 4k):
+        // their derivatives along it, which obey the same equations forced by the direction's
+        // coefficients times the responses themselves
+        const int dim = 4 + 4 * static_cast<int>(m_dir.size());
         DdeSolver solver(
-            4, 0.0, [](double, double* y) { y[0] = y[1] = y[2] = y[3] = 0.0; },
+            dim, 0.0, [dim](double, double* y) { std::fill(y, y + dim, 0.0); },
             [this](double t, const double* y, const DdeSolver& s, double* f) {
+                const auto at = [&](int i, double d) { return d == 0.0 ? y[i] : s.value(i, t - d); };
                 double a = 0.0, b = 1.0;
                 for (const auto& [c, d] : m_gap) {
-                    a += c * (d == 0.0 ? y[0] : s.value(0, t - d));
-                    b += c * (d == 0.0 ? y[2] : s.value(2, t - d));
+                    a += c * at(0, d);
+                    b += c * at(2, d);
                 }
                 for (const auto& [c, d] : m_own) {
-                    a += c * (d == 0.0 ? y[1] : s.value(1, t - d));
-                    b += c * (d == 0.0 ? y[3] : s.value(3, t - d));
+                    a += c * at(1, d);
+                    b += c * at(3, d);
                 }
                 f[0] = 1.0 - y[1];
                 f[1] = a;
                 f[2] = -y[3];
                 f[3] = b;
+                for (std::size_t k = 0; k < m_dir.size(); ++k) {
+                    const int o = 4 + 4 * static_cast<int>(k);
+                    double da = 0.0, db = 0.0;
+                    for (const auto& [c, d] : m_gap) {
+                        da += c * at(o, d);
+                        db += c * at(o + 2, d);
+                    }
+                    for (const auto& [c, d] : m_own) {
+                        da += c * at(o + 1, d);
+                        db += c * at(o + 3, d);
+                    }
+                    for (const auto& [c, d] : m_dir[k].gap) {
+                        da += c * at(0, d);
+                        db += c * at(2, d);
+                    }
+                    for (const auto& [c, d] : m_dir[k].own) {
+                        da += c * at(1, d);
+                        db += c * at(3, d);
+                    }
+                    f[o] = -y[o + 1];
+                    f[o + 1] = da;
+                    f[o + 2] = -y[o + 3];
+                    f[o + 3] = db;
+                }
             });
         // the derivatives of the responses jump at sums of up to three delays
         std::vector<double> bp, level{0.0};
@@ -106,6 +159,26 @@ public:
             double v = solver.value(1, t);
             for (const auto& [c, d] : m_lead) v += c * solver.value(3, t - d);
             return v;
+        };
+        // the derivative of y along direction k
+        const auto dy = [&](std::size_t k, double t) {
+            const int o = 4 + 4 * static_cast<int>(k);
+            double v = solver.value(o + 1, t);
+            for (const auto& [c, d] : m_lead) v += c * solver.value(o + 3, t - d);
+            for (const auto& [c, d] : m_dir[k].lead) v += c * solver.value(3, t - d);
+            return v;
+        };
+        // d TV = sum over the pieces between the nodes and the extrema of sign(y_b - y_a) (dy_b - dy_a):
+        // the extrema move with the parameters, but y' = 0 there, so to first order only the
+        // values at the (moving) ends of the monotone pieces change
+        const std::size_t nd = m_dir.size();
+        std::vector<double> grad(nd, 0.0), dya(nd), dyz(nd), dyb(nd);
+        auto dy_all = [&](double t, std::vector<double>& out) {
+            for (std::size_t k = 0; k < nd; ++k) out[k] = dy(k, t);
+        };
+        auto add_piece = [&](double from, double to, const std::vector<double>& dfrom, const std::vector<double>& dto) {
+            const double sg = to > from ? 1.0 : to < from ? -1.0 : 0.0;
+            for (std::size_t k = 0; k < nd; ++k) grad[k] += sg * (dto[k] - dfrom[k]);
         };
         const auto vb_rate = [&](double t) {  // v_b'(t), 0 before the step
             if (t <= 0.0) return 0.0;
@@ -135,9 +208,11 @@ public:
         double tv = 0.0, ymax = 0.0, hmax_tail = 0.0;
         const double tail_from = T - std::min(T / 4.0, 5.0 / std::abs(alpha));
         double ya = y(nodes[0]);
+        if (nd) dy_all(nodes[0], dya);
         for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
             const double a = nodes[i], b = nodes[i + 1];
             const double yb = y(b);
+            if (nd) dy_all(b, dyb);
             const double e = 1e-9 * (b - a);
             const double ra = rate(a + e), rb = rate(b - e);
             if (b > tail_from) hmax_tail = std::max({hmax_tail, std::abs(ra), std::abs(rb)});
@@ -154,14 +229,22 @@ public:
                 }
                 const double yz = y(0.5 * (lo + hi));
                 tv += std::abs(yz - ya) + std::abs(yb - yz);
+                if (nd) {
+                    dy_all(0.5 * (lo + hi), dyz);
+                    add_piece(ya, yz, dya, dyz);
+                    add_piece(yz, yb, dyz, dyb);
+                }
                 ymax = std::max(ymax, yz);
             } else {
                 tv += std::abs(yb - ya);
+                if (nd) add_piece(ya, yb, dya, dyb);
             }
             ymax = std::max(ymax, yb);
             ya = yb;
+            dya.swap(dyb);
         }
         out.norm = tv;
+        out.gradient = std::move(grad);
         // the rounding of the sum: each of the n increments carries a relative error of a few eps
         out.rounding = 4.0 * std::numeric_limits<double>::epsilon() * static_cast<double>(nodes.size()) * std::max(1.0, tv);
         out.overshoot = std::max(0.0, ymax - 1.0);
@@ -170,7 +253,11 @@ public:
     }
 
 private:
+    struct Direction {
+        Terms gap, own, lead;
+    };
     Terms m_gap, m_own, m_lead;
+    std::vector<Direction> m_dir;
     std::vector<double> m_delays;
     double m_short = 0.0;
 };
@@ -178,7 +265,14 @@ private:
 }  // namespace
 
 PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa, const PeakOptions& options) {
+    std::vector<double> none;
+    return peak_string_stability(lin, plant_abscissa, options, {}, none);
+}
+
+PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa, const PeakOptions& options,
+                                 const std::vector<Linearisation>& directions, std::vector<double>& gradient) {
     options.validate();
+    gradient.clear();
     require_single_leader(lin, "peak string stability");
     PeakResult r;
     if (!std::isfinite(plant_abscissa)) {
@@ -194,7 +288,7 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
     double size = 0.0;
     for (const ExpPoly* p : {&lin.gap, &lin.own, &lin.lead}) size += p->abs_sum();
     // delays this short together move ||h||_1 by about half the tolerance at most (short_error)
-    const StepResponse sr(lin, options.tolerance / (20.0 * std::max(1.0, size)));
+    const StepResponse sr(lin, options.tolerance / (20.0 * std::max(1.0, size)), directions);
     const double rate = std::max(1.0, sr.size());
     double h = 0.05 / rate;
     if (sr.min_delay() > 0.0) h = std::min(h, sr.min_delay() / 2.0);
@@ -233,6 +327,7 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
             return r;
         }
         r.norm = fine.norm;
+        gradient = fine.gradient;
         r.overshoot = fine.overshoot;
         r.t_end = T;
         r.step = h;

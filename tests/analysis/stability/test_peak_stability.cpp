@@ -215,3 +215,89 @@ TEST_CASE("peak norm: every step budget gives a settled norm or names the budget
     CHECK_FALSE(s.peak->finite);
     CHECK(s.peak->message.find("sup |Gamma(i w)| > 1") != std::string::npos);
 }
+
+namespace {
+/// The OVRV linearisation's derivatives in k1, k2 and th (gap = k1 e^{-s tau},
+/// own = -(k1 th + k2), lead = k2 e^{-s tau}), as directions of peak_string_stability.
+std::vector<Linearisation> ovrv_directions(double k1, double th, double tau) {
+    Linearisation d1, d2, d3;
+    d1.gap.add(1.0, tau);
+    d1.own.add(-th, 0.0);
+    d2.own.add(-1.0, 0.0);
+    d2.lead.add(1.0, tau);
+    d3.own.add(-k1, 0.0);
+    return {d1, d2, d3};
+}
+}  // namespace
+
+TEST_CASE("peak norm's gradient: against differences of the closed form without delay, and of the computed norm with a delay") {
+    // without delay: the closed form above, differenced with a step of 1e-6 relative (its own
+    // rounding ~1e-15: differences good to ~1e-9)
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    PeakOptions tight;
+    tight.tolerance = 1e-10;
+    double worst_ode = 0.0, worst_delay = 0.0;
+    int overshooting = 0;
+    for (int i = 0; i < 12; ++i) {
+        const double k1 = 0.05 + 0.5 * u(rng), k2 = 0.1 + 0.8 * u(rng), th = 0.5 + 2.0 * u(rng);
+        double a = 0.0;
+        const double n0 = closed_norm(k1, k2, th, &a);
+        if (n0 > 1.0 + 1e-6) ++overshooting;
+        std::vector<double> g;
+        const PeakResult r = peak_string_stability(ovrv_ode(k1, k2, th), a, tight, ovrv_directions(k1, th, 0.0), g);
+        REQUIRE(r.status == Status::Converged);
+        REQUIRE(g.size() == 3);
+        const double x[3] = {k1, k2, th};
+        for (int j = 0; j < 3; ++j) {
+            double p[3] = {k1, k2, th}, m[3] = {k1, k2, th};
+            const double h = 1e-6 * x[j];
+            p[j] += h;
+            m[j] -= h;
+            double ap = 0.0, am = 0.0;
+            const double fd = (closed_norm(p[0], p[1], p[2], &ap) - closed_norm(m[0], m[1], m[2], &am)) / (2.0 * h);
+            CAPTURE(k1);
+            CAPTURE(k2);
+            CAPTURE(th);
+            CAPTURE(j);
+            CHECK(std::abs(g[static_cast<std::size_t>(j)] - fd) <= tol::peak_gradient * (1.0 + std::abs(fd)));
+            worst_ode = std::max(worst_ode, std::abs(g[static_cast<std::size_t>(j)] - fd) / (1.0 + std::abs(fd)));
+        }
+    }
+    CHECK(overshooting >= 3);  // pieces with extrema inside, not only monotone responses
+    // with a delay: central differences of the computed norm (tolerance 1e-10, step 1e-4
+    // relative: differences good to ~1e-6)
+    for (int i = 0; i < 6; ++i) {
+        const double k1 = 0.05 + 0.4 * u(rng), k2 = 0.2 + 0.8 * u(rng), th = 1.0 + 1.5 * u(rng), tau = 0.1 + 0.4 * u(rng);
+        const Linearisation lin = test::ovrv(k1, k2, th, tau);
+        const StringResult s = analyse_string(lin);
+        if (!s.plant_stable) continue;
+        std::vector<double> g;
+        const PeakResult r = peak_string_stability(lin, s.plant_abscissa, tight, ovrv_directions(k1, th, tau), g);
+        REQUIRE(r.status == Status::Converged);
+        const double x[3] = {k1, k2, th};
+        for (int j = 0; j < 3; ++j) {
+            double p[3] = {k1, k2, th}, m[3] = {k1, k2, th};
+            const double h = 1e-4 * x[j];
+            p[j] += h;
+            m[j] -= h;
+            auto norm_at = [&](const double* q) {
+                const Linearisation l = test::ovrv(q[0], q[1], q[2], tau);
+                const PeakResult pr = peak_string_stability(l, analyse_string(l).plant_abscissa, tight);
+                REQUIRE(pr.status == Status::Converged);
+                return pr.norm;
+            };
+            const double fd = (norm_at(p) - norm_at(m)) / (2.0 * h);
+            CAPTURE(r.norm);
+            CAPTURE(j);
+            CHECK(std::abs(g[static_cast<std::size_t>(j)] - fd) <= tol::peak_gradient_delay * (1.0 + std::abs(fd)));
+            worst_delay = std::max(worst_delay, std::abs(g[static_cast<std::size_t>(j)] - fd) / (1.0 + std::abs(fd)));
+        }
+    }
+    MESSAGE("peak gradient against differences: closed form " << worst_ode << ", delayed " << worst_delay);
+    // a direction with a delay the linearisation lacks is refused
+    std::vector<double> g;
+    Linearisation bad;
+    bad.gap.add(1.0, 0.7);
+    CHECK_THROWS_AS(peak_string_stability(test::ovrv(0.1, 0.5, 1.5, 0.3), -0.1, tight, {bad}, g), std::invalid_argument);
+}

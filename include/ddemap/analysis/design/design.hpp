@@ -34,10 +34,11 @@
 /// frequency or the rightmost root: d|Gamma(i w*)|/dx_j, dmu/dx_j = d(q/|N|^2)(w*)/dx_j, and for a
 /// root lambda of the characteristic function Delta, dlambda/dx_j = -(dDelta/dx_j) / Delta'(lambda);
 /// the partials in x_j of N, D and Delta at the fixed w* or lambda by central differences of the
-/// law's linearisation (step 1e-6 relative, error ~1e-12). The peak norm has no such formula here:
-/// its gradient is a difference of ||h||_1 (step 1e-3 of the value, the norm computed to 1e-6
-/// with at most 200,000 integrator steps during the search), at most 40 evaluations per run, so
-/// `peak` is slower and less precise than the others. sup-gamma and peak are at least 1: a run
+/// law's linearisation (step 1e-6 relative, error ~1e-12). The peak norm's gradient comes from
+/// the sensitivity equations of the step response along those partials of the coefficients
+/// (peak_stability.hpp; a difference of ||h||_1, step 1e-3 of the value, where a free parameter
+/// moves a delay), the norm computed to 1e-6 with at most 200,000 integrator steps during the
+/// search, at most 40 evaluations per run: `peak` is the slowest objective. sup-gamma and peak are at least 1: a run
 /// that reaches 1 has found a global minimum, and the remaining starts are skipped. peak runs
 /// its starts in the order of their norm (one norm each; the nearest L2 design among them), and
 /// a point it reaches with ||h||_1 = 1 is walked back toward the car: the result is the point

@@ -11,6 +11,7 @@
 /// peak stability implies the L2 (head-to-tail) string stability of analyse_string.
 
 #include <string>
+#include <vector>
 
 #include "ddemap/core/status.hpp"
 #include "ddemap/traffic/model.hpp"
@@ -61,5 +62,19 @@ struct PeakResult {
 /// most d max|x'|); longer ones bound the step, and a run of more than max_steps steps is
 /// undecided (BudgetExhausted) rather than slow.
 PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa, const PeakOptions& options = {});
+
+/// The same, and the derivatives of ||h||_1 along `directions` into `gradient` (one per
+/// direction; empty unless the result converged with a finite norm). A direction holds the
+/// derivatives of `lin`'s coefficients at the same delays (d/dp of sum_j c_j e^{-s d_j} with every
+/// d_j held; std::invalid_argument when it has a delay `lin` does not). The derivatives w_k of
+/// the responses along direction k obey the same equations forced by the direction's
+/// coefficients times the responses, integrated with them, and
+///     d||h||_1 = sum over the pieces [z_k, z_{k+1}] of sign(y(z_{k+1}) - y(z_k)) (w(z_{k+1}) - w(z_k)),
+/// the pieces as in the norm: the zeros z_k of h move with the parameters, but y' = 0 there, so
+/// to first order only the values at the ends change (where an extremum is born or the pieces'
+/// count changes, ||h||_1 is not differentiable and this is the derivative of one side). At the
+/// finest run's resolution, without an error estimate of its own.
+PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa, const PeakOptions& options,
+                                 const std::vector<Linearisation>& directions, std::vector<double>& gradient);
 
 }  // namespace ddemap
