@@ -77,6 +77,7 @@ constexpr double kPlantMargin = 1e-3;
 constexpr long kSearchPeakSteps = 200000;
 // Evaluations of one run of the peak search at most
 constexpr int kPeakEvaluations = 40;
+constexpr long kQpSets = 1000000;  // active sets a QP step of nearest tries at most
 
 std::string join(const std::vector<std::string>& v, const std::string& sep) {
     std::string s;
@@ -127,7 +128,12 @@ public:
     // f() evaluated with lin() at every scenario in turn
     template <class F>
     void for_each_scenario(const F& f) {
-        for (m_active = 0; m_active < m_scenarios.size(); ++m_active) f();
+        try {
+            for (m_active = 0; m_active < m_scenarios.size(); ++m_active) f();
+        } catch (...) {
+            m_active = 0;
+            throw;
+        }
         m_active = 0;
     }
     // every scenario's plant stable (abscissa below 0) and, when asked, its margin at least m
@@ -402,7 +408,7 @@ public:
             if (!exact) directions.clear();
             std::vector<double> g;
             const double v = peak_value(L, a, directions, exact ? &g : nullptr);
-            if (exact && std::isfinite(v) && g.size() == n()) {
+            if (exact && std::isfinite(v) && g.size() == n() && Eigen::Map<const Eigen::VectorXd>(g.data(), static_cast<Eigen::Index>(n())).allFinite()) {
                 *grad = Eigen::Map<const Eigen::VectorXd>(g.data(), static_cast<Eigen::Index>(n()));
                 return v;
             }
@@ -469,16 +475,26 @@ public:
                 y = cand;
             }
         };
-        std::function<void(int)> extend = [&](int from) {
-            consider();
-            if (static_cast<int>(S.size()) == nn) return;
+        // the QP is strictly convex (M > 0): a feasible point with multipliers >= 0 is its unique
+        // minimum, so the sets are tried by size (the active sets of the steps have one or two
+        // rows) and the first such point ends the search; at most kQpSets sets are tried (the
+        // robust design's scenarios add rows), beyond which the step counts as unsolved
+        long tried = 0;
+        std::function<bool(int, int)> extend = [&](int from, int size) {
+            if (static_cast<int>(S.size()) == size) {
+                ++tried;
+                consider();
+                return std::isfinite(best) || tried >= kQpSets;
+            }
             for (int i = from; i < k; ++i) {
                 S.push_back(i);
-                extend(i + 1);
+                const bool stop = extend(i + 1, size);
                 S.pop_back();
+                if (stop) return true;
             }
+            return false;
         };
-        extend(0);
+        for (int size = 0; size <= nn && !std::isfinite(best) && tried < kQpSets; ++size) extend(0, size);
         return std::isfinite(best);
     }
 
@@ -945,8 +961,9 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         std::string message = "no start gave a finite objective";
     };
     const bool two_phases = options.objective == DesignObjective::SupGamma;
-    // the peak norm's gradient is a difference of norms computed to ~1e-7: a looser stationarity
-    // test and a budget of kPeakEvaluations evaluations per run (each is 1 + 2 n norms)
+    // the peak norm is computed to 1e-6 during the search and each evaluation integrates the
+    // step response with its sensitivities (4 + 4n states; 1 + 2n norms where a free parameter
+    // moves a delay): a looser stationarity test and a budget of kPeakEvaluations per run
     NonsmoothOptions search = options.optimizer;
     if (options.objective == DesignObjective::Peak) {
         search.max_evaluations = std::min(search.max_evaluations, kPeakEvaluations);
@@ -1132,7 +1149,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             Eigen::VectorXd xn;
             if (crossing(l2, xn)) starts.insert(starts.begin(), xn);
             // a run that reaches ||h||_1 = 1 ends the search (a global minimum), and a run costs
-            // up to kPeakEvaluations gradients of 1 + 2n norms: the starts are run in the order
+            // up to kPeakEvaluations norms with their gradients: the starts are run in the order
             // of their norm (one norm each; where it cannot be computed within the search's
             // step budget, last, in the order given)
             const auto tick = P.tick;
@@ -1199,10 +1216,11 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         }
     } else if (options.objective == DesignObjective::Peak && !skipped && first.best <= 1.0 + std::max(options.peak.tolerance, 1e-6)) {
         // peak reached its least value 1 (no overshoot), on a plateau of such gains; the runs are
-        // ordered by their start's norm, so the point may lie far from the car: of the gains
-        // on the segment from the car's own values to it, the nearest that is peak stable by
-        // the result's own verdict (bisection on that verdict; the point itself is kept where
-        // that verdict does not confirm it)
+        // ordered by their start's norm, so the point may lie far from the car: on the segment
+        // from the car's own values to it (the part inside the box), a point peak stable by the
+        // result's own verdict, found by bisection on that verdict toward the car (the nearest
+        // such point of the segment when those points form one interval; the point itself is
+        // kept where that verdict does not confirm it)
         auto stable_at = [&](const Eigen::VectorXd& y) {
             bool ok = true;
             P.for_each_scenario([&] {
@@ -1213,12 +1231,25 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
             });
             return ok;
         };
-        if (stable_at(x)) {
-            double lo_t = 0.0, hi_t = 1.0;  // x0 + lo_t d not (or not shown) peak stable, x0 + hi_t d peak stable
-            if (stable_at(x0)) hi_t = 0.0;
+        // the segment's points x0 + t (x - x0) inside the box: t >= t_in (x is inside)
+        double t_in = 0.0;
+        for (std::size_t j = 0; j < n; ++j) {
+            const auto J = static_cast<Eigen::Index>(j);
+            const double d = x[J] - x0[J];
+            if (x0[J] < P.lo[j] && d > 0.0) t_in = std::max(t_in, (P.lo[j] - x0[J]) / d);
+            if (x0[J] > P.hi[j] && d < 0.0) t_in = std::max(t_in, (P.hi[j] - x0[J]) / d);
+        }
+        auto point = [&](double t) {  // on the segment, snapped into the box (rounding at t_in)
+            Eigen::VectorXd y = x0 + t * (x - x0);
+            for (std::size_t j = 0; j < n; ++j) y[static_cast<Eigen::Index>(j)] = std::clamp(y[static_cast<Eigen::Index>(j)], P.lo[j], P.hi[j]);
+            return y;
+        };
+        if (t_in < 1.0 && stable_at(x)) {
+            double lo_t = t_in, hi_t = 1.0;  // point(lo_t) not (or not shown) peak stable, point(hi_t) peak stable
+            if (stable_at(point(t_in))) hi_t = t_in;
             for (int it = 0; it < 30 && hi_t - lo_t > 1e-6; ++it) {
                 const double m = 0.5 * (lo_t + hi_t);
-                if (stable_at(x0 + m * (x - x0))) hi_t = m;
+                if (stable_at(point(m))) hi_t = m;
                 else lo_t = m;
             }
             if (hi_t < 1.0) {
@@ -1226,13 +1257,15 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
                 DesignStart walk;
                 walk.objective = "peak";
                 walk.start = P.free_map(x);
-                x = x0 + hi_t * (x - x0);
+                x = point(hi_t);
                 walk.end = P.free_map(x);
                 walk.path = {walk.start, walk.end};
+                const int ev0 = P.evaluations;
                 walk.value = P.value(x, nullptr, DesignObjective::Peak);
+                walk.evaluations = P.evaluations - ev0;
                 walk.message = "bisection on the peak verdict toward the car's own values";
                 r.starts.push_back(walk);
-                best_message += "; of the gains on the segment from the car's own values to that point, the nearest with no overshoot (bisection on the peak verdict)";
+                best_message += "; walked back toward the car's own values along the segment to the edge of the gains with no overshoot (bisection on the peak verdict)";
             }
         }
     }

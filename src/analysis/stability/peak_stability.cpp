@@ -327,7 +327,6 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
             return r;
         }
         r.norm = fine.norm;
-        gradient = fine.gradient;
         r.overshoot = fine.overshoot;
         r.t_end = T;
         r.step = h;
@@ -339,7 +338,10 @@ PeakResult peak_string_stability(const Linearisation& lin, double plant_abscissa
                         num(2 * h) + " s (tolerance " + num(options.tolerance) + "): no peak verdict";
             return r;
         }
-        if (fine.tail <= options.tolerance / 10.0) break;
+        if (fine.tail <= options.tolerance / 10.0) {
+            gradient = fine.gradient;  // only with a converged norm
+            break;
+        }
         if (T >= options.max_time) {
             r.status = Status::BudgetExhausted;
             r.message = "the step response has not decayed after " + num(T) + " s (tail estimate " + num(fine.tail) + "): no peak verdict";

@@ -396,6 +396,16 @@ TEST_CASE("design peak: C_min's starts run in the order of their norm, and the r
     REQUIRE(s.peak.has_value());
     CAPTURE(s.peak->norm);
     CHECK(s.peak->verdict == Verdict::Unstable);
+    // bounds that exclude the car's own k2: the walk stays inside the box (it stopped outside it)
+    DesignOptions ob = o;
+    ob.bounds = {{"k2", 1.95, 2.69}};
+    const DesignResult rb = design_gains("ovrv", car, ob);
+    CAPTURE(rb.message);
+    CHECK(rb.status == Status::Converged);
+    REQUIRE(rb.string.peak.has_value());
+    CHECK(rb.string.peak->verdict == Verdict::Stable);
+    CHECK(rb.gains.at("k2") >= 1.95);
+    CHECK(rb.gains.at("k2") <= 2.69);
 }
 
 TEST_CASE("design under a fit's uncertainty of the held delay: the probability of string stability against an independent Monte Carlo") {

@@ -41,9 +41,10 @@
 /// search, at most 40 evaluations per run: `peak` is the slowest objective. sup-gamma and peak are at least 1: a run
 /// that reaches 1 has found a global minimum, and the remaining starts are skipped. peak runs
 /// its starts in the order of their norm (one norm each; the nearest L2 design among them), and
-/// a point it reaches with ||h||_1 = 1 is walked back toward the car: the result is the point
-/// x0 + t (x - x0) of least t in [0, 1] found by bisection (to 1e-6 in t) on the certified peak
-/// verdict, a stage of its own in `starts`.
+/// a point x it reaches with ||h||_1 = 1 is walked back toward the car: the result is a point
+/// x0 + t (x - x0) of the segment's part inside the box at the edge of the certified peak
+/// verdict, found by bisection (to 1e-6 in t; the nearest such point when the peak-stable points
+/// of the segment form one interval), a stage of its own in `starts`.
 /// The minimiser: solve/optimize/nonsmooth.hpp, in the coordinates z_j with
 /// x_j = lo_j + (hi_j - lo_j)(1 - cos z_j)/2 (the bounds reached at z_j = 0, pi), from the car's
 /// own values (moved a millionth of the box inside it when they lie outside or on a bound) and
