@@ -1247,7 +1247,7 @@ DesignResult design_at(const std::string& model, const ParameterMap& parameters,
         if (t_in < 1.0 && stable_at(x)) {
             double lo_t = t_in, hi_t = 1.0;  // point(lo_t) not (or not shown) peak stable, point(hi_t) peak stable
             if (stable_at(point(t_in))) hi_t = t_in;
-            for (int it = 0; it < 30 && hi_t - lo_t > 1e-6; ++it) {
+            for (int it = 0; it < 30 && hi_t - lo_t > 1e-4; ++it) {
                 const double m = 0.5 * (lo_t + hi_t);
                 if (stable_at(point(m))) hi_t = m;
                 else lo_t = m;

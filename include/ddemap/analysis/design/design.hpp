@@ -43,7 +43,7 @@
 /// its starts in the order of their norm (one norm each; the nearest L2 design among them), and
 /// a point x it reaches with ||h||_1 = 1 is walked back toward the car: the result is a point
 /// x0 + t (x - x0) of the segment's part inside the box at the edge of the certified peak
-/// verdict, found by bisection (to 1e-6 in t; the nearest such point when the peak-stable points
+/// verdict, found by bisection (to 1e-4 in t; the nearest such point when the peak-stable points
 /// of the segment form one interval), a stage of its own in `starts`.
 /// The minimiser: solve/optimize/nonsmooth.hpp, in the coordinates z_j with
 /// x_j = lo_j + (hi_j - lo_j)(1 - cos z_j)/2 (the bounds reached at z_j = 0, pi), from the car's
