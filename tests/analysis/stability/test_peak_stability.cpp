@@ -228,6 +228,25 @@ std::vector<Linearisation> ovrv_directions(double k1, double th, double tau) {
     d3.own.add(-k1, 0.0);
     return {d1, d2, d3};
 }
+
+/// Checks the gradient g in (k1, k2, th) against central differences of norm(k1, k2, th) with a
+/// step of rel times each value, to tolerance (1 + |difference|); returns the worst relative error.
+template <class Norm>
+double check_against_differences(const std::vector<double>& g, const double (&x)[3], double rel, double tolerance, const Norm& norm) {
+    double worst = 0.0;
+    for (int j = 0; j < 3; ++j) {
+        double p[3] = {x[0], x[1], x[2]}, m[3] = {x[0], x[1], x[2]};
+        const double h = rel * x[j];
+        p[j] += h;
+        m[j] -= h;
+        const double fd = (norm(p) - norm(m)) / (2.0 * h);
+        const double err = std::abs(g[static_cast<std::size_t>(j)] - fd) / (1.0 + std::abs(fd));
+        CAPTURE(j);
+        CHECK(err <= tolerance);
+        worst = std::max(worst, err);
+    }
+    return worst;
+}
 }  // namespace
 
 TEST_CASE("peak norm's gradient: against differences of the closed form without delay, and of the computed norm with a delay") {
@@ -248,21 +267,15 @@ TEST_CASE("peak norm's gradient: against differences of the closed form without 
         const PeakResult r = peak_string_stability(ovrv_ode(k1, k2, th), a, tight, ovrv_directions(k1, th, 0.0), g);
         REQUIRE(r.status == Status::Converged);
         REQUIRE(g.size() == 3);
+        CAPTURE(k1);
+        CAPTURE(k2);
+        CAPTURE(th);
         const double x[3] = {k1, k2, th};
-        for (int j = 0; j < 3; ++j) {
-            double p[3] = {k1, k2, th}, m[3] = {k1, k2, th};
-            const double h = 1e-6 * x[j];
-            p[j] += h;
-            m[j] -= h;
-            double ap = 0.0, am = 0.0;
-            const double fd = (closed_norm(p[0], p[1], p[2], &ap) - closed_norm(m[0], m[1], m[2], &am)) / (2.0 * h);
-            CAPTURE(k1);
-            CAPTURE(k2);
-            CAPTURE(th);
-            CAPTURE(j);
-            CHECK(std::abs(g[static_cast<std::size_t>(j)] - fd) <= tol::peak_gradient * (1.0 + std::abs(fd)));
-            worst_ode = std::max(worst_ode, std::abs(g[static_cast<std::size_t>(j)] - fd) / (1.0 + std::abs(fd)));
-        }
+        const double w = check_against_differences(g, x, 1e-6, tol::peak_gradient, [](const double* q) {
+            double abscissa = 0.0;
+            return closed_norm(q[0], q[1], q[2], &abscissa);
+        });
+        worst_ode = std::max(worst_ode, w);
     }
     CHECK(overshooting >= 3);  // pieces with extrema inside, not only monotone responses
     // with a delay: central differences of the computed norm (tolerance 1e-10, step 1e-4
@@ -279,24 +292,15 @@ TEST_CASE("peak norm's gradient: against differences of the closed form without 
         REQUIRE(r.status == Status::Converged);
         REQUIRE(g.size() == 3);
         ++delayed;
+        CAPTURE(r.norm);
         const double x[3] = {k1, k2, th};
-        for (int j = 0; j < 3; ++j) {
-            double p[3] = {k1, k2, th}, m[3] = {k1, k2, th};
-            const double h = 1e-4 * x[j];
-            p[j] += h;
-            m[j] -= h;
-            auto norm_at = [&](const double* q) {
-                const Linearisation l = test::ovrv(q[0], q[1], q[2], tau);
-                const PeakResult pr = peak_string_stability(l, analyse_string(l).plant_abscissa, tight);
-                REQUIRE(pr.status == Status::Converged);
-                return pr.norm;
-            };
-            const double fd = (norm_at(p) - norm_at(m)) / (2.0 * h);
-            CAPTURE(r.norm);
-            CAPTURE(j);
-            CHECK(std::abs(g[static_cast<std::size_t>(j)] - fd) <= tol::peak_gradient_delay * (1.0 + std::abs(fd)));
-            worst_delay = std::max(worst_delay, std::abs(g[static_cast<std::size_t>(j)] - fd) / (1.0 + std::abs(fd)));
-        }
+        const double w = check_against_differences(g, x, 1e-4, tol::peak_gradient_delay, [&](const double* q) {
+            const Linearisation l = test::ovrv(q[0], q[1], q[2], tau);
+            const PeakResult pr = peak_string_stability(l, analyse_string(l).plant_abscissa, tight);
+            REQUIRE(pr.status == Status::Converged);
+            return pr.norm;
+        });
+        worst_delay = std::max(worst_delay, w);
     }
     CHECK(delayed >= 4);
     MESSAGE("peak gradient against differences: closed form " << worst_ode << ", delayed " << worst_delay << " (" << delayed << " delayed cars)");
